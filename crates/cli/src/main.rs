@@ -1,0 +1,2 @@
+//! The `porofrac` command.
+fn main() {}

@@ -1,0 +1,1 @@
+//! porofrac-flow (under construction).

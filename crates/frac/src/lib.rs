@@ -1,0 +1,1 @@
+//! porofrac-frac (under construction).

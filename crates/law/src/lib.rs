@@ -1,0 +1,112 @@
+//! The [`CellLaw`] trait, Kelvin notation and elastic stiffness tensors.
+//!
+//! A *cell law* turns the nodal displacements of one cell into its elastic energy, the
+//! forces it exerts on its nodes, its stress, and its local stiffness (seed §2: VEM,
+//! MDEM and central-force DEM are all cell laws). Laws know nothing about sparse
+//! matrices or grids beyond the [`CellGeometry`] view of one cell; assembly lives in
+//! `porofrac-sim`.
+//!
+//! # Conventions
+//!
+//! * Displacements and forces of a cell are flat slices, node-major: dof `D·i + a` is
+//!   component `a` of the cell's `i`-th node (the order of [`CellGeometry::coords`]).
+//! * [`CellLaw::forces`] returns the forces the cell exerts *on* its nodes,
+//!   `F = −∂E/∂u` (restoring); [`CellLaw::stiffness`] returns `K = ∂²E/∂u² = −∂F/∂u`,
+//!   symmetric positive semi-definite for a stable law.
+//! * Tension is positive; stress is returned as a symmetric `D × D` tensor.
+
+use nalgebra::{DMatrix, SMatrix};
+use porofrac_grid::{Grid, Point};
+
+/// A symmetric second-order tensor (stress or strain) in D dimensions.
+pub type Tensor<const D: usize> = SMatrix<f64, D, D>;
+
+/// The geometry of one cell as a law sees it.
+///
+/// `node_normals[i] = ∫_∂K φ_i n dS` (see [`Grid::cell_node_normals`]); they satisfy
+/// `Σ_i node_normals[i] ⊗ coords[i] = volume · I`, and the exact volume change of the
+/// cell under nodal displacements `u` is `Σ_i node_normals[i] · u_i`.
+#[derive(Clone, Copy, Debug)]
+pub struct CellGeometry<'a, const D: usize> {
+    /// Node coordinates, in the cell's node order (counter-clockwise in 2D).
+    pub coords: &'a [Point<D>],
+    /// Boundary integrals of the nodal basis functions times the outward normal.
+    pub node_normals: &'a [Point<D>],
+    /// Cell volume (area in 2D).
+    pub volume: f64,
+}
+
+/// Reusable buffers that let one thread evaluate many cells without allocating.
+///
+/// Create one per thread (e.g. with rayon's `map_init`) and pass it to every call; a law
+/// may resize and overwrite any field.
+#[derive(Clone, Debug, Default)]
+pub struct Scratch {
+    /// Dense work matrices.
+    pub mats: [DMatrix<f64>; 4],
+    /// Work vectors.
+    pub vecs: [Vec<f64>; 2],
+}
+
+/// Buffers for the geometry of one cell, filled from a grid.
+#[derive(Clone, Debug, Default)]
+pub struct GeometryBuffer<const D: usize> {
+    coords: Vec<Point<D>>,
+    normals: Vec<Point<D>>,
+}
+
+impl<const D: usize> GeometryBuffer<D> {
+    /// Fill the buffers for cell `c` of `grid` and return the view.
+    pub fn load<'a>(&'a mut self, grid: &Grid<D>, c: usize) -> CellGeometry<'a, D> {
+        let nodes = grid.cell_nodes(c);
+        self.coords.clear();
+        self.coords.extend(nodes.iter().map(|&n| *grid.node(n)));
+        self.normals.resize(nodes.len(), Point::<D>::zeros());
+        grid.cell_node_normals(c, &mut self.normals);
+        CellGeometry {
+            coords: &self.coords,
+            node_normals: &self.normals,
+            volume: grid.cell_volume(c),
+        }
+    }
+}
+
+/// A constitutive law of one cell: energy, nodal forces, stress and stiffness.
+///
+/// The trait is object safe, so a scene can hold `Box<dyn CellLaw<D>>` for laws defined
+/// in other crates. A law is immutable during evaluation; state that changes in time
+/// (e.g. which cells are fractured) is held by the caller, which picks the law per cell.
+pub trait CellLaw<const D: usize>: Send + Sync {
+    /// A short name for output (`"vem"`, `"mdem"`, ...).
+    fn name(&self) -> &str;
+
+    /// Whether the stiffness is independent of the displacement. Linear laws are
+    /// assembled once; nonlinear ones (e.g. compression-only DEM) are re-evaluated.
+    fn is_linear(&self) -> bool {
+        true
+    }
+
+    /// Whether the law can handle a cell with `num_nodes` nodes (MDEM: simplices only).
+    fn supports(&self, num_nodes: usize) -> bool {
+        let _ = num_nodes;
+        true
+    }
+
+    /// Elastic energy of the cell for nodal displacements `u` (length `D·n`).
+    fn energy(&self, cell: &CellGeometry<'_, D>, u: &[f64], scratch: &mut Scratch) -> f64;
+
+    /// Forces the cell exerts on its nodes, `F = −∂E/∂u`, written to `out` (length `D·n`).
+    fn forces(&self, cell: &CellGeometry<'_, D>, u: &[f64], out: &mut [f64], scratch: &mut Scratch);
+
+    /// Local stiffness `K = ∂²E/∂u²` at `u`, written to `out` (resized to `D·n × D·n`).
+    fn stiffness(
+        &self,
+        cell: &CellGeometry<'_, D>,
+        u: &[f64],
+        out: &mut DMatrix<f64>,
+        scratch: &mut Scratch,
+    );
+
+    /// Cell stress for nodal displacements `u` (tension positive).
+    fn stress(&self, cell: &CellGeometry<'_, D>, u: &[f64], scratch: &mut Scratch) -> Tensor<D>;
+}

@@ -1,0 +1,1 @@
+//! porofrac-mdem (under construction).

@@ -1,0 +1,1 @@
+//! porofrac-sim (under construction).

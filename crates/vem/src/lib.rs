@@ -1,0 +1,1 @@
+//! porofrac-vem (under construction).
