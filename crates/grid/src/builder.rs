@@ -79,36 +79,49 @@ impl<const D: usize> Grid<D> {
         let num_cells = cells.num_cells();
         let num_loops = cells.loop_pos.len() - 1;
 
-        // --- Match face occurrences by their node sets (hash, sort, compare). ---
-        let keys: Vec<(u64, usize)> = (0..num_loops)
+        // --- Match face occurrences by their node sets. ---
+        // Bucket the loops by their smallest node (a counting sort: linear, and local for
+        // grids numbered with some locality), then compare the few loops of each bucket.
+        let min_node = |k: usize| cells.face_loop(k).iter().copied().min().unwrap_or(0);
+        let mut bucket_pos = vec![0usize; nodes.len() + 1];
+        for k in 0..num_loops {
+            bucket_pos[min_node(k) + 1] += 1;
+        }
+        for n in 0..nodes.len() {
+            bucket_pos[n + 1] += bucket_pos[n];
+        }
+        let mut bucket_items = vec![0usize; num_loops];
+        {
+            let mut fill = bucket_pos.clone();
+            for k in 0..num_loops {
+                let m = min_node(k);
+                bucket_items[fill[m]] = k;
+                fill[m] += 1;
+            }
+        }
+        const NODE_CHUNK: usize = 4096;
+        let pairs: Vec<Vec<(usize, usize)>> = (0..nodes.len().div_ceil(NODE_CHUNK))
             .into_par_iter()
-            .map(|k| (face_hash(cells.face_loop(k)), k))
-            .collect();
-        let mut sorted = keys;
-        sorted.par_sort_unstable();
+            .map(|ch| {
+                let mut out = Vec::new();
+                let mut matched = Vec::new();
+                for n in ch * NODE_CHUNK..((ch + 1) * NODE_CHUNK).min(nodes.len()) {
+                    let bucket = &bucket_items[bucket_pos[n]..bucket_pos[n + 1]];
+                    match_bucket(cells, bucket, &mut matched, &mut out)?;
+                }
+                Ok(out)
+            })
+            .collect::<Result<_>>()?;
+        drop(bucket_items);
+        drop(bucket_pos);
         // rep[k] = the first occurrence (smallest loop index) with the same node set as k.
         let mut rep: Vec<usize> = (0..num_loops).collect();
         let mut partner: Vec<usize> = vec![usize::MAX; num_loops];
-        let mut i = 0;
-        let mut buf_a = Vec::new();
-        let mut buf_b = Vec::new();
-        while i < sorted.len() {
-            let mut j = i + 1;
-            while j < sorted.len() && sorted[j].0 == sorted[i].0 {
-                j += 1;
-            }
-            if j - i > 1 {
-                match_run(
-                    cells,
-                    &sorted[i..j],
-                    &mut rep,
-                    &mut partner,
-                    &mut buf_a,
-                    &mut buf_b,
-                )?;
-            }
-            i = j;
+        for &(first, second) in pairs.iter().flatten() {
+            partner[first] = second;
+            rep[second] = first;
         }
+        drop(pairs);
         let loop_cell = loop_owner(cells);
 
         // --- Number faces in order of first occurrence. ---
@@ -140,19 +153,32 @@ impl<const D: usize> Grid<D> {
         let cell_faces = face_of_loop;
         let cell_face_outward: Vec<bool> = (0..num_loops).map(|k| rep[k] == k).collect();
 
-        // --- Cell nodes. ---
-        let per_cell: Vec<Vec<usize>> = (0..num_cells)
+        // --- Cell nodes (in chunks of cells: no per-cell allocation). ---
+        const CELL_CHUNK: usize = 2048;
+        let chunks: Vec<(Vec<usize>, Vec<usize>)> = (0..num_cells.div_ceil(CELL_CHUNK))
             .into_par_iter()
-            .map(|c| cell_node_list::<D>(cells, c))
+            .map(|ch| {
+                let range = ch * CELL_CHUNK..((ch + 1) * CELL_CHUNK).min(num_cells);
+                let mut counts = Vec::with_capacity(range.len());
+                let mut list = Vec::with_capacity(range.len() * (D + 1));
+                for c in range {
+                    let before = list.len();
+                    cell_node_list::<D>(cells, c, &mut list)?;
+                    counts.push(list.len() - before);
+                }
+                Ok((counts, list))
+            })
             .collect::<Result<_>>()?;
         let mut cell_node_pos = Vec::with_capacity(num_cells + 1);
         cell_node_pos.push(0);
-        let mut cell_nodes = Vec::with_capacity(per_cell.iter().map(Vec::len).sum());
-        for v in &per_cell {
-            cell_nodes.extend_from_slice(v);
-            cell_node_pos.push(cell_nodes.len());
+        let mut cell_nodes = Vec::with_capacity(chunks.iter().map(|c| c.1.len()).sum());
+        for (counts, list) in &chunks {
+            for &k in counts {
+                cell_node_pos.push(cell_node_pos[cell_node_pos.len() - 1] + k);
+            }
+            cell_nodes.extend_from_slice(list);
         }
-        drop(per_cell);
+        drop(chunks);
 
         let mut grid = Grid {
             nodes,
@@ -179,20 +205,36 @@ impl<const D: usize> Grid<D> {
 
     /// Compute face and cell geometry; fails on degenerate faces and cells.
     pub(crate) fn compute_geometry(&mut self) -> Result<()> {
-        let face_geo: Vec<(f64, Point<D>, Point<D>)> = (0..self.num_faces())
-            .into_par_iter()
-            .map(|f| self.face_geometry(f))
-            .collect::<Result<_>>()?;
-        self.face_area = face_geo.iter().map(|g| g.0).collect();
-        self.face_normal = face_geo.iter().map(|g| g.1).collect();
-        self.face_centroid = face_geo.iter().map(|g| g.2).collect();
-        drop(face_geo);
-        let cell_geo: Vec<(f64, Point<D>)> = (0..self.num_cells())
-            .into_par_iter()
-            .map(|c| self.cell_geometry(c))
-            .collect::<Result<_>>()?;
-        self.cell_volume = cell_geo.iter().map(|g| g.0).collect();
-        self.cell_centroid = cell_geo.iter().map(|g| g.1).collect();
+        // Indexed parallel writes into preallocated arrays (a fallible `collect` would go
+        // through linked lists of vectors).
+        let nf = self.num_faces();
+        let mut area = vec![0.0; nf];
+        let mut normal = vec![Point::<D>::zeros(); nf];
+        let mut centroid = vec![Point::<D>::zeros(); nf];
+        area.par_iter_mut()
+            .zip(normal.par_iter_mut())
+            .zip(centroid.par_iter_mut())
+            .enumerate()
+            .try_for_each(|(f, ((a, n), c))| {
+                (*a, *n, *c) = self.face_geometry(f)?;
+                Ok::<(), GridError>(())
+            })?;
+        self.face_area = area;
+        self.face_normal = normal;
+        self.face_centroid = centroid;
+        let nc = self.num_cells();
+        let mut volume = vec![0.0; nc];
+        let mut centroid = vec![Point::<D>::zeros(); nc];
+        volume
+            .par_iter_mut()
+            .zip(centroid.par_iter_mut())
+            .enumerate()
+            .try_for_each(|(c, (v, x))| {
+                (*v, *x) = self.cell_geometry(c)?;
+                Ok::<(), GridError>(())
+            })?;
+        self.cell_volume = volume;
+        self.cell_centroid = centroid;
         if D == 2 {
             (0..self.num_cells())
                 .into_par_iter()
@@ -229,7 +271,7 @@ impl<const D: usize> Grid<D> {
         });
         let area = area_vec.norm();
         let size = face_size(p);
-        if !(area > DEGENERATE * size.powi(D as i32 - 1)) {
+        if area.is_nan() || area <= DEGENERATE * size.powi(D as i32 - 1) {
             return Err(GridError::Face {
                 face: f,
                 nodes: nodes.to_vec(),
@@ -252,11 +294,21 @@ impl<const D: usize> Grid<D> {
         let xc = cn.iter().map(|&n| self.nodes[n]).sum::<Point<D>>() / cn.len() as f64;
         let mut vol = 0.0;
         let mut moment = Point::<D>::zeros();
-        let mut pts: Vec<Point<D>> = Vec::new();
+        const STACK: usize = 16;
+        let mut stack = [Point::<D>::zeros(); STACK];
+        let mut heap: Vec<Point<D>> = Vec::new();
         for (&face, &out) in self.cell_faces(c).iter().zip(self.cell_face_outward(c)) {
-            pts.clear();
-            pts.extend(self.oriented_face_nodes(face, out).map(|n| self.nodes[n]));
-            for_each_facet::<D>(&pts, |a, ct, _| {
+            let m = self.face_nodes(face).len();
+            let pts: &mut [Point<D>] = if m <= STACK {
+                &mut stack[..m]
+            } else {
+                heap.resize(m, Point::<D>::zeros());
+                &mut heap[..]
+            };
+            for (p, n) in pts.iter_mut().zip(self.oriented_face_nodes(face, out)) {
+                *p = self.nodes[n];
+            }
+            for_each_facet::<D>(pts, |a, ct, _| {
                 let v = a.dot(&(ct - xc)) / D as f64;
                 vol += v;
                 moment += (xc + ct * D as f64) * (v / (D as f64 + 1.0));
@@ -322,73 +374,56 @@ fn face_size<const D: usize>(p: &[Point<D>]) -> f64 {
     s
 }
 
-fn face_hash(nodes: &[usize]) -> u64 {
-    // Order-independent: combine a commutative sum and xor of mixed node ids, plus the length.
-    let mut sum: u64 = 0;
-    let mut xor: u64 = 0;
-    for &n in nodes {
-        let h = mix(n as u64);
-        sum = sum.wrapping_add(h);
-        xor ^= h.rotate_left(17);
-    }
-    mix(sum ^ mix(xor) ^ (nodes.len() as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15))
+/// Whether two loops (each without repeated nodes) have the same node set.
+fn same_node_set(a: &[usize], b: &[usize]) -> bool {
+    a.len() == b.len() && a.iter().all(|n| b.contains(n))
 }
 
-fn mix(mut x: u64) -> u64 {
-    x ^= x >> 33;
-    x = x.wrapping_mul(0xff51_afd7_ed55_8ccd);
-    x ^= x >> 33;
-    x = x.wrapping_mul(0xc4ce_b9fe_1a85_ec53);
-    x ^ (x >> 33)
-}
-
-fn sorted_into(nodes: &[usize], buf: &mut Vec<usize>) {
-    buf.clear();
-    buf.extend_from_slice(nodes);
-    buf.sort_unstable();
-}
-
-/// Within a run of equal hashes, pair up loops with equal node sets.
-fn match_run(
+/// Pair up the loops of one bucket (loops sharing their smallest node, in increasing
+/// loop order) that have equal node sets; pairs `(first, second)` go to `out`.
+fn match_bucket(
     cells: &CellFaceLoops,
-    run: &[(u64, usize)],
-    rep: &mut [usize],
-    partner: &mut [usize],
-    buf_a: &mut Vec<usize>,
-    buf_b: &mut Vec<usize>,
+    bucket: &[usize],
+    matched: &mut Vec<bool>,
+    out: &mut Vec<(usize, usize)>,
 ) -> Result<()> {
-    for (x, &(_, a)) in run.iter().enumerate() {
-        if rep[a] != a {
+    if bucket.len() < 2 {
+        return Ok(());
+    }
+    matched.clear();
+    matched.resize(bucket.len(), false);
+    for x in 0..bucket.len() {
+        if matched[x] {
             continue;
         }
-        sorted_into(cells.face_loop(a), buf_a);
-        for &(_, b) in &run[x + 1..] {
-            if rep[b] != b {
+        let a = bucket[x];
+        let la = cells.face_loop(a);
+        let mut found = false;
+        for y in x + 1..bucket.len() {
+            let b = bucket[y];
+            let lb = cells.face_loop(b);
+            if matched[y] || !same_node_set(la, lb) {
                 continue;
             }
-            sorted_into(cells.face_loop(b), buf_b);
-            if buf_a != buf_b {
-                continue;
-            }
-            let (first, second) = (a.min(b), a.max(b));
-            if partner[first] != usize::MAX {
+            if found {
                 return Err(GridError::Face {
-                    face: first,
-                    nodes: cells.face_loop(first).to_vec(),
+                    face: a,
+                    nodes: la.to_vec(),
                     what: "shared by more than two cells".into(),
                 });
             }
-            if !is_reversed(cells.face_loop(first), cells.face_loop(second)) {
+            if !is_reversed(la, lb) {
                 return Err(GridError::Face {
-                    face: first,
-                    nodes: cells.face_loop(first).to_vec(),
+                    face: a,
+                    nodes: la.to_vec(),
                     what:
                         "its two cells give it the same orientation (inconsistent or inverted cell)"
                             .into(),
                 });
             }
-            partner[first] = second;
-            rep[second] = first;
+            found = true;
+            matched[y] = true;
+            out.push((a, b));
         }
     }
     Ok(())
@@ -397,6 +432,10 @@ fn match_run(
 /// Whether loop `b` is loop `a` traversed backwards (up to a cyclic shift).
 fn is_reversed(a: &[usize], b: &[usize]) -> bool {
     let m = a.len();
+    if m == 2 {
+        // A 2D face is a directed segment: a cyclic shift of [b, a] is [a, b] itself.
+        return b[0] == a[1] && b[1] == a[0];
+    }
     let Some(p) = b.iter().position(|&n| n == a[0]) else {
         return false;
     };
@@ -431,7 +470,8 @@ fn check_structure<const D: usize>(nodes: &[Point<D>], cells: &CellFaceLoops) ->
     if cells.num_cells() == 0 {
         return Err(GridError::Input("the grid has no cells".into()));
     }
-    (0..cells.num_cells()).into_par_iter().try_for_each(|c| {
+    let scratch = || (Vec::new(), Vec::new(), Vec::new());
+    (0..cells.num_cells()).into_par_iter().try_for_each_init(scratch, |(edges, starts, ends): &mut (Vec<(usize, usize)>, Vec<usize>, Vec<usize>), c| {
         let loops = cells.cell_pos[c]..cells.cell_pos[c + 1];
         if loops.len() < D + 1 {
             return Err(cell_err(c, format!("{} faces; a {D}D cell needs at least {}", loops.len(), D + 1)));
@@ -451,7 +491,7 @@ fn check_structure<const D: usize>(nodes: &[Point<D>], cells: &CellFaceLoops) ->
             }
         }
         // Closed boundary: each directed edge (a, b) of the face loops has a reverse (b, a).
-        let mut edges: Vec<(usize, usize)> = Vec::new();
+        edges.clear();
         for k in loops {
             let l = cells.face_loop(k);
             let m = l.len();
@@ -462,8 +502,10 @@ fn check_structure<const D: usize>(nodes: &[Point<D>], cells: &CellFaceLoops) ->
         }
         if D == 2 {
             // Edges (a, b): every node is the start of exactly one edge and the end of one.
-            let mut starts: Vec<usize> = edges.iter().map(|e| e.0).collect();
-            let mut ends: Vec<usize> = edges.iter().map(|e| e.1).collect();
+            starts.clear();
+            starts.extend(edges.iter().map(|e| e.0));
+            ends.clear();
+            ends.extend(edges.iter().map(|e| e.1));
             starts.sort_unstable();
             ends.sort_unstable();
             if starts != ends || starts.windows(2).any(|w| w[0] == w[1]) {
@@ -474,7 +516,7 @@ fn check_structure<const D: usize>(nodes: &[Point<D>], cells: &CellFaceLoops) ->
             if edges.windows(2).any(|w| w[0] == w[1]) {
                 return Err(cell_err(c, "two faces traverse an edge in the same direction (inconsistent face orientation)"));
             }
-            for &(a, b) in &edges {
+            for &(a, b) in edges.iter() {
                 if edges.binary_search(&(b, a)).is_err() {
                     return Err(cell_err(c, format!("not closed: edge {a}-{b} belongs to only one face")));
                 }
@@ -484,36 +526,47 @@ fn check_structure<const D: usize>(nodes: &[Point<D>], cells: &CellFaceLoops) ->
     })
 }
 
-/// Cell node list: in 2D the polygon in loop order (chained), in 3D first appearance.
-fn cell_node_list<const D: usize>(cells: &CellFaceLoops, c: usize) -> Result<Vec<usize>> {
+/// Append the cell's node list to `out`: in 2D the polygon in loop order (chained), in
+/// 3D the nodes in order of first appearance in the cell's faces.
+fn cell_node_list<const D: usize>(
+    cells: &CellFaceLoops,
+    c: usize,
+    out: &mut Vec<usize>,
+) -> Result<()> {
     let loops = cells.cell_pos[c]..cells.cell_pos[c + 1];
+    let start = out.len();
     if D == 2 {
-        let edges: Vec<[usize; 2]> = loops
-            .map(|k| [cells.face_loop(k)[0], cells.face_loop(k)[1]])
-            .collect();
-        let mut out = Vec::with_capacity(edges.len());
-        let mut cur = edges[0][0];
-        for _ in 0..edges.len() {
+        let m = loops.len();
+        let edge = |k: usize| {
+            let l = cells.face_loop(loops.start + k);
+            (l[0], l[1])
+        };
+        let mut cur = edge(0).0;
+        // Start the search at the edge after the last one used (the common case of a
+        // polygon given in order makes this linear).
+        let mut at = 0;
+        for _ in 0..m {
             out.push(cur);
-            // Try the next edge first (the common case of a polygon given in order).
-            let next = edges.iter().find(|e| e[0] == cur).map(|e| e[1]);
-            cur = next.ok_or_else(|| cell_err(c, "polygon boundary is not closed"))?;
+            let next = (0..m)
+                .map(|s| (at + s) % m)
+                .find(|&k| edge(k).0 == cur)
+                .ok_or_else(|| cell_err(c, "polygon boundary is not closed"))?;
+            cur = edge(next).1;
+            at = next + 1;
         }
-        if cur != out[0] {
+        if cur != out[start] {
             return Err(cell_err(c, "polygon boundary is more than one loop"));
         }
-        Ok(out)
     } else {
-        let mut out: Vec<usize> = Vec::new();
         for k in loops {
             for &n in cells.face_loop(k) {
-                if !out.contains(&n) {
+                if !out[start..].contains(&n) {
                     out.push(n);
                 }
             }
         }
-        Ok(out)
     }
+    Ok(())
 }
 
 fn check_nodes_used_and_distinct<const D: usize>(g: &Grid<D>) -> Result<()> {
@@ -527,18 +580,25 @@ fn check_nodes_used_and_distinct<const D: usize>(g: &Grid<D>) -> Result<()> {
             what: "not used by any cell".into(),
         });
     }
-    let mut order: Vec<usize> = (0..g.nodes.len()).collect();
-    order.par_sort_unstable_by(|&a, &b| {
-        let (pa, pb) = (&g.nodes[a], &g.nodes[b]);
-        pa.as_slice()
-            .partial_cmp(pb.as_slice())
-            .unwrap_or(std::cmp::Ordering::Equal)
-    });
+    // Sort (coordinate keys, node) records: equal coordinates become neighbours. The key
+    // is a total order on finite floats (sign-flipped bits) with −0 mapped to +0.
+    let key = |x: f64| {
+        let b = (x + 0.0).to_bits();
+        if b >> 63 == 1 { !b } else { b | (1 << 63) }
+    };
+    let mut order: Vec<([u64; D], usize)> = g
+        .nodes
+        .par_iter()
+        .enumerate()
+        .map(|(n, p)| (std::array::from_fn(|a| key(p[a])), n))
+        .collect();
+    order.par_sort_unstable();
     for w in order.windows(2) {
-        if g.nodes[w[0]] == g.nodes[w[1]] {
+        if w[0].0 == w[1].0 {
+            let (a, b) = (w[0].1, w[1].1);
             return Err(GridError::Node {
-                node: w[0].max(w[1]),
-                what: format!("coincides with node {}", w[0].min(w[1])),
+                node: a.max(b),
+                what: format!("coincides with node {}", a.min(b)),
             });
         }
     }
@@ -592,4 +652,45 @@ fn _assert_send_sync() {
     fn f<T: Send + Sync>() {}
     f::<Grid<2>>();
     f::<Grid<3>>();
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn p(x: f64, y: f64) -> Point<2> {
+        Point::<2>::new(x, y)
+    }
+
+    #[test]
+    fn shared_faces_are_matched_and_checked() {
+        // Two triangles sharing the edge 0–1: 5 faces, one interior.
+        let nodes = vec![p(0.0, 0.0), p(1.0, 0.0), p(0.5, 1.0), p(0.5, -1.0)];
+        let g = Grid::from_polygons(nodes.clone(), &[0, 3, 6], &[0, 1, 2, 1, 0, 3]).unwrap();
+        assert_eq!(g.num_faces(), 5);
+        assert_eq!(g.boundary_faces().len(), 4);
+        assert_eq!(g.face_cells(0), (0, Some(1)));
+        // Same orientation on the shared edge (the second triangle clockwise).
+        let e = Grid::from_polygons(nodes.clone(), &[0, 3, 6], &[0, 1, 2, 0, 1, 3]);
+        assert!(
+            matches!(&e, Err(GridError::Face { what, .. }) if what.contains("same orientation")),
+            "{e:?}"
+        );
+        // Two triangles without a shared edge but with coincident nodes 1 and 4.
+        let mut dup = nodes.clone();
+        dup.push(p(1.0, 0.0));
+        let e = Grid::from_polygons(dup, &[0, 3, 6], &[0, 1, 2, 4, 0, 3]);
+        assert!(
+            matches!(&e, Err(GridError::Node { node: 4, what }) if what.contains("coincides with node 1")),
+            "{e:?}"
+        );
+        // Three cells on one edge.
+        let mut nodes3 = nodes;
+        nodes3.push(p(0.5, 2.0));
+        let e = Grid::from_polygons(nodes3, &[0, 3, 6, 9], &[0, 1, 2, 1, 0, 3, 0, 1, 4]);
+        assert!(
+            matches!(&e, Err(GridError::Face { what, .. }) if what.contains("more than two")),
+            "{e:?}"
+        );
+    }
 }

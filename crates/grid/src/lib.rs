@@ -30,6 +30,8 @@ pub mod builder;
 pub mod error;
 pub mod generate;
 pub mod grid;
+/// Mesh files: Gmsh `.msh` import, VTK `.vtu` import/export, `.pvd` time series.
+pub mod io;
 pub mod point;
 
 pub use builder::CellFaceLoops;

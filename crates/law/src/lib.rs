@@ -14,9 +14,42 @@
 //!   `F = −∂E/∂u` (restoring); [`CellLaw::stiffness`] returns `K = ∂²E/∂u² = −∂F/∂u`,
 //!   symmetric positive semi-definite for a stable law.
 //! * Tension is positive; stress is returned as a symmetric `D × D` tensor.
+//!
+//! # Modules
+//!
+//! * [`kelvin`] — Kelvin notation for symmetric tensors (`[e11, e22, √2 e12]` in 2D,
+//!   `[e11, e22, e33, √2 e23, √2 e13, √2 e12]` in 3D) and its fixed-size representation.
+//! * [`stiffness`] — [`Stiffness`]: isotropic (3D, plane strain, plane stress) and
+//!   general anisotropic elastic stiffness in Kelvin form, validated.
+//! * [`testkit`] — the invariants every cell law must satisfy, as checks usable from any
+//!   crate's tests (see `examples/user_law.rs` for a law defined outside this crate).
+
+pub mod error;
+pub mod kelvin;
+pub mod stiffness;
+pub mod testkit;
+
+pub use error::LawError;
+pub use kelvin::{Kelvin, KelvinMatrix, kelvin_len};
+pub use stiffness::Stiffness;
 
 use nalgebra::{DMatrix, SMatrix};
 use porofrac_grid::{Grid, Point};
+
+/// Make `m` a zero `rows × cols` matrix, reusing its allocation when it is large enough.
+///
+/// `DMatrix::resize_mut` clones; this helper keeps the buffer, so a matrix reused across
+/// cells of different sizes allocates only when it has to grow.
+pub fn zero_matrix(m: &mut DMatrix<f64>, rows: usize, cols: usize) {
+    if m.nrows() == rows && m.ncols() == cols {
+        m.fill(0.0);
+        return;
+    }
+    let mut v: Vec<f64> = std::mem::replace(m, DMatrix::zeros(0, 0)).data.into();
+    v.clear();
+    v.resize(rows * cols, 0.0);
+    *m = DMatrix::from_vec(rows, cols, v);
+}
 
 /// A symmetric second-order tensor (stress or strain) in D dimensions.
 pub type Tensor<const D: usize> = SMatrix<f64, D, D>;

@@ -1,1 +1,58 @@
-//! porofrac-sim (under construction).
+//! porofrac-sim: mechanics assembly, boundary conditions and the static direct solve.
+//!
+//! The pieces, in the order a static solve uses them:
+//!
+//! 1. [`bc`]: displacement conditions, rigid platens, tractions, body force and gravity,
+//!    with values that may depend on position and time ([`ScalarField`]).
+//! 2. [`dofs::DofMap`]: dof → equation map; prescribed dofs are eliminated, platen nodes
+//!    share equations; conflicting conditions and free rigid-body modes are errors.
+//! 3. [`pattern::Pattern`]: the sparsity pattern of the reduced stiffness (upper triangle,
+//!    CSC), built once, with per-cell scatter maps for a parallel, race-free fill.
+//! 4. [`assembly`]: reduced stiffness and internal forces from the cell laws
+//!    ([`porofrac_law::CellLaw`], chosen per cell by a [`LawMap`]), and the nodal loads.
+//! 5. [`solve`]: sparse Cholesky with the symbolic factorization reused
+//!    ([`DirectSolver`]), [`solve_static`], cell stresses and reaction forces.
+//!
+//! State that changes (displacements, time) is passed explicitly; the types above are
+//! built once per grid and set of conditions.
+//!
+//! ```no_run
+//! # use porofrac_sim::*;
+//! # fn run(grid: &porofrac_grid::Grid<2>, law: &dyn porofrac_law::CellLaw<2>) -> Result<()> {
+//! let bottom = Displacement {
+//!     name: "ymin".into(),
+//!     faces: grid.boundary("ymin")?,
+//!     components: [Some(0.0.into()), Some(0.0.into())],
+//! };
+//! let dofs = DofMap::new(grid, &[bottom], &[])?;
+//! let pattern = Pattern::new(grid, &dofs)?;
+//! let laws = LawMap::uniform(grid, law)?;
+//! let loads = Loads::default();
+//! let mut solver = DirectSolver::new(&pattern)?;
+//! let problem = StaticProblem { grid, laws: &laws, dofs: &dofs, pattern: &pattern, loads: &loads };
+//! let sol = solve_static(&problem, &mut solver, 0.0, &StaticOptions::default())?;
+//! let stress = cell_stresses(grid, &laws, &sol.displacement)?;
+//! # Ok(()) }
+//! ```
+
+pub mod assembly;
+pub mod bc;
+pub mod dofs;
+pub mod error;
+pub mod field;
+pub mod laws;
+pub mod pattern;
+mod quadrature;
+pub mod solve;
+
+pub use assembly::{assemble, nodal_loads};
+pub use bc::{Displacement, Gravity, Loads, Platen, Traction};
+pub use dofs::DofMap;
+pub use error::{Result, SimError};
+pub use field::{FieldFn, ScalarField};
+pub use laws::LawMap;
+pub use pattern::Pattern;
+pub use solve::{
+    DirectSolver, Par, StaticOptions, StaticProblem, StaticSolution, cell_stresses, reaction,
+    solve_static,
+};

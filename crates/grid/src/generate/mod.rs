@@ -5,7 +5,18 @@
 //!   each cube into 6 tetrahedra sharing the diagonal (i, j, k)–(i+1, j+1, k+1) (the Kuhn
 //!   or Freudenthal split). Both are the same construction: one simplex per permutation of
 //!   the axes, walking from the cube's lowest to its highest corner.
+//! * [`perturb`]: seeded random jitter of the interior nodes of any grid (2D or 3D).
+//! * [`voronoi`]: a 2D Voronoi (PEBI) grid of `n` cells clipped to a box, with Lloyd
+//!   iterations.
+//! * [`composite`]: a 2D Cartesian far field with a refined triangle zone around a point,
+//!   joined by hanging nodes, with `refined` and well cell tags.
 
+mod composite;
+mod perturb;
 mod structured;
+mod voronoi;
 
+pub use composite::{CompositeSpec, Diagonals, REFINED_TAG, composite};
+pub use perturb::{MAX_PERTURB, perturb};
 pub use structured::{cartesian, simplices};
+pub use voronoi::{DEFAULT_LLOYD, voronoi};

@@ -112,8 +112,11 @@ pub(crate) fn push_simplex<const D: usize>(
 ) {
     debug_assert_eq!(v.len(), D + 1);
     // Orientation: sign of the volume of (v1 − v0, ..., vD − v0).
-    let face0: Vec<Point<D>> = v[1..].iter().map(|&i| nodes[i]).collect();
-    let a = facet_area_vector::<D>(&face0);
+    let mut face0 = [Point::<D>::zeros(); 3];
+    for (p, &i) in face0.iter_mut().zip(&v[1..]) {
+        *p = nodes[i];
+    }
+    let a = facet_area_vector::<D>(&face0[..D]);
     let positive = a.dot(&(nodes[v[1]] - nodes[v[0]])) > 0.0;
     // Face opposite vertex k: the other vertices, in an order whose normal points away
     // from vertex k. For a positively oriented simplex, the loop v[1..] is outward for the
@@ -127,7 +130,7 @@ pub(crate) fn push_simplex<const D: usize>(
                 m += 1;
             }
         }
-        let flip = (k % 2 == 1) != !positive;
+        let flip = (k % 2 == 1) == positive;
         if flip {
             face[..D].swap(0, 1);
         }
@@ -153,6 +156,10 @@ pub fn simplices<const D: usize>(lo: Point<D>, hi: Point<D>, n: [usize; D]) -> R
         ]
     };
     let mut loops = CellFaceLoops::new();
+    let simplices_total = n.iter().product::<usize>() * perms.len();
+    loops.cell_pos.reserve(simplices_total);
+    loops.loop_pos.reserve(simplices_total * (D + 1));
+    loops.loop_nodes.reserve(simplices_total * (D + 1) * D);
     let mut v = [0usize; 4];
     for cell in cells_iter(n) {
         for perm in perms {

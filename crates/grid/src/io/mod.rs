@@ -1,0 +1,347 @@
+//! Mesh import and export: Gmsh 4.1 ASCII `.msh` (read), VTK XML `.vtu` (read and write)
+//! and ParaView `.pvd` time series (write).
+//!
+//! # Cells and face orientation
+//!
+//! The grid stores every cell as a set of *outward* face loops ([`crate::CellFaceLoops`]).
+//! Gmsh and VTK store standard cells as node lists in a reference order; each shape has a
+//! fixed table that turns the node list into outward loops:
+//!
+//! | shape | Gmsh / VTK type | outward faces (local node numbers) |
+//! |---|---|---|
+//! | triangle | 2 / 5 | polygon `0 1 2` (counter-clockwise) |
+//! | quadrilateral | 3 / 9 | polygon `0 1 2 3` |
+//! | tetrahedron | 4 / 10 | `0 2 1`, `0 1 3`, `0 3 2`, `1 2 3` |
+//! | hexahedron | 5 / 12 | `0 3 2 1`, `4 5 6 7`, `0 1 5 4`, `1 2 6 5`, `2 3 7 6`, `0 4 7 3` |
+//! | prism / wedge | 6 / 13 | `0 2 1`, `3 4 5`, `0 1 4 3`, `1 2 5 4`, `0 3 5 2` |
+//! | pyramid | 7 / 14 | `0 3 2 1`, `0 1 4`, `1 2 4`, `2 3 4`, `3 0 4` |
+//!
+//! A tetrahedron is positively oriented when `(x₁ − x₀) × (x₂ − x₀) · (x₃ − x₀) > 0`;
+//! a hexahedron, prism or pyramid when its first face (`0 1 2 …`) turns counter-clockwise
+//! seen from the opposite face or apex. Gmsh and VTK agree on all these orders (VTK's wedge
+//! has its parametric corners `(0,0,0), (1,0,0), (0,1,0)` at the bottom like Gmsh's prism;
+//! VTK's own quality filter gives a negative volume for the mirrored order).
+//! Elements are **never reoriented**:
+//! an element with negative signed volume
+//! `|K| = (1/D) Σ_facets a_f · (c_f − x̄)` (the divergence theorem over the outward loops,
+//! the same facet split as the grid) is reported as an inverted cell, naming the file, the
+//! cell (= element order among the cells) and the element's tag and line.
+//!
+//! # Nodes
+//!
+//! Nodes that no cell uses (geometry points, nodes of boundary-only elements) are dropped
+//! and the rest renumbered compactly in file order. A 2D mesh must lie in a plane
+//! `z = const`.
+//!
+//! # Errors
+//!
+//! A missing or unreadable file is [`GridError::Io`] with its path; malformed text is
+//! [`GridError::Parse`] with the 1-based line; a well-formed file whose grid is invalid
+//! (degenerate or inverted cells, non-matching faces) is [`GridError::InFile`] wrapping the
+//! grid error, whose cell index is the cell's position among the file's cells.
+
+mod base64;
+mod gmsh;
+mod pvd;
+mod vtu;
+mod xml;
+
+pub use gmsh::{parse_msh, read_msh};
+pub use pvd::PvdWriter;
+pub use vtu::{Encoding, Field, kelvin_to_vtk_sym, read_vtu, write_vtu, write_vtu_with};
+
+use std::fs;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use crate::builder::CellFaceLoops;
+use crate::error::{GridError, Result};
+use crate::grid::Grid;
+use crate::point::{Point, for_each_facet};
+
+/// First-order element shapes shared by Gmsh and VTK.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Shape {
+    Triangle,
+    Quad,
+    Tetra,
+    Hexa,
+    /// Gmsh prism and VTK wedge: `0 1 2` counter-clockwise seen from `3 4 5`.
+    Prism,
+    Pyramid,
+}
+
+impl Shape {
+    pub(crate) fn num_nodes(self) -> usize {
+        match self {
+            Shape::Triangle => 3,
+            Shape::Quad | Shape::Tetra => 4,
+            Shape::Pyramid => 5,
+            Shape::Prism => 6,
+            Shape::Hexa => 8,
+        }
+    }
+    pub(crate) fn dim(self) -> usize {
+        match self {
+            Shape::Triangle | Shape::Quad => 2,
+            _ => 3,
+        }
+    }
+    pub(crate) fn name(self) -> &'static str {
+        match self {
+            Shape::Triangle => "triangle",
+            Shape::Quad => "quadrilateral",
+            Shape::Tetra => "tetrahedron",
+            Shape::Hexa => "hexahedron",
+            Shape::Prism => "prism",
+            Shape::Pyramid => "pyramid",
+        }
+    }
+    /// Outward face loops in local node numbers (3D shapes only).
+    fn faces(self) -> &'static [&'static [usize]] {
+        match self {
+            Shape::Triangle | Shape::Quad => &[],
+            Shape::Tetra => &[&[0, 2, 1], &[0, 1, 3], &[0, 3, 2], &[1, 2, 3]],
+            Shape::Hexa => &[
+                &[0, 3, 2, 1],
+                &[4, 5, 6, 7],
+                &[0, 1, 5, 4],
+                &[1, 2, 6, 5],
+                &[2, 3, 7, 6],
+                &[0, 4, 7, 3],
+            ],
+            Shape::Prism => &[
+                &[0, 2, 1],
+                &[3, 4, 5],
+                &[0, 1, 4, 3],
+                &[1, 2, 5, 4],
+                &[0, 3, 5, 2],
+            ],
+            Shape::Pyramid => &[
+                &[0, 3, 2, 1],
+                &[0, 1, 4],
+                &[1, 2, 4],
+                &[2, 3, 4],
+                &[3, 0, 4],
+            ],
+        }
+    }
+    /// Append the cell with global node numbers `v` (in the shape's reference order).
+    pub(crate) fn push(self, loops: &mut CellFaceLoops, v: &[usize]) {
+        debug_assert_eq!(v.len(), self.num_nodes());
+        if self.dim() == 2 {
+            loops.push_polygon(v);
+            return;
+        }
+        let mut buf = [0usize; 4];
+        for f in self.faces() {
+            for (k, &l) in f.iter().enumerate() {
+                buf[k] = v[l];
+            }
+            loops.push_face(&buf[..f.len()]);
+        }
+        loops.finish_cell();
+    }
+}
+
+/// Where a cell came from, for error messages.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Origin {
+    /// 1-based line of the element (Gmsh) or of the cell arrays (VTK).
+    pub line: usize,
+    /// Element tag (Gmsh) or cell index (VTK).
+    pub tag: u64,
+    /// Whether the cell is a standard shape (orientation check applies).
+    pub standard: bool,
+}
+
+/// A mesh as read from a file, before validation.
+pub(crate) struct RawMesh<const D: usize> {
+    /// All nodes in file order.
+    pub nodes: Vec<Point<D>>,
+    /// File label (Gmsh tag or VTK point index) and line of each node.
+    pub node_label: Vec<(u64, usize)>,
+    /// Cells as outward loops in `nodes` numbering.
+    pub loops: CellFaceLoops,
+    /// One per cell.
+    pub origin: Vec<Origin>,
+    /// `"Gmsh element"` or `"VTK cell"`.
+    pub what_cell: &'static str,
+    /// `"Gmsh node"` or `"VTK point"`.
+    pub what_node: &'static str,
+}
+
+/// The validated grid and the map from file node index to grid node (`usize::MAX` if the
+/// node was dropped).
+pub(crate) struct Built<const D: usize> {
+    pub grid: Grid<D>,
+    pub node_map: Vec<usize>,
+}
+
+impl<const D: usize> RawMesh<D> {
+    /// Drop unused nodes, build and validate the grid; errors are wrapped in
+    /// [`GridError::InFile`] and name the element.
+    pub(crate) fn build(mut self, path: &Path) -> Result<Built<D>> {
+        let in_file = |e: GridError| GridError::InFile {
+            path: path.to_path_buf(),
+            source: Box::new(e),
+        };
+        if self.loops.num_cells() == 0 {
+            return Err(in_file(GridError::Input(format!(
+                "the file has no {D}D cells"
+            ))));
+        }
+        let mut node_map = vec![usize::MAX; self.nodes.len()];
+        for &n in &self.loops.loop_nodes {
+            node_map[n] = 0;
+        }
+        let mut kept = Vec::with_capacity(self.nodes.len());
+        let mut labels = Vec::with_capacity(self.nodes.len());
+        for (n, m) in node_map.iter_mut().enumerate() {
+            if *m == 0 {
+                *m = kept.len();
+                kept.push(self.nodes[n]);
+                labels.push(self.node_label[n]);
+            }
+        }
+        for n in &mut self.loops.loop_nodes {
+            *n = node_map[*n];
+        }
+        match Grid::from_cell_faces(kept, &self.loops) {
+            Ok(grid) => Ok(Built { grid, node_map }),
+            Err(e) => {
+                // Prefer the precise diagnosis of an inverted standard element.
+                let nodes: Vec<Point<D>> = compact_nodes(&self.nodes, &node_map, labels.len());
+                for c in 0..self.loops.num_cells() {
+                    if !self.origin[c].standard {
+                        continue;
+                    }
+                    let (vol, size) = signed_volume(&nodes, &self.loops, c);
+                    if vol < -1e-13 * size.powi(D as i32) {
+                        return Err(in_file(GridError::Cell {
+                            cell: c,
+                            what: format!(
+                                "inverted element: signed volume {vol:e} < 0 ({}); elements are \
+                                 not reoriented, fix the node order in the mesh",
+                                self.describe(c)
+                            ),
+                        }));
+                    }
+                }
+                Err(in_file(match e {
+                    GridError::Cell { cell, what } if cell < self.origin.len() => GridError::Cell {
+                        cell,
+                        what: format!("{what} ({})", self.describe(cell)),
+                    },
+                    GridError::Node { node, what } if node < labels.len() => GridError::Node {
+                        node,
+                        what: format!(
+                            "{what} ({} {}, line {})",
+                            self.what_node, labels[node].0, labels[node].1
+                        ),
+                    },
+                    other => other,
+                }))
+            }
+        }
+    }
+
+    fn describe(&self, c: usize) -> String {
+        let o = self.origin[c];
+        format!("{} {}, line {}", self.what_cell, o.tag, o.line)
+    }
+}
+
+fn compact_nodes<const D: usize>(
+    all: &[Point<D>],
+    node_map: &[usize],
+    kept: usize,
+) -> Vec<Point<D>> {
+    let mut out = vec![Point::<D>::zeros(); kept];
+    for (n, &m) in node_map.iter().enumerate() {
+        if m != usize::MAX {
+            out[m] = all[n];
+        }
+    }
+    out
+}
+
+/// Signed volume of cell `c` from its loops, and its bounding-box size.
+fn signed_volume<const D: usize>(
+    nodes: &[Point<D>],
+    loops: &CellFaceLoops,
+    c: usize,
+) -> (f64, f64) {
+    let ls = loops.cell_pos[c]..loops.cell_pos[c + 1];
+    let all = &loops.loop_nodes[loops.loop_pos[ls.start]..loops.loop_pos[ls.end]];
+    let xc = all.iter().map(|&n| nodes[n]).sum::<Point<D>>() / all.len() as f64;
+    let mut lo = Point::<D>::repeat(f64::INFINITY);
+    let mut hi = Point::<D>::repeat(f64::NEG_INFINITY);
+    for &n in all {
+        lo = lo.inf(&nodes[n]);
+        hi = hi.sup(&nodes[n]);
+    }
+    let mut vol = 0.0;
+    // Only called on the error path: a plain buffer is fine.
+    let mut pts: Vec<Point<D>> = Vec::new();
+    for k in ls {
+        let l = &loops.loop_nodes[loops.loop_pos[k]..loops.loop_pos[k + 1]];
+        pts.clear();
+        pts.extend(l.iter().map(|&n| nodes[n]));
+        for_each_facet::<D>(&pts, |a, ct, _| vol += a.dot(&(ct - xc)) / D as f64);
+    }
+    (vol, (hi - lo).amax())
+}
+
+/// Write a file atomically: the content goes to a temporary file in the same directory,
+/// which is then renamed over `path` (a killed run leaves the old or the new file, never a
+/// partial one).
+pub(crate) fn write_atomic(path: &Path, content: &[u8]) -> Result<()> {
+    let io_err = |p: &Path, source| GridError::Io {
+        path: p.to_path_buf(),
+        source,
+    };
+    let name = path.file_name().ok_or_else(|| {
+        io_err(
+            path,
+            std::io::Error::new(std::io::ErrorKind::InvalidInput, "not a file path"),
+        )
+    })?;
+    let mut tmp_name = std::ffi::OsString::from(".");
+    tmp_name.push(name);
+    tmp_name.push(format!(".tmp{}", std::process::id()));
+    let tmp: PathBuf = path.with_file_name(tmp_name);
+    let result = (|| {
+        let mut f = fs::File::create(&tmp)?;
+        f.write_all(content)?;
+        f.sync_all()?;
+        drop(f);
+        fs::rename(&tmp, path)
+    })();
+    result.map_err(|e| {
+        let _ = fs::remove_file(&tmp);
+        io_err(path, e)
+    })
+}
+
+/// Read a whole file, mapping failures to [`GridError::Io`] with the path.
+pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>> {
+    fs::read(path).map_err(|source| GridError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// Escape a string for an XML attribute value.
+pub(crate) fn xml_escape(s: &str, out: &mut String) {
+    for ch in s.chars() {
+        match ch {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&apos;"),
+            c => out.push(c),
+        }
+    }
+}

@@ -1,0 +1,391 @@
+//! Assembly of the reduced stiffness, the internal forces and the external loads.
+//!
+//! # Weak form
+//!
+//! Find `u` with `u = g` on the Dirichlet boundary such that for all admissible `v`
+//!
+//! ```text
+//!   Σ_K a_K(u, v) = ∫_Ω (b + ρ g) · v dx + ∫_Γt t · v ds  (+ platen forces)
+//! ```
+//!
+//! where `a_K` is the bilinear form of the cell law of cell `K` (seed §2.2–2.3: VEM, MDEM
+//! or P1), represented by its local stiffness `K_K` and its nodal forces
+//! `F_K(u) = −∂E_K/∂u`. [`assemble`] evaluates, at a given nodal displacement `u`
+//! (prescribed values filled in), the reduced tangent `Tᵀ K_ff T` (see [`crate::dofs`])
+//! into the values of a [`Pattern`] and the reduced internal forces `Tᵀ F(u)`. For a
+//! linear law `F(u) = −K u`, so at `u = (0, u_p)` the internal forces are exactly the
+//! elimination term `−K_fp u_p`; for nonlinear laws [`porofrac_law::CellLaw::forces`] is called and the
+//! same vector is the Newton residual.
+//!
+//! # Load integration
+//!
+//! The virtual-element basis function `φ_i` is not known inside a cell, so loads are
+//! integrated with a piecewise-linear surrogate that is exact on simplices: each cell is
+//! split into the simplices formed by the facets of its faces (the grid's face-point
+//! triangulation, [`porofrac_grid::point::for_each_facet`]) and the cell's vertex average
+//! `x_K`. On each sub-simplex φ_i is linear, with value `δ_ij` at face vertices `j`,
+//! `1/m` at the face point of an `m`-gon face (3D), and `1/n` at `x_K` (`n` nodes). Then
+//! `Σ_i φ_i = 1`, `Σ_i φ_i x_i = x` (so constant and linear loads have exact moments), and
+//! on a triangle or tetrahedron φ_i is the P1 hat function. The nodal load is
+//!
+//! ```text
+//!   f_i = Σ_{sub-simplices S} |S| Σ_q w_q φ_i(x_q) (b(x_q, t) + ρ_K g)
+//! ```
+//!
+//! with a rule exact for degree 4 on triangles (6 points) and degree 2 on tetrahedra (4
+//! points), so loads linear in x are integrated exactly. Tractions use φ restricted to
+//! the face: on a 2D edge `∫_e t φ_i ds` by 2-point Gauss (exact to degree 3), on a 3D face
+//! the same facets with the edge-midpoint rule (degree 2); nodal loads are exact for
+//! linear tractions.
+
+use nalgebra::DMatrix;
+use porofrac_grid::point::for_each_facet;
+use porofrac_grid::{Grid, Point};
+use porofrac_law::{GeometryBuffer, Scratch};
+use rayon::prelude::*;
+
+use crate::bc::Loads;
+use crate::dofs::DofMap;
+use crate::error::{AXES, Result, SimError, fmt_point};
+use crate::laws::LawMap;
+use crate::pattern::Pattern;
+use crate::quadrature::{cell_rule, facet_rule};
+
+/// Per-thread buffers for evaluating cells.
+#[derive(Default)]
+pub(crate) struct Work<const D: usize> {
+    pub(crate) scratch: Scratch,
+    pub(crate) geo: GeometryBuffer<D>,
+    pub(crate) k: DMatrix<f64>,
+    pub(crate) u: Vec<f64>,
+    pub(crate) f: Vec<f64>,
+}
+
+impl<const D: usize> Work<D> {
+    /// Gather the displacements of cell `c` from the nodal vector `u`.
+    pub(crate) fn gather(&mut self, grid: &Grid<D>, c: usize, u: &[f64]) {
+        self.u.clear();
+        for &n in grid.cell_nodes(c) {
+            self.u.extend_from_slice(&u[D * n..D * n + D]);
+        }
+    }
+    /// Nodal forces of cell `c` at the gathered displacement, into `self.f`.
+    pub(crate) fn forces(&mut self, grid: &Grid<D>, laws: &LawMap<'_, D>, c: usize) -> Result<()> {
+        let law = laws.law(c);
+        let geo = self.geo.load(grid, c);
+        self.f.clear();
+        self.f.resize(self.u.len(), 0.0);
+        law.forces(&geo, &self.u, &mut self.f, &mut self.scratch);
+        if let Some(i) = self.f.iter().position(|v| !v.is_finite()) {
+            return Err(cell_error(
+                laws,
+                c,
+                format!("non-finite nodal force at local dof {i}"),
+            ));
+        }
+        Ok(())
+    }
+}
+
+pub(crate) fn cell_error<const D: usize>(laws: &LawMap<'_, D>, c: usize, what: String) -> SimError {
+    SimError::Cell {
+        cell: c,
+        law: laws.law(c).name().to_string(),
+        what,
+    }
+}
+
+/// Assemble the reduced tangent stiffness and internal forces at the nodal displacement
+/// `u` (length `D · nodes`, prescribed values filled in).
+///
+/// `values` (length [`Pattern::nnz`]) receives `Tᵀ K_ff(u) T` in the pattern's upper
+/// triangle; `forces` (length = equations) receives `Tᵀ F(u)`, the restoring forces of the
+/// cells summed into the equations. Both are overwritten. Cells are evaluated in parallel
+/// (see [`crate::pattern`] for the race-free partition). Errors name the cell whose law
+/// returned a wrong-sized or non-finite stiffness or force.
+pub fn assemble<const D: usize>(
+    grid: &Grid<D>,
+    laws: &LawMap<'_, D>,
+    dofs: &DofMap<D>,
+    pattern: &Pattern,
+    u: &[f64],
+    values: &mut [f64],
+    forces: &mut [f64],
+) -> Result<()> {
+    if u.len() != dofs.num_dofs()
+        || values.len() != pattern.nnz()
+        || forces.len() != pattern.num_equations()
+    {
+        return Err(SimError::Input(format!(
+            "assemble: lengths u {} (want {}), values {} (want {}), forces {} (want {})",
+            u.len(),
+            dofs.num_dofs(),
+            values.len(),
+            pattern.nnz(),
+            forces.len(),
+            pattern.num_equations()
+        )));
+    }
+    let raw = dofs.raw();
+    let mut parts = Vec::with_capacity(pattern.chunks.len());
+    let (mut vrest, mut frest) = (values, forces);
+    for ch in &pattern.chunks {
+        let (v, vr) = vrest.split_at_mut(ch.vals.len());
+        let (f, fr) = frest.split_at_mut(ch.cols.len());
+        parts.push((ch, v, f));
+        vrest = vr;
+        frest = fr;
+    }
+    parts
+        .into_par_iter()
+        .try_for_each_init(Work::<D>::default, |w, (ch, vals, frc)| {
+            vals.fill(0.0);
+            frc.fill(0.0);
+            for &c in &pattern.chunk_cells[ch.cells.clone()] {
+                let law = laws.law(c);
+                w.gather(grid, c, u);
+                let m = w.u.len();
+                {
+                    let geo = w.geo.load(grid, c);
+                    law.stiffness(&geo, &w.u, &mut w.k, &mut w.scratch);
+                }
+                if w.k.nrows() != m || w.k.ncols() != m {
+                    return Err(cell_error(
+                        laws,
+                        c,
+                        format!(
+                            "stiffness is {}×{}, expected {m}×{m}",
+                            w.k.nrows(),
+                            w.k.ncols()
+                        ),
+                    ));
+                }
+                if !w.k.iter().all(|v| v.is_finite()) {
+                    return Err(cell_error(laws, c, "non-finite stiffness".into()));
+                }
+                let (v0, vlen) = (ch.vals.start, vals.len());
+                for (&p, &kv) in pattern.cell_scatter(c).iter().zip(w.k.as_slice()) {
+                    let k = (p as usize).wrapping_sub(v0);
+                    if k < vlen {
+                        vals[k] += kv;
+                    }
+                }
+                // Internal forces: −K u for linear laws (nothing to do at u = 0), else the law's.
+                if law.is_linear() {
+                    if w.u.iter().all(|&x| x == 0.0) {
+                        continue;
+                    }
+                    w.f.clear();
+                    w.f.resize(m, 0.0);
+                    for j in 0..m {
+                        let uj = w.u[j];
+                        if uj != 0.0 {
+                            for (fi, kij) in w.f.iter_mut().zip(w.k.column(j).iter()) {
+                                *fi -= kij * uj;
+                            }
+                        }
+                    }
+                } else {
+                    w.forces(grid, laws, c)?;
+                }
+                let (c0, clen) = (ch.cols.start, frc.len());
+                let nodes = grid.cell_nodes(c);
+                for (i, fi) in w.f.iter().enumerate() {
+                    let e = raw[D * nodes[i / D] + i % D];
+                    let k = e.wrapping_sub(c0);
+                    if k < clen {
+                        frc[k] += fi;
+                    }
+                }
+            }
+            Ok(())
+        })
+}
+
+/// Nodal external loads at time `t` (body force, gravity and tractions; platen forces are
+/// added to the reduced system by [`DofMap::add_platen_forces`]), written to `out`
+/// (length `D · nodes`, node-major). See the module docs for the integration rules.
+///
+/// Errors: a density array of the wrong length, a traction on an interior or out-of-range
+/// face, or a non-finite load (naming the node).
+pub fn nodal_loads<const D: usize>(
+    grid: &Grid<D>,
+    loads: &Loads<D>,
+    t: f64,
+    out: &mut [f64],
+) -> Result<()> {
+    let ndof = D * grid.num_nodes();
+    if out.len() != ndof {
+        return Err(SimError::Input(format!(
+            "nodal_loads: output length {}, want {ndof}",
+            out.len()
+        )));
+    }
+    out.fill(0.0);
+    if let Some(gr) = &loads.gravity
+        && gr.density.len() != grid.num_cells()
+    {
+        return Err(SimError::Input(format!(
+            "gravity: {} densities for {} cells",
+            gr.density.len(),
+            grid.num_cells()
+        )));
+    }
+    if loads.body_force.is_some() || loads.gravity.is_some() {
+        // Per-split accumulators are full nodal vectors: keep the splits few.
+        let acc = (0..grid.num_cells())
+            .into_par_iter()
+            .with_min_len(
+                grid.num_cells()
+                    .div_ceil(4 * rayon::current_num_threads())
+                    .max(1),
+            )
+            .fold(
+                || (vec![0.0; ndof], Vec::<Point<D>>::new(), Vec::<usize>::new()),
+                |(mut acc, mut pts, mut ids), c| {
+                    body_load_cell(grid, loads, t, c, &mut acc, &mut pts, &mut ids);
+                    (acc, pts, ids)
+                },
+            )
+            .map(|(acc, _, _)| acc)
+            .reduce(
+                || vec![0.0; ndof],
+                |mut a, b| {
+                    a.iter_mut().zip(&b).for_each(|(x, y)| *x += y);
+                    a
+                },
+            );
+        out.copy_from_slice(&acc);
+    }
+    let mut pts: Vec<Point<D>> = Vec::new();
+    let rule = facet_rule::<D>();
+    for tr in &loads.tractions {
+        for &f in &tr.faces {
+            if f >= grid.num_faces() || !grid.is_boundary_face(f) {
+                return Err(SimError::Face {
+                    condition: format!("traction on `{}`", tr.name),
+                    face: f,
+                    what: if f >= grid.num_faces() {
+                        "is out of range".into()
+                    } else {
+                        "is not a boundary face".into()
+                    },
+                });
+            }
+            let ids = grid.face_nodes(f);
+            pts.clear();
+            pts.extend(ids.iter().map(|&n| *grid.node(n)));
+            let m = ids.len();
+            let xf = pts.iter().sum::<Point<D>>() / m as f64;
+            for_each_facet::<D>(&pts, |area, _centroid, corners| {
+                let a = area.norm();
+                let vert = |k: usize| {
+                    if corners[k] == usize::MAX {
+                        xf
+                    } else {
+                        pts[corners[k]]
+                    }
+                };
+                for (w, l) in rule {
+                    let x: Point<D> = (0..D).map(|k| vert(k) * l[k]).sum();
+                    for comp in 0..D {
+                        let tv = tr.traction[comp].eval(x.as_slice(), t) * w * a;
+                        for k in 0..D {
+                            let share = l[k] * tv;
+                            if corners[k] == usize::MAX {
+                                for &n in ids {
+                                    out[D * n + comp] += share / m as f64;
+                                }
+                            } else {
+                                out[D * ids[corners[k]] + comp] += share;
+                            }
+                        }
+                    }
+                }
+            });
+        }
+    }
+    if let Some(i) = out.iter().position(|v| !v.is_finite()) {
+        return Err(SimError::NotFinite {
+            location: format!(
+                "the external load at node {} at {}, component {}",
+                i / D,
+                fmt_point(grid.node(i / D).as_slice()),
+                AXES[i % D]
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// Body force and gravity of cell `c`, added to `acc` (see the module docs).
+fn body_load_cell<const D: usize>(
+    grid: &Grid<D>,
+    loads: &Loads<D>,
+    t: f64,
+    c: usize,
+    acc: &mut [f64],
+    pts: &mut Vec<Point<D>>,
+    ids: &mut Vec<usize>,
+) {
+    let cn = grid.cell_nodes(c);
+    let n = cn.len();
+    let xc = cn.iter().map(|&i| grid.node(i)).sum::<Point<D>>() / n as f64;
+    let rho_g = loads
+        .gravity
+        .as_ref()
+        .map_or(Point::<D>::zeros(), |g| g.g * g.density[c]);
+    let rule = cell_rule::<D>();
+    let mut centre = Point::<D>::zeros();
+    for (&face, &outward) in grid.cell_faces(c).iter().zip(grid.cell_face_outward(c)) {
+        ids.clear();
+        ids.extend(grid.oriented_face_nodes(face, outward));
+        pts.clear();
+        pts.extend(ids.iter().map(|&i| *grid.node(i)));
+        let (pts, ids): (&[Point<D>], &[usize]) = (pts, ids);
+        let m = ids.len();
+        let xf = pts.iter().sum::<Point<D>>() / m as f64;
+        for_each_facet::<D>(pts, |area, centroid, corners| {
+            let vol = area.dot(&(centroid - xc)) / D as f64;
+            let vert = |k: usize| {
+                if corners[k] == usize::MAX {
+                    xf
+                } else {
+                    pts[corners[k]]
+                }
+            };
+            for (w, l) in rule {
+                let x: Point<D> = (0..D).map(|k| vert(k) * l[k]).sum::<Point<D>>() + xc * l[D];
+                let mut fv = rho_g;
+                if let Some(b) = &loads.body_force {
+                    for a in 0..D {
+                        fv[a] += b[a].eval(x.as_slice(), t);
+                    }
+                }
+                fv *= w * vol;
+                centre += fv * l[D];
+                for k in 0..D {
+                    if corners[k] == usize::MAX {
+                        let share = fv * (l[k] / m as f64);
+                        for &i in ids.iter() {
+                            for a in 0..D {
+                                acc[D * i + a] += share[a];
+                            }
+                        }
+                    } else {
+                        let i = ids[corners[k]];
+                        for a in 0..D {
+                            acc[D * i + a] += l[k] * fv[a];
+                        }
+                    }
+                }
+            }
+        });
+    }
+    centre /= n as f64;
+    for &i in cn {
+        for a in 0..D {
+            acc[D * i + a] += centre[a];
+        }
+    }
+}

@@ -1,0 +1,283 @@
+//! The sparsity pattern of the reduced stiffness matrix and the per-cell scatter map.
+//!
+//! The reduced matrix `A = Tᵀ K_ff T` (see [`crate::dofs`]) is symmetric; only its upper
+//! triangle (row ≤ column) is stored, in compressed sparse column (CSC) form as faer
+//! expects it. Entry `(r, c)` is nonzero when equations `r` and `c` share a cell.
+//!
+//! The pattern is built once per grid and dof map. For every cell it stores a *scatter
+//! map*: for each pair `(i, j)` of local dofs (column-major over the `D·n × D·n` local
+//! matrix, like nalgebra stores it: pair `i + D·n·j`), the position in the values array of global entry
+//! `(min(e_i, e_j), max(e_i, e_j))`, or none when a dof is prescribed or `e_i > e_j` (the
+//! mirror pair carries that entry). Pairs with `e_i = e_j` (two nodes of one platen, or a
+//! dof with itself) all add to the diagonal. Filling values is then a loop over cells with
+//! no searching and no triplet buffers, and new values (time steps, law switches) reuse
+//! the pattern.
+//!
+//! # Parallel fill
+//!
+//! The columns are split into contiguous *chunks* of about equal numbers of entries
+//! (four per thread). A chunk owns its columns' slice of the values array and its
+//! equations' slice of the right-hand side, so threads never write the same entry and no
+//! atomics or per-thread copies are needed. Each chunk visits the cells touching any of its
+//! columns, in increasing cell order, and adds only the entries it owns. A cell touching
+//! two chunks is evaluated twice; with equations numbered node by node that is a thin
+//! layer of cells per chunk boundary ([`Pattern::duplication`] reports the fraction).
+//! Because every entry is summed by one chunk in increasing cell order, the result is
+//! bitwise independent of the number of threads.
+
+use std::ops::Range;
+
+use porofrac_grid::Grid;
+use rayon::prelude::*;
+
+use crate::dofs::DofMap;
+use crate::error::{Result, SimError};
+
+/// Marker of a local pair that writes nothing.
+pub(crate) const NONE: u32 = u32::MAX;
+
+/// A contiguous range of columns (and the matching values and equations).
+#[derive(Clone, Debug)]
+pub(crate) struct Chunk {
+    pub(crate) cols: Range<usize>,
+    pub(crate) vals: Range<usize>,
+    pub(crate) cells: Range<usize>,
+}
+
+/// Upper-triangular CSC pattern of the reduced stiffness with per-cell scatter maps.
+#[derive(Clone, Debug)]
+pub struct Pattern {
+    n: usize,
+    col_ptr: Vec<usize>,
+    row_idx: Vec<usize>,
+    scatter_pos: Vec<usize>,
+    scatter: Vec<u32>,
+    pub(crate) chunks: Vec<Chunk>,
+    pub(crate) chunk_cells: Vec<usize>,
+    num_cells: usize,
+}
+
+/// Equations of a cell's local dofs (`usize::MAX` for prescribed), node-major.
+pub(crate) fn cell_equations<const D: usize>(
+    grid: &Grid<D>,
+    dofs: &DofMap<D>,
+    c: usize,
+    out: &mut Vec<usize>,
+) {
+    out.clear();
+    let raw = dofs.raw();
+    for &n in grid.cell_nodes(c) {
+        out.extend_from_slice(&raw[D * n..D * n + D]);
+    }
+}
+
+impl Pattern {
+    /// Build the pattern, scatter maps and fill chunks for `grid` and `dofs`, using the
+    /// current rayon thread count for the number of chunks.
+    pub fn new<const D: usize>(grid: &Grid<D>, dofs: &DofMap<D>) -> Result<Self> {
+        Self::with_chunks(grid, dofs, 4 * rayon::current_num_threads())
+    }
+
+    /// As [`Self::new`] with a given number of fill chunks (at least 1).
+    pub fn with_chunks<const D: usize>(
+        grid: &Grid<D>,
+        dofs: &DofMap<D>,
+        num_chunks: usize,
+    ) -> Result<Self> {
+        if dofs.num_dofs() != D * grid.num_nodes() {
+            return Err(SimError::Input(format!(
+                "dof map has {} dofs, grid has {} nodes",
+                dofs.num_dofs(),
+                grid.num_nodes()
+            )));
+        }
+        let n = dofs.num_equations();
+        let nc = grid.num_cells();
+        // Cell → sorted unique free equations.
+        let mut cell_eq_pos = Vec::with_capacity(nc + 1);
+        cell_eq_pos.push(0);
+        let mut cell_eqs = Vec::new();
+        let mut buf = Vec::new();
+        for c in 0..nc {
+            cell_equations(grid, dofs, c, &mut buf);
+            buf.retain(|&e| e != usize::MAX);
+            buf.sort_unstable();
+            buf.dedup();
+            cell_eqs.extend_from_slice(&buf);
+            cell_eq_pos.push(cell_eqs.len());
+        }
+        let eqs_of = |c: usize| &cell_eqs[cell_eq_pos[c]..cell_eq_pos[c + 1]];
+        // Equation → cells.
+        let mut eq_cell_pos = vec![0usize; n + 1];
+        for &e in &cell_eqs {
+            eq_cell_pos[e + 1] += 1;
+        }
+        for e in 0..n {
+            eq_cell_pos[e + 1] += eq_cell_pos[e];
+        }
+        let mut eq_cells = vec![0usize; cell_eqs.len()];
+        let mut next = eq_cell_pos.clone();
+        for c in 0..nc {
+            for &e in eqs_of(c) {
+                eq_cells[next[e]] = c;
+                next[e] += 1;
+            }
+        }
+        // Columns, in parallel blocks: rows r ≤ c of the cells containing c.
+        const BLOCK: usize = 4096;
+        let blocks: Vec<(Vec<usize>, Vec<usize>)> = (0..n.div_ceil(BLOCK))
+            .into_par_iter()
+            .map(|b| {
+                let mut counts = Vec::with_capacity(BLOCK);
+                let mut rows = Vec::new();
+                let mut col = Vec::new();
+                for c in b * BLOCK..((b + 1) * BLOCK).min(n) {
+                    col.clear();
+                    for &cell in &eq_cells[eq_cell_pos[c]..eq_cell_pos[c + 1]] {
+                        col.extend(eqs_of(cell).iter().copied().filter(|&r| r <= c));
+                    }
+                    col.sort_unstable();
+                    col.dedup();
+                    counts.push(col.len());
+                    rows.extend_from_slice(&col);
+                }
+                (counts, rows)
+            })
+            .collect();
+        let mut col_ptr = Vec::with_capacity(n + 1);
+        col_ptr.push(0);
+        let mut row_idx = Vec::new();
+        for (counts, rows) in blocks {
+            for k in counts {
+                col_ptr.push(col_ptr.last().copied().unwrap_or(0) + k);
+            }
+            row_idx.extend_from_slice(&rows);
+        }
+        let nnz = row_idx.len();
+        if nnz >= NONE as usize {
+            return Err(SimError::Input(format!(
+                "{nnz} stiffness entries exceed the 32-bit scatter map"
+            )));
+        }
+        // Scatter maps.
+        let mut scatter_pos = Vec::with_capacity(nc + 1);
+        scatter_pos.push(0);
+        for c in 0..nc {
+            let m = D * grid.cell_nodes(c).len();
+            scatter_pos.push(scatter_pos[c] + m * m);
+        }
+        let cell_blocks: Vec<Vec<u32>> = (0..nc.div_ceil(BLOCK))
+            .into_par_iter()
+            .map(|b| {
+                let range = b * BLOCK..((b + 1) * BLOCK).min(nc);
+                let mut out = Vec::with_capacity(scatter_pos[range.end] - scatter_pos[range.start]);
+                let mut eqs = Vec::new();
+                for c in range {
+                    cell_equations(grid, dofs, c, &mut eqs);
+                    for &ej in &eqs {
+                        for &ei in &eqs {
+                            if ei == usize::MAX || ej == usize::MAX || ei > ej {
+                                out.push(NONE);
+                                continue;
+                            }
+                            let rows = &row_idx[col_ptr[ej]..col_ptr[ej + 1]];
+                            // Invariant: (ei, ej) was inserted above since both are in cell c.
+                            let k = rows.binary_search(&ei).unwrap_or(0);
+                            out.push((col_ptr[ej] + k) as u32);
+                        }
+                    }
+                }
+                out
+            })
+            .collect();
+        let scatter: Vec<u32> = cell_blocks.concat();
+        // Fill chunks: contiguous columns with about nnz / num_chunks entries each.
+        let num_chunks = num_chunks.clamp(1, n.max(1));
+        let mut bounds = vec![0usize];
+        for k in 1..num_chunks {
+            let target = nnz * k / num_chunks;
+            let c = col_ptr.partition_point(|&p| p < target).min(n);
+            if c > *bounds.last().unwrap_or(&0) {
+                bounds.push(c);
+            }
+        }
+        if n > *bounds.last().unwrap_or(&0) || bounds.len() == 1 {
+            bounds.push(n);
+        }
+        let chunk_of = |e: usize| bounds.partition_point(|&b| b <= e) - 1;
+        let nch = bounds.len() - 1;
+        let mut lists: Vec<Vec<usize>> = vec![Vec::new(); nch];
+        for c in 0..nc {
+            let mut last = usize::MAX;
+            for &e in eqs_of(c) {
+                let k = chunk_of(e);
+                if k != last {
+                    lists[k].push(c);
+                    last = k;
+                }
+            }
+        }
+        let mut chunks = Vec::with_capacity(nch);
+        let mut chunk_cells = Vec::new();
+        for (k, list) in lists.into_iter().enumerate() {
+            let start = chunk_cells.len();
+            chunk_cells.extend_from_slice(&list);
+            chunks.push(Chunk {
+                cols: bounds[k]..bounds[k + 1],
+                vals: col_ptr[bounds[k]]..col_ptr[bounds[k + 1]],
+                cells: start..chunk_cells.len(),
+            });
+        }
+        Ok(Self {
+            n,
+            col_ptr,
+            row_idx,
+            scatter_pos,
+            scatter,
+            chunks,
+            chunk_cells,
+            num_cells: nc,
+        })
+    }
+
+    /// Number of equations (rows and columns).
+    pub fn num_equations(&self) -> usize {
+        self.n
+    }
+    /// Number of stored entries (upper triangle with diagonal).
+    pub fn nnz(&self) -> usize {
+        self.row_idx.len()
+    }
+    /// Column offsets (length `n + 1`).
+    pub fn col_ptr(&self) -> &[usize] {
+        &self.col_ptr
+    }
+    /// Row index of each stored entry, sorted within each column.
+    pub fn row_idx(&self) -> &[usize] {
+        &self.row_idx
+    }
+    /// The scatter map of cell `c` (column-major over its local dofs; `u32::MAX` = none).
+    pub fn cell_scatter(&self, c: usize) -> &[u32] {
+        &self.scatter[self.scatter_pos[c]..self.scatter_pos[c + 1]]
+    }
+    /// Number of fill chunks.
+    pub fn num_chunks(&self) -> usize {
+        self.chunks.len()
+    }
+    /// Cell evaluations per fill divided by the number of cells (1 = no duplication).
+    pub fn duplication(&self) -> f64 {
+        self.chunk_cells.len() as f64 / self.num_cells.max(1) as f64
+    }
+    /// `y += A x` for the symmetric matrix with these upper-triangle `values`.
+    pub fn mul_add(&self, values: &[f64], x: &[f64], y: &mut [f64]) {
+        for c in 0..self.n {
+            for p in self.col_ptr[c]..self.col_ptr[c + 1] {
+                let r = self.row_idx[p];
+                y[r] += values[p] * x[c];
+                if r != c {
+                    y[c] += values[p] * x[r];
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,424 @@
+//! The direct solver and the static solve.
+//!
+//! [`DirectSolver`] factorises the reduced stiffness `A = Tᵀ K_ff T` (symmetric positive
+//! definite once the rigid modes are removed) by a sparse Cholesky factorization
+//! `P A Pᵀ = L Lᵀ` (faer, AMD ordering `P`). The symbolic part (ordering, elimination
+//! tree, the pattern of `L`) depends only on the [`Pattern`] and is computed once in
+//! [`DirectSolver::new`]; [`DirectSolver::factorize`] recomputes only the numbers, so time
+//! steps and law switches reuse it.
+//!
+//! [`solve_static`] solves `Σ_K F_K(u) + f_ext = 0` for the free dofs with prescribed
+//! values `u_p(t)`: Newton's method `A(u) Δx = f_ext + Tᵀ F(u)`, `u_f ← u_f + T Δx`, which
+//! for linear laws is one step from `u = (0, u_p)`: `A x = Tᵀ (f_f − K_fp u_p) + F_platen`.
+//! Before factorising it checks the rigid-body modes ([`DofMap::check_rigid_modes`]); after
+//! solving it checks that the solution is finite and that the relative residual
+//! `‖A Δx − r‖ / ‖r‖` is below `1e-8`, which catches numerically singular systems
+//! (an unconstrained piece) that a Cholesky factorization with tiny pivots may let through.
+
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::sparse::linalg::cholesky::{
+    CholeskySymbolicParams, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
+};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::{Conj, MatMut, Side};
+use porofrac_grid::{Grid, Point};
+use porofrac_law::Tensor;
+use rayon::prelude::*;
+
+pub use faer::Par;
+
+use crate::assembly::{Work, assemble, nodal_loads};
+use crate::bc::Loads;
+use crate::dofs::DofMap;
+use crate::error::{Result, SimError};
+use crate::laws::LawMap;
+use crate::pattern::Pattern;
+
+/// Sparse Cholesky solver for the reduced stiffness, with the symbolic factorization
+/// computed once per pattern and reused for every numeric factorization.
+#[derive(Debug)]
+pub struct DirectSolver {
+    symbolic: SymbolicCholesky<usize>,
+    l_values: Vec<f64>,
+    par: Par,
+    n: usize,
+    nnz: usize,
+    symbolic_count: usize,
+    numeric_count: usize,
+    factored: bool,
+}
+
+impl DirectSolver {
+    /// Symbolic analysis (AMD ordering and the pattern of the factor) of `pattern`.
+    ///
+    /// The default parallelism is sequential: on the 2-core reference machine it was as
+    /// fast as two threads for the 2D benchmark sizes (see the crate's benchmark); change
+    /// it with [`Self::set_parallelism`].
+    pub fn new(pattern: &Pattern) -> Result<Self> {
+        let n = pattern.num_equations();
+        let sym =
+            SymbolicSparseColMatRef::new_checked(n, n, pattern.col_ptr(), None, pattern.row_idx());
+        let symbolic = factorize_symbolic_cholesky(
+            sym,
+            Side::Upper,
+            SymmetricOrdering::Amd,
+            CholeskySymbolicParams::default(),
+        )
+        .map_err(|e| SimError::LinearAlgebra(format!("symbolic Cholesky: {e:?}")))?;
+        Ok(Self {
+            l_values: Vec::new(),
+            symbolic,
+            par: Par::Seq,
+            n,
+            nnz: pattern.nnz(),
+            symbolic_count: 1,
+            numeric_count: 0,
+            factored: false,
+        })
+    }
+
+    /// Use `par` (e.g. `Par::Seq` or `Par::rayon(2)`) for factorizing and solving.
+    pub fn set_parallelism(&mut self, par: Par) {
+        self.par = par;
+    }
+
+    /// Number of symbolic factorizations done (1: it is never repeated).
+    pub fn symbolic_factorizations(&self) -> usize {
+        self.symbolic_count
+    }
+    /// Number of numeric factorizations done.
+    pub fn numeric_factorizations(&self) -> usize {
+        self.numeric_count
+    }
+    /// Number of stored entries of the factor `L`.
+    pub fn factor_nnz(&self) -> usize {
+        self.symbolic.len_val()
+    }
+
+    /// Numeric factorization of the matrix with the given upper-triangle `values` of the
+    /// pattern this solver was built for.
+    ///
+    /// Error [`SimError::NotPositiveDefinite`] names the failing equation in the original
+    /// numbering (its `location` says `equation e`; [`solve_static`] maps it to the node).
+    pub fn factorize(&mut self, pattern: &Pattern, values: &[f64]) -> Result<()> {
+        if pattern.num_equations() != self.n
+            || pattern.nnz() != self.nnz
+            || values.len() != self.nnz
+        {
+            return Err(SimError::Input(format!(
+                "factorize: pattern of {} equations / {} entries and {} values, solver built for {} / {}",
+                pattern.num_equations(),
+                pattern.nnz(),
+                values.len(),
+                self.n,
+                self.nnz
+            )));
+        }
+        self.factored = false;
+        let sym = SymbolicSparseColMatRef::new_checked(
+            self.n,
+            self.n,
+            pattern.col_ptr(),
+            None,
+            pattern.row_idx(),
+        );
+        let mat = SparseColMatRef::new(sym, values);
+        self.l_values.resize(self.symbolic.len_val(), 0.0);
+        let req = self
+            .symbolic
+            .factorize_numeric_llt_scratch::<f64>(self.par, Default::default());
+        let mut mem =
+            MemBuffer::try_new(req).map_err(|_| SimError::LinearAlgebra("out of memory".into()))?;
+        let res = self.symbolic.factorize_numeric_llt(
+            &mut self.l_values,
+            mat,
+            Side::Upper,
+            Default::default(),
+            self.par,
+            MemStack::new(&mut mem),
+            Default::default(),
+        );
+        self.numeric_count += 1;
+        match res {
+            Ok(_) => {
+                self.factored = true;
+                Ok(())
+            }
+            Err(faer::linalg::solvers::LltError::NonPositivePivot { index }) => {
+                let equation = match self.symbolic.perm() {
+                    Some(p) => p.arrays().0[index],
+                    None => index,
+                };
+                Err(SimError::NotPositiveDefinite {
+                    equation,
+                    location: format!("equation {equation}"),
+                })
+            }
+        }
+    }
+
+    /// Solve `A x = b` in place (`rhs` holds `b` on entry and `x` on return).
+    pub fn solve_in_place(&self, rhs: &mut [f64]) -> Result<()> {
+        if !self.factored {
+            return Err(SimError::Input(
+                "solve before a successful factorization".into(),
+            ));
+        }
+        if rhs.len() != self.n {
+            return Err(SimError::Input(format!(
+                "right-hand side of length {}, want {}",
+                rhs.len(),
+                self.n
+            )));
+        }
+        let llt = faer::sparse::linalg::cholesky::LltRef::<'_, usize, f64>::new(
+            &self.symbolic,
+            &self.l_values,
+        );
+        let mut mem = MemBuffer::try_new(self.symbolic.solve_in_place_scratch::<f64>(1, self.par))
+            .map_err(|_| SimError::LinearAlgebra("out of memory".into()))?;
+        let n = self.n;
+        llt.solve_in_place_with_conj(
+            Conj::No,
+            MatMut::from_column_major_slice_mut(rhs, n, 1),
+            self.par,
+            MemStack::new(&mut mem),
+        );
+        Ok(())
+    }
+}
+
+/// The immutable description of a static mechanics problem (all borrowed).
+#[derive(Clone, Copy)]
+pub struct StaticProblem<'a, const D: usize> {
+    /// The grid.
+    pub grid: &'a porofrac_grid::Grid<D>,
+    /// The law of each cell.
+    pub laws: &'a LawMap<'a, D>,
+    /// Dofs and equations from the displacement and platen conditions.
+    pub dofs: &'a DofMap<D>,
+    /// The sparsity pattern built from `grid` and `dofs`.
+    pub pattern: &'a Pattern,
+    /// External loads.
+    pub loads: &'a Loads<D>,
+}
+
+/// Options of [`solve_static`].
+#[derive(Clone, Copy, Debug)]
+pub struct StaticOptions {
+    /// Newton iterations allowed for nonlinear laws (linear problems take one step).
+    pub max_iterations: usize,
+    /// Relative residual at which a nonlinear solve stops.
+    pub tolerance: f64,
+}
+
+impl Default for StaticOptions {
+    fn default() -> Self {
+        Self {
+            max_iterations: 30,
+            tolerance: 1e-10,
+        }
+    }
+}
+
+/// The result of a static solve.
+#[derive(Clone, Debug)]
+pub struct StaticSolution<const D: usize> {
+    /// Nodal displacements, node-major (`D` per node), prescribed values filled in.
+    pub displacement: Vec<f64>,
+    /// Linear solves done.
+    pub iterations: usize,
+    /// Relative residual of the last linear solve, `‖A Δx − r‖ / ‖r‖`.
+    pub residual: f64,
+}
+
+impl<const D: usize> StaticSolution<D> {
+    /// Displacement of node `n`.
+    pub fn node(&self, n: usize) -> Point<D> {
+        Point::<D>::from_column_slice(&self.displacement[D * n..D * n + D])
+    }
+}
+
+fn norm(v: &[f64]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+/// Solve the static problem at time `t` with `solver` (built for `problem.pattern`).
+///
+/// Errors: [`SimError::Singular`] if rigid-body modes are free (checked first),
+/// [`SimError::NotPositiveDefinite`] naming the node and component of a failing pivot,
+/// [`SimError::NotFinite`] or an ill-conditioned residual, [`SimError::NoConvergence`] for
+/// a nonlinear solve, and the assembly and load errors.
+pub fn solve_static<const D: usize>(
+    problem: &StaticProblem<'_, D>,
+    solver: &mut DirectSolver,
+    t: f64,
+    options: &StaticOptions,
+) -> Result<StaticSolution<D>> {
+    let StaticProblem {
+        grid,
+        laws,
+        dofs,
+        pattern,
+        loads,
+    } = *problem;
+    dofs.check_rigid_modes(grid)?;
+    let neq = dofs.num_equations();
+    let mut u = vec![0.0; dofs.num_dofs()];
+    dofs.set_prescribed(grid, t, &mut u);
+    let mut full = vec![0.0; dofs.num_dofs()];
+    nodal_loads(grid, loads, t, &mut full)?;
+    let mut fext = vec![0.0; neq];
+    dofs.reduce_add(&full, &mut fext);
+    dofs.add_platen_forces(grid, t, &mut fext);
+    let mut values = vec![0.0; pattern.nnz()];
+    let mut forces = vec![0.0; neq];
+    let mut r = vec![0.0; neq];
+    let mut ar = vec![0.0; neq];
+    let linear = laws.all_linear();
+    let mut reference = 0.0f64;
+    let mut residual = 0.0;
+    for it in 1..=options.max_iterations.max(1) {
+        assemble(grid, laws, dofs, pattern, &u, &mut values, &mut forces)?;
+        r.iter_mut()
+            .zip(fext.iter().zip(&forces))
+            .for_each(|(ri, (a, b))| *ri = a + b);
+        let rn = norm(&r);
+        if it == 1 {
+            reference = rn.max(f64::MIN_POSITIVE);
+        } else if rn <= options.tolerance * reference {
+            return Ok(StaticSolution {
+                displacement: u,
+                iterations: it - 1,
+                residual,
+            });
+        }
+        solver.factorize(pattern, &values).map_err(|e| match e {
+            SimError::NotPositiveDefinite { equation, .. } => SimError::NotPositiveDefinite {
+                equation,
+                location: dofs.describe_equation(grid, equation),
+            },
+            e => e,
+        })?;
+        let mut dx = r.clone();
+        solver.solve_in_place(&mut dx)?;
+        if let Some(e) = dx.iter().position(|v| !v.is_finite()) {
+            return Err(SimError::NotFinite {
+                location: dofs.describe_equation(grid, e),
+            });
+        }
+        ar.fill(0.0);
+        pattern.mul_add(&values, &dx, &mut ar);
+        let err = ar
+            .iter()
+            .zip(&r)
+            .map(|(a, b)| (a - b) * (a - b))
+            .sum::<f64>()
+            .sqrt();
+        residual = if rn > 0.0 { err / rn } else { err };
+        if residual > 1e-8 {
+            let (e, _) = dx.iter().enumerate().fold((0, 0.0f64), |acc, (i, v)| {
+                if v.abs() > acc.1 { (i, v.abs()) } else { acc }
+            });
+            return Err(SimError::NotPositiveDefinite {
+                equation: e,
+                location: format!(
+                    "{}; numerically singular: relative residual {residual:.2e}, largest displacement there",
+                    dofs.describe_equation(grid, e)
+                ),
+            });
+        }
+        dofs.scatter_add(&dx, &mut u);
+        if linear {
+            return Ok(StaticSolution {
+                displacement: u,
+                iterations: 1,
+                residual,
+            });
+        }
+    }
+    Err(SimError::NoConvergence {
+        iterations: options.max_iterations,
+        residual: {
+            assemble(grid, laws, dofs, pattern, &u, &mut values, &mut forces)?;
+            let rn: f64 = fext
+                .iter()
+                .zip(&forces)
+                .map(|(a, b)| (a + b) * (a + b))
+                .sum::<f64>()
+                .sqrt();
+            rn / reference
+        },
+    })
+}
+
+/// Stress of every cell for the nodal displacement `u` (via [`porofrac_law::CellLaw::stress`],
+/// in parallel).
+pub fn cell_stresses<const D: usize>(
+    grid: &Grid<D>,
+    laws: &LawMap<'_, D>,
+    u: &[f64],
+) -> Result<Vec<Tensor<D>>> {
+    if u.len() != D * grid.num_nodes() {
+        return Err(SimError::Input(format!(
+            "displacement of length {}, want {}",
+            u.len(),
+            D * grid.num_nodes()
+        )));
+    }
+    let mut out = vec![Tensor::<D>::zeros(); grid.num_cells()];
+    out.par_iter_mut()
+        .enumerate()
+        .for_each_init(Work::<D>::default, |w, (c, s)| {
+            w.gather(grid, c, u);
+            let geo = w.geo.load(grid, c);
+            *s = laws.law(c).stress(&geo, &w.u, &mut w.scratch);
+        });
+    Ok(out)
+}
+
+/// The force that holds the nodes of `faces` in place: `R = −Σ_{n ∈ nodes(faces)} F_n(u)`,
+/// with `F` the restoring forces of the cells. At equilibrium it equals the support
+/// reaction (or the applied load) on those nodes.
+pub fn reaction<const D: usize>(
+    grid: &Grid<D>,
+    laws: &LawMap<'_, D>,
+    u: &[f64],
+    faces: &[usize],
+) -> Result<Point<D>> {
+    if u.len() != D * grid.num_nodes() {
+        return Err(SimError::Input(format!(
+            "displacement of length {}, want {}",
+            u.len(),
+            D * grid.num_nodes()
+        )));
+    }
+    if let Some(&f) = faces.iter().find(|&&f| f >= grid.num_faces()) {
+        return Err(SimError::Input(format!("reaction: face {f} out of range")));
+    }
+    let mut marked = vec![false; grid.num_nodes()];
+    for n in grid.nodes_of_faces(faces) {
+        marked[n] = true;
+    }
+    let sum = (0..grid.num_cells())
+        .into_par_iter()
+        .filter(|&c| grid.cell_nodes(c).iter().any(|&n| marked[n]))
+        .try_fold(
+            || (Work::<D>::default(), Point::<D>::zeros()),
+            |(mut w, mut acc), c| {
+                w.gather(grid, c, u);
+                w.forces(grid, laws, c)?;
+                for (i, &n) in grid.cell_nodes(c).iter().enumerate() {
+                    if marked[n] {
+                        for a in 0..D {
+                            acc[a] -= w.f[D * i + a];
+                        }
+                    }
+                }
+                Ok::<_, SimError>((w, acc))
+            },
+        )
+        .map(|r| r.map(|(_, acc)| acc))
+        .try_reduce(Point::<D>::zeros, |a, b| Ok(a + b))?;
+    Ok(sum)
+}
