@@ -1,0 +1,827 @@
+//! Running a scene: grid, composition per cell, conditions, solves, outputs.
+//!
+//! Mechanics-only scenes are solved statically at every time of the schedule (the
+//! conditions may depend on time); the laws' stiffness is factorized once when all laws
+//! are linear.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+use porofrac_grid::generate::{CompositeSpec, cartesian, composite, perturb, simplices, voronoi};
+use porofrac_grid::io::{Field, PvdWriter, read_msh, read_vtu, write_vtu};
+use porofrac_grid::{Grid, GridError, Point};
+use porofrac_law::{CellLaw, Stiffness, Tensor};
+use porofrac_sim::{
+    DirectSolver, Displacement, DofMap, Gravity, LawMap, Loads, Pattern, Platen, ScalarField,
+    SimError, StaticOptions, StaticProblem, Traction, cell_stresses, solve_static,
+};
+
+use crate::check::{LoadedScene, SceneError, k, ki};
+use crate::expr::Expr;
+use crate::output::{
+    CsvTable, OutputError, SolverStats, Summary, WallSeconds, peak_memory_bytes, write_atomic,
+};
+use crate::sample::{Location, locate};
+use crate::scene::{CellCount, NumOrExpr, Select};
+
+/// Set by Ctrl-C: the run stops after the current step and keeps what it wrote.
+pub static STOP: AtomicBool = AtomicBool::new(false);
+
+/// Anything that ends a run.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// A problem in the scene file.
+    #[error("{0}")]
+    Scene(#[from] SceneError),
+    /// The grid could not be built or read.
+    #[error("grid: {0}")]
+    Grid(#[from] GridError),
+    /// The mechanics failed (singular system, bad law composition, ...).
+    #[error("{0}")]
+    Sim(#[from] SimError),
+    /// Writing output failed.
+    #[error("output: {0}")]
+    Output(#[from] OutputError),
+    /// A plot could not be drawn.
+    #[error("plot: {0}")]
+    Plot(#[from] crate::plots::PlotError),
+}
+
+/// A grid of either dimension.
+pub enum AnyGrid {
+    /// 2D.
+    Two(Grid<2>),
+    /// 3D.
+    Three(Grid<3>),
+}
+
+fn point<const D: usize>(v: &[f64]) -> Point<D> {
+    Point::<D>::from_fn(|i, _| v[i])
+}
+
+/// Build (or read) the grid of a checked scene.
+pub fn build_grid(ls: &LoadedScene) -> Result<AnyGrid, RunError> {
+    let g = &ls.scene.grid;
+    let d = ls.scene.scene.dim as usize;
+    let seed = g.seed.unwrap_or(0);
+    let per_axis = || match &g.cells {
+        Some(CellCount::PerAxis(v)) => v.iter().map(|&n| n as usize).collect::<Vec<_>>(),
+        _ => vec![],
+    };
+    let ext = g
+        .extent
+        .clone()
+        .unwrap_or_else(|| [vec![0.0; d], vec![1.0; d]]);
+    let at_grid = |e: GridError| {
+        RunError::Scene(ls.error(&k(&["grid", "kind"]), format!("= \"{}\": {e}", g.kind)))
+    };
+    let grid = match (d, g.kind.as_str()) {
+        (2, "cartesian") => {
+            let n = per_axis();
+            AnyGrid::Two(cartesian(point(&ext[0]), point(&ext[1]), [n[0], n[1]]).map_err(at_grid)?)
+        }
+        (3, "cartesian") => {
+            let n = per_axis();
+            AnyGrid::Three(
+                cartesian(point(&ext[0]), point(&ext[1]), [n[0], n[1], n[2]]).map_err(at_grid)?,
+            )
+        }
+        (2, "triangles") => {
+            let n = per_axis();
+            AnyGrid::Two(simplices(point(&ext[0]), point(&ext[1]), [n[0], n[1]]).map_err(at_grid)?)
+        }
+        (3, "tetrahedra") => {
+            let n = per_axis();
+            AnyGrid::Three(
+                simplices(point(&ext[0]), point(&ext[1]), [n[0], n[1], n[2]]).map_err(at_grid)?,
+            )
+        }
+        (2, "voronoi") => {
+            let n = match &g.cells {
+                Some(CellCount::One(n)) => *n as usize,
+                _ => 0,
+            };
+            let lloyd = g.lloyd.map_or(porofrac_grid::generate::DEFAULT_LLOYD, |l| {
+                l.max(0) as usize
+            });
+            AnyGrid::Two(voronoi(point(&ext[0]), point(&ext[1]), n, seed, lloyd).map_err(at_grid)?)
+        }
+        (2, "composite") => {
+            let n = per_axis();
+            let c = g.center.clone().unwrap_or_default();
+            if c.len() != 2 {
+                return Err(ls
+                    .error(&k(&["grid", "center"]), "must have 2 components")
+                    .into());
+            }
+            let mut spec = CompositeSpec::new(
+                point(&ext[0]),
+                point(&ext[1]),
+                [n[0], n[1]],
+                point(&c),
+                g.zone_half_width.unwrap_or(0.0),
+                g.refine.unwrap_or(0).max(0) as usize,
+                g.well_radius.unwrap_or(0.0),
+            );
+            if let Some(t) = &g.well_tag {
+                spec.well_tag = t.clone();
+            }
+            spec.perturb = g.perturb.unwrap_or(0.0);
+            spec.seed = seed;
+            // The jitter applies to the refined zone only; see docs/grid.md.
+            return Ok(AnyGrid::Two(composite(&spec).map_err(at_grid)?));
+        }
+        (_, "file") => {
+            let path = ls.resolve(g.path.as_deref().unwrap_or(""));
+            let is_vtu = path.extension().is_some_and(|e| e == "vtu");
+            let at_path = |e: GridError| {
+                RunError::Scene(ls.error(
+                    &k(&["grid", "path"]),
+                    format!("= \"{}\": {e}", path.display()),
+                ))
+            };
+            return Ok(match (d, is_vtu) {
+                (2, true) => AnyGrid::Two(read_vtu(&path).map_err(at_path)?),
+                (2, false) => AnyGrid::Two(read_msh(&path).map_err(at_path)?),
+                (_, true) => AnyGrid::Three(read_vtu(&path).map_err(at_path)?),
+                (_, false) => AnyGrid::Three(read_msh(&path).map_err(at_path)?),
+            });
+        }
+        (_, kind) => {
+            return Err(ls
+                .error(
+                    &k(&["grid", "kind"]),
+                    format!("= \"{kind}\" is not available in {d}D"),
+                )
+                .into());
+        }
+    };
+    let amp = g.perturb.unwrap_or(0.0);
+    if amp > 0.0 {
+        let at_perturb = |e: GridError| {
+            RunError::Scene(ls.error(&k(&["grid", "perturb"]), format!("= {amp}: {e}")))
+        };
+        return Ok(match grid {
+            AnyGrid::Two(gr) => AnyGrid::Two(perturb(&gr, amp, seed).map_err(at_perturb)?),
+            AnyGrid::Three(gr) => AnyGrid::Three(perturb(&gr, amp, seed).map_err(at_perturb)?),
+        });
+    }
+    Ok(grid)
+}
+
+fn field(ls: &LoadedScene, v: &NumOrExpr) -> ScalarField {
+    match v {
+        NumOrExpr::Num(x) => ScalarField::Const(*x),
+        NumOrExpr::Expr(s) => {
+            // Checked before: the expression parses.
+            let e = Expr::parse(s).expect("expression checked");
+            match e.as_constant() {
+                Some(c) => ScalarField::Const(c),
+                None => {
+                    let _ = ls;
+                    ScalarField::from_fn(move |x, t| e.eval(x, t))
+                }
+            }
+        }
+    }
+}
+
+fn component(ls: &LoadedScene, v: &NumOrExpr) -> Option<ScalarField> {
+    match v {
+        NumOrExpr::Expr(s) if s == "free" => None,
+        v => Some(field(ls, v)),
+    }
+}
+
+/// Which cells a selection picks (by centroid).
+fn select_cells<const D: usize>(
+    ls: &LoadedScene,
+    i: usize,
+    grid: &Grid<D>,
+    sel: &Select,
+) -> Result<Vec<usize>, RunError> {
+    let centroids = grid.cell_centroids();
+    let pick = |f: &dyn Fn(&Point<D>) -> bool| -> Vec<usize> {
+        (0..grid.num_cells())
+            .filter(|&c| f(&centroids[c]))
+            .collect()
+    };
+    let cells = match sel {
+        Select::All(_) => (0..grid.num_cells()).collect(),
+        Select::Box(b) => pick(&|x| (0..D).all(|a| x[a] >= b[0][a] && x[a] <= b[1][a])),
+        Select::Circle(ball) | Select::Sphere(ball) => {
+            let c: Point<D> = point(&ball.center);
+            pick(&|x| (x - c).norm() <= ball.radius)
+        }
+        Select::Tag(name) => {
+            match grid.cell_tags().get(name) {
+                Some(v) => v.clone(),
+                None => {
+                    let known: Vec<_> = grid.cell_tags().keys().cloned().collect();
+                    return Err(ls
+                    .error(&ki("region", i, &["select"]), format!("= {{ tag = \"{name}\" }}: the grid has no such cell tag (known: {})", if known.is_empty() { "none".into() } else { known.join(", ") }))
+                    .into());
+                }
+            }
+        }
+    };
+    if cells.is_empty() {
+        return Err(ls
+            .error(
+                &ki("region", i, &["select"]),
+                "selects no cell (cells are selected by their centroid)",
+            )
+            .into());
+    }
+    Ok(cells)
+}
+
+/// Run a checked scene and write its outputs into `out`.
+pub fn run(ls: &LoadedScene, out: &Path) -> Result<Summary, RunError> {
+    let start = Instant::now();
+    check_supported(ls)?;
+    let grid = build_grid(ls)?;
+    let grid_time = start.elapsed().as_secs_f64();
+    let mut summary = match grid {
+        AnyGrid::Two(g) => run_dim::<2>(ls, &g, out, start)?,
+        AnyGrid::Three(g) => run_dim::<3>(ls, &g, out, start)?,
+    };
+    summary.wall_seconds.grid = grid_time;
+    summary.wall_seconds.total = start.elapsed().as_secs_f64();
+    summary.peak_memory_bytes = peak_memory_bytes();
+    summary.write(out)?;
+    Ok(summary)
+}
+
+/// Physics this version does not model yet is an error, not silently ignored.
+fn check_supported(ls: &LoadedScene) -> Result<(), RunError> {
+    let s = &ls.scene;
+    let unsupported = |path: Vec<crate::scene::KeyPart>, what: &str| -> RunError {
+        ls.error(
+            &path,
+            format!("{what} is not available in this version of porofrac"),
+        )
+        .into()
+    };
+    if s.physics.flow == Some(true) {
+        return Err(unsupported(k(&["physics", "flow"]), "= true: flow"));
+    }
+    if s.physics.fracture == Some(true) {
+        return Err(unsupported(
+            k(&["physics", "fracture"]),
+            "= true: fracturing",
+        ));
+    }
+    if let Some(c) = &s.physics.coupling {
+        if c != "none" {
+            return Err(unsupported(
+                k(&["physics", "coupling"]),
+                &format!("= \"{c}\": coupling"),
+            ));
+        }
+    }
+    if s.solver.mechanics.as_deref() == Some("explicit") {
+        return Err(unsupported(
+            k(&["solver", "mechanics"]),
+            "= \"explicit\": the explicit solver",
+        ));
+    }
+    if s.solver.linear.as_deref() == Some("cg-amg") {
+        return Err(unsupported(
+            k(&["solver", "linear"]),
+            "= \"cg-amg\": the AMG solver",
+        ));
+    }
+    for (i, r) in s.region.iter().enumerate() {
+        if let Some(l) = &r.law {
+            if l != "vem" {
+                return Err(unsupported(
+                    ki("region", i, &["law"]),
+                    &format!("= \"{l}\": this law"),
+                ));
+            }
+        }
+    }
+    for (i, bc) in s.bc.iter().enumerate() {
+        if bc.pressure.is_some() || bc.flux.is_some() {
+            return Err(unsupported(
+                ki("bc", i, &["pressure"]),
+                "flow boundary conditions",
+            ));
+        }
+    }
+    if !s.source.is_empty() {
+        return Err(unsupported(ki("source", 0, &[]), "a fluid source"));
+    }
+    Ok(())
+}
+
+/// Cell law and material chosen by the regions (later regions override earlier ones).
+struct Composition<const D: usize> {
+    /// `(law name, material name)` of each law instance.
+    keys: Vec<(String, String)>,
+    laws: Vec<Box<dyn CellLaw<D>>>,
+    law_of_cell: Vec<usize>,
+}
+
+fn compose<const D: usize>(ls: &LoadedScene, grid: &Grid<D>) -> Result<Composition<D>, RunError> {
+    let s = &ls.scene;
+    let n = grid.num_cells();
+    let mut law_name: Vec<Option<usize>> = vec![None; n];
+    let mut mat_name: Vec<Option<usize>> = vec![None; n];
+    for (i, r) in s.region.iter().enumerate() {
+        let cells = select_cells(ls, i, grid, &r.select)?;
+        for c in cells {
+            if r.law.is_some() {
+                law_name[c] = Some(i);
+            }
+            if r.material.is_some() {
+                mat_name[c] = Some(i);
+            }
+        }
+    }
+    if let Some(c) = (0..n).find(|&c| law_name[c].is_none() || mat_name[c].is_none()) {
+        let x = grid.cell_centroid(c);
+        return Err(ls
+            .error(&k(&["region"]), format!("leaves cell {c} (centroid {:?}) without a law or material: add a region that selects it", x.as_slice()))
+            .into());
+    }
+    let mut keys: Vec<(String, String)> = Vec::new();
+    let mut laws: Vec<Box<dyn CellLaw<D>>> = Vec::new();
+    let mut law_of_cell = vec![0; n];
+    let plane_stress = s.scene.plane.as_deref() == Some("stress");
+    for c in 0..n {
+        let (lr, mr) = (law_name[c].unwrap_or(0), mat_name[c].unwrap_or(0));
+        let key = (
+            s.region[lr].law.clone().unwrap_or_default(),
+            s.region[mr].material.clone().unwrap_or_default(),
+        );
+        let idx = match keys.iter().position(|k| *k == key) {
+            Some(i) => i,
+            None => {
+                let m = &s.material[&key.1];
+                let stiffness = if plane_stress {
+                    // Plane stress: λ* = 2λμ/(λ + 2μ) (scene.plane is 2D only).
+                    let (e, nu) = (m.youngs_modulus, m.poisson_ratio);
+                    let (lambda, mu) = (
+                        e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)),
+                        e / (2.0 * (1.0 + nu)),
+                    );
+                    Stiffness::<D>::from_lame(2.0 * lambda * mu / (lambda + 2.0 * mu), mu)
+                } else {
+                    Stiffness::<D>::isotropic(m.youngs_modulus, m.poisson_ratio)
+                }
+                .map_err(|e| ls.error(&k(&["material", &key.1]), e))?;
+                let law: Box<dyn CellLaw<D>> = match key.0.as_str() {
+                    "vem" => Box::new(porofrac_vem::VemLaw::new(stiffness)),
+                    other => {
+                        return Err(ls
+                            .error(
+                                &ki("region", lr, &["law"]),
+                                format!("= \"{other}\" is not available"),
+                            )
+                            .into());
+                    }
+                };
+                keys.push(key);
+                laws.push(law);
+                keys.len() - 1
+            }
+        };
+        law_of_cell[c] = idx;
+    }
+    Ok(Composition {
+        keys,
+        laws,
+        law_of_cell,
+    })
+}
+
+/// Boundary conditions and loads of the scene.
+struct Conditions<const D: usize> {
+    displacements: Vec<Displacement<D>>,
+    platens: Vec<Platen<D>>,
+    loads: Loads<D>,
+}
+
+fn conditions<const D: usize>(
+    ls: &LoadedScene,
+    grid: &Grid<D>,
+    comp: &Composition<D>,
+) -> Result<Conditions<D>, RunError> {
+    let s = &ls.scene;
+    let mut out = Conditions {
+        displacements: Vec::new(),
+        platens: Vec::new(),
+        loads: Loads::default(),
+    };
+    for (i, bc) in s.bc.iter().enumerate() {
+        let faces = grid.boundary(&bc.boundary).map_err(|e| {
+            ls.error(
+                &ki("bc", i, &["boundary"]),
+                format!("= \"{}\": {e}", bc.boundary),
+            )
+        })?;
+        if faces.is_empty() {
+            return Err(ls
+                .error(
+                    &ki("bc", i, &["boundary"]),
+                    format!("= \"{}\" has no faces on this grid", bc.boundary),
+                )
+                .into());
+        }
+        if let Some(u) = &bc.displacement {
+            let components: [Option<ScalarField>; D] =
+                std::array::from_fn(|a| component(ls, &u[a]));
+            out.displacements.push(Displacement {
+                name: format!("bc[{i}] {}", bc.boundary),
+                faces: faces.clone(),
+                components,
+            });
+        }
+        if let Some(t) = &bc.traction {
+            let traction: [ScalarField; D] = std::array::from_fn(|a| field(ls, &t[a]));
+            out.loads.tractions.push(Traction {
+                name: format!("bc[{i}] {}", bc.boundary),
+                faces: faces.clone(),
+                traction,
+            });
+        }
+        if let Some(p) = &bc.platen {
+            let force: [Option<ScalarField>; D] =
+                std::array::from_fn(|a| component(ls, &p.force[a]));
+            out.platens.push(Platen {
+                name: format!("bc[{i}] {}", bc.boundary),
+                faces,
+                force,
+            });
+        }
+    }
+    if let Some(l) = &s.loads {
+        if let Some(b) = &l.body_force {
+            out.loads.body_force = Some(std::array::from_fn(|a| field(ls, &b[a])));
+        }
+        if let Some(g) = &l.gravity {
+            let mut density = vec![0.0; grid.num_cells()];
+            for c in 0..grid.num_cells() {
+                let mat = &comp.keys[comp.law_of_cell[c]].1;
+                density[c] = s.material[mat].density.ok_or_else(|| {
+                    ls.error(
+                        &k(&["material", mat, "density"]),
+                        "is required by loads.gravity",
+                    )
+                })?;
+            }
+            out.loads.gravity = Some(Gravity {
+                g: point(g),
+                density,
+            });
+        }
+    }
+    Ok(out)
+}
+
+/// The output times: 0, then every step of the schedule.
+fn times(ls: &LoadedScene) -> Vec<f64> {
+    let mut t = vec![0.0];
+    if let Some(sch) = &ls.scene.schedule {
+        let n = match (sch.dt, sch.steps) {
+            (Some(dt), _) => (sch.end_time / dt - 1e-9).ceil().max(1.0) as usize,
+            (None, Some(n)) => n as usize,
+            _ => 1,
+        };
+        let dt = sch.dt.unwrap_or(sch.end_time / n as f64);
+        for k in 1..=n {
+            t.push((k as f64 * dt).min(sch.end_time));
+        }
+    }
+    t
+}
+
+/// Principal stresses (largest, smallest) of a symmetric tensor.
+fn principal<const D: usize>(s: &Tensor<D>) -> (f64, f64) {
+    let m = nalgebra::DMatrix::from_fn(D, D, |i, j| s[(i, j)]);
+    let e = m.symmetric_eigenvalues();
+    (e.max(), e.min())
+}
+
+/// The value of a named field at a located point.
+fn sample<const D: usize>(field: &str, loc: &Location, u: &[f64], stress: &[Tensor<D>]) -> f64 {
+    let s = &stress[loc.cell];
+    let comp = |a: usize, b: usize| if a < D && b < D { s[(a, b)] } else { 0.0 };
+    match field {
+        "ux" => loc.nodal(u, D, 0),
+        "uy" => loc.nodal(u, D, 1),
+        "uz" if D == 3 => loc.nodal(u, D, 2),
+        "sxx" => comp(0, 0),
+        "syy" => comp(1, 1),
+        "szz" => comp(2, 2),
+        "sxy" => comp(0, 1),
+        "syz" => comp(1, 2),
+        "sxz" => comp(0, 2),
+        "smax" => principal(s).0,
+        "smin" => principal(s).1,
+        _ => 0.0, // "fractured": no cell fails in a scene without fracturing
+    }
+}
+
+fn run_dim<const D: usize>(
+    ls: &LoadedScene,
+    grid: &Grid<D>,
+    out: &Path,
+    start: Instant,
+) -> Result<Summary, RunError> {
+    let s = &ls.scene;
+    let mut wall = WallSeconds::default();
+    let comp = compose(ls, grid)?;
+    let cond = conditions(ls, grid, &comp)?;
+    let law_refs: Vec<&dyn CellLaw<D>> = comp.laws.iter().map(|l| l.as_ref()).collect();
+    let laws = LawMap::new(grid, law_refs, comp.law_of_cell.clone())?;
+    let t_asm = Instant::now();
+    let dofs = DofMap::new(grid, &cond.displacements, &cond.platens)?;
+    let pattern = Pattern::new(grid, &dofs)?;
+    let mut solver = DirectSolver::new(&pattern)?;
+    wall.assembly += t_asm.elapsed().as_secs_f64();
+    let problem = StaticProblem {
+        grid,
+        laws: &laws,
+        dofs: &dofs,
+        pattern: &pattern,
+        loads: &cond.loads,
+    };
+    let options = StaticOptions {
+        tolerance: s.solver.tolerance.unwrap_or(1e-10),
+        ..StaticOptions::default()
+    };
+
+    // Probes and lines are located once.
+    let mut probe_locs = Vec::new();
+    for (i, p) in s.output.probe.iter().enumerate() {
+        if p.field == "pressure" {
+            return Err(ls
+                .error(
+                    &ki("output.probe", i, &["field"]),
+                    "= \"pressure\" needs [physics] flow = true",
+                )
+                .into());
+        }
+        let loc = locate(grid, &point(&p.at)).ok_or_else(|| {
+            ls.error(
+                &ki("output.probe", i, &["at"]),
+                format!("= {:?} is outside the grid", p.at),
+            )
+        })?;
+        probe_locs.push(loc);
+    }
+    let mut line_locs: Vec<Vec<(f64, Point<D>, Location)>> = Vec::new();
+    for (i, l) in s.output.line.iter().enumerate() {
+        if l.field == "pressure" {
+            return Err(ls
+                .error(
+                    &ki("output.line", i, &["field"]),
+                    "= \"pressure\" needs [physics] flow = true",
+                )
+                .into());
+        }
+        let (a, b): (Point<D>, Point<D>) = (point(&l.from), point(&l.to));
+        let mut pts = Vec::new();
+        for j in 0..l.points as usize {
+            let f = j as f64 / (l.points as f64 - 1.0);
+            let x = a + (b - a) * f;
+            let loc = locate(grid, &x).ok_or_else(|| {
+                ls.error(
+                    &ki("output.line", i, &["from"]),
+                    format!("point {:?} of the line is outside the grid", x.as_slice()),
+                )
+            })?;
+            pts.push(((b - a).norm() * f, x, loc));
+        }
+        line_locs.push(pts);
+    }
+
+    let mut header = vec!["time".to_string()];
+    header.extend(s.output.probe.iter().map(|p| p.name.clone()));
+    let mut probes = CsvTable::new(out.join("probes.csv"), &header);
+    let axes = ["x", "y", "z"];
+    let mut line_header = vec!["time".to_string(), "s".to_string()];
+    line_header.extend(axes[..D].iter().map(|a| a.to_string()));
+    line_header.push("value".into());
+    let mut lines: Vec<CsvTable> = s
+        .output
+        .line
+        .iter()
+        .map(|l| {
+            CsvTable::new(
+                out.join("lines").join(format!("{}.csv", l.name)),
+                &line_header,
+            )
+        })
+        .collect();
+    let mut fracture_header = vec!["cell".to_string()];
+    fracture_header.extend(axes[..D].iter().map(|a| a.to_string()));
+    fracture_header.extend(["time".to_string(), "mode".to_string()]);
+    CsvTable::new(out.join("fracture.csv"), &fracture_header).flush()?;
+    if s.output.vtk {
+        std::fs::create_dir_all(out.join("vtk")).map_err(|source| OutputError {
+            path: out.join("vtk"),
+            source,
+        })?;
+    }
+    let mut pvd = if s.output.vtk {
+        Some(PvdWriter::create(
+            out.join(format!("{}.pvd", s.scene.name)),
+        )?)
+    } else {
+        None
+    };
+
+    let law_ids: Vec<i32> = comp.law_of_cell.iter().map(|&l| l as i32).collect();
+    let fractured = vec![0i32; grid.num_cells()];
+    let mut series: Vec<Vec<f64>> = vec![Vec::new(); s.output.probe.len()];
+    let mut written_times = Vec::new();
+    let mut stats = SolverStats {
+        linear: "cholesky".into(),
+        ..SolverStats::default()
+    };
+    let all_times = times(ls);
+    let zero_start = s.initial.as_ref().and_then(|i| i.mechanics.as_deref()) == Some("zero");
+    let mut last: Option<(Vec<f64>, Vec<Tensor<D>>)> = None;
+    let mut steps = 0;
+    for (step, &t) in all_times.iter().enumerate() {
+        let (u, stress) = if step == 0 && zero_start {
+            (
+                vec![0.0; D * grid.num_nodes()],
+                vec![Tensor::<D>::zeros(); grid.num_cells()],
+            )
+        } else {
+            let t_solve = Instant::now();
+            let sol = solve_static(&problem, &mut solver, t, &options)?;
+            wall.solve += t_solve.elapsed().as_secs_f64();
+            stats.max_relative_residual = stats.max_relative_residual.max(sol.residual);
+            let t_asm = Instant::now();
+            let stress = cell_stresses(grid, &laws, &sol.displacement)?;
+            wall.assembly += t_asm.elapsed().as_secs_f64();
+            (sol.displacement, stress)
+        };
+        let write = step == 0 || step % s.output.every as usize == 0 || step + 1 == all_times.len();
+        if write {
+            let t_out = Instant::now();
+            let mut row = vec![t];
+            for (j, (p, loc)) in s.output.probe.iter().zip(&probe_locs).enumerate() {
+                let v = sample(&p.field, loc, &u, &stress);
+                series[j].push(v);
+                row.push(v);
+            }
+            probes.push(&row)?;
+            for ((l, pts), table) in s.output.line.iter().zip(&line_locs).zip(lines.iter_mut()) {
+                for (dist, x, loc) in pts {
+                    let mut r = vec![t, *dist];
+                    r.extend(x.iter().copied());
+                    r.push(sample(&l.field, loc, &u, &stress));
+                    table.push(&r)?;
+                }
+            }
+            if let Some(pvd) = pvd.as_mut() {
+                let name = format!("step_{:04}.vtu", written_times.len());
+                let disp: Vec<Point<D>> = (0..grid.num_nodes())
+                    .map(|n| Point::<D>::from_column_slice(&u[D * n..D * n + D]))
+                    .collect();
+                let sym: Vec<[f64; 6]> = stress.iter().map(vtk_sym).collect();
+                write_vtu(
+                    out.join("vtk").join(&name),
+                    grid,
+                    &[("displacement", Field::Vectors(&disp))],
+                    &[
+                        ("stress", Field::SymTensors(&sym)),
+                        ("law", Field::Ints(&law_ids)),
+                        ("fractured", Field::Ints(&fractured)),
+                    ],
+                )?;
+                pvd.add(t, format!("vtk/{name}"))?;
+            }
+            written_times.push(t);
+            wall.output += t_out.elapsed().as_secs_f64();
+        }
+        if step > 0 {
+            steps += 1;
+        }
+        last = Some((u, stress));
+        if STOP.load(Ordering::Relaxed) {
+            break;
+        }
+    }
+    stats.factorizations = solver.numeric_factorizations();
+    stats.symbolic_factorizations = solver.symbolic_factorizations();
+    stats.factor_nnz = solver.factor_nnz();
+
+    let t_out = Instant::now();
+    if s.output.plots {
+        let columns: Vec<(String, Vec<f64>)> = s
+            .output
+            .probe
+            .iter()
+            .map(|p| p.name.clone())
+            .zip(series)
+            .collect();
+        if !columns.is_empty() {
+            crate::plots::time_series(
+                &out.join("plots").join("probes.png"),
+                &written_times,
+                &columns,
+                &format!("{}: probes", s.scene.name),
+            )?;
+        }
+        if let (Some((u, stress)), Some(g2)) = (&last, as_2d(grid)) {
+            let marked = vec![false; g2.num_cells()];
+            let n = g2.num_cells();
+            let cell_mean = |a: usize| -> Vec<f64> {
+                (0..n)
+                    .map(|c| {
+                        let nodes = g2.cell_nodes(c);
+                        nodes.iter().map(|&p| u[2 * p + a]).sum::<f64>() / nodes.len() as f64
+                    })
+                    .collect()
+            };
+            let plots: Vec<(&str, Vec<f64>)> = vec![
+                ("ux", cell_mean(0)),
+                ("uy", cell_mean(1)),
+                ("sxx", stress.iter().map(|s| s[(0, 0)]).collect()),
+                ("syy", stress.iter().map(|s| s[(1, 1)]).collect()),
+                ("sxy", stress.iter().map(|s| s[(0, 1)]).collect()),
+                ("smax", stress.iter().map(|s| principal(s).0).collect()),
+                ("smin", stress.iter().map(|s| principal(s).1).collect()),
+            ];
+            let t_last = written_times.last().copied().unwrap_or(0.0);
+            for (name, vals) in plots {
+                crate::plots::cell_field(
+                    &out.join("plots").join(format!("{name}.png")),
+                    g2,
+                    &vals,
+                    &format!("{name} at t = {t_last} s"),
+                    &marked,
+                )?;
+            }
+        }
+    }
+    wall.output += t_out.elapsed().as_secs_f64();
+    let _ = start;
+    Ok(Summary {
+        scene: s.scene.name.clone(),
+        dim: D,
+        cells: grid.num_cells(),
+        nodes: grid.num_nodes(),
+        dofs: dofs.num_equations(),
+        steps,
+        status: "ok".into(),
+        fractured_cells: 0,
+        wall_seconds: wall,
+        peak_memory_bytes: 0,
+        solver: stats,
+        version: env!("CARGO_PKG_VERSION").into(),
+    })
+}
+
+/// Plain symmetric components `[xx, yy, zz, xy, yz, xz]` for VTK.
+fn vtk_sym<const D: usize>(s: &Tensor<D>) -> [f64; 6] {
+    let c = |a: usize, b: usize| if a < D && b < D { s[(a, b)] } else { 0.0 };
+    [c(0, 0), c(1, 1), c(2, 2), c(0, 1), c(1, 2), c(0, 2)]
+}
+
+/// The grid as a 2D grid, if it is one (plots are 2D only).
+fn as_2d<const D: usize>(grid: &Grid<D>) -> Option<&Grid<2>> {
+    (grid as &dyn std::any::Any).downcast_ref::<Grid<2>>()
+}
+
+/// Default output directory of a scene: `out/<name>`.
+pub fn default_out(ls: &LoadedScene) -> PathBuf {
+    PathBuf::from("out").join(&ls.scene.scene.name)
+}
+
+/// Write an error status into `summary.json` of a failed run (best effort).
+pub fn write_failed_summary(ls: &LoadedScene, out: &Path, error: &str, start: Instant) {
+    let summary = Summary {
+        scene: ls.scene.scene.name.clone(),
+        dim: ls.scene.scene.dim as usize,
+        cells: 0,
+        nodes: 0,
+        dofs: 0,
+        steps: 0,
+        status: error.to_string(),
+        fractured_cells: 0,
+        wall_seconds: WallSeconds {
+            total: start.elapsed().as_secs_f64(),
+            ..WallSeconds::default()
+        },
+        peak_memory_bytes: peak_memory_bytes(),
+        solver: SolverStats::default(),
+        version: env!("CARGO_PKG_VERSION").into(),
+    };
+    let _ = std::fs::create_dir_all(out);
+    let _ = write_atomic(
+        &out.join("summary.json"),
+        serde_json::to_string_pretty(&summary)
+            .unwrap_or_default()
+            .as_bytes(),
+    );
+}

@@ -1,0 +1,454 @@
+//! The scene file: typed TOML sections of `SCENE.md`, and the locations of keys for error
+//! messages.
+//!
+//! Parsing is strict: unknown keys and wrong types are errors that name the file, line and
+//! key; values are checked in [`crate::check`].
+
+use std::collections::BTreeMap;
+
+use serde::Deserialize;
+
+/// A number, or a string expression in x, y, z (m) and t (s).
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(untagged)]
+pub enum NumOrExpr {
+    /// A constant.
+    Num(f64),
+    /// An expression (see [`crate::expr`]).
+    Expr(String),
+}
+
+/// One component of a displacement condition: a number, an expression, or `"free"`.
+pub type Component = NumOrExpr;
+
+/// A whole scene file.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// `[scene]`.
+    pub scene: SceneSection,
+    /// `[grid]`.
+    pub grid: GridSection,
+    /// `[[region]]`: later regions override earlier ones.
+    #[serde(default)]
+    pub region: Vec<Region>,
+    /// `[material.<name>]`.
+    #[serde(default)]
+    pub material: BTreeMap<String, Material>,
+    /// `[fluid]`.
+    pub fluid: Option<Fluid>,
+    /// `[[bc]]`.
+    #[serde(default)]
+    pub bc: Vec<Bc>,
+    /// `[loads]`.
+    pub loads: Option<Loads>,
+    /// `[[source]]`.
+    #[serde(default)]
+    pub source: Vec<Source>,
+    /// `[initial]`.
+    pub initial: Option<Initial>,
+    /// `[schedule]`: absent means one static solve.
+    pub schedule: Option<Schedule>,
+    /// `[physics]`.
+    #[serde(default)]
+    pub physics: Physics,
+    /// `[solver]`.
+    #[serde(default)]
+    pub solver: Solver,
+    /// `[output]`.
+    #[serde(default)]
+    pub output: Output,
+}
+
+/// `[scene]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneSection {
+    /// Output goes to `out/<name>/` unless `--out` is given.
+    pub name: String,
+    /// 2 or 3.
+    pub dim: i64,
+    /// 2D only: `"strain"` (default) or `"stress"`.
+    pub plane: Option<String>,
+}
+
+/// `[grid]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GridSection {
+    /// `cartesian | triangles | tetrahedra | voronoi | file | composite`.
+    pub kind: String,
+    /// Min and max corner.
+    pub extent: Option<[Vec<f64>; 2]>,
+    /// Cells per axis (one number for voronoi).
+    pub cells: Option<CellCount>,
+    /// Seed of random generators.
+    pub seed: Option<u64>,
+    /// Interior node jitter, fraction of the local cell size.
+    pub perturb: Option<f64>,
+    /// Mesh file for `kind = "file"`, relative to the scene file.
+    pub path: Option<String>,
+    /// Composite: centre of the refined zone.
+    pub center: Option<Vec<f64>>,
+    /// Composite: half-width of the refined zone (m).
+    pub zone_half_width: Option<f64>,
+    /// Composite: subdivisions per coarse cell in the zone.
+    pub refine: Option<i64>,
+    /// Composite: radius of the tagged well cells (m).
+    pub well_radius: Option<f64>,
+    /// Composite: name of the well tag (default `well`).
+    pub well_tag: Option<String>,
+    /// Voronoi: Lloyd iterations.
+    pub lloyd: Option<i64>,
+}
+
+/// `cells = [nx, ny(, nz)]` or, for Voronoi, one number.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(untagged)]
+pub enum CellCount {
+    /// One number.
+    One(i64),
+    /// Per axis.
+    PerAxis(Vec<i64>),
+}
+
+/// `[[region]]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Region {
+    /// Name (for `[[source]] region = ...`).
+    pub name: String,
+    /// Which cells (by centroid).
+    pub select: Select,
+    /// `vem | mdem | dem`.
+    pub law: Option<String>,
+    /// Name of a `[material.<name>]`.
+    pub material: Option<String>,
+}
+
+/// A cell selection.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(rename_all = "lowercase", deny_unknown_fields)]
+pub enum Select {
+    /// `{ all = true }`.
+    All(bool),
+    /// `{ box = [[x0, y0], [x1, y1]] }`.
+    Box([Vec<f64>; 2]),
+    /// `{ circle = { center = [x, y], radius = r } }`.
+    Circle(Ball),
+    /// `{ sphere = { center = [x, y, z], radius = r } }`.
+    Sphere(Ball),
+    /// `{ tag = "name" }`.
+    Tag(String),
+}
+
+/// Centre and radius.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Ball {
+    /// Centre.
+    pub center: Vec<f64>,
+    /// Radius (m).
+    pub radius: f64,
+}
+
+/// Scalar or per-axis permeability.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(untagged)]
+pub enum Permeability {
+    /// Isotropic (m²).
+    Scalar(f64),
+    /// `[kx, ky(, kz)]` (m²).
+    Diagonal(Vec<f64>),
+}
+
+/// `[material.<name>]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Material {
+    /// E (Pa).
+    pub youngs_modulus: f64,
+    /// ν.
+    pub poisson_ratio: f64,
+    /// ρ (kg/m³).
+    pub density: Option<f64>,
+    /// Biot α.
+    pub biot_alpha: Option<f64>,
+    /// φ.
+    pub porosity: Option<f64>,
+    /// k (m²).
+    pub permeability: Option<Permeability>,
+    /// K_s (Pa).
+    pub solid_bulk_modulus: Option<f64>,
+    /// Tensile strength (Pa).
+    pub tensile_strength: Option<f64>,
+    /// Mohr–Coulomb cohesion (Pa).
+    pub cohesion: Option<f64>,
+    /// Mohr–Coulomb friction angle (degrees).
+    pub friction_angle: Option<f64>,
+}
+
+/// `[fluid]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Fluid {
+    /// μ (Pa s).
+    pub viscosity: f64,
+    /// c_f (1/Pa).
+    pub compressibility: f64,
+}
+
+/// `[[bc]]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Bc {
+    /// A side `xmin … zmax` or a face tag.
+    pub boundary: String,
+    /// Per component: number, expression or `"free"`.
+    pub displacement: Option<Vec<Component>>,
+    /// Traction (Pa) per component.
+    pub traction: Option<Vec<NumOrExpr>>,
+    /// Flow Dirichlet pressure (Pa).
+    pub pressure: Option<NumOrExpr>,
+    /// Outward Darcy flux (m/s).
+    pub flux: Option<NumOrExpr>,
+    /// Rigid platen.
+    pub platen: Option<Platen>,
+}
+
+/// `platen = { force = [...] }`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Platen {
+    /// Total force per component (N; per metre in 2D), or `"free"`.
+    pub force: Vec<Component>,
+}
+
+/// `[loads]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Loads {
+    /// Gravity (m/s²), uses the material density.
+    pub gravity: Option<Vec<f64>>,
+    /// Body force (N/m³) per component.
+    pub body_force: Option<Vec<NumOrExpr>>,
+}
+
+/// `[[source]]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Source {
+    /// Name of a `[[region]]`.
+    pub region: String,
+    /// m³/s over the region.
+    pub rate: Option<f64>,
+    /// The region's pore volume per hour.
+    pub pore_volumes_per_hour: Option<f64>,
+}
+
+/// `[initial]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Initial {
+    /// Initial pressure (Pa).
+    pub pressure: Option<NumOrExpr>,
+    /// `"equilibrium"` (default) or `"zero"`.
+    pub mechanics: Option<String>,
+}
+
+/// `[schedule]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Schedule {
+    /// End time (s).
+    pub end_time: f64,
+    /// Step (s).
+    pub dt: Option<f64>,
+    /// Or a number of steps.
+    pub steps: Option<i64>,
+}
+
+/// `[physics]`.
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Physics {
+    /// Solve flow.
+    pub flow: Option<bool>,
+    /// `monolithic | fixed-stress | explicit-pressure | none`.
+    pub coupling: Option<String>,
+    /// Check failure criteria.
+    pub fracture: Option<bool>,
+}
+
+/// `[solver]`.
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Solver {
+    /// `direct | explicit`.
+    pub mechanics: Option<String>,
+    /// `auto | cholesky | cg-amg`.
+    pub linear: Option<String>,
+    /// Relative residual / unbalanced-force ratio.
+    pub tolerance: Option<f64>,
+    /// Threads (0: default).
+    pub threads: Option<i64>,
+}
+
+/// `[output]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Output {
+    /// Write VTK files.
+    #[serde(default = "yes")]
+    pub vtk: bool,
+    /// Write PNG plots.
+    #[serde(default = "yes")]
+    pub plots: bool,
+    /// Write every n-th step.
+    #[serde(default = "one")]
+    pub every: i64,
+    /// `[[output.probe]]`.
+    #[serde(default)]
+    pub probe: Vec<Probe>,
+    /// `[[output.line]]`.
+    #[serde(default)]
+    pub line: Vec<Line>,
+}
+
+impl Default for Output {
+    fn default() -> Self {
+        Self {
+            vtk: true,
+            plots: true,
+            every: 1,
+            probe: Vec::new(),
+            line: Vec::new(),
+        }
+    }
+}
+
+fn yes() -> bool {
+    true
+}
+fn one() -> i64 {
+    1
+}
+
+/// `[[output.probe]]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Probe {
+    /// Column name.
+    pub name: String,
+    /// Field name.
+    pub field: String,
+    /// Position.
+    pub at: Vec<f64>,
+}
+
+/// `[[output.line]]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Line {
+    /// File name (`lines/<name>.csv`).
+    pub name: String,
+    /// Field name.
+    pub field: String,
+    /// Start point.
+    pub from: Vec<f64>,
+    /// End point.
+    pub to: Vec<f64>,
+    /// Number of sample points.
+    pub points: i64,
+}
+
+/// One step of a key path: a table key or an index into an array of tables.
+#[derive(Clone, Debug, PartialEq)]
+pub enum KeyPart {
+    /// A key.
+    Key(String),
+    /// An index into an array of tables (`[[bc]]` number k, from 0).
+    Index(usize),
+}
+
+/// Render a key path the way users write it: `material.rock.poisson_ratio`, `bc[2].traction`.
+pub fn key_text(path: &[KeyPart]) -> String {
+    let mut s = String::new();
+    for p in path {
+        match p {
+            KeyPart::Key(k) => {
+                if !s.is_empty() {
+                    s.push('.');
+                }
+                s.push_str(k);
+            }
+            KeyPart::Index(i) => s.push_str(&format!("[{i}]")),
+        }
+    }
+    s
+}
+
+/// The 1-based line where a key path is written in the TOML text (best effort: the line of
+/// the deepest table header or key found; 1 if nothing matches).
+pub fn locate(text: &str, path: &[KeyPart]) -> usize {
+    let mut header: Vec<KeyPart> = Vec::new();
+    let mut counts: BTreeMap<String, usize> = BTreeMap::new();
+    let mut best = (0usize, 1usize); // (matched parts, line)
+    for (no, raw) in text.lines().enumerate() {
+        let line = raw.split('#').next().unwrap_or("").trim();
+        let line_no = no + 1;
+        if let Some(inner) = line.strip_prefix("[[").and_then(|l| l.split("]]").next()) {
+            let name = inner.trim().to_string();
+            let k = counts.entry(name.clone()).or_insert(0);
+            header = name
+                .split('.')
+                .map(|p| KeyPart::Key(p.trim().to_string()))
+                .collect();
+            header.push(KeyPart::Index(*k));
+            *k += 1;
+            let m = common_prefix(&header, path);
+            if m > best.0 {
+                best = (m, line_no);
+            }
+            continue;
+        }
+        if let Some(inner) = line.strip_prefix('[').and_then(|l| l.split(']').next()) {
+            header = inner
+                .split('.')
+                .map(|p| KeyPart::Key(p.trim().to_string()))
+                .collect();
+            let m = common_prefix(&header, path);
+            if m > best.0 {
+                best = (m, line_no);
+            }
+            continue;
+        }
+        if let Some((key, _)) = line.split_once('=') {
+            let mut full = header.clone();
+            full.extend(
+                key.split('.')
+                    .map(|p| KeyPart::Key(p.trim().trim_matches('"').to_string())),
+            );
+            let m = common_prefix(&full, path);
+            if m > best.0 || (m == best.0 && m == full.len() && m > 0 && best.1 == 0) {
+                best = (m, line_no);
+            }
+        }
+    }
+    best.1
+}
+
+fn common_prefix(a: &[KeyPart], b: &[KeyPart]) -> usize {
+    let m = a.iter().zip(b).take_while(|(x, y)| x == y).count();
+    // A header or key counts only if it matched completely.
+    if m == a.len() { m } else { 0 }
+}
+
+/// The 1-based line of a byte offset.
+pub fn line_of_offset(text: &str, offset: usize) -> usize {
+    text[..offset.min(text.len())]
+        .bytes()
+        .filter(|&b| b == b'\n')
+        .count()
+        + 1
+}

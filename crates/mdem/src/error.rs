@@ -1,0 +1,80 @@
+//! The error type of the crate.
+
+use thiserror::Error;
+
+/// Errors of the MDEM/DEM laws and the lattice model.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum MdemError {
+    /// Only 2D and 3D are supported.
+    #[error("MDEM/DEM laws support dimension 2 or 3, not {0}")]
+    UnsupportedDimension(usize),
+    /// The material stiffness matrix has the wrong shape.
+    #[error("material stiffness must be {expected}×{expected} (Kelvin form), got {rows}×{cols}")]
+    MaterialShape {
+        /// Rows given.
+        rows: usize,
+        /// Columns given.
+        cols: usize,
+        /// Required size (3 in 2D, 6 in 3D).
+        expected: usize,
+    },
+    /// The material stiffness matrix has a NaN or infinite entry.
+    #[error("material stiffness entry ({i}, {j}) is not finite")]
+    MaterialNotFinite {
+        /// Row.
+        i: usize,
+        /// Column.
+        j: usize,
+    },
+    /// The material stiffness matrix is not symmetric.
+    #[error("material stiffness is not symmetric: D[{i}][{j}] = {a} but D[{j}][{i}] = {b}")]
+    MaterialNotSymmetric {
+        /// Row.
+        i: usize,
+        /// Column.
+        j: usize,
+        /// `D[i][j]`.
+        a: f64,
+        /// `D[j][i]`.
+        b: f64,
+    },
+    /// The material stiffness matrix is not positive definite.
+    #[error("material stiffness is not positive definite")]
+    MaterialNotPositiveDefinite,
+    /// The cell is not a simplex (`D + 1` nodes).
+    #[error("cell has {got} nodes; MDEM/DEM laws need a simplex with {expected} nodes")]
+    NotASimplex {
+        /// Number of nodes given.
+        got: usize,
+        /// `D + 1`.
+        expected: usize,
+    },
+    /// The simplex has (almost) zero volume; its edge map `M` is singular.
+    #[error("degenerate simplex: volume {volume:e} for edge length scale {scale:e}")]
+    Degenerate {
+        /// Volume (area in 2D).
+        volume: f64,
+        /// Longest edge.
+        scale: f64,
+    },
+    /// A slice has the wrong length.
+    #[error("{what} has length {got}, expected {expected}")]
+    Length {
+        /// Which argument.
+        what: &'static str,
+        /// Length given.
+        got: usize,
+        /// Length required.
+        expected: usize,
+    },
+    /// A lattice parameter is out of range.
+    #[error("lattice parameter {what} = {value} is invalid ({why})")]
+    LatticeParameter {
+        /// Which parameter.
+        what: &'static str,
+        /// The value given.
+        value: f64,
+        /// The requirement.
+        why: &'static str,
+    },
+}
