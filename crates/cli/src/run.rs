@@ -293,16 +293,6 @@ fn check_supported(ls: &LoadedScene) -> Result<(), RunError> {
             "= \"cg-amg\": the AMG solver",
         ));
     }
-    for (i, r) in s.region.iter().enumerate() {
-        if let Some(l) = &r.law {
-            if l != "vem" {
-                return Err(unsupported(
-                    ki("region", i, &["law"]),
-                    &format!("= \"{l}\": this law"),
-                ));
-            }
-        }
-    }
     for (i, bc) in s.bc.iter().enumerate() {
         if bc.pressure.is_some() || bc.flux.is_some() {
             return Err(unsupported(
@@ -373,8 +363,16 @@ fn compose<const D: usize>(ls: &LoadedScene, grid: &Grid<D>) -> Result<Compositi
                     Stiffness::<D>::isotropic(m.youngs_modulus, m.poisson_ratio)
                 }
                 .map_err(|e| ls.error(&k(&["material", &key.1]), e))?;
+                let law_err = |e: porofrac_mdem::MdemError| {
+                    ls.error(&ki("region", lr, &["law"]), format!("= \"{}\": {e}", key.0))
+                };
                 let law: Box<dyn CellLaw<D>> = match key.0.as_str() {
                     "vem" => Box::new(porofrac_vem::VemLaw::new(stiffness)),
+                    "mdem" => Box::new(porofrac_mdem::MdemLaw::new(&stiffness).map_err(law_err)?),
+                    "dem" => Box::new(
+                        porofrac_mdem::DemLaw::new(&stiffness, porofrac_mdem::DemMode::Elastic)
+                            .map_err(law_err)?,
+                    ),
                     other => {
                         return Err(ls
                             .error(

@@ -1,0 +1,320 @@
+//! The bundled scenes and the error contract, through the user's path: the `porofrac`
+//! binary, its exit status and the files it writes.
+//!
+//! Checks and references:
+//! * `scenes/patch_test.toml`: an affine displacement on the boundary of a perturbed
+//!   grid; probes and the line output equal the affine field and its constant stress
+//!   (plane strain, E = 1e9, ν = 0.3) to 1e-10 relative.
+//! * `scenes/hybrid_uniaxial.toml`: MDEM near the well, VEM with hanging nodes outside,
+//!   ramped uniaxial traction; probes equal the closed-form plane-strain solution
+//!   `uy = −p y (1 − ν²)/E`, `ux = p x ν (1 + ν)/E`, `σyy = −p`, `σxx = 0` at every
+//!   written time, p = 1e7 min(t/60, 1), to 1e-9 relative.
+//! * Errors: invalid values, unknown keys, bad expressions, missing references,
+//!   singular systems and missing mesh files exit with status 1 and one line naming the
+//!   file, line and key; command-line misuse exits with status 2.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn tmp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("porofrac-cli-test-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn porofrac(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_porofrac"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap().split(',').map(String::from).collect();
+    let rows = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    (header, rows)
+}
+
+fn close(a: f64, b: f64, scale: f64, tol: f64) -> bool {
+    (a - b).abs() <= tol * scale
+}
+
+/// Plane strain, E = 1e9, ν = 0.3.
+fn lame() -> (f64, f64) {
+    let (e, nu) = (1e9, 0.3);
+    (
+        e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)),
+        e / (2.0 * (1.0 + nu)),
+    )
+}
+
+#[test]
+fn patch_test_scene_reproduces_the_affine_field() {
+    let out = tmp_dir("patch");
+    let scene = root().join("scenes/patch_test.toml");
+    let (code, _, err) = porofrac(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let u = |x: f64, y: f64| (1e-4 + 1e-3 * x + 2e-4 * y, -2e-4 - 5e-4 * x + 3e-4 * y);
+    let (l, m) = lame();
+    let sxx = (l + 2.0 * m) * 1e-3 + l * 3e-4;
+    let (header, rows) = read_csv(&out.join("probes.csv"));
+    assert_eq!(header, ["time", "ux_center", "sxx_center"]);
+    assert_eq!(rows.len(), 1);
+    assert_eq!(rows[0][0], 0.0);
+    assert!(
+        close(rows[0][1], u(0.5, 0.5).0, 1e-3, 1e-10),
+        "{}",
+        rows[0][1]
+    );
+    assert!(
+        close(rows[0][2], sxx, sxx, 1e-10),
+        "{} vs {sxx}",
+        rows[0][2]
+    );
+    let (header, rows) = read_csv(&out.join("lines/diagonal.csv"));
+    assert_eq!(header, ["time", "s", "x", "y", "value"]);
+    assert_eq!(rows.len(), 11);
+    for r in &rows {
+        assert!(close(r[4], u(r[2], r[3]).1, 1e-3, 1e-10), "{r:?}");
+        assert!(close(r[1], (r[2] * r[2] + r[3] * r[3]).sqrt(), 1.0, 1e-14));
+    }
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["status"], "ok");
+    assert_eq!(summary["cells"], 64);
+    assert_eq!(summary["nodes"], 81);
+    assert_eq!(summary["dofs"], 2 * 49);
+    assert_eq!(summary["steps"], 0);
+    assert_eq!(summary["fractured_cells"], 0);
+    for phase in ["total", "grid", "assembly", "solve", "flow", "output"] {
+        assert!(summary["wall_seconds"][phase].as_f64().unwrap() >= 0.0);
+    }
+    assert!(summary["peak_memory_bytes"].as_u64().unwrap() > 0);
+    assert!(out.join("vtk/step_0000.vtu").is_file());
+    let pvd = std::fs::read_to_string(out.join("patch_test.pvd")).unwrap();
+    assert!(pvd.contains("vtk/step_0000.vtu"));
+    let vtu = std::fs::read_to_string(out.join("vtk/step_0000.vtu")).unwrap();
+    assert!(vtu.contains("Name=\"displacement\""));
+    for plot in ["probes.png", "ux.png", "syy.png", "smin.png"] {
+        assert!(out.join("plots").join(plot).is_file(), "{plot}");
+    }
+    let (header, rows) = read_csv(&out.join("fracture.csv"));
+    assert_eq!(header, ["cell", "x", "y", "time", "mode"]);
+    assert!(rows.is_empty());
+    // The grid read back from the written .vtu is the grid the run used.
+    let g: porofrac_grid::Grid<2> =
+        porofrac_grid::io::read_vtu(out.join("vtk/step_0000.vtu")).unwrap();
+    assert_eq!(g.num_cells(), 64);
+}
+
+#[test]
+fn hybrid_scene_matches_the_uniaxial_solution_at_every_time() {
+    let out = tmp_dir("hybrid");
+    let scene = root().join("scenes/hybrid_uniaxial.toml");
+    let (code, _, err) = porofrac(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let (e, nu) = (1e9, 0.3);
+    let (header, rows) = read_csv(&out.join("probes.csv"));
+    assert_eq!(
+        header,
+        ["time", "uy_top", "ux_right", "syy_well", "sxx_far"]
+    );
+    let times: Vec<f64> = rows.iter().map(|r| r[0]).collect();
+    assert_eq!(times, [0.0, 30.0, 60.0, 90.0, 120.0]);
+    for r in &rows {
+        let p = 1e7 * (r[0] / 60.0).min(1.0);
+        assert!(
+            close(r[1], -p * 30.0 * (1.0 - nu * nu) / e, 0.3, 1e-9),
+            "{r:?}"
+        );
+        assert!(
+            close(r[2], p * 30.0 * nu * (1.0 + nu) / e, 0.3, 1e-9),
+            "{r:?}"
+        );
+        assert!(close(r[3], -p, 1e7, 1e-9), "{r:?}");
+        assert!(close(r[4], 0.0, 1e7, 1e-9), "{r:?}");
+    }
+    let (_, line) = read_csv(&out.join("lines/vertical.csv"));
+    assert_eq!(line.len(), 5 * 31);
+    for r in &line {
+        let p = 1e7 * (r[0] / 60.0).min(1.0);
+        assert!(
+            close(r[4], -p * r[3] * (1.0 - nu * nu) / e, 0.3, 1e-9),
+            "{r:?}"
+        );
+    }
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["steps"], 4);
+    // All laws are linear: one symbolic and one numeric factorization for all steps.
+    assert_eq!(summary["solver"]["symbolic_factorizations"], 1);
+}
+
+/// Write `text` as `<name>.toml` in a fresh directory and run `porofrac check` on it.
+fn check_text(name: &str, text: &str) -> (i32, String) {
+    let dir = tmp_dir(name);
+    let path = dir.join(format!("{name}.toml"));
+    std::fs::write(&path, text).unwrap();
+    let (code, _, err) = porofrac(&[
+        "run",
+        path.to_str().unwrap(),
+        "--out",
+        dir.join("out").to_str().unwrap(),
+    ]);
+    (code, err)
+}
+
+fn patch_text() -> String {
+    std::fs::read_to_string(root().join("scenes/patch_test.toml")).unwrap()
+}
+
+/// The 1-based line of the first line containing `needle`.
+fn line_of(text: &str, needle: &str) -> usize {
+    text.lines().position(|l| l.contains(needle)).unwrap() + 1
+}
+
+#[test]
+fn invalid_values_name_file_line_and_key() {
+    let text = patch_text().replace("poisson_ratio = 0.3", "poisson_ratio = 0.5");
+    let (code, err) = check_text("nu", &text);
+    assert_eq!(code, 1);
+    let line = line_of(&text, "poisson_ratio");
+    assert_eq!(
+        err.trim(),
+        format!("error: nu.toml:{line}: material.rock.poisson_ratio = 0.5 must be < 0.5")
+    );
+
+    let text = patch_text().replace("youngs_modulus = 1.0e9", "youngs_modulus = -1.0");
+    let (code, err) = check_text("e", &text);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains(&format!(
+            "e.toml:{}: material.rock.youngs_modulus = -1 must be > 0",
+            line_of(&text, "youngs")
+        )),
+        "{err}"
+    );
+}
+
+#[test]
+fn unknown_keys_and_types_are_errors() {
+    let text = patch_text().replace("poisson_ratio = 0.3", "poisson = 0.3");
+    let (code, err) = check_text("unknown", &text);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains(&format!("unknown.toml:{}:", line_of(&text, "poisson = "))),
+        "{err}"
+    );
+    assert!(err.contains("unknown field `poisson`"), "{err}");
+    let text = patch_text().replace("cells = [8, 8]", "cells = \"many\"");
+    let (code, err) = check_text("types", &text);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains(&format!("types.toml:{}:", line_of(&text, "cells = "))),
+        "{err}"
+    );
+}
+
+#[test]
+fn bad_expressions_and_references_are_errors() {
+    let text = patch_text().replacen("3e-4*y\"]", "3e-4*yy\"]", 1);
+    let (code, err) = check_text("expr", &text);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains(&format!(
+            "expr.toml:{}: bc[0].displacement",
+            line_of(&text, "yy")
+        )),
+        "{err}"
+    );
+    assert!(err.contains("unknown name `yy`"), "{err}");
+
+    let text = patch_text().replace("material = \"rock\"", "material = \"granite\"");
+    let (code, err) = check_text("refs", &text);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains(&format!(
+            "refs.toml:{}: region[0].material = \"granite\" is not a defined material",
+            line_of(&text, "granite")
+        )),
+        "{err}"
+    );
+
+    let text = patch_text().replace("boundary = \"ymax\"", "boundary = \"top\"");
+    let (code, err) = check_text("side", &text);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains(&format!(
+            "side.toml:{}: bc[3].boundary = \"top\"",
+            line_of(&text, "\"top\"")
+        )),
+        "{err}"
+    );
+}
+
+#[test]
+fn singular_systems_name_the_free_rigid_modes() {
+    let mut text = patch_text();
+    let start = text.find("[[bc]]").unwrap();
+    let end = text.find("[[output.probe]]").unwrap();
+    text.replace_range(
+        start..end,
+        "[[bc]]\nboundary = \"ymin\"\ndisplacement = [\"free\", 0.0]\n\n",
+    );
+    let (code, err) = check_text("singular", &text);
+    assert_eq!(code, 1);
+    assert!(err.contains("translation x"), "{err}");
+    assert!(!err.contains("rotation"), "{err}");
+}
+
+#[test]
+fn missing_mesh_file_and_misuse() {
+    let text = patch_text().replace(
+        "kind = \"cartesian\"",
+        "kind = \"file\"\npath = \"nowhere.msh\"",
+    );
+    let (code, err) = check_text("mesh", &text);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains("grid.path = ") && err.contains("nowhere.msh"),
+        "{err}"
+    );
+
+    let (code, _, _) = porofrac(&["frobnicate"]);
+    assert_eq!(code, 2);
+    let (code, _, _) = porofrac(&["run"]);
+    assert_eq!(code, 2);
+    let (code, _, err) = porofrac(&["run", "/nonexistent/scene.toml"]);
+    assert_eq!(code, 1);
+    assert!(err.contains("scene.toml"), "{err}");
+    let (code, out, _) = porofrac(&[
+        "check",
+        root().join("scenes/hybrid_uniaxial.toml").to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0);
+    assert!(out.contains("ok"));
+}
