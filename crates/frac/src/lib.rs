@@ -1,1 +1,375 @@
-//! porofrac-frac (under construction).
+//! Failure criteria, the irreversible failure state of cells, and stress recovery.
+//!
+//! * [`FailureCriterion`]: a stress-based criterion on the effective (skeleton) stress
+//!   that the cell laws compute, tension positive. Built in: [`Tensile`] (seed eq. 31,
+//!   `max σ > σ_tens`) and [`MohrCoulomb`]; [`Combined`] checks several and reports the
+//!   first mode that fails.
+//! * [`FailureState`]: which cells have failed, when and how. Failure is irreversible.
+//! * [`recovery`]: superconvergent patch recovery (Zienkiewicz–Zhu) of nodal stresses
+//!   from cell stresses on any grid (seed Fig. 5), and cell values from the recovered
+//!   nodal field, so a criterion can be evaluated on a smoother stress near a tip.
+//!
+//! What a failed cell becomes is the caller's choice: in porofrac's scenes a failed MDEM
+//! cell switches to the compression-only central-force law (seed eqs. 32–33).
+
+pub mod recovery;
+
+use porofrac_law::Tensor;
+
+/// How a cell failed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FailureMode {
+    /// The largest principal stress exceeded the tensile strength.
+    Tensile,
+    /// The Mohr–Coulomb shear criterion was met.
+    Shear,
+}
+
+impl FailureMode {
+    /// `"tensile"` or `"shear"` (as written in `fracture.csv`).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            FailureMode::Tensile => "tensile",
+            FailureMode::Shear => "shear",
+        }
+    }
+}
+
+/// Errors of this crate: invalid strength parameters.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum FracError {
+    /// A parameter is out of range.
+    #[error("{name} = {value} {reason}")]
+    Parameter {
+        /// Parameter name.
+        name: &'static str,
+        /// Its value.
+        value: f64,
+        /// Why it is invalid.
+        reason: &'static str,
+    },
+}
+
+/// Principal stresses in decreasing order (tension positive), `D` of them.
+pub fn principal_stresses<const D: usize>(s: &Tensor<D>) -> [f64; 3] {
+    let mut e = [0.0; 3];
+    if D == 2 {
+        let (a, b, c) = (s[(0, 0)], s[(1, 1)], s[(0, 1)]);
+        let m = 0.5 * (a + b);
+        let r = (0.25 * (a - b) * (a - b) + c * c).sqrt();
+        e[0] = m + r;
+        e[1] = m - r;
+    } else {
+        let m = nalgebra::Matrix3::from_fn(|i, j| s[(i, j)]);
+        let v = m.symmetric_eigenvalues();
+        let mut v = [v[0], v[1], v[2]];
+        v.sort_by(|a, b| b.total_cmp(a));
+        e = v;
+    }
+    e
+}
+
+/// A stress-based failure criterion.
+pub trait FailureCriterion<const D: usize>: Send + Sync {
+    /// The failure mode if the effective stress `s` (tension positive) fails the
+    /// criterion, else `None`.
+    fn check(&self, s: &Tensor<D>) -> Option<FailureMode>;
+
+    /// How close the stress is to failure: ≥ 1 means failed (used to pick the most
+    /// critical cell when failures are resolved one at a time).
+    fn utilization(&self, s: &Tensor<D>) -> f64;
+}
+
+/// Tensile failure (seed eq. 31): `max σ > σ_tens`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tensile {
+    strength: f64,
+}
+
+impl Tensile {
+    /// A tensile criterion; the strength must be positive and finite.
+    pub fn new(strength: f64) -> Result<Self, FracError> {
+        if !(strength.is_finite() && strength > 0.0) {
+            return Err(FracError::Parameter {
+                name: "tensile_strength",
+                value: strength,
+                reason: "must be > 0",
+            });
+        }
+        Ok(Self { strength })
+    }
+    /// The tensile strength (Pa).
+    pub fn strength(&self) -> f64 {
+        self.strength
+    }
+}
+
+impl<const D: usize> FailureCriterion<D> for Tensile {
+    fn check(&self, s: &Tensor<D>) -> Option<FailureMode> {
+        (principal_stresses(s)[0] > self.strength).then_some(FailureMode::Tensile)
+    }
+    fn utilization(&self, s: &Tensor<D>) -> f64 {
+        principal_stresses(s)[0] / self.strength
+    }
+}
+
+/// Mohr–Coulomb shear failure with cohesion `c` and friction angle `φ`.
+///
+/// With principal stresses σ₁ ≥ σ₃ (tension positive; in 2D the in-plane ones), the
+/// Mohr circle touches the envelope `|τ| = c − σₙ tan φ` when
+/// `(σ₁ − σ₃)/2 ≥ c cos φ − (σ₁ + σ₃)/2 · sin φ`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MohrCoulomb {
+    cohesion: f64,
+    sin_phi: f64,
+    cos_phi: f64,
+}
+
+impl MohrCoulomb {
+    /// A Mohr–Coulomb criterion; `cohesion ≥ 0`, `0 ≤ friction_angle_deg < 90`.
+    pub fn new(cohesion: f64, friction_angle_deg: f64) -> Result<Self, FracError> {
+        if !(cohesion.is_finite() && cohesion >= 0.0) {
+            return Err(FracError::Parameter {
+                name: "cohesion",
+                value: cohesion,
+                reason: "must be ≥ 0",
+            });
+        }
+        if !(0.0..90.0).contains(&friction_angle_deg) {
+            return Err(FracError::Parameter {
+                name: "friction_angle",
+                value: friction_angle_deg,
+                reason: "must be in [0, 90) degrees",
+            });
+        }
+        let phi = friction_angle_deg.to_radians();
+        Ok(Self {
+            cohesion,
+            sin_phi: phi.sin(),
+            cos_phi: phi.cos(),
+        })
+    }
+
+    fn radius_and_limit<const D: usize>(&self, s: &Tensor<D>) -> (f64, f64) {
+        let p = principal_stresses(s);
+        let (s1, s3) = (p[0], p[D - 1]);
+        let radius = 0.5 * (s1 - s3);
+        let limit = self.cohesion * self.cos_phi - 0.5 * (s1 + s3) * self.sin_phi;
+        (radius, limit)
+    }
+}
+
+impl<const D: usize> FailureCriterion<D> for MohrCoulomb {
+    fn check(&self, s: &Tensor<D>) -> Option<FailureMode> {
+        let (radius, limit) = self.radius_and_limit(s);
+        (radius >= limit && radius > 0.0).then_some(FailureMode::Shear)
+    }
+    fn utilization(&self, s: &Tensor<D>) -> f64 {
+        let (radius, limit) = self.radius_and_limit(s);
+        if limit <= 0.0 {
+            if radius > 0.0 { f64::INFINITY } else { 0.0 }
+        } else {
+            radius / limit
+        }
+    }
+}
+
+/// Several criteria: the first that fails gives the mode.
+#[derive(Clone, Debug, Default)]
+pub struct Combined {
+    /// Tensile criterion, if the material has a tensile strength.
+    pub tensile: Option<Tensile>,
+    /// Shear criterion, if the material has a cohesion and friction angle.
+    pub shear: Option<MohrCoulomb>,
+}
+
+impl Combined {
+    /// Whether no criterion is set (the material never fails).
+    pub fn is_empty(&self) -> bool {
+        self.tensile.is_none() && self.shear.is_none()
+    }
+}
+
+impl<const D: usize> FailureCriterion<D> for Combined {
+    fn check(&self, s: &Tensor<D>) -> Option<FailureMode> {
+        self.tensile
+            .as_ref()
+            .and_then(|c| FailureCriterion::<D>::check(c, s))
+            .or_else(|| {
+                self.shear
+                    .as_ref()
+                    .and_then(|c| FailureCriterion::<D>::check(c, s))
+            })
+    }
+    fn utilization(&self, s: &Tensor<D>) -> f64 {
+        let t = self
+            .tensile
+            .as_ref()
+            .map_or(0.0, |c| FailureCriterion::<D>::utilization(c, s));
+        let m = self
+            .shear
+            .as_ref()
+            .map_or(0.0, |c| FailureCriterion::<D>::utilization(c, s));
+        t.max(m)
+    }
+}
+
+/// One recorded failure.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Failure {
+    /// The cell.
+    pub cell: usize,
+    /// When it failed (s).
+    pub time: f64,
+    /// How.
+    pub mode: FailureMode,
+}
+
+/// Irreversible failure state of the cells of a grid.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FailureState {
+    failed: Vec<bool>,
+    log: Vec<Failure>,
+}
+
+impl FailureState {
+    /// No cell failed yet.
+    pub fn new(num_cells: usize) -> Self {
+        Self {
+            failed: vec![false; num_cells],
+            log: Vec::new(),
+        }
+    }
+    /// Whether cell `c` has failed.
+    pub fn is_failed(&self, c: usize) -> bool {
+        self.failed[c]
+    }
+    /// Per-cell flags.
+    pub fn flags(&self) -> &[bool] {
+        &self.failed
+    }
+    /// All failures in the order they happened.
+    pub fn log(&self) -> &[Failure] {
+        &self.log
+    }
+    /// Number of failed cells.
+    pub fn count(&self) -> usize {
+        self.log.len()
+    }
+    /// Record a failure; returns `false` (and changes nothing) if the cell had already
+    /// failed: failure is irreversible and recorded once.
+    pub fn fail(&mut self, cell: usize, time: f64, mode: FailureMode) -> bool {
+        if self.failed[cell] {
+            return false;
+        }
+        self.failed[cell] = true;
+        self.log.push(Failure { cell, time, mode });
+        true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn t2(a: f64, b: f64, c: f64) -> Tensor<2> {
+        Tensor::<2>::new(a, c, c, b)
+    }
+
+    #[test]
+    fn principal_stresses_of_a_rotated_state() {
+        // σ = R diag(3, -1) Rᵀ with a 30° rotation.
+        let (s, c) = (30f64.to_radians().sin(), 30f64.to_radians().cos());
+        let r = nalgebra::Matrix2::new(c, -s, s, c);
+        let m = r * nalgebra::Matrix2::new(3.0, 0.0, 0.0, -1.0) * r.transpose();
+        let p = principal_stresses::<2>(&m);
+        assert!((p[0] - 3.0).abs() < 1e-14 && (p[1] + 1.0).abs() < 1e-14);
+        let m3 = nalgebra::Matrix3::new(2.0, 1.0, 0.0, 1.0, 2.0, 0.0, 0.0, 0.0, -5.0);
+        let p = principal_stresses::<3>(&m3);
+        assert!(
+            (p[0] - 3.0).abs() < 1e-13 && (p[1] - 1.0).abs() < 1e-13 && (p[2] + 5.0).abs() < 1e-13
+        );
+    }
+
+    #[test]
+    fn tensile_criterion_is_eq_31() {
+        let c = Tensile::new(2e5).unwrap();
+        assert_eq!(
+            FailureCriterion::<2>::check(&c, &t2(1.9e5, -1e7, 0.0)),
+            None
+        );
+        assert_eq!(
+            FailureCriterion::<2>::check(&c, &t2(2.1e5, -1e7, 0.0)),
+            Some(FailureMode::Tensile)
+        );
+        // Pure shear τ has principal stresses ±τ.
+        assert_eq!(
+            FailureCriterion::<2>::check(&c, &t2(0.0, 0.0, 2.5e5)),
+            Some(FailureMode::Tensile)
+        );
+        assert!((FailureCriterion::<2>::utilization(&c, &t2(1e5, 0.0, 0.0)) - 0.5).abs() < 1e-15);
+        assert!(Tensile::new(0.0).is_err() && Tensile::new(f64::NAN).is_err());
+    }
+
+    #[test]
+    fn mohr_coulomb_matches_the_envelope() {
+        // φ = 30°: failure when σ1 − σ3 ≥ c·√3 − (σ1 + σ3)/2 (sin 30° = 1/2, times 2).
+        let c = MohrCoulomb::new(1e6, 30.0).unwrap();
+        // Uniaxial compression σ3 = −q: fails at q = 2c cos φ / (1 − sin φ) = 2√3·1e6.
+        let q = 2.0 * 1e6 * 30f64.to_radians().cos() / (1.0 - 0.5);
+        assert_eq!(
+            FailureCriterion::<2>::check(&c, &t2(0.0, -0.999 * q, 0.0)),
+            None
+        );
+        assert_eq!(
+            FailureCriterion::<2>::check(&c, &t2(0.0, -1.001 * q, 0.0)),
+            Some(FailureMode::Shear)
+        );
+        assert!((FailureCriterion::<2>::utilization(&c, &t2(0.0, -q, 0.0)) - 1.0).abs() < 1e-12);
+        // Confinement strengthens: the same deviator with −5 MPa all round does not fail.
+        assert_eq!(
+            FailureCriterion::<2>::check(&c, &t2(-5e6, -5e6 - 1.001 * q, 0.0)),
+            None
+        );
+        // Hydrostatic compression never fails.
+        assert_eq!(
+            FailureCriterion::<3>::check(&c, &Tensor::<3>::identity().scale(-1e9)),
+            None
+        );
+        assert!(MohrCoulomb::new(-1.0, 30.0).is_err() && MohrCoulomb::new(1.0, 90.0).is_err());
+    }
+
+    #[test]
+    fn combined_reports_tension_first_and_state_is_irreversible() {
+        let c = Combined {
+            tensile: Some(Tensile::new(1e5).unwrap()),
+            shear: Some(MohrCoulomb::new(1e5, 30.0).unwrap()),
+        };
+        assert_eq!(
+            FailureCriterion::<2>::check(&c, &t2(2e5, -1e7, 0.0)),
+            Some(FailureMode::Tensile)
+        );
+        assert_eq!(
+            FailureCriterion::<2>::check(&c, &t2(-1e5, -1e7, 0.0)),
+            Some(FailureMode::Shear)
+        );
+        assert!(Combined::default().is_empty());
+        assert_eq!(
+            FailureCriterion::<2>::check(&Combined::default(), &t2(1e12, 0.0, 0.0)),
+            None
+        );
+        let mut st = FailureState::new(4);
+        assert!(st.fail(2, 1.0, FailureMode::Tensile));
+        assert!(!st.fail(2, 2.0, FailureMode::Shear));
+        assert_eq!(st.count(), 1);
+        assert_eq!(
+            st.log()[0],
+            Failure {
+                cell: 2,
+                time: 1.0,
+                mode: FailureMode::Tensile
+            }
+        );
+        assert_eq!(st.flags(), &[false, false, true, false]);
+    }
+}
