@@ -358,6 +358,14 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
             ));
         }
     }
+    if let Some(f) = &s.physics.failure_stress {
+        if f != "cell" && f != "recovered" {
+            return Err(ls.error(
+                &k(&["physics", "failure_stress"]),
+                format!("= \"{f}\" must be \"cell\" or \"recovered\""),
+            ));
+        }
+    }
     if let Some(m) = &s.solver.mechanics {
         if m != "direct" && m != "explicit" {
             return Err(ls.error(

@@ -8,6 +8,10 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
+use porofrac_frac::recovery::{NodeCells, cell_average, recover_nodal};
+use porofrac_frac::{
+    Combined, FailurePolicy, FailureState, MohrCoulomb, ResolveError, Tensile, resolve,
+};
 use porofrac_grid::generate::{CompositeSpec, cartesian, composite, perturb, simplices, voronoi};
 use porofrac_grid::io::{Field, PvdWriter, read_msh, read_vtu, write_vtu};
 use porofrac_grid::{Grid, GridError, Point};
@@ -43,6 +47,9 @@ pub enum RunError {
     /// Writing output failed.
     #[error("output: {0}")]
     Output(#[from] OutputError),
+    /// Failures did not settle within a step.
+    #[error("fracture: {0}")]
+    Fracture(String),
     /// A plot could not be drawn.
     #[error("plot: {0}")]
     Plot(#[from] crate::plots::PlotError),
@@ -267,12 +274,6 @@ fn check_supported(ls: &LoadedScene) -> Result<(), RunError> {
     if s.physics.flow == Some(true) {
         return Err(unsupported(k(&["physics", "flow"]), "= true: flow"));
     }
-    if s.physics.fracture == Some(true) {
-        return Err(unsupported(
-            k(&["physics", "fracture"]),
-            "= true: fracturing",
-        ));
-    }
     if let Some(c) = &s.physics.coupling {
         if c != "none" {
             return Err(unsupported(
@@ -313,6 +314,11 @@ struct Composition<const D: usize> {
     keys: Vec<(String, String)>,
     laws: Vec<Box<dyn CellLaw<D>>>,
     law_of_cell: Vec<usize>,
+    /// For each law instance: the instance a failed cell switches to (MDEM and DEM cells
+    /// become compression-only DEM, seed eqs. 32–33; VEM cells keep their law).
+    post_failure: Vec<usize>,
+    /// For each law instance: the failure criterion of its material.
+    criteria: Vec<Combined>,
 }
 
 fn compose<const D: usize>(ls: &LoadedScene, grid: &Grid<D>) -> Result<Composition<D>, RunError> {
@@ -389,10 +395,50 @@ fn compose<const D: usize>(ls: &LoadedScene, grid: &Grid<D>) -> Result<Compositi
         };
         law_of_cell[c] = idx;
     }
+    let fracture = s.physics.fracture == Some(true);
+    let mut criteria = Vec::new();
+    for (law, mat) in &keys {
+        let m = &s.material[mat];
+        let mut c = Combined::default();
+        if fracture {
+            if let Some(t) = m.tensile_strength {
+                c.tensile = Some(
+                    Tensile::new(t)
+                        .map_err(|e| ls.error(&k(&["material", mat, "tensile_strength"]), e))?,
+                );
+            }
+            if let (Some(coh), Some(phi)) = (m.cohesion, m.friction_angle) {
+                c.shear = Some(
+                    MohrCoulomb::new(coh, phi)
+                        .map_err(|e| ls.error(&k(&["material", mat, "cohesion"]), e))?,
+                );
+            }
+        }
+        let _ = law;
+        criteria.push(c);
+    }
+    let mut post_failure: Vec<usize> = (0..keys.len()).collect();
+    for i in 0..keys.len() {
+        if criteria[i].is_empty() || (keys[i].0 != "mdem" && keys[i].0 != "dem") {
+            continue;
+        }
+        let m = &s.material[&keys[i].1];
+        let stiffness = Stiffness::<D>::isotropic(m.youngs_modulus, m.poisson_ratio)
+            .map_err(|e| ls.error(&k(&["material", &keys[i].1]), e))?;
+        let dem = porofrac_mdem::DemLaw::new(&stiffness, porofrac_mdem::DemMode::CompressionOnly)
+            .map_err(|e| ls.error(&k(&["material", &keys[i].1]), e))?;
+        post_failure[i] = laws.len();
+        keys.push(("dem-compression".into(), keys[i].1.clone()));
+        laws.push(Box::new(dem));
+        criteria.push(Combined::default());
+        post_failure.push(laws.len() - 1);
+    }
     Ok(Composition {
         keys,
         laws,
         law_of_cell,
+        post_failure,
+        criteria,
     })
 }
 
@@ -505,7 +551,13 @@ fn principal<const D: usize>(s: &Tensor<D>) -> (f64, f64) {
 }
 
 /// The value of a named field at a located point.
-fn sample<const D: usize>(field: &str, loc: &Location, u: &[f64], stress: &[Tensor<D>]) -> f64 {
+fn sample<const D: usize>(
+    field: &str,
+    loc: &Location,
+    u: &[f64],
+    stress: &[Tensor<D>],
+    failed: &[bool],
+) -> f64 {
     let s = &stress[loc.cell];
     let comp = |a: usize, b: usize| if a < D && b < D { s[(a, b)] } else { 0.0 };
     match field {
@@ -520,7 +572,7 @@ fn sample<const D: usize>(field: &str, loc: &Location, u: &[f64], stress: &[Tens
         "sxz" => comp(0, 2),
         "smax" => principal(s).0,
         "smin" => principal(s).1,
-        _ => 0.0, // "fractured": no cell fails in a scene without fracturing
+        _ => f64::from(u8::from(failed[loc.cell])), // "fractured"
     }
 }
 
@@ -535,19 +587,24 @@ fn run_dim<const D: usize>(
     let comp = compose(ls, grid)?;
     let cond = conditions(ls, grid, &comp)?;
     let law_refs: Vec<&dyn CellLaw<D>> = comp.laws.iter().map(|l| l.as_ref()).collect();
-    let laws = LawMap::new(grid, law_refs, comp.law_of_cell.clone())?;
+    // Checks every cell against its law once (e.g. MDEM on a polygon is an error).
+    LawMap::new(grid, law_refs.clone(), comp.law_of_cell.clone())?;
+    let law_of = |flags: &[bool]| -> Vec<usize> {
+        comp.law_of_cell
+            .iter()
+            .zip(flags)
+            .map(|(&l, &f)| if f { comp.post_failure[l] } else { l })
+            .collect()
+    };
+    let fracture_on = comp.criteria.iter().any(|c| !c.is_empty());
+    let recovered = s.physics.failure_stress.as_deref() == Some("recovered");
+    let adjacency = (fracture_on && recovered).then(|| NodeCells::new(grid));
+    let mut failures = FailureState::new(grid.num_cells());
     let t_asm = Instant::now();
     let dofs = DofMap::new(grid, &cond.displacements, &cond.platens)?;
     let pattern = Pattern::new(grid, &dofs)?;
     let mut solver = DirectSolver::new(&pattern)?;
     wall.assembly += t_asm.elapsed().as_secs_f64();
-    let problem = StaticProblem {
-        grid,
-        laws: &laws,
-        dofs: &dofs,
-        pattern: &pattern,
-        loads: &cond.loads,
-    };
     let options = StaticOptions {
         tolerance: s.solver.tolerance.unwrap_or(1e-10),
         ..StaticOptions::default()
@@ -619,7 +676,9 @@ fn run_dim<const D: usize>(
     let mut fracture_header = vec!["cell".to_string()];
     fracture_header.extend(axes[..D].iter().map(|a| a.to_string()));
     fracture_header.extend(["time".to_string(), "mode".to_string()]);
-    CsvTable::new(out.join("fracture.csv"), &fracture_header).flush()?;
+    let mut fracture_csv = CsvTable::new(out.join("fracture.csv"), &fracture_header);
+    fracture_csv.flush()?;
+    let mut logged = 0;
     if s.output.vtk {
         std::fs::create_dir_all(out.join("vtk")).map_err(|source| OutputError {
             path: out.join("vtk"),
@@ -635,7 +694,6 @@ fn run_dim<const D: usize>(
     };
 
     let law_ids: Vec<i32> = comp.law_of_cell.iter().map(|&l| l as i32).collect();
-    let fractured = vec![0i32; grid.num_cells()];
     let mut series: Vec<Vec<f64>> = vec![Vec::new(); s.output.probe.len()];
     let mut written_times = Vec::new();
     let mut stats = SolverStats {
@@ -653,21 +711,60 @@ fn run_dim<const D: usize>(
                 vec![Tensor::<D>::zeros(); grid.num_cells()],
             )
         } else {
-            let t_solve = Instant::now();
-            let sol = solve_static(&problem, &mut solver, t, &options)?;
-            wall.solve += t_solve.elapsed().as_secs_f64();
-            stats.max_relative_residual = stats.max_relative_residual.max(sol.residual);
-            let t_asm = Instant::now();
-            let stress = cell_stresses(grid, &laws, &sol.displacement)?;
-            wall.assembly += t_asm.elapsed().as_secs_f64();
-            (sol.displacement, stress)
+            let solve = |flags: &FailureState| -> Result<((Vec<f64>, Vec<Tensor<D>>), Vec<Tensor<D>>), RunError> {
+                let laws = LawMap::new(grid, law_refs.clone(), law_of(flags.flags()))?;
+                let problem = StaticProblem {
+                    grid,
+                    laws: &laws,
+                    dofs: &dofs,
+                    pattern: &pattern,
+                    loads: &cond.loads,
+                };
+                let t_solve = Instant::now();
+                let sol = solve_static(&problem, &mut solver, t, &options)?;
+                wall.solve += t_solve.elapsed().as_secs_f64();
+                stats.max_relative_residual = stats.max_relative_residual.max(sol.residual);
+                let t_asm = Instant::now();
+                let stress = cell_stresses(grid, &laws, &sol.displacement)?;
+                let measure = match &adjacency {
+                    Some(adj) => cell_average(grid, &recover_nodal(grid, adj, &stress)),
+                    None => stress.clone(),
+                };
+                wall.assembly += t_asm.elapsed().as_secs_f64();
+                Ok(((sol.displacement, stress), measure))
+            };
+            let class: Vec<usize> = comp.law_of_cell.clone();
+            let (solution, _, _, _) = resolve(
+                &mut failures,
+                t,
+                &comp.criteria,
+                &class,
+                FailurePolicy::default(),
+                if fracture_on { 200 } else { 1 },
+                solve,
+            )
+            .map_err(|e| match e {
+                ResolveError::Solve(e) => e,
+                other => RunError::Fracture(other.to_string()),
+            })?;
+            solution
         };
+        for f in &failures.log()[logged..] {
+            let x = grid.cell_centroid(f.cell);
+            let mut row = vec![f.cell.to_string()];
+            row.extend(x.iter().map(|v| v.to_string()));
+            row.push(f.time.to_string());
+            row.push(f.mode.as_str().to_string());
+            fracture_csv.push_text(&row)?;
+        }
+        logged = failures.count();
+        let fractured: Vec<i32> = failures.flags().iter().map(|&f| f as i32).collect();
         let write = step == 0 || step % s.output.every as usize == 0 || step + 1 == all_times.len();
         if write {
             let t_out = Instant::now();
             let mut row = vec![t];
             for (j, (p, loc)) in s.output.probe.iter().zip(&probe_locs).enumerate() {
-                let v = sample(&p.field, loc, &u, &stress);
+                let v = sample(&p.field, loc, &u, &stress, failures.flags());
                 series[j].push(v);
                 row.push(v);
             }
@@ -676,7 +773,7 @@ fn run_dim<const D: usize>(
                 for (dist, x, loc) in pts {
                     let mut r = vec![t, *dist];
                     r.extend(x.iter().copied());
-                    r.push(sample(&l.field, loc, &u, &stress));
+                    r.push(sample(&l.field, loc, &u, &stress, failures.flags()));
                     table.push(&r)?;
                 }
             }
@@ -731,7 +828,7 @@ fn run_dim<const D: usize>(
             )?;
         }
         if let (Some((u, stress)), Some(g2)) = (&last, as_2d(grid)) {
-            let marked = vec![false; g2.num_cells()];
+            let marked = failures.flags().to_vec();
             let n = g2.num_cells();
             let cell_mean = |a: usize| -> Vec<f64> {
                 (0..n)
@@ -772,7 +869,7 @@ fn run_dim<const D: usize>(
         dofs: dofs.num_equations(),
         steps,
         status: "ok".into(),
-        fractured_cells: 0,
+        fractured_cells: failures.count(),
         wall_seconds: wall,
         peak_memory_bytes: 0,
         solver: stats,

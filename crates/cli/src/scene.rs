@@ -278,6 +278,9 @@ pub struct Physics {
     pub coupling: Option<String>,
     /// Check failure criteria.
     pub fracture: Option<bool>,
+    /// Stress the failure criteria see: `"cell"` (default, the cell law's stress) or
+    /// `"recovered"` (patch-recovered nodal stress averaged over the cell).
+    pub failure_stress: Option<String>,
 }
 
 /// `[solver]`.

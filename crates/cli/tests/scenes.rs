@@ -318,3 +318,45 @@ fn missing_mesh_file_and_misuse() {
     assert_eq!(code, 0);
     assert!(out.contains("ok"));
 }
+
+/// `scenes/tension_band.toml`: σyy = E/(1 − ν²)·1e-4·t until the weak band fails at the
+/// first step with σyy > 5e5 Pa (t = 5 s); all 20 band triangles fail then, in tension,
+/// and the plate carries no stress afterwards (|σyy| < 1e-6 of the pre-failure value).
+#[test]
+fn tension_band_fails_at_the_predicted_time() {
+    let out = tmp_dir("band");
+    let scene = root().join("scenes/tension_band.toml");
+    let (code, _, err) = porofrac(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let e_prime = 1e9 / (1.0 - 0.25f64 * 0.25);
+    let (_, rows) = read_csv(&out.join("probes.csv"));
+    assert_eq!(rows.len(), 9);
+    for r in &rows {
+        let t = r[0];
+        if t < 5.0 {
+            assert!(close(r[1], e_prime * 1e-4 * t, 1e5, 1e-10), "{r:?}");
+            assert_eq!(r[2], 0.0);
+        } else {
+            assert!(r[1].abs() < 1e-6 * 5e5, "{r:?}");
+            assert_eq!(r[2], 1.0);
+        }
+    }
+    let text = std::fs::read_to_string(out.join("fracture.csv")).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines[0], "cell,x,y,time,mode");
+    assert_eq!(lines.len(), 21);
+    for l in &lines[1..] {
+        let f: Vec<&str> = l.split(',').collect();
+        let y: f64 = f[2].parse().unwrap();
+        assert!((0.4..=0.5).contains(&y), "{l}");
+        assert_eq!((f[3], f[4]), ("5", "tensile"));
+    }
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["fractured_cells"], 20);
+}

@@ -5,6 +5,8 @@
 //!   `max σ > σ_tens`) and [`MohrCoulomb`]; [`Combined`] checks several and reports the
 //!   first mode that fails.
 //! * [`FailureState`]: which cells have failed, when and how. Failure is irreversible.
+//! * [`resolve`]: the loop that solves, checks, fails and re-solves within a time step
+//!   until the state is consistent.
 //! * [`recovery`]: superconvergent patch recovery (Zienkiewicz–Zhu) of nodal stresses
 //!   from cell stresses on any grid (seed Fig. 5), and cell values from the recovered
 //!   nodal field, so a criterion can be evaluated on a smoother stress near a tip.
@@ -13,6 +15,9 @@
 //! cell switches to the compression-only central-force law (seed eqs. 32–33).
 
 pub mod recovery;
+pub mod resolve;
+
+pub use resolve::{FailurePolicy, ResolveError, resolve};
 
 use porofrac_law::Tensor;
 

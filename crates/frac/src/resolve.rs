@@ -1,0 +1,214 @@
+//! Resolving failures within one time step.
+//!
+//! Failure changes the stiffness, which changes the stress, which may fail more cells. At
+//! a given time the loop is: solve with the current failure state, evaluate the criteria
+//! on the cells that have not failed, fail the most critical ones, solve again, until no
+//! cell fails (a consistent state: no half-updated steps). Which cells fail per round is a
+//! [`FailurePolicy`]; the default fails, per round, every violating cell whose utilization
+//! is within 1 % of the largest, so symmetric states fail together while a redistributed
+//! stress gets the chance to relieve neighbours.
+
+use porofrac_law::Tensor;
+
+use crate::{Combined, FailureCriterion, FailureState};
+
+/// Which violating cells fail in one round.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FailurePolicy {
+    /// Every cell that violates its criterion.
+    All,
+    /// Violating cells with utilization ≥ `fraction` × the largest utilization.
+    MostCritical {
+        /// In (0, 1].
+        fraction: f64,
+    },
+}
+
+impl Default for FailurePolicy {
+    fn default() -> Self {
+        FailurePolicy::MostCritical { fraction: 0.99 }
+    }
+}
+
+/// An error of [`resolve`]: the solver's, or too many rounds.
+#[derive(Debug, thiserror::Error)]
+pub enum ResolveError<E> {
+    /// The solve failed.
+    #[error("{0}")]
+    Solve(E),
+    /// Failures kept appearing after `rounds` solves.
+    #[error(
+        "failures did not settle within {rounds} solves at t = {time} s ({failed} cells failed)"
+    )]
+    NotSettled {
+        /// Solves done.
+        rounds: usize,
+        /// The time.
+        time: f64,
+        /// Cells failed so far.
+        failed: usize,
+    },
+}
+
+/// Solve, check, fail and re-solve at time `time` until no cell fails.
+///
+/// `criteria[k]` is the criterion of class `k` and `criterion_of_cell[c]` the class of
+/// cell `c` (an empty [`Combined`] never fails). `solve` gets the current state and
+/// returns a solution and the cell stresses (effective, tension positive) used by the
+/// criteria, e.g. raw or recovered cell stresses.
+pub fn resolve<const D: usize, S, E>(
+    state: &mut FailureState,
+    time: f64,
+    criteria: &[Combined],
+    criterion_of_cell: &[usize],
+    policy: FailurePolicy,
+    max_solves: usize,
+    mut solve: impl FnMut(&FailureState) -> Result<(S, Vec<Tensor<D>>), E>,
+) -> Result<(S, Vec<Tensor<D>>, usize, usize), ResolveError<E>> {
+    // Returns the solution, its cell stresses, the cells failed here and the solves done.
+    let mut new_failures = 0;
+    for round in 1..=max_solves {
+        let (solution, stress) = solve(state).map_err(ResolveError::Solve)?;
+        let mut violating: Vec<(usize, f64, crate::FailureMode)> = Vec::new();
+        for (c, s) in stress.iter().enumerate() {
+            if state.is_failed(c) {
+                continue;
+            }
+            let crit = &criteria[criterion_of_cell[c]];
+            if let Some(mode) = FailureCriterion::<D>::check(crit, s) {
+                violating.push((c, FailureCriterion::<D>::utilization(crit, s), mode));
+            }
+        }
+        if violating.is_empty() {
+            return Ok((solution, stress, new_failures, round));
+        }
+        let threshold = match policy {
+            FailurePolicy::All => f64::NEG_INFINITY,
+            FailurePolicy::MostCritical { fraction } => {
+                fraction
+                    * violating
+                        .iter()
+                        .map(|v| v.1)
+                        .fold(f64::NEG_INFINITY, f64::max)
+            }
+        };
+        for &(c, u, mode) in &violating {
+            if u >= threshold && state.fail(c, time, mode) {
+                new_failures += 1;
+            }
+        }
+    }
+    Err(ResolveError::NotSettled {
+        rounds: max_solves,
+        time,
+        failed: state.count(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{FailureMode, Tensile};
+
+    /// A chain of springs in series under a prescribed total stretch: the stress is the
+    /// same in every intact cell; a failed cell carries nothing, so after the weakest cell
+    /// fails all stresses vanish and no further cell fails.
+    #[test]
+    fn weakest_link_fails_alone() {
+        let strengths = [3.0, 2.0, 2.5, 4.0];
+        let criteria: Vec<Combined> = strengths
+            .iter()
+            .map(|&s| Combined {
+                tensile: Some(Tensile::new(s).unwrap()),
+                shear: None,
+            })
+            .collect();
+        let class: Vec<usize> = (0..4).collect();
+        let mut st = FailureState::new(4);
+        let load = 2.2;
+        let (sol, stress, n, solves) = resolve::<2, f64, ()>(
+            &mut st,
+            5.0,
+            &criteria,
+            &class,
+            FailurePolicy::default(),
+            10,
+            |st| {
+                let broken = st.flags().iter().any(|&f| f);
+                let s = if broken { 0.0 } else { load };
+                Ok((s, vec![Tensor::<2>::new(s, 0.0, 0.0, 0.0); 4]))
+            },
+        )
+        .unwrap();
+        assert_eq!((n, solves), (1, 2));
+        assert_eq!(sol, 0.0);
+        assert_eq!(stress[0][(0, 0)], 0.0);
+        assert_eq!(
+            st.log(),
+            &[crate::Failure {
+                cell: 1,
+                time: 5.0,
+                mode: FailureMode::Tensile
+            }]
+        );
+    }
+
+    #[test]
+    fn policy_all_fails_every_violator_and_rounds_are_bounded() {
+        let criteria = vec![Combined {
+            tensile: Some(Tensile::new(1.0).unwrap()),
+            shear: None,
+        }];
+        let class = vec![0; 3];
+        let mut st = FailureState::new(3);
+        let stresses = [1.5, 3.0, 0.5];
+        let (_, _, n, _) = resolve::<2, (), ()>(
+            &mut st,
+            0.0,
+            &criteria,
+            &class,
+            FailurePolicy::All,
+            5,
+            |_| {
+                Ok((
+                    (),
+                    stresses
+                        .iter()
+                        .map(|&s| Tensor::<2>::new(s, 0.0, 0.0, 0.0))
+                        .collect(),
+                ))
+            },
+        )
+        .unwrap();
+        assert_eq!(n, 2);
+        assert_eq!(st.flags(), &[true, true, false]);
+        // MostCritical with fraction 0.99 fails only cell 1 per round; one round allowed.
+        let mut st = FailureState::new(3);
+        let err = resolve::<2, (), ()>(
+            &mut st,
+            0.0,
+            &criteria,
+            &class,
+            FailurePolicy::default(),
+            1,
+            |_| {
+                Ok((
+                    (),
+                    stresses
+                        .iter()
+                        .map(|&s| Tensor::<2>::new(s, 0.0, 0.0, 0.0))
+                        .collect(),
+                ))
+            },
+        )
+        .unwrap_err();
+        assert!(matches!(
+            err,
+            ResolveError::NotSettled {
+                rounds: 1,
+                failed: 1,
+                ..
+            }
+        ));
+    }
+}
