@@ -543,6 +543,9 @@ fn times(ls: &LoadedScene) -> Vec<f64> {
     t
 }
 
+/// Nodal displacements and cell stresses.
+type State<const D: usize> = (Vec<f64>, Vec<Tensor<D>>);
+
 /// Principal stresses (largest, smallest) of a symmetric tensor.
 fn principal<const D: usize>(s: &Tensor<D>) -> (f64, f64) {
     let m = nalgebra::DMatrix::from_fn(D, D, |i, j| s[(i, j)]);
@@ -711,7 +714,7 @@ fn run_dim<const D: usize>(
                 vec![Tensor::<D>::zeros(); grid.num_cells()],
             )
         } else {
-            let solve = |flags: &FailureState| -> Result<((Vec<f64>, Vec<Tensor<D>>), Vec<Tensor<D>>), RunError> {
+            let solve = |flags: &FailureState| -> Result<(State<D>, Vec<Tensor<D>>), RunError> {
                 let laws = LawMap::new(grid, law_refs.clone(), law_of(flags.flags()))?;
                 let problem = StaticProblem {
                     grid,
