@@ -5,6 +5,7 @@
 
 pub mod check;
 pub mod expr;
+pub mod flowsetup;
 pub mod output;
 pub mod plots;
 pub mod run;

@@ -50,6 +50,9 @@ pub enum RunError {
     /// Failures did not settle within a step.
     #[error("fracture: {0}")]
     Fracture(String),
+    /// The flow model could not be built or solved.
+    #[error("flow: {0}")]
+    Flow(String),
     /// A plot could not be drawn.
     #[error("plot: {0}")]
     Plot(#[from] crate::plots::PlotError),
@@ -202,7 +205,7 @@ fn component(ls: &LoadedScene, v: &NumOrExpr) -> Option<ScalarField> {
 }
 
 /// Which cells a selection picks (by centroid).
-fn select_cells<const D: usize>(
+pub(crate) fn select_cells<const D: usize>(
     ls: &LoadedScene,
     i: usize,
     grid: &Grid<D>,
@@ -271,9 +274,6 @@ fn check_supported(ls: &LoadedScene) -> Result<(), RunError> {
         )
         .into()
     };
-    if s.physics.flow == Some(true) {
-        return Err(unsupported(k(&["physics", "flow"]), "= true: flow"));
-    }
     if let Some(c) = &s.physics.coupling {
         if c != "none" {
             return Err(unsupported(
@@ -294,16 +294,27 @@ fn check_supported(ls: &LoadedScene) -> Result<(), RunError> {
             "= \"cg-amg\": the AMG solver",
         ));
     }
+    let flow = s.physics.flow == Some(true);
     for (i, bc) in s.bc.iter().enumerate() {
-        if bc.pressure.is_some() || bc.flux.is_some() {
-            return Err(unsupported(
-                ki("bc", i, &["pressure"]),
-                "flow boundary conditions",
-            ));
+        if !flow && (bc.pressure.is_some() || bc.flux.is_some()) {
+            return Err(ls
+                .error(
+                    &ki("bc", i, &["pressure"]),
+                    "is a flow condition: set [physics] flow = true",
+                )
+                .into());
         }
     }
-    if !s.source.is_empty() {
-        return Err(unsupported(ki("source", 0, &[]), "a fluid source"));
+    if !flow && !s.source.is_empty() {
+        return Err(ls
+            .error(&ki("source", 0, &[]), "needs [physics] flow = true")
+            .into());
+    }
+    if flow && s.physics.coupling.as_deref() != Some("none") {
+        return Err(unsupported(
+            k(&["physics", "coupling"]),
+            "coupled flow (monolithic, fixed-stress, explicit-pressure); set coupling = \"none\" for flow on a fixed skeleton,",
+        ));
     }
     Ok(())
 }
@@ -560,6 +571,7 @@ fn sample<const D: usize>(
     u: &[f64],
     stress: &[Tensor<D>],
     failed: &[bool],
+    pressure: Option<&[f64]>,
 ) -> f64 {
     let s = &stress[loc.cell];
     let comp = |a: usize, b: usize| if a < D && b < D { s[(a, b)] } else { 0.0 };
@@ -575,6 +587,7 @@ fn sample<const D: usize>(
         "sxz" => comp(0, 2),
         "smax" => principal(s).0,
         "smin" => principal(s).1,
+        "pressure" => pressure.map_or(f64::NAN, |p| p[loc.cell]),
         _ => f64::from(u8::from(failed[loc.cell])), // "fractured"
     }
 }
@@ -603,6 +616,21 @@ fn run_dim<const D: usize>(
     let recovered = s.physics.failure_stress.as_deref() == Some("recovered");
     let adjacency = (fracture_on && recovered).then(|| NodeCells::new(grid));
     let mut failures = FailureState::new(grid.num_cells());
+    let flow_on = s.physics.flow == Some(true);
+    let material_of_cell: Vec<&str> = comp
+        .law_of_cell
+        .iter()
+        .map(|&l| comp.keys[l].1.as_str())
+        .collect();
+    let mut flow = if flow_on {
+        let t_flow = Instant::now();
+        let f = crate::flowsetup::flow_setup(ls, grid, &material_of_cell)?;
+        wall.flow += t_flow.elapsed().as_secs_f64();
+        Some(f)
+    } else {
+        None
+    };
+    let mut pressure: Option<Vec<f64>> = flow.as_ref().map(|f| f.p0.clone());
     let t_asm = Instant::now();
     let dofs = DofMap::new(grid, &cond.displacements, &cond.platens)?;
     let pattern = Pattern::new(grid, &dofs)?;
@@ -616,7 +644,7 @@ fn run_dim<const D: usize>(
     // Probes and lines are located once.
     let mut probe_locs = Vec::new();
     for (i, p) in s.output.probe.iter().enumerate() {
-        if p.field == "pressure" {
+        if p.field == "pressure" && !flow_on {
             return Err(ls
                 .error(
                     &ki("output.probe", i, &["field"]),
@@ -634,7 +662,7 @@ fn run_dim<const D: usize>(
     }
     let mut line_locs: Vec<Vec<(f64, Point<D>, Location)>> = Vec::new();
     for (i, l) in s.output.line.iter().enumerate() {
-        if l.field == "pressure" {
+        if l.field == "pressure" && !flow_on {
             return Err(ls
                 .error(
                     &ki("output.line", i, &["field"]),
@@ -762,12 +790,29 @@ fn run_dim<const D: usize>(
         }
         logged = failures.count();
         let fractured: Vec<i32> = failures.flags().iter().map(|&f| f as i32).collect();
+        if let (Some(f), Some(p), true) = (flow.as_mut(), pressure.as_mut(), step > 0) {
+            let t_flow = Instant::now();
+            let t_prev = all_times[step - 1];
+            let res = f
+                .model
+                .step(p, t - t_prev, t_prev)
+                .map_err(|e| RunError::Flow(e.to_string()))?;
+            *p = res.pressure;
+            wall.flow += t_flow.elapsed().as_secs_f64();
+        }
         let write = step == 0 || step % s.output.every as usize == 0 || step + 1 == all_times.len();
         if write {
             let t_out = Instant::now();
             let mut row = vec![t];
             for (j, (p, loc)) in s.output.probe.iter().zip(&probe_locs).enumerate() {
-                let v = sample(&p.field, loc, &u, &stress, failures.flags());
+                let v = sample(
+                    &p.field,
+                    loc,
+                    &u,
+                    &stress,
+                    failures.flags(),
+                    pressure.as_deref(),
+                );
                 series[j].push(v);
                 row.push(v);
             }
@@ -776,7 +821,14 @@ fn run_dim<const D: usize>(
                 for (dist, x, loc) in pts {
                     let mut r = vec![t, *dist];
                     r.extend(x.iter().copied());
-                    r.push(sample(&l.field, loc, &u, &stress, failures.flags()));
+                    r.push(sample(
+                        &l.field,
+                        loc,
+                        &u,
+                        &stress,
+                        failures.flags(),
+                        pressure.as_deref(),
+                    ));
                     table.push(&r)?;
                 }
             }
@@ -786,15 +838,19 @@ fn run_dim<const D: usize>(
                     .map(|n| Point::<D>::from_column_slice(&u[D * n..D * n + D]))
                     .collect();
                 let sym: Vec<[f64; 6]> = stress.iter().map(vtk_sym).collect();
+                let mut cell_data = vec![
+                    ("stress", Field::SymTensors(&sym)),
+                    ("law", Field::Ints(&law_ids)),
+                    ("fractured", Field::Ints(&fractured)),
+                ];
+                if let Some(p) = pressure.as_deref() {
+                    cell_data.push(("pressure", Field::Scalars(p)));
+                }
                 write_vtu(
                     out.join("vtk").join(&name),
                     grid,
                     &[("displacement", Field::Vectors(&disp))],
-                    &[
-                        ("stress", Field::SymTensors(&sym)),
-                        ("law", Field::Ints(&law_ids)),
-                        ("fractured", Field::Ints(&fractured)),
-                    ],
+                    &cell_data,
                 )?;
                 pvd.add(t, format!("vtk/{name}"))?;
             }
@@ -841,7 +897,7 @@ fn run_dim<const D: usize>(
                     })
                     .collect()
             };
-            let plots: Vec<(&str, Vec<f64>)> = vec![
+            let mut plots: Vec<(&str, Vec<f64>)> = vec![
                 ("ux", cell_mean(0)),
                 ("uy", cell_mean(1)),
                 ("sxx", stress.iter().map(|s| s[(0, 0)]).collect()),
@@ -850,6 +906,9 @@ fn run_dim<const D: usize>(
                 ("smax", stress.iter().map(|s| principal(s).0).collect()),
                 ("smin", stress.iter().map(|s| principal(s).1).collect()),
             ];
+            if let Some(p) = &pressure {
+                plots.push(("pressure", p.clone()));
+            }
             let t_last = written_times.last().copied().unwrap_or(0.0);
             for (name, vals) in plots {
                 crate::plots::cell_field(

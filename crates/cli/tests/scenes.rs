@@ -360,3 +360,40 @@ fn tension_band_fails_at_the_predicted_time() {
         serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
     assert_eq!(summary["fractured_cells"], 20);
 }
+
+/// `scenes/flow_column.toml`: pressure diffusion on a fixed skeleton (coupling "none"),
+/// drained top, closed bottom. Every sampled cell pressure at t = 10, 20, 30 s matches the
+/// Fourier series within 0.5 % of p0 (implicit Euler with Δt = 0.25 s, 100 cells).
+#[test]
+fn flow_column_matches_the_fourier_series() {
+    let out = tmp_dir("flow");
+    let scene = root().join("scenes/flow_column.toml");
+    let (code, _, err) = porofrac(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let (p0, h, c) = (1e7, 10.0, 1e-13 / (1e-3 * 0.3 * 1e-9));
+    let exact = |y: f64, t: f64| -> f64 {
+        (0..200)
+            .map(|m| {
+                let k = (2 * m + 1) as f64 * std::f64::consts::PI;
+                4.0 / k * (k * (h - y) / (2.0 * h)).sin() * (-k * k * c * t / (4.0 * h * h)).exp()
+            })
+            .sum::<f64>()
+            * p0
+    };
+    let (_, rows) = read_csv(&out.join("lines/pressure.csv"));
+    let mut worst: f64 = 0.0;
+    for r in rows.iter().filter(|r| r[0] > 0.0) {
+        worst = worst.max((r[4] - exact(r[3], r[0])).abs() / p0);
+    }
+    assert_eq!(rows.len(), 4 * 100);
+    assert!(worst < 5e-3, "worst {worst:e}");
+    let (_, probes) = read_csv(&out.join("probes.csv"));
+    assert_eq!(probes[0][1], p0);
+    let vtu = std::fs::read_to_string(out.join("vtk/step_0003.vtu")).unwrap();
+    assert!(vtu.contains("Name=\"pressure\""));
+}
