@@ -37,8 +37,10 @@
 
 pub mod assembly;
 pub mod bc;
+pub mod biot;
 pub mod dofs;
 pub mod error;
+pub mod explicit;
 pub mod field;
 pub mod laws;
 pub mod pattern;
@@ -47,8 +49,13 @@ pub mod solve;
 
 pub use assembly::{assemble, nodal_loads};
 pub use bc::{Displacement, Gravity, Loads, Platen, Traction};
+pub use biot::{
+    BiotCoupling, BiotError, BiotState, BiotStep, BiotSystem, ExplicitPressure, FixedStress,
+    Monolithic, drained_bulk_modulus,
+};
 pub use dofs::DofMap;
 pub use error::{Result, SimError};
+pub use explicit::{ExplicitOptions, ExplicitSolution, ExplicitState, solve_explicit};
 pub use field::{FieldFn, ScalarField};
 pub use laws::LawMap;
 pub use pattern::Pattern;

@@ -1,0 +1,1196 @@
+//! Biot poroelasticity: the coupling of the mechanics of this crate with the TPFA flow of
+//! `porofrac-flow` (seed §2.5, eqs. 28–30).
+//!
+//! # Continuous model and sign convention
+//!
+//! Tension is positive. With `u` the displacement, `p` the pore pressure, `p₀` the initial
+//! pore pressure (in equilibrium, it does not deform the rock: the coupling acts on
+//! `p − p₀`), `σ'` the effective stress of the cell laws and α the Biot–Willis
+//! coefficient, the total stress is `σ = σ' − α (p − p₀) I` and (seed eq. 28)
+//!
+//! ```text
+//!   ∇·σ + f = 0,      ∂/∂t (S p + α ∇·u) − ∇·(k/μ ∇p) = q .
+//! ```
+//!
+//! # Discrete operators
+//!
+//! The discrete divergence of seed eq. 30 is the exact volume change of the first-order
+//! VEM projection: with `N_i = ∫_∂K φ_i n dS` ([`porofrac_grid::Grid::cell_node_normals`]),
+//!
+//! ```text
+//!   ΔV_K(u) = Σ_{i ∈ K} N_i · u_i = |K| tr ε(Π u) = ∫_K ∇·(Π u) dx ,
+//! ```
+//!
+//! exact for every linear field ([`BiotSystem::volume_change`]). The coupling matrix is
+//! `C_{K,(i,a)} = α_K N_{i,a}` (cells × dofs), so `C u` is α times the volume change. The
+//! weak form of `−α (p − p₀) I` in the momentum balance is `−∫ α (p − p₀) ∇·v`, i.e. with a
+//! cell-wise constant pressure the nodal *pore-pressure force*
+//!
+//! ```text
+//!   f_i = Σ_{K ∋ i} α_K (p_K − p₀_K) N_i = (Cᵀ (p − p₀))_i
+//! ```
+//!
+//! ([`BiotSystem::pore_pressure_forces`]): the same `N_i` as the volume change, so the
+//! mechanics sees exactly the transpose of the flow's coupling block.
+//!
+//! # Time discretization (seed eqs. 29–30)
+//!
+//! Implicit Euler from `(uⁿ, pⁿ)` at `t` to `t + Δt`, with `K` the reduced stiffness,
+//! `M = diag(|K| S_K)` the accumulation, `A` the TPFA flux matrix and `b` the flow forcing
+//! of [`porofrac_flow::FlowModel`] and `g` the mechanical load vector at `t + Δt`:
+//!
+//! ```text
+//!   K u^{n+1} − Cᵀ (p^{n+1} − p₀)                          = g
+//!   C (u^{n+1} − uⁿ) + M (p^{n+1} − pⁿ) + Δt A p^{n+1}   = Δt b .
+//! ```
+//!
+//! The unknowns are the reduced displacements `x` and the pressure *increment*
+//! `δp = p^{n+1} − pⁿ`; the flow rows are multiplied by `−1`, giving the symmetric
+//! quasi-definite system
+//!
+//! ```text
+//!   [  K        −Cᵀ       ] [x ]   [ g + Cᵀ (pⁿ − p₀)                        ]
+//!   [ −C   −(M + Δt A)    ] [δp] = [ −Δt (b − A pⁿ) + C u_p^{n+1} − C uⁿ      ]
+//! ```
+//!
+//! (`u_p` the prescribed displacements). `K` is positive definite and `M + Δt A` positive
+//! definite as soon as every connected flow region has storage or a pressure anchor, so
+//! the matrix is *quasi-definite* and has an `LDLᵀ` factorization for every symmetric
+//! ordering (Vanderbei 1995): [`Monolithic`] uses faer's sparse `LDLᵀ` with an AMD
+//! ordering, the symbolic analysis done once. `Δt = 0` is allowed and gives the
+//! *undrained* response to an instantaneous load (no flux, `C δu + M δp = 0`); it needs
+//! `S > 0` in every cell (with `S = 0` the block system is a saddle point without the
+//! quasi-definite structure, and is rejected: take a small `Δt > 0` instead).
+//!
+//! **Scaling.** With `E ~ 1e9 Pa` and `p ~ 1e7 Pa` the blocks differ by many orders of
+//! magnitude. The pressure unknown is scaled, `δp = s y`, and the flow rows multiplied by
+//! `s`, which keeps the symmetry:
+//! `[[K, −s Cᵀ], [−s C, −s² (M + Δt A)]]`. The default
+//! `s = mean diag(K) / mean |C_{K,e}|` (units Pa/m) makes the coupling block as large as
+//! the stiffness; `s` is a pure change of variables, so the solution does not depend on it
+//! (tested to 1e-10).
+//!
+//! # Fixed-stress split
+//!
+//! [`FixedStress`] iterates flow then mechanics (Kim, Tchelepi & Juanes 2011; Mikelić &
+//! Wheeler 2013). Flow iteration `k + 1`, with the stabilisation `β_K = α_K² / K_dr,K`:
+//!
+//! ```text
+//!   (M + β|K| + Δt A) δp^{k+1} = Δt (b − A pⁿ) − C (u^k − uⁿ) + β|K| δp^k ,
+//! ```
+//!
+//! then the mechanics `K u^{k+1} = g + Cᵀ (pⁿ + δp^{k+1} − p₀)`, until both changes are
+//! below a tolerance. At convergence this is the monolithic system. `K_dr` is the drained
+//! bulk modulus of each cell's material: for an isotropic material
+//! `K_dr = λ + 2μ/D`, i.e. `λ + μ` in 2D plane strain (the in-plane bulk modulus relating
+//! the mean in-plane stress to the area change with `ε_zz = 0`) and `λ + 2μ/3` in 3D;
+//! [`drained_bulk_modulus`] computes `(1/D²) Σ_{a,b ≤ D} D_ab` of the Kelvin matrix,
+//! which is that value for isotropic materials and the Reuss-like mean-normal stiffness
+//! for anisotropic ones.
+//!
+//! # Explicit pressure update (seed §2.5)
+//!
+//! For explicit mechanics the seed keeps the volumetric term only in fractured cells and
+//! updates the pressure otherwise without feedback. [`ExplicitPressure::update_pressure`]
+//! takes `u^{n+1}`, `uⁿ`, `pⁿ` and the set `F` of fractured cells and solves
+//!
+//! ```text
+//!   (M + Δt A) (p^{n+1} − pⁿ) = Δt (b − A pⁿ) − Σ_{K ∈ F} α_K (ΔV_K(u^{n+1}) − ΔV_K(uⁿ)) e_K ,
+//! ```
+//!
+//! i.e. the flow is implicit in the fluxes (stable for any `Δt`, needed since fractured
+//! cells take a high permeability) and explicit in the coupling. As a [`BiotCoupling`] it
+//! is the staggered scheme: mechanics with `pⁿ`, then this update.
+//!
+//! # Restrictions
+//!
+//! The cell laws must be linear (the stiffness is assembled once); the pressure `p` and
+//! `p₀` are cell values, one per grid cell, in the flow model's cell order.
+
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::solvers::Solve;
+use faer::sparse::linalg::cholesky::{
+    CholeskySymbolicParams, LdltRef, SymbolicCholesky, SymmetricOrdering,
+    factorize_symbolic_cholesky,
+};
+use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::{Conj, MatMut, Par, Side};
+use porofrac_flow::{FlowError, FlowModel};
+use porofrac_grid::Point;
+use porofrac_law::Stiffness;
+
+use crate::assembly::{assemble, nodal_loads};
+use crate::error::SimError;
+use crate::solve::{DirectSolver, StaticProblem};
+
+/// Errors of the Biot coupling.
+#[derive(Debug, thiserror::Error)]
+pub enum BiotError {
+    /// An error of the mechanics (assembly, conditions, factorization).
+    #[error("mechanics: {0}")]
+    Mechanics(#[from] SimError),
+    /// An error of the flow model (boundary values, lengths).
+    #[error("flow: {0}")]
+    Flow(#[from] FlowError),
+    /// Invalid input: a length, a value out of range (naming what and where).
+    #[error("invalid input: {0}")]
+    Input(String),
+    /// A linear system is singular or its solution is inaccurate.
+    #[error("linear solve: {0}")]
+    Solver(String),
+    /// The fixed-stress iteration did not converge.
+    #[error(
+        "fixed-stress iteration did not converge in {iterations} iterations (last relative change {change:.3e})"
+    )]
+    NoConvergence {
+        /// Iterations done.
+        iterations: usize,
+        /// The last relative change.
+        change: f64,
+    },
+}
+
+/// Result alias of the Biot module.
+pub type BiotResult<T> = std::result::Result<T, BiotError>;
+
+/// Drained bulk modulus `K_dr = (1/D²) Σ_{a,b < D} D_ab` of a stiffness (Kelvin form):
+/// `λ + 2μ/D` for an isotropic material (`λ + μ` in 2D plane strain, `λ + 2μ/3` in 3D).
+pub fn drained_bulk_modulus<const D: usize>(stiffness: &Stiffness<D>) -> f64 {
+    let k = stiffness.kelvin();
+    let mut s = 0.0;
+    for a in 0..D {
+        for b in 0..D {
+            s += k[(a, b)];
+        }
+    }
+    s / (D * D) as f64
+}
+
+/// The mechanics and flow of one poroelastic problem, with the coupling operators.
+///
+/// Built once per grid, conditions and materials; the couplings ([`Monolithic`],
+/// [`FixedStress`], [`ExplicitPressure`]) take it by reference at every step.
+pub struct BiotSystem<'a, const D: usize> {
+    mech: StaticProblem<'a, D>,
+    flow: &'a FlowModel<D>,
+    alpha: Vec<f64>,
+    p0: Vec<f64>,
+    drained_bulk: Option<Vec<f64>>,
+    node_ptr: Vec<usize>,
+    normals: Vec<Point<D>>,
+    k_values: Vec<f64>,
+}
+
+impl<'a, const D: usize> BiotSystem<'a, D> {
+    /// Couple `mechanics` with `flow` through the Biot coefficient `alpha` (per cell, in
+    /// [0, 1]; it should equal the `biot_alpha` of the flow's rock, which sets its
+    /// storage) and the initial pressure `p0` (per cell).
+    ///
+    /// Errors: length mismatches, α out of range, a non-finite `p0`, a nonlinear cell
+    /// law, free rigid-body modes, or an assembly error.
+    pub fn new(
+        mechanics: StaticProblem<'a, D>,
+        flow: &'a FlowModel<D>,
+        alpha: Vec<f64>,
+        p0: Vec<f64>,
+    ) -> BiotResult<Self> {
+        let grid = mechanics.grid;
+        let nc = grid.num_cells();
+        if flow.num_cells() != nc {
+            return Err(BiotError::Input(format!(
+                "flow model has {} cells, grid has {nc}",
+                flow.num_cells()
+            )));
+        }
+        check_len("alpha", alpha.len(), nc)?;
+        check_len("initial pressure", p0.len(), nc)?;
+        if let Some(c) = alpha
+            .iter()
+            .position(|a| !(a.is_finite() && (0.0..=1.0).contains(a)))
+        {
+            return Err(BiotError::Input(format!(
+                "cell {c}: Biot coefficient must be in [0, 1], got {}",
+                alpha[c]
+            )));
+        }
+        if let Some(c) = p0.iter().position(|p| !p.is_finite()) {
+            return Err(BiotError::Input(format!(
+                "cell {c}: initial pressure is {}",
+                p0[c]
+            )));
+        }
+        if !mechanics.laws.all_linear() {
+            return Err(BiotError::Input(
+                "the Biot coupling needs linear cell laws (the stiffness is assembled once)".into(),
+            ));
+        }
+        mechanics.dofs.check_rigid_modes(grid)?;
+        let mut node_ptr = Vec::with_capacity(nc + 1);
+        node_ptr.push(0);
+        for c in 0..nc {
+            node_ptr.push(node_ptr[c] + grid.cell_nodes(c).len());
+        }
+        let mut normals = vec![Point::<D>::zeros(); node_ptr[nc]];
+        for c in 0..nc {
+            grid.cell_node_normals(c, &mut normals[node_ptr[c]..node_ptr[c + 1]]);
+        }
+        let mut k_values = vec![0.0; mechanics.pattern.nnz()];
+        let mut forces = vec![0.0; mechanics.dofs.num_equations()];
+        let u = vec![0.0; mechanics.dofs.num_dofs()];
+        assemble(
+            grid,
+            mechanics.laws,
+            mechanics.dofs,
+            mechanics.pattern,
+            &u,
+            &mut k_values,
+            &mut forces,
+        )?;
+        Ok(Self {
+            mech: mechanics,
+            flow,
+            alpha,
+            p0,
+            drained_bulk: None,
+            node_ptr,
+            normals,
+            k_values,
+        })
+    }
+
+    /// Set the drained bulk modulus of every cell (Pa, > 0), needed by [`FixedStress`]
+    /// (see [`drained_bulk_modulus`]).
+    pub fn with_drained_bulk_modulus(mut self, k_dr: Vec<f64>) -> BiotResult<Self> {
+        check_len("drained bulk modulus", k_dr.len(), self.num_cells())?;
+        if let Some(c) = k_dr.iter().position(|k| !(k.is_finite() && *k > 0.0)) {
+            return Err(BiotError::Input(format!(
+                "cell {c}: drained bulk modulus must be finite and > 0, got {}",
+                k_dr[c]
+            )));
+        }
+        self.drained_bulk = Some(k_dr);
+        Ok(self)
+    }
+
+    /// Number of cells (pressure unknowns).
+    pub fn num_cells(&self) -> usize {
+        self.alpha.len()
+    }
+    /// The mechanics problem.
+    pub fn mechanics(&self) -> &StaticProblem<'a, D> {
+        &self.mech
+    }
+    /// The flow model.
+    pub fn flow(&self) -> &FlowModel<D> {
+        self.flow
+    }
+    /// Biot coefficient per cell.
+    pub fn alpha(&self) -> &[f64] {
+        &self.alpha
+    }
+    /// Initial pressure per cell.
+    pub fn initial_pressure(&self) -> &[f64] {
+        &self.p0
+    }
+    /// The reduced stiffness values (upper triangle of the mechanics [`crate::Pattern`]).
+    pub fn stiffness_values(&self) -> &[f64] {
+        &self.k_values
+    }
+
+    /// The state at rest: zero displacement everywhere (prescribed dofs included) and
+    /// `p = p₀`. A first step from it applies the loads *and* the prescribed displacements
+    /// at `t + Δt` as a jump (with `Δt = 0`: the undrained response to both).
+    pub fn rest_state(&self) -> BiotState {
+        BiotState {
+            displacement: vec![0.0; self.mech.dofs.num_dofs()],
+            pressure: self.p0.clone(),
+        }
+    }
+
+    /// The initial state of the design: `p = p₀` and the displacement in equilibrium with
+    /// the loads at time `t` (the initial pressure exerts no force).
+    pub fn initial_state(&self, t: f64) -> BiotResult<BiotState> {
+        let mut solver = DirectSolver::new(self.mech.pattern)?;
+        solver.factorize(self.mech.pattern, &self.k_values)?;
+        let mut st = self.rest_state();
+        let mut rhs = vec![0.0; self.mech.dofs.num_equations()];
+        let mut uf = Vec::new();
+        self.mechanics_base(t, &mut uf, &mut rhs)?;
+        solver.solve_in_place(&mut rhs)?;
+        st.displacement.copy_from_slice(&uf);
+        self.mech.dofs.scatter(&rhs, &mut st.displacement);
+        Ok(st)
+    }
+
+    /// Volume change of every cell, `ΔV_K = Σ_i N_i · u_i` (m³; m² in 2D), for the nodal
+    /// displacement `u` (length `D · nodes`), written to `out` (one per cell). Exact for
+    /// linear fields: `ΔV_K = |K| ∇·u`.
+    pub fn volume_change(&self, u: &[f64], out: &mut [f64]) -> BiotResult<()> {
+        check_len("displacement", u.len(), self.mech.dofs.num_dofs())?;
+        check_len("volume change output", out.len(), self.num_cells())?;
+        let grid = self.mech.grid;
+        for (c, o) in out.iter_mut().enumerate() {
+            let nodes = grid.cell_nodes(c);
+            let nn = &self.normals[self.node_ptr[c]..self.node_ptr[c + 1]];
+            let mut s = 0.0;
+            for (&n, ni) in nodes.iter().zip(nn) {
+                for a in 0..D {
+                    s += ni[a] * u[D * n + a];
+                }
+            }
+            *o = s;
+        }
+        Ok(())
+    }
+
+    /// The nodal pore-pressure force `f_i = Σ_{K ∋ i} α_K (p_K − p₀_K) N_i` (length
+    /// `D · nodes`, overwritten): the transpose of the coupling `C` applied to `p − p₀`,
+    /// to be added to the external forces of a mechanics solve (e.g. an explicit one).
+    pub fn pore_pressure_forces(&self, p: &[f64], out: &mut [f64]) -> BiotResult<()> {
+        check_len("pressure", p.len(), self.num_cells())?;
+        check_len("force output", out.len(), self.mech.dofs.num_dofs())?;
+        out.fill(0.0);
+        let grid = self.mech.grid;
+        for c in 0..self.num_cells() {
+            let q = self.alpha[c] * (p[c] - self.p0[c]);
+            if q == 0.0 {
+                continue;
+            }
+            let nn = &self.normals[self.node_ptr[c]..self.node_ptr[c + 1]];
+            for (&n, ni) in grid.cell_nodes(c).iter().zip(nn) {
+                for a in 0..D {
+                    out[D * n + a] += q * ni[a];
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// `out[e] += Σ α_K q_K N_{i,a}` over the free dofs `(i, a)` of equation `e`.
+    fn add_coupling_transpose(&self, q: &[f64], out: &mut [f64]) {
+        let grid = self.mech.grid;
+        let dofs = self.mech.dofs;
+        for c in 0..self.num_cells() {
+            let w = self.alpha[c] * q[c];
+            if w == 0.0 {
+                continue;
+            }
+            let nn = &self.normals[self.node_ptr[c]..self.node_ptr[c + 1]];
+            for (&n, ni) in grid.cell_nodes(c).iter().zip(nn) {
+                for a in 0..D {
+                    if let Some(e) = dofs.equation(n, a) {
+                        out[e] += w * ni[a];
+                    }
+                }
+            }
+        }
+    }
+
+    /// The prescribed displacements at `t` (free entries zero) into `u_fixed`, and the
+    /// reduced mechanical right-hand side without pore pressure,
+    /// `g = Tᵀ (f_f − K_fp u_p) + F_platen`, into `rhs`.
+    fn mechanics_base(&self, t: f64, u_fixed: &mut Vec<f64>, rhs: &mut [f64]) -> BiotResult<()> {
+        let StaticProblem {
+            grid,
+            laws,
+            dofs,
+            pattern,
+            loads,
+        } = self.mech;
+        u_fixed.clear();
+        u_fixed.resize(dofs.num_dofs(), 0.0);
+        dofs.set_prescribed(grid, t, u_fixed);
+        let mut full = vec![0.0; dofs.num_dofs()];
+        nodal_loads(grid, loads, t, &mut full)?;
+        rhs.fill(0.0);
+        dofs.reduce_add(&full, rhs);
+        dofs.add_platen_forces(grid, t, rhs);
+        if u_fixed.iter().any(|&v| v != 0.0) {
+            let mut vals = vec![0.0; pattern.nnz()];
+            let mut forces = vec![0.0; dofs.num_equations()];
+            assemble(grid, laws, dofs, pattern, u_fixed, &mut vals, &mut forces)?;
+            rhs.iter_mut().zip(&forces).for_each(|(r, f)| *r += f);
+        }
+        Ok(())
+    }
+
+    /// `out = Δt (b(t) − A pⁿ)`, the flow residual at the old pressure.
+    fn flow_residual(&self, p_old: &[f64], t: f64, dt: f64, out: &mut [f64]) -> BiotResult<()> {
+        self.flow.forcing(t, out)?;
+        let a = self.flow.flux_matrix();
+        let (cp, ri, v) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
+        for k in 0..self.num_cells() {
+            for q in cp[k]..cp[k + 1] {
+                out[ri[q]] -= v[q] * p_old[k];
+            }
+        }
+        out.iter_mut().for_each(|x| *x *= dt);
+        Ok(())
+    }
+
+    /// `out = α_K ΔV_K(u)` for every cell.
+    fn alpha_volume_change(&self, u: &[f64], out: &mut [f64]) -> BiotResult<()> {
+        self.volume_change(u, out)?;
+        out.iter_mut().zip(&self.alpha).for_each(|(o, a)| *o *= a);
+        Ok(())
+    }
+
+    /// The default pressure scale `s = mean diag(K) / mean |C_{K,e}|` (see module docs).
+    pub fn default_pressure_scale(&self) -> f64 {
+        let pat = self.mech.pattern;
+        let (cp, ri) = (pat.col_ptr(), pat.row_idx());
+        let (mut sk, mut nk) = (0.0, 0usize);
+        for j in 0..pat.num_equations() {
+            for q in cp[j]..cp[j + 1] {
+                if ri[q] == j {
+                    sk += self.k_values[q].abs();
+                    nk += 1;
+                }
+            }
+        }
+        let (mut sc, mut ncpl) = (0.0, 0usize);
+        let grid = self.mech.grid;
+        for c in 0..self.num_cells() {
+            let nn = &self.normals[self.node_ptr[c]..self.node_ptr[c + 1]];
+            for (&n, ni) in grid.cell_nodes(c).iter().zip(nn) {
+                for a in 0..D {
+                    let w = (self.alpha[c] * ni[a]).abs();
+                    if w > 0.0 && self.mech.dofs.equation(n, a).is_some() {
+                        sc += w;
+                        ncpl += 1;
+                    }
+                }
+            }
+        }
+        if nk == 0 || ncpl == 0 || sk == 0.0 {
+            return 1.0;
+        }
+        (sk / nk as f64) / (sc / ncpl as f64)
+    }
+}
+
+fn check_len(what: &str, got: usize, want: usize) -> BiotResult<()> {
+    if got == want {
+        Ok(())
+    } else {
+        Err(BiotError::Input(format!(
+            "{what}: length {got}, want {want}"
+        )))
+    }
+}
+
+fn check_step(dt: f64, t: f64) -> BiotResult<()> {
+    if !(dt.is_finite() && dt >= 0.0 && t.is_finite()) {
+        return Err(BiotError::Input(format!(
+            "time step must be finite and ≥ 0 and t finite, got Δt = {dt}, t = {t}"
+        )));
+    }
+    Ok(())
+}
+
+fn inf_norm(v: &[f64]) -> f64 {
+    v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
+}
+
+/// Displacement and pressure at one time.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BiotState {
+    /// Nodal displacements, node-major (`D` per node), prescribed values filled in.
+    pub displacement: Vec<f64>,
+    /// Cell pressures (Pa), absolute (the coupling acts on `p − p₀`).
+    pub pressure: Vec<f64>,
+}
+
+/// The result of one coupled step.
+#[derive(Clone, Debug)]
+pub struct BiotStep {
+    /// The state at the new time.
+    pub state: BiotState,
+    /// Iterations (1 for the monolithic and explicit schemes).
+    pub iterations: usize,
+    /// Monolithic: relative residual of the linear solve; fixed-stress: the last relative
+    /// change; explicit: 0.
+    pub residual: f64,
+}
+
+/// A scheme that advances a poroelastic state by one time step.
+pub trait BiotCoupling<const D: usize> {
+    /// A short name for output.
+    fn name(&self) -> &str;
+    /// Advance `state` (at time `t`) to `t + dt`; loads and boundary values are evaluated
+    /// at `t + dt`. `dt = 0` gives the undrained response (no flow) where the scheme
+    /// allows it.
+    fn step(
+        &mut self,
+        system: &BiotSystem<'_, D>,
+        state: &BiotState,
+        t: f64,
+        dt: f64,
+    ) -> BiotResult<BiotStep>;
+}
+
+// ---------------------------------------------------------------------------------------
+// Monolithic
+
+/// The fully implicit monolithic scheme (seed eq. 30): one symmetric quasi-definite
+/// system per step, solved by a sparse `LDLᵀ` factorization (see the module docs for the
+/// block form and the scaling).
+pub struct Monolithic {
+    scale: Option<f64>,
+    s: f64,
+    nm: usize,
+    col_ptr: Vec<usize>,
+    row_idx: Vec<usize>,
+    /// Per cell-local dof (aligned with the system's normals × D): block position or MAX.
+    cpos: Vec<usize>,
+    /// Per flow-pattern entry: block position (upper part) or MAX.
+    fpos: Vec<usize>,
+    symbolic: SymbolicCholesky<usize>,
+    values: Vec<f64>,
+    factored_values: Vec<f64>,
+    l_values: Vec<f64>,
+    factored: bool,
+    par: Par,
+    factorizations: usize,
+}
+
+impl Monolithic {
+    /// Build the block pattern and its symbolic `LDLᵀ` analysis for `system`. `scale` is
+    /// the pressure scale `s` (Pa/m); `None` uses
+    /// [`BiotSystem::default_pressure_scale`].
+    pub fn new<const D: usize>(system: &BiotSystem<'_, D>, scale: Option<f64>) -> BiotResult<Self> {
+        if let Some(s) = scale
+            && !(s.is_finite() && s > 0.0)
+        {
+            return Err(BiotError::Input(format!(
+                "pressure scale must be finite and > 0, got {s}"
+            )));
+        }
+        let pat = system.mech.pattern;
+        let grid = system.mech.grid;
+        let dofs = system.mech.dofs;
+        let nm = pat.num_equations();
+        let nc = system.num_cells();
+        let fpat = system.flow.pattern();
+        let (fcp, fri) = (fpat.col_ptr(), fpat.row_idx());
+        let mut col_ptr = pat.col_ptr().to_vec();
+        let mut row_idx = pat.row_idx().to_vec();
+        let mut cpos = vec![usize::MAX; D * system.normals.len()];
+        let mut fpos = vec![usize::MAX; fri.len()];
+        let mut eqs: Vec<usize> = Vec::new();
+        for c in 0..nc {
+            let start = row_idx.len();
+            eqs.clear();
+            for &n in grid.cell_nodes(c) {
+                for a in 0..D {
+                    if let Some(e) = dofs.equation(n, a) {
+                        eqs.push(e);
+                    }
+                }
+            }
+            eqs.sort_unstable();
+            eqs.dedup();
+            row_idx.extend_from_slice(&eqs);
+            for (i, &n) in grid.cell_nodes(c).iter().enumerate() {
+                for a in 0..D {
+                    if let Some(e) = dofs.equation(n, a) {
+                        // Invariant: e was pushed above.
+                        let k = eqs.binary_search(&e).unwrap_or(0);
+                        cpos[D * (system.node_ptr[c] + i) + a] = start + k;
+                    }
+                }
+            }
+            for q in fcp[c]..fcp[c + 1] {
+                if fri[q] <= c {
+                    fpos[q] = row_idx.len();
+                    row_idx.push(nm + fri[q]);
+                }
+            }
+            col_ptr.push(row_idx.len());
+        }
+        let n = nm + nc;
+        let sym = SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row_idx);
+        let symbolic = factorize_symbolic_cholesky(
+            sym,
+            Side::Upper,
+            SymmetricOrdering::Amd,
+            CholeskySymbolicParams::default(),
+        )
+        .map_err(|e| BiotError::Solver(format!("symbolic LDLᵀ: {e:?}")))?;
+        let nnz = row_idx.len();
+        Ok(Self {
+            scale,
+            s: 1.0,
+            nm,
+            col_ptr,
+            row_idx,
+            cpos,
+            fpos,
+            symbolic,
+            values: vec![0.0; nnz],
+            factored_values: Vec::new(),
+            l_values: Vec::new(),
+            factored: false,
+            par: Par::Seq,
+            factorizations: 0,
+        })
+    }
+
+    /// Use `par` for factorizing and solving (default sequential).
+    pub fn set_parallelism(&mut self, par: Par) {
+        self.par = par;
+    }
+    /// Number of numeric factorizations done (a step with the same `Δt` reuses it).
+    pub fn numeric_factorizations(&self) -> usize {
+        self.factorizations
+    }
+    /// The pressure scale `s` of the last step.
+    pub fn pressure_scale(&self) -> f64 {
+        self.s
+    }
+    /// Number of unknowns of the block system (reduced displacements + cells).
+    pub fn num_unknowns(&self) -> usize {
+        self.col_ptr.len() - 1
+    }
+
+    fn fill<const D: usize>(&mut self, sys: &BiotSystem<'_, D>, dt: f64) {
+        let s = self.s;
+        let mech_nnz = sys.k_values.len();
+        self.values[..mech_nnz].copy_from_slice(&sys.k_values);
+        self.values[mech_nnz..].fill(0.0);
+        for c in 0..sys.num_cells() {
+            let w = -s * sys.alpha[c];
+            for i in sys.node_ptr[c]..sys.node_ptr[c + 1] {
+                for a in 0..D {
+                    let p = self.cpos[D * i + a];
+                    if p != usize::MAX {
+                        self.values[p] += w * sys.normals[i][a];
+                    }
+                }
+            }
+        }
+        let a = sys.flow.flux_matrix();
+        let av = a.val();
+        for (q, &p) in self.fpos.iter().enumerate() {
+            if p != usize::MAX {
+                self.values[p] = -s * s * dt * av[q];
+            }
+        }
+        let dpos = sys.flow.diagonal_positions();
+        for (c, m) in sys.flow.accumulation().iter().enumerate() {
+            self.values[self.fpos[dpos[c]]] -= s * s * m;
+        }
+    }
+
+    fn factorize(&mut self) -> BiotResult<()> {
+        if self.factored && self.factored_values == self.values {
+            return Ok(());
+        }
+        self.factored = false;
+        let n = self.num_unknowns();
+        let sym = SymbolicSparseColMatRef::new_checked(n, n, &self.col_ptr, None, &self.row_idx);
+        let mat = SparseColMatRef::new(sym, &self.values);
+        self.l_values.resize(self.symbolic.len_val(), 0.0);
+        let req = self
+            .symbolic
+            .factorize_numeric_ldlt_scratch::<f64>(self.par, Default::default());
+        let mut mem =
+            MemBuffer::try_new(req).map_err(|_| BiotError::Solver("out of memory".into()))?;
+        let res = self.symbolic.factorize_numeric_ldlt(
+            &mut self.l_values,
+            mat,
+            Side::Upper,
+            Default::default(),
+            self.par,
+            MemStack::new(&mut mem),
+            Default::default(),
+        );
+        self.factorizations += 1;
+        match res {
+            Ok(_) => {
+                self.factored = true;
+                self.factored_values.clone_from(&self.values);
+                Ok(())
+            }
+            Err(e) => Err(BiotError::Solver(format!(
+                "LDLᵀ of the coupled system failed ({e:?}); a flow region may lack storage \
+                 and a pressure anchor"
+            ))),
+        }
+    }
+
+    fn solve_in_place(&self, rhs: &mut [f64]) -> BiotResult<()> {
+        let ldlt = LdltRef::<'_, usize, f64>::new(&self.symbolic, &self.l_values);
+        let mut mem = MemBuffer::try_new(self.symbolic.solve_in_place_scratch::<f64>(1, self.par))
+            .map_err(|_| BiotError::Solver("out of memory".into()))?;
+        let n = rhs.len();
+        ldlt.solve_in_place_with_conj(
+            Conj::No,
+            MatMut::from_column_major_slice_mut(rhs, n, 1),
+            self.par,
+            MemStack::new(&mut mem),
+        );
+        Ok(())
+    }
+
+    /// `y += A x` with the symmetric matrix stored as its upper triangle.
+    fn sym_mul_add(&self, x: &[f64], y: &mut [f64]) {
+        for j in 0..self.num_unknowns() {
+            for q in self.col_ptr[j]..self.col_ptr[j + 1] {
+                let (r, v) = (self.row_idx[q], self.values[q]);
+                y[r] += v * x[j];
+                if r != j {
+                    y[j] += v * x[r];
+                }
+            }
+        }
+    }
+}
+
+impl<const D: usize> BiotCoupling<D> for Monolithic {
+    fn name(&self) -> &str {
+        "monolithic"
+    }
+
+    fn step(
+        &mut self,
+        sys: &BiotSystem<'_, D>,
+        state: &BiotState,
+        t: f64,
+        dt: f64,
+    ) -> BiotResult<BiotStep> {
+        check_step(dt, t)?;
+        check_state(sys, state)?;
+        if self.num_unknowns() != sys.mech.pattern.num_equations() + sys.num_cells()
+            || self.nm != sys.mech.pattern.num_equations()
+            || self.cpos.len() != D * sys.normals.len()
+            || self.fpos.len() != sys.flow.pattern().row_idx().len()
+        {
+            return Err(BiotError::Input(
+                "monolithic solver built for another system".into(),
+            ));
+        }
+        if dt == 0.0
+            && let Some(c) = sys.flow.accumulation().iter().position(|&m| m <= 0.0)
+        {
+            return Err(BiotError::Input(format!(
+                "an undrained step (Δt = 0) needs storage in every cell, cell {c} has none \
+                 (the system would be a saddle point): use a small Δt > 0"
+            )));
+        }
+        self.s = self.scale.unwrap_or_else(|| sys.default_pressure_scale());
+        let s = self.s;
+        let (nm, nc) = (self.nm, sys.num_cells());
+        let t1 = t + dt;
+        let mut rhs = vec![0.0; nm + nc];
+        let mut uf = Vec::new();
+        sys.mechanics_base(t1, &mut uf, &mut rhs[..nm])?;
+        let dp0: Vec<f64> = state
+            .pressure
+            .iter()
+            .zip(&sys.p0)
+            .map(|(p, q)| p - q)
+            .collect();
+        sys.add_coupling_transpose(&dp0, &mut rhs[..nm]);
+        let mut flow = vec![0.0; nc];
+        sys.flow_residual(&state.pressure, t1, dt, &mut flow)?;
+        let mut cv = vec![0.0; nc];
+        sys.alpha_volume_change(&uf, &mut cv)?;
+        let mut cvo = vec![0.0; nc];
+        sys.alpha_volume_change(&state.displacement, &mut cvo)?;
+        for c in 0..nc {
+            rhs[nm + c] = s * (-flow[c] + cv[c] - cvo[c]);
+        }
+        self.fill(sys, dt);
+        self.factorize()?;
+        let mut z = rhs.clone();
+        self.solve_in_place(&mut z)?;
+        if let Some(i) = z.iter().position(|v| !v.is_finite()) {
+            return Err(BiotError::Solver(format!(
+                "non-finite solution at unknown {i}"
+            )));
+        }
+        let mut az = vec![0.0; nm + nc];
+        self.sym_mul_add(&z, &mut az);
+        let rn = rhs.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let en = az
+            .iter()
+            .zip(&rhs)
+            .map(|(a, b)| (a - b) * (a - b))
+            .sum::<f64>()
+            .sqrt();
+        let residual = if rn > 0.0 { en / rn } else { en };
+        if residual > 1e-8 {
+            return Err(BiotError::Solver(format!(
+                "coupled system numerically singular: relative residual {residual:.2e}"
+            )));
+        }
+        let mut u = uf;
+        sys.mech.dofs.scatter(&z[..nm], &mut u);
+        let p = state
+            .pressure
+            .iter()
+            .zip(&z[nm..])
+            .map(|(p, y)| p + s * y)
+            .collect();
+        Ok(BiotStep {
+            state: BiotState {
+                displacement: u,
+                pressure: p,
+            },
+            iterations: 1,
+            residual,
+        })
+    }
+}
+
+fn check_state<const D: usize>(sys: &BiotSystem<'_, D>, state: &BiotState) -> BiotResult<()> {
+    check_len(
+        "state displacement",
+        state.displacement.len(),
+        sys.mech.dofs.num_dofs(),
+    )?;
+    check_len("state pressure", state.pressure.len(), sys.num_cells())?;
+    if let Some(c) = state.pressure.iter().position(|p| !p.is_finite()) {
+        return Err(BiotError::Input(format!(
+            "cell {c}: pressure is {}",
+            state.pressure[c]
+        )));
+    }
+    Ok(())
+}
+
+// ---------------------------------------------------------------------------------------
+// Flow-only SPD solves (fixed-stress and explicit updates)
+
+/// Sparse Cholesky of `diag(d) + Δt A` on the flow pattern, refactorized only when the
+/// matrix changes.
+struct FlowSolver {
+    symbolic: Option<SymbolicLlt<usize>>,
+    llt: Option<Llt<usize, f64>>,
+    vals: Vec<f64>,
+    factored_vals: Vec<f64>,
+    factorizations: usize,
+}
+
+impl FlowSolver {
+    fn new() -> Self {
+        Self {
+            symbolic: None,
+            llt: None,
+            vals: Vec::new(),
+            factored_vals: Vec::new(),
+            factorizations: 0,
+        }
+    }
+
+    fn factorize<const D: usize>(
+        &mut self,
+        flow: &FlowModel<D>,
+        diag: &[f64],
+        dt: f64,
+    ) -> BiotResult<()> {
+        let a = flow.flux_matrix();
+        self.vals.clear();
+        self.vals.extend(a.val().iter().map(|v| v * dt));
+        for (c, &p) in flow.diagonal_positions().iter().enumerate() {
+            self.vals[p] += diag[c];
+        }
+        if self.llt.is_some() && self.vals == self.factored_vals {
+            return Ok(());
+        }
+        self.llt = None;
+        if self.symbolic.is_none() {
+            self.symbolic = Some(
+                SymbolicLlt::try_new(flow.pattern().as_ref(), Side::Lower)
+                    .map_err(|e| BiotError::Solver(format!("symbolic Cholesky: {e:?}")))?,
+            );
+        }
+        let sym = self
+            .symbolic
+            .clone()
+            .ok_or_else(|| BiotError::Solver("symbolic Cholesky missing".into()))?;
+        let mat = SparseColMatRef::new(flow.pattern().as_ref(), &self.vals);
+        let llt = Llt::try_new_with_symbolic(sym, mat, Side::Lower).map_err(|e| {
+            BiotError::Solver(format!(
+                "flow Cholesky failed ({e}); a region lacks storage and a pressure anchor"
+            ))
+        })?;
+        self.factorizations += 1;
+        self.llt = Some(llt);
+        self.factored_vals.clone_from(&self.vals);
+        Ok(())
+    }
+
+    fn solve(&self, rhs: &mut [f64]) -> BiotResult<()> {
+        let llt = self
+            .llt
+            .as_ref()
+            .ok_or_else(|| BiotError::Solver("flow solve before factorization".into()))?;
+        llt.solve_in_place(faer::col::ColMut::from_slice_mut(rhs));
+        if let Some(c) = rhs.iter().position(|v| !v.is_finite()) {
+            return Err(BiotError::Solver(format!(
+                "non-finite pressure in cell {c}"
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// The mechanics solve `K x = g + Cᵀ (p − p₀)` shared by the split schemes.
+struct MechSolver {
+    solver: Option<DirectSolver>,
+    factored_vals: Vec<f64>,
+}
+
+impl MechSolver {
+    fn new() -> Self {
+        Self {
+            solver: None,
+            factored_vals: Vec::new(),
+        }
+    }
+
+    /// Displacement in equilibrium with the loads at `t` and the pressure `p`.
+    fn solve<const D: usize>(
+        &mut self,
+        sys: &BiotSystem<'_, D>,
+        t: f64,
+        p: &[f64],
+        u_out: &mut Vec<f64>,
+    ) -> BiotResult<()> {
+        let pat = sys.mech.pattern;
+        if self.solver.is_none() {
+            self.solver = Some(DirectSolver::new(pat)?);
+        }
+        let solver = self
+            .solver
+            .as_mut()
+            .ok_or_else(|| BiotError::Solver("mechanics solver missing".into()))?;
+        if self.factored_vals != sys.k_values {
+            solver.factorize(pat, &sys.k_values)?;
+            self.factored_vals.clone_from(&sys.k_values);
+        }
+        let mut rhs = vec![0.0; pat.num_equations()];
+        sys.mechanics_base(t, u_out, &mut rhs)?;
+        let dp: Vec<f64> = p.iter().zip(&sys.p0).map(|(a, b)| a - b).collect();
+        sys.add_coupling_transpose(&dp, &mut rhs);
+        solver.solve_in_place(&mut rhs)?;
+        sys.mech.dofs.scatter(&rhs, u_out);
+        Ok(())
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Fixed stress
+
+/// The fixed-stress split (see the module docs): flow with the stabilisation
+/// `α²/K_dr`, then mechanics, iterated to convergence within each step.
+pub struct FixedStress {
+    /// Relative pressure change `‖δp^{k+1} − δp^k‖∞ / max(‖p − p₀‖∞, ‖δp‖∞)` at which
+    /// the iteration stops (it also stops when the change is below the rounding level
+    /// `16 ε ‖p‖∞`). The displacement is solved exactly for each pressure iterate, so its
+    /// change is a bounded image of the pressure change.
+    pub tolerance: f64,
+    /// Iterations allowed per step.
+    pub max_iterations: usize,
+    flow: FlowSolver,
+    mech: MechSolver,
+}
+
+impl FixedStress {
+    /// A fixed-stress scheme with the given tolerance and iteration limit.
+    pub fn new(tolerance: f64, max_iterations: usize) -> Self {
+        Self {
+            tolerance,
+            max_iterations,
+            flow: FlowSolver::new(),
+            mech: MechSolver::new(),
+        }
+    }
+}
+
+impl<const D: usize> BiotCoupling<D> for FixedStress {
+    fn name(&self) -> &str {
+        "fixed-stress"
+    }
+
+    fn step(
+        &mut self,
+        sys: &BiotSystem<'_, D>,
+        state: &BiotState,
+        t: f64,
+        dt: f64,
+    ) -> BiotResult<BiotStep> {
+        check_step(dt, t)?;
+        check_state(sys, state)?;
+        if !(self.tolerance.is_finite() && self.tolerance > 0.0) {
+            return Err(BiotError::Input(format!(
+                "fixed-stress tolerance must be > 0, got {}",
+                self.tolerance
+            )));
+        }
+        let kdr = sys.drained_bulk.as_ref().ok_or_else(|| {
+            BiotError::Input(
+                "fixed-stress needs the drained bulk modulus (BiotSystem::with_drained_bulk_modulus)"
+                    .into(),
+            )
+        })?;
+        let nc = sys.num_cells();
+        let t1 = t + dt;
+        let vols = sys.mech.grid.cell_volumes();
+        let beta: Vec<f64> = (0..nc)
+            .map(|c| sys.alpha[c] * sys.alpha[c] / kdr[c] * vols[c])
+            .collect();
+        let diag: Vec<f64> = sys
+            .flow
+            .accumulation()
+            .iter()
+            .zip(&beta)
+            .map(|(m, b)| m + b)
+            .collect();
+        self.flow.factorize(sys.flow, &diag, dt)?;
+        let mut r0 = vec![0.0; nc];
+        sys.flow_residual(&state.pressure, t1, dt, &mut r0)?;
+        let mut cvo = vec![0.0; nc];
+        sys.alpha_volume_change(&state.displacement, &mut cvo)?;
+        let mut u_k = state.displacement.clone();
+        let mut dp_k = vec![0.0; nc];
+        let mut cv = vec![0.0; nc];
+        let mut rhs = vec![0.0; nc];
+        let mut p = vec![0.0; nc];
+        let mut u_new = Vec::new();
+        let mut change = f64::INFINITY;
+        for it in 1..=self.max_iterations.max(1) {
+            sys.alpha_volume_change(&u_k, &mut cv)?;
+            for c in 0..nc {
+                rhs[c] = r0[c] - (cv[c] - cvo[c]) + beta[c] * dp_k[c];
+            }
+            self.flow.solve(&mut rhs)?;
+            for c in 0..nc {
+                p[c] = state.pressure[c] + rhs[c];
+            }
+            self.mech.solve(sys, t1, &p, &mut u_new)?;
+            let dpc = rhs
+                .iter()
+                .zip(&dp_k)
+                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            let pref = p
+                .iter()
+                .zip(&sys.p0)
+                .fold(inf_norm(&rhs), |m, (a, b)| m.max((a - b).abs()));
+            // The mechanics is solved exactly for the new pressure, so the displacement
+            // change is a bounded linear image of the pressure change: the pressure change
+            // alone measures convergence. Rounding floor: 16 ε |p|.
+            let floor = 16.0 * f64::EPSILON * inf_norm(&p);
+            change = dpc / pref.max(f64::MIN_POSITIVE);
+            // The first iterate starts from the old displacement, which ignores the new
+            // loads: at least two iterations.
+            let converged = it >= 2 && (change <= self.tolerance || dpc <= floor);
+            dp_k.copy_from_slice(&rhs);
+            std::mem::swap(&mut u_k, &mut u_new);
+            if converged {
+                return Ok(BiotStep {
+                    state: BiotState {
+                        displacement: u_k,
+                        pressure: p,
+                    },
+                    iterations: it,
+                    residual: change,
+                });
+            }
+        }
+        Err(BiotError::NoConvergence {
+            iterations: self.max_iterations,
+            change,
+        })
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Explicit pressure update
+
+/// The seed's explicit-pressure coupling (§2.5): the volumetric term only in fractured
+/// cells, no feedback iteration (see the module docs).
+pub struct ExplicitPressure {
+    /// `fractured[K]`: whether cell `K` carries the volumetric coupling term.
+    pub fractured: Vec<bool>,
+    flow: FlowSolver,
+    mech: MechSolver,
+}
+
+impl ExplicitPressure {
+    /// The scheme with the given fractured-cell flags (one per cell).
+    pub fn new(fractured: Vec<bool>) -> Self {
+        Self {
+            fractured,
+            flow: FlowSolver::new(),
+            mech: MechSolver::new(),
+        }
+    }
+
+    /// The pressure at `t + dt` from the displacements `u_new = u^{n+1}`, `u_old = uⁿ`
+    /// (nodal, `D · nodes`) and the pressure `p_old = pⁿ`: solves
+    /// `(M + Δt A)(p^{n+1} − pⁿ) = Δt (b(t + Δt) − A pⁿ) − Σ_{K fractured} α_K ΔV_K(u^{n+1} − uⁿ) e_K`.
+    /// Volume changes of cells not flagged fractured are ignored. Errors: lengths, a
+    /// negative `dt`, or a singular flow matrix (`dt = 0` with a cell without storage).
+    pub fn update_pressure<const D: usize>(
+        &mut self,
+        sys: &BiotSystem<'_, D>,
+        u_new: &[f64],
+        u_old: &[f64],
+        p_old: &[f64],
+        t: f64,
+        dt: f64,
+    ) -> BiotResult<Vec<f64>> {
+        check_step(dt, t)?;
+        let nc = sys.num_cells();
+        check_len("fractured flags", self.fractured.len(), nc)?;
+        check_len("old pressure", p_old.len(), nc)?;
+        let mut rhs = vec![0.0; nc];
+        sys.flow_residual(p_old, t + dt, dt, &mut rhs)?;
+        let mut a = vec![0.0; nc];
+        let mut b = vec![0.0; nc];
+        sys.alpha_volume_change(u_new, &mut a)?;
+        sys.alpha_volume_change(u_old, &mut b)?;
+        for c in 0..nc {
+            if self.fractured[c] {
+                rhs[c] -= a[c] - b[c];
+            }
+        }
+        self.flow.factorize(sys.flow, sys.flow.accumulation(), dt)?;
+        self.flow.solve(&mut rhs)?;
+        Ok(p_old.iter().zip(&rhs).map(|(p, d)| p + d).collect())
+    }
+}
+
+impl<const D: usize> BiotCoupling<D> for ExplicitPressure {
+    fn name(&self) -> &str {
+        "explicit-pressure"
+    }
+
+    /// Staggered step: the mechanics in equilibrium with the loads at `t + dt` and the
+    /// old pressure, then [`ExplicitPressure::update_pressure`].
+    fn step(
+        &mut self,
+        sys: &BiotSystem<'_, D>,
+        state: &BiotState,
+        t: f64,
+        dt: f64,
+    ) -> BiotResult<BiotStep> {
+        check_step(dt, t)?;
+        check_state(sys, state)?;
+        let mut u = Vec::new();
+        self.mech.solve(sys, t + dt, &state.pressure, &mut u)?;
+        let p = self.update_pressure(sys, &u, &state.displacement, &state.pressure, t, dt)?;
+        Ok(BiotStep {
+            state: BiotState {
+                displacement: u,
+                pressure: p,
+            },
+            iterations: 1,
+            residual: 0.0,
+        })
+    }
+}
