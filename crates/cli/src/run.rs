@@ -17,8 +17,10 @@ use porofrac_grid::io::{Field, PvdWriter, read_msh, read_vtu, write_vtu};
 use porofrac_grid::{Grid, GridError, Point};
 use porofrac_law::{CellLaw, Stiffness, Tensor};
 use porofrac_sim::{
-    DirectSolver, Displacement, DofMap, Gravity, LawMap, Loads, Pattern, Platen, ScalarField,
-    SimError, StaticOptions, StaticProblem, Traction, cell_stresses, solve_static,
+    BiotCoupling, BiotState, BiotSystem, DirectSolver, Displacement, DofMap, ExplicitOptions,
+    FixedStress, Gravity, LawMap, Loads, Monolithic, Pattern, Platen, ScalarField, SimError,
+    StaticOptions, StaticProblem, Traction, cell_stresses, drained_bulk_modulus, solve_explicit,
+    solve_static,
 };
 
 use crate::check::{LoadedScene, SceneError, k, ki};
@@ -53,6 +55,9 @@ pub enum RunError {
     /// The flow model could not be built or solved.
     #[error("flow: {0}")]
     Flow(String),
+    /// The poroelastic coupling failed.
+    #[error("coupling: {0}")]
+    Biot(#[from] porofrac_sim::BiotError),
     /// A plot could not be drawn.
     #[error("plot: {0}")]
     Plot(#[from] crate::plots::PlotError),
@@ -274,20 +279,6 @@ fn check_supported(ls: &LoadedScene) -> Result<(), RunError> {
         )
         .into()
     };
-    if let Some(c) = &s.physics.coupling {
-        if c != "none" {
-            return Err(unsupported(
-                k(&["physics", "coupling"]),
-                &format!("= \"{c}\": coupling"),
-            ));
-        }
-    }
-    if s.solver.mechanics.as_deref() == Some("explicit") {
-        return Err(unsupported(
-            k(&["solver", "mechanics"]),
-            "= \"explicit\": the explicit solver",
-        ));
-    }
     if s.solver.linear.as_deref() == Some("cg-amg") {
         return Err(unsupported(
             k(&["solver", "linear"]),
@@ -310,10 +301,23 @@ fn check_supported(ls: &LoadedScene) -> Result<(), RunError> {
             .error(&ki("source", 0, &[]), "needs [physics] flow = true")
             .into());
     }
-    if flow && s.physics.coupling.as_deref() != Some("none") {
+    let coupling = s.physics.coupling.as_deref().unwrap_or("monolithic");
+    if flow && coupling == "explicit-pressure" {
         return Err(unsupported(
             k(&["physics", "coupling"]),
-            "coupled flow (monolithic, fixed-stress, explicit-pressure); set coupling = \"none\" for flow on a fixed skeleton,",
+            "= \"explicit-pressure\" in scenes",
+        ));
+    }
+    if flow && coupling != "none" && s.physics.fracture == Some(true) {
+        return Err(unsupported(
+            k(&["physics", "fracture"]),
+            "= true with coupled flow (failed cells make the mechanics nonlinear)",
+        ));
+    }
+    if flow && coupling != "none" && s.solver.mechanics.as_deref() == Some("explicit") {
+        return Err(unsupported(
+            k(&["solver", "mechanics"]),
+            "= \"explicit\" with coupled flow",
         ));
     }
     Ok(())
@@ -616,6 +620,23 @@ fn run_dim<const D: usize>(
     let recovered = s.physics.failure_stress.as_deref() == Some("recovered");
     let adjacency = (fracture_on && recovered).then(|| NodeCells::new(grid));
     let mut failures = FailureState::new(grid.num_cells());
+    // Explicit mechanics: density per cell (scaled for quasi-static relaxation).
+    let explicit: Option<Vec<f64>> = if s.solver.mechanics.as_deref() == Some("explicit") {
+        let mut density = Vec::with_capacity(grid.num_cells());
+        for &l in &comp.law_of_cell {
+            let mat = &comp.keys[l].1;
+            density.push(s.material[mat].density.ok_or_else(|| {
+                ls.error(
+                    &k(&["material", mat, "density"]),
+                    "is required by solver.mechanics = \"explicit\"",
+                )
+            })?);
+        }
+        Some(density)
+    } else {
+        None
+    };
+    let mut previous_u: Option<Vec<f64>> = None;
     let flow_on = s.physics.flow == Some(true);
     let material_of_cell: Vec<&str> = comp
         .law_of_cell
@@ -631,10 +652,62 @@ fn run_dim<const D: usize>(
         None
     };
     let mut pressure: Option<Vec<f64>> = flow.as_ref().map(|f| f.p0.clone());
+    let coupling = s
+        .physics
+        .coupling
+        .clone()
+        .unwrap_or_else(|| "monolithic".into());
+    let coupled_flow = if flow_on && coupling != "none" {
+        flow.take()
+    } else {
+        None
+    };
     let t_asm = Instant::now();
     let dofs = DofMap::new(grid, &cond.displacements, &cond.platens)?;
     let pattern = Pattern::new(grid, &dofs)?;
     let mut solver = DirectSolver::new(&pattern)?;
+    // Coupled poroelasticity (linear laws; the stiffness is assembled once).
+    let coupled_laws = match &coupled_flow {
+        Some(_) => Some(LawMap::new(
+            grid,
+            law_refs.clone(),
+            comp.law_of_cell.clone(),
+        )?),
+        None => None,
+    };
+    let biot = match (&coupled_flow, &coupled_laws) {
+        (Some(f), Some(laws)) => {
+            let problem = StaticProblem {
+                grid,
+                laws,
+                dofs: &dofs,
+                pattern: &pattern,
+                loads: &cond.loads,
+            };
+            let mut system = BiotSystem::new(problem, &f.model, f.alpha.clone(), f.p0.clone())?;
+            if coupling == "fixed-stress" {
+                let mut k_dr = Vec::with_capacity(grid.num_cells());
+                for &l in &comp.law_of_cell {
+                    let m = &s.material[&comp.keys[l].1];
+                    let st = Stiffness::<D>::isotropic(m.youngs_modulus, m.poisson_ratio)
+                        .map_err(|e| ls.error(&k(&["material", &comp.keys[l].1]), e))?;
+                    k_dr.push(drained_bulk_modulus(&st));
+                }
+                system = system.with_drained_bulk_modulus(k_dr)?;
+            }
+            Some(system)
+        }
+        _ => None,
+    };
+    let mut scheme: Option<Box<dyn BiotCoupling<D>>> = match &biot {
+        Some(system) if coupling == "fixed-stress" => Some(Box::new(FixedStress::new(
+            s.solver.tolerance.unwrap_or(1e-10),
+            500,
+        ))),
+        Some(system) => Some(Box::new(Monolithic::new(system, None)?)),
+        None => None,
+    };
+    let mut biot_state: Option<BiotState> = None;
     wall.assembly += t_asm.elapsed().as_secs_f64();
     let options = StaticOptions {
         tolerance: s.solver.tolerance.unwrap_or(1e-10),
@@ -728,7 +801,12 @@ fn run_dim<const D: usize>(
     let mut series: Vec<Vec<f64>> = vec![Vec::new(); s.output.probe.len()];
     let mut written_times = Vec::new();
     let mut stats = SolverStats {
-        linear: "cholesky".into(),
+        linear: if explicit.is_some() {
+            "explicit"
+        } else {
+            "cholesky"
+        }
+        .into(),
         ..SolverStats::default()
     };
     let all_times = times(ls);
@@ -736,7 +814,30 @@ fn run_dim<const D: usize>(
     let mut last: Option<(Vec<f64>, Vec<Tensor<D>>)> = None;
     let mut steps = 0;
     for (step, &t) in all_times.iter().enumerate() {
-        let (u, stress) = if step == 0 && zero_start {
+        let (u, stress) = if let (Some(system), Some(coupler)) = (&biot, scheme.as_mut()) {
+            let t_solve = Instant::now();
+            let next = match (&biot_state, step) {
+                (None, _) if zero_start => system.rest_state(),
+                (None, _) => system.initial_state(t)?,
+                (Some(st), _) => {
+                    let t_prev = all_times[step - 1];
+                    let res = coupler.step(system, st, t_prev, t - t_prev)?;
+                    stats.iterations += res.iterations;
+                    stats.max_relative_residual = stats.max_relative_residual.max(res.residual);
+                    res.state
+                }
+            };
+            wall.solve += t_solve.elapsed().as_secs_f64();
+            let stress = cell_stresses(
+                grid,
+                coupled_laws.as_ref().expect("coupled laws"),
+                &next.displacement,
+            )?;
+            pressure = Some(next.pressure.clone());
+            let u = next.displacement.clone();
+            biot_state = Some(next);
+            (u, stress)
+        } else if step == 0 && zero_start {
             (
                 vec![0.0; D * grid.num_nodes()],
                 vec![Tensor::<D>::zeros(); grid.num_cells()],
@@ -752,17 +853,36 @@ fn run_dim<const D: usize>(
                     loads: &cond.loads,
                 };
                 let t_solve = Instant::now();
-                let sol = solve_static(&problem, &mut solver, t, &options)?;
+                let sol = match &explicit {
+                    None => {
+                        let sol = solve_static(&problem, &mut solver, t, &options)?;
+                        stats.max_relative_residual = stats.max_relative_residual.max(sol.residual);
+                        sol.displacement
+                    }
+                    Some(density) => {
+                        // Damped dynamic relaxation from the previous state.
+                        let opts = ExplicitOptions {
+                            tolerance: s.solver.tolerance.unwrap_or(1e-8),
+                            density_scaling: Some(1.0),
+                            ..ExplicitOptions::default()
+                        };
+                        let sol =
+                            solve_explicit(&problem, density, t, &opts, previous_u.as_deref())?;
+                        stats.iterations += sol.steps;
+                        stats.max_relative_residual =
+                            stats.max_relative_residual.max(sol.unbalanced_ratio);
+                        sol.displacement
+                    }
+                };
                 wall.solve += t_solve.elapsed().as_secs_f64();
-                stats.max_relative_residual = stats.max_relative_residual.max(sol.residual);
                 let t_asm = Instant::now();
-                let stress = cell_stresses(grid, &laws, &sol.displacement)?;
+                let stress = cell_stresses(grid, &laws, &sol)?;
                 let measure = match &adjacency {
                     Some(adj) => cell_average(grid, &recover_nodal(grid, adj, &stress)),
                     None => stress.clone(),
                 };
                 wall.assembly += t_asm.elapsed().as_secs_f64();
-                Ok(((sol.displacement, stress), measure))
+                Ok(((sol, stress), measure))
             };
             let class: Vec<usize> = comp.law_of_cell.clone();
             let (solution, _, _, _) = resolve(
@@ -859,6 +979,9 @@ fn run_dim<const D: usize>(
         }
         if step > 0 {
             steps += 1;
+        }
+        if explicit.is_some() {
+            previous_u = Some(u.clone());
         }
         last = Some((u, stress));
         if STOP.load(Ordering::Relaxed) {

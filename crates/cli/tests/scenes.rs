@@ -397,3 +397,93 @@ fn flow_column_matches_the_fourier_series() {
     let vtu = std::fs::read_to_string(out.join("vtk/step_0003.vtu")).unwrap();
     assert!(vtu.contains("Name=\"pressure\""));
 }
+
+/// The patch test solved by damped explicit dynamics (`solver.mechanics = "explicit"`,
+/// Cundall damping, density scaling) reaches the affine solution to 1e-6 relative.
+#[test]
+fn explicit_mechanics_reaches_the_static_solution() {
+    let text = patch_text().replace(
+        "poisson_ratio = 0.3",
+        "poisson_ratio = 0.3\ndensity = 2500.0",
+    ) + "\n[solver]\nmechanics = \"explicit\"\ntolerance = 1e-10\n";
+    let dir = tmp_dir("explicit");
+    let path = dir.join("explicit.toml");
+    std::fs::write(&path, &text).unwrap();
+    let out = dir.join("out");
+    let (code, _, err) = porofrac(&[
+        "run",
+        path.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let (l, m) = lame();
+    let sxx = (l + 2.0 * m) * 1e-3 + l * 3e-4;
+    let (_, rows) = read_csv(&out.join("probes.csv"));
+    assert!(close(rows[0][1], 7e-4, 7e-4, 1e-6), "{}", rows[0][1]);
+    assert!(close(rows[0][2], sxx, sxx, 1e-6), "{}", rows[0][2]);
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["solver"]["linear"], "explicit");
+    assert!(summary["solver"]["iterations"].as_u64().unwrap() > 0);
+    // Without a density the explicit solver is refused with the key named.
+    let text = patch_text() + "\n[solver]\nmechanics = \"explicit\"\n";
+    let (code, err) = check_text("nodensity", &text);
+    assert_eq!(code, 1);
+    assert!(err.contains("material.rock.density is required"), "{err}");
+}
+
+/// `scenes/terzaghi.toml`: coupled (monolithic) Terzaghi consolidation through the scene
+/// path. At every written time (T = c_v t/H² ≈ 0.25, 0.5, 0.75, 1.0) the pressure along the
+/// column is within 1 % of the undrained pressure p_i of the series solution, and the top
+/// settlement within 1 % of the closed form s0 + (s∞ − s0)·U(T).
+#[test]
+fn terzaghi_scene_matches_the_series_solution() {
+    let out = tmp_dir("terzaghi");
+    let scene = root().join("scenes/terzaghi.toml");
+    let (code, _, err) = porofrac(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let (e, nu, h, sigma0) = (1e9, 0.25, 10.0, 1e6);
+    let m = e * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu));
+    let s = 0.3 * 1e-10;
+    let p_i = sigma0 / (1.0 + s * m);
+    let cv = (1e-15 / 1e-3) / (s + 1.0 / m);
+    let series = |f: &dyn Fn(f64) -> f64| {
+        (0..200)
+            .map(|k| f((2 * k + 1) as f64 * std::f64::consts::PI))
+            .sum::<f64>()
+    };
+    let (_, rows) = read_csv(&out.join("lines/pressure.csv"));
+    let mut worst: f64 = 0.0;
+    for r in rows.iter().filter(|r| r[0] > 0.0) {
+        let (t, y) = (r[0], r[3]);
+        let exact = 1e7
+            + p_i
+                * series(&|k| {
+                    4.0 / k
+                        * (k * (h - y) / (2.0 * h)).sin()
+                        * (-k * k * cv * t / (4.0 * h * h)).exp()
+                });
+        worst = worst.max((r[4] - exact).abs() / p_i);
+    }
+    assert_eq!(rows.len(), 5 * 50);
+    assert!(worst < 1e-2, "pressure error {worst:e} of p_i");
+    let (s_inf, s0) = (sigma0 * h / m, sigma0 * h / (m + 1.0 / s));
+    let (_, probes) = read_csv(&out.join("probes.csv"));
+    for r in probes.iter().filter(|r| r[0] > 0.0) {
+        let tt = cv * r[0] / (h * h);
+        let u = 1.0 - series(&|k| 8.0 / (k * k) * (-k * k * tt / 4.0).exp());
+        let exact = -(s0 + (s_inf - s0) * u);
+        assert!(
+            (r[2] - exact).abs() < 1e-2 * exact.abs(),
+            "t = {}: {} vs {exact}",
+            r[0],
+            r[2]
+        );
+    }
+}
