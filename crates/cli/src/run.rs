@@ -810,6 +810,7 @@ fn run_dim<const D: usize>(
         ..SolverStats::default()
     };
     let all_times = times(ls);
+    let mut progress = Progress::new(all_times.len());
     let zero_start = s.initial.as_ref().and_then(|i| i.mechanics.as_deref()) == Some("zero");
     let mut last: Option<(Vec<f64>, Vec<Tensor<D>>)> = None;
     let mut steps = 0;
@@ -984,6 +985,7 @@ fn run_dim<const D: usize>(
             previous_u = Some(u.clone());
         }
         last = Some((u, stress));
+        progress.step(step, t, stats.iterations, failures.count());
         if STOP.load(Ordering::Relaxed) {
             break;
         }
@@ -1104,4 +1106,41 @@ pub fn write_failed_summary(ls: &LoadedScene, out: &Path, error: &str, start: In
             .unwrap_or_default()
             .as_bytes(),
     );
+}
+
+/// Progress of a run: an indicatif bar when stderr is a terminal, plain lines otherwise.
+struct Progress {
+    bar: Option<indicatif::ProgressBar>,
+    total: usize,
+}
+
+impl Progress {
+    fn new(total: usize) -> Self {
+        use std::io::IsTerminal;
+        let bar = (std::io::stderr().is_terminal() && total > 1).then(|| {
+            let bar = indicatif::ProgressBar::new(total as u64);
+            if let Ok(style) = indicatif::ProgressStyle::with_template(
+                "{bar:30} step {pos}/{len}  {msg}  ETA {eta}",
+            ) {
+                bar.set_style(style);
+            }
+            bar
+        });
+        Self { bar, total }
+    }
+
+    fn step(&mut self, step: usize, t: f64, iterations: usize, fractured: usize) {
+        let msg = format!("t = {t:.4e} s, solver iterations {iterations}, fractured {fractured}");
+        match &self.bar {
+            Some(bar) => {
+                bar.set_position(step as u64 + 1);
+                bar.set_message(msg);
+                if step + 1 == self.total {
+                    bar.finish_and_clear();
+                }
+            }
+            None if self.total > 1 => eprintln!("step {}/{}: {msg}", step + 1, self.total),
+            None => {}
+        }
+    }
 }

@@ -487,3 +487,28 @@ fn terzaghi_scene_matches_the_series_solution() {
         );
     }
 }
+
+/// `scenes/cantilever.toml`: Timoshenko–Goodier cantilever, plane stress, VEM on
+/// 128 × 16 squares: the tip deflection is within 1 % of the exact 2.07, and the
+/// deflection line within 1 % of the exact `uy(x, 0)` at every sample.
+#[test]
+fn cantilever_scene_tip_deflection_within_one_percent() {
+    let out = tmp_dir("cantilever");
+    let scene = root().join("scenes/cantilever.toml");
+    let (code, _, err) = porofrac(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let (_, rows) = read_csv(&out.join("probes.csv"));
+    let tip = rows[0][1];
+    assert!((tip - 2.07).abs() < 0.01 * 2.07, "tip {tip}");
+    let (_, line) = read_csv(&out.join("lines/deflection.csv"));
+    for r in &line {
+        let x = r[2];
+        let exact = 0.002 * (5.5 * x / 4.0 + (24.0 - x) * x * x);
+        assert!((r[4] - exact).abs() <= 0.01 * 2.07, "{r:?} vs {exact}");
+    }
+}
