@@ -665,7 +665,16 @@ fn run_dim<const D: usize>(
     let t_asm = Instant::now();
     let dofs = DofMap::new(grid, &cond.displacements, &cond.platens)?;
     let pattern = Pattern::new(grid, &dofs)?;
-    let mut solver = DirectSolver::new(&pattern)?;
+    // Fill-reducing ordering: geometric nested dissection in 3D (2.9x faster than AMD on
+    // E3 n = 40, see docs/BENCHMARKS.md), AMD in 2D.
+    let mut solver = if D == 3 {
+        DirectSolver::with_ordering(
+            &pattern,
+            &porofrac_sim::ordering::nested_dissection(grid, &dofs),
+        )?
+    } else {
+        DirectSolver::new(&pattern)?
+    };
     // Coupled poroelasticity (linear laws; the stiffness is assembled once).
     let coupled_laws = match &coupled_flow {
         Some(_) => Some(LawMap::new(

@@ -512,3 +512,74 @@ fn cantilever_scene_tip_deflection_within_one_percent() {
         assert!((r[4] - exact).abs() <= 0.01 * 2.07, "{r:?} vs {exact}");
     }
 }
+
+/// A 3D scene (tetrahedra, nested-dissection ordering): uniaxial traction with rollers
+/// gives `uz = −p z/E`, `ux = ν p x/E` at every probe to 1e-9 relative.
+#[test]
+fn three_d_uniaxial_scene() {
+    let text = r#"
+[scene]
+name = "cube"
+dim = 3
+[grid]
+kind = "tetrahedra"
+extent = [[0.0, 0.0, 0.0], [1.0, 2.0, 3.0]]
+cells = [4, 5, 6]
+seed = 2
+perturb = 0.2
+[[region]]
+name = "rock"
+select = { all = true }
+law = "mdem"
+material = "rock"
+[material.rock]
+youngs_modulus = 2.0e9
+poisson_ratio = 0.2
+[[bc]]
+boundary = "xmin"
+displacement = [0.0, "free", "free"]
+[[bc]]
+boundary = "ymin"
+displacement = ["free", 0.0, "free"]
+[[bc]]
+boundary = "zmin"
+displacement = ["free", "free", 0.0]
+[[bc]]
+boundary = "zmax"
+traction = [0.0, 0.0, -4.0e6]
+[output]
+plots = false
+[[output.probe]]
+name = "uz"
+field = "uz"
+at = [0.3, 1.1, 3.0]
+[[output.probe]]
+name = "ux"
+field = "ux"
+at = [1.0, 0.7, 1.3]
+[[output.probe]]
+name = "szz"
+field = "szz"
+at = [0.5, 0.5, 0.5]
+"#;
+    let dir = tmp_dir("cube");
+    let path = dir.join("cube.toml");
+    std::fs::write(&path, text).unwrap();
+    let out = dir.join("out");
+    let (code, _, err) = porofrac(&[
+        "run",
+        path.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let (p, e, nu) = (4e6, 2e9, 0.2);
+    let (_, rows) = read_csv(&out.join("probes.csv"));
+    assert!(close(rows[0][1], -p * 3.0 / e, 6e-3, 1e-9), "{:?}", rows[0]);
+    assert!(
+        close(rows[0][2], nu * p * 1.0 / e, 6e-3, 1e-9),
+        "{:?}",
+        rows[0]
+    );
+    assert!(close(rows[0][3], -p, p, 1e-9), "{:?}", rows[0]);
+}

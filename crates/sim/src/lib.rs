@@ -43,6 +43,7 @@ pub mod error;
 pub mod explicit;
 pub mod field;
 pub mod laws;
+pub mod ordering;
 pub mod pattern;
 mod quadrature;
 pub mod solve;

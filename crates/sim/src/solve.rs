@@ -55,13 +55,46 @@ impl DirectSolver {
     /// fast as two threads for the 2D benchmark sizes (see the crate's benchmark); change
     /// it with [`Self::set_parallelism`].
     pub fn new(pattern: &Pattern) -> Result<Self> {
+        Self::analyse(pattern, None)
+    }
+
+    /// Symbolic analysis with a given fill-reducing ordering: `perm[k]` is the equation
+    /// eliminated `k`-th (e.g. [`crate::ordering::nested_dissection`]).
+    pub fn with_ordering(pattern: &Pattern, perm: &[usize]) -> Result<Self> {
+        Self::analyse(pattern, Some(perm))
+    }
+
+    fn analyse(pattern: &Pattern, perm: Option<&[usize]>) -> Result<Self> {
         let n = pattern.num_equations();
         let sym =
             SymbolicSparseColMatRef::new_checked(n, n, pattern.col_ptr(), None, pattern.row_idx());
+        let inverse: Vec<usize>;
+        let ordering = match perm {
+            None => SymmetricOrdering::Amd,
+            Some(fwd) => {
+                let mut inv = vec![usize::MAX; n];
+                for (k, &e) in fwd.iter().enumerate() {
+                    if e >= n || inv[e] != usize::MAX {
+                        return Err(SimError::Input(format!(
+                            "ordering is not a permutation of the {n} equations (entry {k} = {e})"
+                        )));
+                    }
+                    inv[e] = k;
+                }
+                if fwd.len() != n {
+                    return Err(SimError::Input(format!(
+                        "ordering has {} entries for {n} equations",
+                        fwd.len()
+                    )));
+                }
+                inverse = inv;
+                SymmetricOrdering::Custom(faer::perm::PermRef::new_checked(fwd, &inverse, n))
+            }
+        };
         let symbolic = factorize_symbolic_cholesky(
             sym,
             Side::Upper,
-            SymmetricOrdering::Amd,
+            ordering,
             CholeskySymbolicParams::default(),
         )
         .map_err(|e| SimError::LinearAlgebra(format!("symbolic Cholesky: {e:?}")))?;
