@@ -25,7 +25,7 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
-    /// Run a scene; output goes to out/<scene name>/ unless --out is given.
+    /// Run a scene; output goes to out/NAME/ (NAME from the scene) unless --out is given.
     Run {
         /// The scene file (TOML).
         scene: PathBuf,

@@ -5,7 +5,7 @@
 //!   `max σ > σ_tens`) and [`MohrCoulomb`]; [`Combined`] checks several and reports the
 //!   first mode that fails.
 //! * [`FailureState`]: which cells have failed, when and how. Failure is irreversible.
-//! * [`resolve`]: the loop that solves, checks, fails and re-solves within a time step
+//! * [`mod@resolve`]: the loop that solves, checks, fails and re-solves within a time step
 //!   until the state is consistent.
 //! * [`recovery`]: superconvergent patch recovery (Zienkiewicz–Zhu) of nodal stresses
 //!   from cell stresses on any grid (seed Fig. 5), and cell values from the recovered
