@@ -583,3 +583,46 @@ at = [0.5, 0.5, 0.5]
     );
     assert!(close(rows[0][3], -p, p, 1e-9), "{:?}", rows[0]);
 }
+
+/// `scenes/manufactured_e2.toml` through the scene path at n = 20, 40 and 80: the largest
+/// error of ux at the grid nodes on the diagonal falls with a fitted order 2 ± 0.2, and is
+/// below 2 % of max |ux| = 0.01 at n = 40.
+#[test]
+fn manufactured_scene_converges_at_second_order() {
+    let base = std::fs::read_to_string(root().join("scenes/manufactured_e2.toml")).unwrap();
+    let mut errors = Vec::new();
+    for n in [20usize, 40, 80] {
+        let text = base
+            .replace("cells = [40, 40]", &format!("cells = [{n}, {n}]"))
+            .replace("points = 41", &format!("points = {}", n + 1));
+        let dir = tmp_dir(&format!("mms{n}"));
+        let path = dir.join("mms.toml");
+        std::fs::write(&path, text).unwrap();
+        let out = dir.join("out");
+        let (code, _, err) = porofrac(&[
+            "run",
+            path.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 0, "{err}");
+        let (_, rows) = read_csv(&out.join("lines/diagonal_ux.csv"));
+        let worst = rows
+            .iter()
+            .map(|r| {
+                (r[4]
+                    - (std::f64::consts::PI * r[2]).sin() * (std::f64::consts::PI * r[3]).sin()
+                        / 100.0)
+                    .abs()
+            })
+            .fold(0.0f64, f64::max);
+        errors.push(worst);
+    }
+    let order1 = (errors[0] / errors[1]).log2();
+    let order2 = (errors[1] / errors[2]).log2();
+    assert!(errors[1] < 2e-2 * 0.01, "{errors:?}");
+    assert!(
+        (order1 - 2.0).abs() < 0.2 && (order2 - 2.0).abs() < 0.2,
+        "{errors:?} orders {order1} {order2}"
+    );
+}
