@@ -39,6 +39,17 @@ fn porofrac(args: &[&str]) -> (i32, String, String) {
     )
 }
 
+/// Run `porofrac run <scene> --out <out>` and require success (exit status 0).
+fn run_ok(scene: &Path, out: &Path) {
+    let (code, _, err) = porofrac(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{}: {err}", scene.display());
+}
+
 fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
     let text = std::fs::read_to_string(path).unwrap();
     let mut lines = text.lines();
@@ -66,13 +77,7 @@ fn lame() -> (f64, f64) {
 fn patch_test_scene_reproduces_the_affine_field() {
     let out = tmp_dir("patch");
     let scene = root().join("scenes/patch_test.toml");
-    let (code, _, err) = porofrac(&[
-        "run",
-        scene.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert_eq!(code, 0, "{err}");
+    run_ok(&scene, &out);
     let u = |x: f64, y: f64| (1e-4 + 1e-3 * x + 2e-4 * y, -2e-4 - 5e-4 * x + 3e-4 * y);
     let (l, m) = lame();
     let sxx = (l + 2.0 * m) * 1e-3 + l * 3e-4;
@@ -130,13 +135,7 @@ fn patch_test_scene_reproduces_the_affine_field() {
 fn hybrid_scene_matches_the_uniaxial_solution_at_every_time() {
     let out = tmp_dir("hybrid");
     let scene = root().join("scenes/hybrid_uniaxial.toml");
-    let (code, _, err) = porofrac(&[
-        "run",
-        scene.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert_eq!(code, 0, "{err}");
+    run_ok(&scene, &out);
     let (e, nu) = (1e9, 0.3);
     let (header, rows) = read_csv(&out.join("probes.csv"));
     assert_eq!(
@@ -326,13 +325,7 @@ fn missing_mesh_file_and_misuse() {
 fn tension_band_fails_at_the_predicted_time() {
     let out = tmp_dir("band");
     let scene = root().join("scenes/tension_band.toml");
-    let (code, _, err) = porofrac(&[
-        "run",
-        scene.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert_eq!(code, 0, "{err}");
+    run_ok(&scene, &out);
     let e_prime = 1e9 / (1.0 - 0.25f64 * 0.25);
     let (_, rows) = read_csv(&out.join("probes.csv"));
     assert_eq!(rows.len(), 9);
@@ -368,13 +361,7 @@ fn tension_band_fails_at_the_predicted_time() {
 fn flow_column_matches_the_fourier_series() {
     let out = tmp_dir("flow");
     let scene = root().join("scenes/flow_column.toml");
-    let (code, _, err) = porofrac(&[
-        "run",
-        scene.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert_eq!(code, 0, "{err}");
+    run_ok(&scene, &out);
     let (p0, h, c) = (1e7, 10.0, 1e-13 / (1e-3 * 0.3 * 1e-9));
     let exact = |y: f64, t: f64| -> f64 {
         (0..200)
@@ -410,13 +397,7 @@ fn explicit_mechanics_reaches_the_static_solution() {
     let path = dir.join("explicit.toml");
     std::fs::write(&path, &text).unwrap();
     let out = dir.join("out");
-    let (code, _, err) = porofrac(&[
-        "run",
-        path.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert_eq!(code, 0, "{err}");
+    run_ok(&path, &out);
     let (l, m) = lame();
     let sxx = (l + 2.0 * m) * 1e-3 + l * 3e-4;
     let (_, rows) = read_csv(&out.join("probes.csv"));
@@ -441,13 +422,7 @@ fn explicit_mechanics_reaches_the_static_solution() {
 fn terzaghi_scene_matches_the_series_solution() {
     let out = tmp_dir("terzaghi");
     let scene = root().join("scenes/terzaghi.toml");
-    let (code, _, err) = porofrac(&[
-        "run",
-        scene.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert_eq!(code, 0, "{err}");
+    run_ok(&scene, &out);
     let (e, nu, h, sigma0) = (1e9, 0.25, 10.0, 1e6);
     let m = e * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu));
     let s = 0.3 * 1e-10;
@@ -495,13 +470,7 @@ fn terzaghi_scene_matches_the_series_solution() {
 fn cantilever_scene_tip_deflection_within_one_percent() {
     let out = tmp_dir("cantilever");
     let scene = root().join("scenes/cantilever.toml");
-    let (code, _, err) = porofrac(&[
-        "run",
-        scene.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert_eq!(code, 0, "{err}");
+    run_ok(&scene, &out);
     let (_, rows) = read_csv(&out.join("probes.csv"));
     let tip = rows[0][1];
     assert!((tip - 2.07).abs() < 0.01 * 2.07, "tip {tip}");
@@ -566,13 +535,7 @@ at = [0.5, 0.5, 0.5]
     let path = dir.join("cube.toml");
     std::fs::write(&path, text).unwrap();
     let out = dir.join("out");
-    let (code, _, err) = porofrac(&[
-        "run",
-        path.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert_eq!(code, 0, "{err}");
+    run_ok(&path, &out);
     let (p, e, nu) = (4e6, 2e9, 0.2);
     let (_, rows) = read_csv(&out.join("probes.csv"));
     assert!(close(rows[0][1], -p * 3.0 / e, 6e-3, 1e-9), "{:?}", rows[0]);
