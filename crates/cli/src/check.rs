@@ -366,6 +366,17 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
             ));
         }
     }
+    if let Some(kf) = s.physics.fracture_permeability {
+        positive(ls, &k(&["physics", "fracture_permeability"]), kf)?;
+    }
+    if let Some(r) = s.physics.open_edge_stiffness
+        && !(r.is_finite() && (0.0..1.0).contains(&r))
+    {
+        return Err(ls.error(
+            &k(&["physics", "open_edge_stiffness"]),
+            format!("= {r} must be in [0, 1)"),
+        ));
+    }
     if let Some(m) = &s.solver.mechanics {
         if m != "direct" && m != "explicit" {
             return Err(ls.error(
@@ -510,6 +521,14 @@ fn check_grid(ls: &LoadedScene, d: usize) -> Result<(), SceneError> {
         if !(0.0..0.5).contains(&p) {
             return Err(ls.error(&key("perturb"), format!("= {p} must be in [0, 0.5)")));
         }
+    }
+    if let Some(d) = &g.diagonals
+        && (g.kind != "composite" || (d != "structured" && d != "alternating"))
+    {
+        return Err(ls.error(
+            &key("diagonals"),
+            format!("= \"{d}\" must be \"structured\" or \"alternating\" (composite grids)"),
+        ));
     }
     if g.kind == "composite" {
         for f in ["center", "zone_half_width", "refine", "well_radius"] {

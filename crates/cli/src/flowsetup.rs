@@ -19,6 +19,8 @@ pub struct FlowSetup<const D: usize> {
     pub alpha: Vec<f64>,
     /// Permeability per cell as given (m²), before any fracture update.
     pub permeability: Permeability<D>,
+    /// Cells of a fluid source (injection or production region).
+    pub source_cells: Vec<bool>,
 }
 
 fn value(v: &NumOrExpr) -> Value {
@@ -110,6 +112,7 @@ pub fn flow_setup<const D: usize>(
             problem = problem.flux_bc(faces, value(q));
         }
     }
+    let mut source_cells = vec![false; n];
     for (i, src) in s.source.iter().enumerate() {
         let (r, region) = s
             .region
@@ -127,6 +130,9 @@ pub fn flow_setup<const D: usize>(
                     .into());
             }
         };
+        for &c in &cells {
+            source_cells[c] = true;
+        }
         problem = problem.source(src.region.clone(), cells, rate);
     }
     let p0: Vec<f64> = match s.initial.as_ref().and_then(|i| i.pressure.as_ref()) {
@@ -145,5 +151,6 @@ pub fn flow_setup<const D: usize>(
         p0,
         alpha,
         permeability,
+        source_cells,
     })
 }

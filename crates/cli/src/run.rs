@@ -17,9 +17,10 @@ use porofrac_grid::io::{Field, PvdWriter, read_msh, read_vtu, write_vtu};
 use porofrac_grid::{Grid, GridError, Point};
 use porofrac_law::{CellLaw, Stiffness, Tensor};
 use porofrac_sim::{
-    BiotCoupling, BiotState, BiotSystem, DirectSolver, Displacement, DofMap, ExplicitOptions,
-    FixedStress, Gravity, LawMap, Loads, Monolithic, Pattern, Platen, ScalarField, SimError,
-    StaticOptions, StaticProblem, Traction, cell_stresses, drained_bulk_modulus, solve_explicit,
+    BiotState, Body, DirectSolver, Displacement, DofMap, ExplicitOptions, ExplicitPressure,
+    FixedStress, FractureFlow, FractureLaws, FractureSettings, FractureStep, Fracturing, Gravity,
+    LawMap, Loads, Monolithic, Pattern, Platen, ScalarField, Scheme, SimError, StaticOptions,
+    StaticProblem, StressMeasure, Traction, cell_stresses, drained_bulk_modulus, solve_explicit,
     solve_static,
 };
 
@@ -61,6 +62,9 @@ pub enum RunError {
     /// A plot could not be drawn.
     #[error("plot: {0}")]
     Plot(#[from] crate::plots::PlotError),
+    /// The coupled fracturing step failed.
+    #[error("{0}")]
+    Coupled(#[from] porofrac_sim::FractureError),
 }
 
 /// A grid of either dimension.
@@ -141,6 +145,9 @@ pub fn build_grid(ls: &LoadedScene) -> Result<AnyGrid, RunError> {
             );
             if let Some(t) = &g.well_tag {
                 spec.well_tag = t.clone();
+            }
+            if g.diagonals.as_deref() == Some("alternating") {
+                spec.diagonals = porofrac_grid::generate::Diagonals::Alternating;
             }
             spec.perturb = g.perturb.unwrap_or(0.0);
             spec.seed = seed;
@@ -302,18 +309,6 @@ fn check_supported(ls: &LoadedScene) -> Result<(), RunError> {
             .into());
     }
     let coupling = s.physics.coupling.as_deref().unwrap_or("monolithic");
-    if flow && coupling == "explicit-pressure" {
-        return Err(unsupported(
-            k(&["physics", "coupling"]),
-            "= \"explicit-pressure\" in scenes",
-        ));
-    }
-    if flow && coupling != "none" && s.physics.fracture == Some(true) {
-        return Err(unsupported(
-            k(&["physics", "fracture"]),
-            "= true with coupled flow (failed cells make the mechanics nonlinear)",
-        ));
-    }
     if flow && coupling != "none" && s.solver.mechanics.as_deref() == Some("explicit") {
         return Err(unsupported(
             k(&["solver", "mechanics"]),
@@ -441,6 +436,7 @@ fn compose<const D: usize>(ls: &LoadedScene, grid: &Grid<D>) -> Result<Compositi
         let stiffness = Stiffness::<D>::isotropic(m.youngs_modulus, m.poisson_ratio)
             .map_err(|e| ls.error(&k(&["material", &keys[i].1]), e))?;
         let dem = porofrac_mdem::DemLaw::new(&stiffness, porofrac_mdem::DemMode::CompressionOnly)
+            .and_then(|d| d.with_open_stiffness(s.physics.open_edge_stiffness.unwrap_or(1e-6)))
             .map_err(|e| ls.error(&k(&["material", &keys[i].1]), e))?;
         post_failure[i] = laws.len();
         keys.push(("dem-compression".into(), keys[i].1.clone()));
@@ -455,6 +451,68 @@ fn compose<const D: usize>(ls: &LoadedScene, grid: &Grid<D>) -> Result<Compositi
         post_failure,
         criteria,
     })
+}
+
+/// The coupled flow–mechanics run of a scene ([`Fracturing`]: with failure criteria when
+/// a material has a strength, without them it is plain poroelasticity).
+fn coupled_setup<'a, const D: usize>(
+    ls: &LoadedScene,
+    grid: &'a Grid<D>,
+    comp: &Composition<D>,
+    law_refs: &[&'a dyn CellLaw<D>],
+    f: crate::flowsetup::FlowSetup<D>,
+    dofs: &'a DofMap<D>,
+    pattern: &'a Pattern,
+    cond: &'a Conditions<D>,
+    recovered: bool,
+) -> Result<Fracturing<'a, D>, RunError> {
+    let s = &ls.scene;
+    let coupling = s.physics.coupling.as_deref().unwrap_or("monolithic");
+    let fracture_on = comp.criteria.iter().any(|c| !c.is_empty());
+    let body = Body {
+        grid,
+        dofs,
+        pattern,
+        loads: &cond.loads,
+    };
+    let laws = FractureLaws {
+        laws: law_refs.to_vec(),
+        law_of_cell: comp.law_of_cell.clone(),
+        post_failure: comp.post_failure.clone(),
+    };
+    let mut settings = FractureSettings::new(comp.criteria.clone(), comp.law_of_cell.clone());
+    if recovered {
+        settings.stress = StressMeasure::Recovered;
+    }
+    let source_cells = f.source_cells.clone();
+    let flow = FractureFlow {
+        model: f.model,
+        permeability: f.permeability,
+        fracture_permeability: fracture_on
+            .then(|| s.physics.fracture_permeability.unwrap_or(1e-12)),
+        alpha: f.alpha,
+        p0: f.p0,
+    };
+    let mut k_dr = Vec::new();
+    if coupling == "fixed-stress" {
+        for &l in &comp.law_of_cell {
+            let m = &s.material[&comp.keys[l].1];
+            let st = Stiffness::<D>::isotropic(m.youngs_modulus, m.poisson_ratio)
+                .map_err(|e| ls.error(&k(&["material", &comp.keys[l].1]), e))?;
+            k_dr.push(drained_bulk_modulus(&st));
+        }
+    }
+    let tolerance = s.solver.tolerance.unwrap_or(1e-10);
+    Ok(Fracturing::new(body, laws, settings, flow, |sys| {
+        let sys: &porofrac_sim::BiotSystem<'_, D> = sys;
+        Ok(match coupling {
+            "fixed-stress" => Scheme::FixedStress(FixedStress::new(tolerance, 500), k_dr),
+            "explicit-pressure" => {
+                Scheme::ExplicitPressure(ExplicitPressure::new(source_cells.clone()), source_cells)
+            }
+            _ => Scheme::Monolithic(Monolithic::new(sys, None)?),
+        })
+    })?)
 }
 
 /// Boundary conditions and loads of the scene.
@@ -675,45 +733,9 @@ fn run_dim<const D: usize>(
     } else {
         DirectSolver::new(&pattern)?
     };
-    // Coupled poroelasticity (linear laws; the stiffness is assembled once).
-    let coupled_laws = match &coupled_flow {
-        Some(_) => Some(LawMap::new(
-            grid,
-            law_refs.clone(),
-            comp.law_of_cell.clone(),
-        )?),
-        None => None,
-    };
-    let biot = match (&coupled_flow, &coupled_laws) {
-        (Some(f), Some(laws)) => {
-            let problem = StaticProblem {
-                grid,
-                laws,
-                dofs: &dofs,
-                pattern: &pattern,
-                loads: &cond.loads,
-            };
-            let mut system = BiotSystem::new(problem, &f.model, f.alpha.clone(), f.p0.clone())?;
-            if coupling == "fixed-stress" {
-                let mut k_dr = Vec::with_capacity(grid.num_cells());
-                for &l in &comp.law_of_cell {
-                    let m = &s.material[&comp.keys[l].1];
-                    let st = Stiffness::<D>::isotropic(m.youngs_modulus, m.poisson_ratio)
-                        .map_err(|e| ls.error(&k(&["material", &comp.keys[l].1]), e))?;
-                    k_dr.push(drained_bulk_modulus(&st));
-                }
-                system = system.with_drained_bulk_modulus(k_dr)?;
-            }
-            Some(system)
-        }
-        _ => None,
-    };
-    let mut scheme: Option<Box<dyn BiotCoupling<D>>> = match &biot {
-        Some(system) if coupling == "fixed-stress" => Some(Box::new(FixedStress::new(
-            s.solver.tolerance.unwrap_or(1e-10),
-            500,
-        ))),
-        Some(system) => Some(Box::new(Monolithic::new(system, None)?)),
+    // Coupled poroelasticity, with fracturing when a material has a strength.
+    let mut coupled = match coupled_flow {
+        Some(f) => Some(coupled_setup(ls, grid, &comp, &law_refs, f, &dofs, &pattern, &cond, adjacency.is_some())?),
         None => None,
     };
     let mut biot_state: Option<BiotState> = None;
@@ -824,29 +846,34 @@ fn run_dim<const D: usize>(
     let mut last: Option<(Vec<f64>, Vec<Tensor<D>>)> = None;
     let mut steps = 0;
     for (step, &t) in all_times.iter().enumerate() {
-        let (u, stress) = if let (Some(system), Some(coupler)) = (&biot, scheme.as_mut()) {
+        let (u, stress) = if let Some(frac) = coupled.as_mut() {
             let t_solve = Instant::now();
-            let next = match (&biot_state, step) {
-                (None, _) if zero_start => system.rest_state(),
-                (None, _) => system.initial_state(t)?,
-                (Some(st), _) => {
+            let next = match &biot_state {
+                None if zero_start => FractureStep {
+                    state: BiotState {
+                        displacement: vec![0.0; D * grid.num_nodes()],
+                        pressure: frac.initial_pressure().to_vec(),
+                    },
+                    stress: vec![Tensor::<D>::zeros(); grid.num_cells()],
+                    new_failures: 0,
+                    rounds: 1,
+                    solves: 0,
+                    residual: 0.0,
+                },
+                None => frac.initial_state(t)?,
+                Some(st) => {
                     let t_prev = all_times[step - 1];
-                    let res = coupler.step(system, st, t_prev, t - t_prev)?;
-                    stats.iterations += res.iterations;
-                    stats.max_relative_residual = stats.max_relative_residual.max(res.residual);
-                    res.state
+                    frac.step(st, t_prev, t - t_prev)?
                 }
             };
+            stats.iterations += next.solves;
+            stats.max_relative_residual = stats.max_relative_residual.max(next.residual);
             wall.solve += t_solve.elapsed().as_secs_f64();
-            let stress = cell_stresses(
-                grid,
-                coupled_laws.as_ref().expect("coupled laws"),
-                &next.displacement,
-            )?;
-            pressure = Some(next.pressure.clone());
-            let u = next.displacement.clone();
-            biot_state = Some(next);
-            (u, stress)
+            failures = frac.failures().clone();
+            pressure = Some(next.state.pressure.clone());
+            let u = next.state.displacement.clone();
+            biot_state = Some(next.state);
+            (u, next.stress)
         } else if step == 0 && zero_start {
             (
                 vec![0.0; D * grid.num_nodes()],

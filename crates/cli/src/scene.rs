@@ -98,6 +98,8 @@ pub struct GridSection {
     pub well_radius: Option<f64>,
     /// Composite: name of the well tag (default `well`).
     pub well_tag: Option<String>,
+    /// Composite: split of the fine squares, `"structured"` (default) or `"alternating"`.
+    pub diagonals: Option<String>,
     /// Voronoi: Lloyd iterations.
     pub lloyd: Option<i64>,
 }
@@ -281,6 +283,10 @@ pub struct Physics {
     /// Stress the failure criteria see: `"cell"` (default, the cell law's stress) or
     /// `"recovered"` (patch-recovered nodal stress averaged over the cell).
     pub failure_stress: Option<String>,
+    /// Isotropic permeability (m²) of failed cells with flow (default 1e-12).
+    pub fracture_permeability: Option<f64>,
+    /// Residual stiffness ratio of open edges of failed cells (default 1e-6).
+    pub open_edge_stiffness: Option<f64>,
 }
 
 /// `[solver]`.

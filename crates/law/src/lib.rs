@@ -119,6 +119,15 @@ pub trait CellLaw<const D: usize>: Send + Sync {
         true
     }
 
+    /// Whether the forces are `F(u) = −K(u) u` with `K(u)` the [`CellLaw::stiffness`] at
+    /// `u`, and `K(u)` is piecewise constant (e.g. compression-only DEM: each edge spring
+    /// is on or off). Such a law is solved exactly by a linear solve per *active set*:
+    /// linearize at `u`, solve, repeat until the stiffness at the solution equals the one
+    /// used. Linear laws are trivially piecewise linear.
+    fn is_piecewise_linear(&self) -> bool {
+        self.is_linear()
+    }
+
     /// Whether the law can handle a cell with `num_nodes` nodes (MDEM: simplices only).
     fn supports(&self, num_nodes: usize) -> bool {
         let _ = num_nodes;

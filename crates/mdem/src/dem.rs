@@ -11,7 +11,9 @@
 //!   `𝐊_d(U)_ii = 𝐊_ii` if `U_i < 0` (the edge shortens), else 0. The energy is
 //!   `E = ½ Σ_i 𝐊_ii min(U_i, 0)²` (continuously differentiable), the forces are its
 //!   exact negative gradient and the stiffness its Hessian away from `U_i = 0` (an edge
-//!   with `U_i = 0` counts as open). Not linear: [`CellLaw::is_linear`] is false.
+//!   with `U_i = 0` counts as open). Not linear: [`CellLaw::is_linear`] is false, but
+//!   piecewise linear ([`CellLaw::is_piecewise_linear`]: `F = −K(u) u`). Optionally open
+//!   edges keep a residual fraction of their stiffness ([`DemLaw::with_open_stiffness`]).
 //!
 //! Stress follows eq. 18: `σ = (1/|K|) Mᵀ F`, i.e. `σ = (1/|K|) Σ_i F_i l_i t_i ⊗ t_i`.
 
@@ -50,6 +52,7 @@ pub enum EdgeState {
 pub struct DemLaw<const D: usize> {
     mat: Material,
     mode: DemMode,
+    open_ratio: f64,
 }
 
 impl<const D: usize> DemLaw<D> {
@@ -65,7 +68,26 @@ impl<const D: usize> DemLaw<D> {
         Ok(Self {
             mat: Material::new(D, d)?,
             mode,
+            open_ratio: 0.0,
         })
+    }
+
+    /// Keep a residual fraction `ratio` (in [0, 1)) of the spring stiffness on open edges
+    /// of the compression-only law: `𝐊_d(U)_ii = ratio · 𝐊_ii` for `U_i ≥ 0`. The default
+    /// 0 is eq. 33 exactly; a small ratio (e.g. 1e-6) keeps a node whose every edge is
+    /// open determined in an implicit solve (the law stays piecewise linear). Errors if
+    /// `ratio` is not in [0, 1).
+    pub fn with_open_stiffness(mut self, ratio: f64) -> Result<Self, MdemError> {
+        if !(ratio.is_finite() && (0.0..1.0).contains(&ratio)) {
+            return Err(MdemError::OpenStiffness(ratio));
+        }
+        self.open_ratio = ratio;
+        Ok(self)
+    }
+
+    /// The residual stiffness ratio of open edges (see [`DemLaw::with_open_stiffness`]).
+    pub fn open_stiffness(&self) -> f64 {
+        self.open_ratio
     }
 
     /// The mode.
@@ -89,7 +111,7 @@ impl<const D: usize> DemLaw<D> {
         let kd = SVector::<f64, K>::from_fn(|i, _| match self.mode {
             DemMode::Elastic => kmat[(i, i)],
             DemMode::CompressionOnly if du[i] < 0.0 => kmat[(i, i)],
-            DemMode::CompressionOnly => 0.0,
+            DemMode::CompressionOnly => self.open_ratio * kmat[(i, i)],
         });
         (kd, du)
     }
@@ -221,6 +243,11 @@ impl<const D: usize> CellLaw<D> for DemLaw<D> {
 
     fn is_linear(&self) -> bool {
         self.mode == DemMode::Elastic
+    }
+
+    /// Both modes: an edge force is `𝐊_ii U_i` or 0, so `F = −K(u) u` exactly.
+    fn is_piecewise_linear(&self) -> bool {
+        true
     }
 
     fn supports(&self, num_nodes: usize) -> bool {

@@ -67,6 +67,9 @@ pub enum MdemError {
         /// Length required.
         expected: usize,
     },
+    /// The residual open-edge stiffness ratio is outside [0, 1).
+    #[error("open-edge stiffness ratio must be in [0, 1), got {0}")]
+    OpenStiffness(f64),
     /// A lattice parameter is out of range.
     #[error("lattice parameter {what} = {value} is invalid ({why})")]
     LatticeParameter {

@@ -102,6 +102,20 @@ fn compression_only<const D: usize>(s: &Simplex<D>) {
     assert_eq!(law.energy(&cell, &u, &mut sc), 0.0);
     assert_eq!(law.stress(&cell, &u, &mut sc), Tensor::<D>::zeros());
 
+    // With a residual open stiffness ratio r, the open springs carry r times the elastic
+    // force; invalid ratios are errors.
+    let r = 1e-6;
+    let soft = law.clone().with_open_stiffness(r).unwrap();
+    assert_eq!(soft.open_stiffness(), r);
+    soft.forces(&cell, &u, &mut f, &mut sc);
+    full.forces(&cell, &u, &mut f_full, &mut sc);
+    for i in 0..n {
+        assert!((f[i] - r * f_full[i]).abs() <= 1e-15 * f_full[i].abs().max(1e-300));
+    }
+    for bad in [-0.1, 1.0, f64::NAN] {
+        assert!(law.clone().with_open_stiffness(bad).is_err());
+    }
+
     // Uniform compression: all closed, identical to the elastic DEM law.
     linear_field(
         &cell,
@@ -154,6 +168,21 @@ fn compression_only<const D: usize>(s: &Simplex<D>) {
     let ej = check_stiffness_jacobian(&law, &cell, &u, &opts, &mut sc).unwrap();
     let es = check_stiffness_symmetric(&law, &cell, &u, &opts, &mut sc).unwrap();
     println!("{D}D compression-only: grad {eg:e}, jacobian {ej:e}, symmetry {es:e}");
+    // Piecewise linear through the origin: F(u) = −K(u) u exactly (active-set solves).
+    assert!(law.is_piecewise_linear());
+    let mut kmat = nalgebra::DMatrix::<f64>::zeros(0, 0);
+    law.stiffness(&cell, &u, &mut kmat, &mut sc);
+    law.forces(&cell, &u, &mut f, &mut sc);
+    let ku = &kmat * nalgebra::DVector::from_column_slice(&u);
+    let fscale = f.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    for i in 0..n {
+        assert!(
+            (f[i] + ku[i]).abs() <= 1e-13 * fscale,
+            "F ≠ −K(u) u at {i}: {} vs {}",
+            f[i],
+            -ku[i]
+        );
+    }
     // Stress eq. 18: (1/|K|) Σ F_i l_i t_i ⊗ t_i.
     let mut sig = Tensor::<D>::zeros();
     for (i, &(a, b)) in edges(D).iter().enumerate() {

@@ -104,8 +104,13 @@
 //!
 //! # Restrictions
 //!
-//! The cell laws must be linear (the stiffness is assembled once); the pressure `p` and
-//! `p₀` are cell values, one per grid cell, in the flow model's cell order.
+//! The cell laws must be linear or piecewise linear (`F(u) = −K(u) u`, e.g. the
+//! compression-only DEM of fractured cells): the couplings use the stiffness of the last
+//! [`BiotSystem::linearize`] (at zero displacement after construction), and an active-set
+//! loop around a step ([`crate::fracturing`]) makes it consistent. Prescribed non-zero
+//! displacements act through the laws evaluated at the prescribed field alone, exact for
+//! linear laws. The pressure `p` and `p₀` are cell values, one per grid cell, in the flow
+//! model's cell order.
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::solvers::Solve;
@@ -220,9 +225,11 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
                 p0[c]
             )));
         }
-        if !mechanics.laws.all_linear() {
+        if !mechanics.laws.all_piecewise_linear() {
             return Err(BiotError::Input(
-                "the Biot coupling needs linear cell laws (the stiffness is assembled once)".into(),
+                "the Biot coupling needs linear or piecewise-linear cell laws (the stiffness \
+                 is a linearization, see BiotSystem::linearize)"
+                    .into(),
             ));
         }
         mechanics.dofs.check_rigid_modes(grid)?;
@@ -296,6 +303,45 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
     /// The reduced stiffness values (upper triangle of the mechanics [`crate::Pattern`]).
     pub fn stiffness_values(&self) -> &[f64] {
         &self.k_values
+    }
+
+    /// Re-linearize the mechanics at the displacement `u` (nodal, prescribed values
+    /// filled in) and measure the mechanical equilibrium of `(u, p)` at time `t`.
+    ///
+    /// The stiffness used by the couplings becomes the tangent `K(u)` (values only, the
+    /// pattern is reused). For piecewise-linear laws ([`porofrac_law::CellLaw::is_piecewise_linear`])
+    /// `F(u) = −K(u) u`, so a coupled step solved with `K(u^k)` is the exact solution once
+    /// the stiffness at the solution equals the one used (an *active-set* iteration). The
+    /// returned [`Linearization`] says whether the stiffness changed and gives the relative
+    /// residual `‖g(t) + Cᵀ(p − p₀) + Tᵀ F(u)‖ / (‖g(t) + Cᵀ(p − p₀)‖ + ‖Tᵀ F(u)‖)` of the
+    /// nonlinear equilibrium (0 for a consistent active set up to rounding).
+    pub fn linearize(&mut self, u: &[f64], p: &[f64], t: f64) -> BiotResult<Linearization> {
+        check_len("displacement", u.len(), self.mech.dofs.num_dofs())?;
+        check_len("pressure", p.len(), self.num_cells())?;
+        let StaticProblem {
+            grid,
+            laws,
+            dofs,
+            pattern,
+            loads,
+        } = self.mech;
+        let mut values = vec![0.0; pattern.nnz()];
+        let mut internal = vec![0.0; dofs.num_equations()];
+        assemble(grid, laws, dofs, pattern, u, &mut values, &mut internal)?;
+        let mut full = vec![0.0; dofs.num_dofs()];
+        nodal_loads(grid, loads, t, &mut full)?;
+        let mut external = vec![0.0; dofs.num_equations()];
+        dofs.reduce_add(&full, &mut external);
+        dofs.add_platen_forces(grid, t, &mut external);
+        let dp: Vec<f64> = p.iter().zip(&self.p0).map(|(a, b)| a - b).collect();
+        self.add_coupling_transpose(&dp, &mut external);
+        let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let scale = norm(&external) + norm(&internal);
+        let r: Vec<f64> = external.iter().zip(&internal).map(|(a, b)| a + b).collect();
+        let residual = if scale > 0.0 { norm(&r) / scale } else { 0.0 };
+        let changed = values != self.k_values;
+        self.k_values = values;
+        Ok(Linearization { changed, residual })
     }
 
     /// The state at rest: zero displacement everywhere (prescribed dofs included) and
@@ -491,6 +537,15 @@ fn check_step(dt: f64, t: f64) -> BiotResult<()> {
 
 fn inf_norm(v: &[f64]) -> f64 {
     v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
+}
+
+/// The outcome of [`BiotSystem::linearize`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Linearization {
+    /// Whether the stiffness at the new displacement differs from the previous one.
+    pub changed: bool,
+    /// Relative residual of the nonlinear mechanical equilibrium at the given state.
+    pub residual: f64,
 }
 
 /// Displacement and pressure at one time.

@@ -86,4 +86,8 @@ impl<'a, const D: usize> LawMap<'a, D> {
     pub fn all_linear(&self) -> bool {
         self.laws.iter().all(|l| l.is_linear())
     }
+    /// Whether every law is piecewise linear ([`CellLaw::is_piecewise_linear`]).
+    pub fn all_piecewise_linear(&self) -> bool {
+        self.laws.iter().all(|l| l.is_piecewise_linear())
+    }
 }

@@ -42,6 +42,7 @@ pub mod dofs;
 pub mod error;
 pub mod explicit;
 pub mod field;
+pub mod fracturing;
 pub mod laws;
 pub mod ordering;
 pub mod pattern;
@@ -52,7 +53,11 @@ pub use assembly::{assemble, nodal_loads};
 pub use bc::{Displacement, Gravity, Loads, Platen, Traction};
 pub use biot::{
     BiotCoupling, BiotError, BiotState, BiotStep, BiotSystem, ExplicitPressure, FixedStress,
-    Monolithic, drained_bulk_modulus,
+    Linearization, Monolithic, drained_bulk_modulus,
+};
+pub use fracturing::{
+    Body, FractureError, FractureFlow, FractureLaws, FractureSettings, FractureStep, Fracturing,
+    Scheme, StressMeasure,
 };
 pub use dofs::DofMap;
 pub use error::{Result, SimError};

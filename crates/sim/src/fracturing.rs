@@ -1,0 +1,515 @@
+//! Fracturing of a poroelastic body: failure criteria, law switching, fracture
+//! permeability and the coupled step (seed §2.5–2.7).
+//!
+//! # The model
+//!
+//! Every cell has an intact law (VEM, MDEM, ...) and a failure criterion on its
+//! effective (skeleton) stress, tension positive ([`porofrac_frac::Combined`]: tensile,
+//! seed eq. 31, and Mohr–Coulomb). A cell that fails stays failed: its law switches to the
+//! post-failure law of its instance (a failed MDEM cell becomes the compression-only
+//! central-force DEM of seed eqs. 32–33; a law without a post-failure law keeps its own)
+//! and, when a fracture permeability is set, its permeability becomes that value so the
+//! fluid enters the fracture.
+//!
+//! # One time step
+//!
+//! From the state `(uⁿ, pⁿ)` at `t` to `t + Δt`, with the failure state `F`:
+//!
+//! 1. **Coupled solve** for the current `F`: the laws of `F`, the permeability of `F`,
+//!    then an *active-set* iteration: linearize at `uⁿ`, take the coupled step
+//!    (monolithic, fixed-stress or explicit-pressure, [`crate::biot`]), re-linearize at
+//!    the new displacement ([`BiotSystem::linearize`]) and repeat until the stiffness at
+//!    the solution is the one used (the compression-only law is piecewise linear, so that
+//!    solution is exact) or the nonlinear equilibrium residual is below
+//!    [`FractureSettings::active_set_tolerance`] (an edge that chatters across `U = 0`
+//!    carries almost no force). More than [`FractureSettings::max_active_set`] iterations
+//!    is an error ([`FractureError::ActiveSet`]) naming the time and the residual.
+//! 2. **Failure check** on the cells that have not failed, on the cell stress or the
+//!    recovered (Zienkiewicz–Zhu) stress ([`StressMeasure`]); the violating cells chosen
+//!    by the [`FailurePolicy`] fail at `t + Δt`, and the step is solved again from
+//!    `(uⁿ, pⁿ)` ([`porofrac_frac::resolve`]) until no cell fails: a step never ends half
+//!    updated. More than [`FractureSettings::max_rounds`] rounds is an error.
+//!
+//! The initial state ([`Fracturing::initial_state`]) is the mechanical equilibrium with
+//! the loads at `t₀` and `p = p₀` (the coupling acts on `p − p₀`), with the same failure
+//! resolution.
+
+use porofrac_flow::{FlowError, FlowModel, Permeability};
+use porofrac_frac::recovery::{NodeCells, cell_average, recover_nodal};
+use porofrac_frac::{Combined, FailurePolicy, FailureState, ResolveError, resolve};
+use porofrac_grid::Grid;
+use porofrac_law::{CellLaw, Tensor};
+
+use crate::biot::{
+    BiotCoupling, BiotError, BiotState, BiotSystem, ExplicitPressure, FixedStress, Monolithic,
+};
+use crate::bc::Loads;
+use crate::dofs::DofMap;
+use crate::error::SimError;
+use crate::laws::LawMap;
+use crate::pattern::Pattern;
+use crate::solve::{StaticProblem, cell_stresses};
+
+/// Errors of the fracturing driver.
+#[derive(Debug, thiserror::Error)]
+pub enum FractureError {
+    /// The coupled solve failed.
+    #[error("{0}")]
+    Biot(#[from] BiotError),
+    /// The mechanics (laws, assembly, stresses) failed.
+    #[error("mechanics: {0}")]
+    Mechanics(#[from] SimError),
+    /// The flow model rejected the fracture permeability.
+    #[error("flow: {0}")]
+    Flow(#[from] FlowError),
+    /// Invalid input (naming what).
+    #[error("invalid input: {0}")]
+    Input(String),
+    /// The active set of the piecewise-linear laws did not settle.
+    #[error(
+        "the open/closed state of fractured cells did not settle at t = {time} s after \
+         {iterations} solves (relative equilibrium residual {residual:.3e} > {tolerance:.1e})"
+    )]
+    ActiveSet {
+        /// Time at the end of the step.
+        time: f64,
+        /// Solves done.
+        iterations: usize,
+        /// The last relative residual.
+        residual: f64,
+        /// The tolerance.
+        tolerance: f64,
+    },
+    /// Failures kept appearing.
+    #[error("failures did not settle within {rounds} solves at t = {time} s ({failed} cells failed)")]
+    NotSettled {
+        /// Rounds done.
+        rounds: usize,
+        /// Time.
+        time: f64,
+        /// Cells failed so far.
+        failed: usize,
+    },
+}
+
+/// Result alias of this module.
+pub type FractureResult<T> = std::result::Result<T, FractureError>;
+
+/// The stress the failure criteria see.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum StressMeasure {
+    /// The cell stress of the law (constant per cell).
+    #[default]
+    Cell,
+    /// The cell average of the Zienkiewicz–Zhu recovered nodal stress (seed Fig. 5).
+    Recovered,
+}
+
+/// The laws of a fracturing body: instances, the intact instance of every cell and the
+/// post-failure instance of every instance.
+pub struct FractureLaws<'a, const D: usize> {
+    /// Law instances.
+    pub laws: Vec<&'a dyn CellLaw<D>>,
+    /// The intact law instance of every cell.
+    pub law_of_cell: Vec<usize>,
+    /// For every instance, the instance a failed cell switches to (itself: no switch).
+    pub post_failure: Vec<usize>,
+}
+
+impl<'a, const D: usize> FractureLaws<'a, D> {
+    /// The law map for the failure flags `failed` (one per cell).
+    pub fn law_map(&self, grid: &Grid<D>, failed: &[bool]) -> FractureResult<LawMap<'a, D>> {
+        let of: Vec<usize> = self
+            .law_of_cell
+            .iter()
+            .zip(failed)
+            .map(|(&l, &f)| if f { self.post_failure[l] } else { l })
+            .collect();
+        Ok(LawMap::new(grid, self.laws.clone(), of)?)
+    }
+}
+
+/// Failure criteria and iteration limits.
+#[derive(Clone, Debug)]
+pub struct FractureSettings {
+    /// Criterion of every class (an empty [`Combined`] never fails).
+    pub criteria: Vec<Combined>,
+    /// The class of every cell.
+    pub class_of_cell: Vec<usize>,
+    /// Which violating cells fail per round.
+    pub policy: FailurePolicy,
+    /// The stress the criteria see.
+    pub stress: StressMeasure,
+    /// Failure rounds (coupled solves with a new failure state) allowed per step.
+    pub max_rounds: usize,
+    /// Active-set iterations allowed per coupled solve.
+    pub max_active_set: usize,
+    /// Relative equilibrium residual accepted when the active set has not settled.
+    pub active_set_tolerance: f64,
+}
+
+impl FractureSettings {
+    /// Settings with the given criteria, default policy, cell stress, 500 rounds, 30
+    /// active-set iterations and tolerance 1e-6.
+    pub fn new(criteria: Vec<Combined>, class_of_cell: Vec<usize>) -> Self {
+        Self {
+            criteria,
+            class_of_cell,
+            policy: FailurePolicy::default(),
+            stress: StressMeasure::Cell,
+            max_rounds: 500,
+            max_active_set: 30,
+            active_set_tolerance: 1e-6,
+        }
+    }
+}
+
+/// The coupling scheme of a [`Fracturing`] run.
+pub enum Scheme {
+    /// Fully implicit monolithic (seed eq. 30).
+    Monolithic(Monolithic),
+    /// Fixed-stress split; needs the drained bulk modulus of every cell.
+    FixedStress(FixedStress, Vec<f64>),
+    /// The seed's explicit-pressure update (§2.5): the volumetric term in the failed cells
+    /// and in the cells flagged here (e.g. the injection cells).
+    ExplicitPressure(ExplicitPressure, Vec<bool>),
+}
+
+impl Scheme {
+    fn name(&self) -> &'static str {
+        match self {
+            Scheme::Monolithic(_) => "monolithic",
+            Scheme::FixedStress(..) => "fixed-stress",
+            Scheme::ExplicitPressure(..) => "explicit-pressure",
+        }
+    }
+}
+
+/// The mechanics of the body: grid, dof map, pattern and loads.
+#[derive(Clone, Copy)]
+pub struct Body<'a, const D: usize> {
+    /// The grid.
+    pub grid: &'a Grid<D>,
+    /// Dof map (conditions).
+    pub dofs: &'a DofMap<D>,
+    /// Stiffness pattern.
+    pub pattern: &'a Pattern,
+    /// Loads.
+    pub loads: &'a Loads<D>,
+}
+
+/// The flow of the body with its permeability before and after failure.
+pub struct FractureFlow<const D: usize> {
+    /// The flow model (its permeability is updated as cells fail).
+    pub model: FlowModel<D>,
+    /// The intact permeability of every cell.
+    pub permeability: Permeability<D>,
+    /// Isotropic permeability of failed cells (m²); `None` keeps the intact value.
+    pub fracture_permeability: Option<f64>,
+    /// Biot coefficient per cell.
+    pub alpha: Vec<f64>,
+    /// Initial pressure per cell.
+    pub p0: Vec<f64>,
+}
+
+/// The result of one step.
+#[derive(Clone, Debug)]
+pub struct FractureStep<const D: usize> {
+    /// The state at the end of the step.
+    pub state: BiotState,
+    /// Cell stresses of the laws at that state (effective, tension positive).
+    pub stress: Vec<Tensor<D>>,
+    /// Cells failed in this step.
+    pub new_failures: usize,
+    /// Coupled solves with a new failure state (1: nothing failed).
+    pub rounds: usize,
+    /// Linear coupled solves (all rounds and active-set iterations).
+    pub solves: usize,
+    /// Largest relative equilibrium residual accepted.
+    pub residual: f64,
+}
+
+/// A fracturing poroelastic body advanced step by step (see the module docs).
+pub struct Fracturing<'a, const D: usize> {
+    body: Body<'a, D>,
+    laws: FractureLaws<'a, D>,
+    settings: FractureSettings,
+    flow: FractureFlow<D>,
+    scheme: Scheme,
+    failures: FailureState,
+    adjacency: Option<NodeCells>,
+    perm_of_failed: Vec<bool>,
+}
+
+impl<'a, const D: usize> Fracturing<'a, D> {
+    /// Set up the run. `scheme` builds the coupling for the intact system (e.g.
+    /// `|sys| Ok(Scheme::Monolithic(Monolithic::new(sys, None)?))`).
+    ///
+    /// Errors: lengths of the per-cell arrays, a class or post-failure index out of range,
+    /// a failed law that does not support its cell, or an error of the scheme.
+    pub fn new(
+        body: Body<'a, D>,
+        laws: FractureLaws<'a, D>,
+        settings: FractureSettings,
+        flow: FractureFlow<D>,
+        scheme: impl FnOnce(&BiotSystem<'_, D>) -> FractureResult<Scheme>,
+    ) -> FractureResult<Self> {
+        let nc = body.grid.num_cells();
+        let len = |what: &str, got: usize| {
+            if got == nc {
+                Ok(())
+            } else {
+                Err(FractureError::Input(format!(
+                    "{what}: length {got}, want {nc}"
+                )))
+            }
+        };
+        len("law of cell", laws.law_of_cell.len())?;
+        len("class of cell", settings.class_of_cell.len())?;
+        if laws.post_failure.len() != laws.laws.len()
+            || laws.post_failure.iter().any(|&l| l >= laws.laws.len())
+        {
+            return Err(FractureError::Input(
+                "post-failure laws: one valid instance per law".into(),
+            ));
+        }
+        if let Some(c) = settings
+            .class_of_cell
+            .iter()
+            .position(|&k| k >= settings.criteria.len())
+        {
+            return Err(FractureError::Input(format!(
+                "cell {c}: criterion class out of range"
+            )));
+        }
+        if let Some(k) = flow.fracture_permeability
+            && !(k.is_finite() && k > 0.0)
+        {
+            return Err(FractureError::Input(format!(
+                "fracture permeability must be finite and > 0, got {k}"
+            )));
+        }
+        // Every cell must accept its failed law too.
+        laws.law_map(body.grid, &vec![true; nc])?;
+        let intact = laws.law_map(body.grid, &vec![false; nc])?;
+        let system = BiotSystem::new(
+            problem(&body, &intact),
+            &flow.model,
+            flow.alpha.clone(),
+            flow.p0.clone(),
+        )?;
+        let scheme = scheme(&system)?;
+        drop(system);
+        let adjacency = (settings.stress == StressMeasure::Recovered)
+            .then(|| NodeCells::new(body.grid));
+        Ok(Self {
+            body,
+            laws,
+            settings,
+            flow,
+            scheme,
+            failures: FailureState::new(nc),
+            adjacency,
+            perm_of_failed: vec![false; nc],
+        })
+    }
+
+    /// The failure state (flags and the log of failures).
+    pub fn failures(&self) -> &FailureState {
+        &self.failures
+    }
+    /// The flow model with the current permeability.
+    pub fn flow(&self) -> &FlowModel<D> {
+        &self.flow.model
+    }
+    /// The initial pressure `p₀` of every cell.
+    pub fn initial_pressure(&self) -> &[f64] {
+        &self.flow.p0
+    }
+    /// The name of the coupling scheme.
+    pub fn scheme_name(&self) -> &'static str {
+        self.scheme.name()
+    }
+    /// The law map of the current failure state.
+    pub fn law_map(&self) -> FractureResult<LawMap<'a, D>> {
+        self.laws.law_map(self.body.grid, self.failures.flags())
+    }
+
+    /// The initial state at `t`: mechanical equilibrium with the loads and `p = p₀`,
+    /// failures resolved.
+    pub fn initial_state(&mut self, t: f64) -> FractureResult<FractureStep<D>> {
+        self.advance(None, t, 0.0)
+    }
+
+    /// Advance `state` at `t` to `t + dt` (see the module docs).
+    pub fn step(
+        &mut self,
+        state: &BiotState,
+        t: f64,
+        dt: f64,
+    ) -> FractureResult<FractureStep<D>> {
+        self.advance(Some(state), t, dt)
+    }
+
+    fn advance(
+        &mut self,
+        state: Option<&BiotState>,
+        t: f64,
+        dt: f64,
+    ) -> FractureResult<FractureStep<D>> {
+        let Self {
+            body,
+            laws,
+            settings,
+            flow,
+            scheme,
+            failures,
+            adjacency,
+            perm_of_failed,
+        } = self;
+        let grid = body.grid;
+        let t1 = t + dt;
+        let mut solves = 0;
+        let mut worst = 0.0f64;
+        let solve = |fs: &FailureState| -> FractureResult<((BiotState, Vec<Tensor<D>>), Vec<Tensor<D>>)> {
+            let map = laws.law_map(grid, fs.flags())?;
+            update_permeability(grid, flow, fs.flags(), perm_of_failed)?;
+            let mut system = BiotSystem::new(
+                problem(body, &map),
+                &flow.model,
+                flow.alpha.clone(),
+                flow.p0.clone(),
+            )?;
+            if let Scheme::FixedStress(_, k_dr) = scheme {
+                system = system.with_drained_bulk_modulus(k_dr.clone())?;
+            }
+            if let Scheme::ExplicitPressure(ep, extra) = scheme {
+                ep.fractured = fs.flags().iter().zip(extra.iter()).map(|(a, b)| *a || *b).collect();
+            }
+            let (new, residual, n) = active_set_solve(&mut system, scheme, state, t, dt, settings)?;
+            solves += n;
+            worst = worst.max(residual);
+            let stress = cell_stresses(grid, &map, &new.displacement)?;
+            let measure = match adjacency {
+                Some(adj) => cell_average(grid, &recover_nodal(grid, adj, &stress)),
+                None => stress.clone(),
+            };
+            Ok(((new, stress), measure))
+        };
+        let ((state, stress), _, new_failures, rounds) = resolve(
+            failures,
+            t1,
+            &settings.criteria,
+            &settings.class_of_cell,
+            settings.policy,
+            settings.max_rounds,
+            solve,
+        )
+        .map_err(|e| match e {
+            ResolveError::Solve(e) => e,
+            ResolveError::NotSettled {
+                rounds,
+                time,
+                failed,
+            } => FractureError::NotSettled {
+                rounds,
+                time,
+                failed,
+            },
+        })?;
+        Ok(FractureStep {
+            state,
+            stress,
+            new_failures,
+            rounds,
+            solves,
+            residual: worst,
+        })
+    }
+}
+
+fn problem<'b, const D: usize>(body: &Body<'b, D>, laws: &'b LawMap<'b, D>) -> StaticProblem<'b, D> {
+    StaticProblem {
+        grid: body.grid,
+        laws,
+        dofs: body.dofs,
+        pattern: body.pattern,
+        loads: body.loads,
+    }
+}
+
+/// Raise the permeability of newly failed cells (only when the flags changed).
+fn update_permeability<const D: usize>(
+    grid: &Grid<D>,
+    flow: &mut FractureFlow<D>,
+    failed: &[bool],
+    applied: &mut [bool],
+) -> FractureResult<()> {
+    let Some(k) = flow.fracture_permeability else {
+        return Ok(());
+    };
+    if applied == failed {
+        return Ok(());
+    }
+    let mut perm = flow.permeability.clone();
+    for (c, &f) in failed.iter().enumerate() {
+        if f {
+            perm.set(c, Tensor::<D>::identity() * k)?;
+        }
+    }
+    flow.model.set_permeability(grid, &perm)?;
+    applied.copy_from_slice(failed);
+    Ok(())
+}
+
+/// One coupled step (or the initial equilibrium when `state` is `None`) iterated over the
+/// active set of the piecewise-linear laws. Returns the state, the accepted residual and
+/// the number of linear solves.
+fn active_set_solve<const D: usize>(
+    system: &mut BiotSystem<'_, D>,
+    scheme: &mut Scheme,
+    state: Option<&BiotState>,
+    t: f64,
+    dt: f64,
+    settings: &FractureSettings,
+) -> FractureResult<(BiotState, f64, usize)> {
+    let t1 = t + dt;
+    let p0 = system.initial_pressure().to_vec();
+    match state {
+        Some(s) => system.linearize(&s.displacement, &s.pressure, t)?,
+        None => system.linearize(&vec![0.0; system.mechanics().dofs.num_dofs()], &p0, t)?,
+    };
+    let mut residual = f64::INFINITY;
+    for it in 1..=settings.max_active_set.max(1) {
+        let (new, p_used) = match state {
+            None => {
+                let st = system.initial_state(t)?;
+                (st, p0.clone())
+            }
+            Some(s) => {
+                let res = match scheme {
+                    Scheme::Monolithic(m) => m.step(system, s, t, dt)?,
+                    Scheme::FixedStress(f, _) => f.step(system, s, t, dt)?,
+                    Scheme::ExplicitPressure(e, _) => e.step(system, s, t, dt)?,
+                };
+                // The explicit-pressure mechanics is in equilibrium with the old pressure.
+                let p_used = match scheme {
+                    Scheme::ExplicitPressure(..) => s.pressure.clone(),
+                    _ => res.state.pressure.clone(),
+                };
+                (res.state, p_used)
+            }
+        };
+        let lin = system.linearize(&new.displacement, &p_used, t1)?;
+        residual = lin.residual;
+        if !lin.changed || residual <= settings.active_set_tolerance {
+            return Ok((new, residual, it));
+        }
+    }
+    Err(FractureError::ActiveSet {
+        time: t1,
+        iterations: settings.max_active_set,
+        residual,
+        tolerance: settings.active_set_tolerance,
+    })
+}
