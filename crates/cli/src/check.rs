@@ -369,6 +369,14 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
     if let Some(kf) = s.physics.fracture_permeability {
         positive(ls, &k(&["physics", "fracture_permeability"]), kf)?;
     }
+    if let Some(a) = s.physics.crack_tracking
+        && !(a.is_finite() && a > 0.0 && a <= 90.0)
+    {
+        return Err(ls.error(
+            &k(&["physics", "crack_tracking"]),
+            format!("= {a} must be an angle in (0, 90] degrees"),
+        ));
+    }
     if let Some(r) = s.physics.open_edge_stiffness
         && !(r.is_finite() && (0.0..1.0).contains(&r))
     {

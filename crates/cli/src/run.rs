@@ -10,7 +10,8 @@ use std::time::Instant;
 
 use porofrac_frac::recovery::{NodeCells, cell_average, recover_nodal};
 use porofrac_frac::{
-    Combined, FailurePolicy, FailureState, MohrCoulomb, ResolveError, Tensile, resolve,
+    Combined, CrackTracking, FailurePolicy, FailureState, MohrCoulomb, ResolveError, Tensile,
+    resolve,
 };
 use porofrac_grid::generate::{CompositeSpec, cartesian, composite, perturb, simplices, voronoi};
 use porofrac_grid::io::{Field, PvdWriter, read_msh, read_vtu, write_vtu};
@@ -484,6 +485,7 @@ fn coupled_setup<'a, const D: usize>(
     if recovered {
         settings.stress = StressMeasure::Recovered;
     }
+    settings.tracking_angle = s.physics.crack_tracking;
     let source_cells = f.source_cells.clone();
     let flow = FractureFlow {
         model: f.model,
@@ -677,6 +679,13 @@ fn run_dim<const D: usize>(
     let fracture_on = comp.criteria.iter().any(|c| !c.is_empty());
     let recovered = s.physics.failure_stress.as_deref() == Some("recovered");
     let adjacency = (fracture_on && recovered).then(|| NodeCells::new(grid));
+    let tracking = match (fracture_on, s.physics.crack_tracking) {
+        (true, Some(a)) => Some(
+            CrackTracking::new(grid, a)
+                .map_err(|e| ls.error(&k(&["physics", "crack_tracking"]), e))?,
+        ),
+        _ => None,
+    };
     let mut failures = FailureState::new(grid.num_cells());
     // Explicit mechanics: density per cell (scaled for quasi-static relaxation).
     let explicit: Option<Vec<f64>> = if s.solver.mechanics.as_deref() == Some("explicit") {
@@ -735,7 +744,17 @@ fn run_dim<const D: usize>(
     };
     // Coupled poroelasticity, with fracturing when a material has a strength.
     let mut coupled = match coupled_flow {
-        Some(f) => Some(coupled_setup(ls, grid, &comp, &law_refs, f, &dofs, &pattern, &cond, adjacency.is_some())?),
+        Some(f) => Some(coupled_setup(
+            ls,
+            grid,
+            &comp,
+            &law_refs,
+            f,
+            &dofs,
+            &pattern,
+            &cond,
+            adjacency.is_some(),
+        )?),
         None => None,
     };
     let mut biot_state: Option<BiotState> = None;
@@ -928,6 +947,7 @@ fn run_dim<const D: usize>(
                 &comp.criteria,
                 &class,
                 FailurePolicy::default(),
+                tracking.as_ref(),
                 if fracture_on { 200 } else { 1 },
                 solve,
             )

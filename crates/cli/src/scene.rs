@@ -287,6 +287,8 @@ pub struct Physics {
     pub fracture_permeability: Option<f64>,
     /// Residual stiffness ratio of open edges of failed cells (default 1e-6).
     pub open_edge_stiffness: Option<f64>,
+    /// Crack tracking angle in degrees (absent: no tracking).
+    pub crack_tracking: Option<f64>,
 }
 
 /// `[solver]`.

@@ -10,14 +10,18 @@
 //! * [`recovery`]: superconvergent patch recovery (Zienkiewicz–Zhu) of nodal stresses
 //!   from cell stresses on any grid (seed Fig. 5), and cell values from the recovered
 //!   nodal field, so a criterion can be evaluated on a smoother stress near a tip.
+//! * [`tracking`]: crack tracking, so a crack grows perpendicular to the largest principal
+//!   stress rather than along mesh diagonals.
 //!
 //! What a failed cell becomes is the caller's choice: in porofrac's scenes a failed MDEM
 //! cell switches to the compression-only central-force law (seed eqs. 32–33).
 
 pub mod recovery;
 pub mod resolve;
+pub mod tracking;
 
 pub use resolve::{FailurePolicy, ResolveError, resolve};
+pub use tracking::CrackTracking;
 
 use porofrac_law::Tensor;
 

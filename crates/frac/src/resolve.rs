@@ -10,6 +10,7 @@
 
 use porofrac_law::Tensor;
 
+use crate::tracking::CrackTracking;
 use crate::{Combined, FailureCriterion, FailureState};
 
 /// Which violating cells fail in one round.
@@ -55,13 +56,15 @@ pub enum ResolveError<E> {
 /// `criteria[k]` is the criterion of class `k` and `criterion_of_cell[c]` the class of
 /// cell `c` (an empty [`Combined`] never fails). `solve` gets the current state and
 /// returns a solution and the cell stresses (effective, tension positive) used by the
-/// criteria, e.g. raw or recovered cell stresses.
+/// criteria, e.g. raw or recovered cell stresses. With `tracking`, a violating cell next
+/// to failed cells fails only where [`CrackTracking::admits`] it.
 pub fn resolve<const D: usize, S, E>(
     state: &mut FailureState,
     time: f64,
     criteria: &[Combined],
     criterion_of_cell: &[usize],
     policy: FailurePolicy,
+    tracking: Option<&CrackTracking<D>>,
     max_solves: usize,
     mut solve: impl FnMut(&FailureState) -> Result<(S, Vec<Tensor<D>>), E>,
 ) -> Result<(S, Vec<Tensor<D>>, usize, usize), ResolveError<E>> {
@@ -76,6 +79,11 @@ pub fn resolve<const D: usize, S, E>(
             }
             let crit = &criteria[criterion_of_cell[c]];
             if let Some(mode) = FailureCriterion::<D>::check(crit, s) {
+                if let Some(t) = tracking
+                    && !t.admits(c, s, state.flags())
+                {
+                    continue;
+                }
                 violating.push((c, FailureCriterion::<D>::utilization(crit, s), mode));
             }
         }
@@ -132,6 +140,7 @@ mod tests {
             &criteria,
             &class,
             FailurePolicy::default(),
+            None,
             10,
             |st| {
                 let broken = st.flags().iter().any(|&f| f);
@@ -168,6 +177,7 @@ mod tests {
             &criteria,
             &class,
             FailurePolicy::All,
+            None,
             5,
             |_| {
                 Ok((
@@ -190,6 +200,7 @@ mod tests {
             &criteria,
             &class,
             FailurePolicy::default(),
+            None,
             1,
             |_| {
                 Ok((

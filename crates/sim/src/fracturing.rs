@@ -27,7 +27,7 @@
 //! 2. **Failure check** on the cells that have not failed, on the cell stress or the
 //!    recovered (Zienkiewicz–Zhu) stress ([`StressMeasure`]); the violating cells chosen
 //!    by the [`FailurePolicy`] fail at `t + Δt`, and the step is solved again from
-//!    `(uⁿ, pⁿ)` ([`porofrac_frac::resolve`]) until no cell fails: a step never ends half
+//!    `(uⁿ, pⁿ)` ([`porofrac_frac::resolve()`]) until no cell fails: a step never ends half
 //!    updated. More than [`FractureSettings::max_rounds`] rounds is an error.
 //!
 //! The initial state ([`Fracturing::initial_state`]) is the mechanical equilibrium with
@@ -36,14 +36,14 @@
 
 use porofrac_flow::{FlowError, FlowModel, Permeability};
 use porofrac_frac::recovery::{NodeCells, cell_average, recover_nodal};
-use porofrac_frac::{Combined, FailurePolicy, FailureState, ResolveError, resolve};
+use porofrac_frac::{Combined, CrackTracking, FailurePolicy, FailureState, ResolveError, resolve};
 use porofrac_grid::Grid;
 use porofrac_law::{CellLaw, Tensor};
 
+use crate::bc::Loads;
 use crate::biot::{
     BiotCoupling, BiotError, BiotState, BiotSystem, ExplicitPressure, FixedStress, Monolithic,
 };
-use crate::bc::Loads;
 use crate::dofs::DofMap;
 use crate::error::SimError;
 use crate::laws::LawMap;
@@ -81,7 +81,9 @@ pub enum FractureError {
         tolerance: f64,
     },
     /// Failures kept appearing.
-    #[error("failures did not settle within {rounds} solves at t = {time} s ({failed} cells failed)")]
+    #[error(
+        "failures did not settle within {rounds} solves at t = {time} s ({failed} cells failed)"
+    )]
     NotSettled {
         /// Rounds done.
         rounds: usize,
@@ -140,6 +142,9 @@ pub struct FractureSettings {
     pub policy: FailurePolicy,
     /// The stress the criteria see.
     pub stress: StressMeasure,
+    /// Crack tracking: the largest angle (degrees) between a crack's growth and the plane
+    /// normal to `σ₁` ([`porofrac_frac::tracking`]); `None`: no tracking.
+    pub tracking_angle: Option<f64>,
     /// Failure rounds (coupled solves with a new failure state) allowed per step.
     pub max_rounds: usize,
     /// Active-set iterations allowed per coupled solve.
@@ -157,6 +162,7 @@ impl FractureSettings {
             class_of_cell,
             policy: FailurePolicy::default(),
             stress: StressMeasure::Cell,
+            tracking_angle: None,
             max_rounds: 500,
             max_active_set: 30,
             active_set_tolerance: 1e-6,
@@ -238,6 +244,7 @@ pub struct Fracturing<'a, const D: usize> {
     scheme: Scheme,
     failures: FailureState,
     adjacency: Option<NodeCells>,
+    tracking: Option<CrackTracking<D>>,
     perm_of_failed: Vec<bool>,
 }
 
@@ -300,8 +307,15 @@ impl<'a, const D: usize> Fracturing<'a, D> {
         )?;
         let scheme = scheme(&system)?;
         drop(system);
-        let adjacency = (settings.stress == StressMeasure::Recovered)
-            .then(|| NodeCells::new(body.grid));
+        let adjacency =
+            (settings.stress == StressMeasure::Recovered).then(|| NodeCells::new(body.grid));
+        let tracking = match settings.tracking_angle {
+            Some(a) => Some(
+                CrackTracking::new(body.grid, a)
+                    .map_err(|e| FractureError::Input(e.to_string()))?,
+            ),
+            None => None,
+        };
         Ok(Self {
             body,
             laws,
@@ -310,6 +324,7 @@ impl<'a, const D: usize> Fracturing<'a, D> {
             scheme,
             failures: FailureState::new(nc),
             adjacency,
+            tracking,
             perm_of_failed: vec![false; nc],
         })
     }
@@ -342,12 +357,7 @@ impl<'a, const D: usize> Fracturing<'a, D> {
     }
 
     /// Advance `state` at `t` to `t + dt` (see the module docs).
-    pub fn step(
-        &mut self,
-        state: &BiotState,
-        t: f64,
-        dt: f64,
-    ) -> FractureResult<FractureStep<D>> {
+    pub fn step(&mut self, state: &BiotState, t: f64, dt: f64) -> FractureResult<FractureStep<D>> {
         self.advance(Some(state), t, dt)
     }
 
@@ -365,13 +375,14 @@ impl<'a, const D: usize> Fracturing<'a, D> {
             scheme,
             failures,
             adjacency,
+            tracking,
             perm_of_failed,
         } = self;
         let grid = body.grid;
         let t1 = t + dt;
         let mut solves = 0;
         let mut worst = 0.0f64;
-        let solve = |fs: &FailureState| -> FractureResult<((BiotState, Vec<Tensor<D>>), Vec<Tensor<D>>)> {
+        let solve = |fs: &FailureState| -> FractureResult<(Solved<D>, Vec<Tensor<D>>)> {
             let map = laws.law_map(grid, fs.flags())?;
             update_permeability(grid, flow, fs.flags(), perm_of_failed)?;
             let mut system = BiotSystem::new(
@@ -384,7 +395,12 @@ impl<'a, const D: usize> Fracturing<'a, D> {
                 system = system.with_drained_bulk_modulus(k_dr.clone())?;
             }
             if let Scheme::ExplicitPressure(ep, extra) = scheme {
-                ep.fractured = fs.flags().iter().zip(extra.iter()).map(|(a, b)| *a || *b).collect();
+                ep.fractured = fs
+                    .flags()
+                    .iter()
+                    .zip(extra.iter())
+                    .map(|(a, b)| *a || *b)
+                    .collect();
             }
             let (new, residual, n) = active_set_solve(&mut system, scheme, state, t, dt, settings)?;
             solves += n;
@@ -402,6 +418,7 @@ impl<'a, const D: usize> Fracturing<'a, D> {
             &settings.criteria,
             &settings.class_of_cell,
             settings.policy,
+            tracking.as_ref(),
             settings.max_rounds,
             solve,
         )
@@ -428,7 +445,13 @@ impl<'a, const D: usize> Fracturing<'a, D> {
     }
 }
 
-fn problem<'b, const D: usize>(body: &Body<'b, D>, laws: &'b LawMap<'b, D>) -> StaticProblem<'b, D> {
+/// A coupled solution and its cell stresses.
+type Solved<const D: usize> = (BiotState, Vec<Tensor<D>>);
+
+fn problem<'b, const D: usize>(
+    body: &Body<'b, D>,
+    laws: &'b LawMap<'b, D>,
+) -> StaticProblem<'b, D> {
     StaticProblem {
         grid: body.grid,
         laws,

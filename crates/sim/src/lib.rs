@@ -55,14 +55,14 @@ pub use biot::{
     BiotCoupling, BiotError, BiotState, BiotStep, BiotSystem, ExplicitPressure, FixedStress,
     Linearization, Monolithic, drained_bulk_modulus,
 };
-pub use fracturing::{
-    Body, FractureError, FractureFlow, FractureLaws, FractureSettings, FractureStep, Fracturing,
-    Scheme, StressMeasure,
-};
 pub use dofs::DofMap;
 pub use error::{Result, SimError};
 pub use explicit::{ExplicitOptions, ExplicitSolution, ExplicitState, solve_explicit};
 pub use field::{FieldFn, ScalarField};
+pub use fracturing::{
+    Body, FractureError, FractureFlow, FractureLaws, FractureSettings, FractureStep, Fracturing,
+    Scheme, StressMeasure,
+};
 pub use laws::LawMap;
 pub use pattern::Pattern;
 pub use solve::{

@@ -1,0 +1,513 @@
+//! Strength of connection between nodes, greedy aggregation and the tentative
+//! prolongator.
+//!
+//! # Nodes and strength
+//!
+//! Equations are grouped into *nodes* (blocks): the `D` displacement components of a grid
+//! node on the finest level — fewer where components are prescribed — and the coarse
+//! equations of one aggregate on coarser levels. With `A_IJ` the block of rows of node
+//! `I` and columns of node `J`, node `J` is a *strong* neighbour of `I ≠ J` when
+//!
+//! ```text
+//!   ‖A_IJ‖_F > θ √(‖A_II‖_F ‖A_JJ‖_F),
+//! ```
+//!
+//! the symmetric block version of the classical criterion (θ = 0 keeps every structural
+//! neighbour with a nonzero block).
+//!
+//! # Aggregation (Vaněk, Mandel, Brezina 1996)
+//!
+//! 1. Visit the nodes in order; a node whose strong neighbours are all still free forms an
+//!    aggregate with them (its *root neighbourhood*). Disjoint neighbourhoods give
+//!    aggregates of diameter two that cover most of the grid.
+//! 2. Every free node joins the pass-1 aggregate it is most strongly connected to.
+//! 3. Nodes still free (no strong neighbour in any aggregate) form aggregates with their
+//!    free strong neighbours.
+//!
+//! # Tentative prolongator
+//!
+//! Let `B` (n × m) be the near-null space on this level and `B_a` its rows on the equations
+//! of aggregate `a`. A thin QR factorization `B_a = Q_a R_a` (modified Gram–Schmidt with
+//! one reorthogonalization; a column whose remainder is below `10⁻⁸` of its norm is
+//! linearly dependent and dropped, so `Q_a` has `k_a ≤ m` orthonormal columns) gives
+//!
+//! ```text
+//!   P_tent = blockdiag(Q_a),   B_coarse = [R_1; R_2; …],   P_tent B_coarse = B,
+//! ```
+//!
+//! so the coarse space reproduces the near-null space exactly, `P_tentᵀ P_tent = I`, and the
+//! coarse equations of aggregate `a` form the coarse node `a` with `k_a` equations.
+
+use rayon::prelude::*;
+
+use crate::csr::{CsrMatrix, ROWS_PER_TASK};
+use crate::error::{AmgError, Result};
+use crate::nullspace::NearNullSpace;
+use crate::product::Blocked;
+
+/// Relative size below which a Gram–Schmidt remainder counts as linearly dependent.
+const RANK_TOL: f64 = 1e-8;
+/// Marker of a free node.
+const FREE: u32 = u32::MAX;
+
+/// Equations grouped into nodes: `eqs[ptr[I]..ptr[I+1]]` are the equations of node `I`.
+#[derive(Clone, Debug)]
+pub(crate) struct Blocks {
+    pub(crate) node_of: Vec<u32>,
+    pub(crate) ptr: Vec<usize>,
+    pub(crate) eqs: Vec<u32>,
+}
+
+impl Blocks {
+    /// Group equations by the node ids `node_of_equation` (any ids; numbered in increasing
+    /// order of id).
+    pub(crate) fn from_ids(node_of_equation: &[usize]) -> Result<Self> {
+        let n = node_of_equation.len();
+        if n >= u32::MAX as usize {
+            return Err(AmgError::Input(format!(
+                "{n} equations exceed the 32-bit indices"
+            )));
+        }
+        let mut order: Vec<(usize, u32)> = node_of_equation
+            .iter()
+            .enumerate()
+            .map(|(e, &id)| (id, e as u32))
+            .collect();
+        order.sort_unstable();
+        let mut node_of = vec![0u32; n];
+        let mut ptr = vec![0usize];
+        let mut eqs = Vec::with_capacity(n);
+        for (k, &(id, e)) in order.iter().enumerate() {
+            if k > 0 && order[k - 1].0 != id {
+                ptr.push(k);
+            }
+            node_of[e as usize] = (ptr.len() - 1) as u32;
+            eqs.push(e);
+        }
+        ptr.push(n);
+        if n == 0 {
+            ptr.truncate(1);
+        }
+        Ok(Self { node_of, ptr, eqs })
+    }
+
+    /// Number of nodes.
+    pub(crate) fn len(&self) -> usize {
+        self.ptr.len() - 1
+    }
+
+    fn node(&self, i: usize) -> &[u32] {
+        &self.eqs[self.ptr[i]..self.ptr[i + 1]]
+    }
+}
+
+/// Node graph of strong connections: neighbours of `I` are `adj[ptr[I]..ptr[I+1]]` with
+/// strengths `w` (block norms).
+#[derive(Clone, Debug)]
+pub(crate) struct Strength {
+    ptr: Vec<usize>,
+    adj: Vec<u32>,
+    w: Vec<f64>,
+}
+
+impl Strength {
+    fn nbrs(&self, i: usize) -> (&[u32], &[f64]) {
+        let r = self.ptr[i]..self.ptr[i + 1];
+        (&self.adj[r.clone()], &self.w[r])
+    }
+}
+
+/// A dense accumulator over `n` columns with a marker per column (node `I` marks `I + 1`,
+/// so the zero-initialised markers cost nothing until touched).
+struct Spa {
+    mark: Vec<u32>,
+    acc: Vec<f64>,
+    list: Vec<u32>,
+}
+
+impl Spa {
+    fn new(n: usize) -> Self {
+        Self {
+            mark: vec![0; n],
+            acc: vec![0.0; n],
+            list: Vec::new(),
+        }
+    }
+}
+
+/// `‖A_IJ‖_F²` for every structural neighbour `J ≠ I` of node `I`, in `spa`.
+fn block_norms(a: &CsrMatrix, blocks: &Blocks, node: usize, spa: &mut Spa) {
+    spa.list.clear();
+    let stamp = node as u32 + 1;
+    for &i in blocks.node(node) {
+        let (cols, vals) = a.row(i as usize);
+        for (&j, &v) in cols.iter().zip(vals) {
+            let nj = blocks.node_of[j as usize];
+            let slot = nj as usize;
+            if slot == node {
+                continue;
+            }
+            if spa.mark[slot] != stamp {
+                spa.mark[slot] = stamp;
+                spa.acc[slot] = 0.0;
+                spa.list.push(nj);
+            }
+            spa.acc[slot] += v * v;
+        }
+    }
+}
+
+/// `‖A_II‖_F`.
+fn diagonal_block_norm(a: &CsrMatrix, blocks: &Blocks, node: usize) -> f64 {
+    let mut s = 0.0;
+    for &i in blocks.node(node) {
+        let (cols, vals) = a.row(i as usize);
+        for (&j, &v) in cols.iter().zip(vals) {
+            if blocks.node_of[j as usize] as usize == node {
+                s += v * v;
+            }
+        }
+    }
+    s.sqrt()
+}
+
+/// The strong-connection graph of the nodes of `a` with threshold `theta`.
+pub(crate) fn strength(a: &CsrMatrix, blocks: &Blocks, theta: f64) -> Strength {
+    let nn = blocks.len();
+    let nblocks = nn.div_ceil(ROWS_PER_TASK);
+    let diag: Vec<f64> = (0..nn)
+        .into_par_iter()
+        .with_min_len(ROWS_PER_TASK)
+        .map(|node| diagonal_block_norm(a, blocks, node))
+        .collect();
+    let parts: Vec<(Vec<usize>, Vec<u32>, Vec<f64>)> = (0..nblocks)
+        .into_par_iter()
+        .map_init(
+            || Spa::new(nn),
+            |spa, b| {
+                let range = b * ROWS_PER_TASK..((b + 1) * ROWS_PER_TASK).min(nn);
+                let mut counts = Vec::with_capacity(range.len());
+                let mut adj = Vec::new();
+                let mut w = Vec::new();
+                let mut row: Vec<(u32, f64)> = Vec::new();
+                for node in range {
+                    block_norms(a, blocks, node, spa);
+                    row.clear();
+                    for &nj in &spa.list {
+                        let j = nj as usize;
+                        let s = spa.acc[j].sqrt();
+                        if s > theta * (diag[node] * diag[j]).sqrt() {
+                            row.push((nj, s));
+                        }
+                    }
+                    row.sort_unstable_by_key(|&(j, _)| j);
+                    counts.push(row.len());
+                    adj.extend(row.iter().map(|&(j, _)| j));
+                    w.extend(row.iter().map(|&(_, s)| s));
+                }
+                (counts, adj, w)
+            },
+        )
+        .collect();
+    let mut ptr = Vec::with_capacity(nn + 1);
+    ptr.push(0);
+    let mut adj = Vec::new();
+    let mut w = Vec::new();
+    for (counts, a_part, w_part) in parts {
+        for c in counts {
+            ptr.push(ptr.last().copied().unwrap_or(0) + c);
+        }
+        adj.extend_from_slice(&a_part);
+        w.extend_from_slice(&w_part);
+    }
+    Strength { ptr, adj, w }
+}
+
+/// Greedy aggregation in three passes (see the module docs). Returns the aggregate of
+/// every node and the number of aggregates.
+pub(crate) fn aggregate(s: &Strength) -> (Vec<u32>, usize) {
+    let nn = s.ptr.len() - 1;
+    let mut agg = vec![FREE; nn];
+    let mut count = 0u32;
+    // Pass 1: root neighbourhoods.
+    for i in 0..nn {
+        if agg[i] != FREE {
+            continue;
+        }
+        let (nb, _) = s.nbrs(i);
+        if nb.iter().all(|&j| agg[j as usize] == FREE) {
+            agg[i] = count;
+            for &j in nb {
+                agg[j as usize] = count;
+            }
+            count += 1;
+        }
+    }
+    // Pass 2: attach to the most strongly connected pass-1 aggregate.
+    let first = agg.clone();
+    for i in 0..nn {
+        if agg[i] != FREE {
+            continue;
+        }
+        let (nb, w) = s.nbrs(i);
+        let mut best: Option<(f64, u32)> = None;
+        for (&j, &wj) in nb.iter().zip(w) {
+            let a = first[j as usize];
+            if a != FREE && best.is_none_or(|(bw, _)| wj > bw) {
+                best = Some((wj, a));
+            }
+        }
+        if let Some((_, a)) = best {
+            agg[i] = a;
+        }
+    }
+    // Pass 3: the rest form aggregates with their free neighbours.
+    for i in 0..nn {
+        if agg[i] != FREE {
+            continue;
+        }
+        agg[i] = count;
+        let (nb, _) = s.nbrs(i);
+        for &j in nb {
+            if agg[j as usize] == FREE {
+                agg[j as usize] = count;
+            }
+        }
+        count += 1;
+    }
+    (agg, count as usize)
+}
+
+/// The tentative prolongator of an aggregation, with the coarse near-null space and the
+/// coarse nodes.
+pub(crate) struct Tentative {
+    /// `P_tent` (fine equations × coarse equations), orthonormal columns, one block per
+    /// row.
+    pub(crate) p: Blocked,
+    /// Aggregate of every fine equation.
+    pub(crate) eq_agg: Vec<u32>,
+    /// The near-null space on the coarse level.
+    pub(crate) coarse_null: NearNullSpace,
+    /// The coarse equations grouped by aggregate (`ptr` is the column layout `off`).
+    pub(crate) coarse_blocks: Blocks,
+}
+
+/// QR of one aggregate's near-null rows: `(Q column-major r × k, R row-major k × m, k)`.
+fn local_qr(b: &NearNullSpace, rows: &[u32]) -> (Vec<f64>, Vec<f64>, usize) {
+    let r = rows.len();
+    let m = b.num_vectors();
+    let mut q: Vec<f64> = Vec::with_capacity(r * m);
+    let mut k = 0;
+    let mut v = vec![0.0; r];
+    for col in 0..m {
+        for (vi, &e) in v.iter_mut().zip(rows) {
+            *vi = b.get(e as usize, col);
+        }
+        let norm0 = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        if norm0 == 0.0 {
+            continue;
+        }
+        for _ in 0..2 {
+            for j in 0..k {
+                let qj = &q[j * r..(j + 1) * r];
+                let d: f64 = qj.iter().zip(&v).map(|(a, b)| a * b).sum();
+                v.iter_mut().zip(qj).for_each(|(vi, qi)| *vi -= d * qi);
+            }
+        }
+        let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        if norm > RANK_TOL * norm0 {
+            q.extend(v.iter().map(|x| x / norm));
+            k += 1;
+        }
+    }
+    // R = Qᵀ B_a.
+    let mut rmat = vec![0.0; k * m];
+    for j in 0..k {
+        let qj = &q[j * r..(j + 1) * r];
+        for col in 0..m {
+            rmat[j * m + col] = qj
+                .iter()
+                .zip(rows)
+                .map(|(qi, &e)| qi * b.get(e as usize, col))
+                .sum();
+        }
+    }
+    (q, rmat, k)
+}
+
+/// Build the tentative prolongator for aggregates `agg` (per node) of `blocks`.
+pub(crate) fn tentative(
+    blocks: &Blocks,
+    agg: &[u32],
+    num_agg: usize,
+    b: &NearNullSpace,
+) -> Result<Tentative> {
+    let n = blocks.node_of.len();
+    let m = b.num_vectors();
+    // Aggregate → equations (nodes in increasing order, their equations in block order).
+    let mut aptr = vec![0usize; num_agg + 1];
+    for (node, &a) in agg.iter().enumerate() {
+        aptr[a as usize + 1] += blocks.ptr[node + 1] - blocks.ptr[node];
+    }
+    for a in 0..num_agg {
+        aptr[a + 1] += aptr[a];
+    }
+    let mut next = aptr.clone();
+    let mut aeqs = vec![0u32; n];
+    for (node, &a) in agg.iter().enumerate() {
+        for &e in blocks.node(node) {
+            aeqs[next[a as usize]] = e;
+            next[a as usize] += 1;
+        }
+    }
+    let qrs: Vec<(Vec<f64>, Vec<f64>, usize)> = (0..num_agg)
+        .into_par_iter()
+        .map(|a| local_qr(b, &aeqs[aptr[a]..aptr[a + 1]]))
+        .collect();
+    // Coarse numbering: aggregate a owns coarse equations off[a]..off[a] + k_a.
+    let mut off = vec![0usize; num_agg + 1];
+    for (a, (_, _, k)) in qrs.iter().enumerate() {
+        off[a + 1] = off[a] + k;
+    }
+    let nc = off[num_agg];
+    if nc >= u32::MAX as usize {
+        return Err(AmgError::Input(format!(
+            "{nc} coarse equations exceed the 32-bit indices"
+        )));
+    }
+    // One block per row (none where the aggregate has no coarse equation).
+    let eq_agg: Vec<u32> = blocks.node_of.iter().map(|&nd| agg[nd as usize]).collect();
+    let mut bptr = Vec::with_capacity(n + 1);
+    bptr.push(0);
+    let mut bagg = Vec::with_capacity(n);
+    for &a in &eq_agg {
+        if off[a as usize + 1] > off[a as usize] {
+            bagg.push(a);
+        }
+        bptr.push(bagg.len());
+    }
+    let mut p = Blocked::from_blocks(n, &off, bptr, bagg);
+    let row_ptr = p.m.row_ptr().to_vec();
+    let vals = p.m.values_mut();
+    let mut bdata = vec![0.0; nc * m];
+    let mut node_of = vec![0u32; nc];
+    for (a, (q, rmat, k)) in qrs.iter().enumerate() {
+        let rows = &aeqs[aptr[a]..aptr[a + 1]];
+        let r = rows.len();
+        for (l, &e) in rows.iter().enumerate() {
+            let p0 = row_ptr[e as usize];
+            for j in 0..*k {
+                vals[p0 + j] = q[j * r + l];
+            }
+        }
+        for j in 0..*k {
+            node_of[off[a] + j] = a as u32;
+            for c in 0..m {
+                bdata[c * nc + off[a] + j] = rmat[j * m + c];
+            }
+        }
+    }
+    let coarse_null = NearNullSpace::from_parts(nc, m, bdata);
+    let coarse_blocks = Blocks {
+        node_of,
+        ptr: off,
+        eqs: (0..nc as u32).collect(),
+    };
+    Ok(Tentative {
+        p,
+        eq_agg,
+        coarse_null,
+        coarse_blocks,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::csr::SymCsr;
+
+    /// 1D Laplacian [−1 2 −1] of size n, upper CSC.
+    fn laplace_1d(n: usize) -> SymCsr {
+        let mut cp = vec![0];
+        let mut ri = vec![];
+        let mut v = vec![];
+        for c in 0..n {
+            if c > 0 {
+                ri.push(c - 1);
+                v.push(-1.0);
+            }
+            ri.push(c);
+            v.push(2.0);
+            cp.push(ri.len());
+        }
+        SymCsr::from_upper_csc(n, &cp, &ri, &v).unwrap()
+    }
+
+    #[test]
+    fn blocks_group_by_id() {
+        let b = Blocks::from_ids(&[7, 3, 7, 3, 9]).unwrap();
+        assert_eq!(b.len(), 3);
+        assert_eq!(b.node_of, vec![1, 0, 1, 0, 2]);
+        assert_eq!(b.node(0), &[1, 3]);
+        assert_eq!(b.node(1), &[0, 2]);
+        assert_eq!(b.node(2), &[4]);
+    }
+
+    #[test]
+    fn aggregates_of_a_chain_are_triples() {
+        let a = laplace_1d(9);
+        let blocks = Blocks::from_ids(&(0..9).collect::<Vec<_>>()).unwrap();
+        let s = strength(a.matrix(), &blocks, 0.0);
+        let (agg, na) = aggregate(&s);
+        // Pass 1 takes {0,1}, {2,3,4}, {5,6,7}; node 8 joins {5,6,7}.
+        assert_eq!(na, 3);
+        assert_eq!(agg, vec![0, 0, 1, 1, 1, 2, 2, 2, 2]);
+    }
+
+    #[test]
+    fn tentative_prolongator_reproduces_the_null_space() {
+        // 2 vectors (constant and linear) on 9 equations, 3 aggregates.
+        let n = 9;
+        let mut data = vec![1.0; n];
+        data.extend((0..n).map(|i| i as f64));
+        let b = NearNullSpace::from_vectors(n, data).unwrap();
+        let blocks = Blocks::from_ids(&(0..n).collect::<Vec<_>>()).unwrap();
+        let agg = vec![0, 0, 1, 1, 1, 2, 2, 2, 2];
+        let t = tentative(&blocks, &agg, 3, &b).unwrap();
+        let p = &t.p.m;
+        assert_eq!(p.ncols(), 6);
+        // P Bc = B.
+        for k in 0..2 {
+            let mut y = vec![0.0; n];
+            p.mul(t.coarse_null.vector(k), &mut y).unwrap();
+            for (yi, bi) in y.iter().zip(b.vector(k)) {
+                assert!((yi - bi).abs() < 1e-13, "{yi} vs {bi}");
+            }
+        }
+        // Orthonormal columns: Pᵀ P = I.
+        let (pt, _) = p.transpose_with_map();
+        for i in 0..6 {
+            for j in 0..6 {
+                let mut ei = vec![0.0; 6];
+                ei[j] = 1.0;
+                let mut col = vec![0.0; n];
+                p.mul(&ei, &mut col).unwrap();
+                let mut out = vec![0.0; 6];
+                pt.mul(&col, &mut out).unwrap();
+                let want = if i == j { 1.0 } else { 0.0 };
+                assert!((out[i] - want).abs() < 1e-14);
+            }
+        }
+    }
+
+    #[test]
+    fn dependent_columns_are_dropped() {
+        // A one-equation aggregate cannot hold two independent vectors.
+        let b = NearNullSpace::from_vectors(2, vec![1.0, 1.0, 2.0, 3.0]).unwrap();
+        let blocks = Blocks::from_ids(&[0, 1]).unwrap();
+        let t = tentative(&blocks, &[0, 1], 2, &b).unwrap();
+        assert_eq!(t.p.m.ncols(), 2);
+        assert_eq!(t.coarse_blocks.ptr, vec![0, 1, 2]);
+        assert_eq!(t.coarse_null.vector(1), &[2.0, 3.0]);
+    }
+}

@@ -1,0 +1,204 @@
+//! Preconditioned conjugate gradients with the V-cycle as preconditioner.
+//!
+//! For SPD `A` and SPD `M ≈ A⁻¹`, CG minimises the `A`-norm of the error over the Krylov
+//! space `x₀ + span{M r₀, (M A) M r₀, …}`:
+//!
+//! ```text
+//!   r₀ = b − A x₀,  z₀ = M r₀,  p₀ = z₀,
+//!   α_k = (r_k·z_k) / (p_k·A p_k),  x_{k+1} = x_k + α_k p_k,  r_{k+1} = r_k − α_k A p_k,
+//!   z_{k+1} = M r_{k+1},  β_k = (r_{k+1}·z_{k+1}) / (r_k·z_k),  p_{k+1} = z_{k+1} + β_k p_k,
+//! ```
+//!
+//! and `‖e_k‖_A ≤ 2 ((√κ − 1)/(√κ + 1))^k ‖e₀‖_A` with `κ = κ(M A)`: a multigrid
+//! preconditioner with a mesh-independent `κ` gives mesh-independent iteration counts.
+//!
+//! It stops when the recursively updated residual satisfies `‖r_k‖ ≤ tol ‖b‖`, then checks
+//! the true residual `‖b − A x_k‖` (the recursion drifts from it by rounding); if that is
+//! still above the tolerance, CG restarts from `x_k` with the true residual. It fails
+//! loudly instead of returning a wrong answer: `p·Ap ≤ 0` or `r·z ≤ 0` is a
+//! [`AmgError::Breakdown`] (the matrix or the preconditioner is not positive definite), no
+//! new smallest residual within the stagnation window (or three restarts that do not reach
+//! the tolerance) is [`AmgError::Stagnation`], and the iteration limit is
+//! [`AmgError::NoConvergence`] with the residual reached.
+
+use crate::csr::{dot, norm, par_rows, par_zip2};
+use crate::error::{AmgError, Result, check_finite};
+use crate::hierarchy::Amg;
+
+/// Statistics of a converged solve.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CgStats {
+    /// CG iterations (each one V-cycle and one product with `A`).
+    pub iterations: usize,
+    /// True relative residual `‖b − A x‖ / ‖b‖` of the returned solution.
+    pub relative_residual: f64,
+}
+
+/// Restarts allowed when the true residual misses the tolerance.
+const MAX_RESTARTS: usize = 3;
+
+impl Amg {
+    /// Solve `A x = b` by preconditioned CG to `‖b − A x‖ ≤ tol ‖b‖`, starting from the
+    /// given `x` (use zeros without a better guess), in at most `max_iter` iterations.
+    ///
+    /// Errors: wrong lengths, non-finite `b` or `x`, a tolerance that is not a positive
+    /// finite number, a hierarchy left unusable by a failed [`Amg::update_values`], and
+    /// the failures described in the module docs.
+    pub fn solve(
+        &mut self,
+        x: &mut [f64],
+        b: &[f64],
+        tol: f64,
+        max_iter: usize,
+    ) -> Result<CgStats> {
+        self.check_valid()?;
+        let n = self.n();
+        if x.len() != n || b.len() != n {
+            return Err(AmgError::Input(format!(
+                "solve with x of length {} and b of length {}, want {n}",
+                x.len(),
+                b.len()
+            )));
+        }
+        if !(tol > 0.0 && tol.is_finite()) {
+            return Err(AmgError::Input(format!(
+                "tolerance {tol} must be a positive finite number"
+            )));
+        }
+        check_finite(b, "right-hand side")?;
+        check_finite(x, "initial guess")?;
+        let mut v = std::mem::take(&mut self.cg);
+        for w in v.iter_mut() {
+            w.resize(n, 0.0);
+        }
+        let result = self.pcg(x, b, tol, max_iter, &mut v);
+        self.cg = v;
+        result
+    }
+
+    fn pcg(
+        &mut self,
+        x: &mut [f64],
+        b: &[f64],
+        tol: f64,
+        max_iter: usize,
+        v: &mut [Vec<f64>; 4],
+    ) -> Result<CgStats> {
+        let [r, z, p, q] = v;
+        let bnorm = norm(b);
+        if bnorm == 0.0 {
+            x.fill(0.0);
+            return Ok(CgStats {
+                iterations: 0,
+                relative_residual: 0.0,
+            });
+        }
+        let target = tol * bnorm;
+        self.matrix().residual(b, x, r);
+        let rn0 = norm(r);
+        if rn0 <= target {
+            return Ok(CgStats {
+                iterations: 0,
+                relative_residual: rn0 / bnorm,
+            });
+        }
+        let mut rz = self.restart(r, z, p, 0)?;
+        let mut best = rn0;
+        let mut since_best = 0;
+        let mut restarts = 0;
+        for it in 1..=max_iter {
+            self.matrix().spmv(p, q);
+            let pq = dot(p, q);
+            if pq.is_nan() || pq <= 0.0 {
+                return Err(AmgError::Breakdown {
+                    iteration: it,
+                    what: format!("pᵀAp = {pq:e}"),
+                });
+            }
+            let alpha = rz / pq;
+            {
+                let (pp, qq): (&[f64], &[f64]) = (p, q);
+                par_zip2(x, r, |i, xi, ri| {
+                    *xi += alpha * pp[i];
+                    *ri -= alpha * qq[i];
+                });
+            }
+            let rn = norm(r);
+            if !rn.is_finite() {
+                return Err(AmgError::Breakdown {
+                    iteration: it,
+                    what: format!("residual norm {rn}"),
+                });
+            }
+            if rn <= target {
+                // Check the true residual.
+                self.matrix().residual(b, x, q);
+                let true_rn = norm(q);
+                if true_rn <= target {
+                    return Ok(CgStats {
+                        iterations: it,
+                        relative_residual: true_rn / bnorm,
+                    });
+                }
+                restarts += 1;
+                if restarts > MAX_RESTARTS {
+                    return Err(AmgError::Stagnation {
+                        iterations: it,
+                        residual: true_rn / bnorm,
+                        tolerance: tol,
+                    });
+                }
+                r.copy_from_slice(q);
+                rz = self.restart(r, z, p, it)?;
+                continue;
+            }
+            if rn < best {
+                best = rn;
+                since_best = 0;
+            } else {
+                since_best += 1;
+                if since_best >= self.options.stagnation_window {
+                    self.matrix().residual(b, x, q);
+                    return Err(AmgError::Stagnation {
+                        iterations: it,
+                        residual: norm(q) / bnorm,
+                        tolerance: tol,
+                    });
+                }
+            }
+            self.vcycle(r, z);
+            let rz_new = dot(r, z);
+            if rz_new.is_nan() || rz_new <= 0.0 {
+                return Err(AmgError::Breakdown {
+                    iteration: it,
+                    what: format!("rᵀMr = {rz_new:e}"),
+                });
+            }
+            let beta = rz_new / rz;
+            rz = rz_new;
+            let zz: &[f64] = z;
+            par_rows(p, |i, pi| *pi = zz[i] + beta * *pi);
+        }
+        self.matrix().residual(b, x, q);
+        let true_rn = norm(q);
+        Err(AmgError::NoConvergence {
+            iterations: max_iter,
+            residual: true_rn / bnorm,
+            tolerance: tol,
+        })
+    }
+
+    /// `z = M r`, `p = z`; returns `rᵀz` (error if not positive).
+    fn restart(&mut self, r: &[f64], z: &mut [f64], p: &mut [f64], it: usize) -> Result<f64> {
+        self.vcycle(r, z);
+        let rz = dot(r, z);
+        if rz.is_nan() || rz <= 0.0 {
+            return Err(AmgError::Breakdown {
+                iteration: it,
+                what: format!("rᵀMr = {rz:e}"),
+            });
+        }
+        p.copy_from_slice(z);
+        Ok(rz)
+    }
+}

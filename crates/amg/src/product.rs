@@ -1,0 +1,776 @@
+//! Sparse products of the setup, on aggregate blocks: the smoothed prolongator, the
+//! restriction, and the Galerkin operator.
+//!
+//! # Column blocks
+//!
+//! Every coarse equation belongs to one aggregate, and aggregate `b` owns the consecutive
+//! coarse equations `off[b]..off[b+1]` (`k_b ≤ m` of them, `m` the near-null dimension:
+//! 3 in 2D, 6 in 3D elasticity, 1 for diffusion). A row of the tentative prolongator, of
+//! the smoothed prolongator and of `A P` either holds all columns of an aggregate or none.
+//! These matrices are therefore stored with, for every row, its list of aggregate *blocks*
+//! (aggregate, position of the first value); the values of a block are contiguous. The
+//! products then do their index work (markers, positions) once per block and the
+//! arithmetic on short dense vectors: `k` times less bookkeeping than scalar sparse
+//! products.
+//!
+//! All products run row by row with a dense accumulator over the aggregates (a marker or a
+//! position per aggregate, per thread): no triplets, no hashing, no per-row allocation.
+//! Rows are distributed over threads in fixed blocks and each row is summed in a fixed
+//! order, so the results do not depend on the number of threads. The patterns are
+//! computed once in the setup; a numeric rebuild for new matrix values scatters into them.
+//!
+//! # Prolongator smoothing
+//!
+//! `P = (I − ω D⁻¹ A) P_tent` row by row: `p_i = t_i − ω/a_ii Σ_j a_ij t_j`, with `t_j` the
+//! single block of row `j` of `P_tent`. Row `i` of `P` has one block per aggregate that
+//! contains a neighbour of `i`.
+//!
+//! # Galerkin operator
+//!
+//! `A_c = Pᵀ (A P)`: first `W = A P` (blocks of a row in the order they are met, since only
+//! the next product reads them), then, for aggregate `a` with the rows `i` whose `P` row
+//! has a block `p_{i,a}`, the block row
+//!
+//! ```text
+//!   (A_c)_{a,b} = Σ_i p_{i,a} w_{i,b}ᵀ        (k_a × k_b outer products).
+//! ```
+//!
+//! Only the blocks `b ≥ a` are summed; the diagonal blocks are averaged with their
+//! transposes and the blocks `b < a` are copied from the transposed blocks `(b, a)`. This
+//! halves the arithmetic and makes `A_c` exactly symmetric, so the V-cycle is an exactly
+//! symmetric operator.
+//!
+//! # Restriction
+//!
+//! `(Pᵀ r)_{off[a]..off[a+1]} = Σ_i r_i p_{i,a}`, over the same per-aggregate list of rows,
+//! in parallel over aggregates. The blocks `p_{i,a}` are copied into one contiguous array
+//! per aggregate (the block transpose), so the restriction reads memory in order.
+
+use rayon::prelude::*;
+
+use crate::csr::{CsrMatrix, ROWS_PER_TASK, zeros};
+
+/// The marker of row (or aggregate) `i` in a dense accumulator. Markers start at zero
+/// (fresh zero pages cost nothing until touched), so row `i` is marked `i + 1`.
+#[inline]
+fn stamp(i: usize) -> u32 {
+    i as u32 + 1
+}
+/// Aggregates per parallel task in the Galerkin product.
+const AGGS_PER_TASK: usize = 64;
+
+/// A matrix with scalar rows and columns in aggregate blocks (see the module docs).
+#[derive(Clone, Debug)]
+pub(crate) struct Blocked {
+    /// The scalar form (columns sorted), used for products with vectors.
+    pub(crate) m: CsrMatrix,
+    /// Blocks of row `i`: `bptr[i]..bptr[i+1]`.
+    bptr: Vec<usize>,
+    /// Aggregate of each block.
+    bagg: Vec<u32>,
+    /// Position in `m`'s values of each block's first value.
+    bpos: Vec<usize>,
+}
+
+impl Blocked {
+    /// The matrix (values zero) whose row `i` holds the aggregates
+    /// `bagg[bptr[i]..bptr[i+1]]` (increasing) with the column layout `off`.
+    pub(crate) fn from_blocks(
+        nrows: usize,
+        off: &[usize],
+        bptr: Vec<usize>,
+        bagg: Vec<u32>,
+    ) -> Self {
+        let width = |b: u32| off[b as usize + 1] - off[b as usize];
+        let mut row_ptr = Vec::with_capacity(nrows + 1);
+        row_ptr.push(0);
+        let mut bpos = Vec::with_capacity(bagg.len());
+        let mut len = 0;
+        for i in 0..nrows {
+            for &b in &bagg[bptr[i]..bptr[i + 1]] {
+                bpos.push(len);
+                len += width(b);
+            }
+            row_ptr.push(len);
+        }
+        let mut col = Vec::with_capacity(len);
+        for &b in &bagg {
+            col.extend(off[b as usize] as u32..off[b as usize + 1] as u32);
+        }
+        let ncols = *off.last().unwrap_or(&0);
+        Self {
+            m: CsrMatrix::from_parts(nrows, ncols, row_ptr, col, zeros(len)),
+            bptr,
+            bagg,
+            bpos,
+        }
+    }
+
+    /// Aggregates and value positions of the blocks of row `i`.
+    #[inline]
+    pub(crate) fn blocks(&self, i: usize) -> (&[u32], &[usize]) {
+        let r = self.bptr[i]..self.bptr[i + 1];
+        (&self.bagg[r.clone()], &self.bpos[r])
+    }
+
+    /// Number of blocks.
+    pub(crate) fn num_blocks(&self) -> usize {
+        self.bagg.len()
+    }
+}
+
+/// Per-row block lists computed in parallel blocks of rows and concatenated.
+fn concat_block_lists(parts: Vec<(Vec<usize>, Vec<u32>)>, nrows: usize) -> (Vec<usize>, Vec<u32>) {
+    let mut bptr = Vec::with_capacity(nrows + 1);
+    bptr.push(0);
+    let mut bagg = Vec::with_capacity(parts.iter().map(|p| p.1.len()).sum());
+    for (counts, aggs) in parts {
+        for c in counts {
+            bptr.push(bptr.last().copied().unwrap_or(0) + c);
+        }
+        bagg.extend_from_slice(&aggs);
+    }
+    (bptr, bagg)
+}
+
+/// The pattern of `P = (I − ω D⁻¹A) P_tent`: row `i` has a block for every aggregate
+/// `eq_agg[j]` of a column `j` of row `i` of `A` (aggregates of width zero excluded).
+pub(crate) fn symbolic_prolongator(a: &CsrMatrix, eq_agg: &[u32], off: &[usize]) -> Blocked {
+    let n = a.nrows();
+    let nagg = off.len() - 1;
+    let parts: Vec<(Vec<usize>, Vec<u32>)> = (0..n.div_ceil(ROWS_PER_TASK))
+        .into_par_iter()
+        .map_init(
+            || vec![0u32; nagg],
+            |mark, blk| {
+                let rows = blk * ROWS_PER_TASK..((blk + 1) * ROWS_PER_TASK).min(n);
+                let mut counts = Vec::with_capacity(rows.len());
+                let mut aggs = Vec::new();
+                for i in rows {
+                    let start = aggs.len();
+                    for &j in a.row(i).0 {
+                        let b = eq_agg[j as usize] as usize;
+                        if mark[b] != stamp(i) && off[b + 1] > off[b] {
+                            mark[b] = stamp(i);
+                            aggs.push(b as u32);
+                        }
+                    }
+                    aggs[start..].sort_unstable();
+                    counts.push(aggs.len() - start);
+                }
+                (counts, aggs)
+            },
+        )
+        .collect();
+    let (bptr, bagg) = concat_block_lists(parts, n);
+    Blocked::from_blocks(n, off, bptr, bagg)
+}
+
+/// Split `val` (laid out by `row_ptr`) into the value slices of consecutive row blocks.
+fn row_blocks_mut<'a>(row_ptr: &[usize], val: &'a mut [f64]) -> Vec<(usize, &'a mut [f64])> {
+    let nrows = row_ptr.len() - 1;
+    let mut out = Vec::with_capacity(nrows.div_ceil(ROWS_PER_TASK));
+    let mut rest = val;
+    let mut start = 0;
+    while start < nrows {
+        let end = (start + ROWS_PER_TASK).min(nrows);
+        let (head, tail) = rest.split_at_mut(row_ptr[end] - row_ptr[start]);
+        out.push((start, head));
+        rest = tail;
+        start = end;
+    }
+    out
+}
+
+/// `y += s x` on short slices of equal length, unrolled for the common block widths
+/// (6: 3D rigid modes, 3: 2D rigid modes).
+#[inline]
+fn axpy(y: &mut [f64], s: f64, x: &[f64]) {
+    match y.len() {
+        6 => axpy_fixed::<6>(y, s, x),
+        3 => axpy_fixed::<3>(y, s, x),
+        _ => {
+            for (yi, xi) in y.iter_mut().zip(x) {
+                *yi += s * xi;
+            }
+        }
+    }
+}
+
+#[inline]
+fn axpy_fixed<const K: usize>(y: &mut [f64], s: f64, x: &[f64]) {
+    if let (Ok(y), Ok(x)) = (<&mut [f64; K]>::try_from(y), <&[f64; K]>::try_from(x)) {
+        for t in 0..K {
+            y[t] += s * x[t];
+        }
+    }
+}
+
+/// Fill `p` (from [`symbolic_prolongator`]) with `T − ω D⁻¹ A T`; `dinv` holds `1/a_ii`.
+pub(crate) fn smooth_prolongator(
+    a: &CsrMatrix,
+    dinv: &[f64],
+    omega: f64,
+    t: &Blocked,
+    off: &[usize],
+    p: &mut Blocked,
+) {
+    let nagg = off.len() - 1;
+    let row_ptr = p.m.row_ptr().to_vec();
+    let n = row_ptr.len() - 1;
+    let (bptr, bagg, bpos) = (&p.bptr, &p.bagg, &p.bpos);
+    let tv = t.m.values();
+    let blocks = row_blocks_mut(&row_ptr, p.m.values_mut());
+    blocks.into_par_iter().for_each_init(
+        || vec![0usize; nagg],
+        |pos, (start, vals)| {
+            let base = row_ptr[start];
+            for i in start..(start + ROWS_PER_TASK).min(n) {
+                for q in bptr[i]..bptr[i + 1] {
+                    pos[bagg[q] as usize] = bpos[q] - base;
+                }
+                let row = &mut vals[row_ptr[i] - base..row_ptr[i + 1] - base];
+                row.fill(0.0);
+                let (ac, av) = a.row(i);
+                for (&j, &aij) in ac.iter().zip(av) {
+                    let (tb, tp) = t.blocks(j as usize);
+                    for (&b, &s) in tb.iter().zip(tp) {
+                        let k = off[b as usize + 1] - off[b as usize];
+                        let d = pos[b as usize];
+                        axpy(&mut vals[d..d + k], aij, &tv[s..s + k]);
+                    }
+                }
+                let scale = -omega * dinv[i];
+                vals[row_ptr[i] - base..row_ptr[i + 1] - base]
+                    .iter_mut()
+                    .for_each(|v| *v *= scale);
+                let (tb, tp) = t.blocks(i);
+                for (&b, &s) in tb.iter().zip(tp) {
+                    let k = off[b as usize + 1] - off[b as usize];
+                    let d = pos[b as usize];
+                    axpy(&mut vals[d..d + k], 1.0, &tv[s..s + k]);
+                }
+            }
+        },
+    );
+}
+
+/// Rows of `W = A P` in blocks (unsorted within a row), stored per parallel task. The
+/// storage is kept between products (levels, rebuilds) so that later products write into
+/// memory that is already mapped.
+#[derive(Default)]
+pub(crate) struct BlockRows {
+    parts: Vec<RowsPart>,
+}
+
+/// The rows `blk · ROWS_PER_TASK ..` of a [`BlockRows`].
+#[derive(Default)]
+struct RowsPart {
+    bptr: Vec<u32>,
+    bagg: Vec<u32>,
+    bpos: Vec<u32>,
+    vals: Vec<f64>,
+}
+
+impl RowsPart {
+    fn clear(&mut self) {
+        self.bptr.clear();
+        self.bagg.clear();
+        self.bpos.clear();
+        self.vals.clear();
+    }
+}
+
+impl BlockRows {
+    /// Aggregates, value positions and values of the blocks of row `i`.
+    #[inline]
+    fn row(&self, i: usize) -> (&[u32], &[u32], &[f64]) {
+        let part = &self.parts[i / ROWS_PER_TASK];
+        let l = i % ROWS_PER_TASK;
+        let r = part.bptr[l] as usize..part.bptr[l + 1] as usize;
+        (&part.bagg[r.clone()], &part.bpos[r], &part.vals)
+    }
+}
+
+/// `W = A P` on blocks, into the storage of `w`.
+pub(crate) fn product_blocked(a: &CsrMatrix, p: &Blocked, off: &[usize], w: &mut BlockRows) {
+    let n = a.nrows();
+    let nagg = off.len() - 1;
+    let pv = p.m.values();
+    let nparts = n.div_ceil(ROWS_PER_TASK);
+    if w.parts.len() < nparts {
+        w.parts.resize_with(nparts, RowsPart::default);
+    }
+    w.parts[..nparts].par_iter_mut().enumerate().for_each_init(
+        || vec![(0u32, 0u32); nagg],
+        |slot, (blk, part)| {
+            let rows = blk * ROWS_PER_TASK..((blk + 1) * ROWS_PER_TASK).min(n);
+            part.clear();
+            part.bptr.push(0);
+            for i in rows {
+                let (ac, av) = a.row(i);
+                for (&j, &aij) in ac.iter().zip(av) {
+                    let (pb, pp) = p.blocks(j as usize);
+                    for (&b, &s) in pb.iter().zip(pp) {
+                        let bu = b as usize;
+                        let k = off[bu + 1] - off[bu];
+                        let (mark, pos) = &mut slot[bu];
+                        if *mark != stamp(i) {
+                            *mark = stamp(i);
+                            *pos = part.vals.len() as u32;
+                            part.bagg.push(b);
+                            part.bpos.push(*pos);
+                            part.vals.extend(pv[s..s + k].iter().map(|v| aij * v));
+                        } else {
+                            let d = *pos as usize;
+                            axpy(&mut part.vals[d..d + k], aij, &pv[s..s + k]);
+                        }
+                    }
+                }
+                part.bptr.push(part.bagg.len() as u32);
+            }
+        },
+    );
+}
+
+/// The block transpose of `P`: for every aggregate `a`, the rows `i` of `P` with a block
+/// of `a` (increasing), that block's value position in `P`, and a copy of the block values
+/// stored contiguously per aggregate (so the restriction reads memory in order).
+#[derive(Clone, Debug)]
+pub(crate) struct Transposed {
+    ptr: Vec<usize>,
+    row: Vec<u32>,
+    pos: Vec<usize>,
+    /// Values of aggregate `a` start at `vstart[a]`: `k_a` per row of the list.
+    vstart: Vec<usize>,
+    vals: Vec<f64>,
+}
+
+impl Transposed {
+    /// Rows and the start of their values in `vals`.
+    #[inline]
+    fn of(&self, a: usize) -> (&[u32], usize) {
+        (&self.row[self.ptr[a]..self.ptr[a + 1]], self.vstart[a])
+    }
+
+    /// Copy the block values from `p` (after a numeric change of `p`).
+    pub(crate) fn fill(&mut self, p: &Blocked) {
+        let pv = p.m.values();
+        let (ptr, pos, vstart) = (&self.ptr, &self.pos, &self.vstart);
+        let nagg = ptr.len() - 1;
+        split_by(&mut self.vals, vstart, AGGS_PER_TASK)
+            .into_par_iter()
+            .for_each(|(a0, out)| {
+                let base = vstart[a0];
+                for a in a0..(a0 + AGGS_PER_TASK).min(nagg) {
+                    let k = if ptr[a + 1] > ptr[a] {
+                        (vstart[a + 1] - vstart[a]) / (ptr[a + 1] - ptr[a])
+                    } else {
+                        0
+                    };
+                    for (t, &q) in pos[ptr[a]..ptr[a + 1]].iter().enumerate() {
+                        let d = vstart[a] - base + t * k;
+                        out[d..d + k].copy_from_slice(&pv[q..q + k]);
+                    }
+                }
+            });
+    }
+}
+
+/// Split `v` at `bounds[a]` for every `step`-th `a`: `(a, slice of bounds[a]..bounds[a+step])`.
+fn split_by<'a, T>(v: &'a mut [T], bounds: &[usize], step: usize) -> Vec<(usize, &'a mut [T])> {
+    let n = bounds.len() - 1;
+    let mut out = Vec::with_capacity(n.div_ceil(step));
+    let mut rest = v;
+    let mut a = 0;
+    while a < n {
+        let e = (a + step).min(n);
+        let (head, tail) = rest.split_at_mut(bounds[e] - bounds[a]);
+        out.push((a, head));
+        rest = tail;
+        a = e;
+    }
+    out
+}
+
+/// The block transpose of `p` over the aggregates of the column layout `off`, with values.
+pub(crate) fn block_transpose(p: &Blocked, off: &[usize]) -> Transposed {
+    let nagg = off.len() - 1;
+    let mut ptr = vec![0usize; nagg + 1];
+    for &b in &p.bagg {
+        ptr[b as usize + 1] += 1;
+    }
+    for a in 0..nagg {
+        ptr[a + 1] += ptr[a];
+    }
+    let mut vstart = vec![0usize; nagg + 1];
+    for a in 0..nagg {
+        vstart[a + 1] = vstart[a] + (ptr[a + 1] - ptr[a]) * (off[a + 1] - off[a]);
+    }
+    let mut next = ptr.clone();
+    let nb = p.num_blocks();
+    let mut row = vec![0u32; nb];
+    let mut pos = vec![0usize; nb];
+    for i in 0..p.m.nrows() {
+        for q in p.bptr[i]..p.bptr[i + 1] {
+            let b = p.bagg[q] as usize;
+            row[next[b]] = i as u32;
+            pos[next[b]] = p.bpos[q];
+            next[b] += 1;
+        }
+    }
+    let mut t = Transposed {
+        ptr,
+        row,
+        pos,
+        vals: zeros(vstart[nagg]),
+        vstart,
+    };
+    t.fill(p);
+    t
+}
+
+/// `out = Pᵀ r`, aggregate by aggregate: `out[off[a]..off[a+1]] = Σ_i r_i p_{i,a}`.
+pub(crate) fn restrict(pt: &Transposed, off: &[usize], r: &[f64], out: &mut [f64]) {
+    let nagg = off.len() - 1;
+    split_by(out, off, AGGS_PER_TASK)
+        .into_par_iter()
+        .for_each(|(a0, out)| {
+            let base = off[a0];
+            for a in a0..(a0 + AGGS_PER_TASK).min(nagg) {
+                let acc = &mut out[off[a] - base..off[a + 1] - base];
+                let k = acc.len();
+                acc.fill(0.0);
+                let (rows, v0) = pt.of(a);
+                for (t, &i) in rows.iter().enumerate() {
+                    let d = v0 + t * k;
+                    axpy(acc, r[i as usize], &pt.vals[d..d + k]);
+                }
+            }
+        });
+}
+
+/// The block pattern of `A_c`, with the offsets and mirrors the numeric product needs.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Galerkin {
+    /// Blocks of block row `a`: `bptr[a]..bptr[a+1]`, aggregates increasing.
+    bptr: Vec<usize>,
+    bagg: Vec<u32>,
+    /// Column offset of each block within its (scalar) rows.
+    boff: Vec<usize>,
+    /// Index of the mirror block `(b, a)` of each block `(a, b)`.
+    mirror: Vec<usize>,
+}
+
+/// The pattern of `A_c = Pᵀ W` (block rows of the coarse aggregates) and `A_c` with zero
+/// values.
+pub(crate) fn symbolic_galerkin(
+    pt: &Transposed,
+    w: &BlockRows,
+    off: &[usize],
+) -> (Galerkin, CsrMatrix) {
+    let nagg = off.len() - 1;
+    let parts: Vec<(Vec<usize>, Vec<u32>)> = (0..nagg.div_ceil(AGGS_PER_TASK))
+        .into_par_iter()
+        .map_init(
+            || vec![0u32; nagg],
+            |mark, blk| {
+                let aggs = blk * AGGS_PER_TASK..((blk + 1) * AGGS_PER_TASK).min(nagg);
+                let mut counts = Vec::with_capacity(aggs.len());
+                let mut list = Vec::new();
+                for a in aggs {
+                    let start = list.len();
+                    if off[a + 1] > off[a] {
+                        for &i in pt.of(a).0 {
+                            for &b in w.row(i as usize).0 {
+                                if mark[b as usize] != stamp(a) {
+                                    mark[b as usize] = stamp(a);
+                                    list.push(b);
+                                }
+                            }
+                        }
+                    }
+                    list[start..].sort_unstable();
+                    counts.push(list.len() - start);
+                }
+                (counts, list)
+            },
+        )
+        .collect();
+    let (bptr, bagg) = concat_block_lists(parts, nagg);
+    let width = |b: u32| off[b as usize + 1] - off[b as usize];
+    let mut boff = Vec::with_capacity(bagg.len());
+    let mut row_len = vec![0usize; nagg];
+    for a in 0..nagg {
+        let mut len = 0;
+        for &b in &bagg[bptr[a]..bptr[a + 1]] {
+            boff.push(len);
+            len += width(b);
+        }
+        row_len[a] = len;
+    }
+    let mirror: Vec<usize> = (0..nagg)
+        .into_par_iter()
+        .flat_map_iter(|a| {
+            let (bptr, bagg) = (&bptr, &bagg);
+            bagg[bptr[a]..bptr[a + 1]].iter().map(move |&b| {
+                let row = &bagg[bptr[b as usize]..bptr[b as usize + 1]];
+                // The pattern is symmetric: (a, b) present ⇒ (b, a) present.
+                bptr[b as usize] + row.binary_search(&(a as u32)).unwrap_or(0)
+            })
+        })
+        .collect();
+    let nc = off[nagg];
+    let mut row_ptr = Vec::with_capacity(nc + 1);
+    row_ptr.push(0);
+    for a in 0..nagg {
+        for _ in 0..width(a as u32) {
+            row_ptr.push(row_ptr.last().copied().unwrap_or(0) + row_len[a]);
+        }
+    }
+    let nnz = row_ptr[nc];
+    let mut col = Vec::with_capacity(nnz);
+    for a in 0..nagg {
+        for _ in 0..width(a as u32) {
+            for &b in &bagg[bptr[a]..bptr[a + 1]] {
+                col.extend(off[b as usize] as u32..off[b as usize + 1] as u32);
+            }
+        }
+    }
+    let ac = CsrMatrix::from_parts(nc, nc, row_ptr, col, zeros(nnz));
+    (
+        Galerkin {
+            bptr,
+            bagg,
+            boff,
+            mirror,
+        },
+        ac,
+    )
+}
+
+/// Split the values of `ac` into those of consecutive groups of block rows.
+fn agg_chunks_mut<'a>(
+    ac_row_ptr: &[usize],
+    off: &[usize],
+    val: &'a mut [f64],
+) -> Vec<(usize, &'a mut [f64])> {
+    let nagg = off.len() - 1;
+    let mut out = Vec::with_capacity(nagg.div_ceil(AGGS_PER_TASK));
+    let mut rest = val;
+    let mut a = 0;
+    while a < nagg {
+        let e = (a + AGGS_PER_TASK).min(nagg);
+        let len = ac_row_ptr[off[e]] - ac_row_ptr[off[a]];
+        let (head, tail) = rest.split_at_mut(len);
+        out.push((a, head));
+        rest = tail;
+        a = e;
+    }
+    out
+}
+
+/// Fill `ac` (from [`symbolic_galerkin`]) with `Pᵀ W`, exactly symmetric.
+pub(crate) fn numeric_galerkin(
+    g: &Galerkin,
+    pt: &Transposed,
+    w: &BlockRows,
+    off: &[usize],
+    ac: &mut CsrMatrix,
+    scratch: &mut Vec<f64>,
+) {
+    let nagg = off.len() - 1;
+    let width = |b: usize| off[b + 1] - off[b];
+    let row_ptr = ac.row_ptr().to_vec();
+    // Pass 1: blocks (a, b ≥ a); diagonal blocks symmetrized.
+    agg_chunks_mut(&row_ptr, off, ac.values_mut())
+        .into_par_iter()
+        .for_each_init(
+            || vec![0usize; nagg],
+            |pos, (a0, vals)| {
+                let base = row_ptr[off[a0]];
+                for a in a0..(a0 + AGGS_PER_TASK).min(nagg) {
+                    let ka = width(a);
+                    if ka == 0 {
+                        continue;
+                    }
+                    let start = row_ptr[off[a]] - base;
+                    let len = row_ptr[off[a] + 1] - row_ptr[off[a]];
+                    let block_row = &mut vals[start..start + ka * len];
+                    block_row.fill(0.0);
+                    for q in g.bptr[a]..g.bptr[a + 1] {
+                        pos[g.bagg[q] as usize] = g.boff[q];
+                    }
+                    let (rows, v0) = pt.of(a);
+                    for (t, &i) in rows.iter().enumerate() {
+                        let pia = &pt.vals[v0 + t * ka..v0 + (t + 1) * ka];
+                        let (wb, wp, wv) = w.row(i as usize);
+                        for (&b, &s) in wb.iter().zip(wp) {
+                            let b = b as usize;
+                            if b < a {
+                                continue;
+                            }
+                            let kb = width(b);
+                            let wib = &wv[s as usize..s as usize + kb];
+                            let co = pos[b];
+                            for (r, &x) in pia.iter().enumerate() {
+                                let d = r * len + co;
+                                axpy(&mut block_row[d..d + kb], x, wib);
+                            }
+                        }
+                    }
+                    let co = pos[a];
+                    for r in 0..ka {
+                        for c in r + 1..ka {
+                            let (u, l) = (r * len + co + c, c * len + co + r);
+                            let v = 0.5 * (block_row[u] + block_row[l]);
+                            block_row[u] = v;
+                            block_row[l] = v;
+                        }
+                    }
+                }
+            },
+        );
+    // Pass 2: blocks (a, b < a) from the transposed blocks (b, a).
+    scratch.clear();
+    scratch.extend_from_slice(ac.values());
+    let src = &scratch[..];
+    agg_chunks_mut(&row_ptr, off, ac.values_mut())
+        .into_par_iter()
+        .for_each(|(a0, vals)| {
+            let base = row_ptr[off[a0]];
+            for a in a0..(a0 + AGGS_PER_TASK).min(nagg) {
+                let ka = width(a);
+                if ka == 0 {
+                    continue;
+                }
+                let start = row_ptr[off[a]] - base;
+                let len = row_ptr[off[a] + 1] - row_ptr[off[a]];
+                for q in g.bptr[a]..g.bptr[a + 1] {
+                    let b = g.bagg[q] as usize;
+                    if b >= a {
+                        break;
+                    }
+                    let kb = width(b);
+                    let m = g.mirror[q];
+                    let sbase = row_ptr[off[b]] + g.boff[m];
+                    let slen = row_ptr[off[b] + 1] - row_ptr[off[b]];
+                    for r in 0..ka {
+                        for c in 0..kb {
+                            vals[start + r * len + g.boff[q] + c] = src[sbase + c * slen + r];
+                        }
+                    }
+                }
+            }
+        });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn dense(m: &CsrMatrix) -> Vec<Vec<f64>> {
+        let mut d = vec![vec![0.0; m.ncols()]; m.nrows()];
+        for i in 0..m.nrows() {
+            let (c, v) = m.row(i);
+            for (&j, &x) in c.iter().zip(v) {
+                d[i][j as usize] += x;
+            }
+        }
+        d
+    }
+
+    fn from_dense(d: &[Vec<f64>]) -> CsrMatrix {
+        let mut rp = vec![0];
+        let mut c = vec![];
+        let mut v = vec![];
+        for row in d {
+            for (j, &x) in row.iter().enumerate() {
+                if x != 0.0 {
+                    c.push(j as u32);
+                    v.push(x);
+                }
+            }
+            rp.push(c.len());
+        }
+        CsrMatrix::from_parts(d.len(), d[0].len(), rp, c, v)
+    }
+
+    fn matmul(a: &[Vec<f64>], b: &[Vec<f64>]) -> Vec<Vec<f64>> {
+        let mut c = vec![vec![0.0; b[0].len()]; a.len()];
+        for i in 0..a.len() {
+            for k in 0..b.len() {
+                for j in 0..b[0].len() {
+                    c[i][j] += a[i][k] * b[k][j];
+                }
+            }
+        }
+        c
+    }
+
+    fn transpose(a: &[Vec<f64>]) -> Vec<Vec<f64>> {
+        (0..a[0].len())
+            .map(|j| a.iter().map(|r| r[j]).collect())
+            .collect()
+    }
+
+    #[test]
+    fn block_products_match_dense() {
+        // A 6×6 SPD matrix (a 1D chain with a longer-range coupling), three aggregates
+        // {0,1}, {2,3}, {4,5} of widths 2, 1, 2.
+        let n = 6;
+        let mut a = vec![vec![0.0; n]; n];
+        for i in 0..n {
+            a[i][i] = 4.0 + i as f64 * 0.1;
+            if i + 1 < n {
+                a[i][i + 1] = -1.0;
+                a[i + 1][i] = -1.0;
+            }
+            if i + 2 < n {
+                a[i][i + 2] = -0.3;
+                a[i + 2][i] = -0.3;
+            }
+        }
+        let off = vec![0, 2, 3, 5];
+        let eq_agg: Vec<u32> = vec![0, 0, 1, 1, 2, 2];
+        // Tentative: row i has the block of its aggregate.
+        let mut t = Blocked::from_blocks(n, &off, (0..=n).collect(), eq_agg.clone());
+        let tvals = [0.6, 0.8, -0.8, 0.6, 0.7, 0.7, 1.0, 0.0, 0.0, 1.0];
+        t.m.values_mut().copy_from_slice(&tvals);
+        let am = from_dense(&a);
+        let mut p = symbolic_prolongator(&am, &eq_agg, &off);
+        let dinv: Vec<f64> = (0..n).map(|i| 1.0 / a[i][i]).collect();
+        let omega = 0.4;
+        smooth_prolongator(&am, &dinv, omega, &t, &off, &mut p);
+        let td = dense(&t.m);
+        let at = matmul(&a, &td);
+        let pd = dense(&p.m);
+        for i in 0..n {
+            for j in 0..5 {
+                let want = td[i][j] - omega * dinv[i] * at[i][j];
+                assert!((pd[i][j] - want).abs() < 1e-15, "P[{i}][{j}]");
+            }
+        }
+        let mut w = BlockRows::default();
+        product_blocked(&am, &p, &off, &mut w);
+        let pt = block_transpose(&p, &off);
+        let (g, mut ac) = symbolic_galerkin(&pt, &w, &off);
+        numeric_galerkin(&g, &pt, &w, &off, &mut ac, &mut Vec::new());
+        let want = matmul(&transpose(&pd), &matmul(&a, &pd));
+        let got = dense(&ac);
+        for i in 0..5 {
+            for j in 0..5 {
+                assert!((got[i][j] - want[i][j]).abs() < 1e-14, "Ac[{i}][{j}]");
+                assert_eq!(got[i][j], got[j][i]);
+            }
+        }
+        // Restriction.
+        let r: Vec<f64> = (0..n).map(|i| (i as f64).sin()).collect();
+        let mut rc = vec![0.0; 5];
+        restrict(&pt, &off, &r, &mut rc);
+        for j in 0..5 {
+            let want: f64 = (0..n).map(|i| pd[i][j] * r[i]).sum();
+            assert!((rc[j] - want).abs() < 1e-15);
+        }
+    }
+}
