@@ -679,7 +679,7 @@ fn run_dim<const D: usize>(
     let fracture_on = comp.criteria.iter().any(|c| !c.is_empty());
     let recovered = s.physics.failure_stress.as_deref() == Some("recovered");
     let adjacency = (fracture_on && recovered).then(|| NodeCells::new(grid));
-    let tracking = match (fracture_on, s.physics.crack_tracking) {
+    let mut tracking = match (fracture_on, s.physics.crack_tracking) {
         (true, Some(a)) => Some(
             CrackTracking::new(grid, a)
                 .map_err(|e| ls.error(&k(&["physics", "crack_tracking"]), e))?,
@@ -947,7 +947,7 @@ fn run_dim<const D: usize>(
                 &comp.criteria,
                 &class,
                 FailurePolicy::default(),
-                tracking.as_ref(),
+                tracking.as_mut(),
                 if fracture_on { 200 } else { 1 },
                 solve,
             )

@@ -13,56 +13,11 @@
 //!   singular systems and missing mesh files exit with status 1 and one line naming the
 //!   file, line and key; command-line misuse exits with status 2.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod common;
 
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
+use std::path::Path;
 
-fn tmp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("porofrac-cli-test-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn porofrac(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_porofrac"))
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
-/// Run `porofrac run <scene> --out <out>` and require success (exit status 0).
-fn run_ok(scene: &Path, out: &Path) {
-    let (code, _, err) = porofrac(&[
-        "run",
-        scene.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert_eq!(code, 0, "{}: {err}", scene.display());
-}
-
-fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut lines = text.lines();
-    let header = lines.next().unwrap().split(',').map(String::from).collect();
-    let rows = lines
-        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
-        .collect();
-    (header, rows)
-}
-
-fn close(a: f64, b: f64, scale: f64, tol: f64) -> bool {
-    (a - b).abs() <= tol * scale
-}
+use common::{close, porofrac, read_csv, root, run_ok, tmp_dir};
 
 /// Plane strain, E = 1e9, ν = 0.3.
 fn lame() -> (f64, f64) {

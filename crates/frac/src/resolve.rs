@@ -57,14 +57,15 @@ pub enum ResolveError<E> {
 /// cell `c` (an empty [`Combined`] never fails). `solve` gets the current state and
 /// returns a solution and the cell stresses (effective, tension positive) used by the
 /// criteria, e.g. raw or recovered cell stresses. With `tracking`, a violating cell next
-/// to failed cells fails only where [`CrackTracking::admits`] it.
+/// to failed cells fails only where [`CrackTracking::admits`] it, and every failure records
+/// its crack normal ([`CrackTracking::record`]).
 pub fn resolve<const D: usize, S, E>(
     state: &mut FailureState,
     time: f64,
     criteria: &[Combined],
     criterion_of_cell: &[usize],
     policy: FailurePolicy,
-    tracking: Option<&CrackTracking<D>>,
+    mut tracking: Option<&mut CrackTracking<D>>,
     max_solves: usize,
     mut solve: impl FnMut(&FailureState) -> Result<(S, Vec<Tensor<D>>), E>,
 ) -> Result<(S, Vec<Tensor<D>>, usize, usize), ResolveError<E>> {
@@ -79,7 +80,7 @@ pub fn resolve<const D: usize, S, E>(
             }
             let crit = &criteria[criterion_of_cell[c]];
             if let Some(mode) = FailureCriterion::<D>::check(crit, s) {
-                if let Some(t) = tracking
+                if let Some(t) = tracking.as_deref()
                     && !t.admits(c, s, state.flags())
                 {
                     continue;
@@ -103,6 +104,9 @@ pub fn resolve<const D: usize, S, E>(
         for &(c, u, mode) in &violating {
             if u >= threshold && state.fail(c, time, mode) {
                 new_failures += 1;
+                if let Some(t) = tracking.as_deref_mut() {
+                    t.record(c, &stress[c]);
+                }
             }
         }
     }

@@ -1,19 +1,22 @@
-//! Crack tracking: a failing cell next to a crack must continue it across its largest
-//! principal stress.
+//! Crack tracking: a crack grows in its own plane, perpendicular to the largest principal
+//! stress at the time it opened.
 //!
 //! With stress constant per cell, a cell at angle θ from the tip of a mode-I crack sees the
 //! largest principal stress `σ₁ ∝ cos(θ/2)(1 + sin(θ/2))`, which peaks at θ ≈ ±60°, not
 //! straight ahead (θ = 0, where the hoop stress peaks). A criterion on `σ₁` alone
-//! therefore lets cracks branch and follow the mesh diagonals (the grid-orientation
+//! therefore lets cracks branch, widen and follow the mesh diagonals (the grid-orientation
 //! effect of the seed, §3). Crack-tracking schemes for smeared cracks (Cervera &
 //! Chiumenti 2006) restrict where a crack may grow; this module uses the local form:
 //!
+//! * when a cell fails, its *crack normal* `n_f` is recorded: the direction of its largest
+//!   principal stress at that moment ([`CrackTracking::record`]);
 //! * a violating cell with no failed neighbour (sharing a node) may fail anywhere: a new
 //!   crack nucleates;
-//! * a violating cell next to failed cells may fail only if, for some failed neighbour
+//! * a violating cell `c` next to failed cells may fail only if, for some failed neighbour
 //!   `f`, the direction `d̂ = (x_c − x_f)/|x_c − x_f|` between their centroids lies within
-//!   `max_angle` of the plane normal to the cell's largest principal direction `n₁`, i.e.
-//!   `|d̂ · n₁| ≤ sin(max_angle)`: the crack grows perpendicular to `σ₁`.
+//!   `max_angle` of the crack plane of `f`, i.e. `|d̂ · n_f| ≤ sin(max_angle)`: the crack
+//!   continues in its plane instead of widening. A crack still turns when the stress
+//!   rotates, since each new cell records its own normal.
 //!
 //! Violating cells that are not admissible stay intact in this round (the criterion is
 //! checked again after every re-solve).
@@ -29,6 +32,7 @@ use crate::recovery::NodeCells;
 pub struct CrackTracking<const D: usize> {
     centroids: Vec<Point<D>>,
     neighbours: Vec<Vec<usize>>,
+    normals: Vec<Option<Point<D>>>,
     sin_max: f64,
     max_angle: f64,
 }
@@ -59,6 +63,7 @@ impl<const D: usize> CrackTracking<D> {
             })
             .collect();
         Ok(Self {
+            normals: vec![None; grid.num_cells()],
             centroids: grid.cell_centroids().to_vec(),
             neighbours,
             sin_max: max_angle_deg.to_radians().sin(),
@@ -71,19 +76,32 @@ impl<const D: usize> CrackTracking<D> {
         self.max_angle
     }
 
+    /// Record that cell `c` failed under the stress `s`: its crack normal is the direction
+    /// of the largest principal stress of `s`.
+    pub fn record(&mut self, c: usize, s: &Tensor<D>) {
+        self.normals[c] = Some(largest_principal_direction(s));
+    }
+
+    /// The recorded crack normal of cell `c` (`None` while intact).
+    pub fn normal(&self, c: usize) -> Option<Point<D>> {
+        self.normals[c]
+    }
+
     /// Whether cell `c` with stress `s` may fail given the failure flags (see the module
-    /// docs).
+    /// docs). A failed neighbour without a recorded normal (failed before tracking
+    /// started) lends the candidate's own largest principal direction.
     pub fn admits(&self, c: usize, s: &Tensor<D>, failed: &[bool]) -> bool {
         let mut near_crack = false;
-        let n1 = largest_principal_direction(s);
+        let own = largest_principal_direction(s);
         for &f in &self.neighbours[c] {
             if !failed[f] {
                 continue;
             }
             near_crack = true;
+            let n = self.normals[f].unwrap_or(own);
             let d = self.centroids[c] - self.centroids[f];
             let len = d.norm();
-            if len > 0.0 && (d.dot(&n1) / len).abs() <= self.sin_max + 1e-12 {
+            if len > 0.0 && (d.dot(&n) / len).abs() <= self.sin_max + 1e-12 {
                 return true;
             }
         }
@@ -136,6 +154,26 @@ mod tests {
         assert!(wide.admits(3, &s45, &failed));
         for bad in [0.0, -1.0, 91.0, f64::NAN] {
             assert!(CrackTracking::<2>::new(&g, bad).is_err());
+        }
+    }
+
+    /// A crack that opened under σ₁ along x grows along y even when its neighbours' stress
+    /// has rotated: the recorded normal of the failed cell decides, so it does not widen.
+    #[test]
+    fn recorded_normal_keeps_the_crack_in_its_plane() {
+        let g = cartesian([0.0, 0.0].into(), [3.0, 3.0].into(), [3, 3]).unwrap();
+        let mut t = CrackTracking::new(&g, 20.0).unwrap();
+        let mut failed = vec![false; 9];
+        let sx = Tensor::<2>::new(1.0, 0.0, 0.0, -1.0);
+        let sy = Tensor::<2>::new(-1.0, 0.0, 0.0, 1.0);
+        failed[4] = true; // the centre cell opened with its normal along x
+        t.record(4, &sx);
+        assert!(t.normal(4).unwrap()[0].abs() > 0.999);
+        // Above (cell 7) and below (cell 1): in the crack plane, admissible whatever
+        // their own stress; beside (cells 3, 5): across the plane, never.
+        for s in [&sx, &sy] {
+            assert!(t.admits(7, s, &failed) && t.admits(1, s, &failed));
+            assert!(!t.admits(3, s, &failed) && !t.admits(5, s, &failed));
         }
     }
 

@@ -418,7 +418,7 @@ impl<'a, const D: usize> Fracturing<'a, D> {
             &settings.criteria,
             &settings.class_of_cell,
             settings.policy,
-            tracking.as_ref(),
+            tracking.as_mut(),
             settings.max_rounds,
             solve,
         )

@@ -1,0 +1,183 @@
+//! The seed's hydraulic-fracture scene (`scenes/hydrofrac_seed.toml`, seed §3, Fig. 4)
+//! through the command, and two variants of it.
+//!
+//! References:
+//! * **No failure at t = 0.** Before injection the well is a soft inclusion in a plate
+//!   under σyy = −1e7 Pa and, from the rollers in plane strain, σxx = ν/(1 − ν) σyy =
+//!   −4.29e6 Pa. Kirsch's solution for a hole puts the least compressive hoop stress at
+//!   the top and bottom of the well, 3σxx − σyy = −2.9e6 Pa: nothing is in tension, so no
+//!   cell may fail at t = 0 (criterion: 2e5 Pa in tension).
+//! * **Start at the well.** Injection raises the pressure of the well; the first cells to
+//!   fail touch the well (centroid within the well radius plus two fine cell diagonals).
+//! * **Orientation.** The fracture opens against the least compressive stress, so it grows
+//!   along the largest compression: the principal axis of the fractured cells' centroids
+//!   is within 15° of the loaded axis (y for the top load, x for the side load), and the
+//!   set is elongated (ratio of the principal standard deviations ≥ 2.5: a crack, not a
+//!   blob).
+//! * **No injection, no fracture**: without the source nothing fails and the pressure
+//!   stays p₀ = 1e7 Pa (to 1e-9 relative).
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use common::{read_csv, root, run_ok, summary, tmp_dir};
+
+/// Well centre, well radius and fine cell size of the scene (m).
+const CENTER: [f64; 2] = [15.0, 15.0];
+const WELL_RADIUS: f64 = 0.25;
+const FINE_H: f64 = 1.0 / 12.0;
+
+fn seed_scene() -> String {
+    std::fs::read_to_string(root().join("scenes/hydrofrac_seed.toml")).unwrap()
+}
+
+/// Write `text` with every `(from, to)` replaced (each must occur) and return its path.
+fn variant(dir: &Path, text: &str, edits: &[(&str, &str)]) -> PathBuf {
+    let mut t = text.to_string();
+    for (from, to) in edits {
+        assert!(t.contains(from), "the scene no longer contains {from:?}");
+        t = t.replacen(from, to, 1);
+    }
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, t).unwrap();
+    path
+}
+
+/// Fractured cells of `fracture.csv`: `(x, y, time)`.
+fn fractures(out: &Path) -> Vec<[f64; 3]> {
+    let text = std::fs::read_to_string(out.join("fracture.csv")).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("cell,x,y,time,mode"));
+    lines
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            assert!(["tensile", "shear"].contains(&f[4]), "{l}");
+            [f[1], f[2], f[3]].map(|v| v.parse().unwrap())
+        })
+        .collect()
+}
+
+/// Principal axis of a point set: (angle of the major axis from x in degrees, in
+/// (−90, 90], and the ratio of the major to the minor standard deviation).
+fn principal_axis(points: &[[f64; 3]]) -> (f64, f64) {
+    let n = points.len() as f64;
+    let (mx, my) = (
+        points.iter().map(|p| p[0]).sum::<f64>() / n,
+        points.iter().map(|p| p[1]).sum::<f64>() / n,
+    );
+    let (mut sxx, mut syy, mut sxy) = (0.0, 0.0, 0.0);
+    for p in points {
+        let (dx, dy) = (p[0] - mx, p[1] - my);
+        sxx += dx * dx / n;
+        syy += dy * dy / n;
+        sxy += dx * dy / n;
+    }
+    let angle = 0.5 * (2.0 * sxy).atan2(sxx - syy).to_degrees();
+    let mean = 0.5 * (sxx + syy);
+    let r = (0.25 * (sxx - syy).powi(2) + sxy * sxy).sqrt();
+    (angle, ((mean + r) / (mean - r).max(1e-300)).sqrt())
+}
+
+fn distance_to_well(p: &[f64; 3]) -> f64 {
+    (p[0] - CENTER[0]).hypot(p[1] - CENTER[1])
+}
+
+/// Angle between two axes (degrees, in [0, 90]).
+fn axis_angle(a: f64, b: f64) -> f64 {
+    let d = (a - b).rem_euclid(180.0);
+    d.min(180.0 - d)
+}
+
+/// Checks shared by the top and the side load; `axis` is the loaded axis (degrees).
+fn check_fracture(out: &Path, axis: f64) {
+    let s = summary(out);
+    assert_eq!(s["status"], "ok");
+    let f = fractures(out);
+    assert_eq!(s["fractured_cells"].as_u64().unwrap() as usize, f.len());
+    assert!(f.len() >= 20, "only {} cells failed", f.len());
+    assert!(
+        f.iter().all(|p| p[2] > 0.0),
+        "a cell failed at t = 0, before any injection"
+    );
+    let first = f.iter().map(|p| p[2]).fold(f64::INFINITY, f64::min);
+    for p in f.iter().filter(|p| p[2] == first) {
+        let r = distance_to_well(p);
+        assert!(
+            r <= WELL_RADIUS + 2.0 * FINE_H * 2f64.sqrt(),
+            "first failure at {p:?} is {r} m from the well centre"
+        );
+    }
+    let (angle, elongation) = principal_axis(&f);
+    assert!(
+        axis_angle(angle, axis) <= 15.0,
+        "fracture axis at {angle}° from x, expected within 15° of {axis}°"
+    );
+    assert!(
+        elongation >= 2.5,
+        "fractured set not elongated: {elongation}"
+    );
+    let reach = f.iter().map(distance_to_well).fold(0.0, f64::max);
+    assert!(
+        reach >= 1.0,
+        "fracture reaches only {reach} m from the well"
+    );
+}
+
+#[test]
+fn seed_scene_fracture_starts_at_the_well_and_grows_along_the_largest_compression() {
+    let out = tmp_dir("hydrofrac");
+    run_ok(&root().join("scenes/hydrofrac_seed.toml"), &out);
+    check_fracture(&out, 90.0);
+    // Injection raised the well pressure above p0.
+    let (header, rows) = read_csv(&out.join("probes.csv"));
+    assert_eq!(header[1], "p_well");
+    assert_eq!(rows[0][1], 1e7);
+    assert!(rows.last().unwrap()[1] > 1.1e7, "{:?}", rows.last());
+}
+
+#[test]
+fn load_on_the_side_turns_the_fracture_by_ninety_degrees() {
+    let dir = tmp_dir("hydrofrac-side");
+    let scene = variant(
+        &dir,
+        &seed_scene(),
+        &[
+            (
+                "boundary = \"xmax\"\ndisplacement = [0.0, \"free\"]",
+                "boundary = \"xmax\"\ntraction = [-1.0e7, 0.0]",
+            ),
+            (
+                "boundary = \"ymax\"\ntraction = [0.0, -1.0e7]",
+                "boundary = \"ymax\"\ndisplacement = [\"free\", 0.0]",
+            ),
+        ],
+    );
+    let out = dir.join("out");
+    run_ok(&scene, &out);
+    check_fracture(&out, 0.0);
+}
+
+#[test]
+fn no_injection_no_fracture() {
+    let dir = tmp_dir("hydrofrac-shut-in");
+    let scene = variant(
+        &dir,
+        &seed_scene(),
+        &[(
+            "[[source]]\nregion = \"well\"\npore_volumes_per_hour = 1.0\n",
+            "",
+        )],
+    );
+    let out = dir.join("out");
+    run_ok(&scene, &out);
+    assert_eq!(summary(&out)["fractured_cells"], 0);
+    assert!(fractures(&out).is_empty());
+    let (_, rows) = read_csv(&out.join("probes.csv"));
+    assert!(rows.len() > 2);
+    for r in &rows {
+        for &p in &r[1..] {
+            assert!((p - 1e7).abs() <= 1e-9 * 1e7, "{r:?}");
+        }
+    }
+}
