@@ -18,11 +18,11 @@ use porofrac_grid::io::{Field, PvdWriter, read_msh, read_vtu, write_vtu};
 use porofrac_grid::{Grid, GridError, Point};
 use porofrac_law::{CellLaw, Stiffness, Tensor};
 use porofrac_sim::{
-    BiotState, Body, DirectSolver, Displacement, DofMap, ExplicitOptions, ExplicitPressure,
-    FixedStress, FractureFlow, FractureLaws, FractureSettings, FractureStep, Fracturing, Gravity,
-    LawMap, Loads, Monolithic, Pattern, Platen, ScalarField, Scheme, SimError, StaticOptions,
-    StaticProblem, StressMeasure, Traction, cell_stresses, drained_bulk_modulus, solve_explicit,
-    solve_static,
+    BiotState, Body, Displacement, DofMap, ExplicitOptions, ExplicitPressure, FixedStress,
+    FractureFlow, FractureLaws, FractureSettings, FractureStep, Fracturing, Gravity, LawMap,
+    LinearSolver, Loads, Monolithic, Pattern, Platen, ScalarField, Scheme, SimError, StaticOptions,
+    StaticProblem, StaticSolver, StressMeasure, Traction, cell_stresses, drained_bulk_modulus,
+    solve_explicit, solve_static,
 };
 
 use crate::check::{LoadedScene, SceneError, k, ki};
@@ -287,13 +287,21 @@ fn check_supported(ls: &LoadedScene) -> Result<(), RunError> {
         )
         .into()
     };
-    if s.solver.linear.as_deref() == Some("cg-amg") {
-        return Err(unsupported(
-            k(&["solver", "linear"]),
-            "= \"cg-amg\": the AMG solver",
-        ));
-    }
     let flow = s.physics.flow == Some(true);
+    // CG-AMG solves the static mechanics (SPD); the Biot system is indefinite.
+    if s.solver.linear.as_deref() == Some("cg-amg") {
+        let coupled = flow && s.physics.coupling.as_deref() != Some("none");
+        let explicit = s.solver.mechanics.as_deref() == Some("explicit");
+        if coupled || explicit {
+            return Err(ls
+                .error(
+                    &k(&["solver", "linear"]),
+                    "= \"cg-amg\" solves static mechanics only; coupled flow (an indefinite \
+                     Biot system) and explicit mechanics need \"cholesky\" or \"auto\"",
+                )
+                .into());
+        }
+    }
     for (i, bc) in s.bc.iter().enumerate() {
         if !flow && (bc.pressure.is_some() || bc.flux.is_some()) {
             return Err(ls
@@ -732,16 +740,20 @@ fn run_dim<const D: usize>(
     let t_asm = Instant::now();
     let dofs = DofMap::new(grid, &cond.displacements, &cond.platens)?;
     let pattern = Pattern::new(grid, &dofs)?;
-    // Fill-reducing ordering: geometric nested dissection in 3D (2.9x faster than AMD on
-    // E3 n = 40, see docs/BENCHMARKS.md), AMD in 2D.
-    let mut solver = if D == 3 {
-        DirectSolver::with_ordering(
-            &pattern,
-            &porofrac_sim::ordering::nested_dissection(grid, &dofs),
-        )?
-    } else {
-        DirectSolver::new(&pattern)?
+    // Cholesky with nested dissection in 3D (2.9x faster than AMD on E3 n = 40, see
+    // docs/BENCHMARKS.md) and AMD in 2D, or CG-AMG; "auto" picks by size.
+    let cg = LinearSolver::CgAmg {
+        tolerance: s.solver.tolerance.unwrap_or(1e-8),
     };
+    let linear = match s.solver.linear.as_deref() {
+        Some("cholesky") => LinearSolver::Cholesky,
+        Some("cg-amg") => cg,
+        _ => match LinearSolver::Auto.resolve(D, dofs.num_equations()) {
+            LinearSolver::CgAmg { .. } => cg,
+            other => other,
+        },
+    };
+    let mut solver = StaticSolver::new(grid, &dofs, &pattern, linear)?;
     // Coupled poroelasticity, with fracturing when a material has a strength.
     let mut coupled = match coupled_flow {
         Some(f) => Some(coupled_setup(
@@ -853,8 +865,10 @@ fn run_dim<const D: usize>(
     let mut stats = SolverStats {
         linear: if explicit.is_some() {
             "explicit"
-        } else {
+        } else if coupled.is_some() {
             "cholesky"
+        } else {
+            solver.name()
         }
         .into(),
         ..SolverStats::default()
@@ -913,6 +927,7 @@ fn run_dim<const D: usize>(
                     None => {
                         let sol = solve_static(&problem, &mut solver, t, &options)?;
                         stats.max_relative_residual = stats.max_relative_residual.max(sol.residual);
+                        stats.iterations += sol.linear_iterations;
                         sol.displacement
                     }
                     Some(density) => {

@@ -81,6 +81,10 @@ pub enum SimError {
     /// An error inside the sparse linear algebra (e.g. out of memory).
     #[error("sparse linear algebra: {0}")]
     LinearAlgebra(String),
+    /// An iterative linear solve failed: iteration limit, stagnation or breakdown (the
+    /// message names the iterations and the relative residual reached), or its setup.
+    #[error("iterative linear solver: {0}")]
+    Iterative(String),
     /// A nonlinear static solve did not converge.
     #[error(
         "static solve did not converge in {iterations} iterations (relative residual {residual:.3e})"

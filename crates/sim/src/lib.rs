@@ -11,7 +11,9 @@
 //! 4. [`assembly`]: reduced stiffness and internal forces from the cell laws
 //!    ([`porofrac_law::CellLaw`], chosen per cell by a [`LawMap`]), and the nodal loads.
 //! 5. [`solve`]: sparse Cholesky with the symbolic factorization reused
-//!    ([`DirectSolver`]), [`solve_static`], cell stresses and reaction forces.
+//!    ([`DirectSolver`]), [`solve_static`], cell stresses and reaction forces;
+//!    [`linear`]: the choice of linear solver ([`LinearSolver`]: Cholesky, CG with
+//!    algebraic multigrid, or automatic by size).
 //!
 //! State that changes (displacements, time) is passed explicitly; the types above are
 //! built once per grid and set of conditions.
@@ -44,6 +46,7 @@ pub mod explicit;
 pub mod field;
 pub mod fracturing;
 pub mod laws;
+pub mod linear;
 pub mod ordering;
 pub mod pattern;
 mod quadrature;
@@ -64,6 +67,7 @@ pub use fracturing::{
     Scheme, StressMeasure,
 };
 pub use laws::LawMap;
+pub use linear::{AmgSolver, LinearSolve, LinearSolver, LinearStats, StaticSolver};
 pub use pattern::Pattern;
 pub use solve::{
     DirectSolver, Par, StaticOptions, StaticProblem, StaticSolution, cell_stresses, reaction,

@@ -12,8 +12,11 @@
 //! for linear laws is one step from `u = (0, u_p)`: `A x = Tᵀ (f_f − K_fp u_p) + F_platen`.
 //! Before factorising it checks the rigid-body modes ([`DofMap::check_rigid_modes`]); after
 //! solving it checks that the solution is finite and that the relative residual
-//! `‖A Δx − r‖ / ‖r‖` is below `1e-8`, which catches numerically singular systems
-//! (an unconstrained piece) that a Cholesky factorization with tiny pivots may let through.
+//! `‖A Δx − r‖ / ‖r‖` is below `1e-8` (for CG-AMG: its tolerance), which catches
+//! numerically singular systems (an unconstrained piece) that a Cholesky factorization
+//! with tiny pivots may let through. The linear solver is any [`LinearSolve`]:
+//! [`DirectSolver`], [`crate::linear::AmgSolver`] or the [`crate::linear::StaticSolver`]
+//! chosen by a [`crate::linear::LinearSolver`].
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::cholesky::{
@@ -32,6 +35,7 @@ use crate::bc::Loads;
 use crate::dofs::DofMap;
 use crate::error::{Result, SimError};
 use crate::laws::LawMap;
+use crate::linear::LinearSolve;
 use crate::pattern::Pattern;
 
 /// Sparse Cholesky solver for the reduced stiffness, with the symbolic factorization
@@ -263,6 +267,9 @@ pub struct StaticSolution<const D: usize> {
     pub iterations: usize,
     /// Relative residual of the last linear solve, `‖A Δx − r‖ / ‖r‖`.
     pub residual: f64,
+    /// Iterations of an iterative linear solver, summed over the linear solves (0 for
+    /// Cholesky).
+    pub linear_iterations: usize,
 }
 
 impl<const D: usize> StaticSolution<D> {
@@ -280,11 +287,12 @@ fn norm(v: &[f64]) -> f64 {
 ///
 /// Errors: [`SimError::Singular`] if rigid-body modes are free (checked first),
 /// [`SimError::NotPositiveDefinite`] naming the node and component of a failing pivot,
-/// [`SimError::NotFinite`] or an ill-conditioned residual, [`SimError::NoConvergence`] for
-/// a nonlinear solve, and the assembly and load errors.
-pub fn solve_static<const D: usize>(
+/// [`SimError::NotFinite`] or an ill-conditioned residual, [`SimError::Iterative`] for an
+/// iterative linear solve that does not converge, [`SimError::NoConvergence`] for a
+/// nonlinear solve, and the assembly and load errors.
+pub fn solve_static<const D: usize, S: LinearSolve + ?Sized>(
     problem: &StaticProblem<'_, D>,
-    solver: &mut DirectSolver,
+    solver: &mut S,
     t: f64,
     options: &StaticOptions,
 ) -> Result<StaticSolution<D>> {
@@ -311,6 +319,7 @@ pub fn solve_static<const D: usize>(
     let linear = laws.all_linear();
     let mut reference = 0.0f64;
     let mut residual = 0.0;
+    let mut linear_iterations = 0;
     for it in 1..=options.max_iterations.max(1) {
         assemble(grid, laws, dofs, pattern, &u, &mut values, &mut forces)?;
         r.iter_mut()
@@ -324,17 +333,20 @@ pub fn solve_static<const D: usize>(
                 displacement: u,
                 iterations: it - 1,
                 residual,
+                linear_iterations,
             });
         }
-        solver.factorize(pattern, &values).map_err(|e| match e {
-            SimError::NotPositiveDefinite { equation, .. } => SimError::NotPositiveDefinite {
-                equation,
-                location: dofs.describe_equation(grid, equation),
-            },
-            e => e,
-        })?;
-        let mut dx = r.clone();
-        solver.solve_in_place(&mut dx)?;
+        let mut dx = vec![0.0; neq];
+        let stats = solver
+            .solve_system(pattern, &values, &r, &mut dx)
+            .map_err(|e| match e {
+                SimError::NotPositiveDefinite { equation, .. } => SimError::NotPositiveDefinite {
+                    equation,
+                    location: dofs.describe_equation(grid, equation),
+                },
+                e => e,
+            })?;
+        linear_iterations += stats.iterations;
         if let Some(e) = dx.iter().position(|v| !v.is_finite()) {
             return Err(SimError::NotFinite {
                 location: dofs.describe_equation(grid, e),
@@ -349,7 +361,7 @@ pub fn solve_static<const D: usize>(
             .sum::<f64>()
             .sqrt();
         residual = if rn > 0.0 { err / rn } else { err };
-        if residual > 1e-8 {
+        if residual > solver.residual_limit() {
             let (e, _) = dx.iter().enumerate().fold((0, 0.0f64), |acc, (i, v)| {
                 if v.abs() > acc.1 { (i, v.abs()) } else { acc }
             });
@@ -367,6 +379,7 @@ pub fn solve_static<const D: usize>(
                 displacement: u,
                 iterations: 1,
                 residual,
+                linear_iterations,
             });
         }
     }

@@ -1,0 +1,432 @@
+//! The choice of linear solver for the static mechanics solve.
+//!
+//! [`solve_static`](crate::solve_static) solves `A Δx = r` with the reduced stiffness `A`
+//! (symmetric positive definite) once per Newton step, through the [`LinearSolve`] trait:
+//!
+//! * [`DirectSolver`]: sparse Cholesky, symbolic factorization reused; exact up to
+//!   rounding, memory and time grow like the factor (`n log n` / `n^{3/2}` in 2D,
+//!   `n^{4/3}` / `n²` in 3D with nested dissection).
+//! * [`AmgSolver`]: conjugate gradients preconditioned by smoothed-aggregation multigrid
+//!   ([`porofrac_amg`], rigid-body near-null space from the node coordinates), to a
+//!   relative residual `‖A Δx − r‖ / ‖r‖ ≤ tolerance`; `O(n)` memory and time per
+//!   iteration, iteration counts nearly independent of `n`. The hierarchy is built on the
+//!   first solve; later solves with new values on the same pattern only redo its numeric
+//!   part ([`porofrac_amg::Amg::update_values`]: aggregates, patterns and the symbolic
+//!   coarse factorization are kept), and a solve with unchanged values reuses it as is.
+//!   A solve that reaches the iteration limit, stagnates or breaks down is an error
+//!   ([`SimError::Iterative`]) naming the iterations and the residual reached.
+//! * [`StaticSolver`]: one of the two, chosen by [`LinearSolver`]; `Auto` picks by the
+//!   measured crossover ([`LinearSolver::resolve`]).
+
+use porofrac_amg::{Amg, AmgOptions, SymCsr};
+use porofrac_grid::Grid;
+
+use crate::dofs::DofMap;
+use crate::error::{Result, SimError};
+use crate::ordering::nested_dissection;
+use crate::pattern::Pattern;
+use crate::solve::DirectSolver;
+
+/// Default relative residual of the iterative solver.
+pub const DEFAULT_TOLERANCE: f64 = 1e-8;
+/// Default iteration limit of the iterative solver.
+pub const DEFAULT_MAX_ITERATIONS: usize = 500;
+/// `Auto` uses CG-AMG in 3D from this many equations (E3 n = 20, 20 577 equations:
+/// CG-AMG 0.24 s against 0.67 s for nested-dissection Cholesky; docs/BENCHMARKS.md).
+pub const AUTO_MIN_EQUATIONS_3D: usize = 10_000;
+/// `Auto` uses CG-AMG in 2D from this many equations (docs/BENCHMARKS.md, "Linear
+/// solvers: direct vs AMG-CG": below it the AMD Cholesky is faster).
+pub const AUTO_MIN_EQUATIONS_2D: usize = 1_500_000;
+
+/// Which linear solver the static mechanics uses.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum LinearSolver {
+    /// Sparse Cholesky (AMD in 2D, geometric nested dissection in 3D).
+    Cholesky,
+    /// CG preconditioned by smoothed-aggregation AMG, to the relative residual
+    /// `tolerance`.
+    CgAmg {
+        /// Relative residual `‖A x − b‖ / ‖b‖` to reach.
+        tolerance: f64,
+    },
+    /// [`Self::CgAmg`] with [`DEFAULT_TOLERANCE`] for 3D systems of at least
+    /// [`AUTO_MIN_EQUATIONS_3D`] equations and 2D systems of at least
+    /// [`AUTO_MIN_EQUATIONS_2D`], [`Self::Cholesky`] otherwise.
+    #[default]
+    Auto,
+}
+
+impl LinearSolver {
+    /// The concrete choice for a `dim`-dimensional system of `equations` equations
+    /// (`Auto` resolved; the others unchanged).
+    pub fn resolve(self, dim: usize, equations: usize) -> Self {
+        match self {
+            Self::Auto => {
+                let min = if dim >= 3 {
+                    AUTO_MIN_EQUATIONS_3D
+                } else {
+                    AUTO_MIN_EQUATIONS_2D
+                };
+                if equations >= min {
+                    Self::CgAmg {
+                        tolerance: DEFAULT_TOLERANCE,
+                    }
+                } else {
+                    Self::Cholesky
+                }
+            }
+            other => other,
+        }
+    }
+
+    /// Short name: `"cholesky"`, `"cg-amg"` or `"auto"`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Cholesky => "cholesky",
+            Self::CgAmg { .. } => "cg-amg",
+            Self::Auto => "auto",
+        }
+    }
+}
+
+/// Statistics of one linear solve.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LinearStats {
+    /// Iterations of an iterative solver (0 for a direct solve).
+    pub iterations: usize,
+}
+
+/// A solver of `A x = b` for the reduced stiffness `A`, given by its upper-triangle
+/// `values` on `pattern`.
+pub trait LinearSolve {
+    /// Solve `A x = b` into `x` (its content on entry is ignored).
+    ///
+    /// Errors: [`SimError::NotPositiveDefinite`] (with `equation`; the caller names the
+    /// node), [`SimError::Iterative`], [`SimError::Input`] for inconsistent sizes.
+    fn solve_system(
+        &mut self,
+        pattern: &Pattern,
+        values: &[f64],
+        b: &[f64],
+        x: &mut [f64],
+    ) -> Result<LinearStats>;
+
+    /// Largest relative residual `‖A x − b‖ / ‖b‖` a successful solve may leave; above
+    /// it the caller reports a numerically singular system.
+    fn residual_limit(&self) -> f64 {
+        1e-8
+    }
+}
+
+impl LinearSolve for DirectSolver {
+    fn solve_system(
+        &mut self,
+        pattern: &Pattern,
+        values: &[f64],
+        b: &[f64],
+        x: &mut [f64],
+    ) -> Result<LinearStats> {
+        self.factorize(pattern, values)?;
+        x.copy_from_slice(b);
+        self.solve_in_place(x)?;
+        Ok(LinearStats::default())
+    }
+}
+
+/// CG preconditioned by smoothed-aggregation AMG with rigid-body modes (see the module
+/// docs).
+pub struct AmgSolver {
+    amg: Option<Amg>,
+    /// Values the hierarchy was last built or updated with.
+    values: Vec<f64>,
+    coords: Vec<f64>,
+    eq_dofs: Vec<(usize, usize)>,
+    dim: usize,
+    n: usize,
+    nnz: usize,
+    options: AmgOptions,
+    tolerance: f64,
+    max_iterations: usize,
+    setups: usize,
+    updates: usize,
+    last_iterations: usize,
+    total_iterations: usize,
+}
+
+impl std::fmt::Debug for AmgSolver {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("AmgSolver")
+            .field("amg", &self.amg)
+            .field("n", &self.n)
+            .field("tolerance", &self.tolerance)
+            .field("max_iterations", &self.max_iterations)
+            .field("setups", &self.setups)
+            .field("updates", &self.updates)
+            .field("total_iterations", &self.total_iterations)
+            .finish()
+    }
+}
+
+impl AmgSolver {
+    /// A solver for the equations of `dofs` on `pattern` (node coordinates from `grid`),
+    /// to the relative residual `tolerance`, with the default multigrid options and
+    /// [`DEFAULT_MAX_ITERATIONS`]. The hierarchy is built on the first solve.
+    pub fn new<const D: usize>(
+        grid: &Grid<D>,
+        dofs: &DofMap<D>,
+        pattern: &Pattern,
+        tolerance: f64,
+    ) -> Result<Self> {
+        if !(tolerance > 0.0 && tolerance < 1.0) {
+            return Err(SimError::Input(format!(
+                "CG-AMG tolerance {tolerance} must be in (0, 1)"
+            )));
+        }
+        let n = dofs.num_equations();
+        if pattern.num_equations() != n {
+            return Err(SimError::Input(format!(
+                "pattern of {} equations for a dof map of {n}",
+                pattern.num_equations()
+            )));
+        }
+        let coords: Vec<f64> = grid
+            .nodes()
+            .iter()
+            .flat_map(|p| p.iter().copied().collect::<Vec<_>>())
+            .collect();
+        // (node, component) of every equation; a platen's shared equation takes its
+        // first node.
+        let mut eq_dofs = vec![(usize::MAX, 0); n];
+        for node in 0..grid.num_nodes() {
+            for a in 0..D {
+                if let Some(e) = dofs.equation(node, a)
+                    && eq_dofs[e].0 == usize::MAX
+                {
+                    eq_dofs[e] = (node, a);
+                }
+            }
+        }
+        Ok(Self {
+            amg: None,
+            values: Vec::new(),
+            coords,
+            eq_dofs,
+            dim: D,
+            n,
+            nnz: pattern.nnz(),
+            options: AmgOptions::default(),
+            tolerance,
+            max_iterations: DEFAULT_MAX_ITERATIONS,
+            setups: 0,
+            updates: 0,
+            last_iterations: 0,
+            total_iterations: 0,
+        })
+    }
+
+    /// Iteration limit of each solve (at least 1).
+    pub fn set_max_iterations(&mut self, max_iterations: usize) {
+        self.max_iterations = max_iterations.max(1);
+    }
+    /// Multigrid options (takes effect at the next full setup, i.e. before the first
+    /// solve).
+    pub fn set_options(&mut self, options: AmgOptions) {
+        self.options = options;
+    }
+    /// The relative residual each solve reaches.
+    pub fn tolerance(&self) -> f64 {
+        self.tolerance
+    }
+    /// Full hierarchy setups done (1 after the first solve: never repeated).
+    pub fn setups(&self) -> usize {
+        self.setups
+    }
+    /// Numeric rebuilds for new values on the same pattern.
+    pub fn updates(&self) -> usize {
+        self.updates
+    }
+    /// CG iterations of the last solve.
+    pub fn last_iterations(&self) -> usize {
+        self.last_iterations
+    }
+    /// CG iterations of all solves.
+    pub fn total_iterations(&self) -> usize {
+        self.total_iterations
+    }
+    /// The hierarchy (after the first solve).
+    pub fn hierarchy(&self) -> Option<&Amg> {
+        self.amg.as_ref()
+    }
+
+    fn prepare(&mut self, pattern: &Pattern, values: &[f64]) -> Result<()> {
+        let amg_err = |e: porofrac_amg::AmgError| SimError::Iterative(format!("AMG setup: {e}"));
+        match self.amg.as_mut() {
+            Some(amg) => {
+                if self.values != values {
+                    if let Err(e) = amg.update_values(values) {
+                        // The hierarchy refuses to solve after a failed update.
+                        self.values.clear();
+                        return Err(amg_err(e));
+                    }
+                    self.values.clear();
+                    self.values.extend_from_slice(values);
+                    self.updates += 1;
+                }
+            }
+            None => {
+                let sym =
+                    SymCsr::from_upper_csc(self.n, pattern.col_ptr(), pattern.row_idx(), values)
+                        .map_err(amg_err)?;
+                let amg =
+                    Amg::elasticity(sym, &self.coords, self.dim, &self.eq_dofs, &self.options)
+                        .map_err(amg_err)?;
+                self.amg = Some(amg);
+                self.values = values.to_vec();
+                self.setups += 1;
+            }
+        }
+        Ok(())
+    }
+}
+
+impl LinearSolve for AmgSolver {
+    fn solve_system(
+        &mut self,
+        pattern: &Pattern,
+        values: &[f64],
+        b: &[f64],
+        x: &mut [f64],
+    ) -> Result<LinearStats> {
+        if pattern.num_equations() != self.n
+            || pattern.nnz() != self.nnz
+            || values.len() != self.nnz
+            || b.len() != self.n
+            || x.len() != self.n
+        {
+            return Err(SimError::Input(format!(
+                "CG-AMG: pattern of {} equations / {} entries, {} values, vectors of {} and {}; solver built for {} / {}",
+                pattern.num_equations(),
+                pattern.nnz(),
+                values.len(),
+                b.len(),
+                x.len(),
+                self.n,
+                self.nnz
+            )));
+        }
+        if self.n == 0 {
+            return Ok(LinearStats::default());
+        }
+        self.prepare(pattern, values)?;
+        let amg = self
+            .amg
+            .as_mut()
+            .ok_or_else(|| SimError::Iterative("AMG hierarchy missing".into()))?;
+        x.fill(0.0);
+        let stats = amg
+            .solve(x, b, self.tolerance, self.max_iterations)
+            .map_err(|e| SimError::Iterative(format!("CG-AMG: {e}")))?;
+        self.last_iterations = stats.iterations;
+        self.total_iterations += stats.iterations;
+        Ok(LinearStats {
+            iterations: stats.iterations,
+        })
+    }
+
+    fn residual_limit(&self) -> f64 {
+        // CG checks its true residual against the tolerance; the caller recomputes it
+        // with another summation order.
+        self.tolerance * (1.0 + 1e-6) + 1e-14
+    }
+}
+
+/// The static mechanics solver chosen by a [`LinearSolver`].
+// One per run: the size of the variants does not matter.
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug)]
+pub enum StaticSolver {
+    /// Sparse Cholesky.
+    Direct(DirectSolver),
+    /// CG-AMG.
+    CgAmg(AmgSolver),
+}
+
+impl StaticSolver {
+    /// The solver `choice` (with `Auto` resolved by [`LinearSolver::resolve`]) for the
+    /// equations of `dofs` on `pattern`: Cholesky with nested dissection in 3D and AMD in
+    /// 2D, or CG-AMG.
+    pub fn new<const D: usize>(
+        grid: &Grid<D>,
+        dofs: &DofMap<D>,
+        pattern: &Pattern,
+        choice: LinearSolver,
+    ) -> Result<Self> {
+        match choice.resolve(D, dofs.num_equations()) {
+            LinearSolver::CgAmg { tolerance } => {
+                Ok(Self::CgAmg(AmgSolver::new(grid, dofs, pattern, tolerance)?))
+            }
+            _ => Ok(Self::Direct(if D == 3 {
+                DirectSolver::with_ordering(pattern, &nested_dissection(grid, dofs))?
+            } else {
+                DirectSolver::new(pattern)?
+            })),
+        }
+    }
+
+    /// `"cholesky"` or `"cg-amg"`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Direct(_) => "cholesky",
+            Self::CgAmg(_) => "cg-amg",
+        }
+    }
+    /// Symbolic factorizations (Cholesky) or full hierarchy setups (CG-AMG).
+    pub fn symbolic_factorizations(&self) -> usize {
+        match self {
+            Self::Direct(d) => d.symbolic_factorizations(),
+            Self::CgAmg(a) => a.setups(),
+        }
+    }
+    /// Numeric factorizations (Cholesky) or setups plus numeric rebuilds (CG-AMG).
+    pub fn numeric_factorizations(&self) -> usize {
+        match self {
+            Self::Direct(d) => d.numeric_factorizations(),
+            Self::CgAmg(a) => a.setups() + a.updates(),
+        }
+    }
+    /// Entries of the Cholesky factor (for CG-AMG: of the coarsest level's factor).
+    pub fn factor_nnz(&self) -> usize {
+        match self {
+            Self::Direct(d) => d.factor_nnz(),
+            Self::CgAmg(a) => a.hierarchy().map_or(0, |h| h.coarse_factor_nnz()),
+        }
+    }
+    /// CG iterations of all solves (0 for Cholesky).
+    pub fn total_iterations(&self) -> usize {
+        match self {
+            Self::Direct(_) => 0,
+            Self::CgAmg(a) => a.total_iterations(),
+        }
+    }
+}
+
+impl LinearSolve for StaticSolver {
+    fn solve_system(
+        &mut self,
+        pattern: &Pattern,
+        values: &[f64],
+        b: &[f64],
+        x: &mut [f64],
+    ) -> Result<LinearStats> {
+        match self {
+            Self::Direct(d) => d.solve_system(pattern, values, b, x),
+            Self::CgAmg(a) => a.solve_system(pattern, values, b, x),
+        }
+    }
+    fn residual_limit(&self) -> f64 {
+        match self {
+            Self::Direct(d) => d.residual_limit(),
+            Self::CgAmg(a) => a.residual_limit(),
+        }
+    }
+}
