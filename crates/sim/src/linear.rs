@@ -32,11 +32,13 @@ pub const DEFAULT_TOLERANCE: f64 = 1e-8;
 /// Default iteration limit of the iterative solver.
 pub const DEFAULT_MAX_ITERATIONS: usize = 500;
 /// `Auto` uses CG-AMG in 3D from this many equations (E3 n = 20, 20 577 equations:
-/// CG-AMG 0.24 s against 0.67 s for nested-dissection Cholesky; docs/BENCHMARKS.md).
+/// CG-AMG 0.13 s setup + solve against 0.51 s for nested-dissection Cholesky;
+/// docs/BENCHMARKS.md, "Linear solvers: direct vs AMG-CG").
 pub const AUTO_MIN_EQUATIONS_3D: usize = 10_000;
-/// `Auto` uses CG-AMG in 2D from this many equations (docs/BENCHMARKS.md, "Linear
-/// solvers: direct vs AMG-CG": below it the AMD Cholesky is faster).
-pub const AUTO_MIN_EQUATIONS_2D: usize = 1_500_000;
+/// `Auto` uses CG-AMG in 2D from this many equations (E2 setup + solve: at 0.5 M
+/// equations AMD Cholesky 2.84 s against CG-AMG 3.75 s, at 2 M 23.5 s against 10.1 s
+/// with 0.8 GB less memory; docs/BENCHMARKS.md).
+pub const AUTO_MIN_EQUATIONS_2D: usize = 1_000_000;
 
 /// Which linear solver the static mechanics uses.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -258,7 +260,18 @@ impl AmgSolver {
         self.amg.as_ref()
     }
 
-    fn prepare(&mut self, pattern: &Pattern, values: &[f64]) -> Result<()> {
+    /// Build the hierarchy for the upper-triangle `values` on `pattern` (first call), or
+    /// update it numerically if the values changed since the last call. [`LinearSolve::
+    /// solve_system`] calls it; calling it first separates the setup time from the solve.
+    pub fn setup(&mut self, pattern: &Pattern, values: &[f64]) -> Result<()> {
+        if pattern.nnz() != self.nnz || values.len() != self.nnz {
+            return Err(SimError::Input(format!(
+                "CG-AMG setup: pattern of {} entries and {} values, solver built for {}",
+                pattern.nnz(),
+                values.len(),
+                self.nnz
+            )));
+        }
         let amg_err = |e: porofrac_amg::AmgError| SimError::Iterative(format!("AMG setup: {e}"));
         match self.amg.as_mut() {
             Some(amg) => {
@@ -317,7 +330,7 @@ impl LinearSolve for AmgSolver {
         if self.n == 0 {
             return Ok(LinearStats::default());
         }
-        self.prepare(pattern, values)?;
+        self.setup(pattern, values)?;
         let amg = self
             .amg
             .as_mut()
