@@ -481,7 +481,7 @@ fn check_grid(ls: &LoadedScene, d: usize) -> Result<(), SceneError> {
             format!("= \"{}\" must be one of {}", g.kind, kinds.join(", ")),
         ));
     }
-    if (g.kind == "triangles" || g.kind == "voronoi" || g.kind == "composite") && d != 2 {
+    if (g.kind == "triangles" || g.kind == "voronoi") && d != 2 {
         return Err(ls.error(
             &key("kind"),
             format!("= \"{}\" is a 2D grid, the scene is {d}D", g.kind),
@@ -549,6 +549,17 @@ fn check_grid(ls: &LoadedScene, d: usize) -> Result<(), SceneError> {
             if !present {
                 return Err(ls.error(&key(f), "is required for kind = \"composite\""));
             }
+        }
+        if let Some(c) = &g.center
+            && c.len() != 2
+        {
+            return Err(ls.error(
+                &key("center"),
+                format!(
+                    "must have 2 components (in 3D: the x, y of the vertical well axis), got {}",
+                    c.len()
+                ),
+            ));
         }
     }
     Ok(())

@@ -1,5 +1,5 @@
-//! PNG plots a person looks at first: cell fields of 2D scenes (with fractured cells
-//! outlined) and probe time series. Text uses the bundled DejaVu Sans font, so no system
+//! PNG plots a person looks at first: cell and nodal fields of 2D scenes (with fractured
+//! cells outlined, optionally zoomed and with principal directions) and probe time series. Text uses the bundled DejaVu Sans font, so no system
 //! font library is needed.
 
 use std::path::{Path, PathBuf};
@@ -50,38 +50,109 @@ fn perr<E: std::fmt::Display>(path: &Path) -> impl Fn(E) -> PlotError + '_ {
     }
 }
 
-/// Plot a cell field of a 2D grid, colour-mapped, with the cells where `marked` is true
-/// outlined in red (fractured cells).
-pub fn cell_field(
-    path: &Path,
-    grid: &Grid<2>,
-    values: &[f64],
-    title: &str,
-    marked: &[bool],
-) -> Result<(), PlotError> {
+/// Values of a 2D field: constant per cell, or one per node (drawn as the node's share of
+/// each cell: the quadrilateral between the node, its edge midpoints and the centroid).
+#[derive(Clone, Copy, Debug)]
+pub enum Values<'a> {
+    /// One value per cell.
+    Cell(&'a [f64]),
+    /// One value per node.
+    Nodal(&'a [f64]),
+}
+
+/// What a field plot shows besides the values.
+#[derive(Clone, Copy, Debug)]
+pub struct FieldPlot<'a> {
+    /// The grid.
+    pub grid: &'a Grid<2>,
+    /// The title.
+    pub title: &'a str,
+    /// Cells outlined in red (fractured cells).
+    pub marked: &'a [bool],
+    /// The region shown (`[x0, y0]`, `[x1, y1]`); `None`: the whole grid. The colour
+    /// range is that of the cells shown.
+    pub window: Option<([f64; 2], [f64; 2])>,
+    /// A unit direction per cell drawn as a short black segment through its centroid
+    /// (principal directions), for the cells shown when they are at most 10 000.
+    pub directions: Option<&'a [[f64; 2]]>,
+}
+
+impl<'a> FieldPlot<'a> {
+    /// The whole grid with fractured cells outlined.
+    pub fn new(grid: &'a Grid<2>, title: &'a str, marked: &'a [bool]) -> Self {
+        Self {
+            grid,
+            title,
+            marked,
+            window: None,
+            directions: None,
+        }
+    }
+}
+
+/// Plot a field of a 2D grid, colour-mapped (see [`FieldPlot`]).
+pub fn field(path: &Path, plot: &FieldPlot<'_>, values: Values<'_>) -> Result<(), PlotError> {
     register_font();
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir).map_err(perr(path))?;
     }
+    let grid = plot.grid;
+    let (lo, hi) = match plot.window {
+        Some((a, b)) => (a, b),
+        None => {
+            let (a, b) = grid.bounding_box();
+            ([a[0], a[1]], [b[0], b[1]])
+        }
+    };
+    let xy = |n: usize| (grid.node(n)[0], grid.node(n)[1]);
+    let shown: Vec<usize> = (0..grid.num_cells())
+        .filter(|&c| {
+            plot.window.is_none()
+                || grid.cell_nodes(c).iter().any(|&n| {
+                    let (x, y) = xy(n);
+                    (lo[0]..=hi[0]).contains(&x) && (lo[1]..=hi[1]).contains(&y)
+                })
+        })
+        .collect();
+    // Coloured pieces: (polygon, value).
+    let mut pieces: Vec<(Vec<(f64, f64)>, f64)> = Vec::new();
+    for &c in &shown {
+        let nodes = grid.cell_nodes(c);
+        let pts: Vec<(f64, f64)> = nodes.iter().map(|&n| xy(n)).collect();
+        match values {
+            Values::Cell(v) => pieces.push((pts, v[c])),
+            Values::Nodal(v) => {
+                let m = pts.len();
+                let g = grid.cell_centroid(c);
+                let mid = |a: (f64, f64), b: (f64, f64)| (0.5 * (a.0 + b.0), 0.5 * (a.1 + b.1));
+                for i in 0..m {
+                    let (prev, next) = (pts[(i + m - 1) % m], pts[(i + 1) % m]);
+                    pieces.push((
+                        vec![pts[i], mid(pts[i], next), (g[0], g[1]), mid(prev, pts[i])],
+                        v[nodes[i]],
+                    ));
+                }
+            }
+        }
+    }
+    let finite = pieces.iter().map(|p| p.1).filter(|v| v.is_finite());
+    let vmin = finite.clone().fold(f64::INFINITY, f64::min);
+    let vmax = finite.fold(f64::NEG_INFINITY, f64::max);
+    let (vmin, vmax) = if vmin.is_finite() && vmax > vmin {
+        (vmin, vmax)
+    } else {
+        (vmin.min(0.0) - 0.5, vmax.max(0.0) + 0.5)
+    };
     let tmp = tmp_path(path);
     {
-        let (lo, hi) = grid.bounding_box();
         let (w, h) = (hi[0] - lo[0], hi[1] - lo[1]);
         let px_w = 900u32;
         let px_h = ((px_w as f64 - 160.0) * h / w + 120.0).clamp(300.0, 1400.0) as u32;
         let root = BitMapBackend::new(&tmp, (px_w, px_h)).into_drawing_area();
         root.fill(&WHITE).map_err(perr(path))?;
         let (main, bar) = root.split_horizontally(px_w - 110);
-        let finite = values.iter().copied().filter(|v| v.is_finite());
-        let vmin = finite.clone().fold(f64::INFINITY, f64::min);
-        let vmax = finite.fold(f64::NEG_INFINITY, f64::max);
-        let (vmin, vmax) = if vmin.is_finite() && vmax > vmin {
-            (vmin, vmax)
-        } else {
-            (vmin.min(0.0) - 0.5, vmax.max(0.0) + 0.5)
-        };
         let mut chart = ChartBuilder::on(&main)
-            .caption(title, ("sans-serif", 22))
+            .caption(plot.title, ("sans-serif", 22))
             .margin(10)
             .x_label_area_size(35)
             .y_label_area_size(55)
@@ -94,13 +165,7 @@ pub fn cell_field(
             .y_desc("y (m)")
             .draw()
             .map_err(perr(path))?;
-        let polys = (0..grid.num_cells()).map(|c| {
-            let pts: Vec<(f64, f64)> = grid
-                .cell_nodes(c)
-                .iter()
-                .map(|&n| (grid.node(n)[0], grid.node(n)[1]))
-                .collect();
-            let v = values[c];
+        let polys = pieces.into_iter().map(|(pts, v)| {
             let color = if v.is_finite() {
                 ViridisRGB::get_color_normalized(v, vmin, vmax)
             } else {
@@ -109,18 +174,32 @@ pub fn cell_field(
             Polygon::new(pts, color.filled())
         });
         chart.draw_series(polys).map_err(perr(path))?;
-        let outlines = (0..grid.num_cells())
-            .filter(|&c| marked.get(c).copied().unwrap_or(false))
-            .map(|c| {
-                let mut pts: Vec<(f64, f64)> = grid
-                    .cell_nodes(c)
-                    .iter()
-                    .map(|&n| (grid.node(n)[0], grid.node(n)[1]))
-                    .collect();
+        let outlines = shown
+            .iter()
+            .filter(|&&c| plot.marked.get(c).copied().unwrap_or(false))
+            .map(|&c| {
+                let mut pts: Vec<(f64, f64)> = grid.cell_nodes(c).iter().map(|&n| xy(n)).collect();
                 pts.push(pts[0]);
                 PathElement::new(pts, RED.stroke_width(2))
             });
         chart.draw_series(outlines).map_err(perr(path))?;
+        if let Some(dirs) = plot.directions
+            && shown.len() <= 10_000
+        {
+            let segments = shown.iter().map(|&c| {
+                let g = grid.cell_centroid(c);
+                let half = 0.35 * grid.cell_volume(c).sqrt();
+                let d = dirs[c];
+                PathElement::new(
+                    vec![
+                        (g[0] - half * d[0], g[1] - half * d[1]),
+                        (g[0] + half * d[0], g[1] + half * d[1]),
+                    ],
+                    BLACK.stroke_width(1),
+                )
+            });
+            chart.draw_series(segments).map_err(perr(path))?;
+        }
         // Colour bar.
         let mut cb = ChartBuilder::on(&bar)
             .margin_top(40)

@@ -13,7 +13,9 @@ use porofrac_frac::{
     Combined, CrackTracking, FailurePolicy, FailureState, MohrCoulomb, ResolveError, Tensile,
     resolve,
 };
-use porofrac_grid::generate::{CompositeSpec, cartesian, composite, perturb, simplices, voronoi};
+use porofrac_grid::generate::{
+    CompositeSpec, cartesian, composite, extrude, perturb, simplices, voronoi,
+};
 use porofrac_grid::io::{Field, PvdWriter, read_msh, read_vtu, write_vtu};
 use porofrac_grid::{Grid, GridError, Point};
 use porofrac_law::{CellLaw, Stiffness, Tensor};
@@ -127,7 +129,9 @@ pub fn build_grid(ls: &LoadedScene) -> Result<AnyGrid, RunError> {
             });
             AnyGrid::Two(voronoi(point(&ext[0]), point(&ext[1]), n, seed, lloyd).map_err(at_grid)?)
         }
-        (2, "composite") => {
+        (_, "composite") => {
+            // 2D: the composite grid; 3D: the same in x, y, extruded over cells[2] layers
+            // (tetrahedra from the triangles, polygonal prisms from the far field).
             let n = per_axis();
             let c = g.center.clone().unwrap_or_default();
             if c.len() != 2 {
@@ -136,8 +140,8 @@ pub fn build_grid(ls: &LoadedScene) -> Result<AnyGrid, RunError> {
                     .into());
             }
             let mut spec = CompositeSpec::new(
-                point(&ext[0]),
-                point(&ext[1]),
+                point(&ext[0][..2]),
+                point(&ext[1][..2]),
                 [n[0], n[1]],
                 point(&c),
                 g.zone_half_width.unwrap_or(0.0),
@@ -153,7 +157,21 @@ pub fn build_grid(ls: &LoadedScene) -> Result<AnyGrid, RunError> {
             spec.perturb = g.perturb.unwrap_or(0.0);
             spec.seed = seed;
             // The jitter applies to the refined zone only; see docs/grid.md.
-            return Ok(AnyGrid::Two(composite(&spec).map_err(at_grid)?));
+            let g2 = composite(&spec).map_err(at_grid)?;
+            if d == 2 {
+                return Ok(AnyGrid::Two(g2));
+            }
+            let (z0, z1, nz) = (ext[0][2], ext[1][2], n[2]);
+            let levels: Vec<f64> = (0..=nz)
+                .map(|i| {
+                    if i == nz {
+                        z1
+                    } else {
+                        z0 + (z1 - z0) * i as f64 / nz as f64
+                    }
+                })
+                .collect();
+            return Ok(AnyGrid::Three(extrude(&g2, &levels).map_err(at_grid)?));
         }
         (_, "file") => {
             let path = ls.resolve(g.path.as_deref().unwrap_or(""));
@@ -1093,26 +1111,44 @@ fn run_dim<const D: usize>(
                     })
                     .collect()
             };
+            let divergence = cell_divergence(g2, u);
+            let (smax, smin): (Vec<f64>, Vec<f64>) = stress.iter().map(principal).unzip();
             let mut plots: Vec<(&str, Vec<f64>)> = vec![
                 ("ux", cell_mean(0)),
                 ("uy", cell_mean(1)),
                 ("sxx", stress.iter().map(|s| s[(0, 0)]).collect()),
                 ("syy", stress.iter().map(|s| s[(1, 1)]).collect()),
                 ("sxy", stress.iter().map(|s| s[(0, 1)]).collect()),
-                ("smax", stress.iter().map(|s| principal(s).0).collect()),
-                ("smin", stress.iter().map(|s| principal(s).1).collect()),
+                ("smax", smax),
+                ("smin", smin),
+                ("divergence", divergence),
             ];
             if let Some(p) = &pressure {
                 plots.push(("pressure", p.clone()));
             }
             let t_last = written_times.last().copied().unwrap_or(0.0);
-            for (name, vals) in plots {
-                crate::plots::cell_field(
+            for (name, vals) in &plots {
+                let title = format!("{name} at t = {t_last} s");
+                crate::plots::field(
                     &out.join("plots").join(format!("{name}.png")),
+                    &crate::plots::FieldPlot::new(g2, &title, &marked),
+                    crate::plots::Values::Cell(vals),
+                )?;
+            }
+            if failures.count() > 0 {
+                // The seed's Figs. 4 and 5 (any dimension-2 scene with fractures).
+                let stress2: Vec<Tensor<2>> = stress
+                    .iter()
+                    .map(|s| Tensor::<2>::from_fn(|i, j| s[(i, j)]))
+                    .collect();
+                fracture_plots(
+                    &out.join("plots"),
                     g2,
-                    &vals,
-                    &format!("{name} at t = {t_last} s"),
+                    &plots,
+                    &stress2,
                     &marked,
+                    failures.log().iter().map(|f| f.cell),
+                    t_last,
                 )?;
             }
         }
@@ -1133,6 +1169,115 @@ fn run_dim<const D: usize>(
         solver: stats,
         version: env!("CARGO_PKG_VERSION").into(),
     })
+}
+
+/// Cell divergence of the displacement, `div u = Σ_i N_i · u_i / |K|` (the exact volume
+/// change of the VEM projection per unit volume; seed Fig. 4, upper right).
+fn cell_divergence(grid: &Grid<2>, u: &[f64]) -> Vec<f64> {
+    let mut normals = Vec::new();
+    (0..grid.num_cells())
+        .map(|c| {
+            let nodes = grid.cell_nodes(c);
+            normals.resize(nodes.len(), Point::<2>::zeros());
+            grid.cell_node_normals(c, &mut normals);
+            let flux: f64 = nodes
+                .iter()
+                .zip(&normals)
+                .map(|(&n, q)| q[0] * u[2 * n] + q[1] * u[2 * n + 1])
+                .sum();
+            flux / grid.cell_volume(c)
+        })
+        .collect()
+}
+
+/// Principal directions (unit, of the largest and the smallest principal stress).
+fn principal_directions(s: &Tensor<2>) -> ([f64; 2], [f64; 2]) {
+    let theta = 0.5 * (2.0 * s[(0, 1)]).atan2(s[(0, 0)] - s[(1, 1)]);
+    let (c, si) = (theta.cos(), theta.sin());
+    ([c, si], [-si, c])
+}
+
+/// A square window around the points, padded by 30 % and half a metre, inside the grid.
+fn window_around(grid: &Grid<2>, pts: &[Point<2>], pad: f64) -> ([f64; 2], [f64; 2]) {
+    let (glo, ghi) = grid.bounding_box();
+    let mut lo = [f64::INFINITY; 2];
+    let mut hi = [f64::NEG_INFINITY; 2];
+    for p in pts {
+        for a in 0..2 {
+            lo[a] = lo[a].min(p[a]);
+            hi[a] = hi[a].max(p[a]);
+        }
+    }
+    let half = 0.5 * (hi[0] - lo[0]).max(hi[1] - lo[1]) * 1.3 + pad;
+    let mut w = ([0.0; 2], [0.0; 2]);
+    for a in 0..2 {
+        let m = 0.5 * (lo[a] + hi[a]);
+        w.0[a] = (m - half).max(glo[a]);
+        w.1[a] = (m + half).min(ghi[a]);
+    }
+    w
+}
+
+/// Plots of a fractured 2D scene, like the seed's Figs. 4 and 5, in `plots/fracture/`:
+/// the fields of `plots` zoomed on the fractured cells (principal directions on `smax` and
+/// `smin`), and near the crack tip (the last cell to fail) the largest principal stress of
+/// the cells next to the Zienkiewicz–Zhu recovered one (Fig. 5).
+fn fracture_plots(
+    dir: &Path,
+    grid: &Grid<2>,
+    plots: &[(&str, Vec<f64>)],
+    stress: &[Tensor<2>],
+    marked: &[bool],
+    failed_in_order: impl Iterator<Item = usize>,
+    t: f64,
+) -> Result<(), RunError> {
+    let dir = dir.join("fracture");
+    let order: Vec<usize> = failed_in_order.collect();
+    let centroids: Vec<Point<2>> = order.iter().map(|&c| *grid.cell_centroid(c)).collect();
+    let window = window_around(grid, &centroids, 0.5);
+    let (dmax, dmin): (Vec<[f64; 2]>, Vec<[f64; 2]>) =
+        stress.iter().map(principal_directions).unzip();
+    for (name, vals) in plots {
+        let title = format!("{name} at t = {t} s, near the fracture");
+        let mut plot = crate::plots::FieldPlot::new(grid, &title, marked);
+        plot.window = Some(window);
+        plot.directions = match *name {
+            "smax" => Some(&dmax),
+            "smin" => Some(&dmin),
+            _ => None,
+        };
+        crate::plots::field(
+            &dir.join(format!("{name}.png")),
+            &plot,
+            crate::plots::Values::Cell(vals),
+        )?;
+    }
+    // Fig. 5: cell stress against recovered stress at the tip.
+    let Some(&tip) = order.last() else {
+        return Ok(());
+    };
+    let h = grid.cell_volume(tip).sqrt();
+    let tip_window = window_around(grid, &[*grid.cell_centroid(tip)], 6.0 * h);
+    let nodal = recover_nodal(grid, &NodeCells::new(grid), stress);
+    let smax_cell: Vec<f64> = stress.iter().map(|s| principal(s).0).collect();
+    let smax_nodal: Vec<f64> = nodal.iter().map(|s| principal(s).0).collect();
+    for (file, title, values) in [
+        (
+            "tip_smax_cell.png",
+            format!("smax of the cells near the tip, t = {t} s"),
+            crate::plots::Values::Cell(&smax_cell),
+        ),
+        (
+            "tip_smax_recovered.png",
+            format!("smax recovered (ZZ patch) near the tip, t = {t} s"),
+            crate::plots::Values::Nodal(&smax_nodal),
+        ),
+    ] {
+        let mut plot = crate::plots::FieldPlot::new(grid, &title, marked);
+        plot.window = Some(tip_window);
+        crate::plots::field(&dir.join(file), &plot, values)?;
+    }
+    Ok(())
 }
 
 /// Plain symmetric components `[xx, yy, zz, xy, yz, xz]` for VTK.

@@ -14,6 +14,11 @@
 //!   is within 15° of the loaded axis (y for the top load, x for the side load), and the
 //!   set is elongated (ratio of the principal standard deviations ≥ 2.5: a crack, not a
 //!   blob).
+//! * **3D** (`scenes/hydrofrac_3d.toml`, a vertical well section, shortened to 15 minutes
+//!   of injection for the test): the fracture is a vertical plane normal to x, the least
+//!   compressive stress, so in the x–y plane its axis is within 15° of y and it reaches at
+//!   least 0.4 m from the well axis; no cell fails at t = 0 and the first failures touch
+//!   the well.
 //! * **No injection, no fracture**: without the source nothing fails and the pressure
 //!   stays p₀ = 1e7 Pa (to 1e-9 relative).
 
@@ -23,10 +28,9 @@ use std::path::{Path, PathBuf};
 
 use common::{read_csv, root, run_ok, summary, tmp_dir};
 
-/// Well centre, well radius and fine cell size of the scene (m).
+/// Well centre and well radius of the scenes (m).
 const CENTER: [f64; 2] = [15.0, 15.0];
 const WELL_RADIUS: f64 = 0.25;
-const FINE_H: f64 = 1.0 / 12.0;
 
 fn seed_scene() -> String {
     std::fs::read_to_string(root().join("scenes/hydrofrac_seed.toml")).unwrap()
@@ -44,16 +48,22 @@ fn variant(dir: &Path, text: &str, edits: &[(&str, &str)]) -> PathBuf {
     path
 }
 
-/// Fractured cells of `fracture.csv`: `(x, y, time)`.
+/// Fractured cells of `fracture.csv` (2D or 3D): `(x, y, time)`.
 fn fractures(out: &Path) -> Vec<[f64; 3]> {
     let text = std::fs::read_to_string(out.join("fracture.csv")).unwrap();
     let mut lines = text.lines();
-    assert_eq!(lines.next(), Some("cell,x,y,time,mode"));
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert!(
+        header == ["cell", "x", "y", "time", "mode"]
+            || header == ["cell", "x", "y", "z", "time", "mode"],
+        "{header:?}"
+    );
+    let time = header.len() - 2;
     lines
         .map(|l| {
             let f: Vec<&str> = l.split(',').collect();
-            assert!(["tensile", "shear"].contains(&f[4]), "{l}");
-            [f[1], f[2], f[3]].map(|v| v.parse().unwrap())
+            assert!(["tensile", "shear"].contains(&f[time + 1]), "{l}");
+            [f[1], f[2], f[time]].map(|v| v.parse().unwrap())
         })
         .collect()
 }
@@ -89,8 +99,10 @@ fn axis_angle(a: f64, b: f64) -> f64 {
     d.min(180.0 - d)
 }
 
-/// Checks shared by the top and the side load; `axis` is the loaded axis (degrees).
-fn check_fracture(out: &Path, axis: f64) {
+/// Checks shared by the scenes; `axis` is the direction of the largest compression in the
+/// x–y plane (degrees from x), `min_reach` the least distance from the well the fracture
+/// must reach (m), `fine_h` the fine cell size near the well (m).
+fn check_fracture(out: &Path, axis: f64, min_reach: f64, fine_h: f64) {
     let s = summary(out);
     assert_eq!(s["status"], "ok");
     let f = fractures(out);
@@ -104,7 +116,7 @@ fn check_fracture(out: &Path, axis: f64) {
     for p in f.iter().filter(|p| p[2] == first) {
         let r = distance_to_well(p);
         assert!(
-            r <= WELL_RADIUS + 2.0 * FINE_H * 2f64.sqrt(),
+            r <= WELL_RADIUS + 2.0 * fine_h * 2f64.sqrt(),
             "first failure at {p:?} is {r} m from the well centre"
         );
     }
@@ -119,7 +131,7 @@ fn check_fracture(out: &Path, axis: f64) {
     );
     let reach = f.iter().map(distance_to_well).fold(0.0, f64::max);
     assert!(
-        reach >= 1.0,
+        reach >= min_reach,
         "fracture reaches only {reach} m from the well"
     );
 }
@@ -128,7 +140,7 @@ fn check_fracture(out: &Path, axis: f64) {
 fn seed_scene_fracture_starts_at_the_well_and_grows_along_the_largest_compression() {
     let out = tmp_dir("hydrofrac");
     run_ok(&root().join("scenes/hydrofrac_seed.toml"), &out);
-    check_fracture(&out, 90.0);
+    check_fracture(&out, 90.0, 1.0, 1.0 / 12.0);
     // Injection raised the well pressure above p0.
     let (header, rows) = read_csv(&out.join("probes.csv"));
     assert_eq!(header[1], "p_well");
@@ -155,7 +167,7 @@ fn load_on_the_side_turns_the_fracture_by_ninety_degrees() {
     );
     let out = dir.join("out");
     run_ok(&scene, &out);
-    check_fracture(&out, 0.0);
+    check_fracture(&out, 0.0, 1.0, 1.0 / 12.0);
 }
 
 #[test]
@@ -180,4 +192,15 @@ fn no_injection_no_fracture() {
             assert!((p - 1e7).abs() <= 1e-9 * 1e7, "{r:?}");
         }
     }
+}
+
+#[test]
+fn three_d_fracture_opens_against_the_least_compressive_stress() {
+    let dir = tmp_dir("hydrofrac-3d");
+    let text = std::fs::read_to_string(root().join("scenes/hydrofrac_3d.toml")).unwrap();
+    let scene = variant(&dir, &text, &[("end_time = 2400.0", "end_time = 900.0")]);
+    let out = dir.join("out");
+    run_ok(&scene, &out);
+    assert_eq!(summary(&out)["dim"], 3);
+    check_fracture(&out, 90.0, 0.4, 1.0 / 8.0);
 }

@@ -15,8 +15,6 @@
 
 mod common;
 
-use std::path::Path;
-
 use common::{close, porofrac, read_csv, root, run_ok, tmp_dir};
 
 /// Plane strain, E = 1e9, ν = 0.3.

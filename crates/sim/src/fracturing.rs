@@ -22,7 +22,10 @@
 //!    the solution is the one used (the compression-only law is piecewise linear, so that
 //!    solution is exact) or the nonlinear equilibrium residual is below
 //!    [`FractureSettings::active_set_tolerance`] (an edge that chatters across `U = 0`
-//!    carries almost no force). More than [`FractureSettings::max_active_set`] iterations
+//!    carries almost no force). When a full step does not reduce the residual (edges
+//!    flipping open and closed, "chatter"), the step is backtracked (halved, down to 1/64)
+//!    between the best iterate and the new one: both satisfy the linear flow equations,
+//!    so every point between them does, and the next linearization is taken there. More than [`FractureSettings::max_active_set`] iterations
 //!    is an error ([`FractureError::ActiveSet`]) naming the time and the residual.
 //! 2. **Failure check** on the cells that have not failed, on the cell stress or the
 //!    recovered (Zienkiewicz–Zhu) stress ([`StressMeasure`]); the violating cells chosen
@@ -502,6 +505,8 @@ fn active_set_solve<const D: usize>(
         Some(s) => system.linearize(&s.displacement, &s.pressure, t)?,
         None => system.linearize(&vec![0.0; system.mechanics().dofs.num_dofs()], &p0, t)?,
     };
+    // The best iterate so far: state, the pressure its mechanics balances, residual.
+    let mut best: Option<(BiotState, Vec<f64>, f64)> = None;
     let mut residual = f64::INFINITY;
     for it in 1..=settings.max_active_set.max(1) {
         let (new, p_used) = match state {
@@ -528,6 +533,43 @@ fn active_set_solve<const D: usize>(
         if !lin.changed || residual <= settings.active_set_tolerance {
             return Ok((new, residual, it));
         }
+        let Some((b_state, b_p, b_res)) = best.take() else {
+            best = Some((new, p_used, residual));
+            continue;
+        };
+        if residual < b_res {
+            best = Some((new, p_used, residual));
+            continue;
+        }
+        // Chatter: the full step did not reduce the residual. Backtrack along the segment
+        // from the best iterate to the new one; both satisfy the (linear) flow equations,
+        // so every point between them does too, and only the equilibrium residual of the
+        // piecewise-linear laws decides. The point found (or the shortest step tried) is
+        // the next linearization point.
+        let mut omega = 0.5;
+        let mut next = None;
+        while omega >= 1.0 / 64.0 {
+            let mix = |a: &[f64], b: &[f64]| -> Vec<f64> {
+                a.iter().zip(b).map(|(x, y)| x + omega * (y - x)).collect()
+            };
+            let cand = BiotState {
+                displacement: mix(&b_state.displacement, &new.displacement),
+                pressure: mix(&b_state.pressure, &new.pressure),
+            };
+            let cand_p = mix(&b_p, &p_used);
+            let l = system.linearize(&cand.displacement, &cand_p, t1)?;
+            residual = l.residual;
+            if residual <= settings.active_set_tolerance {
+                return Ok((cand, residual, it));
+            }
+            let descent = residual < b_res;
+            next = Some((cand, cand_p, residual));
+            if descent {
+                break;
+            }
+            omega *= 0.5;
+        }
+        best = next;
     }
     Err(FractureError::ActiveSet {
         time: t1,

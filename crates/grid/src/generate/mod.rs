@@ -12,11 +12,13 @@
 //!   joined by hanging nodes, with `refined` and well cell tags.
 
 mod composite;
+mod extrude;
 mod perturb;
 mod structured;
 mod voronoi;
 
 pub use composite::{CompositeSpec, Diagonals, REFINED_TAG, composite};
+pub use extrude::extrude;
 pub use perturb::{MAX_PERTURB, perturb};
 pub use structured::{cartesian, simplices};
 pub use voronoi::{DEFAULT_LLOYD, voronoi};
