@@ -60,16 +60,129 @@ pub enum Values<'a> {
     Nodal(&'a [f64]),
 }
 
+/// The polygons a field is drawn on: the cells of a 2D grid, or the cross-sections of
+/// the cells of a 3D grid with a plane `z = const`.
+#[derive(Clone, Debug)]
+pub struct Canvas {
+    polygons: Vec<Vec<(f64, f64)>>,
+    /// The cell of each polygon.
+    cells: Vec<usize>,
+    /// The grid node of each polygon vertex (2D grids only; nodal values need it).
+    nodes: Option<Vec<Vec<usize>>>,
+}
+
+impl Canvas {
+    /// The cells of a 2D grid.
+    pub fn of_grid(grid: &Grid<2>) -> Self {
+        let xy = |n: usize| (grid.node(n)[0], grid.node(n)[1]);
+        Self {
+            polygons: (0..grid.num_cells())
+                .map(|c| grid.cell_nodes(c).iter().map(|&n| xy(n)).collect())
+                .collect(),
+            cells: (0..grid.num_cells()).collect(),
+            nodes: Some(
+                (0..grid.num_cells())
+                    .map(|c| grid.cell_nodes(c).to_vec())
+                    .collect(),
+            ),
+        }
+    }
+
+    /// The cross-sections of the cells of a 3D grid with the plane `z = z0`: the points
+    /// where the cells' edges cross the plane, ordered by angle about their mean (exact
+    /// for convex cells).
+    pub fn z_slice(grid: &Grid<3>, z0: f64) -> Self {
+        let mut polygons = Vec::new();
+        let mut cells = Vec::new();
+        let mut pts: Vec<(f64, f64)> = Vec::new();
+        for c in 0..grid.num_cells() {
+            pts.clear();
+            for &f in grid.cell_faces(c) {
+                let loop_ = grid.face_nodes(f);
+                let m = loop_.len();
+                for i in 0..m {
+                    let (a, b) = (grid.node(loop_[i]), grid.node(loop_[(i + 1) % m]));
+                    let (da, db) = (a[2] - z0, b[2] - z0);
+                    if da == 0.0 {
+                        pts.push((a[0], a[1]));
+                    } else if da * db < 0.0 {
+                        let t = da / (da - db);
+                        pts.push((a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])));
+                    }
+                }
+            }
+            if pts.len() < 3 {
+                continue;
+            }
+            let n = pts.len() as f64;
+            let (mx, my) = (
+                pts.iter().map(|p| p.0).sum::<f64>() / n,
+                pts.iter().map(|p| p.1).sum::<f64>() / n,
+            );
+            pts.sort_by(|p, q| {
+                (p.1 - my)
+                    .atan2(p.0 - mx)
+                    .total_cmp(&(q.1 - my).atan2(q.0 - mx))
+            });
+            let scale = pts
+                .iter()
+                .map(|p| (p.0 - mx).abs() + (p.1 - my).abs())
+                .fold(0.0, f64::max);
+            pts.dedup_by(|p, q| (p.0 - q.0).abs() + (p.1 - q.1).abs() <= 1e-12 * scale);
+            if pts.len() >= 3 {
+                polygons.push(pts.clone());
+                cells.push(c);
+            }
+        }
+        Self {
+            polygons,
+            cells,
+            nodes: None,
+        }
+    }
+
+    /// Whether the canvas has no polygon.
+    pub fn is_empty(&self) -> bool {
+        self.polygons.is_empty()
+    }
+
+    fn bounding_box(&self) -> ([f64; 2], [f64; 2]) {
+        let mut lo = [f64::INFINITY; 2];
+        let mut hi = [f64::NEG_INFINITY; 2];
+        for p in self.polygons.iter().flatten() {
+            lo = [lo[0].min(p.0), lo[1].min(p.1)];
+            hi = [hi[0].max(p.0), hi[1].max(p.1)];
+        }
+        (lo, hi)
+    }
+}
+
+/// Centroid and area of a polygon.
+fn centroid_area(p: &[(f64, f64)]) -> ((f64, f64), f64) {
+    let (mut a, mut cx, mut cy) = (0.0, 0.0, 0.0);
+    for i in 0..p.len() {
+        let (q, r) = (p[i], p[(i + 1) % p.len()]);
+        let w = q.0 * r.1 - r.0 * q.1;
+        a += w;
+        cx += (q.0 + r.0) * w;
+        cy += (q.1 + r.1) * w;
+    }
+    if a.abs() < f64::MIN_POSITIVE {
+        return (p[0], 0.0);
+    }
+    ((cx / (3.0 * a), cy / (3.0 * a)), 0.5 * a.abs())
+}
+
 /// What a field plot shows besides the values.
 #[derive(Clone, Copy, Debug)]
 pub struct FieldPlot<'a> {
-    /// The grid.
-    pub grid: &'a Grid<2>,
+    /// The polygons.
+    pub canvas: &'a Canvas,
     /// The title.
     pub title: &'a str,
     /// Cells outlined in red (fractured cells).
     pub marked: &'a [bool],
-    /// The region shown (`[x0, y0]`, `[x1, y1]`); `None`: the whole grid. The colour
+    /// The region shown (`[x0, y0]`, `[x1, y1]`); `None`: the whole canvas. The colour
     /// range is that of the cells shown.
     pub window: Option<([f64; 2], [f64; 2])>,
     /// A unit direction per cell drawn as a short black segment through its centroid
@@ -78,10 +191,10 @@ pub struct FieldPlot<'a> {
 }
 
 impl<'a> FieldPlot<'a> {
-    /// The whole grid with fractured cells outlined.
-    pub fn new(grid: &'a Grid<2>, title: &'a str, marked: &'a [bool]) -> Self {
+    /// The whole canvas with fractured cells outlined.
+    pub fn new(canvas: &'a Canvas, title: &'a str, marked: &'a [bool]) -> Self {
         Self {
-            grid,
+            canvas,
             title,
             marked,
             window: None,
@@ -90,45 +203,43 @@ impl<'a> FieldPlot<'a> {
     }
 }
 
-/// Plot a field of a 2D grid, colour-mapped (see [`FieldPlot`]).
+/// Plot a field, colour-mapped (see [`FieldPlot`]); nodal values need a 2D grid's canvas.
 pub fn field(path: &Path, plot: &FieldPlot<'_>, values: Values<'_>) -> Result<(), PlotError> {
     register_font();
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir).map_err(perr(path))?;
     }
-    let grid = plot.grid;
-    let (lo, hi) = match plot.window {
-        Some((a, b)) => (a, b),
-        None => {
-            let (a, b) = grid.bounding_box();
-            ([a[0], a[1]], [b[0], b[1]])
-        }
-    };
-    let xy = |n: usize| (grid.node(n)[0], grid.node(n)[1]);
-    let shown: Vec<usize> = (0..grid.num_cells())
-        .filter(|&c| {
+    let canvas = plot.canvas;
+    let (lo, hi) = plot.window.unwrap_or_else(|| canvas.bounding_box());
+    let shown: Vec<usize> = (0..canvas.polygons.len())
+        .filter(|&k| {
             plot.window.is_none()
-                || grid.cell_nodes(c).iter().any(|&n| {
-                    let (x, y) = xy(n);
-                    (lo[0]..=hi[0]).contains(&x) && (lo[1]..=hi[1]).contains(&y)
-                })
+                || canvas.polygons[k]
+                    .iter()
+                    .any(|p| (lo[0]..=hi[0]).contains(&p.0) && (lo[1]..=hi[1]).contains(&p.1))
         })
         .collect();
     // Coloured pieces: (polygon, value).
     let mut pieces: Vec<(Vec<(f64, f64)>, f64)> = Vec::new();
-    for &c in &shown {
-        let nodes = grid.cell_nodes(c);
-        let pts: Vec<(f64, f64)> = nodes.iter().map(|&n| xy(n)).collect();
+    for &k in &shown {
+        let pts = &canvas.polygons[k];
         match values {
-            Values::Cell(v) => pieces.push((pts, v[c])),
+            Values::Cell(v) => pieces.push((pts.clone(), v[canvas.cells[k]])),
             Values::Nodal(v) => {
+                let Some(nodes) = &canvas.nodes else {
+                    return Err(PlotError {
+                        path: path.to_path_buf(),
+                        what: "nodal values are drawn on 2D grids only".into(),
+                    });
+                };
+                let nodes = &nodes[k];
                 let m = pts.len();
-                let g = grid.cell_centroid(c);
+                let (g, _) = centroid_area(pts);
                 let mid = |a: (f64, f64), b: (f64, f64)| (0.5 * (a.0 + b.0), 0.5 * (a.1 + b.1));
                 for i in 0..m {
                     let (prev, next) = (pts[(i + m - 1) % m], pts[(i + 1) % m]);
                     pieces.push((
-                        vec![pts[i], mid(pts[i], next), (g[0], g[1]), mid(prev, pts[i])],
+                        vec![pts[i], mid(pts[i], next), g, mid(prev, pts[i])],
                         v[nodes[i]],
                     ));
                 }
@@ -176,9 +287,9 @@ pub fn field(path: &Path, plot: &FieldPlot<'_>, values: Values<'_>) -> Result<()
         chart.draw_series(polys).map_err(perr(path))?;
         let outlines = shown
             .iter()
-            .filter(|&&c| plot.marked.get(c).copied().unwrap_or(false))
-            .map(|&c| {
-                let mut pts: Vec<(f64, f64)> = grid.cell_nodes(c).iter().map(|&n| xy(n)).collect();
+            .filter(|&&k| plot.marked.get(canvas.cells[k]).copied().unwrap_or(false))
+            .map(|&k| {
+                let mut pts = canvas.polygons[k].clone();
                 pts.push(pts[0]);
                 PathElement::new(pts, RED.stroke_width(2))
             });
@@ -186,14 +297,14 @@ pub fn field(path: &Path, plot: &FieldPlot<'_>, values: Values<'_>) -> Result<()
         if let Some(dirs) = plot.directions
             && shown.len() <= 10_000
         {
-            let segments = shown.iter().map(|&c| {
-                let g = grid.cell_centroid(c);
-                let half = 0.35 * grid.cell_volume(c).sqrt();
-                let d = dirs[c];
+            let segments = shown.iter().map(|&k| {
+                let (g, area) = centroid_area(&canvas.polygons[k]);
+                let half = 0.35 * area.sqrt();
+                let d = dirs[canvas.cells[k]];
                 PathElement::new(
                     vec![
-                        (g[0] - half * d[0], g[1] - half * d[1]),
-                        (g[0] + half * d[0], g[1] + half * d[1]),
+                        (g.0 - half * d[0], g.1 - half * d[1]),
+                        (g.0 + half * d[0], g.1 + half * d[1]),
                     ],
                     BLACK.stroke_width(1),
                 )

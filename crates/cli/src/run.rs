@@ -1100,43 +1100,61 @@ fn run_dim<const D: usize>(
                 &format!("{}: probes", s.scene.name),
             )?;
         }
-        if let (Some((u, stress)), Some(g2)) = (&last, as_2d(grid)) {
+        if let Some((u, stress)) = &last {
+            // 2D: the grid; 3D: its cross-section at mid-height (shifted off a layer of
+            // nodes by 1e-4 of the height, so extruded grids are cut inside a layer).
+            let (canvas, where_) = match (as_2d(grid), as_3d(grid)) {
+                (Some(g2), _) => (crate::plots::Canvas::of_grid(g2), String::new()),
+                (_, Some(g3)) => {
+                    let (lo, hi) = g3.bounding_box();
+                    let z = lo[2] + (0.5 + 1e-4) * (hi[2] - lo[2]);
+                    (
+                        crate::plots::Canvas::z_slice(g3, z),
+                        format!(" on z = {:.4}", 0.5 * (lo[2] + hi[2])),
+                    )
+                }
+                _ => unreachable!("grids are 2D or 3D"),
+            };
             let marked = failures.flags().to_vec();
-            let n = g2.num_cells();
             let cell_mean = |a: usize| -> Vec<f64> {
-                (0..n)
+                (0..grid.num_cells())
                     .map(|c| {
-                        let nodes = g2.cell_nodes(c);
-                        nodes.iter().map(|&p| u[2 * p + a]).sum::<f64>() / nodes.len() as f64
+                        let nodes = grid.cell_nodes(c);
+                        nodes.iter().map(|&p| u[D * p + a]).sum::<f64>() / nodes.len() as f64
                     })
                     .collect()
             };
-            let divergence = cell_divergence(g2, u);
+            let comp =
+                |i: usize, j: usize| -> Vec<f64> { stress.iter().map(|s| s[(i, j)]).collect() };
             let (smax, smin): (Vec<f64>, Vec<f64>) = stress.iter().map(principal).unzip();
-            let mut plots: Vec<(&str, Vec<f64>)> = vec![
-                ("ux", cell_mean(0)),
-                ("uy", cell_mean(1)),
-                ("sxx", stress.iter().map(|s| s[(0, 0)]).collect()),
-                ("syy", stress.iter().map(|s| s[(1, 1)]).collect()),
-                ("sxy", stress.iter().map(|s| s[(0, 1)]).collect()),
+            let mut plots: Vec<(&str, Vec<f64>)> = vec![("ux", cell_mean(0)), ("uy", cell_mean(1))];
+            if D == 3 {
+                plots.push(("uz", cell_mean(2)));
+            }
+            plots.extend([("sxx", comp(0, 0)), ("syy", comp(1, 1))]);
+            if D == 3 {
+                plots.push(("szz", comp(2, 2)));
+            }
+            plots.extend([
+                ("sxy", comp(0, 1)),
                 ("smax", smax),
                 ("smin", smin),
-                ("divergence", divergence),
-            ];
+                ("divergence", cell_divergence(grid, u)),
+            ]);
             if let Some(p) = &pressure {
                 plots.push(("pressure", p.clone()));
             }
             let t_last = written_times.last().copied().unwrap_or(0.0);
             for (name, vals) in &plots {
-                let title = format!("{name} at t = {t_last} s");
+                let title = format!("{name} at t = {t_last} s{where_}");
                 crate::plots::field(
                     &out.join("plots").join(format!("{name}.png")),
-                    &crate::plots::FieldPlot::new(g2, &title, &marked),
+                    &crate::plots::FieldPlot::new(&canvas, &title, &marked),
                     crate::plots::Values::Cell(vals),
                 )?;
             }
-            if failures.count() > 0 {
-                // The seed's Figs. 4 and 5 (any dimension-2 scene with fractures).
+            if let (Some(g2), true) = (as_2d(grid), failures.count() > 0) {
+                // The seed's Figs. 4 and 5.
                 let stress2: Vec<Tensor<2>> = stress
                     .iter()
                     .map(|s| Tensor::<2>::from_fn(|i, j| s[(i, j)]))
@@ -1144,6 +1162,7 @@ fn run_dim<const D: usize>(
                 fracture_plots(
                     &out.join("plots"),
                     g2,
+                    &canvas,
                     &plots,
                     &stress2,
                     &marked,
@@ -1173,17 +1192,17 @@ fn run_dim<const D: usize>(
 
 /// Cell divergence of the displacement, `div u = Σ_i N_i · u_i / |K|` (the exact volume
 /// change of the VEM projection per unit volume; seed Fig. 4, upper right).
-fn cell_divergence(grid: &Grid<2>, u: &[f64]) -> Vec<f64> {
+fn cell_divergence<const D: usize>(grid: &Grid<D>, u: &[f64]) -> Vec<f64> {
     let mut normals = Vec::new();
     (0..grid.num_cells())
         .map(|c| {
             let nodes = grid.cell_nodes(c);
-            normals.resize(nodes.len(), Point::<2>::zeros());
+            normals.resize(nodes.len(), Point::<D>::zeros());
             grid.cell_node_normals(c, &mut normals);
             let flux: f64 = nodes
                 .iter()
                 .zip(&normals)
-                .map(|(&n, q)| q[0] * u[2 * n] + q[1] * u[2 * n + 1])
+                .map(|(&n, q)| (0..D).map(|a| q[a] * u[D * n + a]).sum::<f64>())
                 .sum();
             flux / grid.cell_volume(c)
         })
@@ -1222,9 +1241,11 @@ fn window_around(grid: &Grid<2>, pts: &[Point<2>], pad: f64) -> ([f64; 2], [f64;
 /// the fields of `plots` zoomed on the fractured cells (principal directions on `smax` and
 /// `smin`), and near the crack tip (the last cell to fail) the largest principal stress of
 /// the cells next to the Zienkiewicz–Zhu recovered one (Fig. 5).
+#[allow(clippy::too_many_arguments)]
 fn fracture_plots(
     dir: &Path,
     grid: &Grid<2>,
+    canvas: &crate::plots::Canvas,
     plots: &[(&str, Vec<f64>)],
     stress: &[Tensor<2>],
     marked: &[bool],
@@ -1239,7 +1260,7 @@ fn fracture_plots(
         stress.iter().map(principal_directions).unzip();
     for (name, vals) in plots {
         let title = format!("{name} at t = {t} s, near the fracture");
-        let mut plot = crate::plots::FieldPlot::new(grid, &title, marked);
+        let mut plot = crate::plots::FieldPlot::new(canvas, &title, marked);
         plot.window = Some(window);
         plot.directions = match *name {
             "smax" => Some(&dmax),
@@ -1273,7 +1294,7 @@ fn fracture_plots(
             crate::plots::Values::Nodal(&smax_nodal),
         ),
     ] {
-        let mut plot = crate::plots::FieldPlot::new(grid, &title, marked);
+        let mut plot = crate::plots::FieldPlot::new(canvas, &title, marked);
         plot.window = Some(tip_window);
         crate::plots::field(&dir.join(file), &plot, values)?;
     }
@@ -1289,6 +1310,11 @@ fn vtk_sym<const D: usize>(s: &Tensor<D>) -> [f64; 6] {
 /// The grid as a 2D grid, if it is one (plots are 2D only).
 fn as_2d<const D: usize>(grid: &Grid<D>) -> Option<&Grid<2>> {
     (grid as &dyn std::any::Any).downcast_ref::<Grid<2>>()
+}
+
+/// The grid as a 3D grid, if it is one.
+fn as_3d<const D: usize>(grid: &Grid<D>) -> Option<&Grid<3>> {
+    (grid as &dyn std::any::Any).downcast_ref::<Grid<3>>()
 }
 
 /// Default output directory of a scene: `out/<name>`.

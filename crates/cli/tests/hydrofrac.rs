@@ -146,6 +146,20 @@ fn seed_scene_fracture_starts_at_the_well_and_grows_along_the_largest_compressio
     assert_eq!(header[1], "p_well");
     assert_eq!(rows[0][1], 1e7);
     assert!(rows.last().unwrap()[1] > 1.1e7, "{:?}", rows.last());
+    // Figs. 4 and 5.
+    for plot in [
+        "pressure",
+        "divergence",
+        "ux",
+        "uy",
+        "smin",
+        "smax",
+        "tip_smax_cell",
+        "tip_smax_recovered",
+    ] {
+        let f = out.join("plots/fracture").join(format!("{plot}.png"));
+        assert!(f.is_file(), "{}", f.display());
+    }
 }
 
 #[test]
@@ -203,4 +217,11 @@ fn three_d_fracture_opens_against_the_least_compressive_stress() {
     run_ok(&scene, &out);
     assert_eq!(summary(&out)["dim"], 3);
     check_fracture(&out, 90.0, 0.4, 1.0 / 8.0);
+    // Fields on the mid-height cross-section.
+    for plot in ["pressure", "uz", "szz", "smax"] {
+        assert!(
+            out.join("plots").join(format!("{plot}.png")).is_file(),
+            "{plot}"
+        );
+    }
 }
