@@ -280,6 +280,21 @@ pub(crate) fn select_cells<const D: usize>(
 
 /// Run a checked scene and write its outputs into `out`.
 pub fn run(ls: &LoadedScene, out: &Path) -> Result<Summary, RunError> {
+    // `[solver] threads`: 0 (default) keeps rayon's pool (one thread per core); n > 0 runs
+    // the scene in a pool of n threads (the parallel assembly, AMG and flow kernels).
+    match ls.scene.solver.threads {
+        Some(n) if n > 0 => {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(n as usize)
+                .build()
+                .map_err(|e| ls.error(&k(&["solver", "threads"]), format!("= {n}: {e}")))?;
+            pool.install(|| run_in_pool(ls, out))
+        }
+        _ => run_in_pool(ls, out),
+    }
+}
+
+fn run_in_pool(ls: &LoadedScene, out: &Path) -> Result<Summary, RunError> {
     let start = Instant::now();
     check_supported(ls)?;
     let grid = build_grid(ls)?;

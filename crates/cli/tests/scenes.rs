@@ -575,3 +575,21 @@ fn platen_with_coupling_matches_the_traction_load() {
         assert!(close(a[2], b[2], 1e-2, 1e-8), "{a:?} vs {b:?}");
     }
 }
+
+/// `[solver] threads = 1` runs the scene in a one-thread pool; the assembly is bitwise
+/// independent of the thread count, so the outputs equal the default run's exactly.
+#[test]
+fn thread_count_does_not_change_the_result() {
+    let dir = tmp_dir("threads");
+    let text = std::fs::read_to_string(root().join("scenes/patch_test.toml")).unwrap();
+    assert!(!text.contains("[solver]"));
+    let one = dir.join("one.toml");
+    std::fs::write(&one, format!("{text}\n[solver]\nthreads = 1\n")).unwrap();
+    run_ok(&root().join("scenes/patch_test.toml"), &dir.join("default"));
+    run_ok(&one, &dir.join("one"));
+    let read = |d: &str| std::fs::read_to_string(dir.join(d).join("probes.csv")).unwrap();
+    assert_eq!(read("default"), read("one"));
+    let (code, err) = check_text("threads.toml", &format!("{text}\n[solver]\nthreads = -1\n"));
+    assert_eq!(code, 1);
+    assert!(err.contains("solver.threads"), "{err}");
+}
