@@ -770,6 +770,15 @@ fn run_dim<const D: usize>(
     } else {
         None
     };
+    // Flow on a fixed skeleton: `linear = "cg-amg"` solves the pressure systems with
+    // CG-AMG too ("auto" keeps Cholesky for them).
+    if let (Some(f), Some("cg-amg")) = (flow.as_mut(), s.solver.linear.as_deref()) {
+        f.model
+            .set_linear_solver(porofrac_flow::FlowLinearSolver::CgAmg {
+                tolerance: s.solver.tolerance.unwrap_or(1e-8),
+            })
+            .map_err(|e| ls.error(&k(&["solver", "tolerance"]), e.to_string()))?;
+    }
     let t_asm = Instant::now();
     let dofs = DofMap::new(grid, &cond.displacements, &cond.platens)?;
     let pattern = Pattern::new(grid, &dofs)?;

@@ -593,3 +593,31 @@ fn thread_count_does_not_change_the_result() {
     assert_eq!(code, 1);
     assert!(err.contains("solver.threads"), "{err}");
 }
+
+/// Flow on a fixed skeleton with `linear = "cg-amg"`: the pressure systems are solved by
+/// CG with a scalar AMG preconditioner to 1e-12; every probe equals the Cholesky run's to
+/// 1e-9 of the initial pressure.
+#[test]
+fn flow_with_cg_amg_matches_cholesky() {
+    let dir = tmp_dir("flow-amg");
+    let text = std::fs::read_to_string(root().join("scenes/flow_column.toml")).unwrap();
+    assert!(!text.contains("[solver]"));
+    let amg = dir.join("amg.toml");
+    std::fs::write(
+        &amg,
+        format!("{text}\n[solver]\nlinear = \"cg-amg\"\ntolerance = 1.0e-12\n"),
+    )
+    .unwrap();
+    run_ok(&root().join("scenes/flow_column.toml"), &dir.join("direct"));
+    run_ok(&amg, &dir.join("amg"));
+    let (h1, direct) = read_csv(&dir.join("direct/probes.csv"));
+    let (h2, cg) = read_csv(&dir.join("amg/probes.csv"));
+    assert_eq!(h1, h2);
+    assert_eq!(direct.len(), cg.len());
+    let p0 = direct[0][1].abs().max(1.0);
+    for (a, b) in direct.iter().zip(&cg) {
+        for (x, y) in a.iter().zip(b) {
+            assert!((x - y).abs() <= 1e-9 * p0, "{a:?} vs {b:?}");
+        }
+    }
+}

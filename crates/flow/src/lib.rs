@@ -65,7 +65,7 @@ pub mod trans;
 pub mod well;
 
 pub use error::{FlowError, Result};
-pub use model::{FlowModel, StepResult};
+pub use model::{FlowLinearSolver, FlowModel, StepResult};
 pub use perm::{Permeability, Tensor};
 pub use problem::{
     BoundaryCondition, BoundaryKind, FieldFn, FlowProblem, Fluid, Rock, Source, SourceRate, Value,

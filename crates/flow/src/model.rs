@@ -105,6 +105,25 @@ pub struct FlowModel<const D: usize> {
     symbolic: Option<SymbolicLlt<usize>>,
     numeric: Option<(f64, Llt<usize, f64>)>,
     sys_vals: Vec<f64>,
+    linear: FlowLinearSolver,
+    /// CG-AMG: the hierarchy and the `1/Δt` it was built for.
+    amg: Option<(f64, porofrac_amg::Amg)>,
+    cg_iterations: usize,
+}
+
+/// How the pressure systems `M/Δt + A` (symmetric positive definite) are solved.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum FlowLinearSolver {
+    /// Sparse Cholesky, the symbolic factorization kept, the numeric one per `Δt`.
+    #[default]
+    Cholesky,
+    /// Conjugate gradients preconditioned by smoothed-aggregation AMG (constant near-null
+    /// space, `porofrac-amg`) to the relative residual `tolerance`, from the old pressure;
+    /// the hierarchy is rebuilt numerically when `Δt` or the permeability changes.
+    CgAmg {
+        /// Relative residual.
+        tolerance: f64,
+    },
 }
 
 impl<const D: usize> FlowModel<D> {
@@ -329,6 +348,9 @@ impl<const D: usize> FlowModel<D> {
             floating: Vec::new(),
             symbolic: None,
             numeric: None,
+            linear: FlowLinearSolver::Cholesky,
+            amg: None,
+            cg_iterations: 0,
         };
         model.fill_flux_matrix();
         Ok(model)
@@ -429,7 +451,30 @@ impl<const D: usize> FlowModel<D> {
         }
         self.trans = trans;
         self.fill_flux_matrix();
+        if let Some(amg) = &mut self.amg {
+            amg.0 = f64::NAN; // values changed: rebuild before the next solve
+        }
         Ok(())
+    }
+
+    /// Choose how the pressure systems are solved (default [`FlowLinearSolver::Cholesky`]).
+    /// Errors: a CG tolerance that is not a finite number in (0, 1).
+    pub fn set_linear_solver(&mut self, solver: FlowLinearSolver) -> Result<()> {
+        if let FlowLinearSolver::CgAmg { tolerance } = solver
+            && !(tolerance.is_finite() && tolerance > 0.0 && tolerance < 1.0)
+        {
+            return Err(FlowError::Solver(format!(
+                "CG tolerance must be in (0, 1), got {tolerance}"
+            )));
+        }
+        self.linear = solver;
+        self.amg = None;
+        Ok(())
+    }
+
+    /// CG iterations of the last CG-AMG solve (0 with Cholesky).
+    pub fn last_cg_iterations(&self) -> usize {
+        self.cg_iterations
     }
 
     /// One implicit Euler step from time `t` (pressure `p_old`) to `t + dt`; boundary values
@@ -476,7 +521,6 @@ impl<const D: usize> FlowModel<D> {
                 }
             )));
         }
-        self.factorize(inv_dt)?;
         let mut p = vec![0.0; n];
         self.forcing(t, &mut p)?;
         if let Some(p_old) = p_old {
@@ -484,8 +528,23 @@ impl<const D: usize> FlowModel<D> {
                 p[c] += self.accumulation[c] * inv_dt * p_old[c];
             }
         }
-        let (_, llt) = self.numeric.as_ref().expect("factorized above");
-        llt.solve_in_place(ColMut::from_slice_mut(&mut p));
+        match self.linear {
+            FlowLinearSolver::Cholesky => {
+                self.factorize(inv_dt)?;
+                let (_, llt) = self.numeric.as_ref().expect("factorized above");
+                llt.solve_in_place(ColMut::from_slice_mut(&mut p));
+            }
+            FlowLinearSolver::CgAmg { tolerance } => {
+                self.amg_setup(inv_dt)?;
+                let (_, amg) = self.amg.as_mut().expect("set up above");
+                let mut x = p_old.map_or_else(|| vec![0.0; n], <[f64]>::to_vec);
+                let stats = amg
+                    .solve(&mut x, &p, tolerance, 1000)
+                    .map_err(|e| FlowError::Solver(format!("CG-AMG: {e}")))?;
+                self.cg_iterations = stats.iterations;
+                p = x;
+            }
+        }
         if let Some(c) = p.iter().position(|v| !v.is_finite()) {
             return Err(FlowError::Solver(format!(
                 "non-finite pressure {} in cell {c}",
@@ -493,6 +552,54 @@ impl<const D: usize> FlowModel<D> {
             )));
         }
         self.result(p, t)
+    }
+
+    /// `M·inv_dt + A` into `sys_vals`.
+    fn fill_system(&mut self, inv_dt: f64) {
+        self.sys_vals.copy_from_slice(&self.flux_vals);
+        for c in 0..self.num_cells() {
+            self.sys_vals[self.diag_pos[c]] += self.accumulation[c] * inv_dt;
+        }
+    }
+
+    /// Build (or rebuild numerically) the AMG hierarchy of `M·inv_dt + A`.
+    fn amg_setup(&mut self, inv_dt: f64) -> Result<()> {
+        if let Some((cached, _)) = &self.amg
+            && cached.to_bits() == inv_dt.to_bits()
+        {
+            return Ok(());
+        }
+        self.fill_system(inv_dt);
+        // The upper triangle, column by column (the pattern stores both).
+        let (cp, ri) = (self.pattern.col_ptr(), self.pattern.row_idx());
+        let n = self.num_cells();
+        let mut col_ptr = Vec::with_capacity(n + 1);
+        let (mut rows, mut vals) = (Vec::new(), Vec::new());
+        col_ptr.push(0);
+        for c in 0..n {
+            for k in cp[c]..cp[c + 1] {
+                if ri[k] <= c {
+                    rows.push(ri[k]);
+                    vals.push(self.sys_vals[k]);
+                }
+            }
+            col_ptr.push(rows.len());
+        }
+        let err = |e: porofrac_amg::AmgError| FlowError::Solver(format!("AMG setup: {e}"));
+        match self.amg.take() {
+            Some((_, mut amg)) => {
+                amg.update_values(&vals).map_err(err)?;
+                self.amg = Some((inv_dt, amg));
+            }
+            None => {
+                let a =
+                    porofrac_amg::SymCsr::from_upper_csc(n, &col_ptr, &rows, &vals).map_err(err)?;
+                let amg = porofrac_amg::Amg::scalar(a, &porofrac_amg::AmgOptions::default())
+                    .map_err(err)?;
+                self.amg = Some((inv_dt, amg));
+            }
+        }
+        Ok(())
     }
 
     /// Assemble `M·inv_dt + A` and factorize it (symbolic once, numeric when needed).
@@ -503,10 +610,7 @@ impl<const D: usize> FlowModel<D> {
             return Ok(());
         }
         self.numeric = None;
-        self.sys_vals.copy_from_slice(&self.flux_vals);
-        for c in 0..self.num_cells() {
-            self.sys_vals[self.diag_pos[c]] += self.accumulation[c] * inv_dt;
-        }
+        self.fill_system(inv_dt);
         if self.symbolic.is_none() {
             let sym = SymbolicLlt::try_new(self.pattern.as_ref(), Side::Lower)
                 .map_err(|e| FlowError::Solver(format!("symbolic Cholesky: {e:?}")))?;
