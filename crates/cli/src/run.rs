@@ -1378,6 +1378,8 @@ pub fn write_failed_summary(ls: &LoadedScene, out: &Path, error: &str, start: In
 struct Progress {
     bar: Option<indicatif::ProgressBar>,
     total: usize,
+    /// Solver iterations reported so far (the lines show those of each step).
+    iterations: usize,
 }
 
 impl Progress {
@@ -1392,11 +1394,21 @@ impl Progress {
             }
             bar
         });
-        Self { bar, total }
+        Self {
+            bar,
+            total,
+            iterations: 0,
+        }
     }
 
+    /// Report step `step` at time `t`; `iterations` is the running total of solver
+    /// iterations (coupled solves, active-set and failure rounds, CG iterations).
     fn step(&mut self, step: usize, t: f64, iterations: usize, fractured: usize) {
-        let msg = format!("t = {t:.4e} s, solver iterations {iterations}, fractured {fractured}");
+        let this_step = iterations.saturating_sub(self.iterations);
+        self.iterations = iterations;
+        let msg = format!(
+            "t = {t:.4e} s, solver iterations {this_step} (total {iterations}), fractured {fractured}"
+        );
         match &self.bar {
             Some(bar) => {
                 bar.set_position(step as u64 + 1);
