@@ -1214,21 +1214,19 @@ fn run_dim<const D: usize>(
     })
 }
 
-/// Cell divergence of the displacement, `div u = Σ_i N_i · u_i / |K|` (the exact volume
-/// change of the VEM projection per unit volume; seed Fig. 4, upper right).
+/// Cell divergence of the displacement, `div u = Σ_i N_i · u_i / |K|`
+/// ([`porofrac_vem::volumetric_strain`]: the exact volume change of the VEM projection per
+/// unit volume; seed Fig. 4, upper right).
 fn cell_divergence<const D: usize>(grid: &Grid<D>, u: &[f64]) -> Vec<f64> {
-    let mut normals = Vec::new();
+    let mut geometry = porofrac_law::GeometryBuffer::<D>::default();
+    let mut local = Vec::new();
     (0..grid.num_cells())
         .map(|c| {
-            let nodes = grid.cell_nodes(c);
-            normals.resize(nodes.len(), Point::<D>::zeros());
-            grid.cell_node_normals(c, &mut normals);
-            let flux: f64 = nodes
-                .iter()
-                .zip(&normals)
-                .map(|(&n, q)| (0..D).map(|a| q[a] * u[D * n + a]).sum::<f64>())
-                .sum();
-            flux / grid.cell_volume(c)
+            local.clear();
+            for &n in grid.cell_nodes(c) {
+                local.extend_from_slice(&u[D * n..D * n + D]);
+            }
+            porofrac_vem::volumetric_strain(&geometry.load(grid, c), &local)
         })
         .collect()
 }
