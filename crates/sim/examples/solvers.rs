@@ -6,6 +6,8 @@
 //!
 //! `cargo run --release -p porofrac-sim --example solvers -- e2 300 cg-amg [tolerance]`
 //! (`none` instead of the solver: grid and assembly only, for the memory baseline).
+//! `AMG_OPTS=theta=0.02,degree=3` overrides multigrid options (`theta`, `degree`,
+//! `upper`, `ratio`, `lanczos`, `omega`, `coarse`: see `porofrac_amg::AmgOptions`).
 //!
 //! Grids: E2 = n × n squares split in two triangles, E3 = n³ cubes split in six
 //! tetrahedra (P1 = VEM on simplices), E = 1, ν = 0.3 (plane strain in 2D), Dirichlet on
@@ -22,7 +24,7 @@ use porofrac_law::Stiffness;
 use porofrac_sim::ordering::nested_dissection;
 use porofrac_sim::{
     AmgSolver, DirectSolver, Displacement, DofMap, LawMap, LinearSolve, Loads, Pattern,
-    ScalarField, assemble, nodal_loads,
+    ScalarField, assemble, elasticity_amg_options, nodal_loads,
 };
 use porofrac_vem::VemLaw;
 
@@ -204,6 +206,24 @@ fn run<const D: usize>(n: usize, solver: &str, tol: f64, exact: Exact<D>, f: [Sc
         "cg-amg" => {
             let t2 = Instant::now();
             let mut s = AmgSolver::new(&grid, &dofs, &pattern, tol).unwrap();
+            if let Ok(spec) = std::env::var("AMG_OPTS") {
+                let mut o = elasticity_amg_options(D);
+                for kv in spec.split(',') {
+                    let (k, v) = kv.split_once('=').unwrap();
+                    let v: f64 = v.parse().unwrap();
+                    match k {
+                        "theta" => o.strength_threshold = v,
+                        "degree" => o.smoother_degree = v as usize,
+                        "upper" => o.chebyshev_upper = v,
+                        "ratio" => o.chebyshev_ratio = v,
+                        "lanczos" => o.lanczos_steps = v as usize,
+                        "omega" => o.prolongation_damping = v,
+                        "coarse" => o.max_coarse = v as usize,
+                        _ => panic!("AMG_OPTS: unknown option {k}"),
+                    }
+                }
+                s.set_options(o);
+            }
             s.setup(&pattern, &values).unwrap();
             let t_setup = t2.elapsed().as_secs_f64();
             let t3 = Instant::now();

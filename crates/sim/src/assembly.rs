@@ -33,7 +33,10 @@
 //! ```
 //!
 //! with a rule exact for degree 4 on triangles (6 points) and degree 2 on tetrahedra (4
-//! points), so loads linear in x are integrated exactly. Tractions use φ restricted to
+//! points), so loads linear in x are integrated exactly. A cell that is itself a simplex
+//! (`D + 1` nodes) is not split: φ_i are its barycentric coordinates and the rule acts on
+//! the whole cell (degree 4 on triangles, as in the standard P1 reference; degree 3 on
+//! tetrahedra with 5 points), with 3× fewer load evaluations. Tractions use φ restricted to
 //! the face: on a 2D edge `∫_e t φ_i ds` by 2-point Gauss (exact to degree 3), on a 3D face
 //! the same facets with the edge-midpoint rule (degree 2); nodal loads are exact for
 //! linear tractions.
@@ -49,7 +52,7 @@ use crate::dofs::DofMap;
 use crate::error::{AXES, Result, SimError, fmt_point};
 use crate::laws::LawMap;
 use crate::pattern::Pattern;
-use crate::quadrature::{cell_rule, facet_rule};
+use crate::quadrature::{cell_rule, facet_rule, simplex_rule};
 
 /// Per-thread buffers for evaluating cells.
 #[derive(Default)]
@@ -330,11 +333,31 @@ fn body_load_cell<const D: usize>(
 ) {
     let cn = grid.cell_nodes(c);
     let n = cn.len();
-    let xc = cn.iter().map(|&i| grid.node(i)).sum::<Point<D>>() / n as f64;
     let rho_g = loads
         .gravity
         .as_ref()
         .map_or(Point::<D>::zeros(), |g| g.g * g.density[c]);
+    if n == D + 1 {
+        // A simplex: φ_i = λ_i on the whole cell.
+        let vol = grid.cell_volume(c);
+        for (w, l) in simplex_rule::<D>() {
+            let x: Point<D> = cn.iter().zip(l).map(|(&i, &li)| grid.node(i) * li).sum();
+            let mut fv = rho_g;
+            if let Some(b) = &loads.body_force {
+                for a in 0..D {
+                    fv[a] += b[a].eval(x.as_slice(), t);
+                }
+            }
+            fv *= w * vol;
+            for (&i, &li) in cn.iter().zip(l) {
+                for a in 0..D {
+                    acc[D * i + a] += li * fv[a];
+                }
+            }
+        }
+        return;
+    }
+    let xc = cn.iter().map(|&i| grid.node(i)).sum::<Point<D>>() / n as f64;
     let rule = cell_rule::<D>();
     let mut centre = Point::<D>::zeros();
     for (&face, &outward) in grid.cell_faces(c).iter().zip(grid.cell_face_outward(c)) {

@@ -67,7 +67,9 @@ pub use fracturing::{
     Scheme, StressMeasure,
 };
 pub use laws::LawMap;
-pub use linear::{AmgSolver, LinearSolve, LinearSolver, LinearStats, StaticSolver};
+pub use linear::{
+    AmgSolver, LinearSolve, LinearSolver, LinearStats, StaticSolver, elasticity_amg_options,
+};
 pub use pattern::Pattern;
 pub use solve::{
     DirectSolver, Par, StaticOptions, StaticProblem, StaticSolution, cell_stresses, reaction,

@@ -169,10 +169,26 @@ impl std::fmt::Debug for AmgSolver {
     }
 }
 
+/// The multigrid options [`AmgSolver`] starts from in `dim` dimensions: the
+/// [`AmgOptions`] defaults, with the strength threshold θ = 0.08 in 2D and 0 in 3D.
+///
+/// On the standard problem E2 (P1 triangles, 2 M equations) θ = 0.08 drops weak
+/// couplings on the coarse levels and cuts CG from 26 to 16 iterations at 5 % more
+/// operator complexity (1.45 → 1.53); on E3 (tetrahedra) the same θ stalls the coarsening
+/// (operator complexity 17 at n = 40) while θ = 0 needs 17 iterations, so 3D keeps every
+/// connection. Measured with `cargo run --release -p porofrac-sim --example solvers`.
+pub fn elasticity_amg_options(dim: usize) -> AmgOptions {
+    AmgOptions {
+        strength_threshold: if dim == 2 { 0.08 } else { 0.0 },
+        ..AmgOptions::default()
+    }
+}
+
 impl AmgSolver {
     /// A solver for the equations of `dofs` on `pattern` (node coordinates from `grid`),
-    /// to the relative residual `tolerance`, with the default multigrid options and
-    /// [`DEFAULT_MAX_ITERATIONS`]. The hierarchy is built on the first solve.
+    /// to the relative residual `tolerance`, with the options of
+    /// [`elasticity_amg_options`] and [`DEFAULT_MAX_ITERATIONS`]. The hierarchy is built
+    /// on the first solve.
     pub fn new<const D: usize>(
         grid: &Grid<D>,
         dofs: &DofMap<D>,
@@ -216,7 +232,7 @@ impl AmgSolver {
             dim: D,
             n,
             nnz: pattern.nnz(),
-            options: AmgOptions::default(),
+            options: elasticity_amg_options(D),
             tolerance,
             max_iterations: DEFAULT_MAX_ITERATIONS,
             setups: 0,

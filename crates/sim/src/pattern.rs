@@ -71,6 +71,40 @@ pub(crate) fn cell_equations<const D: usize>(
     }
 }
 
+/// Prefix sums `[0, n0, n0 + n1, …]` of `counts`.
+fn offsets(counts: &[usize]) -> Vec<usize> {
+    let mut pos = Vec::with_capacity(counts.len() + 1);
+    pos.push(0);
+    let mut sum = 0;
+    for &k in counts {
+        sum += k;
+        pos.push(sum);
+    }
+    pos
+}
+
+/// Fill `out` in parallel: items `i` own `out[pos[i]..pos[i + 1]]`; `fill(items, slice)`
+/// is called on contiguous blocks of items with the slice they own.
+fn fill_blocks<T: Send>(
+    out: &mut [T],
+    pos: &[usize],
+    fill: impl Fn(Range<usize>, &mut [T]) + Sync,
+) {
+    const ITEMS: usize = 4096;
+    let items = pos.len() - 1;
+    let mut blocks = Vec::with_capacity(items.div_ceil(ITEMS));
+    let mut rest = out;
+    for start in (0..items).step_by(ITEMS) {
+        let end = (start + ITEMS).min(items);
+        let (head, tail) = rest.split_at_mut(pos[end] - pos[start]);
+        blocks.push((start..end, head));
+        rest = tail;
+    }
+    blocks
+        .into_par_iter()
+        .for_each(|(range, slice)| fill(range, slice));
+}
+
 impl Pattern {
     /// Build the pattern, scatter maps and fill chunks for `grid` and `dofs`, using the
     /// current rayon thread count for the number of chunks.
@@ -93,19 +127,31 @@ impl Pattern {
         }
         let n = dofs.num_equations();
         let nc = grid.num_cells();
-        // Cell → sorted unique free equations.
-        let mut cell_eq_pos = Vec::with_capacity(nc + 1);
-        cell_eq_pos.push(0);
-        let mut cell_eqs = Vec::new();
-        let mut buf = Vec::new();
-        for c in 0..nc {
-            cell_equations(grid, dofs, c, &mut buf);
+        // Cell → sorted unique free equations: counts, then values, both in parallel.
+        let sorted_free = |c: usize, buf: &mut Vec<usize>| {
+            cell_equations(grid, dofs, c, buf);
             buf.retain(|&e| e != usize::MAX);
             buf.sort_unstable();
             buf.dedup();
-            cell_eqs.extend_from_slice(&buf);
-            cell_eq_pos.push(cell_eqs.len());
-        }
+        };
+        let counts: Vec<usize> = (0..nc)
+            .into_par_iter()
+            .map_init(Vec::new, |buf, c| {
+                sorted_free(c, buf);
+                buf.len()
+            })
+            .collect();
+        let cell_eq_pos = offsets(&counts);
+        let mut cell_eqs = vec![0usize; cell_eq_pos[nc]];
+        fill_blocks(&mut cell_eqs, &cell_eq_pos, |cells, out| {
+            let mut buf = Vec::new();
+            let mut k = 0;
+            for c in cells {
+                sorted_free(c, &mut buf);
+                out[k..k + buf.len()].copy_from_slice(&buf);
+                k += buf.len();
+            }
+        });
         let eqs_of = |c: usize| &cell_eqs[cell_eq_pos[c]..cell_eq_pos[c + 1]];
         // Equation → cells.
         let mut eq_cell_pos = vec![0usize; n + 1];
@@ -131,13 +177,20 @@ impl Pattern {
                 let mut counts = Vec::with_capacity(BLOCK);
                 let mut rows = Vec::new();
                 let mut col = Vec::new();
+                let cells_of = |c: usize| &eq_cells[eq_cell_pos[c]..eq_cell_pos[c + 1]];
                 for c in b * BLOCK..((b + 1) * BLOCK).min(n) {
-                    col.clear();
-                    for &cell in &eq_cells[eq_cell_pos[c]..eq_cell_pos[c + 1]] {
-                        col.extend(eqs_of(cell).iter().copied().filter(|&r| r <= c));
+                    if c > b * BLOCK && cells_of(c) == cells_of(c - 1) {
+                        // Another component of the same node: the same cells, so the
+                        // rows are those of column c − 1 and c itself.
+                        col.push(c);
+                    } else {
+                        col.clear();
+                        for &cell in cells_of(c) {
+                            col.extend(eqs_of(cell).iter().copied().filter(|&r| r <= c));
+                        }
+                        col.sort_unstable();
+                        col.dedup();
                     }
-                    col.sort_unstable();
-                    col.dedup();
                     counts.push(col.len());
                     rows.extend_from_slice(&col);
                 }
@@ -159,38 +212,44 @@ impl Pattern {
                 "{nnz} stiffness entries exceed the 32-bit scatter map"
             )));
         }
-        // Scatter maps.
-        let mut scatter_pos = Vec::with_capacity(nc + 1);
-        scatter_pos.push(0);
-        for c in 0..nc {
-            let m = D * grid.cell_nodes(c).len();
-            scatter_pos.push(scatter_pos[c] + m * m);
-        }
-        let cell_blocks: Vec<Vec<u32>> = (0..nc.div_ceil(BLOCK))
-            .into_par_iter()
-            .map(|b| {
-                let range = b * BLOCK..((b + 1) * BLOCK).min(nc);
-                let mut out = Vec::with_capacity(scatter_pos[range.end] - scatter_pos[range.start]);
-                let mut eqs = Vec::new();
-                for c in range {
-                    cell_equations(grid, dofs, c, &mut eqs);
-                    for &ej in &eqs {
-                        for &ei in &eqs {
-                            if ei == usize::MAX || ej == usize::MAX || ei > ej {
-                                out.push(NONE);
-                                continue;
-                            }
-                            let rows = &row_idx[col_ptr[ej]..col_ptr[ej + 1]];
-                            // Invariant: (ei, ej) was inserted above since both are in cell c.
-                            let k = rows.binary_search(&ei).unwrap_or(0);
-                            out.push((col_ptr[ej] + k) as u32);
+        // Scatter maps, in parallel blocks of cells.
+        let sizes: Vec<usize> = (0..nc)
+            .map(|c| (D * grid.cell_nodes(c).len()).pow(2))
+            .collect();
+        let scatter_pos = offsets(&sizes);
+        let mut scatter = vec![NONE; scatter_pos[nc]];
+        fill_blocks(&mut scatter, &scatter_pos, |cells, out| {
+            let mut eqs = Vec::new();
+            let mut k = 0;
+            for c in cells {
+                cell_equations(grid, dofs, c, &mut eqs);
+                for &ej in &eqs {
+                    // The last position found in this column and its row: the next
+                    // component of a node usually sits right after it. (It never runs
+                    // into the next column: a column ends with its diagonal, and rows
+                    // after the diagonal are skipped.)
+                    let mut last: Option<(usize, usize)> = None;
+                    for &ei in &eqs {
+                        if ei != usize::MAX && ej != usize::MAX && ei <= ej {
+                            let pos = if let Some((e, p)) = last
+                                && ei == e + 1
+                                && row_idx[p + 1] == ei
+                            {
+                                p + 1
+                            } else {
+                                let rows = &row_idx[col_ptr[ej]..col_ptr[ej + 1]];
+                                // Invariant: (ei, ej) was inserted above since both are
+                                // in cell c.
+                                col_ptr[ej] + rows.binary_search(&ei).unwrap_or(0)
+                            };
+                            last = Some((ei, pos));
+                            out[k] = pos as u32;
                         }
+                        k += 1;
                     }
                 }
-                out
-            })
-            .collect();
-        let scatter: Vec<u32> = cell_blocks.concat();
+            }
+        });
         // Fill chunks: contiguous columns with about nnz / num_chunks entries each.
         let num_chunks = num_chunks.clamp(1, n.max(1));
         let mut bounds = vec![0usize];

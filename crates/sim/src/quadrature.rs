@@ -27,6 +27,14 @@ const TET2: [QPoint; 4] = [
     (0.25, [TB, TB, TA, TB]),
     (0.25, [TB, TB, TB, TA]),
 ];
+/// Tetrahedron, degree 3 (5 points, one negative weight).
+const TET3: [QPoint; 5] = [
+    (-0.8, [0.25, 0.25, 0.25, 0.25]),
+    (0.45, [0.5, 1.0 / 6.0, 1.0 / 6.0, 1.0 / 6.0]),
+    (0.45, [1.0 / 6.0, 0.5, 1.0 / 6.0, 1.0 / 6.0]),
+    (0.45, [1.0 / 6.0, 1.0 / 6.0, 0.5, 1.0 / 6.0]),
+    (0.45, [1.0 / 6.0, 1.0 / 6.0, 1.0 / 6.0, 0.5]),
+];
 const G: f64 = 0.288_675_134_594_812_9; // 1 / (2√3)
 /// Segment, degree 3 (2-point Gauss).
 const SEG3: [QPoint; 2] = [
@@ -43,6 +51,11 @@ const TRI2: [QPoint; 3] = [
 /// The rule for a D-simplex (D + 1 barycentric coordinates): degree 4 in 2D, 2 in 3D.
 pub(crate) fn cell_rule<const D: usize>() -> &'static [QPoint] {
     if D == 2 { &TRI4 } else { &TET2 }
+}
+
+/// The rule for a whole simplex cell: degree 4 in 2D (6 points), 3 in 3D (5 points).
+pub(crate) fn simplex_rule<const D: usize>() -> &'static [QPoint] {
+    if D == 2 { &TRI4 } else { &TET3 }
 }
 
 /// The rule for a (D−1)-simplex facet (D barycentric coordinates): degree 3 in 2D, 2 in 3D.
@@ -97,6 +110,7 @@ mod tests {
     fn rules_are_exact_to_their_degree() {
         check(&TRI4, 3, 4);
         check(&TET2, 4, 2);
+        check(&TET3, 4, 3);
         check(&SEG3, 2, 3);
         check(&TRI2, 3, 2);
     }

@@ -1,0 +1,107 @@
+//! The sparsity pattern and scatter maps against a brute-force construction.
+//!
+//! For every grid below, with prescribed components and a platen (equations shared by
+//! several nodes): every column holds exactly the rows `r ≤ c` that share a cell with `c`,
+//! sorted; and every cell's scatter entry for the local pair `(i, j)` is the position of
+//! `(min(e_i, e_j), max(e_i, e_j))` when `e_i ≤ e_j` are both free, `u32::MAX` otherwise.
+//! Grids: Voronoi polygons (2D), triangles, cubes and tetrahedra (3D) — node-major
+//! equations with 2–8 nodes per cell, which exercises the shortcuts of the builder (the
+//! next component of a node, columns of one node sharing their cells).
+
+use std::collections::BTreeSet;
+
+use porofrac_grid::generate::{cartesian, simplices, voronoi};
+use porofrac_grid::{Grid, Point};
+use porofrac_sim::{Displacement, DofMap, Pattern, Platen, ScalarField};
+
+/// Local equations of cell `c` (node-major; `None` when prescribed).
+fn local_equations<const D: usize>(
+    grid: &Grid<D>,
+    dofs: &DofMap<D>,
+    c: usize,
+) -> Vec<Option<usize>> {
+    grid.cell_nodes(c)
+        .iter()
+        .flat_map(|&n| (0..D).map(move |a| (n, a)))
+        .map(|(n, a)| dofs.equation(n, a))
+        .collect()
+}
+
+fn check<const D: usize>(grid: &Grid<D>, what: &str) {
+    // x fixed on xmin, every component on ymin, a platen on ymax.
+    let fix = |name: &str, comps: &[usize]| Displacement {
+        name: name.into(),
+        faces: grid.boundary(name).unwrap(),
+        components: std::array::from_fn(|a| comps.contains(&a).then(|| ScalarField::from(0.0))),
+    };
+    let all: Vec<usize> = (0..D).collect();
+    let bcs = [fix("xmin", &[0]), fix("ymin", &all)];
+    let platen = Platen {
+        name: "ymax".into(),
+        faces: grid.boundary("ymax").unwrap(),
+        force: std::array::from_fn(|a| (a == 1).then(|| ScalarField::from(-1.0))),
+    };
+    let dofs = DofMap::new(grid, &bcs, std::slice::from_ref(&platen)).unwrap();
+    let n = dofs.num_equations();
+    // Brute force: the upper-triangle entries of every cell.
+    let mut cols: Vec<BTreeSet<usize>> = vec![BTreeSet::new(); n];
+    for c in 0..grid.num_cells() {
+        let eqs: Vec<usize> = local_equations(grid, &dofs, c)
+            .into_iter()
+            .flatten()
+            .collect();
+        for &ej in &eqs {
+            for &ei in &eqs {
+                if ei <= ej {
+                    cols[ej].insert(ei);
+                }
+            }
+        }
+    }
+    for chunks in [1, 5] {
+        let pattern = Pattern::with_chunks(grid, &dofs, chunks).unwrap();
+        let (ptr, rows) = (pattern.col_ptr(), pattern.row_idx());
+        assert_eq!(pattern.num_equations(), n, "{what}");
+        for (c, want) in cols.iter().enumerate() {
+            let got = &rows[ptr[c]..ptr[c + 1]];
+            assert!(
+                got.iter().copied().eq(want.iter().copied()),
+                "{what}: column {c} has rows {got:?}, want {want:?}"
+            );
+        }
+        for c in 0..grid.num_cells() {
+            let eqs = local_equations(grid, &dofs, c);
+            let m = eqs.len();
+            let scatter = pattern.cell_scatter(c);
+            assert_eq!(scatter.len(), m * m, "{what}: cell {c}");
+            for j in 0..m {
+                for i in 0..m {
+                    let got = scatter[i + m * j];
+                    match (eqs[i], eqs[j]) {
+                        (Some(ei), Some(ej)) if ei <= ej => {
+                            let p = got as usize;
+                            assert!(
+                                (ptr[ej]..ptr[ej + 1]).contains(&p) && rows[p] == ei,
+                                "{what}: cell {c} pair ({i}, {j}) -> {got}, want entry ({ei}, {ej})"
+                            );
+                        }
+                        _ => assert_eq!(got, u32::MAX, "{what}: cell {c} pair ({i}, {j})"),
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn scatter_maps_match_brute_force() {
+    let (lo2, hi2) = (Point::<2>::zeros(), Point::<2>::repeat(1.0));
+    let (lo3, hi3) = (Point::<3>::zeros(), Point::<3>::repeat(1.0));
+    check(&simplices::<2>(lo2, hi2, [7, 5]).unwrap(), "2D triangles");
+    check(&voronoi(lo2, hi2, 60, 3, 2).unwrap(), "2D Voronoi");
+    check(
+        &simplices::<3>(lo3, hi3, [3, 4, 2]).unwrap(),
+        "3D tetrahedra",
+    );
+    check(&cartesian::<3>(lo3, hi3, [3, 2, 3]).unwrap(), "3D cubes");
+}
