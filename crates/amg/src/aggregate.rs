@@ -24,6 +24,11 @@
 //! 3. Nodes still free (no strong neighbour in any aggregate) form aggregates with their
 //!    free strong neighbours.
 //!
+//! *Aggressive* coarsening runs the same passes on the distance-two graph `S²`
+//! ([`Strength::squared`]): root neighbourhoods of radius two, about three times fewer
+//! aggregates in 2D, a sparser prolongator and a cheaper Galerkin product, at the price of
+//! a weaker coarse space (GAMG's "aggressive coarsening" on its finest level).
+//!
 //! # Tentative prolongator
 //!
 //! Let `B` (n × m) be the near-null space on this level and `B_a` its rows on the equations
@@ -221,6 +226,57 @@ pub(crate) fn strength(a: &CsrMatrix, blocks: &Blocks, theta: f64) -> Strength {
         w.extend_from_slice(&w_part);
     }
     Strength { ptr, adj, w }
+}
+
+impl Strength {
+    /// The distance-two graph `S²`: neighbours of `I` are its strong neighbours and
+    /// theirs (without `I`), sorted; a neighbour at distance two gets the strength of the
+    /// weakest link on its strongest two-step path, so pass 2 of [`aggregate`] still
+    /// prefers direct strong neighbours.
+    pub(crate) fn squared(&self) -> Strength {
+        let nn = self.ptr.len() - 1;
+        let nblocks = nn.div_ceil(ROWS_PER_TASK);
+        let parts: Vec<(Vec<usize>, Vec<u32>, Vec<f64>)> = (0..nblocks)
+            .into_par_iter()
+            .map(|b| {
+                let range = b * ROWS_PER_TASK..((b + 1) * ROWS_PER_TASK).min(nn);
+                let mut counts = Vec::with_capacity(range.len());
+                let (mut adj, mut w) = (Vec::new(), Vec::new());
+                let mut row: Vec<(u32, f64)> = Vec::new();
+                for i in range {
+                    row.clear();
+                    let (nb, wb) = self.nbrs(i);
+                    for (&j, &wj) in nb.iter().zip(wb) {
+                        row.push((j, wj));
+                        let (nb2, wb2) = self.nbrs(j as usize);
+                        for (&k, &wk) in nb2.iter().zip(wb2) {
+                            if k as usize != i {
+                                row.push((k, wj.min(wk)));
+                            }
+                        }
+                    }
+                    // Sort by node, strongest first, and keep the first of each node.
+                    row.sort_unstable_by(|x, y| x.0.cmp(&y.0).then(y.1.total_cmp(&x.1)));
+                    row.dedup_by_key(|x| x.0);
+                    counts.push(row.len());
+                    adj.extend(row.iter().map(|x| x.0));
+                    w.extend(row.iter().map(|x| x.1));
+                }
+                (counts, adj, w)
+            })
+            .collect();
+        let mut ptr = Vec::with_capacity(nn + 1);
+        ptr.push(0);
+        let (mut adj, mut w) = (Vec::new(), Vec::new());
+        for (counts, a_part, w_part) in parts {
+            for c in counts {
+                ptr.push(ptr.last().copied().unwrap_or(0) + c);
+            }
+            adj.extend_from_slice(&a_part);
+            w.extend_from_slice(&w_part);
+        }
+        Strength { ptr, adj, w }
+    }
 }
 
 /// Greedy aggregation in three passes (see the module docs). Returns the aggregate of
@@ -462,6 +518,22 @@ mod tests {
         // Pass 1 takes {0,1}, {2,3,4}, {5,6,7}; node 8 joins {5,6,7}.
         assert_eq!(na, 3);
         assert_eq!(agg, vec![0, 0, 1, 1, 1, 2, 2, 2, 2]);
+    }
+
+    #[test]
+    fn squared_graph_aggregates_a_chain_in_fives() {
+        let a = laplace_1d(12);
+        let blocks = Blocks::from_ids(&(0..12).collect::<Vec<_>>()).unwrap();
+        let s = strength(a.matrix(), &blocks, 0.0).squared();
+        // Neighbours within distance two; a distance-two link is as strong as its weakest
+        // step (every |a_ij| = 1 here).
+        assert_eq!(s.nbrs(0).0, &[1, 2]);
+        assert_eq!(s.nbrs(5).0, &[3, 4, 6, 7]);
+        assert!(s.nbrs(5).1.iter().all(|&w| w == 1.0));
+        let (agg, na) = aggregate(&s);
+        // Pass 1: roots 0, 5 and 10 take {0, 1, 2}, {3, …, 7} and {8, …, 11}.
+        assert_eq!(na, 3);
+        assert_eq!(agg, vec![0, 0, 0, 1, 1, 1, 1, 1, 2, 2, 2, 2]);
     }
 
     #[test]

@@ -73,6 +73,9 @@ pub struct AmgOptions {
     /// CG stops with [`AmgError::Stagnation`] after this many iterations without a new
     /// smallest residual.
     pub stagnation_window: usize,
+    /// The finest `aggressive_levels` levels aggregate on the distance-two strength graph
+    /// (see [`crate::aggregate`]); 0 = never.
+    pub aggressive_levels: usize,
 }
 
 impl Default for AmgOptions {
@@ -88,6 +91,7 @@ impl Default for AmgOptions {
             lanczos_steps: 10,
             prolongation_damping: 4.0 / 3.0,
             stagnation_window: 50,
+            aggressive_levels: 0,
         }
     }
 }
@@ -270,7 +274,10 @@ impl Amg {
                 levels.push(Level::new(a, dinv, None));
                 break;
             }
-            let s = strength(&a, &blocks, options.strength_threshold);
+            let mut s = strength(&a, &blocks, options.strength_threshold);
+            if l < options.aggressive_levels {
+                s = s.squared();
+            }
             let (agg, num_agg) = aggregate(&s);
             drop(s);
             let tent = tentative(&blocks, &agg, num_agg, &null)?;

@@ -6,8 +6,10 @@
 //!
 //! `cargo run --release -p porofrac-sim --example solvers -- e2 300 cg-amg [tolerance]`
 //! (`none` instead of the solver: grid and assembly only, for the memory baseline).
+//! `FAER_THREADS=2` factorizes with `Par::rayon(2)` instead of sequentially;
+//! `RAYON_NUM_THREADS` sets the pool of the parallel assembly and AMG kernels;
 //! `AMG_OPTS=theta=0.02,degree=3` overrides multigrid options (`theta`, `degree`,
-//! `upper`, `ratio`, `lanczos`, `omega`, `coarse`: see `porofrac_amg::AmgOptions`).
+//! `upper`, `ratio`, `lanczos`, `omega`, `coarse`, `aggressive`: see `porofrac_amg::AmgOptions`).
 //!
 //! Grids: E2 = n × n squares split in two triangles, E3 = n³ cubes split in six
 //! tetrahedra (P1 = VEM on simplices), E = 1, ν = 0.3 (plane strain in 2D), Dirichlet on
@@ -190,6 +192,9 @@ fn run<const D: usize>(n: usize, solver: &str, tol: f64, exact: Exact<D>, f: [Sc
             } else {
                 DirectSolver::new(&pattern).unwrap()
             };
+            if let Ok(t) = std::env::var("FAER_THREADS") {
+                s.set_parallelism(faer::Par::rayon(t.parse().expect("FAER_THREADS")));
+            }
             s.factorize(&pattern, &values).unwrap();
             let t_setup = t2.elapsed().as_secs_f64();
             let t3 = Instant::now();
@@ -219,6 +224,7 @@ fn run<const D: usize>(n: usize, solver: &str, tol: f64, exact: Exact<D>, f: [Sc
                         "lanczos" => o.lanczos_steps = v as usize,
                         "omega" => o.prolongation_damping = v,
                         "coarse" => o.max_coarse = v as usize,
+                        "aggressive" => o.aggressive_levels = v as usize,
                         _ => panic!("AMG_OPTS: unknown option {k}"),
                     }
                 }
