@@ -324,39 +324,74 @@ impl SymCsr {
     ) -> Result<Self> {
         validate_upper_csc(n, col_ptr, row_idx, values)?;
         let nnz_up = row_idx.len();
-        let mut count = vec![0usize; n + 1];
-        for c in 0..n {
-            for &r in &row_idx[col_ptr[c]..col_ptr[c + 1]] {
-                count[r + 1] += 1;
-                if r != c {
-                    count[c + 1] += 1;
+        // Full row i = column i of the upper triangle (columns r ≤ i, diagonal last) followed
+        // by the columns c > i whose upper column holds row i — a transpose. The rows are
+        // split into parts, one task each; every task scans all columns in increasing order
+        // and keeps the entries of its own rows, so each row comes out sorted and each task
+        // writes only its own contiguous slice of the output.
+        let parts = (2 * rayon::current_num_threads()).clamp(1, n.max(1));
+        let bounds: Vec<usize> = (0..=parts).map(|k| n * k / parts).collect();
+        let upper_counts: Vec<Vec<u32>> = (0..parts)
+            .into_par_iter()
+            .map(|k| {
+                let rows = bounds[k]..bounds[k + 1];
+                let mut cnt = vec![0u32; rows.len()];
+                for c in rows.start..n {
+                    for &r in &row_idx[col_ptr[c]..col_ptr[c + 1]] {
+                        if r != c && rows.contains(&r) {
+                            cnt[r - rows.start] += 1;
+                        }
+                    }
                 }
+                cnt
+            })
+            .collect();
+        let mut row_ptr = Vec::with_capacity(n + 1);
+        row_ptr.push(0usize);
+        for (k, cnt) in upper_counts.iter().enumerate() {
+            for (i, &u) in (bounds[k]..bounds[k + 1]).zip(cnt) {
+                let len = col_ptr[i + 1] - col_ptr[i] + u as usize;
+                row_ptr.push(row_ptr[i] + len);
             }
         }
-        for i in 0..n {
-            count[i + 1] += count[i];
-        }
-        let nnz = count[n];
-        let row_ptr = count.clone();
-        let mut next = count;
+        let nnz = row_ptr[n];
         let mut col = vec![0u32; nnz];
         let mut src = vec![0u32; nnz];
-        // Columns in increasing order fill every row in increasing column order: row `c`
-        // receives its columns `r < c` and the diagonal while column `c` is processed, and
-        // each later column `c' > c` appends `c'`.
-        for c in 0..n {
-            for p in col_ptr[c]..col_ptr[c + 1] {
-                let r = row_idx[p];
-                col[next[r]] = c as u32;
-                src[next[r]] = p as u32;
-                next[r] += 1;
-                if r != c {
-                    col[next[c]] = r as u32;
-                    src[next[c]] = p as u32;
-                    next[c] += 1;
+        let mut slices = Vec::with_capacity(parts);
+        let (mut col_rest, mut src_rest) = (&mut col[..], &mut src[..]);
+        for k in 0..parts {
+            let len = row_ptr[bounds[k + 1]] - row_ptr[bounds[k]];
+            let (ch, ct) = col_rest.split_at_mut(len);
+            let (sh, st) = src_rest.split_at_mut(len);
+            slices.push((k, ch, sh));
+            (col_rest, src_rest) = (ct, st);
+        }
+        slices.into_par_iter().for_each(|(k, col, src)| {
+            let rows = bounds[k]..bounds[k + 1];
+            let base = row_ptr[rows.start];
+            // Lower part and diagonal, and the write cursor of each row's upper part.
+            let mut next = Vec::with_capacity(rows.len());
+            for i in rows.clone() {
+                let at = row_ptr[i] - base;
+                let m = col_ptr[i + 1] - col_ptr[i];
+                for (q, p) in (col_ptr[i]..col_ptr[i + 1]).enumerate() {
+                    col[at + q] = row_idx[p] as u32;
+                    src[at + q] = p as u32;
+                }
+                next.push(at + m);
+            }
+            for c in rows.start..n {
+                for p in col_ptr[c]..col_ptr[c + 1] {
+                    let r = row_idx[p];
+                    if r != c && rows.contains(&r) {
+                        let at = &mut next[r - rows.start];
+                        col[*at] = c as u32;
+                        src[*at] = p as u32;
+                        *at += 1;
+                    }
                 }
             }
-        }
+        });
         let mut full = CsrMatrix::from_parts(n, n, row_ptr, col, zeros(nnz));
         full.compress_runs();
         let mut out = Self {
