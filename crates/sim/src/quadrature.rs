@@ -27,13 +27,28 @@ const TET2: [QPoint; 4] = [
     (0.25, [TB, TB, TA, TB]),
     (0.25, [TB, TB, TB, TA]),
 ];
-/// Tetrahedron, degree 3 (5 points, one negative weight).
-const TET3: [QPoint; 5] = [
-    (-0.8, [0.25, 0.25, 0.25, 0.25]),
-    (0.45, [0.5, 1.0 / 6.0, 1.0 / 6.0, 1.0 / 6.0]),
-    (0.45, [1.0 / 6.0, 0.5, 1.0 / 6.0, 1.0 / 6.0]),
-    (0.45, [1.0 / 6.0, 1.0 / 6.0, 0.5, 1.0 / 6.0]),
-    (0.45, [1.0 / 6.0, 1.0 / 6.0, 1.0 / 6.0, 0.5]),
+/// Keast's tetrahedron rule of degree 4 (11 points, the centroid weight negative):
+/// `1/14, 11/14` and `(1 ± √(5/14))/4`.
+const K1: f64 = 1.0 / 14.0;
+const K2: f64 = 11.0 / 14.0;
+const K3: f64 = 0.399_403_576_166_799_2;
+const K4: f64 = 0.100_596_423_833_200_8;
+const KW0: f64 = -74.0 * 6.0 / 5625.0;
+const KW1: f64 = 343.0 * 6.0 / 45000.0;
+const KW2: f64 = 56.0 * 6.0 / 2250.0;
+/// Tetrahedron, degree 4 (Keast, 11 points).
+const TET4: [QPoint; 11] = [
+    (KW0, [0.25, 0.25, 0.25, 0.25]),
+    (KW1, [K2, K1, K1, K1]),
+    (KW1, [K1, K2, K1, K1]),
+    (KW1, [K1, K1, K2, K1]),
+    (KW1, [K1, K1, K1, K2]),
+    (KW2, [K3, K3, K4, K4]),
+    (KW2, [K3, K4, K3, K4]),
+    (KW2, [K3, K4, K4, K3]),
+    (KW2, [K4, K3, K3, K4]),
+    (KW2, [K4, K3, K4, K3]),
+    (KW2, [K4, K4, K3, K3]),
 ];
 const G: f64 = 0.288_675_134_594_812_9; // 1 / (2√3)
 /// Segment, degree 3 (2-point Gauss).
@@ -53,9 +68,9 @@ pub(crate) fn cell_rule<const D: usize>() -> &'static [QPoint] {
     if D == 2 { &TRI4 } else { &TET2 }
 }
 
-/// The rule for a whole simplex cell: degree 4 in 2D (6 points), 3 in 3D (5 points).
+/// The rule for a whole simplex cell: degree 4 (6 points in 2D, 11 in 3D).
 pub(crate) fn simplex_rule<const D: usize>() -> &'static [QPoint] {
-    if D == 2 { &TRI4 } else { &TET3 }
+    if D == 2 { &TRI4 } else { &TET4 }
 }
 
 /// The rule for a (D−1)-simplex facet (D barycentric coordinates): degree 3 in 2D, 2 in 3D.
@@ -110,7 +125,7 @@ mod tests {
     fn rules_are_exact_to_their_degree() {
         check(&TRI4, 3, 4);
         check(&TET2, 4, 2);
-        check(&TET3, 4, 3);
+        check(&TET4, 4, 4);
         check(&SEG3, 2, 3);
         check(&TRI2, 3, 2);
     }
