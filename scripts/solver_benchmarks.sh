@@ -27,11 +27,11 @@ for n in 10 20 40; do
     row e3 "$n" cg-amg
 done
 row e3 60 cg-amg
-# Threads: the assembly and AMG kernels on 1 thread; faer's factorization on 2.
+# Threads: the assembly and AMG kernels on 1 thread; faer's factorization sequential.
 RAYON_NUM_THREADS=1 row e2 1000 cg-amg
 RAYON_NUM_THREADS=1 row e3 40 cg-amg
-FAER_THREADS=2 row e2 500 cholesky
-FAER_THREADS=2 row e3 40 cholesky
+FAER_THREADS=1 row e2 500 cholesky
+FAER_THREADS=1 row e3 40 cholesky
 if [[ -n "$py" && -f "$peer" ]]; then
     for args in "2 300" "2 1000" "3 40"; do
         # shellcheck disable=SC2086

@@ -6,7 +6,8 @@
 //!
 //! `cargo run --release -p porofrac-sim --example solvers -- e2 300 cg-amg [tolerance]`
 //! (`none` instead of the solver: grid and assembly only, for the memory baseline).
-//! `FAER_THREADS=2` factorizes with `Par::rayon(2)` instead of sequentially;
+//! `FAER_THREADS=n` factorizes with `Par::rayon(n)` (1: sequentially) instead of the
+//! default (all threads of the pool);
 //! `RAYON_NUM_THREADS` sets the pool of the parallel assembly and AMG kernels;
 //! `AMG_OPTS=theta=0.02,degree=3` overrides multigrid options (`theta`, `degree`,
 //! `upper`, `ratio`, `lanczos`, `omega`, `coarse`, `aggressive`: see `porofrac_amg::AmgOptions`).
@@ -14,7 +15,7 @@
 //! Grids: E2 = n × n squares split in two triangles, E3 = n³ cubes split in six
 //! tetrahedra (P1 = VEM on simplices), E = 1, ν = 0.3 (plane strain in 2D), Dirichlet on
 //! the whole boundary, body force from the manufactured solution. Cholesky uses AMD in
-//! 2D and geometric nested dissection in 3D, sequentially; setup = symbolic + numeric
+//! 2D and geometric nested dissection in 3D, on all threads; setup = symbolic + numeric
 //! factorization. CG-AMG: setup = the multigrid hierarchy. L2 error with a degree-5 rule
 //! per simplex (Radon's 7 points, 64-point collapsed Gauss).
 
@@ -193,7 +194,12 @@ fn run<const D: usize>(n: usize, solver: &str, tol: f64, exact: Exact<D>, f: [Sc
                 DirectSolver::new(&pattern).unwrap()
             };
             if let Ok(t) = std::env::var("FAER_THREADS") {
-                s.set_parallelism(faer::Par::rayon(t.parse().expect("FAER_THREADS")));
+                let t: usize = t.parse().expect("FAER_THREADS");
+                s.set_parallelism(if t == 1 {
+                    faer::Par::Seq
+                } else {
+                    faer::Par::rayon(t)
+                });
             }
             s.factorize(&pattern, &values).unwrap();
             let t_setup = t2.elapsed().as_secs_f64();

@@ -32,13 +32,14 @@ pub const DEFAULT_TOLERANCE: f64 = 1e-8;
 /// Default iteration limit of the iterative solver.
 pub const DEFAULT_MAX_ITERATIONS: usize = 500;
 /// `Auto` uses CG-AMG in 3D from this many equations (E3 n = 20, 20 577 equations:
-/// CG-AMG 0.13 s setup + solve against 0.51 s for nested-dissection Cholesky;
+/// CG-AMG 0.16 s setup + solve against 0.76 s for nested-dissection Cholesky;
 /// docs/BENCHMARKS.md, "Linear solvers: direct vs AMG-CG").
 pub const AUTO_MIN_EQUATIONS_3D: usize = 10_000;
-/// `Auto` uses CG-AMG in 2D from this many equations (E2 setup + solve: at 0.5 M
-/// equations AMD Cholesky 2.84 s against CG-AMG 3.75 s, at 2 M 23.5 s against 10.1 s
-/// with 0.8 GB less memory; docs/BENCHMARKS.md).
-pub const AUTO_MIN_EQUATIONS_2D: usize = 1_000_000;
+/// `Auto` uses CG-AMG in 2D from this many equations (E2 setup + solve: at 0.18 M
+/// equations Cholesky and CG-AMG take about the same time, at 0.5 M CG-AMG 1.8 s against
+/// 1.9 s for AMD Cholesky on two threads, at 2 M 7.6 s against 13.5 s with 0.7 GB less
+/// memory; docs/BENCHMARKS.md). Below it the direct solver's exact answer costs no more.
+pub const AUTO_MIN_EQUATIONS_2D: usize = 400_000;
 
 /// Which linear solver the static mechanics uses.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

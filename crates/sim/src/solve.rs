@@ -38,6 +38,19 @@ use crate::laws::LawMap;
 use crate::linear::LinearSolve;
 use crate::pattern::Pattern;
 
+/// The factorization's default parallelism: `Par::rayon(n)` with the `n` threads of the
+/// current rayon pool (the `[solver] threads` of a scene), sequential for one thread.
+///
+/// Measured on the 2-core machine (`FAER_THREADS=2` in `scripts/solver_benchmarks.sh`):
+/// two threads factorize E3 n = 40 (nested dissection, 2.8e8 factor entries) in 17.9 s
+/// against 34.0 s sequentially, and E2 n = 500 (AMD) in 1.82 s against 2.23 s.
+pub fn default_parallelism() -> Par {
+    match rayon::current_num_threads() {
+        0 | 1 => Par::Seq,
+        n => Par::rayon(n),
+    }
+}
+
 /// Sparse Cholesky solver for the reduced stiffness, with the symbolic factorization
 /// computed once per pattern and reused for every numeric factorization.
 #[derive(Debug)]
@@ -55,9 +68,8 @@ pub struct DirectSolver {
 impl DirectSolver {
     /// Symbolic analysis (AMD ordering and the pattern of the factor) of `pattern`.
     ///
-    /// The default parallelism is sequential: on the 2-core reference machine it was as
-    /// fast as two threads for the 2D benchmark sizes (see the crate's benchmark); change
-    /// it with [`Self::set_parallelism`].
+    /// The default parallelism is [`default_parallelism`] (every thread of the current
+    /// rayon pool); change it with [`Self::set_parallelism`].
     pub fn new(pattern: &Pattern) -> Result<Self> {
         Self::analyse(pattern, None)
     }
@@ -105,7 +117,7 @@ impl DirectSolver {
         Ok(Self {
             l_values: Vec::new(),
             symbolic,
-            par: Par::Seq,
+            par: default_parallelism(),
             n,
             nnz: pattern.nnz(),
             symbolic_count: 1,
