@@ -24,8 +24,7 @@
 //! 3. Nodes still free (no strong neighbour in any aggregate) form aggregates with their
 //!    free strong neighbours.
 //!
-//! *Aggressive* coarsening runs the same passes on the distance-two graph `S²`
-//! ([`Strength::squared`]): root neighbourhoods of radius two, about three times fewer
+//! *Aggressive* coarsening runs the same passes on the distance-two graph `S²`: root neighbourhoods of radius two, about three times fewer
 //! aggregates in 2D, a sparser prolongator and a cheaper Galerkin product, at the price of
 //! a weaker coarse space (GAMG's "aggressive coarsening" on its finest level).
 //!

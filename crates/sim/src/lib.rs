@@ -72,6 +72,6 @@ pub use linear::{
 };
 pub use pattern::Pattern;
 pub use solve::{
-    DirectSolver, Par, StaticOptions, StaticProblem, StaticSolution, cell_stresses,
-    default_parallelism, reaction, solve_static,
+    DirectSolver, PARALLEL_MIN_FACTOR_NNZ, Par, StaticOptions, StaticProblem, StaticSolution,
+    cell_stresses, default_parallelism, reaction, solve_static,
 };

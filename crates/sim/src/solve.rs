@@ -38,16 +38,23 @@ use crate::laws::LawMap;
 use crate::linear::LinearSolve;
 use crate::pattern::Pattern;
 
-/// The factorization's default parallelism: `Par::rayon(n)` with the `n` threads of the
-/// current rayon pool (the `[solver] threads` of a scene), sequential for one thread.
+/// Factors with at least this many entries are factorized on all threads by default.
+pub const PARALLEL_MIN_FACTOR_NNZ: usize = 100_000_000;
+
+/// The factorization's default parallelism for a factor of `factor_nnz` entries:
+/// `Par::rayon(n)` with the `n` threads of the current rayon pool (the `[solver] threads`
+/// of a scene) from [`PARALLEL_MIN_FACTOR_NNZ`] entries, sequential below or for one
+/// thread.
 ///
-/// Measured on the 2-core machine (`FAER_THREADS=2` in `scripts/solver_benchmarks.sh`):
-/// two threads factorize E3 n = 40 (nested dissection, 2.8e8 factor entries) in 17.9 s
-/// against 34.0 s sequentially, and E2 n = 500 (AMD) in 1.82 s against 2.23 s.
-pub fn default_parallelism() -> Par {
+/// Measured on the 2-core machine (`scripts/solver_benchmarks.sh`, docs/BENCHMARKS.md):
+/// two threads factorize E3 n = 40 (nested dissection, 2.8e8 entries) in 17.6 s against
+/// 30.6 s sequentially and E2 n = 1000 (AMD, 3.1e8) in 12.3 s against 17.0 s, but E2
+/// n = 500 (5.3e7) in 2.03 s against 1.66 s; at E2 n = 300 (1.8e7) the criterion bench
+/// found two threads slower too (850 against 511 ms).
+pub fn default_parallelism(factor_nnz: usize) -> Par {
     match rayon::current_num_threads() {
-        0 | 1 => Par::Seq,
-        n => Par::rayon(n),
+        n if n > 1 && factor_nnz >= PARALLEL_MIN_FACTOR_NNZ => Par::rayon(n),
+        _ => Par::Seq,
     }
 }
 
@@ -68,8 +75,8 @@ pub struct DirectSolver {
 impl DirectSolver {
     /// Symbolic analysis (AMD ordering and the pattern of the factor) of `pattern`.
     ///
-    /// The default parallelism is [`default_parallelism`] (every thread of the current
-    /// rayon pool); change it with [`Self::set_parallelism`].
+    /// The default parallelism is [`default_parallelism`] of the factor's size; change it
+    /// with [`Self::set_parallelism`].
     pub fn new(pattern: &Pattern) -> Result<Self> {
         Self::analyse(pattern, None)
     }
@@ -116,8 +123,8 @@ impl DirectSolver {
         .map_err(|e| SimError::LinearAlgebra(format!("symbolic Cholesky: {e:?}")))?;
         Ok(Self {
             l_values: Vec::new(),
+            par: default_parallelism(symbolic.len_val()),
             symbolic,
-            par: default_parallelism(),
             n,
             nnz: pattern.nnz(),
             symbolic_count: 1,
