@@ -56,17 +56,15 @@
 #[path = "../tests/common/mod.rs"]
 mod common;
 
-use std::f64::consts::PI;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 use std::time::Instant;
 
-use common::{TenFn, VecFn, components, dirichlet, errors};
+use common::{Manufactured, components, dirichlet, e2, e3, errors};
 use plotters::prelude::*;
 use porofrac::grid::generate::{DEFAULT_LLOYD, cartesian, simplices, voronoi};
 use porofrac::grid::{Grid, Point};
-use porofrac::law::{CellLaw, Stiffness, Tensor};
+use porofrac::law::{CellLaw, Stiffness};
 use porofrac::mdem::MdemLaw;
 use porofrac::sim::{
     DofMap, ExplicitOptions, LawMap, LinearSolve, LinearSolver, Loads, Pattern, StaticProblem,
@@ -75,79 +73,6 @@ use porofrac::sim::{
 use porofrac::vem::VemLaw;
 
 type BoxError = Box<dyn std::error::Error>;
-
-/// The manufactured solution: displacement, its gradient, body force.
-struct Manufactured<const D: usize> {
-    u: VecFn<D>,
-    grad: TenFn<D>,
-    f: VecFn<D>,
-}
-
-fn e2() -> Manufactured<2> {
-    Manufactured {
-        u: Arc::new(|p: &Point<2>| {
-            let (x, y) = (p[0], p[1]);
-            Point::<2>::new((PI * x).sin() * (PI * y).sin(), x * x * y) / 100.0
-        }),
-        grad: Arc::new(|p: &Point<2>| {
-            let (x, y) = (p[0], p[1]);
-            Tensor::<2>::new(
-                PI * (PI * x).cos() * (PI * y).sin(),
-                PI * (PI * x).sin() * (PI * y).cos(),
-                2.0 * x * y,
-                x * x,
-            ) / 100.0
-        }),
-        f: Arc::new(|p: &Point<2>| {
-            let (x, y) = (p[0], p[1]);
-            let pi2 = PI * PI;
-            Point::<2>::new(
-                -x / 52.0 + 9.0 * pi2 * (PI * x).sin() * (PI * y).sin() / 520.0,
-                -y / 130.0 - pi2 * (PI * x).cos() * (PI * y).cos() / 104.0,
-            )
-        }),
-    }
-}
-
-fn e3() -> Manufactured<3> {
-    Manufactured {
-        u: Arc::new(|p: &Point<3>| {
-            let (x, y, z) = (p[0], p[1], p[2]);
-            Point::<3>::new(
-                (PI * x).sin() * (PI * y).sin() * (PI * z).sin(),
-                x * x * y * z,
-                y * z * (PI * x).cos(),
-            ) / 100.0
-        }),
-        grad: Arc::new(|p: &Point<3>| {
-            let (x, y, z) = (p[0], p[1], p[2]);
-            let (sx, sy, sz) = ((PI * x).sin(), (PI * y).sin(), (PI * z).sin());
-            let (cx, cy, cz) = ((PI * x).cos(), (PI * y).cos(), (PI * z).cos());
-            Tensor::<3>::new(
-                PI * cx * sy * sz,
-                PI * sx * cy * sz,
-                PI * sx * sy * cz,
-                2.0 * x * y * z,
-                x * x * z,
-                x * x * y,
-                -PI * y * z * sx,
-                z * cx,
-                y * cx,
-            ) / 100.0
-        }),
-        f: Arc::new(|p: &Point<3>| {
-            let (x, y, z) = (p[0], p[1], p[2]);
-            let (sx, sy, sz) = ((PI * x).sin(), (PI * y).sin(), (PI * z).sin());
-            let (cx, cy, cz) = ((PI * x).cos(), (PI * y).cos(), (PI * z).cos());
-            let pi2 = PI * PI;
-            Point::<3>::new(
-                -x * z / 52.0 + PI * y * sx / 104.0 + 11.0 * pi2 * sx * sy * sz / 520.0,
-                -y * z / 130.0 - pi2 * sz * cx * cy / 104.0 - cx / 104.0,
-                -x * x / 104.0 + pi2 * y * z * cx / 260.0 - pi2 * sy * cx * cz / 104.0,
-            )
-        }),
-    }
-}
 
 /// The grid family of a ladder.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -681,65 +606,85 @@ fn parse_args() -> Result<Args, BoxError> {
     })
 }
 
-fn e2_ladders(quick: bool) -> Vec<Ladder> {
+/// The methods and sizes of each problem (`quick`: a tiny ladder for a smoke test).
+fn ladders(dim: usize, quick: bool) -> Vec<Ladder> {
     use {Law::*, Mesh::*, Solve::*};
-    let l = |mesh, law, solve, sizes| Ladder {
-        mesh,
-        law,
-        solve,
-        sizes,
-    };
-    if quick {
-        return vec![
-            l(Simplices, Vem, Cholesky, &[20, 40]),
-            l(Simplices, Vem, CgAmg, &[20, 40]),
-            l(Simplices, Mdem, Cholesky, &[20, 40]),
-            l(Boxes, Vem, Cholesky, &[20, 40]),
-            l(Voronoi, Vem, Cholesky, &[400, 1600]),
-            l(Simplices, Vem, Explicit, &[8, 16]),
-        ];
-    }
-    vec![
-        l(
+    type Sizes = &'static [usize];
+    // (mesh, law, solve, E2 sizes, E3 sizes, E2 quick, E3 quick); empty = not run.
+    let table: [(Mesh, Law, Solve, Sizes, Sizes, Sizes, Sizes); 7] = [
+        (
             Simplices,
             Vem,
             Cholesky,
             &[50, 100, 200, 300, 500, 700, 1000],
+            &[5, 10, 15, 20, 30],
+            &[20, 40],
+            &[4, 8],
         ),
-        l(Simplices, Vem, CgAmg, &[50, 100, 200, 300, 500, 700, 1000]),
-        l(Simplices, Mdem, Cholesky, &[50, 100, 200, 300, 500]),
-        l(Boxes, Vem, Cholesky, &[50, 100, 200, 316, 500]),
-        l(Voronoi, Vem, Cholesky, &[2_500, 10_000, 40_000, 100_000]),
-        l(Simplices, Vem, Explicit, &[10, 20, 40, 80]),
-    ]
-}
-
-fn e3_ladders(quick: bool) -> Vec<Ladder> {
-    use {Law::*, Mesh::*, Solve::*};
-    let l = |mesh, law, solve, sizes| Ladder {
-        mesh,
-        law,
-        solve,
-        sizes,
-    };
-    if quick {
-        return vec![
-            l(Simplices, Vem, Cholesky, &[4, 8]),
-            l(Simplices, Vem, CgAmg, &[4, 8]),
-            l(Simplices, Mdem, Cholesky, &[4, 8]),
-            l(Boxes, Vem, Cholesky, &[4, 8]),
-            l(Boxes, Vem, CgAmg, &[4, 8]),
-            l(Simplices, Vem, Explicit, &[4]),
-        ];
-    }
-    vec![
-        l(Simplices, Vem, Cholesky, &[5, 10, 15, 20, 30]),
-        l(Simplices, Vem, CgAmg, &[5, 10, 15, 20, 30, 40]),
-        l(Simplices, Mdem, Cholesky, &[5, 10, 15, 20]),
-        l(Boxes, Vem, Cholesky, &[5, 10, 15, 20, 30]),
-        l(Boxes, Vem, CgAmg, &[10, 20, 30, 40]),
-        l(Simplices, Vem, Explicit, &[4, 6, 8, 10]),
-    ]
+        (
+            Simplices,
+            Vem,
+            CgAmg,
+            &[50, 100, 200, 300, 500, 700, 1000],
+            &[5, 10, 15, 20, 30, 40],
+            &[20, 40],
+            &[4, 8],
+        ),
+        (
+            Simplices,
+            Mdem,
+            Cholesky,
+            &[50, 100, 200, 300, 500],
+            &[5, 10, 15, 20],
+            &[20, 40],
+            &[4, 8],
+        ),
+        (
+            Boxes,
+            Vem,
+            Cholesky,
+            &[50, 100, 200, 316, 500],
+            &[5, 10, 15, 20, 30],
+            &[20, 40],
+            &[4, 8],
+        ),
+        (Boxes, Vem, CgAmg, &[], &[10, 20, 30, 40], &[], &[4, 8]),
+        (
+            Voronoi,
+            Vem,
+            Cholesky,
+            &[2_500, 10_000, 40_000, 100_000],
+            &[],
+            &[400, 1600],
+            &[],
+        ),
+        (
+            Simplices,
+            Vem,
+            Explicit,
+            &[10, 20, 40, 80],
+            &[4, 6, 8, 10],
+            &[8, 16],
+            &[4],
+        ),
+    ];
+    table
+        .into_iter()
+        .filter_map(|(mesh, law, solve, e2, e3, e2q, e3q)| {
+            let sizes = match (dim, quick) {
+                (2, false) => e2,
+                (2, true) => e2q,
+                (_, false) => e3,
+                (_, true) => e3q,
+            };
+            (!sizes.is_empty()).then_some(Ladder {
+                mesh,
+                law,
+                solve,
+                sizes,
+            })
+        })
+        .collect()
 }
 
 fn load_average() -> String {
@@ -767,7 +712,7 @@ fn main() -> Result<(), BoxError> {
             if p == "E2" {
                 run_ladders::<2>(
                     "E2",
-                    &e2_ladders(args.quick),
+                    &ladders(2, args.quick),
                     &e2(),
                     grid2,
                     args.explicit_tol,
@@ -776,7 +721,7 @@ fn main() -> Result<(), BoxError> {
             } else {
                 run_ladders::<3>(
                     "E3",
-                    &e3_ladders(args.quick),
+                    &ladders(3, args.quick),
                     &e3(),
                     grid3,
                     args.explicit_tol,

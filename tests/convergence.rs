@@ -30,91 +30,16 @@
 
 mod common;
 
-use std::f64::consts::PI;
-use std::sync::Arc;
-
 use common::*;
 use porofrac::grid::generate::{DEFAULT_LLOYD, cartesian, simplices, voronoi};
 use porofrac::grid::{Grid, Point};
-use porofrac::law::{Stiffness, Tensor};
+use porofrac::law::Stiffness;
 use porofrac::sim::{LawMap, Loads};
 use porofrac::vem::VemLaw;
 
 /// Exact norms of E2 and E3 from `BENCHMARKS.md`.
 const E2_NORMS: (f64, f64) = (5.627_314_338_7e-3, 1.982_745_350_3e-2);
 const E3_NORMS: (f64, f64) = (4.503_085_362_0e-3, 1.883_636_857_9e-2);
-
-struct Manufactured<const D: usize> {
-    u: VecFn<D>,
-    grad: TenFn<D>,
-    f: VecFn<D>,
-}
-
-fn e2() -> Manufactured<2> {
-    Manufactured {
-        u: Arc::new(|p: &Point<2>| {
-            let (x, y) = (p[0], p[1]);
-            Point::<2>::new((PI * x).sin() * (PI * y).sin(), x * x * y) / 100.0
-        }),
-        grad: Arc::new(|p: &Point<2>| {
-            let (x, y) = (p[0], p[1]);
-            Tensor::<2>::new(
-                PI * (PI * x).cos() * (PI * y).sin(),
-                PI * (PI * x).sin() * (PI * y).cos(),
-                2.0 * x * y,
-                x * x,
-            ) / 100.0
-        }),
-        f: Arc::new(|p: &Point<2>| {
-            let (x, y) = (p[0], p[1]);
-            let pi2 = PI * PI;
-            Point::<2>::new(
-                -x / 52.0 + 9.0 * pi2 * (PI * x).sin() * (PI * y).sin() / 520.0,
-                -y / 130.0 - pi2 * (PI * x).cos() * (PI * y).cos() / 104.0,
-            )
-        }),
-    }
-}
-
-fn e3() -> Manufactured<3> {
-    Manufactured {
-        u: Arc::new(|p: &Point<3>| {
-            let (x, y, z) = (p[0], p[1], p[2]);
-            Point::<3>::new(
-                (PI * x).sin() * (PI * y).sin() * (PI * z).sin(),
-                x * x * y * z,
-                y * z * (PI * x).cos(),
-            ) / 100.0
-        }),
-        grad: Arc::new(|p: &Point<3>| {
-            let (x, y, z) = (p[0], p[1], p[2]);
-            let (sx, sy, sz) = ((PI * x).sin(), (PI * y).sin(), (PI * z).sin());
-            let (cx, cy, cz) = ((PI * x).cos(), (PI * y).cos(), (PI * z).cos());
-            Tensor::<3>::new(
-                PI * cx * sy * sz,
-                PI * sx * cy * sz,
-                PI * sx * sy * cz,
-                2.0 * x * y * z,
-                x * x * z,
-                x * x * y,
-                -PI * y * z * sx,
-                z * cx,
-                y * cx,
-            ) / 100.0
-        }),
-        f: Arc::new(|p: &Point<3>| {
-            let (x, y, z) = (p[0], p[1], p[2]);
-            let (sx, sy, sz) = ((PI * x).sin(), (PI * y).sin(), (PI * z).sin());
-            let (cx, cy, cz) = ((PI * x).cos(), (PI * y).cos(), (PI * z).cos());
-            let pi2 = PI * PI;
-            Point::<3>::new(
-                -x * z / 52.0 + PI * y * sx / 104.0 + 11.0 * pi2 * sx * sy * sz / 520.0,
-                -y * z / 130.0 - pi2 * sz * cx * cy / 104.0 - cx / 104.0,
-                -x * x / 104.0 + pi2 * y * z * cx / 260.0 - pi2 * sy * cx * cz / 104.0,
-            )
-        }),
-    }
-}
 
 fn material<const D: usize>() -> Stiffness<D> {
     // Plane strain in 2D, 3D isotropic in 3D.

@@ -14,6 +14,7 @@
 //! `‖u − u_h‖_E² = Σ_K ∫_K (ε − ε_h) : C : (ε − ε_h)`, with the same quadrature.
 #![allow(dead_code)]
 
+use std::f64::consts::PI;
 use std::sync::Arc;
 
 use porofrac::grid::point::for_each_facet;
@@ -29,6 +30,85 @@ use porofrac::vem::projected_gradient;
 pub type VecFn<const D: usize> = Arc<dyn Fn(&Point<D>) -> Point<D> + Send + Sync>;
 /// A tensor field of position (the displacement gradient `∂u_a/∂x_b` at `(a, b)`).
 pub type TenFn<const D: usize> = Arc<dyn Fn(&Point<D>) -> Tensor<D> + Send + Sync>;
+
+/// A manufactured solution of the standard problems (`BENCHMARKS.md`): displacement, its
+/// gradient and the body force `f = −div σ(u)` for `E = 1`, `ν = 0.3` (plane strain in 2D).
+pub struct Manufactured<const D: usize> {
+    /// The displacement.
+    pub u: VecFn<D>,
+    /// Its gradient.
+    pub grad: TenFn<D>,
+    /// The body force.
+    pub f: VecFn<D>,
+}
+
+/// E2: `u = (sin πx sin πy, x² y) / 100`.
+pub fn e2() -> Manufactured<2> {
+    Manufactured {
+        u: Arc::new(|p: &Point<2>| {
+            let (x, y) = (p[0], p[1]);
+            Point::<2>::new((PI * x).sin() * (PI * y).sin(), x * x * y) / 100.0
+        }),
+        grad: Arc::new(|p: &Point<2>| {
+            let (x, y) = (p[0], p[1]);
+            Tensor::<2>::new(
+                PI * (PI * x).cos() * (PI * y).sin(),
+                PI * (PI * x).sin() * (PI * y).cos(),
+                2.0 * x * y,
+                x * x,
+            ) / 100.0
+        }),
+        f: Arc::new(|p: &Point<2>| {
+            let (x, y) = (p[0], p[1]);
+            let pi2 = PI * PI;
+            Point::<2>::new(
+                -x / 52.0 + 9.0 * pi2 * (PI * x).sin() * (PI * y).sin() / 520.0,
+                -y / 130.0 - pi2 * (PI * x).cos() * (PI * y).cos() / 104.0,
+            )
+        }),
+    }
+}
+
+/// E3: `u = (sin πx sin πy sin πz, x² y z, y z cos πx) / 100`.
+pub fn e3() -> Manufactured<3> {
+    Manufactured {
+        u: Arc::new(|p: &Point<3>| {
+            let (x, y, z) = (p[0], p[1], p[2]);
+            Point::<3>::new(
+                (PI * x).sin() * (PI * y).sin() * (PI * z).sin(),
+                x * x * y * z,
+                y * z * (PI * x).cos(),
+            ) / 100.0
+        }),
+        grad: Arc::new(|p: &Point<3>| {
+            let (x, y, z) = (p[0], p[1], p[2]);
+            let (sx, sy, sz) = ((PI * x).sin(), (PI * y).sin(), (PI * z).sin());
+            let (cx, cy, cz) = ((PI * x).cos(), (PI * y).cos(), (PI * z).cos());
+            Tensor::<3>::new(
+                PI * cx * sy * sz,
+                PI * sx * cy * sz,
+                PI * sx * sy * cz,
+                2.0 * x * y * z,
+                x * x * z,
+                x * x * y,
+                -PI * y * z * sx,
+                z * cx,
+                y * cx,
+            ) / 100.0
+        }),
+        f: Arc::new(|p: &Point<3>| {
+            let (x, y, z) = (p[0], p[1], p[2]);
+            let (sx, sy, sz) = ((PI * x).sin(), (PI * y).sin(), (PI * z).sin());
+            let (cx, cy, cz) = ((PI * x).cos(), (PI * y).cos(), (PI * z).cos());
+            let pi2 = PI * PI;
+            Point::<3>::new(
+                -x * z / 52.0 + PI * y * sx / 104.0 + 11.0 * pi2 * sx * sy * sz / 520.0,
+                -y * z / 130.0 - pi2 * sz * cx * cy / 104.0 - cx / 104.0,
+                -x * x / 104.0 + pi2 * y * z * cx / 260.0 - pi2 * sy * cx * cz / 104.0,
+            )
+        }),
+    }
+}
 
 /// The components of a vector field as scalar fields (for conditions and loads).
 pub fn components<const D: usize>(f: &VecFn<D>) -> [ScalarField; D] {

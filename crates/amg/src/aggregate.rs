@@ -114,7 +114,26 @@ pub(crate) struct Strength {
     w: Vec<f64>,
 }
 
+/// Rows of a [`Strength`] graph built in consecutive parts: per part the neighbour
+/// counts of its rows, their neighbours and their strengths.
+type StrengthPart = (Vec<usize>, Vec<u32>, Vec<f64>);
+
 impl Strength {
+    /// The graph of `nn` nodes from its parts, in order.
+    fn concat(nn: usize, parts: Vec<StrengthPart>) -> Self {
+        let mut ptr = Vec::with_capacity(nn + 1);
+        ptr.push(0);
+        let (mut adj, mut w) = (Vec::new(), Vec::new());
+        for (counts, a_part, w_part) in parts {
+            for c in counts {
+                ptr.push(ptr.last().copied().unwrap_or(0) + c);
+            }
+            adj.extend_from_slice(&a_part);
+            w.extend_from_slice(&w_part);
+        }
+        Strength { ptr, adj, w }
+    }
+
     fn nbrs(&self, i: usize) -> (&[u32], &[f64]) {
         let r = self.ptr[i]..self.ptr[i + 1];
         (&self.adj[r.clone()], &self.w[r])
@@ -184,7 +203,7 @@ pub(crate) fn strength(a: &CsrMatrix, blocks: &Blocks, theta: f64) -> Strength {
         .with_min_len(ROWS_PER_TASK)
         .map(|node| diagonal_block_norm(a, blocks, node))
         .collect();
-    let parts: Vec<(Vec<usize>, Vec<u32>, Vec<f64>)> = (0..nblocks)
+    let parts: Vec<StrengthPart> = (0..nblocks)
         .into_par_iter()
         .map_init(
             || Spa::new(nn),
@@ -213,18 +232,7 @@ pub(crate) fn strength(a: &CsrMatrix, blocks: &Blocks, theta: f64) -> Strength {
             },
         )
         .collect();
-    let mut ptr = Vec::with_capacity(nn + 1);
-    ptr.push(0);
-    let mut adj = Vec::new();
-    let mut w = Vec::new();
-    for (counts, a_part, w_part) in parts {
-        for c in counts {
-            ptr.push(ptr.last().copied().unwrap_or(0) + c);
-        }
-        adj.extend_from_slice(&a_part);
-        w.extend_from_slice(&w_part);
-    }
-    Strength { ptr, adj, w }
+    Strength::concat(nn, parts)
 }
 
 impl Strength {
@@ -235,7 +243,7 @@ impl Strength {
     pub(crate) fn squared(&self) -> Strength {
         let nn = self.ptr.len() - 1;
         let nblocks = nn.div_ceil(ROWS_PER_TASK);
-        let parts: Vec<(Vec<usize>, Vec<u32>, Vec<f64>)> = (0..nblocks)
+        let parts: Vec<StrengthPart> = (0..nblocks)
             .into_par_iter()
             .map(|b| {
                 let range = b * ROWS_PER_TASK..((b + 1) * ROWS_PER_TASK).min(nn);
@@ -264,17 +272,7 @@ impl Strength {
                 (counts, adj, w)
             })
             .collect();
-        let mut ptr = Vec::with_capacity(nn + 1);
-        ptr.push(0);
-        let (mut adj, mut w) = (Vec::new(), Vec::new());
-        for (counts, a_part, w_part) in parts {
-            for c in counts {
-                ptr.push(ptr.last().copied().unwrap_or(0) + c);
-            }
-            adj.extend_from_slice(&a_part);
-            w.extend_from_slice(&w_part);
-        }
-        Strength { ptr, adj, w }
+        Strength::concat(nn, parts)
     }
 }
 
