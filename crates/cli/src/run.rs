@@ -819,49 +819,7 @@ fn run_dim<const D: usize>(
     };
 
     // Probes and lines are located once.
-    let mut probe_locs = Vec::new();
-    for (i, p) in s.output.probe.iter().enumerate() {
-        if p.field == "pressure" && !flow_on {
-            return Err(ls
-                .error(
-                    &ki("output.probe", i, &["field"]),
-                    "= \"pressure\" needs [physics] flow = true",
-                )
-                .into());
-        }
-        let loc = locate(grid, &point(&p.at)).ok_or_else(|| {
-            ls.error(
-                &ki("output.probe", i, &["at"]),
-                format!("= {:?} is outside the grid", p.at),
-            )
-        })?;
-        probe_locs.push(loc);
-    }
-    let mut line_locs: Vec<Vec<(f64, Point<D>, Location)>> = Vec::new();
-    for (i, l) in s.output.line.iter().enumerate() {
-        if l.field == "pressure" && !flow_on {
-            return Err(ls
-                .error(
-                    &ki("output.line", i, &["field"]),
-                    "= \"pressure\" needs [physics] flow = true",
-                )
-                .into());
-        }
-        let (a, b): (Point<D>, Point<D>) = (point(&l.from), point(&l.to));
-        let mut pts = Vec::new();
-        for j in 0..l.points as usize {
-            let f = j as f64 / (l.points as f64 - 1.0);
-            let x = a + (b - a) * f;
-            let loc = locate(grid, &x).ok_or_else(|| {
-                ls.error(
-                    &ki("output.line", i, &["from"]),
-                    format!("point {:?} of the line is outside the grid", x.as_slice()),
-                )
-            })?;
-            pts.push(((b - a).norm() * f, x, loc));
-        }
-        line_locs.push(pts);
-    }
+    let (probe_locs, line_locs) = locate_outputs(ls, grid, flow_on)?;
 
     let mut header = vec!["time".to_string()];
     header.extend(s.output.probe.iter().map(|p| p.name.clone()));
@@ -1109,92 +1067,14 @@ fn run_dim<const D: usize>(
 
     let t_out = Instant::now();
     if s.output.plots {
-        let columns: Vec<(String, Vec<f64>)> = s
-            .output
-            .probe
-            .iter()
-            .map(|p| p.name.clone())
-            .zip(series)
-            .collect();
-        if !columns.is_empty() {
-            crate::plots::time_series(
-                &out.join("plots").join("probes.png"),
-                &written_times,
-                &columns,
-                &format!("{}: probes", s.scene.name),
-            )?;
-        }
-        if let Some((u, stress)) = &last {
-            // 2D: the grid; 3D: its cross-section at mid-height (shifted off a layer of
-            // nodes by 1e-4 of the height, so extruded grids are cut inside a layer).
-            let (canvas, where_) = match (as_2d(grid), as_3d(grid)) {
-                (Some(g2), _) => (crate::plots::Canvas::of_grid(g2), String::new()),
-                (_, Some(g3)) => {
-                    let (lo, hi) = g3.bounding_box();
-                    let z = lo[2] + (0.5 + 1e-4) * (hi[2] - lo[2]);
-                    (
-                        crate::plots::Canvas::z_slice(g3, z),
-                        format!(" on z = {:.4}", 0.5 * (lo[2] + hi[2])),
-                    )
-                }
-                _ => unreachable!("grids are 2D or 3D"),
-            };
-            let marked = failures.flags().to_vec();
-            let cell_mean = |a: usize| -> Vec<f64> {
-                (0..grid.num_cells())
-                    .map(|c| {
-                        let nodes = grid.cell_nodes(c);
-                        nodes.iter().map(|&p| u[D * p + a]).sum::<f64>() / nodes.len() as f64
-                    })
-                    .collect()
-            };
-            let comp =
-                |i: usize, j: usize| -> Vec<f64> { stress.iter().map(|s| s[(i, j)]).collect() };
-            let (smax, smin): (Vec<f64>, Vec<f64>) = stress.iter().map(principal).unzip();
-            let mut plots: Vec<(&str, Vec<f64>)> = vec![("ux", cell_mean(0)), ("uy", cell_mean(1))];
-            if D == 3 {
-                plots.push(("uz", cell_mean(2)));
-            }
-            plots.extend([("sxx", comp(0, 0)), ("syy", comp(1, 1))]);
-            if D == 3 {
-                plots.push(("szz", comp(2, 2)));
-            }
-            plots.extend([
-                ("sxy", comp(0, 1)),
-                ("smax", smax),
-                ("smin", smin),
-                ("divergence", cell_divergence(grid, u)),
-            ]);
-            if let Some(p) = &pressure {
-                plots.push(("pressure", p.clone()));
-            }
-            let t_last = written_times.last().copied().unwrap_or(0.0);
-            for (name, vals) in &plots {
-                let title = format!("{name} at t = {t_last} s{where_}");
-                crate::plots::field(
-                    &out.join("plots").join(format!("{name}.png")),
-                    &crate::plots::FieldPlot::new(&canvas, &title, &marked),
-                    crate::plots::Values::Cell(vals),
-                )?;
-            }
-            if let (Some(g2), true) = (as_2d(grid), failures.count() > 0) {
-                // The seed's Figs. 4 and 5.
-                let stress2: Vec<Tensor<2>> = stress
-                    .iter()
-                    .map(|s| Tensor::<2>::from_fn(|i, j| s[(i, j)]))
-                    .collect();
-                fracture_plots(
-                    &out.join("plots"),
-                    g2,
-                    &canvas,
-                    &plots,
-                    &stress2,
-                    &marked,
-                    failures.log().iter().map(|f| f.cell),
-                    t_last,
-                )?;
-            }
-        }
+        let plotted = PlotInputs {
+            series,
+            written_times: &written_times,
+            last: last.as_ref(),
+            failures: &failures,
+            pressure: pressure.as_deref(),
+        };
+        write_plots(ls, out, grid, plotted)?;
     }
     wall.output += t_out.elapsed().as_secs_f64();
     let _ = start;
@@ -1212,6 +1092,177 @@ fn run_dim<const D: usize>(
         solver: stats,
         version: env!("CARGO_PKG_VERSION").into(),
     })
+}
+
+/// Sample points along an output line: arc length from its start, position, location.
+type LinePoints<const D: usize> = Vec<(f64, Point<D>, Location)>;
+
+/// The cells holding the probes and the points of the output lines; errors name the
+/// probe or line that lies outside the grid or asks for pressure without flow.
+fn locate_outputs<const D: usize>(
+    ls: &LoadedScene,
+    grid: &Grid<D>,
+    flow_on: bool,
+) -> Result<(Vec<Location>, Vec<LinePoints<D>>), RunError> {
+    let s = &ls.scene;
+    let mut probe_locs = Vec::new();
+    for (i, p) in s.output.probe.iter().enumerate() {
+        if p.field == "pressure" && !flow_on {
+            return Err(ls
+                .error(
+                    &ki("output.probe", i, &["field"]),
+                    "= \"pressure\" needs [physics] flow = true",
+                )
+                .into());
+        }
+        let loc = locate(grid, &point(&p.at)).ok_or_else(|| {
+            ls.error(
+                &ki("output.probe", i, &["at"]),
+                format!("= {:?} is outside the grid", p.at),
+            )
+        })?;
+        probe_locs.push(loc);
+    }
+    let mut line_locs: Vec<LinePoints<D>> = Vec::new();
+    for (i, l) in s.output.line.iter().enumerate() {
+        if l.field == "pressure" && !flow_on {
+            return Err(ls
+                .error(
+                    &ki("output.line", i, &["field"]),
+                    "= \"pressure\" needs [physics] flow = true",
+                )
+                .into());
+        }
+        let (a, b): (Point<D>, Point<D>) = (point(&l.from), point(&l.to));
+        let mut pts = Vec::new();
+        for j in 0..l.points as usize {
+            let f = j as f64 / (l.points as f64 - 1.0);
+            let x = a + (b - a) * f;
+            let loc = locate(grid, &x).ok_or_else(|| {
+                ls.error(
+                    &ki("output.line", i, &["from"]),
+                    format!("point {:?} of the line is outside the grid", x.as_slice()),
+                )
+            })?;
+            pts.push(((b - a).norm() * f, x, loc));
+        }
+        line_locs.push(pts);
+    }
+    Ok((probe_locs, line_locs))
+}
+
+/// What the end-of-run plots show: the probe series at the written times, the last
+/// displacement and cell stresses, the failures and the pressure.
+struct PlotInputs<'a, const D: usize> {
+    series: Vec<Vec<f64>>,
+    written_times: &'a [f64],
+    last: Option<&'a (Vec<f64>, Vec<Tensor<D>>)>,
+    failures: &'a FailureState,
+    pressure: Option<&'a [f64]>,
+}
+
+/// `plots/`: the probe time series, the last state's fields (2D: the grid; 3D: the
+/// mid-height section) and, after fracturing in 2D, the seed's Figs. 4 and 5.
+fn write_plots<const D: usize>(
+    ls: &LoadedScene,
+    out: &Path,
+    grid: &Grid<D>,
+    inputs: PlotInputs<'_, D>,
+) -> Result<(), RunError> {
+    let s = &ls.scene;
+    let PlotInputs {
+        series,
+        written_times,
+        last,
+        failures,
+        pressure,
+    } = inputs;
+    let columns: Vec<(String, Vec<f64>)> = s
+        .output
+        .probe
+        .iter()
+        .map(|p| p.name.clone())
+        .zip(series)
+        .collect();
+    if !columns.is_empty() {
+        crate::plots::time_series(
+            &out.join("plots").join("probes.png"),
+            written_times,
+            &columns,
+            &format!("{}: probes", s.scene.name),
+        )?;
+    }
+    if let Some((u, stress)) = &last {
+        // 2D: the grid; 3D: its cross-section at mid-height (shifted off a layer of
+        // nodes by 1e-4 of the height, so extruded grids are cut inside a layer).
+        let (canvas, where_) = match (as_2d(grid), as_3d(grid)) {
+            (Some(g2), _) => (crate::plots::Canvas::of_grid(g2), String::new()),
+            (_, Some(g3)) => {
+                let (lo, hi) = g3.bounding_box();
+                let z = lo[2] + (0.5 + 1e-4) * (hi[2] - lo[2]);
+                (
+                    crate::plots::Canvas::z_slice(g3, z),
+                    format!(" on z = {:.4}", 0.5 * (lo[2] + hi[2])),
+                )
+            }
+            _ => unreachable!("grids are 2D or 3D"),
+        };
+        let marked = failures.flags().to_vec();
+        let cell_mean = |a: usize| -> Vec<f64> {
+            (0..grid.num_cells())
+                .map(|c| {
+                    let nodes = grid.cell_nodes(c);
+                    nodes.iter().map(|&p| u[D * p + a]).sum::<f64>() / nodes.len() as f64
+                })
+                .collect()
+        };
+        let comp = |i: usize, j: usize| -> Vec<f64> { stress.iter().map(|s| s[(i, j)]).collect() };
+        let (smax, smin): (Vec<f64>, Vec<f64>) = stress.iter().map(principal).unzip();
+        let mut plots: Vec<(&str, Vec<f64>)> = vec![("ux", cell_mean(0)), ("uy", cell_mean(1))];
+        if D == 3 {
+            plots.push(("uz", cell_mean(2)));
+        }
+        plots.extend([("sxx", comp(0, 0)), ("syy", comp(1, 1))]);
+        if D == 3 {
+            plots.push(("szz", comp(2, 2)));
+        }
+        plots.extend([
+            ("sxy", comp(0, 1)),
+            ("smax", smax),
+            ("smin", smin),
+            ("divergence", cell_divergence(grid, u)),
+        ]);
+        if let Some(p) = &pressure {
+            plots.push(("pressure", p.to_vec()));
+        }
+        let t_last = written_times.last().copied().unwrap_or(0.0);
+        for (name, vals) in &plots {
+            let title = format!("{name} at t = {t_last} s{where_}");
+            crate::plots::field(
+                &out.join("plots").join(format!("{name}.png")),
+                &crate::plots::FieldPlot::new(&canvas, &title, &marked),
+                crate::plots::Values::Cell(vals),
+            )?;
+        }
+        if let (Some(g2), true) = (as_2d(grid), failures.count() > 0) {
+            // The seed's Figs. 4 and 5.
+            let stress2: Vec<Tensor<2>> = stress
+                .iter()
+                .map(|s| Tensor::<2>::from_fn(|i, j| s[(i, j)]))
+                .collect();
+            fracture_plots(
+                &out.join("plots"),
+                g2,
+                &canvas,
+                &plots,
+                &stress2,
+                &marked,
+                failures.log().iter().map(|f| f.cell),
+                t_last,
+            )?;
+        }
+    }
+    Ok(())
 }
 
 /// Cell divergence of the displacement, `div u = Σ_i N_i · u_i / |K|`
