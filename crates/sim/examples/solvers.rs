@@ -9,7 +9,8 @@
 //! `FAER_THREADS=n` factorizes with `Par::rayon(n)` (1: sequentially) instead of the
 //! default (all threads of the pool);
 //! `RAYON_NUM_THREADS` sets the pool of the parallel assembly and AMG kernels;
-//! `AMG_OPTS=theta=0.02,degree=3` overrides multigrid options (`theta`, `degree`,
+//! `REPEAT=3` runs the whole case (grid to error) three times in the process, one row
+//! each (the peer's "best of" rule); `AMG_OPTS=theta=0.02,degree=3` overrides multigrid options (`theta`, `degree`,
 //! `upper`, `ratio`, `lanczos`, `omega`, `coarse`, `aggressive`: see `porofrac_amg::AmgOptions`).
 //!
 //! Grids: E2 = n × n squares split in two triangles, E3 = n³ cubes split in six
@@ -284,9 +285,12 @@ fn main() {
     }
     let n: usize = args[1].parse().expect("n");
     let tol: f64 = args.get(3).map_or(1e-8, |t| t.parse().expect("tolerance"));
-    match args[0].as_str() {
-        "e2" => run::<2>(n, &args[2], tol, e2_exact, e2_force()),
-        "e3" => run::<3>(n, &args[2], tol, e3_exact, e3_force()),
-        other => panic!("problem {other}: e2 or e3"),
+    let repeat: usize = std::env::var("REPEAT").map_or(1, |r| r.parse().expect("REPEAT"));
+    for _ in 0..repeat {
+        match args[0].as_str() {
+            "e2" => run::<2>(n, &args[2], tol, e2_exact, e2_force()),
+            "e3" => run::<3>(n, &args[2], tol, e3_exact, e3_force()),
+            other => panic!("problem {other}: e2 or e3"),
+        }
     }
 }

@@ -171,16 +171,23 @@ impl std::fmt::Debug for AmgSolver {
 }
 
 /// The multigrid options [`AmgSolver`] starts from in `dim` dimensions: the
-/// [`AmgOptions`] defaults, with the strength threshold θ = 0.08 in 2D and 0 in 3D.
+/// [`AmgOptions`] defaults with aggressive coarsening on the finest level
+/// (`aggressive_levels = 1`) and the strength threshold θ = 0.08 in 2D, 0 in 3D.
 ///
-/// On the standard problem E2 (P1 triangles, 2 M equations) θ = 0.08 drops weak
-/// couplings on the coarse levels and cuts CG from 26 to 16 iterations at 5 % more
-/// operator complexity (1.45 → 1.53); on E3 (tetrahedra) the same θ stalls the coarsening
-/// (operator complexity 17 at n = 40) while θ = 0 needs 17 iterations, so 3D keeps every
-/// connection. Measured with `cargo run --release -p porofrac-sim --example solvers`.
+/// Measured with `cargo run --release -p porofrac-sim --example solvers` (docs/BENCHMARKS.md):
+/// on the standard problem E2 (P1 triangles, 2 M equations) θ = 0.08 drops weak couplings
+/// on the coarse levels and cuts CG from 26 to 16 iterations; on E3 (tetrahedra) the same
+/// θ stalls the coarsening (operator complexity 17 at n = 40), so 3D keeps every
+/// connection. Aggregating the finest level on the distance-two strength graph costs 5–7
+/// more iterations but builds a hierarchy with operator complexity 1.05–1.13 instead of
+/// 1.42–1.53: in back-to-back pairs on the idle machine the total time drops (E2 n = 1000:
+/// 8.1–9.9 s against 8.6–11.3 s; E3 n = 40: 2.0–2.1 s against 2.1–2.4 s; E3 n = 60: 7.4
+/// against 8.2 s) and so does the peak memory (2.74 against 3.33 GB, 0.75 against 0.89 GB,
+/// 2.55 against 3.04 GB).
 pub fn elasticity_amg_options(dim: usize) -> AmgOptions {
     AmgOptions {
         strength_threshold: if dim == 2 { 0.08 } else { 0.0 },
+        aggressive_levels: 1,
         ..AmgOptions::default()
     }
 }
