@@ -52,7 +52,25 @@ struct Runs {
     len: Vec<u32>,
 }
 
+/// Heap bytes of a vector's capacity.
+pub(crate) fn vec_bytes<T>(v: &Vec<T>) -> usize {
+    v.capacity() * std::mem::size_of::<T>()
+}
+
 impl CsrMatrix {
+    /// Heap bytes held (indices, values, run tables).
+    pub(crate) fn bytes(&self) -> usize {
+        vec_bytes(&self.row_ptr)
+            + vec_bytes(&self.col)
+            + vec_bytes(&self.val)
+            + self.runs.as_ref().map_or(0, |r| {
+                vec_bytes(&r.row_group)
+                    + vec_bytes(&r.ptr)
+                    + vec_bytes(&r.start)
+                    + vec_bytes(&r.len)
+            })
+    }
+
     /// Assemble from raw parts (internal: callers guarantee consistency).
     pub(crate) fn from_parts(
         nrows: usize,
@@ -301,12 +319,17 @@ where
 
 /// A symmetric matrix given by its upper triangle in compressed sparse column form,
 /// expanded once to a full [`CsrMatrix`].
+///
+/// No map from the full entries to the upper-triangle values is stored: the lower part
+/// and diagonal of full row `i` (its first entries) are column `i` of the upper triangle,
+/// starting at `col_ptr[i]`, and an entry `(i, c)` with `c > i` is the entry of row `i` in
+/// column `c`, that is at the rank of `i` in full row `c`'s lower part (a binary search
+/// of a few indices). Only the column offsets are kept.
 #[derive(Clone, Debug)]
 pub struct SymCsr {
     full: CsrMatrix,
-    /// For every full entry, its position in the upper-triangle values.
-    src: Vec<u32>,
-    upper_nnz: usize,
+    /// Column offsets of the upper triangle (length `n + 1`).
+    col_ptr: Vec<usize>,
 }
 
 impl SymCsr {
@@ -323,70 +346,62 @@ impl SymCsr {
         values: &[f64],
     ) -> Result<Self> {
         validate_upper_csc(n, col_ptr, row_idx, values)?;
-        let nnz_up = row_idx.len();
         // Full row i = column i of the upper triangle (columns r ≤ i, diagonal last) followed
-        // by the columns c > i whose upper column holds row i — a transpose. The rows are
-        // split into parts, one task each; every task scans all columns in increasing order
-        // and keeps the entries of its own rows, so each row comes out sorted and each task
-        // writes only its own contiguous slice of the output.
-        let parts = (2 * rayon::current_num_threads()).clamp(1, n.max(1));
-        let bounds: Vec<usize> = (0..=parts).map(|k| n * k / parts).collect();
-        let upper_counts: Vec<Vec<u32>> = (0..parts)
-            .into_par_iter()
-            .map(|k| {
-                let rows = bounds[k]..bounds[k + 1];
-                let mut cnt = vec![0u32; rows.len()];
-                for c in rows.start..n {
-                    for &r in &row_idx[col_ptr[c]..col_ptr[c + 1]] {
-                        if r != c && rows.contains(&r) {
-                            cnt[r - rows.start] += 1;
-                        }
-                    }
+        // by the columns c > i whose upper column holds row i — a transpose. One pass counts
+        // the entries of each row and the last column holding it; the rows are then split
+        // into parts, one task each, and every task scans the columns from its first row to
+        // the last column holding one of its rows (a band for equations numbered by
+        // node), keeping the entries of its own rows: each row comes out sorted and each
+        // task writes only its own slice.
+        let mut upper_count = vec![0u32; n];
+        let mut last_col: Vec<u32> = (0..n as u32).collect();
+        for c in 0..n {
+            for &r in &row_idx[col_ptr[c]..col_ptr[c + 1]] {
+                if r != c {
+                    upper_count[r] += 1;
+                    last_col[r] = c as u32;
                 }
-                cnt
-            })
-            .collect();
-        let mut row_ptr = Vec::with_capacity(n + 1);
-        row_ptr.push(0usize);
-        for (k, cnt) in upper_counts.iter().enumerate() {
-            for (i, &u) in (bounds[k]..bounds[k + 1]).zip(cnt) {
-                let len = col_ptr[i + 1] - col_ptr[i] + u as usize;
-                row_ptr.push(row_ptr[i] + len);
             }
         }
-        let nnz = row_ptr[n];
-        let mut col = vec![0u32; nnz];
-        let mut src = vec![0u32; nnz];
-        let mut slices = Vec::with_capacity(parts);
-        let (mut col_rest, mut src_rest) = (&mut col[..], &mut src[..]);
-        for k in 0..parts {
-            let len = row_ptr[bounds[k + 1]] - row_ptr[bounds[k]];
-            let (ch, ct) = col_rest.split_at_mut(len);
-            let (sh, st) = src_rest.split_at_mut(len);
-            slices.push((k, ch, sh));
-            (col_rest, src_rest) = (ct, st);
+        let mut row_ptr = Vec::with_capacity(n + 1);
+        row_ptr.push(0usize);
+        for i in 0..n {
+            row_ptr.push(row_ptr[i] + col_ptr[i + 1] - col_ptr[i] + upper_count[i] as usize);
         }
-        slices.into_par_iter().for_each(|(k, col, src)| {
+        drop(upper_count);
+        let nnz = row_ptr[n];
+        let parts = (4 * rayon::current_num_threads()).clamp(1, n.max(1));
+        let bounds: Vec<usize> = (0..=parts).map(|k| n * k / parts).collect();
+        let mut col = vec![0u32; nnz];
+        let mut slices = Vec::with_capacity(parts);
+        let mut rest = &mut col[..];
+        for k in 0..parts {
+            let (head, tail) = rest.split_at_mut(row_ptr[bounds[k + 1]] - row_ptr[bounds[k]]);
+            slices.push((k, head));
+            rest = tail;
+        }
+        slices.into_par_iter().for_each(|(k, col)| {
             let rows = bounds[k]..bounds[k + 1];
             let base = row_ptr[rows.start];
             // Lower part and diagonal, and the write cursor of each row's upper part.
             let mut next = Vec::with_capacity(rows.len());
             for i in rows.clone() {
                 let at = row_ptr[i] - base;
-                let m = col_ptr[i + 1] - col_ptr[i];
-                for (q, p) in (col_ptr[i]..col_ptr[i + 1]).enumerate() {
-                    col[at + q] = row_idx[p] as u32;
-                    src[at + q] = p as u32;
+                for (q, &r) in row_idx[col_ptr[i]..col_ptr[i + 1]].iter().enumerate() {
+                    col[at + q] = r as u32;
                 }
-                next.push(at + m);
+                next.push(at + col_ptr[i + 1] - col_ptr[i]);
             }
-            for c in rows.start..n {
-                for p in col_ptr[c]..col_ptr[c + 1] {
-                    let r = row_idx[p];
+            let end = rows
+                .clone()
+                .map(|r| last_col[r] as usize + 1)
+                .max()
+                .unwrap_or(0);
+            for c in rows.start..end {
+                for &r in &row_idx[col_ptr[c]..col_ptr[c + 1]] {
                     if r != c && rows.contains(&r) {
                         let at = &mut next[r - rows.start];
                         col[*at] = c as u32;
-                        src[*at] = p as u32;
                         *at += 1;
                     }
                 }
@@ -396,8 +411,7 @@ impl SymCsr {
         full.compress_runs();
         let mut out = Self {
             full,
-            src,
-            upper_nnz: nnz_up,
+            col_ptr: col_ptr.to_vec(),
         };
         out.fill(values);
         Ok(out)
@@ -409,7 +423,7 @@ impl SymCsr {
     }
     /// Number of upper-triangle entries this matrix was built from.
     pub fn upper_nnz(&self) -> usize {
-        self.upper_nnz
+        self.col_ptr[self.n()]
     }
     /// The full matrix.
     pub fn matrix(&self) -> &CsrMatrix {
@@ -418,20 +432,13 @@ impl SymCsr {
 
     /// New upper-triangle values on the same pattern. Errors: wrong length, non-finite.
     pub fn set_values(&mut self, values: &[f64]) -> Result<()> {
-        if values.len() != self.upper_nnz {
-            return Err(AmgError::Input(format!(
-                "{} values for a pattern of {} entries",
-                values.len(),
-                self.upper_nnz
-            )));
-        }
-        check_finite(values, "matrix value")?;
+        check_upper_values(values, self.upper_nnz())?;
         self.fill(values);
         Ok(())
     }
 
     fn fill(&mut self, values: &[f64]) {
-        gather(&mut self.full.val, values, &self.src);
+        fill_from_upper(&mut self.full, &self.col_ptr, values);
     }
 
     /// `y = A x` (in parallel).
@@ -439,20 +446,82 @@ impl SymCsr {
         self.full.mul(x, y)
     }
 
-    pub(crate) fn into_parts(self) -> (CsrMatrix, Vec<u32>, usize) {
-        (self.full, self.src, self.upper_nnz)
+    pub(crate) fn into_parts(self) -> (CsrMatrix, Vec<usize>) {
+        (self.full, self.col_ptr)
     }
 }
 
-/// `dst[k] = values[src[k]]` (in parallel).
-pub(crate) fn gather(dst: &mut [f64], values: &[f64], src: &[u32]) {
-    dst.par_chunks_mut(VEC_BLOCK)
-        .zip(src.par_chunks(VEC_BLOCK))
-        .for_each(|(v, s)| {
-            for (vk, &sk) in v.iter_mut().zip(s) {
-                *vk = values[sk as usize];
-            }
-        });
+/// Error unless `values` has `upper_nnz` finite entries.
+pub(crate) fn check_upper_values(values: &[f64], upper_nnz: usize) -> Result<()> {
+    if values.len() != upper_nnz {
+        return Err(AmgError::Input(format!(
+            "{} values for a pattern of {upper_nnz} entries",
+            values.len(),
+        )));
+    }
+    check_finite(values, "matrix value")
+}
+
+/// Position in the upper-triangle values of every entry of full row `i` (see [`SymCsr`]),
+/// passed to `f(k, position)` with `k` the entry's index within the row.
+#[inline]
+fn upper_positions(full: &CsrMatrix, col_ptr: &[usize], i: usize, mut f: impl FnMut(usize, usize)) {
+    let cols = &full.col[full.row_ptr[i]..full.row_ptr[i + 1]];
+    let m = col_ptr[i + 1] - col_ptr[i];
+    for k in 0..m {
+        f(k, col_ptr[i] + k);
+    }
+    for (k, &c) in cols.iter().enumerate().skip(m) {
+        let c = c as usize;
+        let lower = &full.col[full.row_ptr[c]..full.row_ptr[c] + col_ptr[c + 1] - col_ptr[c]];
+        // Invariant: the pattern is symmetric, so row i is in column c.
+        let t = lower.binary_search(&(i as u32)).unwrap_or(0);
+        f(k, col_ptr[c] + t);
+    }
+}
+
+/// Set the values of the full matrix `full` from the upper-triangle `values` laid out by
+/// `col_ptr` (in parallel over rows).
+pub(crate) fn fill_from_upper(full: &mut CsrMatrix, col_ptr: &[usize], values: &[f64]) {
+    let mut val = std::mem::take(&mut full.val);
+    let f = &*full;
+    let row_ptr = &f.row_ptr;
+    let n = f.nrows;
+    let mut slices = Vec::with_capacity(n.div_ceil(ROWS_PER_TASK));
+    let mut rest = &mut val[..];
+    for start in (0..n).step_by(ROWS_PER_TASK) {
+        let end = (start + ROWS_PER_TASK).min(n);
+        let (head, tail) = rest.split_at_mut(row_ptr[end] - row_ptr[start]);
+        slices.push((start, head));
+        rest = tail;
+    }
+    slices.into_par_iter().for_each(|(start, out)| {
+        let base = row_ptr[start];
+        for i in start..(start + ROWS_PER_TASK).min(n) {
+            let at = row_ptr[i] - base;
+            upper_positions(f, col_ptr, i, |k, p| out[at + k] = values[p]);
+        }
+    });
+    full.val = val;
+}
+
+/// Whether the full matrix `full` holds exactly the upper-triangle `values` laid out by
+/// `col_ptr` (bitwise, in parallel over rows).
+pub(crate) fn equals_upper(full: &CsrMatrix, col_ptr: &[usize], values: &[f64]) -> bool {
+    if values.len() != col_ptr[full.nrows] {
+        return false;
+    }
+    (0..full.nrows)
+        .into_par_iter()
+        .with_min_len(ROWS_PER_TASK)
+        .all(|i| {
+            let vals = full.row(i).1;
+            let mut same = true;
+            upper_positions(full, col_ptr, i, |k, p| {
+                same &= vals[k].to_bits() == values[p].to_bits()
+            });
+            same
+        })
 }
 
 /// Check the upper-triangle CSC arrays.
@@ -629,6 +698,63 @@ mod tests {
         m.mul(&[1.0, 2.0, 3.0], &mut y).unwrap();
         assert_eq!(y, vec![6.0, 17.0, 22.0]);
         assert_eq!(m.diagonal(), vec![4.0, 5.0, 6.0]);
+    }
+
+    #[test]
+    fn expansion_of_an_irregular_band_matches_the_dense_matrix() {
+        // Upper entries (r, c) at distances 0, 1, 3 and 17, some left out; values from the
+        // position so that every entry differs.
+        let n = 60;
+        let (mut col_ptr, mut rows, mut vals) = (vec![0], vec![], vec![]);
+        for c in 0..n {
+            for d in [17, 3, 1, 0] {
+                if d <= c && (d == 0 || (c * 7 + d) % 5 != 1) {
+                    rows.push(c - d);
+                    vals.push(1.0 + (rows.len() as f64).sqrt());
+                }
+            }
+            col_ptr.push(rows.len());
+        }
+        let mut dense = vec![vec![0.0; n]; n];
+        for c in 0..n {
+            for p in col_ptr[c]..col_ptr[c + 1] {
+                dense[rows[p]][c] = vals[p];
+                dense[c][rows[p]] = vals[p];
+            }
+        }
+        let mut a = SymCsr::from_upper_csc(n, &col_ptr, &rows, &vals).unwrap();
+        let check = |a: &SymCsr, dense: &[Vec<f64>]| {
+            let m = a.matrix();
+            for (i, row) in dense.iter().enumerate() {
+                let (cols, v) = m.row(i);
+                assert!(cols.windows(2).all(|w| w[0] < w[1]), "row {i} sorted");
+                let got: Vec<(usize, f64)> =
+                    cols.iter().zip(v).map(|(&j, &x)| (j as usize, x)).collect();
+                let want: Vec<(usize, f64)> = row
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, x)| **x != 0.0)
+                    .map(|(j, &x)| (j, x))
+                    .collect();
+                assert_eq!(got, want, "row {i}");
+            }
+        };
+        check(&a, &dense);
+        assert!(equals_upper(a.matrix(), &col_ptr, &vals));
+        // New values: the expansion follows, and the old ones no longer match.
+        let new: Vec<f64> = vals.iter().map(|v| 2.0 * v + 1.0).collect();
+        a.set_values(&new).unwrap();
+        for row in dense.iter_mut() {
+            for x in row.iter_mut().filter(|x| **x != 0.0) {
+                *x = 2.0 * *x + 1.0;
+            }
+        }
+        check(&a, &dense);
+        assert!(equals_upper(a.matrix(), &col_ptr, &new));
+        assert!(!equals_upper(a.matrix(), &col_ptr, &vals));
+        let mut one_off = new.clone();
+        one_off[rows.len() / 2] += 1e-12;
+        assert!(!equals_upper(a.matrix(), &col_ptr, &one_off));
     }
 
     #[test]

@@ -38,12 +38,14 @@ use faer::dyn_stack::MemBuffer;
 
 use crate::aggregate::{Blocks, aggregate, strength, tentative};
 use crate::coarse::CoarseSolver;
-use crate::csr::{CsrMatrix, SymCsr, gather, zeros};
+use crate::csr::{
+    CsrMatrix, SymCsr, check_upper_values, equals_upper, fill_from_upper, vec_bytes, zeros,
+};
 use crate::error::{AmgError, Result, check_finite};
 use crate::nullspace::NearNullSpace;
 use crate::product::{
-    BlockRows, Blocked, Galerkin, Transposed, block_transpose, numeric_galerkin, product_blocked,
-    restrict, smooth_prolongator, symbolic_galerkin, symbolic_prolongator,
+    Blocked, Galerkin, Transposed, block_transpose, numeric_galerkin, restrict, smooth_prolongator,
+    symbolic_galerkin, symbolic_prolongator,
 };
 use crate::smoother::{Chebyshev, SmoothWork, spectral_radius};
 
@@ -189,6 +191,36 @@ pub struct LevelInfo {
     pub rho: f64,
 }
 
+/// Heap memory of a hierarchy by part, in bytes (see [`Amg::memory`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct AmgMemory {
+    /// The matrices of all levels (full CSR with run tables).
+    pub matrices: usize,
+    /// The column offsets that locate the finest matrix's entries in the caller's
+    /// upper-triangle values.
+    pub fine_map: usize,
+    /// Tentative prolongators.
+    pub tentative: usize,
+    /// Smoothed prolongators and their block transposes.
+    pub prolongators: usize,
+    /// The Galerkin patterns, kept for numeric rebuilds.
+    pub products: usize,
+    /// Inverse diagonals, work vectors, CG vectors, the coarsest factor's buffer.
+    pub vectors: usize,
+}
+
+impl AmgMemory {
+    /// Sum of all parts.
+    pub fn total(&self) -> usize {
+        self.matrices
+            + self.fine_map
+            + self.tentative
+            + self.prolongators
+            + self.products
+            + self.vectors
+    }
+}
+
 /// A smoothed-aggregation multigrid hierarchy for a symmetric positive definite matrix,
 /// usable as a preconditioner ([`Self::apply`]) or solver ([`Self::solve`]).
 pub struct Amg {
@@ -196,14 +228,11 @@ pub struct Amg {
     coarse: CoarseSolver,
     coarse_mem: MemBuffer,
     work: Vec<Work>,
-    fine_src: Vec<u32>,
-    upper_nnz: usize,
+    /// Column offsets of the caller's upper triangle (see [`SymCsr`]).
+    fine_col_ptr: Vec<usize>,
     pub(crate) options: AmgOptions,
     pub(crate) cg: [Vec<f64>; 4],
     scratch: Vec<f64>,
-    /// Storage of the products `A P` (the largest is of the finest level's size), kept
-    /// for rebuilds.
-    w: BlockRows,
     /// False after a failed [`Amg::update_values`].
     valid: bool,
 }
@@ -257,13 +286,12 @@ impl Amg {
                 near_null.len()
             )));
         }
-        let (a0, fine_src, upper_nnz) = matrix.into_parts();
+        let (a0, fine_col_ptr) = matrix.into_parts();
         let mut blocks = Blocks::from_ids(node_of_equation)?;
         let mut null = near_null.clone();
         let mut levels: Vec<Level> = Vec::new();
         let mut a = a0;
         let mut scratch = Vec::new();
-        let mut w = BlockRows::default();
         loop {
             let l = levels.len();
             if l > 0 {
@@ -297,12 +325,12 @@ impl Amg {
                 off,
             };
             let mut level = Level::new(a, dinv, Some(transfer));
-            if !smooth_level(&mut level, options, &mut w) {
+            if !smooth_level(&mut level, options) {
                 return Err(internal());
             }
             let tr = level.transfer.as_mut().ok_or_else(internal)?;
-            let (galerkin, mut ac) = symbolic_galerkin(&tr.pt, &w, &tr.off);
-            numeric_galerkin(&galerkin, &tr.pt, &w, &tr.off, &mut ac, &mut scratch);
+            let (galerkin, mut ac) = symbolic_galerkin(&level.a, &tr.p, &tr.pt, &tr.off);
+            numeric_galerkin(&galerkin, &level.a, &tr.p, &tr.off, &mut ac, &mut scratch);
             tr.galerkin = galerkin;
             levels.push(level);
             a = ac;
@@ -339,12 +367,10 @@ impl Amg {
             coarse,
             coarse_mem,
             work,
-            fine_src,
-            upper_nnz,
+            fine_col_ptr,
             options: options.clone(),
             cg: Default::default(),
             scratch,
-            w,
             valid: true,
         })
     }
@@ -379,33 +405,24 @@ impl Amg {
     /// operator that is not positive definite. After an error on the values (not on the
     /// length) the hierarchy refuses to solve until an update succeeds.
     pub fn update_values(&mut self, values: &[f64]) -> Result<()> {
-        if values.len() != self.upper_nnz {
-            return Err(AmgError::Input(format!(
-                "{} values for a pattern of {} entries",
-                values.len(),
-                self.upper_nnz
-            )));
-        }
-        check_finite(values, "matrix value")?;
+        check_upper_values(values, self.fine_col_ptr[self.n()])?;
         self.valid = false;
-        gather(self.levels[0].a.values_mut(), values, &self.fine_src);
+        fill_from_upper(&mut self.levels[0].a, &self.fine_col_ptr, values);
         let nl = self.levels.len();
         for l in 0..nl {
             let (lo, hi) = self.levels.split_at_mut(l + 1);
             let level = &mut lo[l];
             level.dinv = inverse_diagonal(&level.a, l)?;
-            if !smooth_level(level, &self.options, &mut self.w) {
+            if !smooth_level(level, &self.options) {
                 break;
             }
             let tr = level.transfer.as_ref().ok_or_else(internal)?;
-            let w = &self.w;
-            let next = &mut hi[0];
             numeric_galerkin(
                 &tr.galerkin,
-                &tr.pt,
-                w,
+                &level.a,
+                &tr.p,
                 &tr.off,
-                &mut next.a,
+                &mut hi[0].a,
                 &mut self.scratch,
             );
         }
@@ -413,6 +430,12 @@ impl Amg {
         self.coarse.factorize(&last.a)?;
         self.valid = true;
         Ok(())
+    }
+
+    /// Whether the finest matrix holds exactly these upper-triangle `values` (those of
+    /// the build or of the last [`Self::update_values`]), compared bitwise.
+    pub fn has_values(&self, values: &[f64]) -> bool {
+        equals_upper(&self.levels[0].a, &self.fine_col_ptr, values)
     }
 
     /// Number of equations.
@@ -435,6 +458,32 @@ impl Amg {
                 rho: l.rho,
             })
             .collect()
+    }
+
+    /// Heap memory held, by part (capacities of the stored arrays; the coarsest level's
+    /// Cholesky factor is not counted).
+    pub fn memory(&self) -> AmgMemory {
+        let mut m = AmgMemory {
+            fine_map: vec_bytes(&self.fine_col_ptr),
+            vectors: self.cg.iter().map(vec_bytes).sum::<usize>() + vec_bytes(&self.scratch),
+            ..AmgMemory::default()
+        };
+        for level in &self.levels {
+            m.matrices += level.a.bytes();
+            m.vectors += vec_bytes(&level.dinv);
+            if let Some(tr) = &level.transfer {
+                m.tentative += tr.t.bytes();
+                m.prolongators += tr.p.bytes() + tr.pt.bytes() + vec_bytes(&tr.off);
+                m.products += tr.galerkin.bytes();
+            }
+        }
+        for w in &self.work {
+            m.vectors += [&w.b, &w.x, &w.r, &w.d, &w.dn]
+                .into_iter()
+                .map(vec_bytes)
+                .sum::<usize>();
+        }
+        m
     }
 
     /// Operator complexity: stored entries of all levels over those of the finest.
@@ -545,9 +594,9 @@ fn internal() -> AmgError {
     AmgError::Input("internal inconsistency of the multigrid hierarchy".into())
 }
 
-/// Numeric part of a level with a transfer: `ρ̂`, the smoother interval, `P`, and
-/// `W = A P` (into `w`) for the Galerkin product. Returns false on the coarsest level.
-fn smooth_level(level: &mut Level, options: &AmgOptions, w: &mut BlockRows) -> bool {
+/// Numeric part of a level with a transfer: `ρ̂`, the smoother interval and `P` (with its
+/// block transpose). Returns false on the coarsest level.
+fn smooth_level(level: &mut Level, options: &AmgOptions) -> bool {
     if level.transfer.is_none() {
         return false;
     }
@@ -565,6 +614,5 @@ fn smooth_level(level: &mut Level, options: &AmgOptions, w: &mut BlockRows) -> b
     };
     smooth_prolongator(&level.a, &level.dinv, omega, &tr.t, &tr.off, &mut tr.p);
     tr.pt.fill(&tr.p);
-    product_blocked(&level.a, &tr.p, &tr.off, w);
     true
 }

@@ -59,6 +59,6 @@ pub mod smoother;
 
 pub use csr::{CsrMatrix, SymCsr};
 pub use error::{AmgError, Result};
-pub use hierarchy::{Amg, AmgOptions, LevelInfo};
+pub use hierarchy::{Amg, AmgMemory, AmgOptions, LevelInfo};
 pub use nullspace::NearNullSpace;
 pub use pcg::CgStats;

@@ -27,14 +27,17 @@
 //!
 //! # Galerkin operator
 //!
-//! `A_c = Pᵀ (A P)`: first `W = A P` (blocks of a row in the order they are met, since only
-//! the next product reads them), then, for aggregate `a` with the rows `i` whose `P` row
-//! has a block `p_{i,a}`, the block row
+//! `A_c = Pᵀ (A P)` without storing `W = A P`: the coarse block rows are split into
+//! contiguous *parts*, and each part visits the fine rows `i` whose `P` row has a block
+//! `p_{i,a}` of one of its aggregates, computes the row `w_i = (A P)_i` (blocks in the
+//! order they are met, only the aggregates from the part's first one on) and adds
 //!
 //! ```text
-//!   (A_c)_{a,b} = Σ_i p_{i,a} w_{i,b}ᵀ        (k_a × k_b outer products).
+//!   (A_c)_{a,b} += p_{i,a} w_{i,b}ᵀ        (k_a × k_b outer products)
 //! ```
 //!
+//! to its block rows `a`. A fine row next to two parts is visited by both; the memory of
+//! `W` (larger than `A` itself after aggressive coarsening) is never needed.
 //! Only the blocks `b ≥ a` are summed; the diagonal blocks are averaged with their
 //! transposes and the blocks `b < a` are copied from the transposed blocks `(b, a)`. This
 //! halves the arithmetic and makes `A_c` exactly symmetric, so the V-cycle is an exactly
@@ -48,7 +51,7 @@
 
 use rayon::prelude::*;
 
-use crate::csr::{CsrMatrix, ROWS_PER_TASK, zeros};
+use crate::csr::{CsrMatrix, ROWS_PER_TASK, vec_bytes, zeros};
 
 /// The marker of row (or aggregate) `i` in a dense accumulator. Markers start at zero
 /// (fresh zero pages cost nothing until touched), so row `i` is marked `i + 1`.
@@ -73,6 +76,11 @@ pub(crate) struct Blocked {
 }
 
 impl Blocked {
+    /// Heap bytes held.
+    pub(crate) fn bytes(&self) -> usize {
+        self.m.bytes() + vec_bytes(&self.bptr) + vec_bytes(&self.bagg) + vec_bytes(&self.bpos)
+    }
+
     /// The matrix (values zero) whose row `i` holds the aggregates
     /// `bagg[bptr[i]..bptr[i+1]]` (increasing) with the column layout `off`.
     pub(crate) fn from_blocks(
@@ -255,84 +263,6 @@ pub(crate) fn smooth_prolongator(
     );
 }
 
-/// Rows of `W = A P` in blocks (unsorted within a row), stored per parallel task. The
-/// storage is kept between products (levels, rebuilds) so that later products write into
-/// memory that is already mapped.
-#[derive(Default)]
-pub(crate) struct BlockRows {
-    parts: Vec<RowsPart>,
-}
-
-/// The rows `blk · ROWS_PER_TASK ..` of a [`BlockRows`].
-#[derive(Default)]
-struct RowsPart {
-    bptr: Vec<u32>,
-    bagg: Vec<u32>,
-    bpos: Vec<u32>,
-    vals: Vec<f64>,
-}
-
-impl RowsPart {
-    fn clear(&mut self) {
-        self.bptr.clear();
-        self.bagg.clear();
-        self.bpos.clear();
-        self.vals.clear();
-    }
-}
-
-impl BlockRows {
-    /// Aggregates, value positions and values of the blocks of row `i`.
-    #[inline]
-    fn row(&self, i: usize) -> (&[u32], &[u32], &[f64]) {
-        let part = &self.parts[i / ROWS_PER_TASK];
-        let l = i % ROWS_PER_TASK;
-        let r = part.bptr[l] as usize..part.bptr[l + 1] as usize;
-        (&part.bagg[r.clone()], &part.bpos[r], &part.vals)
-    }
-}
-
-/// `W = A P` on blocks, into the storage of `w`.
-pub(crate) fn product_blocked(a: &CsrMatrix, p: &Blocked, off: &[usize], w: &mut BlockRows) {
-    let n = a.nrows();
-    let nagg = off.len() - 1;
-    let pv = p.m.values();
-    let nparts = n.div_ceil(ROWS_PER_TASK);
-    if w.parts.len() < nparts {
-        w.parts.resize_with(nparts, RowsPart::default);
-    }
-    w.parts[..nparts].par_iter_mut().enumerate().for_each_init(
-        || vec![(0u32, 0u32); nagg],
-        |slot, (blk, part)| {
-            let rows = blk * ROWS_PER_TASK..((blk + 1) * ROWS_PER_TASK).min(n);
-            part.clear();
-            part.bptr.push(0);
-            for i in rows {
-                let (ac, av) = a.row(i);
-                for (&j, &aij) in ac.iter().zip(av) {
-                    let (pb, pp) = p.blocks(j as usize);
-                    for (&b, &s) in pb.iter().zip(pp) {
-                        let bu = b as usize;
-                        let k = off[bu + 1] - off[bu];
-                        let (mark, pos) = &mut slot[bu];
-                        if *mark != stamp(i) {
-                            *mark = stamp(i);
-                            *pos = part.vals.len() as u32;
-                            part.bagg.push(b);
-                            part.bpos.push(*pos);
-                            part.vals.extend(pv[s..s + k].iter().map(|v| aij * v));
-                        } else {
-                            let d = *pos as usize;
-                            axpy(&mut part.vals[d..d + k], aij, &pv[s..s + k]);
-                        }
-                    }
-                }
-                part.bptr.push(part.bagg.len() as u32);
-            }
-        },
-    );
-}
-
 /// The block transpose of `P`: for every aggregate `a`, the rows `i` of `P` with a block
 /// of `a` (increasing), that block's value position in `P`, and a copy of the block values
 /// stored contiguously per aggregate (so the restriction reads memory in order).
@@ -344,6 +274,17 @@ pub(crate) struct Transposed {
     /// Values of aggregate `a` start at `vstart[a]`: `k_a` per row of the list.
     vstart: Vec<usize>,
     vals: Vec<f64>,
+}
+
+impl Transposed {
+    /// Heap bytes held.
+    pub(crate) fn bytes(&self) -> usize {
+        vec_bytes(&self.ptr)
+            + vec_bytes(&self.row)
+            + vec_bytes(&self.pos)
+            + vec_bytes(&self.vstart)
+            + vec_bytes(&self.vals)
+    }
 }
 
 impl Transposed {
@@ -450,7 +391,8 @@ pub(crate) fn restrict(pt: &Transposed, off: &[usize], r: &[f64], out: &mut [f64
         });
 }
 
-/// The block pattern of `A_c`, with the offsets and mirrors the numeric product needs.
+/// The block pattern of `A_c`, with the offsets and mirrors the numeric product needs, and
+/// the fine rows each part of the numeric product visits.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Galerkin {
     /// Blocks of block row `a`: `bptr[a]..bptr[a+1]`, aggregates increasing.
@@ -460,17 +402,81 @@ pub(crate) struct Galerkin {
     boff: Vec<usize>,
     /// Index of the mirror block `(b, a)` of each block `(a, b)`.
     mirror: Vec<usize>,
+    /// Part `k` owns the block rows `part_aggs[k]..part_aggs[k+1]`.
+    part_aggs: Vec<usize>,
+    /// The fine rows of part `k` (increasing): `rows[rptr[k]..rptr[k+1]]`, those whose
+    /// row of `P` has a block in the part's aggregates.
+    rptr: Vec<usize>,
+    rows: Vec<u32>,
 }
 
-/// The pattern of `A_c = Pᵀ W` (block rows of the coarse aggregates) and `A_c` with zero
-/// values.
+impl Galerkin {
+    /// Heap bytes held.
+    pub(crate) fn bytes(&self) -> usize {
+        vec_bytes(&self.bptr)
+            + vec_bytes(&self.bagg)
+            + vec_bytes(&self.boff)
+            + vec_bytes(&self.mirror)
+            + vec_bytes(&self.part_aggs)
+            + vec_bytes(&self.rptr)
+            + vec_bytes(&self.rows)
+    }
+}
+
+/// Row `i` of `W = A P` restricted to the aggregates `≥ lo`, in blocks: appends the
+/// aggregates to `aggs` and their values (`k_b` each, in the same order) to `vals`.
+/// `slot[b]` is `u32::MAX` on entry for every `b` and is restored before returning.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn w_row(
+    a: &CsrMatrix,
+    p: &Blocked,
+    off: &[usize],
+    i: usize,
+    lo: usize,
+    slot: &mut [u32],
+    aggs: &mut Vec<u32>,
+    vals: &mut Vec<f64>,
+) {
+    let pv = p.m.values();
+    aggs.clear();
+    vals.clear();
+    let (ac, av) = a.row(i);
+    for (&j, &aij) in ac.iter().zip(av) {
+        let (pb, pp) = p.blocks(j as usize);
+        for (&b, &s) in pb.iter().zip(pp) {
+            let bu = b as usize;
+            if bu < lo {
+                continue;
+            }
+            let k = off[bu + 1] - off[bu];
+            if slot[bu] == u32::MAX {
+                slot[bu] = vals.len() as u32;
+                aggs.push(b);
+                vals.extend(pv[s..s + k].iter().map(|v| aij * v));
+            } else {
+                let d = slot[bu] as usize;
+                axpy(&mut vals[d..d + k], aij, &pv[s..s + k]);
+            }
+        }
+    }
+    for &b in aggs.iter() {
+        slot[b as usize] = u32::MAX;
+    }
+}
+
+/// The pattern of `A_c = Pᵀ A P` (block rows of the coarse aggregates), the parts of the
+/// numeric product, and `A_c` with zero values.
 pub(crate) fn symbolic_galerkin(
+    a: &CsrMatrix,
+    p: &Blocked,
     pt: &Transposed,
-    w: &BlockRows,
     off: &[usize],
 ) -> (Galerkin, CsrMatrix) {
     let nagg = off.len() - 1;
-    let parts: Vec<(Vec<usize>, Vec<u32>)> = (0..nagg.div_ceil(AGGS_PER_TASK))
+    // Block (a, b) is present when some row i has a block of a in P and a column j of A
+    // whose row of P has a block of b.
+    let lists: Vec<(Vec<usize>, Vec<u32>)> = (0..nagg.div_ceil(AGGS_PER_TASK))
         .into_par_iter()
         .map_init(
             || vec![0u32; nagg],
@@ -478,14 +484,16 @@ pub(crate) fn symbolic_galerkin(
                 let aggs = blk * AGGS_PER_TASK..((blk + 1) * AGGS_PER_TASK).min(nagg);
                 let mut counts = Vec::with_capacity(aggs.len());
                 let mut list = Vec::new();
-                for a in aggs {
+                for ag in aggs {
                     let start = list.len();
-                    if off[a + 1] > off[a] {
-                        for &i in pt.of(a).0 {
-                            for &b in w.row(i as usize).0 {
-                                if mark[b as usize] != stamp(a) {
-                                    mark[b as usize] = stamp(a);
-                                    list.push(b);
+                    if off[ag + 1] > off[ag] {
+                        for &i in pt.of(ag).0 {
+                            for &j in a.row(i as usize).0 {
+                                for &b in p.blocks(j as usize).0 {
+                                    if mark[b as usize] != stamp(ag) {
+                                        mark[b as usize] = stamp(ag);
+                                        list.push(b);
+                                    }
                                 }
                             }
                         }
@@ -497,45 +505,78 @@ pub(crate) fn symbolic_galerkin(
             },
         )
         .collect();
-    let (bptr, bagg) = concat_block_lists(parts, nagg);
+    let (bptr, bagg) = concat_block_lists(lists, nagg);
     let width = |b: u32| off[b as usize + 1] - off[b as usize];
     let mut boff = Vec::with_capacity(bagg.len());
     let mut row_len = vec![0usize; nagg];
-    for a in 0..nagg {
+    for ag in 0..nagg {
         let mut len = 0;
-        for &b in &bagg[bptr[a]..bptr[a + 1]] {
+        for &b in &bagg[bptr[ag]..bptr[ag + 1]] {
             boff.push(len);
             len += width(b);
         }
-        row_len[a] = len;
+        row_len[ag] = len;
     }
     let mirror: Vec<usize> = (0..nagg)
         .into_par_iter()
-        .flat_map_iter(|a| {
+        .flat_map_iter(|ag| {
             let (bptr, bagg) = (&bptr, &bagg);
-            bagg[bptr[a]..bptr[a + 1]].iter().map(move |&b| {
+            bagg[bptr[ag]..bptr[ag + 1]].iter().map(move |&b| {
                 let row = &bagg[bptr[b as usize]..bptr[b as usize + 1]];
                 // The pattern is symmetric: (a, b) present ⇒ (b, a) present.
-                bptr[b as usize] + row.binary_search(&(a as u32)).unwrap_or(0)
+                bptr[b as usize] + row.binary_search(&(ag as u32)).unwrap_or(0)
             })
         })
         .collect();
     let nc = off[nagg];
     let mut row_ptr = Vec::with_capacity(nc + 1);
     row_ptr.push(0);
-    for a in 0..nagg {
-        for _ in 0..width(a as u32) {
-            row_ptr.push(row_ptr.last().copied().unwrap_or(0) + row_len[a]);
+    for ag in 0..nagg {
+        for _ in 0..width(ag as u32) {
+            row_ptr.push(row_ptr.last().copied().unwrap_or(0) + row_len[ag]);
         }
     }
     let nnz = row_ptr[nc];
     let mut col = Vec::with_capacity(nnz);
-    for a in 0..nagg {
-        for _ in 0..width(a as u32) {
-            for &b in &bagg[bptr[a]..bptr[a + 1]] {
+    for ag in 0..nagg {
+        for _ in 0..width(ag as u32) {
+            for &b in &bagg[bptr[ag]..bptr[ag + 1]] {
                 col.extend(off[b as usize] as u32..off[b as usize + 1] as u32);
             }
         }
+    }
+    // Parts: contiguous block rows with about equal numbers of values.
+    let num_parts = (8 * rayon::current_num_threads()).clamp(1, nagg.max(1));
+    let mut part_aggs = vec![0usize];
+    for k in 1..num_parts {
+        let target = nnz * k / num_parts;
+        let ag = (off.partition_point(|&o| row_ptr[o] < target))
+            .saturating_sub(1)
+            .min(nagg);
+        if ag > *part_aggs.last().unwrap_or(&0) {
+            part_aggs.push(ag);
+        }
+    }
+    if nagg > *part_aggs.last().unwrap_or(&0) || part_aggs.len() == 1 {
+        part_aggs.push(nagg);
+    }
+    let row_lists: Vec<Vec<u32>> = part_aggs
+        .par_windows(2)
+        .map(|w| {
+            let mut rows: Vec<u32> = (w[0]..w[1])
+                .flat_map(|ag| pt.of(ag).0.iter().copied())
+                .collect();
+            rows.sort_unstable();
+            rows.dedup();
+            rows
+        })
+        .collect();
+    let mut rptr = Vec::with_capacity(row_lists.len() + 1);
+    rptr.push(0);
+    let mut rows = Vec::with_capacity(row_lists.iter().map(Vec::len).sum());
+    for list in row_lists {
+        rows.extend_from_slice(&list);
+        rptr.push(rows.len());
     }
     let ac = CsrMatrix::from_parts(nc, nc, row_ptr, col, zeros(nnz));
     (
@@ -544,9 +585,153 @@ pub(crate) fn symbolic_galerkin(
             bagg,
             boff,
             mirror,
+            part_aggs,
+            rptr,
+            rows,
         },
         ac,
     )
+}
+
+/// Split the values of `ac` into those of the parts' block rows.
+fn part_values_mut<'a>(
+    ac_row_ptr: &[usize],
+    off: &[usize],
+    part_aggs: &[usize],
+    val: &'a mut [f64],
+) -> Vec<(usize, &'a mut [f64])> {
+    let mut out = Vec::with_capacity(part_aggs.len().saturating_sub(1));
+    let mut rest = val;
+    for (k, w) in part_aggs.windows(2).enumerate() {
+        let len = ac_row_ptr[off[w[1]]] - ac_row_ptr[off[w[0]]];
+        let (head, tail) = rest.split_at_mut(len);
+        out.push((k, head));
+        rest = tail;
+    }
+    out
+}
+
+/// Fill `ac` (from [`symbolic_galerkin`]) with `Pᵀ A P`, exactly symmetric, without
+/// storing `A P`: every part computes the rows `w_i = (A P)_i` of its fine rows (the
+/// aggregates `≥` its first one) and adds `p_{i,a} w_{i,b}ᵀ` to its block rows `a`, for
+/// `b ≥ a`. Each entry is summed by one part, over `i` increasing, so the result does not
+/// depend on the number of parts or threads.
+pub(crate) fn numeric_galerkin(
+    g: &Galerkin,
+    a: &CsrMatrix,
+    p: &Blocked,
+    off: &[usize],
+    ac: &mut CsrMatrix,
+    scratch: &mut Vec<f64>,
+) {
+    let nagg = off.len() - 1;
+    let width = |b: usize| off[b + 1] - off[b];
+    let row_ptr = ac.row_ptr().to_vec();
+    let pv = p.m.values();
+    // Pass 1: blocks (a, b ≥ a); diagonal blocks symmetrized.
+    part_values_mut(&row_ptr, off, &g.part_aggs, ac.values_mut())
+        .into_par_iter()
+        .for_each_init(
+            || {
+                (
+                    vec![u32::MAX; nagg],
+                    vec![0usize; nagg],
+                    Vec::new(),
+                    Vec::new(),
+                )
+            },
+            |(slot, pos, waggs, wvals), (k, vals)| {
+                let (lo, hi) = (g.part_aggs[k], g.part_aggs[k + 1]);
+                let base = row_ptr[off[lo]];
+                vals.fill(0.0);
+                for &i in &g.rows[g.rptr[k]..g.rptr[k + 1]] {
+                    let i = i as usize;
+                    w_row(a, p, off, i, lo, slot, waggs, wvals);
+                    let (pb, pp) = p.blocks(i);
+                    for (&ag, &s) in pb.iter().zip(pp) {
+                        let ag = ag as usize;
+                        if ag < lo || ag >= hi {
+                            continue;
+                        }
+                        let ka = width(ag);
+                        let pia = &pv[s..s + ka];
+                        let start = row_ptr[off[ag]] - base;
+                        let len = row_ptr[off[ag] + 1] - row_ptr[off[ag]];
+                        for q in g.bptr[ag]..g.bptr[ag + 1] {
+                            pos[g.bagg[q] as usize] = g.boff[q];
+                        }
+                        let block_row = &mut vals[start..start + ka * len];
+                        let mut t = 0;
+                        for &b in waggs.iter() {
+                            let b = b as usize;
+                            let kb = width(b);
+                            if b >= ag {
+                                let wib = &wvals[t..t + kb];
+                                let co = pos[b];
+                                for (r, &x) in pia.iter().enumerate() {
+                                    let d = r * len + co;
+                                    axpy(&mut block_row[d..d + kb], x, wib);
+                                }
+                            }
+                            t += kb;
+                        }
+                    }
+                }
+                for ag in lo..hi {
+                    let ka = width(ag);
+                    if ka == 0 {
+                        continue;
+                    }
+                    let start = row_ptr[off[ag]] - base;
+                    let len = row_ptr[off[ag] + 1] - row_ptr[off[ag]];
+                    let q = g.bptr[ag]
+                        + g.bagg[g.bptr[ag]..g.bptr[ag + 1]]
+                            .partition_point(|&b| (b as usize) < ag);
+                    let co = g.boff[q];
+                    let block_row = &mut vals[start..start + ka * len];
+                    for r in 0..ka {
+                        for c in r + 1..ka {
+                            let (u, l) = (r * len + co + c, c * len + co + r);
+                            let v = 0.5 * (block_row[u] + block_row[l]);
+                            block_row[u] = v;
+                            block_row[l] = v;
+                        }
+                    }
+                }
+            },
+        );
+    // Pass 2: blocks (a, b < a) from the transposed blocks (b, a).
+    scratch.clear();
+    scratch.extend_from_slice(ac.values());
+    let src = &scratch[..];
+    agg_chunks_mut(&row_ptr, off, ac.values_mut())
+        .into_par_iter()
+        .for_each(|(a0, vals)| {
+            let base = row_ptr[off[a0]];
+            for ag in a0..(a0 + AGGS_PER_TASK).min(nagg) {
+                let ka = width(ag);
+                if ka == 0 {
+                    continue;
+                }
+                let start = row_ptr[off[ag]] - base;
+                let len = row_ptr[off[ag] + 1] - row_ptr[off[ag]];
+                for q in g.bptr[ag]..g.bptr[ag + 1] {
+                    let b = g.bagg[q] as usize;
+                    if b >= ag {
+                        break;
+                    }
+                    let kb = width(b);
+                    let m = g.mirror[q];
+                    let sbase = row_ptr[off[b]] + g.boff[m];
+                    let slen = row_ptr[off[b] + 1] - row_ptr[off[b]];
+                    for r in 0..ka {
+                        for c in 0..kb {
+                            vals[start + r * len + g.boff[q] + c] = src[sbase + c * slen + r];
+                        }
+                    }
+                }
+            }
+        });
 }
 
 /// Split the values of `ac` into those of consecutive groups of block rows.
@@ -568,101 +753,6 @@ fn agg_chunks_mut<'a>(
         a = e;
     }
     out
-}
-
-/// Fill `ac` (from [`symbolic_galerkin`]) with `Pᵀ W`, exactly symmetric.
-pub(crate) fn numeric_galerkin(
-    g: &Galerkin,
-    pt: &Transposed,
-    w: &BlockRows,
-    off: &[usize],
-    ac: &mut CsrMatrix,
-    scratch: &mut Vec<f64>,
-) {
-    let nagg = off.len() - 1;
-    let width = |b: usize| off[b + 1] - off[b];
-    let row_ptr = ac.row_ptr().to_vec();
-    // Pass 1: blocks (a, b ≥ a); diagonal blocks symmetrized.
-    agg_chunks_mut(&row_ptr, off, ac.values_mut())
-        .into_par_iter()
-        .for_each_init(
-            || vec![0usize; nagg],
-            |pos, (a0, vals)| {
-                let base = row_ptr[off[a0]];
-                for a in a0..(a0 + AGGS_PER_TASK).min(nagg) {
-                    let ka = width(a);
-                    if ka == 0 {
-                        continue;
-                    }
-                    let start = row_ptr[off[a]] - base;
-                    let len = row_ptr[off[a] + 1] - row_ptr[off[a]];
-                    let block_row = &mut vals[start..start + ka * len];
-                    block_row.fill(0.0);
-                    for q in g.bptr[a]..g.bptr[a + 1] {
-                        pos[g.bagg[q] as usize] = g.boff[q];
-                    }
-                    let (rows, v0) = pt.of(a);
-                    for (t, &i) in rows.iter().enumerate() {
-                        let pia = &pt.vals[v0 + t * ka..v0 + (t + 1) * ka];
-                        let (wb, wp, wv) = w.row(i as usize);
-                        for (&b, &s) in wb.iter().zip(wp) {
-                            let b = b as usize;
-                            if b < a {
-                                continue;
-                            }
-                            let kb = width(b);
-                            let wib = &wv[s as usize..s as usize + kb];
-                            let co = pos[b];
-                            for (r, &x) in pia.iter().enumerate() {
-                                let d = r * len + co;
-                                axpy(&mut block_row[d..d + kb], x, wib);
-                            }
-                        }
-                    }
-                    let co = pos[a];
-                    for r in 0..ka {
-                        for c in r + 1..ka {
-                            let (u, l) = (r * len + co + c, c * len + co + r);
-                            let v = 0.5 * (block_row[u] + block_row[l]);
-                            block_row[u] = v;
-                            block_row[l] = v;
-                        }
-                    }
-                }
-            },
-        );
-    // Pass 2: blocks (a, b < a) from the transposed blocks (b, a).
-    scratch.clear();
-    scratch.extend_from_slice(ac.values());
-    let src = &scratch[..];
-    agg_chunks_mut(&row_ptr, off, ac.values_mut())
-        .into_par_iter()
-        .for_each(|(a0, vals)| {
-            let base = row_ptr[off[a0]];
-            for a in a0..(a0 + AGGS_PER_TASK).min(nagg) {
-                let ka = width(a);
-                if ka == 0 {
-                    continue;
-                }
-                let start = row_ptr[off[a]] - base;
-                let len = row_ptr[off[a] + 1] - row_ptr[off[a]];
-                for q in g.bptr[a]..g.bptr[a + 1] {
-                    let b = g.bagg[q] as usize;
-                    if b >= a {
-                        break;
-                    }
-                    let kb = width(b);
-                    let m = g.mirror[q];
-                    let sbase = row_ptr[off[b]] + g.boff[m];
-                    let slen = row_ptr[off[b] + 1] - row_ptr[off[b]];
-                    for r in 0..ka {
-                        for c in 0..kb {
-                            vals[start + r * len + g.boff[q] + c] = src[sbase + c * slen + r];
-                        }
-                    }
-                }
-            }
-        });
 }
 
 #[cfg(test)]
@@ -751,11 +841,9 @@ mod tests {
                 assert!((pd[i][j] - want).abs() < 1e-15, "P[{i}][{j}]");
             }
         }
-        let mut w = BlockRows::default();
-        product_blocked(&am, &p, &off, &mut w);
         let pt = block_transpose(&p, &off);
-        let (g, mut ac) = symbolic_galerkin(&pt, &w, &off);
-        numeric_galerkin(&g, &pt, &w, &off, &mut ac, &mut Vec::new());
+        let (g, mut ac) = symbolic_galerkin(&am, &p, &pt, &off);
+        numeric_galerkin(&g, &am, &p, &off, &mut ac, &mut Vec::new());
         let want = matmul(&transpose(&pd), &matmul(&a, &pd));
         let got = dense(&ac);
         for i in 0..5 {

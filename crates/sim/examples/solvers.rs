@@ -145,11 +145,26 @@ fn l2_error<const D: usize>(grid: &Grid<D>, u: &[f64], exact: Exact<D>) -> f64 {
 }
 
 fn peak_rss_mb() -> f64 {
+    status_mb("VmHWM:")
+}
+
+/// With `MEM_TRACE` set: the resident and peak memory after a stage, on stderr.
+fn trace(stage: &str) {
+    if std::env::var_os("MEM_TRACE").is_some() {
+        eprintln!(
+            "{stage:>10}: resident {:6.0} MB, peak {:6.0} MB",
+            status_mb("VmRSS:"),
+            status_mb("VmHWM:")
+        );
+    }
+}
+
+fn status_mb(key: &str) -> f64 {
     std::fs::read_to_string("/proc/self/status")
         .ok()
         .and_then(|s| {
             s.lines()
-                .find(|l| l.starts_with("VmHWM:"))
+                .find(|l| l.starts_with(key))
                 .and_then(|l| l.split_whitespace().nth(1))
                 .and_then(|v| v.parse::<f64>().ok())
         })
@@ -161,6 +176,7 @@ fn run<const D: usize>(n: usize, solver: &str, tol: f64, exact: Exact<D>, f: [Sc
     let grid =
         generate::simplices::<D>(Point::<D>::zeros(), Point::<D>::repeat(1.0), [n; D]).unwrap();
     let t_grid = t0.elapsed().as_secs_f64();
+    trace("grid");
     let t1 = Instant::now();
     let bc = Displacement {
         name: "boundary".into(),
@@ -168,7 +184,9 @@ fn run<const D: usize>(n: usize, solver: &str, tol: f64, exact: Exact<D>, f: [Sc
         components: std::array::from_fn(|a| Some(ScalarField::from_fn(move |x, _| exact(x)[a]))),
     };
     let dofs = DofMap::new(&grid, &[bc], &[]).unwrap();
+    trace("dofs");
     let pattern = Pattern::new(&grid, &dofs).unwrap();
+    trace("pattern");
     let law = VemLaw::new(Stiffness::<D>::isotropic(1.0, 0.3).unwrap());
     let laws = LawMap::uniform(&grid, &law).unwrap();
     let mut u = vec![0.0; dofs.num_dofs()];
@@ -184,6 +202,7 @@ fn run<const D: usize>(n: usize, solver: &str, tol: f64, exact: Exact<D>, f: [Sc
     nodal_loads(&grid, &loads, 0.0, &mut full).unwrap();
     dofs.reduce_add(&full, &mut rhs);
     let t_asm = t1.elapsed().as_secs_f64();
+    trace("assembly");
     let neq = dofs.num_equations();
     let mut x = vec![0.0; neq];
     let (t_setup, t_solve, iterations, info) = match solver {
@@ -239,9 +258,14 @@ fn run<const D: usize>(n: usize, solver: &str, tol: f64, exact: Exact<D>, f: [Sc
             }
             s.setup(&pattern, &values).unwrap();
             let t_setup = t2.elapsed().as_secs_f64();
+            trace("setup");
             let t3 = Instant::now();
             let st = s.solve_system(&pattern, &values, &rhs, &mut x).unwrap();
             let t_solve = t3.elapsed().as_secs_f64();
+            trace("solve");
+            if std::env::var_os("MEM_TRACE").is_some() {
+                eprintln!("{:?}", s.hierarchy().unwrap().memory());
+            }
             let h = s.hierarchy().unwrap();
             let levels: Vec<String> = h.level_info().iter().map(|l| l.rows.to_string()).collect();
             let info = format!(

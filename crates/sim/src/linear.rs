@@ -140,8 +140,8 @@ impl LinearSolve for DirectSolver {
 /// docs).
 pub struct AmgSolver {
     amg: Option<Amg>,
-    /// Values the hierarchy was last built or updated with.
-    values: Vec<f64>,
+    /// The last numeric update failed: update even if the values did not change.
+    failed_update: bool,
     coords: Vec<f64>,
     eq_dofs: Vec<(usize, usize)>,
     dim: usize,
@@ -234,7 +234,7 @@ impl AmgSolver {
         }
         Ok(Self {
             amg: None,
-            values: Vec::new(),
+            failed_update: false,
             coords,
             eq_dofs,
             dim: D,
@@ -299,14 +299,13 @@ impl AmgSolver {
         let amg_err = |e: porofrac_amg::AmgError| SimError::Iterative(format!("AMG setup: {e}"));
         match self.amg.as_mut() {
             Some(amg) => {
-                if self.values != values {
-                    if let Err(e) = amg.update_values(values) {
-                        // The hierarchy refuses to solve after a failed update.
-                        self.values.clear();
-                        return Err(amg_err(e));
-                    }
-                    self.values.clear();
-                    self.values.extend_from_slice(values);
+                // The hierarchy's finest matrix holds the values it was last built or
+                // updated with: compared in place, no copy kept.
+                if self.failed_update || !amg.has_values(values) {
+                    // The hierarchy refuses to solve after a failed update.
+                    self.failed_update = true;
+                    amg.update_values(values).map_err(amg_err)?;
+                    self.failed_update = false;
                     self.updates += 1;
                 }
             }
@@ -318,7 +317,6 @@ impl AmgSolver {
                     Amg::elasticity(sym, &self.coords, self.dim, &self.eq_dofs, &self.options)
                         .map_err(amg_err)?;
                 self.amg = Some(amg);
-                self.values = values.to_vec();
                 self.setups += 1;
             }
         }

@@ -169,43 +169,50 @@ impl Pattern {
                 next[e] += 1;
             }
         }
-        // Columns, in parallel blocks: rows r ≤ c of the cells containing c.
-        const BLOCK: usize = 4096;
-        let blocks: Vec<(Vec<usize>, Vec<usize>)> = (0..n.div_ceil(BLOCK))
-            .into_par_iter()
-            .map(|b| {
-                let mut counts = Vec::with_capacity(BLOCK);
-                let mut rows = Vec::new();
-                let mut col = Vec::new();
-                let cells_of = |c: usize| &eq_cells[eq_cell_pos[c]..eq_cell_pos[c + 1]];
-                for c in b * BLOCK..((b + 1) * BLOCK).min(n) {
-                    if c > b * BLOCK && cells_of(c) == cells_of(c - 1) {
-                        // Another component of the same node: the same cells, so the
-                        // rows are those of column c − 1 and c itself.
-                        col.push(c);
-                    } else {
-                        col.clear();
-                        for &cell in cells_of(c) {
-                            col.extend(eqs_of(cell).iter().copied().filter(|&r| r <= c));
-                        }
-                        col.sort_unstable();
-                        col.dedup();
-                    }
-                    counts.push(col.len());
-                    rows.extend_from_slice(&col);
+        // Columns: rows r ≤ c of the cells containing c. Counted first and then written
+        // into the final array (both in parallel), so that no per-block buffers are left
+        // behind in the allocator.
+        let cells_of = |c: usize| &eq_cells[eq_cell_pos[c]..eq_cell_pos[c + 1]];
+        let column = |c: usize, first: usize, col: &mut Vec<usize>| {
+            if c > first && cells_of(c) == cells_of(c - 1) {
+                // Another component of the same node: the same cells, so the rows are
+                // those of column c − 1 and c itself.
+                col.push(c);
+            } else {
+                col.clear();
+                for &cell in cells_of(c) {
+                    col.extend(eqs_of(cell).iter().copied().filter(|&r| r <= c));
                 }
-                (counts, rows)
+                col.sort_unstable();
+                col.dedup();
+            }
+        };
+        const BLOCK: usize = 4096;
+        let col_counts: Vec<usize> = (0..n.div_ceil(BLOCK))
+            .into_par_iter()
+            .flat_map_iter(|b| {
+                let cols = b * BLOCK..((b + 1) * BLOCK).min(n);
+                let mut col = Vec::new();
+                cols.map(move |c| {
+                    column(c, b * BLOCK, &mut col);
+                    col.len()
+                })
+                .collect::<Vec<_>>()
             })
             .collect();
-        let mut col_ptr = Vec::with_capacity(n + 1);
-        col_ptr.push(0);
-        let mut row_idx = Vec::new();
-        for (counts, rows) in blocks {
-            for k in counts {
-                col_ptr.push(col_ptr.last().copied().unwrap_or(0) + k);
+        let col_ptr = offsets(&col_counts);
+        drop(col_counts);
+        let mut row_idx = vec![0usize; col_ptr[n]];
+        fill_blocks(&mut row_idx, &col_ptr, |cols, out| {
+            let first = cols.start;
+            let mut col = Vec::new();
+            let mut k = 0;
+            for c in cols {
+                column(c, first, &mut col);
+                out[k..k + col.len()].copy_from_slice(&col);
+                k += col.len();
             }
-            row_idx.extend_from_slice(&rows);
-        }
+        });
         let nnz = row_idx.len();
         if nnz >= NONE as usize {
             return Err(SimError::Input(format!(
