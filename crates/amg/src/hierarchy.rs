@@ -44,8 +44,8 @@ use crate::csr::{
 use crate::error::{AmgError, Result, check_finite};
 use crate::nullspace::NearNullSpace;
 use crate::product::{
-    Blocked, Galerkin, Transposed, block_transpose, numeric_galerkin, restrict, smooth_prolongator,
-    symbolic_galerkin, symbolic_prolongator,
+    Blocked, Galerkin, numeric_galerkin, restrict, smooth_prolongator, symbolic_galerkin,
+    symbolic_prolongator,
 };
 use crate::smoother::{Chebyshev, SmoothWork, spectral_radius};
 
@@ -139,8 +139,6 @@ struct Transfer {
     t: Blocked,
     /// Smoothed prolongator.
     p: Blocked,
-    /// Its block transpose (restriction and Galerkin product).
-    pt: Transposed,
     /// Block pattern of the next level's matrix.
     galerkin: Galerkin,
     /// Coarse equations `off[a]..off[a+1]` of aggregate `a`.
@@ -201,7 +199,7 @@ pub struct AmgMemory {
     pub fine_map: usize,
     /// Tentative prolongators.
     pub tentative: usize,
-    /// Smoothed prolongators and their block transposes.
+    /// Smoothed prolongators.
     pub prolongators: usize,
     /// The Galerkin patterns, kept for numeric rebuilds.
     pub products: usize,
@@ -316,11 +314,9 @@ impl Amg {
             }
             let off = tent.coarse_blocks.ptr.clone();
             let p = symbolic_prolongator(&a, &tent.eq_agg, &off);
-            let pt = block_transpose(&p, &off);
             let transfer = Transfer {
                 t: tent.p,
                 p,
-                pt,
                 galerkin: Galerkin::default(),
                 off,
             };
@@ -329,7 +325,7 @@ impl Amg {
                 return Err(internal());
             }
             let tr = level.transfer.as_mut().ok_or_else(internal)?;
-            let (galerkin, mut ac) = symbolic_galerkin(&level.a, &tr.p, &tr.pt, &tr.off);
+            let (galerkin, mut ac) = symbolic_galerkin(&level.a, &tr.p, &tr.off);
             numeric_galerkin(&galerkin, &level.a, &tr.p, &tr.off, &mut ac, &mut scratch);
             tr.galerkin = galerkin;
             levels.push(level);
@@ -473,7 +469,7 @@ impl Amg {
             m.vectors += vec_bytes(&level.dinv);
             if let Some(tr) = &level.transfer {
                 m.tentative += tr.t.bytes();
-                m.prolongators += tr.p.bytes() + tr.pt.bytes() + vec_bytes(&tr.off);
+                m.prolongators += tr.p.bytes() + vec_bytes(&tr.off);
                 m.products += tr.galerkin.bytes();
             }
         }
@@ -557,7 +553,7 @@ impl Amg {
                 dn: &mut w.dn,
             };
             lev.smoother.smooth(&lev.a, &lev.dinv, b, x, true, true, sw);
-            restrict(&tr.pt, &tr.off, &w.r, &mut hi[0].b);
+            restrict(&tr.galerkin, &tr.p, &tr.off, &w.r, &mut hi[0].b);
         }
         // Coarsest level.
         {
@@ -594,8 +590,8 @@ fn internal() -> AmgError {
     AmgError::Input("internal inconsistency of the multigrid hierarchy".into())
 }
 
-/// Numeric part of a level with a transfer: `ρ̂`, the smoother interval and `P` (with its
-/// block transpose). Returns false on the coarsest level.
+/// Numeric part of a level with a transfer: `ρ̂`, the smoother interval and `P`. Returns
+/// false on the coarsest level.
 fn smooth_level(level: &mut Level, options: &AmgOptions) -> bool {
     if level.transfer.is_none() {
         return false;
@@ -613,6 +609,5 @@ fn smooth_level(level: &mut Level, options: &AmgOptions) -> bool {
         return false;
     };
     smooth_prolongator(&level.a, &level.dinv, omega, &tr.t, &tr.off, &mut tr.p);
-    tr.pt.fill(&tr.p);
     true
 }

@@ -45,9 +45,9 @@
 //!
 //! # Restriction
 //!
-//! `(Pᵀ r)_{off[a]..off[a+1]} = Σ_i r_i p_{i,a}`, over the same per-aggregate list of rows,
-//! in parallel over aggregates. The blocks `p_{i,a}` are copied into one contiguous array
-//! per aggregate (the block transpose), so the restriction reads memory in order.
+//! `(Pᵀ r)_{off[a]..off[a+1]} = Σ_i r_i p_{i,a}`, on the parts of the Galerkin product:
+//! each part runs over its fine rows and adds to its own aggregates, reading `P` row by
+//! row. No transpose of `P` is stored.
 
 use rayon::prelude::*;
 
@@ -263,80 +263,9 @@ pub(crate) fn smooth_prolongator(
     );
 }
 
-/// The block transpose of `P`: for every aggregate `a`, the rows `i` of `P` with a block
-/// of `a` (increasing), that block's value position in `P`, and a copy of the block values
-/// stored contiguously per aggregate (so the restriction reads memory in order).
-#[derive(Clone, Debug)]
-pub(crate) struct Transposed {
-    ptr: Vec<usize>,
-    row: Vec<u32>,
-    pos: Vec<usize>,
-    /// Values of aggregate `a` start at `vstart[a]`: `k_a` per row of the list.
-    vstart: Vec<usize>,
-    vals: Vec<f64>,
-}
-
-impl Transposed {
-    /// Heap bytes held.
-    pub(crate) fn bytes(&self) -> usize {
-        vec_bytes(&self.ptr)
-            + vec_bytes(&self.row)
-            + vec_bytes(&self.pos)
-            + vec_bytes(&self.vstart)
-            + vec_bytes(&self.vals)
-    }
-}
-
-impl Transposed {
-    /// Rows and the start of their values in `vals`.
-    #[inline]
-    fn of(&self, a: usize) -> (&[u32], usize) {
-        (&self.row[self.ptr[a]..self.ptr[a + 1]], self.vstart[a])
-    }
-
-    /// Copy the block values from `p` (after a numeric change of `p`).
-    pub(crate) fn fill(&mut self, p: &Blocked) {
-        let pv = p.m.values();
-        let (ptr, pos, vstart) = (&self.ptr, &self.pos, &self.vstart);
-        let nagg = ptr.len() - 1;
-        split_by(&mut self.vals, vstart, AGGS_PER_TASK)
-            .into_par_iter()
-            .for_each(|(a0, out)| {
-                let base = vstart[a0];
-                for a in a0..(a0 + AGGS_PER_TASK).min(nagg) {
-                    let k = if ptr[a + 1] > ptr[a] {
-                        (vstart[a + 1] - vstart[a]) / (ptr[a + 1] - ptr[a])
-                    } else {
-                        0
-                    };
-                    for (t, &q) in pos[ptr[a]..ptr[a + 1]].iter().enumerate() {
-                        let d = vstart[a] - base + t * k;
-                        out[d..d + k].copy_from_slice(&pv[q..q + k]);
-                    }
-                }
-            });
-    }
-}
-
-/// Split `v` at `bounds[a]` for every `step`-th `a`: `(a, slice of bounds[a]..bounds[a+step])`.
-fn split_by<'a, T>(v: &'a mut [T], bounds: &[usize], step: usize) -> Vec<(usize, &'a mut [T])> {
-    let n = bounds.len() - 1;
-    let mut out = Vec::with_capacity(n.div_ceil(step));
-    let mut rest = v;
-    let mut a = 0;
-    while a < n {
-        let e = (a + step).min(n);
-        let (head, tail) = rest.split_at_mut(bounds[e] - bounds[a]);
-        out.push((a, head));
-        rest = tail;
-        a = e;
-    }
-    out
-}
-
-/// The block transpose of `p` over the aggregates of the column layout `off`, with values.
-pub(crate) fn block_transpose(p: &Blocked, off: &[usize]) -> Transposed {
-    let nagg = off.len() - 1;
+/// For every aggregate `a`, the rows `i` of `P` with a block of `a`, increasing:
+/// `rows[ptr[a]..ptr[a+1]]` (the pattern of the block transpose).
+fn rows_of_aggregates(p: &Blocked, nagg: usize) -> (Vec<usize>, Vec<u32>) {
     let mut ptr = vec![0usize; nagg + 1];
     for &b in &p.bagg {
         ptr[b as usize + 1] += 1;
@@ -344,51 +273,60 @@ pub(crate) fn block_transpose(p: &Blocked, off: &[usize]) -> Transposed {
     for a in 0..nagg {
         ptr[a + 1] += ptr[a];
     }
-    let mut vstart = vec![0usize; nagg + 1];
-    for a in 0..nagg {
-        vstart[a + 1] = vstart[a] + (ptr[a + 1] - ptr[a]) * (off[a + 1] - off[a]);
-    }
     let mut next = ptr.clone();
-    let nb = p.num_blocks();
-    let mut row = vec![0u32; nb];
-    let mut pos = vec![0usize; nb];
+    let mut rows = vec![0u32; p.num_blocks()];
     for i in 0..p.m.nrows() {
-        for q in p.bptr[i]..p.bptr[i + 1] {
-            let b = p.bagg[q] as usize;
-            row[next[b]] = i as u32;
-            pos[next[b]] = p.bpos[q];
-            next[b] += 1;
+        for &b in &p.bagg[p.bptr[i]..p.bptr[i + 1]] {
+            rows[next[b as usize]] = i as u32;
+            next[b as usize] += 1;
         }
     }
-    let mut t = Transposed {
-        ptr,
-        row,
-        pos,
-        vals: zeros(vstart[nagg]),
-        vstart,
-    };
-    t.fill(p);
-    t
+    (ptr, rows)
 }
 
-/// `out = Pᵀ r`, aggregate by aggregate: `out[off[a]..off[a+1]] = Σ_i r_i p_{i,a}`.
-pub(crate) fn restrict(pt: &Transposed, off: &[usize], r: &[f64], out: &mut [f64]) {
-    let nagg = off.len() - 1;
-    split_by(out, off, AGGS_PER_TASK)
-        .into_par_iter()
-        .for_each(|(a0, out)| {
-            let base = off[a0];
-            for a in a0..(a0 + AGGS_PER_TASK).min(nagg) {
-                let acc = &mut out[off[a] - base..off[a + 1] - base];
-                let k = acc.len();
-                acc.fill(0.0);
-                let (rows, v0) = pt.of(a);
-                for (t, &i) in rows.iter().enumerate() {
-                    let d = v0 + t * k;
-                    axpy(acc, r[i as usize], &pt.vals[d..d + k]);
+/// `out = Pᵀ r`: every part of `g` sums `r_i p_{i,a}` into its aggregates `a`, over its
+/// fine rows `i` increasing (so the result does not depend on the parts).
+pub(crate) fn restrict(g: &Galerkin, p: &Blocked, off: &[usize], r: &[f64], out: &mut [f64]) {
+    let pv = p.m.values();
+    part_slices_mut(
+        &g.part_aggs,
+        |k| off[g.part_aggs[k]]..off[g.part_aggs[k + 1]],
+        out,
+    )
+    .into_par_iter()
+    .for_each(|(k, out)| {
+        let (lo, hi) = (g.part_aggs[k], g.part_aggs[k + 1]);
+        let base = off[lo];
+        out.fill(0.0);
+        for &i in &g.rows[g.rptr[k]..g.rptr[k + 1]] {
+            let ri = r[i as usize];
+            let (pb, pp) = p.blocks(i as usize);
+            for (&a, &s) in pb.iter().zip(pp) {
+                let a = a as usize;
+                if (lo..hi).contains(&a) {
+                    let d = off[a] - base;
+                    let ka = off[a + 1] - off[a];
+                    axpy(&mut out[d..d + ka], ri, &pv[s..s + ka]);
                 }
             }
-        });
+        }
+    });
+}
+
+/// Split `v` into the parts' slices `range(k)` (consecutive, covering `v`).
+fn part_slices_mut<'a, T>(
+    part_aggs: &[usize],
+    range: impl Fn(usize) -> std::ops::Range<usize>,
+    v: &'a mut [T],
+) -> Vec<(usize, &'a mut [T])> {
+    let mut out = Vec::with_capacity(part_aggs.len().saturating_sub(1));
+    let mut rest = v;
+    for k in 0..part_aggs.len().saturating_sub(1) {
+        let (head, tail) = rest.split_at_mut(range(k).len());
+        out.push((k, head));
+        rest = tail;
+    }
+    out
 }
 
 /// The block pattern of `A_c`, with the offsets and mirrors the numeric product needs, and
@@ -470,10 +408,11 @@ fn w_row(
 pub(crate) fn symbolic_galerkin(
     a: &CsrMatrix,
     p: &Blocked,
-    pt: &Transposed,
     off: &[usize],
 ) -> (Galerkin, CsrMatrix) {
     let nagg = off.len() - 1;
+    let (pt_ptr, pt_rows) = rows_of_aggregates(p, nagg);
+    let rows_of = |ag: usize| &pt_rows[pt_ptr[ag]..pt_ptr[ag + 1]];
     // Block (a, b) is present when some row i has a block of a in P and a column j of A
     // whose row of P has a block of b.
     let lists: Vec<(Vec<usize>, Vec<u32>)> = (0..nagg.div_ceil(AGGS_PER_TASK))
@@ -487,7 +426,7 @@ pub(crate) fn symbolic_galerkin(
                 for ag in aggs {
                     let start = list.len();
                     if off[ag + 1] > off[ag] {
-                        for &i in pt.of(ag).0 {
+                        for &i in rows_of(ag) {
                             for &j in a.row(i as usize).0 {
                                 for &b in p.blocks(j as usize).0 {
                                     if mark[b as usize] != stamp(ag) {
@@ -564,7 +503,7 @@ pub(crate) fn symbolic_galerkin(
         .par_windows(2)
         .map(|w| {
             let mut rows: Vec<u32> = (w[0]..w[1])
-                .flat_map(|ag| pt.of(ag).0.iter().copied())
+                .flat_map(|ag| rows_of(ag).iter().copied())
                 .collect();
             rows.sort_unstable();
             rows.dedup();
@@ -593,24 +532,6 @@ pub(crate) fn symbolic_galerkin(
     )
 }
 
-/// Split the values of `ac` into those of the parts' block rows.
-fn part_values_mut<'a>(
-    ac_row_ptr: &[usize],
-    off: &[usize],
-    part_aggs: &[usize],
-    val: &'a mut [f64],
-) -> Vec<(usize, &'a mut [f64])> {
-    let mut out = Vec::with_capacity(part_aggs.len().saturating_sub(1));
-    let mut rest = val;
-    for (k, w) in part_aggs.windows(2).enumerate() {
-        let len = ac_row_ptr[off[w[1]]] - ac_row_ptr[off[w[0]]];
-        let (head, tail) = rest.split_at_mut(len);
-        out.push((k, head));
-        rest = tail;
-    }
-    out
-}
-
 /// Fill `ac` (from [`symbolic_galerkin`]) with `Pᵀ A P`, exactly symmetric, without
 /// storing `A P`: every part computes the rows `w_i = (A P)_i` of its fine rows (the
 /// aggregates `≥` its first one) and adds `p_{i,a} w_{i,b}ᵀ` to its block rows `a`, for
@@ -629,77 +550,79 @@ pub(crate) fn numeric_galerkin(
     let row_ptr = ac.row_ptr().to_vec();
     let pv = p.m.values();
     // Pass 1: blocks (a, b ≥ a); diagonal blocks symmetrized.
-    part_values_mut(&row_ptr, off, &g.part_aggs, ac.values_mut())
-        .into_par_iter()
-        .for_each_init(
-            || {
-                (
-                    vec![u32::MAX; nagg],
-                    vec![0usize; nagg],
-                    Vec::new(),
-                    Vec::new(),
-                )
-            },
-            |(slot, pos, waggs, wvals), (k, vals)| {
-                let (lo, hi) = (g.part_aggs[k], g.part_aggs[k + 1]);
-                let base = row_ptr[off[lo]];
-                vals.fill(0.0);
-                for &i in &g.rows[g.rptr[k]..g.rptr[k + 1]] {
-                    let i = i as usize;
-                    w_row(a, p, off, i, lo, slot, waggs, wvals);
-                    let (pb, pp) = p.blocks(i);
-                    for (&ag, &s) in pb.iter().zip(pp) {
-                        let ag = ag as usize;
-                        if ag < lo || ag >= hi {
-                            continue;
-                        }
-                        let ka = width(ag);
-                        let pia = &pv[s..s + ka];
-                        let start = row_ptr[off[ag]] - base;
-                        let len = row_ptr[off[ag] + 1] - row_ptr[off[ag]];
-                        for q in g.bptr[ag]..g.bptr[ag + 1] {
-                            pos[g.bagg[q] as usize] = g.boff[q];
-                        }
-                        let block_row = &mut vals[start..start + ka * len];
-                        let mut t = 0;
-                        for &b in waggs.iter() {
-                            let b = b as usize;
-                            let kb = width(b);
-                            if b >= ag {
-                                let wib = &wvals[t..t + kb];
-                                let co = pos[b];
-                                for (r, &x) in pia.iter().enumerate() {
-                                    let d = r * len + co;
-                                    axpy(&mut block_row[d..d + kb], x, wib);
-                                }
-                            }
-                            t += kb;
-                        }
-                    }
-                }
-                for ag in lo..hi {
-                    let ka = width(ag);
-                    if ka == 0 {
+    {
+        let part_values = |k: usize| row_ptr[off[g.part_aggs[k]]]..row_ptr[off[g.part_aggs[k + 1]]];
+        part_slices_mut(&g.part_aggs, part_values, ac.values_mut())
+    }
+    .into_par_iter()
+    .for_each_init(
+        || {
+            (
+                vec![u32::MAX; nagg],
+                vec![0usize; nagg],
+                Vec::new(),
+                Vec::new(),
+            )
+        },
+        |(slot, pos, waggs, wvals), (k, vals)| {
+            let (lo, hi) = (g.part_aggs[k], g.part_aggs[k + 1]);
+            let base = row_ptr[off[lo]];
+            vals.fill(0.0);
+            for &i in &g.rows[g.rptr[k]..g.rptr[k + 1]] {
+                let i = i as usize;
+                w_row(a, p, off, i, lo, slot, waggs, wvals);
+                let (pb, pp) = p.blocks(i);
+                for (&ag, &s) in pb.iter().zip(pp) {
+                    let ag = ag as usize;
+                    if ag < lo || ag >= hi {
                         continue;
                     }
+                    let ka = width(ag);
+                    let pia = &pv[s..s + ka];
                     let start = row_ptr[off[ag]] - base;
                     let len = row_ptr[off[ag] + 1] - row_ptr[off[ag]];
-                    let q = g.bptr[ag]
-                        + g.bagg[g.bptr[ag]..g.bptr[ag + 1]]
-                            .partition_point(|&b| (b as usize) < ag);
-                    let co = g.boff[q];
+                    for q in g.bptr[ag]..g.bptr[ag + 1] {
+                        pos[g.bagg[q] as usize] = g.boff[q];
+                    }
                     let block_row = &mut vals[start..start + ka * len];
-                    for r in 0..ka {
-                        for c in r + 1..ka {
-                            let (u, l) = (r * len + co + c, c * len + co + r);
-                            let v = 0.5 * (block_row[u] + block_row[l]);
-                            block_row[u] = v;
-                            block_row[l] = v;
+                    let mut t = 0;
+                    for &b in waggs.iter() {
+                        let b = b as usize;
+                        let kb = width(b);
+                        if b >= ag {
+                            let wib = &wvals[t..t + kb];
+                            let co = pos[b];
+                            for (r, &x) in pia.iter().enumerate() {
+                                let d = r * len + co;
+                                axpy(&mut block_row[d..d + kb], x, wib);
+                            }
                         }
+                        t += kb;
                     }
                 }
-            },
-        );
+            }
+            for ag in lo..hi {
+                let ka = width(ag);
+                if ka == 0 {
+                    continue;
+                }
+                let start = row_ptr[off[ag]] - base;
+                let len = row_ptr[off[ag] + 1] - row_ptr[off[ag]];
+                let q = g.bptr[ag]
+                    + g.bagg[g.bptr[ag]..g.bptr[ag + 1]].partition_point(|&b| (b as usize) < ag);
+                let co = g.boff[q];
+                let block_row = &mut vals[start..start + ka * len];
+                for r in 0..ka {
+                    for c in r + 1..ka {
+                        let (u, l) = (r * len + co + c, c * len + co + r);
+                        let v = 0.5 * (block_row[u] + block_row[l]);
+                        block_row[u] = v;
+                        block_row[l] = v;
+                    }
+                }
+            }
+        },
+    );
     // Pass 2: blocks (a, b < a) from the transposed blocks (b, a).
     scratch.clear();
     scratch.extend_from_slice(ac.values());
@@ -841,8 +764,7 @@ mod tests {
                 assert!((pd[i][j] - want).abs() < 1e-15, "P[{i}][{j}]");
             }
         }
-        let pt = block_transpose(&p, &off);
-        let (g, mut ac) = symbolic_galerkin(&am, &p, &pt, &off);
+        let (g, mut ac) = symbolic_galerkin(&am, &p, &off);
         numeric_galerkin(&g, &am, &p, &off, &mut ac, &mut Vec::new());
         let want = matmul(&transpose(&pd), &matmul(&a, &pd));
         let got = dense(&ac);
@@ -855,7 +777,7 @@ mod tests {
         // Restriction.
         let r: Vec<f64> = (0..n).map(|i| (i as f64).sin()).collect();
         let mut rc = vec![0.0; 5];
-        restrict(&pt, &off, &r, &mut rc);
+        restrict(&g, &p, &off, &r, &mut rc);
         for j in 0..5 {
             let want: f64 = (0..n).map(|i| pd[i][j] * r[i]).sum();
             assert!((rc[j] - want).abs() < 1e-15);
