@@ -24,7 +24,8 @@
 //! 3. Nodes still free (no strong neighbour in any aggregate) form aggregates with their
 //!    free strong neighbours.
 //!
-//! *Aggressive* coarsening runs the same passes on the distance-two graph `S²`: root neighbourhoods of radius two, about three times fewer
+//! *Aggressive* coarsening runs the same passes on the distance-two graph `S²` (visited
+//! through `S`, never formed): root neighbourhoods of radius two, about three times fewer
 //! aggregates in 2D, a sparser prolongator and a cheaper Galerkin product, at the price of
 //! a weaker coarse space (GAMG's "aggressive coarsening" on its finest level).
 //!
@@ -236,49 +237,31 @@ pub(crate) fn strength(a: &CsrMatrix, blocks: &Blocks, theta: f64) -> Strength {
 }
 
 impl Strength {
-    /// The distance-two graph `S²`: neighbours of `I` are its strong neighbours and
-    /// theirs (without `I`), sorted; a neighbour at distance two gets the strength of the
-    /// weakest link on its strongest two-step path, so pass 2 of [`aggregate`] still
-    /// prefers direct strong neighbours.
-    pub(crate) fn squared(&self) -> Strength {
-        let nn = self.ptr.len() - 1;
-        let nblocks = nn.div_ceil(ROWS_PER_TASK);
-        let parts: Vec<StrengthPart> = (0..nblocks)
-            .into_par_iter()
-            .map(|b| {
-                let range = b * ROWS_PER_TASK..((b + 1) * ROWS_PER_TASK).min(nn);
-                let mut counts = Vec::with_capacity(range.len());
-                let (mut adj, mut w) = (Vec::new(), Vec::new());
-                let mut row: Vec<(u32, f64)> = Vec::new();
-                for i in range {
-                    row.clear();
-                    let (nb, wb) = self.nbrs(i);
-                    for (&j, &wj) in nb.iter().zip(wb) {
-                        row.push((j, wj));
-                        let (nb2, wb2) = self.nbrs(j as usize);
-                        for (&k, &wk) in nb2.iter().zip(wb2) {
-                            if k as usize != i {
-                                row.push((k, wj.min(wk)));
-                            }
-                        }
+    /// Call `f(J, w)` for every neighbour `J ≠ I` of node `I` in `S` or, with
+    /// `distance_two`, in `S²`: the strong neighbours and theirs, a neighbour at distance
+    /// two with the strength of the weakest link on the path (a node reached on several
+    /// paths is visited once per path). `S²` is never formed.
+    #[inline]
+    fn visit(&self, i: usize, distance_two: bool, mut f: impl FnMut(u32, f64)) {
+        let (nb, wb) = self.nbrs(i);
+        for (&j, &wj) in nb.iter().zip(wb) {
+            f(j, wj);
+            if distance_two {
+                let (nb2, wb2) = self.nbrs(j as usize);
+                for (&k, &wk) in nb2.iter().zip(wb2) {
+                    if k as usize != i {
+                        f(k, wj.min(wk));
                     }
-                    // Sort by node, strongest first, and keep the first of each node.
-                    row.sort_unstable_by(|x, y| x.0.cmp(&y.0).then(y.1.total_cmp(&x.1)));
-                    row.dedup_by_key(|x| x.0);
-                    counts.push(row.len());
-                    adj.extend(row.iter().map(|x| x.0));
-                    w.extend(row.iter().map(|x| x.1));
                 }
-                (counts, adj, w)
-            })
-            .collect();
-        Strength::concat(nn, parts)
+            }
+        }
     }
 }
 
-/// Greedy aggregation in three passes (see the module docs). Returns the aggregate of
-/// every node and the number of aggregates.
-pub(crate) fn aggregate(s: &Strength) -> (Vec<u32>, usize) {
+/// Greedy aggregation in three passes (see the module docs) on the strength graph `s`, or
+/// with `distance_two` on `S²` (aggressive coarsening). Returns the aggregate of every
+/// node and the number of aggregates.
+pub(crate) fn aggregate(s: &Strength, distance_two: bool) -> (Vec<u32>, usize) {
     let nn = s.ptr.len() - 1;
     let mut agg = vec![FREE; nn];
     let mut count = 0u32;
@@ -287,30 +270,29 @@ pub(crate) fn aggregate(s: &Strength) -> (Vec<u32>, usize) {
         if agg[i] != FREE {
             continue;
         }
-        let (nb, _) = s.nbrs(i);
-        if nb.iter().all(|&j| agg[j as usize] == FREE) {
+        let mut all_free = true;
+        s.visit(i, distance_two, |j, _| all_free &= agg[j as usize] == FREE);
+        if all_free {
             agg[i] = count;
-            for &j in nb {
-                agg[j as usize] = count;
-            }
+            s.visit(i, distance_two, |j, _| agg[j as usize] = count);
             count += 1;
         }
     }
-    // Pass 2: attach to the most strongly connected pass-1 aggregate.
+    // Pass 2: attach to the most strongly connected pass-1 aggregate (equal strengths: the
+    // neighbour of the lowest number).
     let first = agg.clone();
     for i in 0..nn {
         if agg[i] != FREE {
             continue;
         }
-        let (nb, w) = s.nbrs(i);
-        let mut best: Option<(f64, u32)> = None;
-        for (&j, &wj) in nb.iter().zip(w) {
+        let mut best: Option<(f64, u32, u32)> = None;
+        s.visit(i, distance_two, |j, w| {
             let a = first[j as usize];
-            if a != FREE && best.is_none_or(|(bw, _)| wj > bw) {
-                best = Some((wj, a));
+            if a != FREE && best.is_none_or(|(bw, bj, _)| w > bw || (w == bw && j < bj)) {
+                best = Some((w, j, a));
             }
-        }
-        if let Some((_, a)) = best {
+        });
+        if let Some((_, _, a)) = best {
             agg[i] = a;
         }
     }
@@ -320,12 +302,11 @@ pub(crate) fn aggregate(s: &Strength) -> (Vec<u32>, usize) {
             continue;
         }
         agg[i] = count;
-        let (nb, _) = s.nbrs(i);
-        for &j in nb {
+        s.visit(i, distance_two, |j, _| {
             if agg[j as usize] == FREE {
                 agg[j as usize] = count;
             }
-        }
+        });
         count += 1;
     }
     (agg, count as usize)
@@ -511,26 +492,79 @@ mod tests {
         let a = laplace_1d(9);
         let blocks = Blocks::from_ids(&(0..9).collect::<Vec<_>>()).unwrap();
         let s = strength(a.matrix(), &blocks, 0.0);
-        let (agg, na) = aggregate(&s);
+        let (agg, na) = aggregate(&s, false);
         // Pass 1 takes {0,1}, {2,3,4}, {5,6,7}; node 8 joins {5,6,7}.
         assert_eq!(na, 3);
         assert_eq!(agg, vec![0, 0, 1, 1, 1, 2, 2, 2, 2]);
     }
 
     #[test]
-    fn squared_graph_aggregates_a_chain_in_fives() {
+    fn distance_two_aggregates_a_chain_in_fives() {
         let a = laplace_1d(12);
         let blocks = Blocks::from_ids(&(0..12).collect::<Vec<_>>()).unwrap();
-        let s = strength(a.matrix(), &blocks, 0.0).squared();
+        let s = strength(a.matrix(), &blocks, 0.0);
         // Neighbours within distance two; a distance-two link is as strong as its weakest
         // step (every |a_ij| = 1 here).
-        assert_eq!(s.nbrs(0).0, &[1, 2]);
-        assert_eq!(s.nbrs(5).0, &[3, 4, 6, 7]);
-        assert!(s.nbrs(5).1.iter().all(|&w| w == 1.0));
-        let (agg, na) = aggregate(&s);
+        let mut nbrs = Vec::new();
+        s.visit(5, true, |j, w| nbrs.push((j, w)));
+        nbrs.sort_by_key(|x| x.0);
+        nbrs.dedup();
+        assert_eq!(nbrs, vec![(3, 1.0), (4, 1.0), (6, 1.0), (7, 1.0)]);
+        let (agg, na) = aggregate(&s, true);
         // Pass 1: roots 0, 5 and 10 take {0, 1, 2}, {3, …, 7} and {8, …, 11}.
         assert_eq!(na, 3);
         assert_eq!(agg, vec![0, 0, 0, 1, 1, 1, 1, 1, 2, 2, 2, 2]);
+    }
+
+    #[test]
+    fn distance_two_equals_aggregation_on_the_squared_graph() {
+        // A 2D grid Laplacian with varying weights (ties and strict maxima), S² formed
+        // explicitly (strongest path per neighbour, sorted) against the on-the-fly visit.
+        let m = 23;
+        let n = m * m;
+        let (mut rp, mut cols, mut vals) = (vec![0usize], Vec::new(), Vec::new());
+        for i in 0..n {
+            let (x, y) = (i % m, i / m);
+            let mut row = vec![(i, 4.0)];
+            for (dx, dy) in [(-1i64, 0i64), (1, 0), (0, -1), (0, 1)] {
+                let (xx, yy) = (x as i64 + dx, y as i64 + dy);
+                if (0..m as i64).contains(&xx) && (0..m as i64).contains(&yy) {
+                    let j = yy as usize * m + xx as usize;
+                    let w = 1.0 + ((i.min(j) * 7 + i.max(j)) % 3) as f64;
+                    row.push((j, -w));
+                }
+            }
+            row.sort_by_key(|e| e.0);
+            for (j, v) in row {
+                cols.push(j as u32);
+                vals.push(v);
+            }
+            rp.push(cols.len());
+        }
+        let a = CsrMatrix::from_parts(n, n, rp, cols, vals);
+        let blocks = Blocks::from_ids(&(0..n).collect::<Vec<_>>()).unwrap();
+        let s = strength(&a, &blocks, 0.0);
+        let mut parts = Vec::new();
+        let (mut counts, mut adj, mut w) = (Vec::new(), Vec::new(), Vec::new());
+        for i in 0..n {
+            let mut row: Vec<(u32, f64)> = Vec::new();
+            s.visit(i, true, |j, wj| row.push((j, wj)));
+            row.sort_unstable_by(|x, y| x.0.cmp(&y.0).then(y.1.total_cmp(&x.1)));
+            row.dedup_by_key(|x| x.0);
+            counts.push(row.len());
+            adj.extend(row.iter().map(|x| x.0));
+            w.extend(row.iter().map(|x| x.1));
+        }
+        parts.push((counts, adj, w));
+        let s2 = Strength::concat(n, parts);
+        let explicit = aggregate(&s2, false);
+        let on_the_fly = aggregate(&s, true);
+        assert_eq!(on_the_fly, explicit);
+        assert!(
+            explicit.1 > 1 && explicit.1 < n / 9,
+            "{} aggregates",
+            explicit.1
+        );
     }
 
     #[test]

@@ -300,11 +300,8 @@ impl Amg {
                 levels.push(Level::new(a, dinv, None));
                 break;
             }
-            let mut s = strength(&a, &blocks, options.strength_threshold);
-            if l < options.aggressive_levels {
-                s = s.squared();
-            }
-            let (agg, num_agg) = aggregate(&s);
+            let s = strength(&a, &blocks, options.strength_threshold);
+            let (agg, num_agg) = aggregate(&s, l < options.aggressive_levels);
             drop(s);
             let tent = tentative(&blocks, &agg, num_agg, &null)?;
             let nc = tent.p.m.ncols();
