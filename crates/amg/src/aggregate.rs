@@ -420,16 +420,17 @@ pub(crate) fn tentative(
         }
         bptr.push(bagg.len());
     }
-    let mut p = Blocked::from_blocks(n, &off, bptr, bagg);
-    let row_ptr = p.m.row_ptr().to_vec();
-    let vals = p.m.values_mut();
+    let mut p = Blocked::from_blocks(n, &off, &bptr, bagg)?;
+    drop(bptr);
+    let row_start: Vec<usize> = (0..n).map(|e| p.row_start(e)).collect();
+    let vals = p.values_mut();
     let mut bdata = vec![0.0; nc * m];
     let mut node_of = vec![0u32; nc];
     for (a, (q, rmat, k)) in qrs.iter().enumerate() {
         let rows = &aeqs[aptr[a]..aptr[a + 1]];
         let r = rows.len();
         for (l, &e) in rows.iter().enumerate() {
-            let p0 = row_ptr[e as usize];
+            let p0 = row_start[e as usize];
             for j in 0..*k {
                 vals[p0 + j] = q[j * r + l];
             }
@@ -577,7 +578,7 @@ mod tests {
         let blocks = Blocks::from_ids(&(0..n).collect::<Vec<_>>()).unwrap();
         let agg = vec![0, 0, 1, 1, 1, 2, 2, 2, 2];
         let t = tentative(&blocks, &agg, 3, &b).unwrap();
-        let p = &t.p.m;
+        let p = &t.p.to_csr(&t.coarse_blocks.ptr);
         assert_eq!(p.ncols(), 6);
         // P Bc = B.
         for k in 0..2 {
@@ -609,7 +610,7 @@ mod tests {
         let b = NearNullSpace::from_vectors(2, vec![1.0, 1.0, 2.0, 3.0]).unwrap();
         let blocks = Blocks::from_ids(&[0, 1]).unwrap();
         let t = tentative(&blocks, &[0, 1], 2, &b).unwrap();
-        assert_eq!(t.p.m.ncols(), 2);
+        assert_eq!(t.p.ncols(), 2);
         assert_eq!(t.coarse_blocks.ptr, vec![0, 1, 2]);
         assert_eq!(t.coarse_null.vector(1), &[2.0, 3.0]);
     }

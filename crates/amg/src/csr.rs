@@ -234,11 +234,6 @@ impl CsrMatrix {
         par_rows(y, |i, yi| *yi = self.row_dot(i, x));
     }
 
-    /// `y += A x` without size checks.
-    pub(crate) fn spmv_add(&self, x: &[f64], y: &mut [f64]) {
-        par_rows(y, |i, yi| *yi += self.row_dot(i, x));
-    }
-
     /// `r = b − A x` without size checks.
     pub(crate) fn residual(&self, b: &[f64], x: &[f64], r: &mut [f64]) {
         par_rows(r, |i, ri| *ri = b[i] - self.row_dot(i, x));

@@ -304,13 +304,13 @@ impl Amg {
             let (agg, num_agg) = aggregate(&s, l < options.aggressive_levels);
             drop(s);
             let tent = tentative(&blocks, &agg, num_agg, &null)?;
-            let nc = tent.p.m.ncols();
+            let nc = tent.p.ncols();
             if nc == 0 || nc as f64 > options.min_coarsening * a.nrows() as f64 {
                 levels.push(Level::new(a, dinv, None));
                 break;
             }
             let off = tent.coarse_blocks.ptr.clone();
-            let p = symbolic_prolongator(&a, &tent.eq_agg, &off);
+            let p = symbolic_prolongator(&a, &tent.eq_agg, &off)?;
             let transfer = Transfer {
                 t: tent.p,
                 p,
@@ -571,7 +571,7 @@ impl Amg {
             } else {
                 (&w.b, &mut w.x)
             };
-            tr.p.m.spmv_add(&hi[0].x, x);
+            tr.p.mul_add(&tr.off, &hi[0].x, x);
             let sw = SmoothWork {
                 r: &mut w.r,
                 d: &mut w.d,

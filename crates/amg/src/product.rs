@@ -51,7 +51,8 @@
 
 use rayon::prelude::*;
 
-use crate::csr::{CsrMatrix, ROWS_PER_TASK, vec_bytes, zeros};
+use crate::csr::{CsrMatrix, ROWS_PER_TASK, par_rows, vec_bytes, zeros};
+use crate::error::{AmgError, Result};
 
 /// The marker of row (or aggregate) `i` in a dense accumulator. Markers start at zero
 /// (fresh zero pages cost nothing until touched), so row `i` is marked `i + 1`.
@@ -62,68 +63,131 @@ fn stamp(i: usize) -> u32 {
 /// Aggregates per parallel task in the Galerkin product.
 const AGGS_PER_TASK: usize = 64;
 
-/// A matrix with scalar rows and columns in aggregate blocks (see the module docs).
+/// A matrix with scalar rows and columns in aggregate blocks (see the module docs), with
+/// 32-bit block tables: no scalar column indices are stored (block `b` covers the columns
+/// `off[b]..off[b+1]` of the layout it was built with).
 #[derive(Clone, Debug)]
 pub(crate) struct Blocked {
-    /// The scalar form (columns sorted), used for products with vectors.
-    pub(crate) m: CsrMatrix,
+    ncols: usize,
     /// Blocks of row `i`: `bptr[i]..bptr[i+1]`.
-    bptr: Vec<usize>,
+    bptr: Vec<u32>,
     /// Aggregate of each block.
     bagg: Vec<u32>,
-    /// Position in `m`'s values of each block's first value.
-    bpos: Vec<usize>,
+    /// Position in `vals` of each block's first value, and the number of values last.
+    bpos: Vec<u32>,
+    vals: Vec<f64>,
 }
 
 impl Blocked {
     /// Heap bytes held.
     pub(crate) fn bytes(&self) -> usize {
-        self.m.bytes() + vec_bytes(&self.bptr) + vec_bytes(&self.bagg) + vec_bytes(&self.bpos)
+        vec_bytes(&self.bptr)
+            + vec_bytes(&self.bagg)
+            + vec_bytes(&self.bpos)
+            + vec_bytes(&self.vals)
     }
 
     /// The matrix (values zero) whose row `i` holds the aggregates
-    /// `bagg[bptr[i]..bptr[i+1]]` (increasing) with the column layout `off`.
+    /// `bagg[bptr[i]..bptr[i+1]]` (increasing) with the column layout `off`. Errors: more
+    /// blocks or values than 32-bit positions hold.
     pub(crate) fn from_blocks(
         nrows: usize,
         off: &[usize],
-        bptr: Vec<usize>,
+        bptr: &[usize],
         bagg: Vec<u32>,
-    ) -> Self {
+    ) -> Result<Self> {
         let width = |b: u32| off[b as usize + 1] - off[b as usize];
-        let mut row_ptr = Vec::with_capacity(nrows + 1);
-        row_ptr.push(0);
-        let mut bpos = Vec::with_capacity(bagg.len());
-        let mut len = 0;
-        for i in 0..nrows {
-            for &b in &bagg[bptr[i]..bptr[i + 1]] {
-                bpos.push(len);
-                len += width(b);
-            }
-            row_ptr.push(len);
+        let len: usize = bagg.iter().map(|&b| width(b)).sum();
+        if len >= u32::MAX as usize {
+            return Err(AmgError::Input(format!(
+                "{len} prolongator entries exceed the 32-bit positions"
+            )));
         }
-        let mut col = Vec::with_capacity(len);
+        let mut bpos = Vec::with_capacity(bagg.len() + 1);
+        let mut at = 0u32;
         for &b in &bagg {
-            col.extend(off[b as usize] as u32..off[b as usize + 1] as u32);
+            bpos.push(at);
+            at += width(b) as u32;
         }
-        let ncols = *off.last().unwrap_or(&0);
-        Self {
-            m: CsrMatrix::from_parts(nrows, ncols, row_ptr, col, zeros(len)),
-            bptr,
+        bpos.push(at);
+        Ok(Self {
+            ncols: *off.last().unwrap_or(&0),
+            bptr: bptr[..=nrows].iter().map(|&q| q as u32).collect(),
             bagg,
             bpos,
-        }
+            vals: zeros(len),
+        })
+    }
+
+    /// Number of rows.
+    pub(crate) fn nrows(&self) -> usize {
+        self.bptr.len() - 1
+    }
+    /// Number of (scalar) columns.
+    pub(crate) fn ncols(&self) -> usize {
+        self.ncols
     }
 
     /// Aggregates and value positions of the blocks of row `i`.
     #[inline]
-    pub(crate) fn blocks(&self, i: usize) -> (&[u32], &[usize]) {
-        let r = self.bptr[i]..self.bptr[i + 1];
+    pub(crate) fn blocks(&self, i: usize) -> (&[u32], &[u32]) {
+        let r = self.bptr[i] as usize..self.bptr[i + 1] as usize;
         (&self.bagg[r.clone()], &self.bpos[r])
+    }
+
+    /// The values of row `i` lie at `row_start(i)..row_start(i + 1)`.
+    #[inline]
+    pub(crate) fn row_start(&self, i: usize) -> usize {
+        self.bpos[self.bptr[i] as usize] as usize
     }
 
     /// Number of blocks.
     pub(crate) fn num_blocks(&self) -> usize {
         self.bagg.len()
+    }
+
+    /// All values, row by row.
+    pub(crate) fn values(&self) -> &[f64] {
+        &self.vals
+    }
+    /// All values, mutable.
+    pub(crate) fn values_mut(&mut self) -> &mut [f64] {
+        &mut self.vals
+    }
+
+    /// `y += M x` for the column layout `off` (in parallel over rows).
+    pub(crate) fn mul_add(&self, off: &[usize], x: &[f64], y: &mut [f64]) {
+        par_rows(y, |i, yi| {
+            let (bb, bp) = self.blocks(i);
+            let mut sum = 0.0;
+            for (&b, &s) in bb.iter().zip(bp) {
+                let (c, k, s) = (
+                    off[b as usize],
+                    off[b as usize + 1] - off[b as usize],
+                    s as usize,
+                );
+                sum += self.vals[s..s + k]
+                    .iter()
+                    .zip(&x[c..c + k])
+                    .map(|(v, xi)| v * xi)
+                    .sum::<f64>();
+            }
+            *yi += sum;
+        });
+    }
+
+    /// The scalar CSR form for the column layout `off`.
+    #[cfg(test)]
+    pub(crate) fn to_csr(&self, off: &[usize]) -> CsrMatrix {
+        let mut row_ptr = vec![0];
+        let mut col = Vec::new();
+        for i in 0..self.nrows() {
+            for &b in self.blocks(i).0 {
+                col.extend(off[b as usize] as u32..off[b as usize + 1] as u32);
+            }
+            row_ptr.push(col.len());
+        }
+        CsrMatrix::from_parts(self.nrows(), self.ncols, row_ptr, col, self.vals.clone())
     }
 }
 
@@ -143,7 +207,11 @@ fn concat_block_lists(parts: Vec<(Vec<usize>, Vec<u32>)>, nrows: usize) -> (Vec<
 
 /// The pattern of `P = (I − ω D⁻¹A) P_tent`: row `i` has a block for every aggregate
 /// `eq_agg[j]` of a column `j` of row `i` of `A` (aggregates of width zero excluded).
-pub(crate) fn symbolic_prolongator(a: &CsrMatrix, eq_agg: &[u32], off: &[usize]) -> Blocked {
+pub(crate) fn symbolic_prolongator(
+    a: &CsrMatrix,
+    eq_agg: &[u32],
+    off: &[usize],
+) -> Result<Blocked> {
     let n = a.nrows();
     let nagg = off.len() - 1;
     let parts: Vec<(Vec<usize>, Vec<u32>)> = (0..n.div_ceil(ROWS_PER_TASK))
@@ -171,18 +239,22 @@ pub(crate) fn symbolic_prolongator(a: &CsrMatrix, eq_agg: &[u32], off: &[usize])
         )
         .collect();
     let (bptr, bagg) = concat_block_lists(parts, n);
-    Blocked::from_blocks(n, off, bptr, bagg)
+    Blocked::from_blocks(n, off, &bptr, bagg)
 }
 
-/// Split `val` (laid out by `row_ptr`) into the value slices of consecutive row blocks.
-fn row_blocks_mut<'a>(row_ptr: &[usize], val: &'a mut [f64]) -> Vec<(usize, &'a mut [f64])> {
-    let nrows = row_ptr.len() - 1;
+/// Split `val` (row `i` at `row_start(i)..row_start(i + 1)`, `nrows` rows) into the value
+/// slices of consecutive groups of rows.
+fn row_blocks_mut(
+    nrows: usize,
+    row_start: impl Fn(usize) -> usize,
+    val: &mut [f64],
+) -> Vec<(usize, &mut [f64])> {
     let mut out = Vec::with_capacity(nrows.div_ceil(ROWS_PER_TASK));
     let mut rest = val;
     let mut start = 0;
     while start < nrows {
         let end = (start + ROWS_PER_TASK).min(nrows);
-        let (head, tail) = rest.split_at_mut(row_ptr[end] - row_ptr[start]);
+        let (head, tail) = rest.split_at_mut(row_start(end) - row_start(start));
         out.push((start, head));
         rest = tail;
         start = end;
@@ -224,38 +296,42 @@ pub(crate) fn smooth_prolongator(
     p: &mut Blocked,
 ) {
     let nagg = off.len() - 1;
-    let row_ptr = p.m.row_ptr().to_vec();
-    let n = row_ptr.len() - 1;
-    let (bptr, bagg, bpos) = (&p.bptr, &p.bagg, &p.bpos);
-    let tv = t.m.values();
-    let blocks = row_blocks_mut(&row_ptr, p.m.values_mut());
+    let n = p.nrows();
+    let Blocked {
+        bptr,
+        bagg,
+        bpos,
+        vals,
+        ..
+    } = p;
+    let row_start = |i: usize| bpos[bptr[i] as usize] as usize;
+    let tv = t.values();
+    let blocks = row_blocks_mut(n, row_start, vals);
     blocks.into_par_iter().for_each_init(
         || vec![0usize; nagg],
         |pos, (start, vals)| {
-            let base = row_ptr[start];
+            let base = row_start(start);
             for i in start..(start + ROWS_PER_TASK).min(n) {
-                for q in bptr[i]..bptr[i + 1] {
-                    pos[bagg[q] as usize] = bpos[q] - base;
+                for q in bptr[i] as usize..bptr[i + 1] as usize {
+                    pos[bagg[q] as usize] = bpos[q] as usize - base;
                 }
-                let row = &mut vals[row_ptr[i] - base..row_ptr[i + 1] - base];
-                row.fill(0.0);
+                let row = row_start(i) - base..row_start(i + 1) - base;
+                vals[row.clone()].fill(0.0);
                 let (ac, av) = a.row(i);
                 for (&j, &aij) in ac.iter().zip(av) {
                     let (tb, tp) = t.blocks(j as usize);
                     for (&b, &s) in tb.iter().zip(tp) {
                         let k = off[b as usize + 1] - off[b as usize];
-                        let d = pos[b as usize];
+                        let (d, s) = (pos[b as usize], s as usize);
                         axpy(&mut vals[d..d + k], aij, &tv[s..s + k]);
                     }
                 }
                 let scale = -omega * dinv[i];
-                vals[row_ptr[i] - base..row_ptr[i + 1] - base]
-                    .iter_mut()
-                    .for_each(|v| *v *= scale);
+                vals[row].iter_mut().for_each(|v| *v *= scale);
                 let (tb, tp) = t.blocks(i);
                 for (&b, &s) in tb.iter().zip(tp) {
                     let k = off[b as usize + 1] - off[b as usize];
-                    let d = pos[b as usize];
+                    let (d, s) = (pos[b as usize], s as usize);
                     axpy(&mut vals[d..d + k], 1.0, &tv[s..s + k]);
                 }
             }
@@ -275,8 +351,8 @@ fn rows_of_aggregates(p: &Blocked, nagg: usize) -> (Vec<usize>, Vec<u32>) {
     }
     let mut next = ptr.clone();
     let mut rows = vec![0u32; p.num_blocks()];
-    for i in 0..p.m.nrows() {
-        for &b in &p.bagg[p.bptr[i]..p.bptr[i + 1]] {
+    for i in 0..p.nrows() {
+        for &b in p.blocks(i).0 {
             rows[next[b as usize]] = i as u32;
             next[b as usize] += 1;
         }
@@ -287,7 +363,7 @@ fn rows_of_aggregates(p: &Blocked, nagg: usize) -> (Vec<usize>, Vec<u32>) {
 /// `out = Pᵀ r`: every part of `g` sums `r_i p_{i,a}` into its aggregates `a`, over its
 /// fine rows `i` increasing (so the result does not depend on the parts).
 pub(crate) fn restrict(g: &Galerkin, p: &Blocked, off: &[usize], r: &[f64], out: &mut [f64]) {
-    let pv = p.m.values();
+    let pv = p.values();
     part_slices_mut(
         &g.part_aggs,
         |k| off[g.part_aggs[k]]..off[g.part_aggs[k + 1]],
@@ -302,7 +378,7 @@ pub(crate) fn restrict(g: &Galerkin, p: &Blocked, off: &[usize], r: &[f64], out:
             let ri = r[i as usize];
             let (pb, pp) = p.blocks(i as usize);
             for (&a, &s) in pb.iter().zip(pp) {
-                let a = a as usize;
+                let (a, s) = (a as usize, s as usize);
                 if (lo..hi).contains(&a) {
                     let d = off[a] - base;
                     let ka = off[a + 1] - off[a];
@@ -376,14 +452,14 @@ fn w_row(
     aggs: &mut Vec<u32>,
     vals: &mut Vec<f64>,
 ) {
-    let pv = p.m.values();
+    let pv = p.values();
     aggs.clear();
     vals.clear();
     let (ac, av) = a.row(i);
     for (&j, &aij) in ac.iter().zip(av) {
         let (pb, pp) = p.blocks(j as usize);
         for (&b, &s) in pb.iter().zip(pp) {
-            let bu = b as usize;
+            let (bu, s) = (b as usize, s as usize);
             if bu < lo {
                 continue;
             }
@@ -548,7 +624,7 @@ pub(crate) fn numeric_galerkin(
     let nagg = off.len() - 1;
     let width = |b: usize| off[b + 1] - off[b];
     let row_ptr = ac.row_ptr().to_vec();
-    let pv = p.m.values();
+    let pv = p.values();
     // Pass 1: blocks (a, b ≥ a); diagonal blocks symmetrized.
     {
         let part_values = |k: usize| row_ptr[off[g.part_aggs[k]]]..row_ptr[off[g.part_aggs[k + 1]]];
@@ -573,7 +649,7 @@ pub(crate) fn numeric_galerkin(
                 w_row(a, p, off, i, lo, slot, waggs, wvals);
                 let (pb, pp) = p.blocks(i);
                 for (&ag, &s) in pb.iter().zip(pp) {
-                    let ag = ag as usize;
+                    let (ag, s) = (ag as usize, s as usize);
                     if ag < lo || ag >= hi {
                         continue;
                     }
@@ -747,17 +823,18 @@ mod tests {
         let off = vec![0, 2, 3, 5];
         let eq_agg: Vec<u32> = vec![0, 0, 1, 1, 2, 2];
         // Tentative: row i has the block of its aggregate.
-        let mut t = Blocked::from_blocks(n, &off, (0..=n).collect(), eq_agg.clone());
+        let bptr: Vec<usize> = (0..=n).collect();
+        let mut t = Blocked::from_blocks(n, &off, &bptr, eq_agg.clone()).unwrap();
         let tvals = [0.6, 0.8, -0.8, 0.6, 0.7, 0.7, 1.0, 0.0, 0.0, 1.0];
-        t.m.values_mut().copy_from_slice(&tvals);
+        t.values_mut().copy_from_slice(&tvals);
         let am = from_dense(&a);
-        let mut p = symbolic_prolongator(&am, &eq_agg, &off);
+        let mut p = symbolic_prolongator(&am, &eq_agg, &off).unwrap();
         let dinv: Vec<f64> = (0..n).map(|i| 1.0 / a[i][i]).collect();
         let omega = 0.4;
         smooth_prolongator(&am, &dinv, omega, &t, &off, &mut p);
-        let td = dense(&t.m);
+        let td = dense(&t.to_csr(&off));
         let at = matmul(&a, &td);
-        let pd = dense(&p.m);
+        let pd = dense(&p.to_csr(&off));
         for i in 0..n {
             for j in 0..5 {
                 let want = td[i][j] - omega * dinv[i] * at[i][j];
