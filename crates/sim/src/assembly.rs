@@ -52,7 +52,7 @@ use crate::bc::Loads;
 use crate::dofs::DofMap;
 use crate::error::{AXES, Result, SimError, fmt_point};
 use crate::laws::LawMap;
-use crate::pattern::Pattern;
+use crate::pattern::{NONE, Pattern, TWICE};
 use crate::quadrature::{cell_rule, facet_rule, simplex_rule};
 
 /// Per-thread buffers for evaluating cells.
@@ -168,10 +168,20 @@ pub fn assemble<const D: usize>(
                     return Err(cell_error(laws, c, "non-finite stiffness".into()));
                 }
                 let (v0, vlen) = (ch.vals.start, vals.len());
-                for (&p, &kv) in pattern.cell_scatter(c).iter().zip(w.k.as_slice()) {
-                    let k = (p as usize).wrapping_sub(v0);
-                    if k < vlen {
-                        vals[k] += kv;
+                let (scatter, kv) = (pattern.cell_scatter(c), w.k.as_slice());
+                let mut q = 0;
+                for j in 0..m {
+                    for i in 0..=j {
+                        let p = scatter[q];
+                        q += 1;
+                        if p == NONE {
+                            continue;
+                        }
+                        let k = ((p & !TWICE) as usize).wrapping_sub(v0);
+                        if k < vlen {
+                            let v = kv[i + m * j];
+                            vals[k] += if p & TWICE != 0 { 2.0 * v } else { v };
+                        }
                     }
                 }
                 // Internal forces: −K u for linear laws (nothing to do at u = 0), else the law's.

@@ -5,13 +5,15 @@
 //! expects it. Entry `(r, c)` is nonzero when equations `r` and `c` share a cell.
 //!
 //! The pattern is built once per grid and dof map. For every cell it stores a *scatter
-//! map*: for each pair `(i, j)` of local dofs (column-major over the `D·n × D·n` local
-//! matrix, like nalgebra stores it: pair `i + D·n·j`), the position in the values array of global entry
-//! `(min(e_i, e_j), max(e_i, e_j))`, or none when a dof is prescribed or `e_i > e_j` (the
-//! mirror pair carries that entry). Pairs with `e_i = e_j` (two nodes of one platen, or a
-//! dof with itself) all add to the diagonal. Filling values is then a loop over cells with
-//! no searching and no triplet buffers, and new values (time steps, law switches) reuse
-//! the pattern.
+//! map* over the pairs `i ≤ j` of its local dofs (the upper triangle of the `D·n × D·n`
+//! local matrix, column by column: pair `(i, j)` at `i + j(j+1)/2`, see [`upper_pair`]):
+//! the position in the values array of global entry `(min(e_i, e_j), max(e_i, e_j))`, or
+//! none when a dof is prescribed. The local matrix is symmetric, so `K_ij` stands for
+//! `K_ji` as well; a pair `i < j` with `e_i = e_j` (two nodes of one platen) adds to the
+//! diagonal twice, which the map marks with its top bit ([`TWICE`]). Filling values is
+//! then a loop over cells with no searching and no triplet buffers, and new values (time
+//! steps, law switches) reuse the pattern. Half the local pairs are stored, and 32 bits
+//! each.
 //!
 //! # Parallel fill
 //!
@@ -35,6 +37,14 @@ use crate::error::{Result, SimError};
 
 /// Marker of a local pair that writes nothing.
 pub(crate) const NONE: u32 = u32::MAX;
+/// Flag of a local pair `i < j` whose two dofs are one equation: it adds twice.
+pub const TWICE: u32 = 1 << 31;
+
+/// Index of the local pair `i ≤ j` in a cell's scatter map (column-major upper triangle).
+#[inline]
+pub fn upper_pair(i: usize, j: usize) -> usize {
+    i + j * (j + 1) / 2
+}
 
 /// A contiguous range of columns (and the matching values and equations).
 #[derive(Clone, Debug)]
@@ -214,43 +224,49 @@ impl Pattern {
             }
         });
         let nnz = row_idx.len();
-        if nnz >= NONE as usize {
+        if nnz >= TWICE as usize {
             return Err(SimError::Input(format!(
-                "{nnz} stiffness entries exceed the 32-bit scatter map"
+                "{nnz} stiffness entries exceed the 31-bit scatter map"
             )));
         }
         // Scatter maps, in parallel blocks of cells.
         let sizes: Vec<usize> = (0..nc)
-            .map(|c| (D * grid.cell_nodes(c).len()).pow(2))
+            .map(|c| {
+                let m = D * grid.cell_nodes(c).len();
+                m * (m + 1) / 2
+            })
             .collect();
         let scatter_pos = offsets(&sizes);
+        drop(sizes);
         let mut scatter = vec![NONE; scatter_pos[nc]];
         fill_blocks(&mut scatter, &scatter_pos, |cells, out| {
             let mut eqs = Vec::new();
             let mut k = 0;
             for c in cells {
                 cell_equations(grid, dofs, c, &mut eqs);
-                for &ej in &eqs {
-                    // The last position found in this column and its row: the next
-                    // component of a node usually sits right after it. (It never runs
-                    // into the next column: a column ends with its diagonal, and rows
-                    // after the diagonal are skipped.)
-                    let mut last: Option<(usize, usize)> = None;
-                    for &ei in &eqs {
-                        if ei != usize::MAX && ej != usize::MAX && ei <= ej {
-                            let pos = if let Some((e, p)) = last
-                                && ei == e + 1
-                                && row_idx[p + 1] == ei
+                for (j, &ej) in eqs.iter().enumerate() {
+                    // The last entry found and its (row, column): the next component of a
+                    // node usually sits right after it in the same column. (It never
+                    // runs into the next column: a column ends with its diagonal.)
+                    let mut last: Option<(usize, usize, usize)> = None;
+                    for (i, &ei) in eqs[..=j].iter().enumerate() {
+                        if ei != usize::MAX && ej != usize::MAX {
+                            let (r, col) = (ei.min(ej), ei.max(ej));
+                            let pos = if let Some((lr, lc, p)) = last
+                                && lc == col
+                                && r == lr + 1
+                                && row_idx[p + 1] == r
                             {
                                 p + 1
                             } else {
-                                let rows = &row_idx[col_ptr[ej]..col_ptr[ej + 1]];
-                                // Invariant: (ei, ej) was inserted above since both are
+                                let rows = &row_idx[col_ptr[col]..col_ptr[col + 1]];
+                                // Invariant: (r, col) was inserted above since both are
                                 // in cell c.
-                                col_ptr[ej] + rows.binary_search(&ei).unwrap_or(0)
+                                col_ptr[col] + rows.binary_search(&r).unwrap_or(0)
                             };
-                            last = Some((ei, pos));
-                            out[k] = pos as u32;
+                            last = Some((r, col, pos));
+                            let twice = if i != j && ei == ej { TWICE } else { 0 };
+                            out[k] = pos as u32 | twice;
                         }
                         k += 1;
                     }
@@ -322,7 +338,8 @@ impl Pattern {
     pub fn row_idx(&self) -> &[usize] {
         &self.row_idx
     }
-    /// The scatter map of cell `c` (column-major over its local dofs; `u32::MAX` = none).
+    /// The scatter map of cell `c`: for the local pair `i ≤ j` at [`upper_pair`]`(i, j)`,
+    /// the value position, with [`TWICE`] set when the pair adds twice; `u32::MAX` = none.
     pub fn cell_scatter(&self, c: usize) -> &[u32] {
         &self.scatter[self.scatter_pos[c]..self.scatter_pos[c + 1]]
     }

@@ -2,8 +2,9 @@
 //!
 //! For every grid below, with prescribed components and a platen (equations shared by
 //! several nodes): every column holds exactly the rows `r ≤ c` that share a cell with `c`,
-//! sorted; and every cell's scatter entry for the local pair `(i, j)` is the position of
-//! `(min(e_i, e_j), max(e_i, e_j))` when `e_i ≤ e_j` are both free, `u32::MAX` otherwise.
+//! sorted; and every cell's scatter entry for the local pair `i ≤ j` is the position of
+//! `(min(e_i, e_j), max(e_i, e_j))` when both are free (flagged to add twice when `i < j`
+//! and `e_i = e_j`), `u32::MAX` otherwise.
 //! Grids: Voronoi polygons (2D), triangles, cubes and tetrahedra (3D) — node-major
 //! equations with 2–8 nodes per cell, which exercises the shortcuts of the builder (the
 //! next component of a node, columns of one node sharing their cells).
@@ -12,6 +13,7 @@ use std::collections::BTreeSet;
 
 use porofrac_grid::generate::{cartesian, simplices, voronoi};
 use porofrac_grid::{Grid, Point};
+use porofrac_sim::pattern::{TWICE, upper_pair};
 use porofrac_sim::{Displacement, DofMap, Pattern, Platen, ScalarField};
 
 /// Local equations of cell `c` (node-major; `None` when prescribed).
@@ -73,16 +75,19 @@ fn check<const D: usize>(grid: &Grid<D>, what: &str) {
             let eqs = local_equations(grid, &dofs, c);
             let m = eqs.len();
             let scatter = pattern.cell_scatter(c);
-            assert_eq!(scatter.len(), m * m, "{what}: cell {c}");
+            assert_eq!(scatter.len(), m * (m + 1) / 2, "{what}: cell {c}");
             for j in 0..m {
-                for i in 0..m {
-                    let got = scatter[i + m * j];
+                for i in 0..=j {
+                    let got = scatter[upper_pair(i, j)];
                     match (eqs[i], eqs[j]) {
-                        (Some(ei), Some(ej)) if ei <= ej => {
-                            let p = got as usize;
+                        (Some(ei), Some(ej)) => {
+                            let (r, col) = (ei.min(ej), ei.max(ej));
+                            let twice = i != j && ei == ej;
+                            assert_eq!(got & TWICE != 0, twice, "{what}: cell {c} pair ({i}, {j})");
+                            let p = (got & !TWICE) as usize;
                             assert!(
-                                (ptr[ej]..ptr[ej + 1]).contains(&p) && rows[p] == ei,
-                                "{what}: cell {c} pair ({i}, {j}) -> {got}, want entry ({ei}, {ej})"
+                                (ptr[col]..ptr[col + 1]).contains(&p) && rows[p] == r,
+                                "{what}: cell {c} pair ({i}, {j}) -> {got}, want entry ({r}, {col})"
                             );
                         }
                         _ => assert_eq!(got, u32::MAX, "{what}: cell {c} pair ({i}, {j})"),
