@@ -60,7 +60,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use common::{Manufactured, components, dirichlet, e2, e3, errors};
+use common::{Manufactured, dirichlet, e2, e3, errors};
 use plotters::prelude::*;
 use porofrac::grid::generate::{DEFAULT_LLOYD, cartesian, simplices, voronoi};
 use porofrac::grid::{Grid, Point};
@@ -217,7 +217,7 @@ fn one_pass<const D: usize>(
 ) -> Result<Pass, BoxError> {
     let bc = dirichlet("boundary", grid.boundary_faces(), &m.u);
     let loads = Loads {
-        body_force: Some(components(&m.f)),
+        body_force: Some(m.body_force()),
         ..Loads::default()
     };
     let t0 = Instant::now();

@@ -61,7 +61,7 @@ fn run<const D: usize>(grid: &Grid<D>, n: usize, h: f64, m: &Manufactured<D>) ->
     let laws = LawMap::uniform(grid, &law).expect("law map");
     let bc = dirichlet("boundary", grid.boundary_faces(), &m.u);
     let loads = Loads {
-        body_force: Some(components(&m.f)),
+        body_force: Some(m.body_force()),
         ..Default::default()
     };
     let sol = solve(grid, &laws, &[bc], &loads).expect("solve");

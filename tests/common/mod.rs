@@ -1,6 +1,7 @@
-//! Shared helpers of the workspace validation tests: a one-call static solve, affine and
-//! manufactured fields, quadrature rules of degree 5 on triangles and tetrahedra, the
-//! per-cell L2 and energy errors, the patch-test check, and rate fitting.
+//! Shared helpers of the workspace validation tests: a one-call static solve, affine
+//! fields, the per-cell L2 and energy errors, the patch-test check, and rate fitting. The
+//! manufactured solutions E2/E3 and the degree-5 simplex rules are
+//! `porofrac::sim::standard`'s, re-exported here.
 //!
 //! # Error norms
 //!
@@ -14,7 +15,6 @@
 //! `‖u − u_h‖_E² = Σ_K ∫_K (ε − ε_h) : C : (ε − ε_h)`, with the same quadrature.
 #![allow(dead_code)]
 
-use std::f64::consts::PI;
 use std::sync::Arc;
 
 use porofrac::grid::point::for_each_facet;
@@ -26,106 +26,12 @@ use porofrac::sim::{
 };
 use porofrac::vem::projected_gradient;
 
-/// A vector field of position.
-pub type VecFn<const D: usize> = Arc<dyn Fn(&Point<D>) -> Point<D> + Send + Sync>;
-/// A tensor field of position (the displacement gradient `∂u_a/∂x_b` at `(a, b)`).
-pub type TenFn<const D: usize> = Arc<dyn Fn(&Point<D>) -> Tensor<D> + Send + Sync>;
-
-/// A manufactured solution of the standard problems (`BENCHMARKS.md`): displacement, its
-/// gradient and the body force `f = −div σ(u)` for `E = 1`, `ν = 0.3` (plane strain in 2D).
-pub struct Manufactured<const D: usize> {
-    /// The displacement.
-    pub u: VecFn<D>,
-    /// Its gradient.
-    pub grad: TenFn<D>,
-    /// The body force.
-    pub f: VecFn<D>,
-}
-
-/// E2: `u = (sin πx sin πy, x² y) / 100`.
-pub fn e2() -> Manufactured<2> {
-    Manufactured {
-        u: Arc::new(|p: &Point<2>| {
-            let (x, y) = (p[0], p[1]);
-            Point::<2>::new((PI * x).sin() * (PI * y).sin(), x * x * y) / 100.0
-        }),
-        grad: Arc::new(|p: &Point<2>| {
-            let (x, y) = (p[0], p[1]);
-            Tensor::<2>::new(
-                PI * (PI * x).cos() * (PI * y).sin(),
-                PI * (PI * x).sin() * (PI * y).cos(),
-                2.0 * x * y,
-                x * x,
-            ) / 100.0
-        }),
-        f: Arc::new(|p: &Point<2>| {
-            let (x, y) = (p[0], p[1]);
-            let pi2 = PI * PI;
-            Point::<2>::new(
-                -x / 52.0 + 9.0 * pi2 * (PI * x).sin() * (PI * y).sin() / 520.0,
-                -y / 130.0 - pi2 * (PI * x).cos() * (PI * y).cos() / 104.0,
-            )
-        }),
-    }
-}
-
-/// E3: `u = (sin πx sin πy sin πz, x² y z, y z cos πx) / 100`.
-pub fn e3() -> Manufactured<3> {
-    Manufactured {
-        u: Arc::new(|p: &Point<3>| {
-            let (x, y, z) = (p[0], p[1], p[2]);
-            Point::<3>::new(
-                (PI * x).sin() * (PI * y).sin() * (PI * z).sin(),
-                x * x * y * z,
-                y * z * (PI * x).cos(),
-            ) / 100.0
-        }),
-        grad: Arc::new(|p: &Point<3>| {
-            let (x, y, z) = (p[0], p[1], p[2]);
-            let (sx, sy, sz) = ((PI * x).sin(), (PI * y).sin(), (PI * z).sin());
-            let (cx, cy, cz) = ((PI * x).cos(), (PI * y).cos(), (PI * z).cos());
-            Tensor::<3>::new(
-                PI * cx * sy * sz,
-                PI * sx * cy * sz,
-                PI * sx * sy * cz,
-                2.0 * x * y * z,
-                x * x * z,
-                x * x * y,
-                -PI * y * z * sx,
-                z * cx,
-                y * cx,
-            ) / 100.0
-        }),
-        f: Arc::new(|p: &Point<3>| {
-            let (x, y, z) = (p[0], p[1], p[2]);
-            let (sx, sy, sz) = ((PI * x).sin(), (PI * y).sin(), (PI * z).sin());
-            let (cx, cy, cz) = ((PI * x).cos(), (PI * y).cos(), (PI * z).cos());
-            let pi2 = PI * PI;
-            Point::<3>::new(
-                -x * z / 52.0 + PI * y * sx / 104.0 + 11.0 * pi2 * sx * sy * sz / 520.0,
-                -y * z / 130.0 - pi2 * sz * cx * cy / 104.0 - cx / 104.0,
-                -x * x / 104.0 + pi2 * y * z * cx / 260.0 - pi2 * sy * cx * cz / 104.0,
-            )
-        }),
-    }
-}
-
-/// The components of a vector field as scalar fields (for conditions and loads).
-pub fn components<const D: usize>(f: &VecFn<D>) -> [ScalarField; D] {
-    std::array::from_fn(|a| {
-        let f = f.clone();
-        ScalarField::from_fn(move |x, _| f(&Point::<D>::from_column_slice(x))[a])
-    })
-}
-
-/// `u = f` prescribed (all components) on the nodes of `faces`.
-pub fn dirichlet<const D: usize>(name: &str, faces: Vec<usize>, f: &VecFn<D>) -> Displacement<D> {
-    Displacement {
-        name: name.into(),
-        faces,
-        components: components(f).map(Some),
-    }
-}
+// Each test binary uses a part of these.
+#[allow(unused_imports)]
+pub use porofrac::sim::standard::{
+    Manufactured, QPoint, TenFn, VecFn, components, dirichlet, e2, e3, simplex_rule5,
+    tetrahedron_rule5, triangle_rule5,
+};
 
 /// Component `a` fixed to zero on `faces` (a roller).
 pub fn roller<const D: usize>(name: &str, faces: Vec<usize>, a: usize) -> Displacement<D> {
@@ -210,60 +116,6 @@ pub fn max_stress_error<const D: usize>(
         .map(|(c, s)| (s - exact(c)).norm())
         .fold(0.0, f64::max)
         / scale
-}
-
-/// A quadrature point on a simplex: weight (summing to 1) and barycentric coordinates.
-pub type QPoint = (f64, [f64; 4]);
-
-/// Triangle rule of degree 5 (Radon's 7 points).
-pub fn triangle_rule5() -> Vec<QPoint> {
-    let s = 15f64.sqrt();
-    let (a1, w1) = ((6.0 - s) / 21.0, (155.0 - s) / 1200.0);
-    let (a2, w2) = ((6.0 + s) / 21.0, (155.0 + s) / 1200.0);
-    let mut r = vec![(9.0 / 40.0, [1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0, 0.0])];
-    for (a, w) in [(a1, w1), (a2, w2)] {
-        let b = 1.0 - 2.0 * a;
-        r.push((w, [b, a, a, 0.0]));
-        r.push((w, [a, b, a, 0.0]));
-        r.push((w, [a, a, b, 0.0]));
-    }
-    r
-}
-
-/// Tetrahedron rule of degree 5: the collapsed (Duffy) product of 4-point Gauss rules,
-/// 64 points. With `x = s`, `y = t (1 − s)`, `z = r (1 − s)(1 − t)` a polynomial of degree
-/// `p` becomes one of degree `p + 2` in `s` (Jacobian `(1 − s)²(1 − t)`), integrated exactly
-/// by 4-point Gauss (degree 7) for `p ≤ 5`.
-pub fn tetrahedron_rule5() -> Vec<QPoint> {
-    let g = [
-        (-0.861_136_311_594_052_6, 0.347_854_845_137_453_9),
-        (-0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
-        (0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
-        (0.861_136_311_594_052_6, 0.347_854_845_137_453_9),
-    ];
-    let g01: Vec<(f64, f64)> = g.iter().map(|&(x, w)| (0.5 * (1.0 + x), 0.5 * w)).collect();
-    let mut r = Vec::with_capacity(64);
-    for &(s, ws) in &g01 {
-        for &(t, wt) in &g01 {
-            for &(q, wq) in &g01 {
-                let x = s;
-                let y = t * (1.0 - s);
-                let z = q * (1.0 - s) * (1.0 - t);
-                let w = 6.0 * ws * wt * wq * (1.0 - s) * (1.0 - s) * (1.0 - t);
-                r.push((w, [1.0 - x - y - z, x, y, z]));
-            }
-        }
-    }
-    r
-}
-
-/// The degree-5 rule for a D-simplex.
-pub fn simplex_rule5<const D: usize>() -> Vec<QPoint> {
-    if D == 2 {
-        triangle_rule5()
-    } else {
-        tetrahedron_rule5()
-    }
 }
 
 /// Largest error of `rule` (k barycentric coordinates) on the monomials `λ^α`, `|α| ≤

@@ -561,7 +561,8 @@ pub(crate) fn symbolic_galerkin(
         }
     }
     // Parts: contiguous block rows with about equal numbers of values.
-    let num_parts = (8 * rayon::current_num_threads()).clamp(1, nagg.max(1));
+    // Few parts: a fine row next to two parts is visited by both.
+    let num_parts = (2 * rayon::current_num_threads()).clamp(1, nagg.max(1));
     let mut part_aggs = vec![0usize];
     for k in 1..num_parts {
         let target = nnz * k / num_parts;

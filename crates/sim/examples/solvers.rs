@@ -15,144 +15,36 @@
 //!
 //! Grids: E2 = n × n squares split in two triangles, E3 = n³ cubes split in six
 //! tetrahedra (P1 = VEM on simplices), E = 1, ν = 0.3 (plane strain in 2D), Dirichlet on
-//! the whole boundary, body force from the manufactured solution. Cholesky uses AMD in
+//! the whole boundary, body force from the manufactured solution
+//! ([`porofrac_sim::standard`]). Cholesky uses AMD in
 //! 2D and geometric nested dissection in 3D, on all threads; setup = symbolic + numeric
 //! factorization. CG-AMG: setup = the multigrid hierarchy. L2 error with a degree-5 rule
 //! per simplex (Radon's 7 points, 64-point collapsed Gauss).
 
-use std::f64::consts::PI;
 use std::time::Instant;
 
-use porofrac_grid::{Grid, Point, generate};
+use porofrac_grid::{Point, generate};
 use porofrac_law::Stiffness;
 use porofrac_sim::ordering::nested_dissection;
+use porofrac_sim::standard::{self, Manufactured};
 use porofrac_sim::{
-    AmgSolver, DirectSolver, Displacement, DofMap, LawMap, LinearSolve, Loads, Pattern,
-    ScalarField, assemble, elasticity_amg_options, nodal_loads,
+    AmgSolver, DirectSolver, DofMap, LawMap, LinearSolve, Loads, Pattern, assemble,
+    elasticity_amg_options, nodal_loads,
 };
 use porofrac_vem::VemLaw;
-
-type Exact<const D: usize> = fn(&[f64]) -> [f64; D];
-
-fn e2_exact(x: &[f64]) -> [f64; 2] {
-    [
-        (PI * x[0]).sin() * (PI * x[1]).sin() / 100.0,
-        x[0] * x[0] * x[1] / 100.0,
-    ]
-}
-
-fn e3_exact(p: &[f64]) -> [f64; 3] {
-    let (x, y, z) = (p[0], p[1], p[2]);
-    [
-        (PI * x).sin() * (PI * y).sin() * (PI * z).sin() / 100.0,
-        x * x * y * z / 100.0,
-        y * z * (PI * x).cos() / 100.0,
-    ]
-}
-
-fn e2_force() -> [ScalarField; 2] {
-    [
-        ScalarField::from_fn(|x, _| {
-            -x[0] / 52.0 + 9.0 * PI * PI * (PI * x[0]).sin() * (PI * x[1]).sin() / 520.0
-        }),
-        ScalarField::from_fn(|x, _| {
-            -x[1] / 130.0 - PI * PI * (PI * x[0]).cos() * (PI * x[1]).cos() / 104.0
-        }),
-    ]
-}
-
-fn e3_force() -> [ScalarField; 3] {
-    [
-        ScalarField::from_fn(|p, _| {
-            let (x, y, z) = (p[0], p[1], p[2]);
-            -x * z / 52.0
-                + PI * y * (PI * x).sin() / 104.0
-                + 11.0 * PI * PI * (PI * x).sin() * (PI * y).sin() * (PI * z).sin() / 520.0
-        }),
-        ScalarField::from_fn(|p, _| {
-            let (x, y, z) = (p[0], p[1], p[2]);
-            -y * z / 130.0
-                - PI * PI * (PI * z).sin() * (PI * x).cos() * (PI * y).cos() / 104.0
-                - (PI * x).cos() / 104.0
-        }),
-        ScalarField::from_fn(|p, _| {
-            let (x, y, z) = (p[0], p[1], p[2]);
-            -x * x / 104.0 + PI * PI * y * z * (PI * x).cos() / 260.0
-                - PI * PI * (PI * y).sin() * (PI * x).cos() * (PI * z).cos() / 104.0
-        }),
-    ]
-}
-
-/// Quadrature point: weight (summing to 1), barycentric coordinates.
-type QPoint = (f64, [f64; 4]);
-
-fn rule5<const D: usize>() -> Vec<QPoint> {
-    if D == 2 {
-        let s = 15f64.sqrt();
-        let (a1, w1) = ((6.0 - s) / 21.0, (155.0 - s) / 1200.0);
-        let (a2, w2) = ((6.0 + s) / 21.0, (155.0 + s) / 1200.0);
-        let mut r = vec![(9.0 / 40.0, [1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0, 0.0])];
-        for (a, w) in [(a1, w1), (a2, w2)] {
-            let b = 1.0 - 2.0 * a;
-            r.push((w, [b, a, a, 0.0]));
-            r.push((w, [a, b, a, 0.0]));
-            r.push((w, [a, a, b, 0.0]));
-        }
-        r
-    } else {
-        let g = [
-            (-0.861_136_311_594_052_6, 0.347_854_845_137_453_9),
-            (-0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
-            (0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
-            (0.861_136_311_594_052_6, 0.347_854_845_137_453_9),
-        ];
-        let g01: Vec<(f64, f64)> = g.iter().map(|&(x, w)| (0.5 * (1.0 + x), 0.5 * w)).collect();
-        let mut r = Vec::with_capacity(64);
-        for &(s, ws) in &g01 {
-            for &(t, wt) in &g01 {
-                for &(q, wq) in &g01 {
-                    let (x, y, z) = (s, t * (1.0 - s), q * (1.0 - s) * (1.0 - t));
-                    let w = 6.0 * ws * wt * wq * (1.0 - s) * (1.0 - s) * (1.0 - t);
-                    r.push((w, [1.0 - x - y - z, x, y, z]));
-                }
-            }
-        }
-        r
-    }
-}
-
-/// `‖u − u_h‖_L2` of the P1 field `u` (node-major) on a simplex grid.
-fn l2_error<const D: usize>(grid: &Grid<D>, u: &[f64], exact: Exact<D>) -> f64 {
-    let rule = rule5::<D>();
-    let mut sum = 0.0;
-    for c in 0..grid.num_cells() {
-        let nodes = grid.cell_nodes(c);
-        let vol = grid.cell_volume(c);
-        for (w, l) in &rule {
-            let mut x = [0.0; 3];
-            let mut uh = [0.0; 3];
-            for (k, &n) in nodes.iter().enumerate() {
-                for a in 0..D {
-                    x[a] += l[k] * grid.node(n)[a];
-                    uh[a] += l[k] * u[D * n + a];
-                }
-            }
-            let ue = exact(&x[..D]);
-            sum += w * vol * (0..D).map(|a| (ue[a] - uh[a]).powi(2)).sum::<f64>();
-        }
-    }
-    sum.sqrt()
-}
 
 fn peak_rss_mb() -> f64 {
     status_mb("VmHWM:")
 }
 
-/// With `MEM_TRACE` set: the resident and peak memory after a stage, on stderr.
+/// With `MEM_TRACE` set: the time since the process started, the resident and peak
+/// memory after a stage, on stderr.
 fn trace(stage: &str) {
+    static START: std::sync::OnceLock<Instant> = std::sync::OnceLock::new();
+    let t = START.get_or_init(Instant::now).elapsed().as_secs_f64();
     if std::env::var_os("MEM_TRACE").is_some() {
         eprintln!(
-            "{stage:>10}: resident {:6.0} MB, peak {:6.0} MB",
+            "{stage:>10}: {t:7.3} s, resident {:6.0} MB, peak {:6.0} MB",
             status_mb("VmRSS:"),
             status_mb("VmHWM:")
         );
@@ -171,18 +63,15 @@ fn status_mb(key: &str) -> f64 {
         .map_or(f64::NAN, |kb| kb / 1024.0)
 }
 
-fn run<const D: usize>(n: usize, solver: &str, tol: f64, exact: Exact<D>, f: [ScalarField; D]) {
+fn run<const D: usize>(n: usize, solver: &str, tol: f64, problem: &Manufactured<D>) {
+    trace("start");
     let t0 = Instant::now();
     let grid =
         generate::simplices::<D>(Point::<D>::zeros(), Point::<D>::repeat(1.0), [n; D]).unwrap();
     let t_grid = t0.elapsed().as_secs_f64();
     trace("grid");
     let t1 = Instant::now();
-    let bc = Displacement {
-        name: "boundary".into(),
-        faces: grid.boundary_faces(),
-        components: std::array::from_fn(|a| Some(ScalarField::from_fn(move |x, _| exact(x)[a]))),
-    };
+    let bc = problem.boundary("boundary", grid.boundary_faces());
     let dofs = DofMap::new(&grid, &[bc], &[]).unwrap();
     trace("dofs");
     let pattern = Pattern::new(&grid, &dofs).unwrap();
@@ -194,8 +83,9 @@ fn run<const D: usize>(n: usize, solver: &str, tol: f64, exact: Exact<D>, f: [Sc
     let mut values = vec![0.0; pattern.nnz()];
     let mut rhs = vec![0.0; dofs.num_equations()];
     assemble(&grid, &laws, &dofs, &pattern, &u, &mut values, &mut rhs).unwrap();
+    trace("stiffness");
     let loads = Loads {
-        body_force: Some(f),
+        body_force: Some(problem.body_force()),
         ..Loads::default()
     };
     let mut full = vec![0.0; dofs.num_dofs()];
@@ -291,7 +181,9 @@ fn run<const D: usize>(n: usize, solver: &str, tol: f64, exact: Exact<D>, f: [Sc
         .sqrt();
     let bn: f64 = rhs.iter().map(|b| b * b).sum::<f64>().sqrt();
     dofs.scatter_add(&x, &mut u);
-    let l2 = l2_error(&grid, &u, exact);
+    let l2 = problem
+        .l2_error_simplices(&grid, &u)
+        .expect("a grid of simplices");
     println!(
         "| E{D} | {n} | {} | {neq} | {solver} | {t_grid:.2} | {t_asm:.2} | {t_setup:.2} | {t_solve:.2} | {:.2} | {iterations} | {:.1e} | {l2:.4e} | {:.0} | {info} |",
         D * grid.num_nodes(),
@@ -312,8 +204,8 @@ fn main() {
     let repeat: usize = std::env::var("REPEAT").map_or(1, |r| r.parse().expect("REPEAT"));
     for _ in 0..repeat {
         match args[0].as_str() {
-            "e2" => run::<2>(n, &args[2], tol, e2_exact, e2_force()),
-            "e3" => run::<3>(n, &args[2], tol, e3_exact, e3_force()),
+            "e2" => run::<2>(n, &args[2], tol, &standard::e2()),
+            "e3" => run::<3>(n, &args[2], tol, &standard::e3()),
             other => panic!("problem {other}: e2 or e3"),
         }
     }

@@ -51,6 +51,7 @@ pub mod ordering;
 pub mod pattern;
 mod quadrature;
 pub mod solve;
+pub mod standard;
 
 pub use assembly::{assemble, nodal_loads};
 pub use bc::{Displacement, Gravity, Loads, Platen, Traction};

@@ -136,6 +136,11 @@ impl Pattern {
             )));
         }
         let n = dofs.num_equations();
+        if n >= TWICE as usize {
+            return Err(SimError::Input(format!(
+                "{n} equations exceed the 31-bit scatter map"
+            )));
+        }
         let nc = grid.num_cells();
         // Cell → sorted unique free equations: counts, then values, both in parallel.
         let sorted_free = |c: usize, buf: &mut Vec<usize>| {
@@ -198,18 +203,34 @@ impl Pattern {
             }
         };
         const BLOCK: usize = 4096;
-        let col_counts: Vec<usize> = (0..n.div_ceil(BLOCK))
-            .into_par_iter()
-            .flat_map_iter(|b| {
-                let cols = b * BLOCK..((b + 1) * BLOCK).min(n);
-                let mut col = Vec::new();
-                cols.map(move |c| {
-                    column(c, b * BLOCK, &mut col);
-                    col.len()
-                })
-                .collect::<Vec<_>>()
-            })
-            .collect();
+        // Counts with a marker per row (no sorting); a column of the same node as the
+        // previous one has one row more.
+        let mut col_counts = vec![0usize; n];
+        col_counts.par_chunks_mut(BLOCK).enumerate().for_each_init(
+            || vec![0u32; n],
+            |mark, (b, out)| {
+                let first = b * BLOCK;
+                let mut count = 0;
+                for (k, slot) in out.iter_mut().enumerate() {
+                    let c = first + k;
+                    if c > first && cells_of(c) == cells_of(c - 1) {
+                        count += 1;
+                    } else {
+                        let stamp = c as u32 + 1;
+                        count = 0;
+                        for &cell in cells_of(c) {
+                            for &r in eqs_of(cell) {
+                                if r <= c && mark[r] != stamp {
+                                    mark[r] = stamp;
+                                    count += 1;
+                                }
+                            }
+                        }
+                    }
+                    *slot = count;
+                }
+            },
+        );
         let col_ptr = offsets(&col_counts);
         drop(col_counts);
         let mut row_idx = vec![0usize; col_ptr[n]];

@@ -3,15 +3,13 @@
 //! their manufactured solutions, and the Cholesky reference solution.
 #![allow(dead_code)]
 
-use std::f64::consts::PI;
-
 use porofrac_amg::SymCsr;
 use porofrac_grid::{Grid, Point, generate};
 use porofrac_law::{CellLaw, Stiffness};
 use porofrac_sim::ordering::nested_dissection;
+use porofrac_sim::standard::{self, Manufactured};
 use porofrac_sim::{
-    DirectSolver, Displacement, DofMap, LawMap, Loads, Pattern, Platen, ScalarField, assemble,
-    nodal_loads,
+    DirectSolver, Displacement, DofMap, LawMap, Loads, Pattern, Platen, assemble, nodal_loads,
 };
 use porofrac_vem::VemLaw;
 
@@ -138,80 +136,31 @@ pub fn build<const D: usize>(
     }
 }
 
-/// E2: unit square, `n × n` squares split in two triangles, E = 1, ν = 0.3 plane strain,
-/// manufactured solution, Dirichlet on the whole boundary; P1 (VEM on triangles).
-pub fn e2(n: usize) -> System<2> {
-    let grid = generate::simplices::<2>(Point::<2>::zeros(), Point::<2>::repeat(1.0), [n, n])
-        .expect("grid");
-    let bc = Displacement {
-        name: "boundary".into(),
-        faces: grid.boundary_faces(),
-        components: [
-            Some(ScalarField::from_fn(|x, _| {
-                (PI * x[0]).sin() * (PI * x[1]).sin() / 100.0
-            })),
-            Some(ScalarField::from_fn(|x, _| x[0] * x[0] * x[1] / 100.0)),
-        ],
-    };
+/// The standard problem on `grid` (Dirichlet on the whole boundary, the manufactured body
+/// force), E = 1, ν = 0.3 (plane strain in 2D), P1 = VEM on simplices.
+fn standard<const D: usize>(grid: Grid<D>, problem: &Manufactured<D>) -> System<D> {
+    let bc = problem.boundary("boundary", grid.boundary_faces());
     let loads = Loads {
-        body_force: Some([
-            ScalarField::from_fn(|x, _| {
-                -x[0] / 52.0 + 9.0 * PI * PI * (PI * x[0]).sin() * (PI * x[1]).sin() / 520.0
-            }),
-            ScalarField::from_fn(|x, _| {
-                -x[1] / 130.0 - PI * PI * (PI * x[0]).cos() * (PI * x[1]).cos() / 104.0
-            }),
-        ]),
+        body_force: Some(problem.body_force()),
         ..Loads::default()
     };
-    let law = VemLaw::new(Stiffness::<2>::isotropic(1.0, 0.3).expect("material"));
+    let law = VemLaw::new(Stiffness::<D>::isotropic(1.0, 0.3).expect("material"));
     build(grid, &[bc], &[], &loads, &law)
 }
 
-/// E3: unit cube, `n³` cubes split in six tetrahedra, E = 1, ν = 0.3, manufactured
-/// solution, Dirichlet on the whole boundary; P1 (VEM on tetrahedra).
+/// E2: unit square, `n × n` squares split in two triangles (see
+/// [`porofrac_sim::standard`]).
+pub fn e2(n: usize) -> System<2> {
+    let grid = generate::simplices::<2>(Point::<2>::zeros(), Point::<2>::repeat(1.0), [n, n])
+        .expect("grid");
+    standard(grid, &standard::e2())
+}
+
+/// E3: unit cube, `n³` cubes split in six tetrahedra (see [`porofrac_sim::standard`]).
 pub fn e3(n: usize) -> System<3> {
     let grid = generate::simplices::<3>(Point::<3>::zeros(), Point::<3>::repeat(1.0), [n, n, n])
         .expect("grid");
-    let bc = Displacement {
-        name: "boundary".into(),
-        faces: grid.boundary_faces(),
-        components: [
-            Some(ScalarField::from_fn(|x, _| {
-                (PI * x[0]).sin() * (PI * x[1]).sin() * (PI * x[2]).sin() / 100.0
-            })),
-            Some(ScalarField::from_fn(|x, _| {
-                x[0] * x[0] * x[1] * x[2] / 100.0
-            })),
-            Some(ScalarField::from_fn(|x, _| {
-                x[1] * x[2] * (PI * x[0]).cos() / 100.0
-            })),
-        ],
-    };
-    let loads = Loads {
-        body_force: Some([
-            ScalarField::from_fn(|p, _| {
-                let (x, y, z) = (p[0], p[1], p[2]);
-                -x * z / 52.0
-                    + PI * y * (PI * x).sin() / 104.0
-                    + 11.0 * PI * PI * (PI * x).sin() * (PI * y).sin() * (PI * z).sin() / 520.0
-            }),
-            ScalarField::from_fn(|p, _| {
-                let (x, y, z) = (p[0], p[1], p[2]);
-                -y * z / 130.0
-                    - PI * PI * (PI * z).sin() * (PI * x).cos() * (PI * y).cos() / 104.0
-                    - (PI * x).cos() / 104.0
-            }),
-            ScalarField::from_fn(|p, _| {
-                let (x, y, z) = (p[0], p[1], p[2]);
-                -x * x / 104.0 + PI * PI * y * z * (PI * x).cos() / 260.0
-                    - PI * PI * (PI * y).sin() * (PI * x).cos() * (PI * z).cos() / 104.0
-            }),
-        ]),
-        ..Loads::default()
-    };
-    let law = VemLaw::new(Stiffness::<3>::isotropic(1.0, 0.3).expect("material"));
-    build(grid, &[bc], &[], &loads, &law)
+    standard(grid, &standard::e3())
 }
 
 /// `‖a − b‖ / ‖b‖`.

@@ -1,0 +1,289 @@
+//! The standard problems E2 and E3 of `docs/BENCHMARKS.md`: manufactured displacements on
+//! the unit square and cube for `E = 1`, `ν = 0.3` (plane strain in 2D), their gradients,
+//! the body forces `f = −div σ(u)`, and the L2 error of a nodal (P1) field on a simplex
+//! grid. One definition for the validation tests, the solver benchmarks and the
+//! speed-against-error study.
+//!
+//! ```text
+//!   E2: u = (sin πx sin πy, x² y) / 100,
+//!   E3: u = (sin πx sin πy sin πz, x² y z, y z cos πx) / 100,
+//! ```
+//!
+//! with `λ = 15/26`, `μ = 5/13`: `f = −(λ + μ) ∇(div u) − μ Δu`.
+
+use std::f64::consts::PI;
+use std::sync::Arc;
+
+use porofrac_grid::{Grid, Point};
+use porofrac_law::Tensor;
+
+use crate::bc::Displacement;
+use crate::field::ScalarField;
+
+/// A vector field of position.
+pub type VecFn<const D: usize> = Arc<dyn Fn(&Point<D>) -> Point<D> + Send + Sync>;
+/// A tensor field of position (the displacement gradient `∂u_a/∂x_b` at `(a, b)`).
+pub type TenFn<const D: usize> = Arc<dyn Fn(&Point<D>) -> Tensor<D> + Send + Sync>;
+
+/// A manufactured solution: displacement, its gradient and the body force.
+#[derive(Clone)]
+pub struct Manufactured<const D: usize> {
+    /// The displacement.
+    pub u: VecFn<D>,
+    /// Its gradient.
+    pub grad: TenFn<D>,
+    /// The body force.
+    pub f: VecFn<D>,
+    /// The body force component by component (evaluated once per component and point by
+    /// the load integration).
+    f_parts: [Part; D],
+}
+
+/// A scalar function of position (one component of a field).
+type Part = fn(&[f64]) -> f64;
+
+/// The vector field of the components `parts`.
+fn from_parts<const D: usize>(parts: [Part; D]) -> VecFn<D> {
+    Arc::new(move |p: &Point<D>| Point::<D>::from_fn(|a, _| parts[a](p.as_slice())))
+}
+
+fn e2_fx(p: &[f64]) -> f64 {
+    let (x, y) = (p[0], p[1]);
+    -x / 52.0 + 9.0 * PI * PI * (PI * x).sin() * (PI * y).sin() / 520.0
+}
+
+fn e2_fy(p: &[f64]) -> f64 {
+    let (x, y) = (p[0], p[1]);
+    -y / 130.0 - PI * PI * (PI * x).cos() * (PI * y).cos() / 104.0
+}
+
+fn e3_fx(p: &[f64]) -> f64 {
+    let (x, y, z) = (p[0], p[1], p[2]);
+    let (sx, sy, sz) = ((PI * x).sin(), (PI * y).sin(), (PI * z).sin());
+    -x * z / 52.0 + PI * y * sx / 104.0 + 11.0 * PI * PI * sx * sy * sz / 520.0
+}
+
+fn e3_fy(p: &[f64]) -> f64 {
+    let (x, y, z) = (p[0], p[1], p[2]);
+    let (cx, cy, sz) = ((PI * x).cos(), (PI * y).cos(), (PI * z).sin());
+    -y * z / 130.0 - PI * PI * sz * cx * cy / 104.0 - cx / 104.0
+}
+
+fn e3_fz(p: &[f64]) -> f64 {
+    let (x, y, z) = (p[0], p[1], p[2]);
+    let (cx, sy, cz) = ((PI * x).cos(), (PI * y).sin(), (PI * z).cos());
+    -x * x / 104.0 + PI * PI * y * z * cx / 260.0 - PI * PI * sy * cx * cz / 104.0
+}
+
+/// E2: `u = (sin πx sin πy, x² y) / 100`.
+pub fn e2() -> Manufactured<2> {
+    Manufactured {
+        u: Arc::new(|p: &Point<2>| {
+            let (x, y) = (p[0], p[1]);
+            Point::<2>::new((PI * x).sin() * (PI * y).sin(), x * x * y) / 100.0
+        }),
+        grad: Arc::new(|p: &Point<2>| {
+            let (x, y) = (p[0], p[1]);
+            Tensor::<2>::new(
+                PI * (PI * x).cos() * (PI * y).sin(),
+                PI * (PI * x).sin() * (PI * y).cos(),
+                2.0 * x * y,
+                x * x,
+            ) / 100.0
+        }),
+        f: from_parts([e2_fx, e2_fy]),
+        f_parts: [e2_fx, e2_fy],
+    }
+}
+
+/// E3: `u = (sin πx sin πy sin πz, x² y z, y z cos πx) / 100`.
+pub fn e3() -> Manufactured<3> {
+    Manufactured {
+        u: Arc::new(|p: &Point<3>| {
+            let (x, y, z) = (p[0], p[1], p[2]);
+            Point::<3>::new(
+                (PI * x).sin() * (PI * y).sin() * (PI * z).sin(),
+                x * x * y * z,
+                y * z * (PI * x).cos(),
+            ) / 100.0
+        }),
+        grad: Arc::new(|p: &Point<3>| {
+            let (x, y, z) = (p[0], p[1], p[2]);
+            let (sx, sy, sz) = ((PI * x).sin(), (PI * y).sin(), (PI * z).sin());
+            let (cx, cy, cz) = ((PI * x).cos(), (PI * y).cos(), (PI * z).cos());
+            Tensor::<3>::new(
+                PI * cx * sy * sz,
+                PI * sx * cy * sz,
+                PI * sx * sy * cz,
+                2.0 * x * y * z,
+                x * x * z,
+                x * x * y,
+                -PI * y * z * sx,
+                z * cx,
+                y * cx,
+            ) / 100.0
+        }),
+        f: from_parts([e3_fx, e3_fy, e3_fz]),
+        f_parts: [e3_fx, e3_fy, e3_fz],
+    }
+}
+
+/// The components of a vector field as scalar fields (for conditions and loads).
+pub fn components<const D: usize>(f: &VecFn<D>) -> [ScalarField; D] {
+    std::array::from_fn(|a| {
+        let f = f.clone();
+        ScalarField::from_fn(move |x, _| f(&Point::<D>::from_column_slice(x))[a])
+    })
+}
+
+/// `u = f` prescribed (all components) on the nodes of `faces`.
+pub fn dirichlet<const D: usize>(name: &str, faces: Vec<usize>, f: &VecFn<D>) -> Displacement<D> {
+    Displacement {
+        name: name.into(),
+        faces,
+        components: components(f).map(Some),
+    }
+}
+
+impl<const D: usize> Manufactured<D> {
+    /// The body force as scalar fields ([`crate::Loads::body_force`]).
+    pub fn body_force(&self) -> [ScalarField; D] {
+        self.f_parts.map(|f| ScalarField::from_fn(move |x, _| f(x)))
+    }
+
+    /// The exact displacement prescribed on the nodes of `faces`.
+    pub fn boundary(&self, name: &str, faces: Vec<usize>) -> Displacement<D> {
+        dirichlet(name, faces, &self.u)
+    }
+
+    /// `‖u − u_h‖_L2` of the nodal field `u` (`D` per node, node-major) as the P1
+    /// interpolant on a grid of simplices, with the degree-5 rules of
+    /// [`simplex_rule5`]. `None` if a cell is not a simplex.
+    pub fn l2_error_simplices(&self, grid: &Grid<D>, u: &[f64]) -> Option<f64> {
+        let rule = simplex_rule5::<D>();
+        let mut sum = 0.0;
+        for c in 0..grid.num_cells() {
+            let nodes = grid.cell_nodes(c);
+            if nodes.len() != D + 1 {
+                return None;
+            }
+            let vol = grid.cell_volume(c);
+            for (w, l) in &rule {
+                let mut x = Point::<D>::zeros();
+                let mut uh = Point::<D>::zeros();
+                for (k, &n) in nodes.iter().enumerate() {
+                    x += grid.node(n) * l[k];
+                    uh += Point::<D>::from_column_slice(&u[D * n..D * n + D]) * l[k];
+                }
+                sum += w * vol * ((self.u)(&x) - uh).norm_squared();
+            }
+        }
+        Some(sum.sqrt())
+    }
+}
+
+/// A quadrature point on a simplex: weight (summing to 1) and barycentric coordinates.
+pub type QPoint = (f64, [f64; 4]);
+
+/// Triangle rule of degree 5 (Radon's 7 points).
+pub fn triangle_rule5() -> Vec<QPoint> {
+    let s = 15f64.sqrt();
+    let (a1, w1) = ((6.0 - s) / 21.0, (155.0 - s) / 1200.0);
+    let (a2, w2) = ((6.0 + s) / 21.0, (155.0 + s) / 1200.0);
+    let mut r = vec![(9.0 / 40.0, [1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0, 0.0])];
+    for (a, w) in [(a1, w1), (a2, w2)] {
+        let b = 1.0 - 2.0 * a;
+        r.push((w, [b, a, a, 0.0]));
+        r.push((w, [a, b, a, 0.0]));
+        r.push((w, [a, a, b, 0.0]));
+    }
+    r
+}
+
+/// Tetrahedron rule of degree 5: the collapsed (Duffy) product of 4-point Gauss rules,
+/// 64 points. With `x = s`, `y = t (1 − s)`, `z = r (1 − s)(1 − t)` a polynomial of degree
+/// `p` becomes one of degree `p + 2` in `s` (Jacobian `(1 − s)²(1 − t)`), integrated exactly
+/// by 4-point Gauss (degree 7) for `p ≤ 5`.
+pub fn tetrahedron_rule5() -> Vec<QPoint> {
+    let g = [
+        (-0.861_136_311_594_052_6, 0.347_854_845_137_453_9),
+        (-0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
+        (0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
+        (0.861_136_311_594_052_6, 0.347_854_845_137_453_9),
+    ];
+    let g01: Vec<(f64, f64)> = g.iter().map(|&(x, w)| (0.5 * (1.0 + x), 0.5 * w)).collect();
+    let mut r = Vec::with_capacity(64);
+    for &(s, ws) in &g01 {
+        for &(t, wt) in &g01 {
+            for &(q, wq) in &g01 {
+                let x = s;
+                let y = t * (1.0 - s);
+                let z = q * (1.0 - s) * (1.0 - t);
+                let w = 6.0 * ws * wt * wq * (1.0 - s) * (1.0 - s) * (1.0 - t);
+                r.push((w, [1.0 - x - y - z, x, y, z]));
+            }
+        }
+    }
+    r
+}
+
+/// The degree-5 rule for a `D`-simplex.
+pub fn simplex_rule5<const D: usize>() -> Vec<QPoint> {
+    if D == 2 {
+        triangle_rule5()
+    } else {
+        tetrahedron_rule5()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `u`, `grad` and `f` agree: the gradient with central differences of `u`, the body
+    /// force with `−div σ` from central differences of the gradient (λ = 15/26, μ = 5/13),
+    /// and the component fields with `f`.
+    fn consistent<const D: usize>(m: &Manufactured<D>) {
+        let (lambda, mu) = (15.0 / 26.0, 5.0 / 13.0);
+        let stress = |x: &Point<D>| {
+            let g = (m.grad)(x);
+            let eps = (g + g.transpose()) * 0.5;
+            Tensor::<D>::identity() * (lambda * eps.trace()) + eps * (2.0 * mu)
+        };
+        let body = m.body_force();
+        for k in 0..5 {
+            let x = Point::<D>::from_fn(|a, _| 0.13 + 0.17 * k as f64 + 0.11 * a as f64);
+            let h = 1e-5;
+            let mut div = Point::<D>::zeros();
+            for b in 0..D {
+                let mut e = Point::<D>::zeros();
+                e[b] = h;
+                let du = ((m.u)(&(x + e)) - (m.u)(&(x - e))) / (2.0 * h);
+                let g = (m.grad)(&x);
+                for a in 0..D {
+                    assert!((du[a] - g[(a, b)]).abs() < 1e-9, "∂u{a}/∂x{b} at {x:?}");
+                }
+                let ds = (stress(&(x + e)) - stress(&(x - e))) / (2.0 * h);
+                for a in 0..D {
+                    div[a] += ds[(a, b)];
+                }
+            }
+            let f = (m.f)(&x);
+            for a in 0..D {
+                assert!(
+                    (f[a] + div[a]).abs() < 1e-7,
+                    "f{a} at {x:?}: {} vs {}",
+                    f[a],
+                    -div[a]
+                );
+                assert_eq!(body[a].eval(x.as_slice(), 0.0), f[a]);
+            }
+        }
+    }
+
+    #[test]
+    fn manufactured_fields_are_consistent() {
+        consistent(&e2());
+        consistent(&e3());
+    }
+}
