@@ -203,7 +203,7 @@ pub struct AmgMemory {
     pub prolongators: usize,
     /// The Galerkin patterns, kept for numeric rebuilds.
     pub products: usize,
-    /// Inverse diagonals, work vectors, CG vectors, the coarsest factor's buffer.
+    /// Inverse diagonals, work vectors and CG vectors.
     pub vectors: usize,
 }
 
@@ -230,7 +230,6 @@ pub struct Amg {
     fine_col_ptr: Vec<usize>,
     pub(crate) options: AmgOptions,
     pub(crate) cg: [Vec<f64>; 4],
-    scratch: Vec<f64>,
     /// False after a failed [`Amg::update_values`].
     valid: bool,
 }
@@ -289,7 +288,6 @@ impl Amg {
         let mut null = near_null.clone();
         let mut levels: Vec<Level> = Vec::new();
         let mut a = a0;
-        let mut scratch = Vec::new();
         loop {
             let l = levels.len();
             if l > 0 {
@@ -323,7 +321,7 @@ impl Amg {
             }
             let tr = level.transfer.as_mut().ok_or_else(internal)?;
             let (galerkin, mut ac) = symbolic_galerkin(&level.a, &tr.p, &tr.off);
-            numeric_galerkin(&galerkin, &level.a, &tr.p, &tr.off, &mut ac, &mut scratch);
+            numeric_galerkin(&galerkin, &level.a, &tr.p, &tr.off, &mut ac);
             tr.galerkin = galerkin;
             levels.push(level);
             a = ac;
@@ -363,7 +361,6 @@ impl Amg {
             fine_col_ptr,
             options: options.clone(),
             cg: Default::default(),
-            scratch,
             valid: true,
         })
     }
@@ -410,14 +407,7 @@ impl Amg {
                 break;
             }
             let tr = level.transfer.as_ref().ok_or_else(internal)?;
-            numeric_galerkin(
-                &tr.galerkin,
-                &level.a,
-                &tr.p,
-                &tr.off,
-                &mut hi[0].a,
-                &mut self.scratch,
-            );
+            numeric_galerkin(&tr.galerkin, &level.a, &tr.p, &tr.off, &mut hi[0].a);
         }
         let last = &self.levels[nl - 1];
         self.coarse.factorize(&last.a)?;
@@ -458,7 +448,7 @@ impl Amg {
     pub fn memory(&self) -> AmgMemory {
         let mut m = AmgMemory {
             fine_map: vec_bytes(&self.fine_col_ptr),
-            vectors: self.cg.iter().map(vec_bytes).sum::<usize>() + vec_bytes(&self.scratch),
+            vectors: self.cg.iter().map(vec_bytes).sum::<usize>(),
             ..AmgMemory::default()
         };
         for level in &self.levels {

@@ -16,13 +16,15 @@
 //!    tentative prolongator from a QR factorization of the near-null space on each
 //!    aggregate.
 //! 4. [`product`]: the Jacobi-smoothed prolongator `P = (I − ω D⁻¹A) P_tent` and the
-//!    Galerkin operator `Pᵀ A P`, row by row with dense accumulators.
+//!    Galerkin operator `Pᵀ A P`, row by row with dense accumulators, without storing
+//!    `A P` or the transpose of `P`.
 //! 5. [`smoother`]: the Lanczos estimate of `ρ(D⁻¹A)` and the Chebyshev smoother.
 //! 6. [`hierarchy`]: levels until a coarse size, sparse Cholesky on the coarsest, the
 //!    V-cycle, and the numeric rebuild for new values on the same pattern.
 //! 7. [`pcg`]: preconditioned CG that reports its iterations and residual and fails loudly.
 //!
 //! All parallel kernels (rayon) give bitwise the same results for any number of threads.
+//! [`Amg::memory`] reports what a hierarchy holds, by part.
 //!
 //! ```
 //! use porofrac_amg::{Amg, AmgOptions, SymCsr};

@@ -620,7 +620,6 @@ pub(crate) fn numeric_galerkin(
     p: &Blocked,
     off: &[usize],
     ac: &mut CsrMatrix,
-    scratch: &mut Vec<f64>,
 ) {
     let nagg = off.len() - 1;
     let width = |b: usize| off[b + 1] - off[b];
@@ -701,9 +700,9 @@ pub(crate) fn numeric_galerkin(
         },
     );
     // Pass 2: blocks (a, b < a) from the transposed blocks (b, a).
-    scratch.clear();
-    scratch.extend_from_slice(ac.values());
-    let src = &scratch[..];
+    // A temporary copy of the upper blocks (freed at return: nothing kept between calls).
+    let copy = ac.values().to_vec();
+    let src = &copy[..];
     agg_chunks_mut(&row_ptr, off, ac.values_mut())
         .into_par_iter()
         .for_each(|(a0, vals)| {
@@ -843,7 +842,7 @@ mod tests {
             }
         }
         let (g, mut ac) = symbolic_galerkin(&am, &p, &off);
-        numeric_galerkin(&g, &am, &p, &off, &mut ac, &mut Vec::new());
+        numeric_galerkin(&g, &am, &p, &off, &mut ac);
         let want = matmul(&transpose(&pd), &matmul(&a, &pd));
         let got = dense(&ac);
         for i in 0..5 {
