@@ -36,7 +36,7 @@
 
 use faer::dyn_stack::MemBuffer;
 
-use crate::aggregate::{Blocks, aggregate, strength, tentative};
+use crate::aggregate::{Blocks, Tentative, aggregate, strength, tentative};
 use crate::coarse::CoarseSolver;
 use crate::csr::{
     CsrMatrix, SymCsr, check_upper_values, equals_upper, fill_from_upper, vec_bytes, zeros,
@@ -271,21 +271,37 @@ impl Amg {
         near_null: &NearNullSpace,
         options: &AmgOptions,
     ) -> Result<Self> {
+        if node_of_equation.len() != matrix.n() {
+            return Err(AmgError::Input(format!(
+                "{} equations and {} node ids",
+                matrix.n(),
+                node_of_equation.len()
+            )));
+        }
+        let blocks = Blocks::from_ids(node_of_equation)?;
+        Self::build(matrix, blocks, near_null.clone(), options)
+    }
+
+    /// [`Self::new`] with the nodes and the near-null space owned: each level's are
+    /// dropped as soon as the next level's exist.
+    fn build(
+        matrix: SymCsr,
+        mut blocks: Blocks,
+        mut null: NearNullSpace,
+        options: &AmgOptions,
+    ) -> Result<Self> {
         options.validate()?;
         let n = matrix.n();
         if n == 0 {
             return Err(AmgError::Input("empty matrix".into()));
         }
-        if node_of_equation.len() != n || near_null.len() != n {
+        if null.len() != n {
             return Err(AmgError::Input(format!(
-                "{n} equations, {} node ids and near-null vectors of length {}",
-                node_of_equation.len(),
-                near_null.len()
+                "{n} equations and near-null vectors of length {}",
+                null.len()
             )));
         }
         let (a0, fine_col_ptr) = matrix.into_parts();
-        let mut blocks = Blocks::from_ids(node_of_equation)?;
-        let mut null = near_null.clone();
         let mut levels: Vec<Level> = Vec::new();
         let mut a = a0;
         loop {
@@ -301,16 +317,26 @@ impl Amg {
             let s = strength(&a, &blocks, options.strength_threshold);
             let (agg, num_agg) = aggregate(&s, l < options.aggressive_levels);
             drop(s);
-            let tent = tentative(&blocks, &agg, num_agg, &null)?;
-            let nc = tent.p.ncols();
+            let Tentative {
+                p: t,
+                eq_agg,
+                coarse_null,
+                coarse_blocks,
+            } = tentative(&blocks, &agg, num_agg, &null)?;
+            drop(agg);
+            // This level's nodes and near-null space are done with.
+            null = coarse_null;
+            blocks = coarse_blocks;
+            let nc = t.ncols();
             if nc == 0 || nc as f64 > options.min_coarsening * a.nrows() as f64 {
                 levels.push(Level::new(a, dinv, None));
                 break;
             }
-            let off = tent.coarse_blocks.ptr.clone();
-            let p = symbolic_prolongator(&a, &tent.eq_agg, &off)?;
+            let off = blocks.ptr.clone();
+            let p = symbolic_prolongator(&a, &eq_agg, &off)?;
+            drop(eq_agg);
             let transfer = Transfer {
-                t: tent.p,
+                t,
                 p,
                 galerkin: Galerkin::default(),
                 off,
@@ -325,8 +351,6 @@ impl Amg {
             tr.galerkin = galerkin;
             levels.push(level);
             a = ac;
-            blocks = tent.coarse_blocks;
-            null = tent.coarse_null;
         }
         let nl = levels.len();
         let last = levels.last().ok_or_else(internal)?;
@@ -375,9 +399,18 @@ impl Amg {
         dofs: &[(usize, usize)],
         options: &AmgOptions,
     ) -> Result<Self> {
+        if dofs.len() != matrix.n() {
+            return Err(AmgError::Input(format!(
+                "{} equations and {} (node, component) pairs",
+                matrix.n(),
+                dofs.len()
+            )));
+        }
         let null = NearNullSpace::rigid_body_modes(coords, dim, dofs)?;
         let nodes: Vec<usize> = dofs.iter().map(|&(node, _)| node).collect();
-        Self::new(matrix, &nodes, &null, options)
+        let blocks = Blocks::from_ids(&nodes)?;
+        drop(nodes);
+        Self::build(matrix, blocks, null, options)
     }
 
     /// Build for a scalar problem: one equation per node, the constant as near-null space.
@@ -385,7 +418,9 @@ impl Amg {
         let n = matrix.n();
         let null = NearNullSpace::constant(n.max(1))?;
         let nodes: Vec<usize> = (0..n).collect();
-        Self::new(matrix, &nodes, &null, options)
+        let blocks = Blocks::from_ids(&nodes)?;
+        drop(nodes);
+        Self::build(matrix, blocks, null, options)
     }
 
     /// Recompute the hierarchy numerically for new upper-triangle `values` on the pattern

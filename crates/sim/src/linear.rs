@@ -317,6 +317,10 @@ impl AmgSolver {
                     Amg::elasticity(sym, &self.coords, self.dim, &self.eq_dofs, &self.options)
                         .map_err(amg_err)?;
                 self.amg = Some(amg);
+                // Only the first setup needs the node coordinates and equation dofs: later
+                // setups update the hierarchy numerically.
+                self.coords = Vec::new();
+                self.eq_dofs = Vec::new();
                 self.setups += 1;
             }
         }
