@@ -164,12 +164,11 @@ fn block_norms(a: &CsrMatrix, blocks: &Blocks, node: usize, spa: &mut Spa) {
     spa.list.clear();
     let stamp = node as u32 + 1;
     for &i in blocks.node(node) {
-        let (cols, vals) = a.row(i as usize);
-        for (&j, &v) in cols.iter().zip(vals) {
+        a.for_each_in_row(i as usize, |j, v| {
             let nj = blocks.node_of[j as usize];
             let slot = nj as usize;
             if slot == node {
-                continue;
+                return;
             }
             if spa.mark[slot] != stamp {
                 spa.mark[slot] = stamp;
@@ -177,20 +176,19 @@ fn block_norms(a: &CsrMatrix, blocks: &Blocks, node: usize, spa: &mut Spa) {
                 spa.list.push(nj);
             }
             spa.acc[slot] += v * v;
-        }
+        });
     }
 }
 
 /// `‖A_II‖_F`.
 fn diagonal_block_norm(a: &CsrMatrix, blocks: &Blocks, node: usize) -> f64 {
-    let mut s = 0.0;
+    let mut s = 0.0f64;
     for &i in blocks.node(node) {
-        let (cols, vals) = a.row(i as usize);
-        for (&j, &v) in cols.iter().zip(vals) {
+        a.for_each_in_row(i as usize, |j, v| {
             if blocks.node_of[j as usize] as usize == node {
                 s += v * v;
             }
-        }
+        });
     }
     s.sqrt()
 }

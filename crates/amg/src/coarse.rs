@@ -37,13 +37,14 @@ impl CoarseSolver {
         let mut row_idx = Vec::new();
         let mut src = Vec::new();
         for j in 0..n {
-            let (cols, _) = a.row(j);
-            for (k, &i) in cols.iter().enumerate() {
+            let mut k = 0;
+            a.for_each_col(j, |i| {
                 if i as usize <= j {
                     row_idx.push(i as usize);
                     src.push(a.row_ptr()[j] + k);
                 }
-            }
+                k += 1;
+            });
             col_ptr.push(row_idx.len());
         }
         let sym = SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row_idx);

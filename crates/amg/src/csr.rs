@@ -92,12 +92,18 @@ impl CsrMatrix {
         }
     }
 
-    /// Store the pattern as column runs of row groups (see [`Runs`]) when that reads less
-    /// memory than the column indices: at least three entries per run on average.
+    /// Store the pattern as column runs of row groups (see [`Runs`]) instead of column
+    /// indices when that reads less memory: at least three entries per run on average.
+    /// The column indices are then dropped (rows are read through
+    /// [`Self::for_each_in_row`] and [`Self::for_each_col`]).
     pub(crate) fn compress_runs(&mut self) {
+        if self.runs.is_some() {
+            return;
+        }
         let runs = self.runs_of();
         if 3 * runs.start.len() <= self.nnz() {
             self.runs = Some(runs);
+            self.col = Vec::new();
         }
     }
 
@@ -109,10 +115,11 @@ impl CsrMatrix {
             len: Vec::new(),
         };
         let mut prev: Option<usize> = None;
+        let cols_of = |i: usize| &self.col[self.row_ptr[i]..self.row_ptr[i + 1]];
         for i in 0..self.nrows {
-            let cols = self.row(i).0;
+            let cols = cols_of(i);
             if let Some(p) = prev
-                && self.row(p).0 == cols
+                && cols_of(p) == cols
             {
                 runs.row_group.push((runs.ptr.len() - 2) as u32);
                 continue;
@@ -145,15 +152,20 @@ impl CsrMatrix {
     }
     /// Number of stored entries.
     pub fn nnz(&self) -> usize {
-        self.col.len()
+        self.val.len()
     }
     /// Row offsets (length `nrows + 1`).
     pub fn row_ptr(&self) -> &[usize] {
         &self.row_ptr
     }
-    /// Column index of every stored entry, sorted within each row.
-    pub fn col_idx(&self) -> &[u32] {
-        &self.col
+    /// Column index of every stored entry, sorted within each row (built from the column
+    /// runs when the matrix stores those).
+    pub fn col_idx(&self) -> Vec<u32> {
+        let mut out = Vec::with_capacity(self.nnz());
+        for i in 0..self.nrows {
+            self.for_each_col(i, |j| out.push(j));
+        }
+        out
     }
     /// Value of every stored entry.
     pub fn values(&self) -> &[f64] {
@@ -162,11 +174,75 @@ impl CsrMatrix {
     pub(crate) fn values_mut(&mut self) -> &mut [f64] {
         &mut self.val
     }
-    /// Column indices and values of row `i`.
+    /// Values of row `i` (in the order of its columns).
     #[inline]
-    pub fn row(&self, i: usize) -> (&[u32], &[f64]) {
-        let r = self.row_ptr[i]..self.row_ptr[i + 1];
-        (&self.col[r.clone()], &self.val[r])
+    pub fn row_values(&self, i: usize) -> &[f64] {
+        &self.val[self.row_ptr[i]..self.row_ptr[i + 1]]
+    }
+
+    /// `f(column, value)` for the entries of row `i`, columns increasing.
+    #[inline]
+    pub fn for_each_in_row(&self, i: usize, mut f: impl FnMut(u32, f64)) {
+        let (p0, p1) = (self.row_ptr[i], self.row_ptr[i + 1]);
+        match &self.runs {
+            Some(r) => {
+                let g = r.row_group[i] as usize;
+                let mut p = p0;
+                for k in r.ptr[g]..r.ptr[g + 1] {
+                    let c = r.start[k];
+                    for (t, &v) in self.val[p..p + r.len[k] as usize].iter().enumerate() {
+                        f(c + t as u32, v);
+                    }
+                    p += r.len[k] as usize;
+                }
+            }
+            None => {
+                for (&c, &v) in self.col[p0..p1].iter().zip(&self.val[p0..p1]) {
+                    f(c, v);
+                }
+            }
+        }
+    }
+
+    /// `f(column)` for the entries of row `i`, increasing.
+    #[inline]
+    pub fn for_each_col(&self, i: usize, mut f: impl FnMut(u32)) {
+        match &self.runs {
+            Some(r) => {
+                let g = r.row_group[i] as usize;
+                for k in r.ptr[g]..r.ptr[g + 1] {
+                    (r.start[k]..r.start[k] + r.len[k]).for_each(&mut f);
+                }
+            }
+            None => self.col[self.row_ptr[i]..self.row_ptr[i + 1]]
+                .iter()
+                .for_each(|&c| f(c)),
+        }
+    }
+
+    /// Position within row `i` of column `c`, if stored.
+    #[inline]
+    pub(crate) fn find_in_row(&self, i: usize, c: u32) -> Option<usize> {
+        match &self.runs {
+            Some(r) => {
+                let g = r.row_group[i] as usize;
+                let mut at = 0;
+                for k in r.ptr[g]..r.ptr[g + 1] {
+                    let (s, l) = (r.start[k], r.len[k]);
+                    if c < s {
+                        return None;
+                    }
+                    if c < s + l {
+                        return Some(at + (c - s) as usize);
+                    }
+                    at += l as usize;
+                }
+                None
+            }
+            None => self.col[self.row_ptr[i]..self.row_ptr[i + 1]]
+                .binary_search(&c)
+                .ok(),
+        }
     }
 
     /// `(A x)_i`, with four partial sums (the products are independent, so they need not
@@ -186,7 +262,8 @@ impl CsrMatrix {
                 }
             }
             None => {
-                let (cols, vals) = self.row(i);
+                let r = self.row_ptr[i]..self.row_ptr[i + 1];
+                let (cols, vals) = (&self.col[r.clone()], &self.val[r]);
                 let mut vc = vals.chunks_exact(4);
                 let mut cc = cols.chunks_exact(4);
                 for (v, c) in (&mut vc).zip(&mut cc) {
@@ -206,9 +283,8 @@ impl CsrMatrix {
     pub fn diagonal(&self) -> Vec<f64> {
         let mut d = zeros(self.nrows);
         par_rows(&mut d, |i, di| {
-            let (cols, vals) = self.row(i);
-            if let Ok(k) = cols.binary_search(&(i as u32)) {
-                *di = vals[k];
+            if let Some(k) = self.find_in_row(i, i as u32) {
+                *di = self.row_values(i)[k];
             }
         });
         d
@@ -242,8 +318,9 @@ impl CsrMatrix {
     /// The transpose, and for each of its entries the position of the same entry in `self`.
     #[cfg(test)]
     pub(crate) fn transpose_with_map(&self) -> (CsrMatrix, Vec<usize>) {
+        let cols = self.col_idx();
         let mut count = vec![0usize; self.ncols + 1];
-        for &c in &self.col {
+        for &c in &cols {
             count[c as usize + 1] += 1;
         }
         for j in 0..self.ncols {
@@ -256,7 +333,7 @@ impl CsrMatrix {
         let mut map = vec![0usize; nnz];
         for i in 0..self.nrows {
             for k in self.row_ptr[i]..self.row_ptr[i + 1] {
-                let j = self.col[k] as usize;
+                let j = cols[k] as usize;
                 col[next[j]] = i as u32;
                 map[next[j]] = k;
                 next[j] += 1;
@@ -461,18 +538,19 @@ pub(crate) fn check_upper_values(values: &[f64], upper_nnz: usize) -> Result<()>
 /// passed to `f(k, position)` with `k` the entry's index within the row.
 #[inline]
 fn upper_positions(full: &CsrMatrix, col_ptr: &[usize], i: usize, mut f: impl FnMut(usize, usize)) {
-    let cols = &full.col[full.row_ptr[i]..full.row_ptr[i + 1]];
     let m = col_ptr[i + 1] - col_ptr[i];
-    for k in 0..m {
-        f(k, col_ptr[i] + k);
-    }
-    for (k, &c) in cols.iter().enumerate().skip(m) {
+    let mut k = 0;
+    full.for_each_col(i, |c| {
         let c = c as usize;
-        let lower = &full.col[full.row_ptr[c]..full.row_ptr[c] + col_ptr[c + 1] - col_ptr[c]];
-        // Invariant: the pattern is symmetric, so row i is in column c.
-        let t = lower.binary_search(&(i as u32)).unwrap_or(0);
-        f(k, col_ptr[c] + t);
-    }
+        if k < m {
+            f(k, col_ptr[i] + k);
+        } else {
+            // Invariant: the pattern is symmetric, so row i is in (the lower part of) row c.
+            let t = full.find_in_row(c, i as u32).unwrap_or(0);
+            f(k, col_ptr[c] + t);
+        }
+        k += 1;
+    });
 }
 
 /// Set the values of the full matrix `full` from the upper-triangle `values` laid out by
@@ -510,7 +588,7 @@ pub(crate) fn equals_upper(full: &CsrMatrix, col_ptr: &[usize], values: &[f64]) 
         .into_par_iter()
         .with_min_len(ROWS_PER_TASK)
         .all(|i| {
-            let vals = full.row(i).1;
+            let vals = full.row_values(i);
             let mut same = true;
             upper_positions(full, col_ptr, i, |k, p| {
                 same &= vals[k].to_bits() == values[p].to_bits()
@@ -681,7 +759,7 @@ mod tests {
         let a = small();
         let m = a.matrix();
         assert_eq!(m.row_ptr(), &[0, 2, 5, 7]);
-        assert_eq!(m.col_idx(), &[0, 1, 0, 1, 2, 1, 2]);
+        assert_eq!(m.col_idx(), vec![0, 1, 0, 1, 2, 1, 2]);
         assert_eq!(m.values(), &[4.0, 1.0, 1.0, 5.0, 2.0, 2.0, 6.0]);
         let mut y = vec![0.0; 3];
         a.mul(&[1.0, 2.0, 3.0], &mut y).unwrap();
@@ -721,10 +799,9 @@ mod tests {
         let check = |a: &SymCsr, dense: &[Vec<f64>]| {
             let m = a.matrix();
             for (i, row) in dense.iter().enumerate() {
-                let (cols, v) = m.row(i);
-                assert!(cols.windows(2).all(|w| w[0] < w[1]), "row {i} sorted");
-                let got: Vec<(usize, f64)> =
-                    cols.iter().zip(v).map(|(&j, &x)| (j as usize, x)).collect();
+                let mut got: Vec<(usize, f64)> = Vec::new();
+                m.for_each_in_row(i, |j, x| got.push((j as usize, x)));
+                assert!(got.windows(2).all(|w| w[0].0 < w[1].0), "row {i} sorted");
                 let want: Vec<(usize, f64)> = row
                     .iter()
                     .enumerate()
@@ -783,7 +860,7 @@ mod tests {
         let m = CsrMatrix::from_parts(2, 3, vec![0, 2, 3], vec![0, 2, 1], vec![1.0, 2.0, 3.0]);
         let (t, map) = m.transpose_with_map();
         assert_eq!(t.row_ptr(), &[0, 1, 2, 3]);
-        assert_eq!(t.col_idx(), &[0, 1, 0]);
+        assert_eq!(t.col_idx(), vec![0, 1, 0]);
         assert_eq!(t.values(), &[1.0, 3.0, 2.0]);
         assert_eq!(map, vec![0, 2, 1]);
         let a: Vec<f64> = (0..10_000).map(|i| i as f64).collect();

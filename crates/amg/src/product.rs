@@ -224,13 +224,13 @@ pub(crate) fn symbolic_prolongator(
                 let mut aggs = Vec::new();
                 for i in rows {
                     let start = aggs.len();
-                    for &j in a.row(i).0 {
+                    a.for_each_col(i, |j| {
                         let b = eq_agg[j as usize] as usize;
                         if mark[b] != stamp(i) && off[b + 1] > off[b] {
                             mark[b] = stamp(i);
                             aggs.push(b as u32);
                         }
-                    }
+                    });
                     aggs[start..].sort_unstable();
                     counts.push(aggs.len() - start);
                 }
@@ -317,15 +317,14 @@ pub(crate) fn smooth_prolongator(
                 }
                 let row = row_start(i) - base..row_start(i + 1) - base;
                 vals[row.clone()].fill(0.0);
-                let (ac, av) = a.row(i);
-                for (&j, &aij) in ac.iter().zip(av) {
+                a.for_each_in_row(i, |j, aij| {
                     let (tb, tp) = t.blocks(j as usize);
                     for (&b, &s) in tb.iter().zip(tp) {
                         let k = off[b as usize + 1] - off[b as usize];
                         let (d, s) = (pos[b as usize], s as usize);
                         axpy(&mut vals[d..d + k], aij, &tv[s..s + k]);
                     }
-                }
+                });
                 let scale = -omega * dinv[i];
                 vals[row].iter_mut().for_each(|v| *v *= scale);
                 let (tb, tp) = t.blocks(i);
@@ -455,8 +454,7 @@ fn w_row(
     let pv = p.values();
     aggs.clear();
     vals.clear();
-    let (ac, av) = a.row(i);
-    for (&j, &aij) in ac.iter().zip(av) {
+    a.for_each_in_row(i, |j, aij| {
         let (pb, pp) = p.blocks(j as usize);
         for (&b, &s) in pb.iter().zip(pp) {
             let (bu, s) = (b as usize, s as usize);
@@ -473,7 +471,7 @@ fn w_row(
                 axpy(&mut vals[d..d + k], aij, &pv[s..s + k]);
             }
         }
-    }
+    });
     for &b in aggs.iter() {
         slot[b as usize] = u32::MAX;
     }
@@ -503,14 +501,14 @@ pub(crate) fn symbolic_galerkin(
                     let start = list.len();
                     if off[ag + 1] > off[ag] {
                         for &i in rows_of(ag) {
-                            for &j in a.row(i as usize).0 {
+                            a.for_each_col(i as usize, |j| {
                                 for &b in p.blocks(j as usize).0 {
                                     if mark[b as usize] != stamp(ag) {
                                         mark[b as usize] = stamp(ag);
                                         list.push(b);
                                     }
                                 }
-                            }
+                            });
                         }
                     }
                     list[start..].sort_unstable();
@@ -761,10 +759,7 @@ mod tests {
     fn dense(m: &CsrMatrix) -> Vec<Vec<f64>> {
         let mut d = vec![vec![0.0; m.ncols()]; m.nrows()];
         for i in 0..m.nrows() {
-            let (c, v) = m.row(i);
-            for (&j, &x) in c.iter().zip(v) {
-                d[i][j as usize] += x;
-            }
+            m.for_each_in_row(i, |j, x| d[i][j as usize] += x);
         }
         d
     }

@@ -53,13 +53,9 @@ fn hash_unit(i: usize) -> f64 {
 fn gershgorin(a: &CsrMatrix, s: &[f64]) -> f64 {
     let mut rows = zeros(a.nrows());
     par_rows(&mut rows, |i, ri| {
-        let (cols, vals) = a.row(i);
-        *ri = s[i]
-            * cols
-                .iter()
-                .zip(vals)
-                .map(|(&j, v)| v.abs() * s[j as usize])
-                .sum::<f64>();
+        let mut sum = 0.0;
+        a.for_each_in_row(i, |j, v| sum += v.abs() * s[j as usize]);
+        *ri = s[i] * sum;
     });
     rows.iter().fold(0.0, |m: f64, &x| m.max(x))
 }
