@@ -504,11 +504,15 @@ mod tests {
         let s = strength(a.matrix(), &blocks, 0.0);
         // Neighbours within distance two; a distance-two link is as strong as its weakest
         // step (every |a_ij| = 1 here).
-        let mut nbrs = Vec::new();
-        s.visit(5, true, |j, w| nbrs.push((j, w)));
-        nbrs.sort_by_key(|x| x.0);
-        nbrs.dedup();
-        assert_eq!(nbrs, vec![(3, 1.0), (4, 1.0), (6, 1.0), (7, 1.0)]);
+        let nbrs = |i: usize| {
+            let mut out = Vec::new();
+            s.visit(i, true, |j, w| out.push((j, w)));
+            out.sort_by_key(|x| x.0);
+            out.dedup();
+            out
+        };
+        assert_eq!(nbrs(0), vec![(1, 1.0), (2, 1.0)]);
+        assert_eq!(nbrs(5), vec![(3, 1.0), (4, 1.0), (6, 1.0), (7, 1.0)]);
         let (agg, na) = aggregate(&s, true);
         // Pass 1: roots 0, 5 and 10 take {0, 1, 2}, {3, …, 7} and {8, …, 11}.
         assert_eq!(na, 3);
