@@ -279,6 +279,41 @@ impl CsrMatrix {
         (acc[0] + acc[1]) + (acc[2] + acc[3])
     }
 
+    /// `f(i, (A x)_i)` for the rows `rows`, in order. Rows of a group (same columns,
+    /// consecutive) are computed together: each piece of `x` is read once for all of them.
+    #[inline]
+    pub(crate) fn rows_times(
+        &self,
+        rows: std::ops::Range<usize>,
+        x: &[f64],
+        mut f: impl FnMut(usize, f64),
+    ) {
+        let Some(r) = &self.runs else {
+            for i in rows {
+                f(i, self.row_dot(i, x));
+            }
+            return;
+        };
+        let mut i = rows.start;
+        while i < rows.end {
+            let g = r.row_group[i];
+            let mut m = 1;
+            while i + m < rows.end && m < 6 && r.row_group[i + m] == g {
+                m += 1;
+            }
+            let runs = r.ptr[g as usize]..r.ptr[g as usize + 1];
+            match m {
+                1 => group_dot::<1>(self, r, runs, i, x, &mut f),
+                2 => group_dot::<2>(self, r, runs, i, x, &mut f),
+                3 => group_dot::<3>(self, r, runs, i, x, &mut f),
+                4 => group_dot::<4>(self, r, runs, i, x, &mut f),
+                5 => group_dot::<5>(self, r, runs, i, x, &mut f),
+                _ => group_dot::<6>(self, r, runs, i, x, &mut f),
+            }
+            i += m;
+        }
+    }
+
     /// The diagonal (0 where no entry is stored).
     pub fn diagonal(&self) -> Vec<f64> {
         let mut d = zeros(self.nrows);
@@ -307,12 +342,51 @@ impl CsrMatrix {
 
     /// `y = A x` without size checks.
     pub(crate) fn spmv(&self, x: &[f64], y: &mut [f64]) {
-        par_rows(y, |i, yi| *yi = self.row_dot(i, x));
+        self.par_products(x, y, |_, ax, yi| *yi = ax);
     }
 
     /// `r = b − A x` without size checks.
     pub(crate) fn residual(&self, b: &[f64], x: &[f64], r: &mut [f64]) {
-        par_rows(r, |i, ri| *ri = b[i] - self.row_dot(i, x));
+        self.par_products(x, r, |i, ax, ri| *ri = b[i] - ax);
+    }
+
+    /// `f(i, (A x)_i, &mut y[i])` for every row, in parallel blocks of rows.
+    pub(crate) fn par_products<F>(&self, x: &[f64], y: &mut [f64], f: F)
+    where
+        F: Fn(usize, f64, &mut f64) + Sync + Send,
+    {
+        y.par_chunks_mut(ROWS_PER_TASK)
+            .enumerate()
+            .for_each(|(b, ys)| {
+                let base = b * ROWS_PER_TASK;
+                self.rows_times(base..base + ys.len(), x, |i, ax| {
+                    f(i, ax, &mut ys[i - base])
+                });
+            });
+    }
+
+    /// `f(i, (A x)_i, &mut y[i], &mut z[i], &mut w[i])` for every row, in parallel blocks.
+    pub(crate) fn par_products3<F>(
+        &self,
+        x: &[f64],
+        y: &mut [f64],
+        z: &mut [f64],
+        w: &mut [f64],
+        f: F,
+    ) where
+        F: Fn(usize, f64, &mut f64, &mut f64, &mut f64) + Sync + Send,
+    {
+        y.par_chunks_mut(ROWS_PER_TASK)
+            .zip(z.par_chunks_mut(ROWS_PER_TASK))
+            .zip(w.par_chunks_mut(ROWS_PER_TASK))
+            .enumerate()
+            .for_each(|(b, ((ys, zs), ws))| {
+                let base = b * ROWS_PER_TASK;
+                self.rows_times(base..base + ys.len(), x, |i, ax| {
+                    let k = i - base;
+                    f(i, ax, &mut ys[k], &mut zs[k], &mut ws[k])
+                });
+            });
     }
 
     /// The transpose, and for each of its entries the position of the same entry in `self`.
@@ -355,6 +429,45 @@ impl CsrMatrix {
                     *vk = src[mk];
                 }
             });
+    }
+}
+
+/// `(A x)_i` for the `M` rows `i0..i0 + M` of one group (same column runs `runs`), passed
+/// to `f`; each row sums in two lanes (even and odd positions).
+#[inline(always)]
+fn group_dot<const M: usize>(
+    a: &CsrMatrix,
+    r: &Runs,
+    runs: std::ops::Range<usize>,
+    i0: usize,
+    x: &[f64],
+    f: &mut impl FnMut(usize, f64),
+) {
+    let base = a.row_ptr[i0];
+    let len = a.row_ptr[i0 + 1] - base;
+    let vals: [&[f64]; M] = std::array::from_fn(|q| &a.val[base + q * len..base + (q + 1) * len]);
+    let mut acc = [[0.0f64; 2]; M];
+    let mut p = 0;
+    for k in runs {
+        let c = r.start[k] as usize;
+        let l = r.len[k] as usize;
+        let xs = &x[c..c + l];
+        for q in 0..M {
+            let v = &vals[q][p..p + l];
+            let mut t = 0;
+            while t + 1 < l {
+                acc[q][0] += v[t] * xs[t];
+                acc[q][1] += v[t + 1] * xs[t + 1];
+                t += 2;
+            }
+            if t < l {
+                acc[q][0] += v[t] * xs[t];
+            }
+        }
+        p += l;
+    }
+    for q in 0..M {
+        f(i0 + q, acc[q][0] + acc[q][1]);
     }
 }
 
@@ -827,6 +940,58 @@ mod tests {
         let mut one_off = new.clone();
         one_off[rows.len() / 2] += 1e-12;
         assert!(!equals_upper(a.matrix(), &col_ptr, &one_off));
+    }
+
+    #[test]
+    fn group_products_match_row_by_row_products() {
+        // Nodes of 1–7 equations coupled to nodes k ± 1 and k ± 5: the rows of a node form
+        // one group (sizes 1–7; 7 is computed as 6 + 1), and the 512-row blocks of the
+        // parallel kernels cut groups.
+        let sizes: Vec<usize> = (0..900).map(|k| 1 + k % 7).collect();
+        let first: Vec<usize> = sizes
+            .iter()
+            .scan(0, |s, &m| {
+                *s += m;
+                Some(*s - m)
+            })
+            .collect();
+        let n: usize = sizes.iter().sum();
+        let node: Vec<usize> = (0..sizes.len())
+            .flat_map(|k| std::iter::repeat_n(k, sizes[k]))
+            .collect();
+        let (mut col_ptr, mut rows, mut vals) = (vec![0], vec![], vec![]);
+        for c in 0..n {
+            let kc = node[c];
+            for kr in kc.saturating_sub(5)..=kc {
+                if kr + 5 == kc || kr + 1 >= kc {
+                    for r in first[kr]..(first[kr] + sizes[kr]).min(c + 1) {
+                        rows.push(r);
+                        vals.push(if r == c {
+                            40.0
+                        } else {
+                            1.0 / (1.0 + (r + 2 * c) as f64)
+                        });
+                    }
+                }
+            }
+            col_ptr.push(rows.len());
+        }
+        let a = SymCsr::from_upper_csc(n, &col_ptr, &rows, &vals).unwrap();
+        assert!(a.matrix().runs.is_some(), "stored as runs");
+        let x: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin()).collect();
+        let mut y = vec![0.0; n];
+        a.mul(&x, &mut y).unwrap();
+        let mut plain = a.matrix().clone();
+        plain.runs = None;
+        plain.col = a.matrix().col_idx();
+        for i in 0..n {
+            let want = plain.row_dot(i, &x);
+            assert!(
+                (y[i] - want).abs() <= 1e-14 * want.abs().max(1.0),
+                "row {i}: {} vs {want}",
+                y[i]
+            );
+        }
     }
 
     #[test]

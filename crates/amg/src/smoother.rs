@@ -80,9 +80,7 @@ pub(crate) fn spectral_radius(a: &CsrMatrix, dinv: &[f64], steps: usize) -> f64 
         // w = S v − β_j v_prev.
         par_rows(&mut u, |i, ui| *ui = s[i] * v[i]);
         let bj = if j > 0 { beta[j - 1] } else { 0.0 };
-        par_rows(&mut w, |i, wi| {
-            *wi = s[i] * a.row_dot(i, &u) - bj * v_prev[i]
-        });
+        a.par_products(&u, &mut w, |i, au, wi| *wi = s[i] * au - bj * v_prev[i]);
         let aj = dot(&w, &v);
         alpha.push(aj);
         par_rows(&mut w, |i, wi| *wi -= aj * v[i]);
@@ -165,8 +163,8 @@ impl Chebyshev {
             let c1 = rho_n * rho;
             let c2 = 2.0 * rho_n / delta;
             let dd: &[f64] = d;
-            par_zip3(r, dn, x, |i, ri, dni, xi| {
-                *ri -= a.row_dot(i, dd);
+            a.par_products3(dd, r, dn, x, |i, ad, ri, dni, xi| {
+                *ri -= ad;
                 *dni = c1 * dd[i] + c2 * dinv[i] * *ri;
                 *xi += *dni;
             });
@@ -175,7 +173,7 @@ impl Chebyshev {
         }
         if residual {
             let dd: &[f64] = d;
-            par_rows(r, |i, ri| *ri -= a.row_dot(i, dd));
+            a.par_products(dd, r, |_, ad, ri| *ri -= ad);
         }
     }
 }
