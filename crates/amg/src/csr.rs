@@ -22,6 +22,74 @@ use rayon::prelude::*;
 
 use crate::error::{AmgError, Result, check_finite};
 
+/// Storage precision of a matrix's values.
+///
+/// A preconditioner only has to be a fixed symmetric positive definite operator close to
+/// `A⁻¹`: storing the finest matrix of a hierarchy in single precision (rounding each entry
+/// to a relative 6e-8) halves the bytes its products read — most of a V-cycle's cost — and
+/// its memory, while the Krylov method keeps multiplying by the exact double-precision
+/// matrix (see [`crate::Amg::solve_upper`]). Products always accumulate in `f64`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Precision {
+    /// `f64` values.
+    #[default]
+    Double,
+    /// `f32` values, read as `f64`.
+    Single,
+}
+
+/// A stored value type: `f64`, or `f32` read as `f64`.
+pub(crate) trait Value: Copy + Default + PartialEq + Send + Sync + 'static {
+    fn get(self) -> f64;
+    fn from_f64(v: f64) -> Self;
+}
+
+impl Value for f64 {
+    #[inline(always)]
+    fn get(self) -> f64 {
+        self
+    }
+    #[inline(always)]
+    fn from_f64(v: f64) -> Self {
+        v
+    }
+}
+
+impl Value for f32 {
+    #[inline(always)]
+    fn get(self) -> f64 {
+        self as f64
+    }
+    #[inline(always)]
+    fn from_f64(v: f64) -> Self {
+        v as f32
+    }
+}
+
+/// The values of a matrix in their storage precision.
+#[derive(Clone, Debug)]
+enum Values {
+    Double(Vec<f64>),
+    Single(Vec<f32>),
+}
+
+impl Default for Values {
+    fn default() -> Self {
+        Values::Double(Vec::new())
+    }
+}
+
+/// Evaluate `$body` with `$v` bound to the value slice of either precision (`$body` must
+/// compile for both).
+macro_rules! with_values {
+    ($vals:expr, $v:ident => $body:expr) => {
+        match $vals {
+            Values::Double($v) => $body,
+            Values::Single($v) => $body,
+        }
+    };
+}
+
 /// Rows per parallel task in matrix kernels.
 pub(crate) const ROWS_PER_TASK: usize = 512;
 /// Entries per parallel task in vector kernels.
@@ -34,7 +102,7 @@ pub struct CsrMatrix {
     ncols: usize,
     row_ptr: Vec<usize>,
     col: Vec<u32>,
-    val: Vec<f64>,
+    val: Values,
     runs: Option<Runs>,
 }
 
@@ -62,7 +130,7 @@ impl CsrMatrix {
     pub(crate) fn bytes(&self) -> usize {
         vec_bytes(&self.row_ptr)
             + vec_bytes(&self.col)
-            + vec_bytes(&self.val)
+            + with_values!(&self.val, v => vec_bytes(v))
             + self.runs.as_ref().map_or(0, |r| {
                 vec_bytes(&r.row_group)
                     + vec_bytes(&r.ptr)
@@ -87,7 +155,7 @@ impl CsrMatrix {
             ncols,
             row_ptr,
             col,
-            val,
+            val: Values::Double(val),
             runs: None,
         }
     }
@@ -152,7 +220,20 @@ impl CsrMatrix {
     }
     /// Number of stored entries.
     pub fn nnz(&self) -> usize {
-        self.val.len()
+        self.row_ptr[self.nrows]
+    }
+    /// Precision of the stored values.
+    pub fn precision(&self) -> Precision {
+        match self.val {
+            Values::Double(_) => Precision::Double,
+            Values::Single(_) => Precision::Single,
+        }
+    }
+    /// Store the values in double precision (a no-op if they are).
+    pub(crate) fn store_double(&mut self) {
+        if let Values::Single(v) = &self.val {
+            self.val = Values::Double(v.iter().map(|x| x.get()).collect());
+        }
     }
     /// Row offsets (length `nrows + 1`).
     pub fn row_ptr(&self) -> &[usize] {
@@ -167,22 +248,41 @@ impl CsrMatrix {
         }
         out
     }
-    /// Value of every stored entry.
-    pub fn values(&self) -> &[f64] {
-        &self.val
+    /// Value of every stored entry of a matrix stored in double precision (empty for one
+    /// in single precision: the matrices whose values are read this way — prolongators,
+    /// coarse levels — are always double).
+    pub(crate) fn values(&self) -> &[f64] {
+        match &self.val {
+            Values::Double(v) => v,
+            Values::Single(_) => {
+                debug_assert!(false, "values() of a single-precision matrix");
+                &[]
+            }
+        }
     }
     pub(crate) fn values_mut(&mut self) -> &mut [f64] {
-        &mut self.val
+        match &mut self.val {
+            Values::Double(v) => v,
+            Values::Single(_) => {
+                debug_assert!(false, "values_mut() of a single-precision matrix");
+                &mut []
+            }
+        }
     }
-    /// Values of row `i` (in the order of its columns).
+    /// The stored value at position `p` (of all entries, rows in order).
     #[inline]
-    pub fn row_values(&self, i: usize) -> &[f64] {
-        &self.val[self.row_ptr[i]..self.row_ptr[i + 1]]
+    pub(crate) fn value_at(&self, p: usize) -> f64 {
+        with_values!(&self.val, v => v[p].get())
     }
 
     /// `f(column, value)` for the entries of row `i`, columns increasing.
     #[inline]
-    pub fn for_each_in_row(&self, i: usize, mut f: impl FnMut(u32, f64)) {
+    pub fn for_each_in_row(&self, i: usize, f: impl FnMut(u32, f64)) {
+        with_values!(&self.val, v => self.for_each_in_row_of(v, i, f))
+    }
+
+    #[inline(always)]
+    fn for_each_in_row_of<T: Value>(&self, val: &[T], i: usize, mut f: impl FnMut(u32, f64)) {
         let (p0, p1) = (self.row_ptr[i], self.row_ptr[i + 1]);
         match &self.runs {
             Some(r) => {
@@ -190,16 +290,39 @@ impl CsrMatrix {
                 let mut p = p0;
                 for k in r.ptr[g]..r.ptr[g + 1] {
                     let c = r.start[k];
-                    for (t, &v) in self.val[p..p + r.len[k] as usize].iter().enumerate() {
-                        f(c + t as u32, v);
+                    for (t, &v) in val[p..p + r.len[k] as usize].iter().enumerate() {
+                        f(c + t as u32, v.get());
                     }
                     p += r.len[k] as usize;
                 }
             }
             None => {
-                for (&c, &v) in self.col[p0..p1].iter().zip(&self.val[p0..p1]) {
-                    f(c, v);
+                for (&c, &v) in self.col[p0..p1].iter().zip(&val[p0..p1]) {
+                    f(c, v.get());
                 }
+            }
+        }
+    }
+
+    /// `f(column)` for the first `m` entries of row `i` (columns increasing).
+    #[inline]
+    pub(crate) fn for_each_col_prefix(&self, i: usize, m: usize, mut f: impl FnMut(u32)) {
+        match &self.runs {
+            Some(r) => {
+                let g = r.row_group[i] as usize;
+                let mut left = m;
+                for k in r.ptr[g]..r.ptr[g + 1] {
+                    if left == 0 {
+                        break;
+                    }
+                    let l = (r.len[k] as usize).min(left);
+                    (r.start[k]..r.start[k] + l as u32).for_each(&mut f);
+                    left -= l;
+                }
+            }
+            None => {
+                let p0 = self.row_ptr[i];
+                self.col[p0..p0 + m].iter().for_each(|&c| f(c));
             }
         }
     }
@@ -248,7 +371,7 @@ impl CsrMatrix {
     /// `(A x)_i`, with four partial sums (the products are independent, so they need not
     /// wait for each other's additions).
     #[inline]
-    pub(crate) fn row_dot(&self, i: usize, x: &[f64]) -> f64 {
+    fn row_dot<T: Value>(&self, val: &[T], i: usize, x: &[f64]) -> f64 {
         let mut acc = [0.0f64; 4];
         match &self.runs {
             Some(r) => {
@@ -257,22 +380,22 @@ impl CsrMatrix {
                 for k in r.ptr[g]..r.ptr[g + 1] {
                     let c = r.start[k] as usize;
                     let l = r.len[k] as usize;
-                    accumulate(&mut acc, &self.val[p..p + l], &x[c..c + l]);
+                    accumulate(&mut acc, &val[p..p + l], &x[c..c + l]);
                     p += l;
                 }
             }
             None => {
                 let r = self.row_ptr[i]..self.row_ptr[i + 1];
-                let (cols, vals) = (&self.col[r.clone()], &self.val[r]);
+                let (cols, vals) = (&self.col[r.clone()], &val[r]);
                 let mut vc = vals.chunks_exact(4);
                 let mut cc = cols.chunks_exact(4);
                 for (v, c) in (&mut vc).zip(&mut cc) {
                     for t in 0..4 {
-                        acc[t] += v[t] * x[c[t] as usize];
+                        acc[t] += v[t].get() * x[c[t] as usize];
                     }
                 }
                 for (v, &c) in vc.remainder().iter().zip(cc.remainder()) {
-                    acc[0] += v * x[c as usize];
+                    acc[0] += v.get() * x[c as usize];
                 }
             }
         }
@@ -286,11 +409,22 @@ impl CsrMatrix {
         &self,
         rows: std::ops::Range<usize>,
         x: &[f64],
+        f: impl FnMut(usize, f64),
+    ) {
+        with_values!(&self.val, v => self.rows_times_of(v, rows, x, f))
+    }
+
+    #[inline(always)]
+    fn rows_times_of<T: Value>(
+        &self,
+        val: &[T],
+        rows: std::ops::Range<usize>,
+        x: &[f64],
         mut f: impl FnMut(usize, f64),
     ) {
         let Some(r) = &self.runs else {
             for i in rows {
-                f(i, self.row_dot(i, x));
+                f(i, self.row_dot(val, i, x));
             }
             return;
         };
@@ -303,12 +437,12 @@ impl CsrMatrix {
             }
             let runs = r.ptr[g as usize]..r.ptr[g as usize + 1];
             match m {
-                1 => group_dot::<1>(self, r, runs, i, x, &mut f),
-                2 => group_dot::<2>(self, r, runs, i, x, &mut f),
-                3 => group_dot::<3>(self, r, runs, i, x, &mut f),
-                4 => group_dot::<4>(self, r, runs, i, x, &mut f),
-                5 => group_dot::<5>(self, r, runs, i, x, &mut f),
-                _ => group_dot::<6>(self, r, runs, i, x, &mut f),
+                1 => group_dot::<1, T>(self, val, r, runs, i, x, &mut f),
+                2 => group_dot::<2, T>(self, val, r, runs, i, x, &mut f),
+                3 => group_dot::<3, T>(self, val, r, runs, i, x, &mut f),
+                4 => group_dot::<4, T>(self, val, r, runs, i, x, &mut f),
+                5 => group_dot::<5, T>(self, val, r, runs, i, x, &mut f),
+                _ => group_dot::<6, T>(self, val, r, runs, i, x, &mut f),
             }
             i += m;
         }
@@ -319,7 +453,7 @@ impl CsrMatrix {
         let mut d = zeros(self.nrows);
         par_rows(&mut d, |i, di| {
             if let Some(k) = self.find_in_row(i, i as u32) {
-                *di = self.row_values(i)[k];
+                *di = self.value_at(self.row_ptr[i] + k);
             }
         });
         d
@@ -414,14 +548,14 @@ impl CsrMatrix {
             }
         }
         let mut t = CsrMatrix::from_parts(self.ncols, self.nrows, row_ptr, col, vec![0.0; nnz]);
-        t.gather_from(&self.val, &map);
+        t.gather_from(self.values(), &map);
         (t, map)
     }
 
     /// `val[k] = src[map[k]]` for every stored entry (in parallel).
     #[cfg(test)]
     pub(crate) fn gather_from(&mut self, src: &[f64], map: &[usize]) {
-        self.val
+        self.values_mut()
             .par_chunks_mut(VEC_BLOCK)
             .zip(map.par_chunks(VEC_BLOCK))
             .for_each(|(v, m)| {
@@ -435,8 +569,9 @@ impl CsrMatrix {
 /// `(A x)_i` for the `M` rows `i0..i0 + M` of one group (same column runs `runs`), passed
 /// to `f`; each row sums in two lanes (even and odd positions).
 #[inline(always)]
-fn group_dot<const M: usize>(
+fn group_dot<const M: usize, T: Value>(
     a: &CsrMatrix,
+    val: &[T],
     r: &Runs,
     runs: std::ops::Range<usize>,
     i0: usize,
@@ -445,7 +580,7 @@ fn group_dot<const M: usize>(
 ) {
     let base = a.row_ptr[i0];
     let len = a.row_ptr[i0 + 1] - base;
-    let vals: [&[f64]; M] = std::array::from_fn(|q| &a.val[base + q * len..base + (q + 1) * len]);
+    let vals: [&[T]; M] = std::array::from_fn(|q| &val[base + q * len..base + (q + 1) * len]);
     let mut acc = [[0.0f64; 2]; M];
     let mut p = 0;
     for k in runs {
@@ -456,12 +591,12 @@ fn group_dot<const M: usize>(
             let v = &vals[q][p..p + l];
             let mut t = 0;
             while t + 1 < l {
-                acc[q][0] += v[t] * xs[t];
-                acc[q][1] += v[t + 1] * xs[t + 1];
+                acc[q][0] += v[t].get() * xs[t];
+                acc[q][1] += v[t + 1].get() * xs[t + 1];
                 t += 2;
             }
             if t < l {
-                acc[q][0] += v[t] * xs[t];
+                acc[q][0] += v[t].get() * xs[t];
             }
         }
         p += l;
@@ -473,16 +608,16 @@ fn group_dot<const M: usize>(
 
 /// `acc += a ⊙ b` summed in four lanes (`a`, `b` of equal length).
 #[inline]
-fn accumulate(acc: &mut [f64; 4], a: &[f64], b: &[f64]) {
+fn accumulate<T: Value>(acc: &mut [f64; 4], a: &[T], b: &[f64]) {
     let mut ac = a.chunks_exact(4);
     let mut bc = b.chunks_exact(4);
     for (x, y) in (&mut ac).zip(&mut bc) {
         for t in 0..4 {
-            acc[t] += x[t] * y[t];
+            acc[t] += x[t].get() * y[t];
         }
     }
     for (t, (x, y)) in ac.remainder().iter().zip(bc.remainder()).enumerate() {
-        acc[t] += x * y;
+        acc[t] += x.get() * y;
     }
 }
 
@@ -525,6 +660,17 @@ impl SymCsr {
     /// unsorted or repeated rows, more than `u32::MAX − 1` equations or entries, non-finite
     /// values.
     pub fn from_upper_csc(
+        n: usize,
+        col_ptr: &[usize],
+        row_idx: &[usize],
+        values: &[f64],
+    ) -> Result<Self> {
+        Self::from_upper_csc_in(Precision::Double, n, col_ptr, row_idx, values)
+    }
+
+    /// [`Self::from_upper_csc`] with the full matrix's values stored in `precision`.
+    pub fn from_upper_csc_in(
+        precision: Precision,
         n: usize,
         col_ptr: &[usize],
         row_idx: &[usize],
@@ -592,7 +738,11 @@ impl SymCsr {
                 }
             }
         });
-        let mut full = CsrMatrix::from_parts(n, n, row_ptr, col, zeros(nnz));
+        let mut full = CsrMatrix::from_parts(n, n, row_ptr, col, Vec::new());
+        full.val = match precision {
+            Precision::Double => Values::Double(zeros_of(nnz)),
+            Precision::Single => Values::Single(zeros_of(nnz)),
+        };
         full.compress_runs();
         let mut out = Self {
             full,
@@ -668,13 +818,18 @@ fn upper_positions(full: &CsrMatrix, col_ptr: &[usize], i: usize, mut f: impl Fn
 
 /// Set the values of the full matrix `full` from the upper-triangle `values` laid out by
 /// `col_ptr` (in parallel over rows).
+/// Values are rounded to the matrix's storage precision.
 pub(crate) fn fill_from_upper(full: &mut CsrMatrix, col_ptr: &[usize], values: &[f64]) {
     let mut val = std::mem::take(&mut full.val);
-    let f = &*full;
+    with_values!(&mut val, v => fill_rows(full, v, col_ptr, values));
+    full.val = val;
+}
+
+fn fill_rows<T: Value>(f: &CsrMatrix, val: &mut [T], col_ptr: &[usize], values: &[f64]) {
     let row_ptr = &f.row_ptr;
     let n = f.nrows;
     let mut slices = Vec::with_capacity(n.div_ceil(ROWS_PER_TASK));
-    let mut rest = &mut val[..];
+    let mut rest = val;
     for start in (0..n).step_by(ROWS_PER_TASK) {
         let end = (start + ROWS_PER_TASK).min(n);
         let (head, tail) = rest.split_at_mut(row_ptr[end] - row_ptr[start]);
@@ -685,29 +840,29 @@ pub(crate) fn fill_from_upper(full: &mut CsrMatrix, col_ptr: &[usize], values: &
         let base = row_ptr[start];
         for i in start..(start + ROWS_PER_TASK).min(n) {
             let at = row_ptr[i] - base;
-            upper_positions(f, col_ptr, i, |k, p| out[at + k] = values[p]);
+            upper_positions(f, col_ptr, i, |k, p| out[at + k] = T::from_f64(values[p]));
         }
     });
-    full.val = val;
 }
 
-/// Whether the full matrix `full` holds exactly the upper-triangle `values` laid out by
-/// `col_ptr` (bitwise, in parallel over rows).
+/// Whether the full matrix `full` holds the upper-triangle `values` laid out by `col_ptr`,
+/// rounded to its storage precision (exactly so for double precision; in parallel over
+/// rows).
 pub(crate) fn equals_upper(full: &CsrMatrix, col_ptr: &[usize], values: &[f64]) -> bool {
     if values.len() != col_ptr[full.nrows] {
         return false;
     }
-    (0..full.nrows)
-        .into_par_iter()
-        .with_min_len(ROWS_PER_TASK)
-        .all(|i| {
-            let vals = full.row_values(i);
-            let mut same = true;
-            upper_positions(full, col_ptr, i, |k, p| {
-                same &= vals[k].to_bits() == values[p].to_bits()
-            });
-            same
-        })
+    with_values!(&full.val, val => (0..full.nrows)
+    .into_par_iter()
+    .with_min_len(ROWS_PER_TASK)
+    .all(|i| {
+        let vals = &val[full.row_ptr[i]..full.row_ptr[i + 1]];
+        let mut same = true;
+        upper_positions(full, col_ptr, i, |k, p| {
+            same &= vals[k] == Value::from_f64(values[p])
+        });
+        same
+    }))
 }
 
 /// Check the upper-triangle CSC arrays.
@@ -784,8 +939,13 @@ pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
 /// from several threads at once and contend. Large outputs of parallel kernels are
 /// allocated with this function instead, which takes the faults here, in one thread.
 pub(crate) fn zeros(n: usize) -> Vec<f64> {
+    zeros_of(n)
+}
+
+/// [`zeros`] of either value type.
+fn zeros_of<T: Value>(n: usize) -> Vec<T> {
     let mut v = Vec::with_capacity(n);
-    v.resize(n, 0.0);
+    v.resize(n, T::default());
     v
 }
 
@@ -985,7 +1145,7 @@ mod tests {
         plain.runs = None;
         plain.col = a.matrix().col_idx();
         for i in 0..n {
-            let want = plain.row_dot(i, &x);
+            let want = plain.row_dot(plain.values(), i, &x);
             assert!(
                 (y[i] - want).abs() <= 1e-14 * want.abs().max(1.0),
                 "row {i}: {} vs {want}",

@@ -58,8 +58,9 @@ pub mod nullspace;
 pub mod pcg;
 pub mod product;
 pub mod smoother;
+pub mod upper;
 
-pub use csr::{CsrMatrix, SymCsr};
+pub use csr::{CsrMatrix, Precision, SymCsr};
 pub use error::{AmgError, Result};
 pub use hierarchy::{Amg, AmgMemory, AmgOptions, LevelInfo};
 pub use nullspace::NearNullSpace;

@@ -21,7 +21,7 @@
 //! the tolerance) is [`AmgError::Stagnation`], and the iteration limit is
 //! [`AmgError::NoConvergence`] with the residual reached.
 
-use crate::csr::{dot, norm, par_rows, par_zip2};
+use crate::csr::{Precision, check_upper_values, dot, norm, par_rows, par_zip2};
 use crate::error::{AmgError, Result, check_finite};
 use crate::hierarchy::Amg;
 
@@ -41,11 +41,51 @@ impl Amg {
     /// Solve `A x = b` by preconditioned CG to `‖b − A x‖ ≤ tol ‖b‖`, starting from the
     /// given `x` (use zeros without a better guess), in at most `max_iter` iterations.
     ///
+    /// The operator is the finest matrix as stored; for one stored in single precision
+    /// ([`Precision::Single`]) use [`Self::solve_upper`] with the exact values.
+    ///
     /// Errors: wrong lengths, non-finite `b` or `x`, a tolerance that is not a positive
-    /// finite number, a hierarchy left unusable by a failed [`Amg::update_values`], and
-    /// the failures described in the module docs.
+    /// finite number, a hierarchy left unusable by a failed [`Amg::update_values`], a
+    /// finest matrix in single precision, and the failures described in the module docs.
     pub fn solve(
         &mut self,
+        x: &mut [f64],
+        b: &[f64],
+        tol: f64,
+        max_iter: usize,
+    ) -> Result<CgStats> {
+        if self.matrix().precision() == Precision::Single {
+            return Err(AmgError::Input(
+                "the finest matrix is stored in single precision: solve with solve_upper and \
+                 the double-precision values"
+                    .into(),
+            ));
+        }
+        self.solve_with(None, x, b, tol, max_iter)
+    }
+
+    /// [`Self::solve`] with the operator given by its upper-triangle `values` in double
+    /// precision, on the pattern the hierarchy was built with (the layout of
+    /// [`crate::SymCsr::from_upper_csc`]); the hierarchy — possibly stored in single
+    /// precision, possibly built for slightly different values — only preconditions.
+    ///
+    /// Errors: those of [`Self::solve`] except the precision, and `values` of the wrong
+    /// length or not finite.
+    pub fn solve_upper(
+        &mut self,
+        values: &[f64],
+        x: &mut [f64],
+        b: &[f64],
+        tol: f64,
+        max_iter: usize,
+    ) -> Result<CgStats> {
+        check_upper_values(values, self.upper_nnz())?;
+        self.solve_with(Some(values), x, b, tol, max_iter)
+    }
+
+    fn solve_with(
+        &mut self,
+        upper: Option<&[f64]>,
         x: &mut [f64],
         b: &[f64],
         tol: f64,
@@ -71,13 +111,14 @@ impl Amg {
         for w in v.iter_mut() {
             w.resize(n, 0.0);
         }
-        let result = self.pcg(x, b, tol, max_iter, &mut v);
+        let result = self.pcg(upper, x, b, tol, max_iter, &mut v);
         self.cg = v;
         result
     }
 
     fn pcg(
         &mut self,
+        upper: Option<&[f64]>,
         x: &mut [f64],
         b: &[f64],
         tol: f64,
@@ -94,7 +135,7 @@ impl Amg {
             });
         }
         let target = tol * bnorm;
-        self.matrix().residual(b, x, r);
+        self.fine_residual(upper, b, x, r);
         let rn0 = norm(r);
         if rn0 <= target {
             return Ok(CgStats {
@@ -107,7 +148,7 @@ impl Amg {
         let mut since_best = 0;
         let mut restarts = 0;
         for it in 1..=max_iter {
-            self.matrix().spmv(p, q);
+            self.fine_product(upper, p, q);
             let pq = dot(p, q);
             if pq.is_nan() || pq <= 0.0 {
                 return Err(AmgError::Breakdown {
@@ -132,7 +173,7 @@ impl Amg {
             }
             if rn <= target {
                 // Check the true residual.
-                self.matrix().residual(b, x, q);
+                self.fine_residual(upper, b, x, q);
                 let true_rn = norm(q);
                 if true_rn <= target {
                     return Ok(CgStats {
@@ -158,7 +199,7 @@ impl Amg {
             } else {
                 since_best += 1;
                 if since_best >= self.options.stagnation_window {
-                    self.matrix().residual(b, x, q);
+                    self.fine_residual(upper, b, x, q);
                     return Err(AmgError::Stagnation {
                         iterations: it,
                         residual: norm(q) / bnorm,
@@ -179,13 +220,19 @@ impl Amg {
             let zz: &[f64] = z;
             par_rows(p, |i, pi| *pi = zz[i] + beta * *pi);
         }
-        self.matrix().residual(b, x, q);
+        self.fine_residual(upper, b, x, q);
         let true_rn = norm(q);
         Err(AmgError::NoConvergence {
             iterations: max_iter,
             residual: true_rn / bnorm,
             tolerance: tol,
         })
+    }
+
+    /// `r = b − A x` with the operator of [`Self::fine_product`].
+    fn fine_residual(&mut self, upper: Option<&[f64]>, b: &[f64], x: &[f64], r: &mut [f64]) {
+        self.fine_product(upper, x, r);
+        par_rows(r, |i, ri| *ri = b[i] - *ri);
     }
 
     /// `z = M r`, `p = z`; returns `rᵀz` (error if not positive).

@@ -11,7 +11,9 @@
 //! `RAYON_NUM_THREADS` sets the pool of the parallel assembly and AMG kernels;
 //! `REPEAT=3` runs the whole case (grid to error) three times in the process, one row
 //! each (the peer's "best of" rule); `AMG_OPTS=theta=0.02,degree=3` overrides multigrid options (`theta`, `degree`,
-//! `upper`, `ratio`, `lanczos`, `omega`, `coarse`, `aggressive`: see `porofrac_amg::AmgOptions`).
+//! `upper`, `ratio`, `lanczos`, `omega`, `coarse`, `aggressive`: see `porofrac_amg::AmgOptions`);
+//! `AMG_PRECISION=double` stores the hierarchy's finest matrix in double instead of single
+//! precision (`AmgSolver::set_precision`).
 //!
 //! Grids: E2 = n × n squares split in two triangles, E3 = n³ cubes split in six
 //! tetrahedra (P1 = VEM on simplices), E = 1, ν = 0.3 (plane strain in 2D), Dirichlet on
@@ -127,6 +129,9 @@ fn run<const D: usize>(n: usize, solver: &str, tol: f64, problem: &Manufactured<
         "cg-amg" => {
             let t2 = Instant::now();
             let mut s = AmgSolver::new(&grid, &dofs, &pattern, tol).unwrap();
+            if std::env::var("AMG_PRECISION").as_deref() == Ok("double") {
+                s.set_precision(porofrac_amg::Precision::Double);
+            }
             if let Ok(spec) = std::env::var("AMG_OPTS") {
                 let mut o = elasticity_amg_options(D);
                 for kv in spec.split(',') {

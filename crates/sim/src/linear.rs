@@ -18,7 +18,7 @@
 //! * [`StaticSolver`]: one of the two, chosen by [`LinearSolver`]; `Auto` picks by the
 //!   measured crossover ([`LinearSolver::resolve`]).
 
-use porofrac_amg::{Amg, AmgOptions, SymCsr};
+use porofrac_amg::{Amg, AmgOptions, Precision, SymCsr};
 use porofrac_grid::Grid;
 
 use crate::dofs::DofMap;
@@ -148,6 +148,7 @@ pub struct AmgSolver {
     n: usize,
     nnz: usize,
     options: AmgOptions,
+    precision: Precision,
     tolerance: f64,
     max_iterations: usize,
     setups: usize,
@@ -241,6 +242,7 @@ impl AmgSolver {
             n,
             nnz: pattern.nnz(),
             options: elasticity_amg_options(D),
+            precision: Precision::Single,
             tolerance,
             max_iterations: DEFAULT_MAX_ITERATIONS,
             setups: 0,
@@ -258,6 +260,13 @@ impl AmgSolver {
     /// solve).
     pub fn set_options(&mut self, options: AmgOptions) {
         self.options = options;
+    }
+    /// Storage precision of the hierarchy's finest matrix (takes effect at the next full
+    /// setup). The default, [`Precision::Single`], halves the bytes the V-cycle reads from
+    /// the finest matrix and its memory; CG multiplies by the assembled double-precision
+    /// values either way, so the solution and the reported residual do not change.
+    pub fn set_precision(&mut self, precision: Precision) {
+        self.precision = precision;
     }
     /// The relative residual each solve reaches.
     pub fn tolerance(&self) -> f64 {
@@ -310,9 +319,14 @@ impl AmgSolver {
                 }
             }
             None => {
-                let sym =
-                    SymCsr::from_upper_csc(self.n, pattern.col_ptr(), pattern.row_idx(), values)
-                        .map_err(amg_err)?;
+                let sym = SymCsr::from_upper_csc_in(
+                    self.precision,
+                    self.n,
+                    pattern.col_ptr(),
+                    pattern.row_idx(),
+                    values,
+                )
+                .map_err(amg_err)?;
                 let amg =
                     Amg::elasticity(sym, &self.coords, self.dim, &self.eq_dofs, &self.options)
                         .map_err(amg_err)?;
@@ -363,7 +377,7 @@ impl LinearSolve for AmgSolver {
             .ok_or_else(|| SimError::Iterative("AMG hierarchy missing".into()))?;
         x.fill(0.0);
         let stats = amg
-            .solve(x, b, self.tolerance, self.max_iterations)
+            .solve_upper(values, x, b, self.tolerance, self.max_iterations)
             .map_err(|e| SimError::Iterative(format!("CG-AMG: {e}")))?;
         self.last_iterations = stats.iterations;
         self.total_iterations += stats.iterations;
