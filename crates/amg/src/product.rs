@@ -19,6 +19,15 @@
 //! order, so the results do not depend on the number of threads. The patterns are
 //! computed once in the setup; a numeric rebuild for new matrix values scatters into them.
 //!
+//! # Precision
+//!
+//! The prolongators store their values in single precision (each computed in double and
+//! rounded once, relative `2⁻²⁴`): the restriction and prolongation of every V-cycle read
+//! half the bytes, and the hierarchy holds less. The rounded `P` is the prolongator: the
+//! coarse operator is the exact (double-precision) Galerkin product `Pᵀ A P` with it, so
+//! the coarse correction stays an `A`-orthogonal projection and the V-cycle symmetric;
+//! only the near-null space is reproduced to single precision instead of exactly.
+//!
 //! # Prolongator smoothing
 //!
 //! `P = (I − ω D⁻¹ A) P_tent` row by row: `p_i = t_i − ω/a_ii Σ_j a_ij t_j`, with `t_j` the
@@ -75,7 +84,8 @@ pub(crate) struct Blocked {
     bagg: Vec<u32>,
     /// Position in `vals` of each block's first value, and the number of values last.
     bpos: Vec<u32>,
-    vals: Vec<f64>,
+    /// Values in single precision (see the module docs).
+    vals: Vec<f32>,
 }
 
 impl Blocked {
@@ -115,7 +125,7 @@ impl Blocked {
             bptr: bptr[..=nrows].iter().map(|&q| q as u32).collect(),
             bagg,
             bpos,
-            vals: zeros(len),
+            vals: vec![0.0; len],
         })
     }
 
@@ -147,11 +157,11 @@ impl Blocked {
     }
 
     /// All values, row by row.
-    pub(crate) fn values(&self) -> &[f64] {
+    pub(crate) fn values(&self) -> &[f32] {
         &self.vals
     }
     /// All values, mutable.
-    pub(crate) fn values_mut(&mut self) -> &mut [f64] {
+    pub(crate) fn values_mut(&mut self) -> &mut [f32] {
         &mut self.vals
     }
 
@@ -169,7 +179,7 @@ impl Blocked {
                 sum += self.vals[s..s + k]
                     .iter()
                     .zip(&x[c..c + k])
-                    .map(|(v, xi)| v * xi)
+                    .map(|(&v, xi)| f64::from(v) * xi)
                     .sum::<f64>();
             }
             *yi += sum;
@@ -187,7 +197,8 @@ impl Blocked {
             }
             row_ptr.push(col.len());
         }
-        CsrMatrix::from_parts(self.nrows(), self.ncols, row_ptr, col, self.vals.clone())
+        let vals = self.vals.iter().map(|&v| f64::from(v)).collect();
+        CsrMatrix::from_parts(self.nrows(), self.ncols, row_ptr, col, vals)
     }
 }
 
@@ -244,11 +255,11 @@ pub(crate) fn symbolic_prolongator(
 
 /// Split `val` (row `i` at `row_start(i)..row_start(i + 1)`, `nrows` rows) into the value
 /// slices of consecutive groups of rows.
-fn row_blocks_mut(
+fn row_blocks_mut<T>(
     nrows: usize,
     row_start: impl Fn(usize) -> usize,
-    val: &mut [f64],
-) -> Vec<(usize, &mut [f64])> {
+    val: &mut [T],
+) -> Vec<(usize, &mut [T])> {
     let mut out = Vec::with_capacity(nrows.div_ceil(ROWS_PER_TASK));
     let mut rest = val;
     let mut start = 0;
@@ -265,23 +276,23 @@ fn row_blocks_mut(
 /// `y += s x` on short slices of equal length, unrolled for the common block widths
 /// (6: 3D rigid modes, 3: 2D rigid modes).
 #[inline]
-fn axpy(y: &mut [f64], s: f64, x: &[f64]) {
+fn axpy<X: Copy + Into<f64>>(y: &mut [f64], s: f64, x: &[X]) {
     match y.len() {
-        6 => axpy_fixed::<6>(y, s, x),
-        3 => axpy_fixed::<3>(y, s, x),
+        6 => axpy_fixed::<6, X>(y, s, x),
+        3 => axpy_fixed::<3, X>(y, s, x),
         _ => {
-            for (yi, xi) in y.iter_mut().zip(x) {
-                *yi += s * xi;
+            for (yi, &xi) in y.iter_mut().zip(x) {
+                *yi += s * xi.into();
             }
         }
     }
 }
 
 #[inline]
-fn axpy_fixed<const K: usize>(y: &mut [f64], s: f64, x: &[f64]) {
-    if let (Ok(y), Ok(x)) = (<&mut [f64; K]>::try_from(y), <&[f64; K]>::try_from(x)) {
+fn axpy_fixed<const K: usize, X: Copy + Into<f64>>(y: &mut [f64], s: f64, x: &[X]) {
+    if let (Ok(y), Ok(x)) = (<&mut [f64; K]>::try_from(y), <&[X; K]>::try_from(x)) {
         for t in 0..K {
-            y[t] += s * x[t];
+            y[t] += s * x[t].into();
         }
     }
 }
@@ -308,30 +319,36 @@ pub(crate) fn smooth_prolongator(
     let tv = t.values();
     let blocks = row_blocks_mut(n, row_start, vals);
     blocks.into_par_iter().for_each_init(
-        || vec![0usize; nagg],
-        |pos, (start, vals)| {
+        || (vec![0usize; nagg], Vec::new()),
+        |(pos, acc), (start, vals)| {
             let base = row_start(start);
             for i in start..(start + ROWS_PER_TASK).min(n) {
+                // The row is summed in double precision, then rounded.
+                let row0 = row_start(i);
                 for q in bptr[i] as usize..bptr[i + 1] as usize {
-                    pos[bagg[q] as usize] = bpos[q] as usize - base;
+                    pos[bagg[q] as usize] = bpos[q] as usize - row0;
                 }
-                let row = row_start(i) - base..row_start(i + 1) - base;
-                vals[row.clone()].fill(0.0);
+                let row = row0 - base..row_start(i + 1) - base;
+                acc.clear();
+                acc.resize(row.len(), 0.0);
                 a.for_each_in_row(i, |j, aij| {
                     let (tb, tp) = t.blocks(j as usize);
                     for (&b, &s) in tb.iter().zip(tp) {
                         let k = off[b as usize + 1] - off[b as usize];
                         let (d, s) = (pos[b as usize], s as usize);
-                        axpy(&mut vals[d..d + k], aij, &tv[s..s + k]);
+                        axpy(&mut acc[d..d + k], aij, &tv[s..s + k]);
                     }
                 });
                 let scale = -omega * dinv[i];
-                vals[row].iter_mut().for_each(|v| *v *= scale);
+                acc.iter_mut().for_each(|v| *v *= scale);
                 let (tb, tp) = t.blocks(i);
                 for (&b, &s) in tb.iter().zip(tp) {
                     let k = off[b as usize + 1] - off[b as usize];
                     let (d, s) = (pos[b as usize], s as usize);
-                    axpy(&mut vals[d..d + k], 1.0, &tv[s..s + k]);
+                    axpy(&mut acc[d..d + k], 1.0, &tv[s..s + k]);
+                }
+                for (v, &x) in vals[row].iter_mut().zip(acc.iter()) {
+                    *v = x as f32;
                 }
             }
         },
@@ -465,7 +482,7 @@ fn w_row(
             if slot[bu] == u32::MAX {
                 slot[bu] = vals.len() as u32;
                 aggs.push(b);
-                vals.extend(pv[s..s + k].iter().map(|v| aij * v));
+                vals.extend(pv[s..s + k].iter().map(|&v| aij * f64::from(v)));
             } else {
                 let d = slot[bu] as usize;
                 axpy(&mut vals[d..d + k], aij, &pv[s..s + k]);
@@ -668,7 +685,7 @@ pub(crate) fn numeric_galerkin(
                             let co = pos[b];
                             for (r, &x) in pia.iter().enumerate() {
                                 let d = r * len + co;
-                                axpy(&mut block_row[d..d + kb], x, wib);
+                                axpy(&mut block_row[d..d + kb], f64::from(x), wib);
                             }
                         }
                         t += kb;
@@ -820,7 +837,7 @@ mod tests {
         // Tentative: row i has the block of its aggregate.
         let bptr: Vec<usize> = (0..=n).collect();
         let mut t = Blocked::from_blocks(n, &off, &bptr, eq_agg.clone()).unwrap();
-        let tvals = [0.6, 0.8, -0.8, 0.6, 0.7, 0.7, 1.0, 0.0, 0.0, 1.0];
+        let tvals = [0.6f32, 0.8, -0.8, 0.6, 0.7, 0.7, 1.0, 0.0, 0.0, 1.0];
         t.values_mut().copy_from_slice(&tvals);
         let am = from_dense(&a);
         let mut p = symbolic_prolongator(&am, &eq_agg, &off).unwrap();
@@ -832,8 +849,9 @@ mod tests {
         let pd = dense(&p.to_csr(&off));
         for i in 0..n {
             for j in 0..5 {
+                // Computed in double precision, stored rounded to single.
                 let want = td[i][j] - omega * dinv[i] * at[i][j];
-                assert!((pd[i][j] - want).abs() < 1e-15, "P[{i}][{j}]");
+                assert_eq!(pd[i][j], want as f32 as f64, "P[{i}][{j}]");
             }
         }
         let (g, mut ac) = symbolic_galerkin(&am, &p, &off);
