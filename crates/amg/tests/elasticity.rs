@@ -327,6 +327,14 @@ fn single_precision_finest_matrix() {
             .solve(&mut x, &sys.rhs, tol, max_iter)
             .unwrap()
             .iterations;
+        // A double-precision hierarchy with the upper triangle as operator: the same
+        // solve up to the summation order of the products.
+        let mut y = vec![0.0; sys.n()];
+        let s_upper = double
+            .solve_upper(&sys.values, &mut y, &sys.rhs, tol, max_iter)
+            .unwrap();
+        assert!(s_upper.iterations.abs_diff(it_double) <= 1);
+        assert!(rel_diff(&y, &x) < 1e2 * tol, "{:e}", rel_diff(&y, &x));
         let chol = sys.cholesky();
         let single = SymCsr::from_upper_csc_in(
             Precision::Single,

@@ -9,10 +9,13 @@
 //! * [`AmgSolver`]: conjugate gradients preconditioned by smoothed-aggregation multigrid
 //!   ([`porofrac_amg`], rigid-body near-null space from the node coordinates), to a
 //!   relative residual `‖A Δx − r‖ / ‖r‖ ≤ tolerance`; `O(n)` memory and time per
-//!   iteration, iteration counts nearly independent of `n`. The hierarchy is built on the
-//!   first solve; later solves with new values on the same pattern only redo its numeric
-//!   part ([`porofrac_amg::Amg::update_values`]: aggregates, patterns and the symbolic
-//!   coarse factorization are kept), and a solve with unchanged values reuses it as is.
+//!   iteration, iteration counts nearly independent of `n`. The hierarchy stores its
+//!   finest matrix in single precision by default ([`AmgSolver::set_precision`]; CG
+//!   multiplies by the double-precision values, [`porofrac_amg::Amg::solve_upper`]). It is
+//!   built on the first solve; later solves with new values on the same pattern only redo
+//!   its numeric part ([`porofrac_amg::Amg::update_values`]: aggregates, patterns and the
+//!   symbolic coarse factorization are kept), and a solve with unchanged values (to the
+//!   stored precision) reuses it as is.
 //!   A solve that reaches the iteration limit, stagnates or breaks down is an error
 //!   ([`SimError::Iterative`]) naming the iterations and the residual reached.
 //! * [`StaticSolver`]: one of the two, chosen by [`LinearSolver`]; `Auto` picks by the
