@@ -259,7 +259,9 @@ impl Pattern {
             .collect();
         let scatter_pos = offsets(&sizes);
         drop(sizes);
-        let mut scatter = vec![NONE; scatter_pos[nc]];
+        // Zeroed memory comes from the kernel untouched, so the pages are first written
+        // by the parallel fill (which writes every entry) instead of a serial fill here.
+        let mut scatter = vec![0u32; scatter_pos[nc]];
         fill_blocks(&mut scatter, &scatter_pos, |cells, out| {
             let mut eqs = Vec::new();
             let mut k = 0;
@@ -288,6 +290,8 @@ impl Pattern {
                             last = Some((r, col, pos));
                             let twice = if i != j && ei == ej { TWICE } else { 0 };
                             out[k] = pos as u32 | twice;
+                        } else {
+                            out[k] = NONE;
                         }
                         k += 1;
                     }
