@@ -8,9 +8,13 @@
 //! bandwidth-bound products). [`SymCsr`] expands a symmetric matrix given by its upper
 //! triangle in compressed sparse *column* form — the layout of the reduced stiffness in
 //! porofrac and of faer's symmetric solvers — into the full matrix once: entry `(r, c)`,
-//! `r ≤ c`, of the upper triangle lands in rows `r` and `c`. It remembers where each full
-//! entry came from, so new values on the same pattern (time steps, fracture updates) are a
-//! parallel gather.
+//! `r ≤ c`, of the upper triangle lands in rows `r` and `c`; new values on the same
+//! pattern (time steps, fracture updates) are a parallel gather (see [`SymCsr`]).
+//!
+//! Rows with the same columns (the components of a node, the coarse equations of an
+//! aggregate) are stored as column runs shared by the group and multiplied together: each
+//! piece of `x` is read once for the whole group. Values are `f64` or `f32`
+//! ([`Precision`]); products always accumulate in `f64`.
 //!
 //! # Determinism
 //!

@@ -21,7 +21,9 @@
 //! 5. [`smoother`]: the Lanczos estimate of `ρ(D⁻¹A)` and the Chebyshev smoother.
 //! 6. [`hierarchy`]: levels until a coarse size, sparse Cholesky on the coarsest, the
 //!    V-cycle, and the numeric rebuild for new values on the same pattern.
-//! 7. [`pcg`]: preconditioned CG that reports its iterations and residual and fails loudly.
+//! 7. [`pcg`]: preconditioned CG that reports its iterations and residual and fails loudly;
+//!    with a hierarchy stored in single precision ([`Precision`]) it multiplies by the
+//!    caller's double-precision upper triangle ([`upper`]).
 //!
 //! All parallel kernels (rayon) give bitwise the same results for any number of threads.
 //! [`Amg::memory`] reports what a hierarchy holds, by part.
