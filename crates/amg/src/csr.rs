@@ -372,36 +372,23 @@ impl CsrMatrix {
         }
     }
 
-    /// `(A x)_i`, with four partial sums (the products are independent, so they need not
-    /// wait for each other's additions).
+    /// `(A x)_i` of a matrix stored with column indices (those stored as runs are
+    /// multiplied by row groups, [`Self::rows_times`]), with four partial sums (the
+    /// products are independent, so they need not wait for each other's additions).
     #[inline]
     fn row_dot<T: Value>(&self, val: &[T], i: usize, x: &[f64]) -> f64 {
         let mut acc = [0.0f64; 4];
-        match &self.runs {
-            Some(r) => {
-                let g = r.row_group[i] as usize;
-                let mut p = self.row_ptr[i];
-                for k in r.ptr[g]..r.ptr[g + 1] {
-                    let c = r.start[k] as usize;
-                    let l = r.len[k] as usize;
-                    accumulate(&mut acc, &val[p..p + l], &x[c..c + l]);
-                    p += l;
-                }
+        let r = self.row_ptr[i]..self.row_ptr[i + 1];
+        let (cols, vals) = (&self.col[r.clone()], &val[r]);
+        let mut vc = vals.chunks_exact(4);
+        let mut cc = cols.chunks_exact(4);
+        for (v, c) in (&mut vc).zip(&mut cc) {
+            for t in 0..4 {
+                acc[t] += v[t].get() * x[c[t] as usize];
             }
-            None => {
-                let r = self.row_ptr[i]..self.row_ptr[i + 1];
-                let (cols, vals) = (&self.col[r.clone()], &val[r]);
-                let mut vc = vals.chunks_exact(4);
-                let mut cc = cols.chunks_exact(4);
-                for (v, c) in (&mut vc).zip(&mut cc) {
-                    for t in 0..4 {
-                        acc[t] += v[t].get() * x[c[t] as usize];
-                    }
-                }
-                for (v, &c) in vc.remainder().iter().zip(cc.remainder()) {
-                    acc[0] += v.get() * x[c as usize];
-                }
-            }
+        }
+        for (v, &c) in vc.remainder().iter().zip(cc.remainder()) {
+            acc[0] += v.get() * x[c as usize];
         }
         (acc[0] + acc[1]) + (acc[2] + acc[3])
     }
@@ -607,21 +594,6 @@ fn group_dot<const M: usize, T: Value>(
     }
     for q in 0..M {
         f(i0 + q, acc[q][0] + acc[q][1]);
-    }
-}
-
-/// `acc += a ⊙ b` summed in four lanes (`a`, `b` of equal length).
-#[inline]
-fn accumulate<T: Value>(acc: &mut [f64; 4], a: &[T], b: &[f64]) {
-    let mut ac = a.chunks_exact(4);
-    let mut bc = b.chunks_exact(4);
-    for (x, y) in (&mut ac).zip(&mut bc) {
-        for t in 0..4 {
-            acc[t] += x[t].get() * y[t];
-        }
-    }
-    for (t, (x, y)) in ac.remainder().iter().zip(bc.remainder()).enumerate() {
-        acc[t] += x.get() * y;
     }
 }
 
