@@ -308,6 +308,20 @@ impl CsrMatrix {
         }
     }
 
+    /// For a matrix stored as runs: the group of row `i` and the runs `(first column,
+    /// length)` of its columns, in order (`None` for a matrix with column indices).
+    #[inline]
+    pub(crate) fn row_runs(
+        &self,
+        i: usize,
+    ) -> Option<(u32, impl Iterator<Item = (usize, usize)> + '_)> {
+        let r = self.runs.as_ref()?;
+        let g = r.row_group[i];
+        let k = r.ptr[g as usize]..r.ptr[g as usize + 1];
+        let runs = r.start[k.clone()].iter().zip(&r.len[k]);
+        Some((g, runs.map(|(&s, &l)| (s as usize, l as usize))))
+    }
+
     /// `f(column)` for the first `m` entries of row `i` (columns increasing).
     #[inline]
     pub(crate) fn for_each_col_prefix(&self, i: usize, m: usize, mut f: impl FnMut(u32)) {

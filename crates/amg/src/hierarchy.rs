@@ -243,7 +243,7 @@ pub struct Amg {
     fine_col_ptr: Vec<usize>,
     pub(crate) options: AmgOptions,
     pub(crate) cg: [Vec<f64>; 4],
-    /// Partition and buffers of the product with the caller's upper triangle (built by the
+    /// Partition of the product with the caller's upper triangle (built by the
     /// first [`Amg::solve_upper`]).
     upper: Option<UpperProduct>,
     /// False after a failed [`Amg::update_values`].
@@ -506,8 +506,7 @@ impl Amg {
     pub fn memory(&self) -> AmgMemory {
         let mut m = AmgMemory {
             fine_map: vec_bytes(&self.fine_col_ptr),
-            vectors: self.cg.iter().map(vec_bytes).sum::<usize>()
-                + self.upper.as_ref().map_or(0, UpperProduct::bytes),
+            vectors: self.cg.iter().map(vec_bytes).sum::<usize>(),
             ..AmgMemory::default()
         };
         for level in &self.levels {

@@ -14,41 +14,43 @@
 //! ```
 //!
 //! the first sum a gather along column `i`, the second the scatter `y_r += u_ri x_i` of the
-//! later columns `i > r`. The rows are cut into parts of a fixed size; a part gathers its
-//! own rows and scatters into its own rows or, for rows before it, into a spill buffer
-//! that is added after the parallel pass, in part order. The parts depend on the matrix
-//! only, not on the number of threads, so neither do the results. For equations numbered
-//! by node the scatter reaches back a band, and the spill buffers are small; the parts are
-//! chosen as small as keeps all spill buffers below `n/2` entries (a matrix with couplings
-//! across the whole numbering ends up with one part, computed by one thread).
+//! later columns `i > r`. The rows are cut into parts of a fixed size, chosen so that the
+//! scatter of a part reaches back into the previous part at most; the even parts are
+//! computed in parallel, then the odd ones, each writing its own rows and those of the
+//! part before it (disjoint within a phase). The parts and the order of the sums depend on
+//! the matrix only, not on the number of threads, so neither do the results. For
+//! equations numbered by node the scatter reaches back a band and the smallest part size
+//! serves; a matrix with couplings across the numbering ends up with larger parts, down to
+//! one computed by one thread. The rows of a node (a group with the same columns, see
+//! [`crate::csr`]) are computed together: each piece of `x` is read and each piece of `y`
+//! updated once for all of them.
 //!
 //! Traffic: one read of the `8 B` upper values (about half the full matrix) and of the
 //! pattern's run tables, instead of `8 B` for every entry of the full matrix.
 
 use rayon::prelude::*;
 
-use crate::csr::{CsrMatrix, vec_bytes};
+use crate::csr::CsrMatrix;
 
 /// Rows per part at least.
 const MIN_PART: usize = 4096;
 
-/// The partition and spill buffers of the upper-triangle product for one pattern.
+/// The partition of the upper-triangle product for one pattern.
 #[derive(Debug, Default)]
 pub(crate) struct UpperProduct {
-    /// Rows per part.
+    /// Rows per part (the last part may be shorter).
     part: usize,
-    /// Lowest row that part `k`'s scatter reaches.
-    lo: Vec<usize>,
-    /// Spill buffer of all parts: part `k` holds rows `lo[k]..k·part`.
-    spill: Vec<f64>,
 }
 
 impl UpperProduct {
     /// The partition for the full pattern `full` and the upper triangle's column offsets
-    /// `col_ptr` (column `i` holds the first `col_ptr[i+1] − col_ptr[i]` entries of row `i`).
+    /// `col_ptr` (column `i` holds the first `col_ptr[i+1] − col_ptr[i]` entries of row `i`):
+    /// the smallest part size from [`MIN_PART`] on (growing fourfold) whose parts scatter
+    /// into the previous part at most.
     pub(crate) fn new(full: &CsrMatrix, col_ptr: &[usize]) -> Self {
         let n = full.nrows();
         let first: Vec<usize> = (0..n)
+            .into_par_iter()
             .map(|i| {
                 let mut c0 = i;
                 if col_ptr[i + 1] > col_ptr[i] {
@@ -57,44 +59,24 @@ impl UpperProduct {
                 c0
             })
             .collect();
-        let lows = |part: usize| -> Vec<usize> {
-            (0..n.div_ceil(part))
-                .map(|k| {
-                    let rows = k * part..((k + 1) * part).min(n);
-                    first[rows.clone()]
-                        .iter()
-                        .copied()
-                        .min()
-                        .unwrap_or(rows.start)
-                })
-                .collect()
-        };
         let mut part = MIN_PART.min(n.max(1));
-        let lo = loop {
-            let lo = lows(part);
-            let spill: usize = lo.iter().enumerate().map(|(k, &l)| k * part - l).sum();
-            if 2 * spill <= n || part >= n {
-                break lo;
+        while part < n {
+            let reaches_back_one = (1..n.div_ceil(part)).all(|k| {
+                let rows = k * part..((k + 1) * part).min(n);
+                first[rows].iter().all(|&c| c >= (k - 1) * part)
+            });
+            if reaches_back_one {
+                break;
             }
             part = (4 * part).min(n);
-        };
-        let total = lo.iter().enumerate().map(|(k, &l)| k * part - l).sum();
-        Self {
-            part,
-            lo,
-            spill: vec![0.0; total],
         }
-    }
-
-    /// Heap bytes held.
-    pub(crate) fn bytes(&self) -> usize {
-        vec_bytes(&self.lo) + vec_bytes(&self.spill)
+        Self { part }
     }
 
     /// `y = A x` for the symmetric `A` with upper triangle `upper` (values in the layout of
     /// `col_ptr`) on the pattern `full` (see the module docs).
     pub(crate) fn apply(
-        &mut self,
+        &self,
         full: &CsrMatrix,
         col_ptr: &[usize],
         upper: &[f64],
@@ -102,49 +84,149 @@ impl UpperProduct {
         y: &mut [f64],
     ) {
         let n = full.nrows();
-        let part = self.part;
-        let mut jobs = Vec::with_capacity(self.lo.len());
-        let (mut ys, mut ss) = (&mut y[..], &mut self.spill[..]);
-        for (k, &lo) in self.lo.iter().enumerate() {
-            let start = k * part;
-            let (yk, yt) = ys.split_at_mut(((k + 1) * part).min(n) - start);
-            let (sk, st) = ss.split_at_mut(start - lo);
-            jobs.push((start, lo, yk, sk));
-            (ys, ss) = (yt, st);
-        }
-        jobs.into_par_iter().for_each(|(start, lo, yk, sk)| {
-            yk.fill(0.0);
-            sk.fill(0.0);
-            for i in start..start + yk.len() {
-                let p0 = col_ptr[i];
-                let vals = &upper[p0..col_ptr[i + 1]];
-                let xi = x[i];
-                let mut acc = [0.0f64; 2];
-                let mut q = 0;
-                full.for_each_col_prefix(i, vals.len(), |c| {
-                    let c = c as usize;
-                    let v = vals[q];
-                    acc[q & 1] += v * x[c];
-                    q += 1;
-                    if c < i {
-                        if c >= start {
-                            yk[c - start] += v * xi;
-                        } else {
-                            sk[c - lo] += v * xi;
-                        }
+        let part = self.part.max(1);
+        let parts = n.div_ceil(part);
+        y.par_chunks_mut(part).for_each(|c| c.fill(0.0));
+        for phase in 0..2 {
+            // Part `k` writes rows `(k − 1)·part..(k + 1)·part`.
+            let mut jobs = Vec::with_capacity(parts / 2 + 1);
+            let (mut rest, mut at) = (&mut y[..], 0);
+            for k in (phase..parts).step_by(2) {
+                let base = k.saturating_sub(1) * part;
+                let end = ((k + 1) * part).min(n);
+                let (_, tail) = rest.split_at_mut(base - at);
+                let (mine, tail) = tail.split_at_mut(end - base);
+                jobs.push((k * part..end, Part { base, y: mine }));
+                (rest, at) = (tail, end);
+            }
+            jobs.into_par_iter().for_each(|(rows, mut p)| {
+                let mut i = rows.start;
+                while i < rows.end {
+                    let Some((g, _)) = full.row_runs(i) else {
+                        p.row(full, col_ptr, upper, x, i);
+                        i += 1;
+                        continue;
+                    };
+                    let mut m = 1;
+                    while i + m < rows.end
+                        && m < 3
+                        && full.row_runs(i + m).is_some_and(|(h, _)| h == g)
+                    {
+                        m += 1;
                     }
-                });
-                yk[i - start] += acc[0] + acc[1];
+                    match m {
+                        1 => p.group::<1>(full, col_ptr, upper, x, i),
+                        2 => p.group::<2>(full, col_ptr, upper, x, i),
+                        _ => p.group::<3>(full, col_ptr, upper, x, i),
+                    }
+                    i += m;
+                }
+            });
+        }
+    }
+}
+
+/// The rows `base..base + y.len()` a part writes: its own and those of the part before.
+struct Part<'a> {
+    base: usize,
+    y: &'a mut [f64],
+}
+
+impl Part<'_> {
+    /// Gather and scatter of one row with column indices, entry by entry.
+    fn row(&mut self, full: &CsrMatrix, col_ptr: &[usize], upper: &[f64], x: &[f64], i: usize) {
+        let vals = &upper[col_ptr[i]..col_ptr[i + 1]];
+        let xi = x[i];
+        let mut acc = 0.0;
+        let mut q = 0;
+        full.for_each_col_prefix(i, vals.len(), |c| {
+            let c = c as usize;
+            let v = vals[q];
+            acc += v * x[c];
+            q += 1;
+            if c < i {
+                self.y[c - self.base] += v * xi;
             }
         });
-        let mut at = 0;
-        for (k, &lo) in self.lo.iter().enumerate() {
-            let len = k * part - lo;
-            for (yi, s) in y[lo..lo + len].iter_mut().zip(&self.spill[at..at + len]) {
-                *yi += s;
+        self.y[i - self.base] += acc;
+    }
+
+    /// Gather and scatter of the `M` rows `i..i + M` of one group (same runs of columns).
+    /// Columns before `i` are in every row's prefix: each piece of `x` is read and each
+    /// piece of `y` updated once for all `M` rows. The few columns from `i` on (the
+    /// node's own block) follow row by row.
+    #[inline(always)]
+    fn group<const M: usize>(
+        &mut self,
+        full: &CsrMatrix,
+        col_ptr: &[usize],
+        upper: &[f64],
+        x: &[f64],
+        i: usize,
+    ) {
+        let vals: [&[f64]; M] = std::array::from_fn(|r| &upper[col_ptr[i + r]..col_ptr[i + r + 1]]);
+        let xr: [f64; M] = std::array::from_fn(|r| x[i + r]);
+        let mut acc = [0.0; M];
+        let mut q = 0;
+        let mut tail = [0usize; M];
+        let mut ntail = 0;
+        let longest = vals.iter().map(|v| v.len()).max().unwrap_or(0);
+        if let Some((_, runs)) = full.row_runs(i) {
+            for (s, l) in runs {
+                // Columns before `i`.
+                let e = (s + l).min(i);
+                if s < e {
+                    let v: [&[f64]; M] = std::array::from_fn(|r| &vals[r][q..q + e - s]);
+                    let y = &mut self.y[s - self.base..e - self.base];
+                    joint(&v, &x[s..e], &xr, &mut acc, y);
+                    q += e - s;
+                }
+                // Columns from `i` on (at most `M` in the prefixes).
+                for c in e.max(s)..s + l {
+                    if q + ntail >= longest || ntail == M {
+                        break;
+                    }
+                    tail[ntail] = c;
+                    ntail += 1;
+                }
+                if q + ntail >= longest {
+                    break;
+                }
             }
-            at += len;
         }
+        for r in 0..M {
+            let row = i + r;
+            for (t, &c) in tail[..ntail].iter().enumerate() {
+                let Some(&v) = vals[r].get(q + t) else {
+                    break;
+                };
+                acc[r] += v * x[c];
+                if c < row {
+                    self.y[c - self.base] += v * xr[r];
+                }
+            }
+            self.y[row - self.base] += acc[r];
+        }
+    }
+}
+
+/// `acc_r += v_r · xs` and `y += Σ_r v_r x_r` over one piece of columns.
+#[inline(always)]
+fn joint<const M: usize>(
+    v: &[&[f64]; M],
+    xs: &[f64],
+    xr: &[f64; M],
+    acc: &mut [f64; M],
+    y: &mut [f64],
+) {
+    for (t, (xc, yc)) in xs.iter().zip(y.iter_mut()).enumerate() {
+        let mut s = 0.0;
+        for r in 0..M {
+            let u = v[r][t];
+            acc[r] += u * xc;
+            s += u * xr[r];
+        }
+        *yc += s;
     }
 }
 
@@ -178,13 +260,41 @@ mod tests {
         (col_ptr, rows, vals)
     }
 
+    /// The band of `band` on `nodes` nodes with a dense `k × k` block per coupling (the
+    /// equations of a node share their columns: the products go by groups).
+    fn node_band(nodes: usize, k: usize, dists: &[usize]) -> (Vec<usize>, Vec<usize>, Vec<f64>) {
+        let (ncp, nrows, _) = band(nodes, dists);
+        let (mut col_ptr, mut rows, mut vals) = (vec![0], vec![], vec![]);
+        for c in 0..nodes * k {
+            let node = c / k;
+            for &rn in &nrows[ncp[node]..ncp[node + 1]] {
+                for r in rn * k..(rn * k + k).min(c + 1) {
+                    rows.push(r);
+                    vals.push(if r == c {
+                        80.0
+                    } else {
+                        1.0 + ((r * 31 + c) % 17) as f64 / 7.0
+                    });
+                }
+            }
+            col_ptr.push(rows.len());
+        }
+        (col_ptr, rows, vals)
+    }
+
     fn check(n: usize, dists: &[usize]) -> UpperProduct {
-        let (col_ptr, rows, vals) = band(n, dists);
+        check_matrix(n, band(n, dists))
+    }
+
+    fn check_matrix(
+        n: usize,
+        (col_ptr, rows, vals): (Vec<usize>, Vec<usize>, Vec<f64>),
+    ) -> UpperProduct {
         let a = SymCsr::from_upper_csc(n, &col_ptr, &rows, &vals).unwrap();
         let x: Vec<f64> = (0..n).map(|i| (0.1 * i as f64).cos()).collect();
         let mut want = vec![0.0; n];
         a.mul(&x, &mut want).unwrap();
-        let mut up = UpperProduct::new(a.matrix(), &col_ptr);
+        let up = UpperProduct::new(a.matrix(), &col_ptr);
         let mut y = vec![f64::NAN; n];
         up.apply(a.matrix(), &col_ptr, &vals, &x, &mut y);
         for i in 0..n {
@@ -208,24 +318,35 @@ mod tests {
 
     #[test]
     fn matches_the_full_product_on_a_band() {
-        // Many parts, each spilling a band of 40 rows back.
+        // Many parts (odd and even), each scattering 40 rows back.
         let up = check(30_000, &[0, 1, 3, 40]);
         assert_eq!(up.part, MIN_PART);
-        assert_eq!(up.lo.len(), 30_000usize.div_ceil(MIN_PART));
-        // Each part but the first spills at most 40 rows back (fewer where the coupling at
-        // distance 40 of its first rows is left out).
-        let parts = up.lo.len() - 1;
-        assert!(up.spill.len() <= 40 * parts && up.spill.len() >= 38 * parts);
+    }
+
+    #[test]
+    fn matches_the_full_product_by_node_groups() {
+        // Nodes of 1–4 equations (groups of up to 3 rows computed together, longer ones
+        // split); groups of 3 straddle the parts of 4096 rows.
+        for k in 1..=4 {
+            let nodes = 12_000 / k;
+            let (col_ptr, rows, vals) = node_band(nodes, k, &[0, 1, 2, 30]);
+            let a = SymCsr::from_upper_csc(nodes * k, &col_ptr, &rows, &vals).unwrap();
+            // One equation per node: short runs, stored with column indices.
+            assert_eq!(a.matrix().row_runs(0).is_some(), k > 1, "k = {k}");
+            check_matrix(nodes * k, (col_ptr, rows, vals));
+        }
     }
 
     #[test]
     fn far_couplings_use_larger_parts() {
-        // Couplings across 9000 rows: parts of 4096 would spill more than n/2.
+        // Couplings across 9000 rows: parts of 4096 would scatter beyond the previous part.
         let up = check(20_000, &[0, 2, 9000]);
-        assert!(up.part > MIN_PART, "part {}", up.part);
-        assert!(2 * up.spill.len() <= 20_000);
-        // Across the whole numbering: one part, no spill.
+        assert_eq!(up.part, 4 * MIN_PART);
+        // The last rows coupled to the first: one part.
+        let up = check(9000, &[0, 1, 8999, 2500]);
+        assert_eq!(up.part, 9000);
+        // Two parts, the second scattering into the whole first.
         let up = check(5000, &[0, 1, 4999, 2500]);
-        assert_eq!((up.lo.len(), up.spill.len()), (1, 0));
+        assert_eq!(up.part, MIN_PART);
     }
 }
