@@ -484,11 +484,6 @@ impl CsrMatrix {
         self.par_products(x, y, |_, ax, yi| *yi = ax);
     }
 
-    /// `r = b − A x` without size checks.
-    pub(crate) fn residual(&self, b: &[f64], x: &[f64], r: &mut [f64]) {
-        self.par_products(x, r, |i, ax, ri| *ri = b[i] - ax);
-    }
-
     /// `f(i, (A x)_i, &mut y[i])` for every row, in parallel blocks of rows.
     pub(crate) fn par_products<F>(&self, x: &[f64], y: &mut [f64], f: F)
     where
@@ -500,6 +495,23 @@ impl CsrMatrix {
                 let base = b * ROWS_PER_TASK;
                 self.rows_times(base..base + ys.len(), x, |i, ax| {
                     f(i, ax, &mut ys[i - base])
+                });
+            });
+    }
+
+    /// `f(i, (A x)_i, &mut y[i], &mut z[i])` for every row, in parallel blocks.
+    pub(crate) fn par_products2<F>(&self, x: &[f64], y: &mut [f64], z: &mut [f64], f: F)
+    where
+        F: Fn(usize, f64, &mut f64, &mut f64) + Sync + Send,
+    {
+        y.par_chunks_mut(ROWS_PER_TASK)
+            .zip(z.par_chunks_mut(ROWS_PER_TASK))
+            .enumerate()
+            .for_each(|(b, (ys, zs))| {
+                let base = b * ROWS_PER_TASK;
+                self.rows_times(base..base + ys.len(), x, |i, ax| {
+                    let k = i - base;
+                    f(i, ax, &mut ys[k], &mut zs[k])
                 });
             });
     }
@@ -975,29 +987,6 @@ where
             let base = blk * ROWS_PER_TASK;
             for (k, (ai, bi)) in xa.iter_mut().zip(xb.iter_mut()).enumerate() {
                 f(base + k, ai, bi);
-            }
-        });
-}
-
-/// Run `f(i, &mut a[i], &mut b[i], &mut c[i])` in parallel blocks.
-#[inline]
-pub(crate) fn par_zip3<F>(a: &mut [f64], b: &mut [f64], c: &mut [f64], f: F)
-where
-    F: Fn(usize, &mut f64, &mut f64, &mut f64) + Sync + Send,
-{
-    a.par_chunks_mut(ROWS_PER_TASK)
-        .zip(b.par_chunks_mut(ROWS_PER_TASK))
-        .zip(c.par_chunks_mut(ROWS_PER_TASK))
-        .enumerate()
-        .for_each(|(blk, ((xa, xb), xc))| {
-            let base = blk * ROWS_PER_TASK;
-            for (k, ((ai, bi), ci)) in xa
-                .iter_mut()
-                .zip(xb.iter_mut())
-                .zip(xc.iter_mut())
-                .enumerate()
-            {
-                f(base + k, ai, bi, ci);
             }
         });
 }

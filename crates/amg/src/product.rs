@@ -176,11 +176,7 @@ impl Blocked {
                     off[b as usize + 1] - off[b as usize],
                     s as usize,
                 );
-                sum += self.vals[s..s + k]
-                    .iter()
-                    .zip(&x[c..c + k])
-                    .map(|(&v, xi)| f64::from(v) * xi)
-                    .sum::<f64>();
+                sum += block_dot(&self.vals[s..s + k], &x[c..c + k]);
             }
             *yi += sum;
         });
@@ -285,6 +281,22 @@ fn axpy<X: Copy + Into<f64>>(y: &mut [f64], s: f64, x: &[X]) {
                 *yi += s * xi.into();
             }
         }
+    }
+}
+
+/// `v · x` on short slices of equal length, unrolled for the common block widths.
+#[inline]
+fn block_dot(v: &[f32], x: &[f64]) -> f64 {
+    fn fixed<const K: usize>(v: &[f32], x: &[f64]) -> f64 {
+        match (<&[f32; K]>::try_from(v), <&[f64; K]>::try_from(x)) {
+            (Ok(v), Ok(x)) => (0..K).map(|t| f64::from(v[t]) * x[t]).sum(),
+            _ => 0.0,
+        }
+    }
+    match v.len() {
+        6 => fixed::<6>(v, x),
+        3 => fixed::<3>(v, x),
+        _ => v.iter().zip(x).map(|(&v, x)| f64::from(v) * x).sum(),
     }
 }
 
