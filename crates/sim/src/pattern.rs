@@ -28,6 +28,7 @@
 //! bitwise independent of the number of threads.
 
 use std::ops::Range;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 use porofrac_grid::Grid;
 use rayon::prelude::*;
@@ -168,22 +169,43 @@ impl Pattern {
             }
         });
         let eqs_of = |c: usize| &cell_eqs[cell_eq_pos[c]..cell_eq_pos[c + 1]];
-        // Equation → cells.
-        let mut eq_cell_pos = vec![0usize; n + 1];
-        for &e in &cell_eqs {
-            eq_cell_pos[e + 1] += 1;
-        }
-        for e in 0..n {
-            eq_cell_pos[e + 1] += eq_cell_pos[e];
-        }
-        let mut eq_cells = vec![0usize; cell_eqs.len()];
-        let mut next = eq_cell_pos.clone();
-        for c in 0..nc {
-            for &e in eqs_of(c) {
-                eq_cells[next[e]] = c;
-                next[e] += 1;
+        // Equation → cells, each list increasing: counted and placed by atomic increments
+        // in parallel over the cells, then each list sorted (in parallel over equations).
+        let eq_cell_pos = {
+            let counts: Vec<AtomicUsize> = (0..n).into_par_iter().map(|_| 0.into()).collect();
+            (0..nc).into_par_iter().for_each(|c| {
+                for &e in eqs_of(c) {
+                    counts[e].fetch_add(1, Ordering::Relaxed);
+                }
+            });
+            let counts: Vec<usize> = counts
+                .into_par_iter()
+                .map(AtomicUsize::into_inner)
+                .collect();
+            offsets(&counts)
+        };
+        let mut eq_cells = {
+            let next: Vec<AtomicUsize> = eq_cell_pos[..n].par_iter().map(|&p| p.into()).collect();
+            let slots: Vec<AtomicUsize> = (0..cell_eqs.len())
+                .into_par_iter()
+                .map(|_| 0.into())
+                .collect();
+            (0..nc).into_par_iter().for_each(|c| {
+                for &e in eqs_of(c) {
+                    slots[next[e].fetch_add(1, Ordering::Relaxed)].store(c, Ordering::Relaxed);
+                }
+            });
+            slots
+                .into_par_iter()
+                .map(AtomicUsize::into_inner)
+                .collect::<Vec<usize>>()
+        };
+        fill_blocks(&mut eq_cells, &eq_cell_pos, |eqs, out| {
+            let base = eq_cell_pos[eqs.start];
+            for e in eqs {
+                out[eq_cell_pos[e] - base..eq_cell_pos[e + 1] - base].sort_unstable();
             }
-        }
+        });
         // Columns: rows r ≤ c of the cells containing c. Counted first and then written
         // into the final array (both in parallel), so that no per-block buffers are left
         // behind in the allocator.
