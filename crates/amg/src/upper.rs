@@ -249,15 +249,20 @@ mod tests {
             here.dedup();
             for r in here {
                 rows.push(r);
-                vals.push(if r == c {
-                    50.0
-                } else {
-                    1.0 + ((r * 31 + c) % 17) as f64 / 7.0
-                });
+                vals.push(entry(r, c, 50.0));
             }
             col_ptr.push(rows.len());
         }
         (col_ptr, rows, vals)
+    }
+
+    /// Entry `(r, c)` of the test matrices: `diag` on the diagonal, 1–3.3 off it.
+    fn entry(r: usize, c: usize, diag: f64) -> f64 {
+        if r == c {
+            diag
+        } else {
+            1.0 + ((r * 31 + c) % 17) as f64 / 7.0
+        }
     }
 
     /// The band of `band` on `nodes` nodes with a dense `k × k` block per coupling (the
@@ -270,11 +275,7 @@ mod tests {
             for &rn in &nrows[ncp[node]..ncp[node + 1]] {
                 for r in rn * k..(rn * k + k).min(c + 1) {
                     rows.push(r);
-                    vals.push(if r == c {
-                        80.0
-                    } else {
-                        1.0 + ((r * 31 + c) % 17) as f64 / 7.0
-                    });
+                    vals.push(entry(r, c, 80.0));
                 }
             }
             col_ptr.push(rows.len());
