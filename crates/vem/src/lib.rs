@@ -145,6 +145,8 @@ fn ci(a: usize, b: usize, c: usize, d: usize) -> usize {
 struct Frame<const D: usize> {
     n: usize,
     xbar: Point<D>,
+    /// Mean of the computed `x_i − x̄` (rounding of `x̄`), taken out of every `d_i`.
+    dbar: Point<D>,
     /// `M = Σ_i d_i d_iᵀ`.
     m: Tensor<D>,
     inv_vol: f64,
@@ -155,17 +157,29 @@ impl<const D: usize> Frame<D> {
     fn new(cell: &CellGeometry<'_, D>) -> Self {
         let n = cell.coords.len();
         let xbar = cell.coords.iter().sum::<Point<D>>() / n as f64;
-        let mut m = Tensor::<D>::zeros();
-        for x in cell.coords {
-            let d = x - xbar;
-            m += d * d.transpose();
-        }
-        Self {
+        // `x̄` is rounded to the spacing of doubles at `|x̄|`, so `Σ_i (x_i − x̄)` is of
+        // order `ε |x̄|`, not zero; the closed forms rely on `Σ_i d_i = 0` (a translation
+        // must leave no remainder), so the mean of the differences — small numbers,
+        // exactly representable to `ε · diam` — is taken out of every `d_i`.
+        let dbar = cell.coords.iter().map(|x| x - xbar).sum::<Point<D>>() / n as f64;
+        let mut f = Self {
             n,
             xbar,
-            m,
+            dbar,
+            m: Tensor::<D>::zeros(),
             inv_vol: 1.0 / cell.volume,
+        };
+        for x in cell.coords {
+            let d = f.d(x);
+            f.m += d * d.transpose();
         }
+        f
+    }
+
+    /// `d = x − x̄` for a node `x` of the cell (with `Σ_i d_i = 0` to `ε · diam`).
+    #[inline]
+    fn d(&self, x: &Point<D>) -> Point<D> {
+        (x - self.xbar) - self.dbar
     }
 }
 
@@ -342,7 +356,7 @@ impl<const D: usize> VemLaw<D> {
         for j in 0..n {
             let sj = &mut buf[j * stride..(j + 1) * stride];
             let nj = &normals[j];
-            let dj = cell.coords[j] - f.xbar;
+            let dj = f.d(&cell.coords[j]);
             let mn = f.m * nj * inv_vol2;
             for a in 0..D {
                 sj[a] = dj[a];
@@ -425,7 +439,7 @@ impl<const D: usize> VemLaw<D> {
             let q = &mut scratch.mats[0];
             zero_matrix(q, n, n);
             for i in 0..n {
-                let di = cell.coords[i] - f.xbar;
+                let di = f.d(&cell.coords[i]);
                 for j in 0..n {
                     let delta = if i == j { 1.0 } else { 0.0 };
                     q[(i, j)] = delta - inv_n - di.dot(&normals[j]) * f.inv_vol;
@@ -488,7 +502,7 @@ impl<const D: usize> CellLaw<D> for VemLaw<D> {
         let w = self.weights(cell, &f);
         let mut stab = 0.0;
         for (i, x) in cell.coords.iter().enumerate() {
-            let r = node_vec::<D>(u, i) - ubar - g * (x - f.xbar);
+            let r = node_vec::<D>(u, i) - ubar - g * f.d(x);
             stab += r.dot(&self.node_weights(w, cell, &f, i).component_mul(&r));
         }
         e += 0.5 * stab;
@@ -510,7 +524,7 @@ impl<const D: usize> CellLaw<D> for VemLaw<D> {
         let mut tbar = Point::<D>::zeros();
         let mut td = Tensor::<D>::zeros();
         for (i, x) in cell.coords.iter().enumerate() {
-            let d = x - f.xbar;
+            let d = f.d(x);
             let r = node_vec::<D>(u, i) - ubar - g * d;
             let t = self.node_weights(w, cell, &f, i).component_mul(&r);
             tbar += t;
@@ -520,7 +534,7 @@ impl<const D: usize> CellLaw<D> for VemLaw<D> {
         td *= f.inv_vol;
         for (i, x) in cell.coords.iter().enumerate() {
             let nj = &cell.node_normals[i];
-            let d = x - f.xbar;
+            let d = f.d(x);
             let r = node_vec::<D>(u, i) - ubar - g * d;
             let t = self.node_weights(w, cell, &f, i).component_mul(&r);
             let fi = -(sigma * nj) - (t - tbar - td * nj);
@@ -588,7 +602,7 @@ pub fn projection_matrix<const D: usize>(cell: &CellGeometry<'_, D>, out: &mut D
     let f = Frame::new(cell);
     zero_matrix(out, D * f.n, D * f.n);
     for i in 0..f.n {
-        let di = cell.coords[i] - f.xbar;
+        let di = f.d(&cell.coords[i]);
         for j in 0..f.n {
             let p = 1.0 / f.n as f64 + di.dot(&cell.node_normals[j]) * f.inv_vol;
             for a in 0..D {
