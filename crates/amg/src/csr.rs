@@ -346,18 +346,22 @@ impl CsrMatrix {
         }
     }
 
-    /// For a matrix stored as runs: the group of row `i` and the runs `(first column,
-    /// length)` of its columns, in order (`None` for a matrix with column indices).
+    /// For a matrix stored as runs: the group of row `i` (`None` for a matrix with column
+    /// indices).
     #[inline]
-    pub(crate) fn row_runs(
-        &self,
-        i: usize,
-    ) -> Option<(u32, impl Iterator<Item = (usize, usize)> + '_)> {
+    pub(crate) fn row_group(&self, i: usize) -> Option<u32> {
+        self.runs.as_ref().map(|r| r.row_group[i])
+    }
+
+    /// For a matrix stored as runs: the runs `(first column, length)` of row `i`'s
+    /// columns, in order (`None` for a matrix with column indices).
+    #[inline]
+    pub(crate) fn row_runs(&self, i: usize) -> Option<impl Iterator<Item = (usize, usize)> + '_> {
         let r = self.runs.as_ref()?;
-        let g = r.row_group[i];
-        let k = r.ptr[g as usize]..r.ptr[g as usize + 1];
+        let g = r.row_group[i] as usize;
+        let k = r.ptr[g]..r.ptr[g + 1];
         let runs = r.start[k.clone()].iter().zip(&r.len[k]);
-        Some((g, runs.map(|(&s, &l)| (s as usize, l as usize))))
+        Some(runs.map(|(&s, &l)| (s as usize, l as usize)))
     }
 
     /// `f(column)` for the first `m` entries of row `i` (columns increasing).
@@ -1087,7 +1091,7 @@ mod tests {
             }
             assert_eq!(cols, &want, "row {i}");
             if i > 0 {
-                let same_group = m.row_runs(i).unwrap().0 == m.row_runs(i - 1).unwrap().0;
+                let same_group = m.row_group(i).unwrap() == m.row_group(i - 1).unwrap();
                 assert_eq!(same_group, rows[i - 1] == *cols, "row {i}");
             }
         }

@@ -102,16 +102,13 @@ impl UpperProduct {
             jobs.into_par_iter().for_each(|(rows, mut p)| {
                 let mut i = rows.start;
                 while i < rows.end {
-                    let Some((g, _)) = full.row_runs(i) else {
+                    let Some(g) = full.row_group(i) else {
                         p.row(full, col_ptr, upper, x, i);
                         i += 1;
                         continue;
                     };
                     let mut m = 1;
-                    while i + m < rows.end
-                        && m < 3
-                        && full.row_runs(i + m).is_some_and(|(h, _)| h == g)
-                    {
+                    while i + m < rows.end && m < 3 && full.row_group(i + m) == Some(g) {
                         m += 1;
                     }
                     match m {
@@ -171,7 +168,7 @@ impl Part<'_> {
         let mut tail = [0usize; M];
         let mut ntail = 0;
         let longest = vals.iter().map(|v| v.len()).max().unwrap_or(0);
-        if let Some((_, runs)) = full.row_runs(i) {
+        if let Some(runs) = full.row_runs(i) {
             for (s, l) in runs {
                 // Columns before `i`.
                 let e = (s + l).min(i);
@@ -333,7 +330,7 @@ mod tests {
             let (col_ptr, rows, vals) = node_band(nodes, k, &[0, 1, 2, 30]);
             let a = SymCsr::from_upper_csc(nodes * k, &col_ptr, &rows, &vals).unwrap();
             // One equation per node: short runs, stored with column indices.
-            assert_eq!(a.matrix().row_runs(0).is_some(), k > 1, "k = {k}");
+            assert_eq!(a.matrix().row_group(0).is_some(), k > 1, "k = {k}");
             check_matrix(nodes * k, (col_ptr, rows, vals));
         }
     }
