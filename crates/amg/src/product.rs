@@ -529,7 +529,15 @@ pub(crate) fn symbolic_galerkin(
                 for ag in aggs {
                     let start = list.len();
                     if off[ag + 1] > off[ag] {
+                        // Rows of one group (the components of a node) have the same
+                        // columns, hence the same blocks: the first of them stands for all.
+                        let mut last_group = None;
                         for &i in rows_of(ag) {
+                            let group = a.row_group(i as usize);
+                            if group.is_some() && group == last_group {
+                                continue;
+                            }
+                            last_group = group;
                             a.for_each_col(i as usize, |j| {
                                 for &b in p.blocks(j as usize).0 {
                                     if mark[b as usize] != stamp(ag) {

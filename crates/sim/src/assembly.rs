@@ -246,30 +246,37 @@ pub fn nodal_loads<const D: usize>(
         )));
     }
     if loads.body_force.is_some() || loads.gravity.is_some() {
-        // Per-split accumulators are full nodal vectors: keep the splits few.
-        let acc = (0..grid.num_cells())
+        // Blocks of consecutive cells, a fixed number of them (so the sums do not depend
+        // on the thread count): each block sums into the span of nodes its cells touch —
+        // a thin band of the nodal vector when the grid is numbered in space — and the
+        // spans are added into `out` in block order.
+        const BLOCKS: usize = 16;
+        let nc = grid.num_cells();
+        let spans: Vec<(usize, Vec<f64>)> = (0..BLOCKS.min(nc))
             .into_par_iter()
-            .with_min_len(
-                grid.num_cells()
-                    .div_ceil(4 * rayon::current_num_threads())
-                    .max(1),
-            )
-            .fold(
-                || (vec![0.0; ndof], Vec::<Point<D>>::new(), Vec::<usize>::new()),
-                |(mut acc, mut pts, mut ids), c| {
-                    body_load_cell(grid, loads, t, c, &mut acc, &mut pts, &mut ids);
-                    (acc, pts, ids)
-                },
-            )
-            .map(|(acc, _, _)| acc)
-            .reduce(
-                || vec![0.0; ndof],
-                |mut a, b| {
-                    a.iter_mut().zip(&b).for_each(|(x, y)| *x += y);
-                    a
-                },
-            );
-        out.copy_from_slice(&acc);
+            .map(|b| {
+                let cells = nc * b / BLOCKS.min(nc)..nc * (b + 1) / BLOCKS.min(nc);
+                let nodes = || {
+                    cells
+                        .clone()
+                        .flat_map(|c| grid.cell_nodes(c).iter().copied())
+                };
+                let first = nodes().min().unwrap_or(0);
+                let last = nodes().max().unwrap_or(0);
+                let mut acc = vec![0.0; D * (last + 1 - first)];
+                let (mut pts, mut ids) = (Vec::new(), Vec::new());
+                for c in cells.clone() {
+                    body_load_cell(grid, loads, t, c, first, &mut acc, &mut pts, &mut ids);
+                }
+                (D * first, acc)
+            })
+            .collect();
+        for (start, acc) in spans {
+            out[start..start + acc.len()]
+                .iter_mut()
+                .zip(&acc)
+                .for_each(|(o, a)| *o += a);
+        }
     }
     let mut pts: Vec<Point<D>> = Vec::new();
     let rule = facet_rule::<D>();
@@ -332,12 +339,14 @@ pub fn nodal_loads<const D: usize>(
     Ok(())
 }
 
-/// Body force and gravity of cell `c`, added to `acc` (see the module docs).
+/// Body force and gravity of cell `c`, added to `acc`, the nodal vector from node `first`
+/// on (see the module docs).
 fn body_load_cell<const D: usize>(
     grid: &Grid<D>,
     loads: &Loads<D>,
     t: f64,
     c: usize,
+    first: usize,
     acc: &mut [f64],
     pts: &mut Vec<Point<D>>,
     ids: &mut Vec<usize>,
@@ -362,7 +371,7 @@ fn body_load_cell<const D: usize>(
             fv *= w * vol;
             for (&i, &li) in cn.iter().zip(l) {
                 for a in 0..D {
-                    acc[D * i + a] += li * fv[a];
+                    acc[D * (i - first) + a] += li * fv[a];
                 }
             }
         }
@@ -403,13 +412,13 @@ fn body_load_cell<const D: usize>(
                         let share = fv * (l[k] / m as f64);
                         for &i in ids.iter() {
                             for a in 0..D {
-                                acc[D * i + a] += share[a];
+                                acc[D * (i - first) + a] += share[a];
                             }
                         }
                     } else {
                         let i = ids[corners[k]];
                         for a in 0..D {
-                            acc[D * i + a] += l[k] * fv[a];
+                            acc[D * (i - first) + a] += l[k] * fv[a];
                         }
                     }
                 }
@@ -419,7 +428,7 @@ fn body_load_cell<const D: usize>(
     centre /= n as f64;
     for &i in cn {
         for a in 0..D {
-            acc[D * i + a] += centre[a];
+            acc[D * (i - first) + a] += centre[a];
         }
     }
 }

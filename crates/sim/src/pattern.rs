@@ -335,22 +335,33 @@ impl Pattern {
         }
         let chunk_of = |e: usize| bounds.partition_point(|&b| b <= e) - 1;
         let nch = bounds.len() - 1;
-        let mut lists: Vec<Vec<usize>> = vec![Vec::new(); nch];
-        for c in 0..nc {
-            let mut last = usize::MAX;
-            for &e in eqs_of(c) {
-                let k = chunk_of(e);
-                if k != last {
-                    lists[k].push(c);
-                    last = k;
+        // The cells of every chunk, increasing: per block of cells in parallel, then
+        // concatenated chunk by chunk in block order.
+        let block_lists: Vec<Vec<Vec<usize>>> = (0..nc.div_ceil(BLOCK))
+            .into_par_iter()
+            .map(|b| {
+                let mut lists = vec![Vec::new(); nch];
+                for c in b * BLOCK..((b + 1) * BLOCK).min(nc) {
+                    let mut last = usize::MAX;
+                    for &e in eqs_of(c) {
+                        let k = chunk_of(e);
+                        if k != last {
+                            lists[k].push(c);
+                            last = k;
+                        }
+                    }
                 }
-            }
-        }
+                lists
+            })
+            .collect();
         let mut chunks = Vec::with_capacity(nch);
-        let mut chunk_cells = Vec::new();
-        for (k, list) in lists.into_iter().enumerate() {
+        let mut chunk_cells =
+            Vec::with_capacity(block_lists.iter().flatten().map(Vec::len).sum::<usize>());
+        for k in 0..nch {
             let start = chunk_cells.len();
-            chunk_cells.extend_from_slice(&list);
+            for lists in &block_lists {
+                chunk_cells.extend_from_slice(&lists[k]);
+            }
             chunks.push(Chunk {
                 cols: bounds[k]..bounds[k + 1],
                 vals: col_ptr[bounds[k]]..col_ptr[bounds[k + 1]],

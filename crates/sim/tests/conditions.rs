@@ -9,6 +9,9 @@
 //! * Nodal loads: `Σ f_i = ∫ b` and `Σ f_i ⊗ x_i = ∫ b ⊗ x` for a linear body force on
 //!   simplices and on Cartesian cells (1e-12), `Σ f_i = ∫ t` and the moment for a linear
 //!   traction (1e-12).
+//! * Nodal loads do not depend on the cell order: the same grid with its cells shuffled
+//!   (cell blocks then touch nodes all over the grid) gives the same loads up to the
+//!   rounding of a different summation order (1e-14 of the largest).
 
 mod common;
 
@@ -265,4 +268,38 @@ fn traction_loads_are_exact_for_linear_tractions() {
     traction_moments(
         &generate::cartesian::<3>(Point::<3>::zeros(), Point::<3>::repeat(1.0), [3, 2, 2]).unwrap(),
     );
+}
+
+#[test]
+fn body_loads_do_not_depend_on_the_cell_order() {
+    let grid =
+        generate::simplices::<2>(Point::<2>::zeros(), Point::<2>::repeat(1.0), [12, 9]).unwrap();
+    let nc = grid.num_cells();
+    // c ↦ 7c mod nc is a permutation (nc = 216 is coprime to 7).
+    let order: Vec<usize> = (0..nc).map(|c| 7 * c % nc).collect();
+    let mut pos = vec![0];
+    let mut conn = Vec::new();
+    for &c in &order {
+        conn.extend_from_slice(grid.cell_nodes(c));
+        pos.push(conn.len());
+    }
+    let shuffled = Grid::from_polygons(grid.nodes().to_vec(), &pos, &conn).unwrap();
+    let loads = Loads {
+        body_force: Some([
+            ScalarField::from_fn(|x, _| (3.0 * x[0]).sin() + x[1] * x[1]),
+            ScalarField::from_fn(|x, _| (2.0 * x[1]).cos() * x[0]),
+        ]),
+        ..Loads::default()
+    };
+    let (mut f, mut g) = (
+        vec![0.0; 2 * grid.num_nodes()],
+        vec![0.0; 2 * grid.num_nodes()],
+    );
+    nodal_loads(&grid, &loads, 0.0, &mut f).unwrap();
+    nodal_loads(&shuffled, &loads, 0.0, &mut g).unwrap();
+    let scale = f.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    assert!(scale > 0.0);
+    for (i, (a, b)) in f.iter().zip(&g).enumerate() {
+        assert!((a - b).abs() <= 1e-14 * scale, "dof {i}: {a} vs {b}");
+    }
 }
