@@ -28,7 +28,6 @@
 //! bitwise independent of the number of threads.
 
 use std::ops::Range;
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 use porofrac_grid::Grid;
 use rayon::prelude::*;
@@ -94,6 +93,17 @@ fn offsets(counts: &[usize]) -> Vec<usize> {
     pos
 }
 
+/// `out` cut into consecutive slices of the lengths `lens`.
+fn split_mut<T>(mut out: &mut [T], lens: impl IntoIterator<Item = usize>) -> Vec<&mut [T]> {
+    let mut slices = Vec::new();
+    for len in lens {
+        let (head, tail) = out.split_at_mut(len);
+        slices.push(head);
+        out = tail;
+    }
+    slices
+}
+
 /// Fill `out` in parallel: items `i` own `out[pos[i]..pos[i + 1]]`; `fill(items, slice)`
 /// is called on contiguous blocks of items with the slice they own.
 fn fill_blocks<T: Send>(
@@ -103,14 +113,12 @@ fn fill_blocks<T: Send>(
 ) {
     const ITEMS: usize = 4096;
     let items = pos.len() - 1;
-    let mut blocks = Vec::with_capacity(items.div_ceil(ITEMS));
-    let mut rest = out;
-    for start in (0..items).step_by(ITEMS) {
-        let end = (start + ITEMS).min(items);
-        let (head, tail) = rest.split_at_mut(pos[end] - pos[start]);
-        blocks.push((start..end, head));
-        rest = tail;
-    }
+    let ranges: Vec<Range<usize>> = (0..items)
+        .step_by(ITEMS)
+        .map(|start| start..(start + ITEMS).min(items))
+        .collect();
+    let slices = split_mut(out, ranges.iter().map(|r| pos[r.end] - pos[r.start]));
+    let blocks: Vec<_> = ranges.into_iter().zip(slices).collect();
     blocks
         .into_par_iter()
         .for_each(|(range, slice)| fill(range, slice));
@@ -169,43 +177,53 @@ impl Pattern {
             }
         });
         let eqs_of = |c: usize| &cell_eqs[cell_eq_pos[c]..cell_eq_pos[c + 1]];
-        // Equation → cells, each list increasing: counted and placed by atomic increments
-        // in parallel over the cells, then each list sorted (in parallel over equations).
+        // Equation → cells, each list increasing. The equations are split into one range
+        // per thread; every range scans all cells in order and keeps its own equations
+        // (counts, then cells), so no atomics are needed and every list comes out sorted.
+        let ranges: Vec<Range<usize>> = {
+            let parts = rayon::current_num_threads().clamp(1, n.max(1));
+            (0..parts)
+                .map(|k| n * k / parts..n * (k + 1) / parts)
+                .collect()
+        };
         let eq_cell_pos = {
-            let counts: Vec<AtomicUsize> = (0..n).into_par_iter().map(|_| 0.into()).collect();
-            (0..nc).into_par_iter().for_each(|c| {
-                for &e in eqs_of(c) {
-                    counts[e].fetch_add(1, Ordering::Relaxed);
+            let mut counts = vec![0usize; n];
+            let slices = split_mut(&mut counts, ranges.iter().map(|r| r.len()));
+            let firsts = ranges.iter().map(|r| r.start);
+            let parts: Vec<_> = firsts.zip(slices).collect();
+            parts.into_par_iter().for_each(|(first, counts)| {
+                for &e in &cell_eqs {
+                    if let Some(k) = e.checked_sub(first)
+                        && k < counts.len()
+                    {
+                        counts[k] += 1;
+                    }
                 }
             });
-            let counts: Vec<usize> = counts
-                .into_par_iter()
-                .map(AtomicUsize::into_inner)
-                .collect();
             offsets(&counts)
         };
-        let mut eq_cells = {
-            let next: Vec<AtomicUsize> = eq_cell_pos[..n].par_iter().map(|&p| p.into()).collect();
-            let slots: Vec<AtomicUsize> = (0..cell_eqs.len())
-                .into_par_iter()
-                .map(|_| 0.into())
-                .collect();
-            (0..nc).into_par_iter().for_each(|c| {
-                for &e in eqs_of(c) {
-                    slots[next[e].fetch_add(1, Ordering::Relaxed)].store(c, Ordering::Relaxed);
+        let mut eq_cells = vec![0usize; cell_eqs.len()];
+        {
+            let lens = ranges
+                .iter()
+                .map(|r| eq_cell_pos[r.end] - eq_cell_pos[r.start]);
+            let slices = split_mut(&mut eq_cells, lens);
+            let parts: Vec<_> = ranges.iter().cloned().zip(slices).collect();
+            parts.into_par_iter().for_each(|(eqs, out)| {
+                let base = eq_cell_pos[eqs.start];
+                let mut next: Vec<usize> =
+                    eq_cell_pos[eqs.clone()].iter().map(|p| p - base).collect();
+                for c in 0..nc {
+                    for &e in eqs_of(c) {
+                        if eqs.contains(&e) {
+                            let at = &mut next[e - eqs.start];
+                            out[*at] = c;
+                            *at += 1;
+                        }
+                    }
                 }
             });
-            slots
-                .into_par_iter()
-                .map(AtomicUsize::into_inner)
-                .collect::<Vec<usize>>()
-        };
-        fill_blocks(&mut eq_cells, &eq_cell_pos, |eqs, out| {
-            let base = eq_cell_pos[eqs.start];
-            for e in eqs {
-                out[eq_cell_pos[e] - base..eq_cell_pos[e + 1] - base].sort_unstable();
-            }
-        });
+        }
         // Columns: rows r ≤ c of the cells containing c. Counted first and then written
         // into the final array (both in parallel), so that no per-block buffers are left
         // behind in the allocator.
