@@ -723,11 +723,8 @@ impl SymCsr {
         validate_upper_csc(n, col_ptr, row_idx, values)?;
         // Full row i = column i of the upper triangle (columns r ≤ i, diagonal last) followed
         // by the columns c > i whose upper column holds row i — a transpose. One pass counts
-        // the entries of each row and the last column holding it; the rows are then split
-        // into parts, one task each, and every task scans the columns from its first row to
-        // the last column holding one of its rows (a band for equations numbered by
-        // node), keeping the entries of its own rows: each row comes out sorted and each
-        // task writes only its own slice.
+        // the entries of each row and the last column holding it; the rows are then written
+        // in parallel, values with their columns ([`UpperCsc::expand_rows`]).
         let mut upper_count = vec![0u32; n];
         let mut last_col: Vec<u32> = (0..n as u32).collect();
         for c in 0..n {
@@ -745,55 +742,24 @@ impl SymCsr {
         }
         drop(upper_count);
         let nnz = row_ptr[n];
-        let parts = (4 * rayon::current_num_threads()).clamp(1, n.max(1));
-        let bounds: Vec<usize> = (0..=parts).map(|k| n * k / parts).collect();
         let mut col = vec![0u32; nnz];
-        let mut slices = Vec::with_capacity(parts);
-        let mut rest = &mut col[..];
-        for k in 0..parts {
-            let (head, tail) = rest.split_at_mut(row_ptr[bounds[k + 1]] - row_ptr[bounds[k]]);
-            slices.push((k, head));
-            rest = tail;
-        }
-        slices.into_par_iter().for_each(|(k, col)| {
-            let rows = bounds[k]..bounds[k + 1];
-            let base = row_ptr[rows.start];
-            // Lower part and diagonal, and the write cursor of each row's upper part.
-            let mut next = Vec::with_capacity(rows.len());
-            for i in rows.clone() {
-                let at = row_ptr[i] - base;
-                for (q, &r) in row_idx[col_ptr[i]..col_ptr[i + 1]].iter().enumerate() {
-                    col[at + q] = r as u32;
-                }
-                next.push(at + col_ptr[i + 1] - col_ptr[i]);
-            }
-            let end = rows
-                .clone()
-                .map(|r| last_col[r] as usize + 1)
-                .max()
-                .unwrap_or(0);
-            for c in rows.start..end {
-                for &r in &row_idx[col_ptr[c]..col_ptr[c + 1]] {
-                    if r != c && rows.contains(&r) {
-                        let at = &mut next[r - rows.start];
-                        col[*at] = c as u32;
-                        *at += 1;
-                    }
-                }
-            }
-        });
-        let mut full = CsrMatrix::from_parts(n, n, row_ptr, col, Vec::new());
-        full.val = match precision {
+        let mut val = match precision {
             Precision::Double => Values::Double(zeros_of(nnz)),
             Precision::Single => Values::Single(zeros_of(nnz)),
         };
+        let upper = UpperCsc {
+            col_ptr,
+            row_idx,
+            values,
+        };
+        with_values!(&mut val, v => upper.expand_rows(&row_ptr, &last_col, &mut col, v));
+        let mut full = CsrMatrix::from_parts(n, n, row_ptr, col, Vec::new());
+        full.val = val;
         full.compress_runs();
-        let mut out = Self {
+        Ok(Self {
             full,
             col_ptr: col_ptr.to_vec(),
-        };
-        out.fill(values);
-        Ok(out)
+        })
     }
 
     /// Number of equations.
@@ -828,6 +794,84 @@ impl SymCsr {
     pub(crate) fn into_parts(self) -> (CsrMatrix, Vec<usize>) {
         (self.full, self.col_ptr)
     }
+}
+
+/// The upper triangle in CSC form, as given to [`SymCsr::from_upper_csc`].
+struct UpperCsc<'a> {
+    col_ptr: &'a [usize],
+    row_idx: &'a [usize],
+    values: &'a [f64],
+}
+
+impl UpperCsc<'_> {
+    /// Column indices and values of the full rows laid out by `row_ptr`. The rows are
+    /// split into parts, one task each; every task scans the columns from its first row to
+    /// the last column holding one of its rows (`last_col`; a band for equations numbered
+    /// by node), keeping the entries of its own rows: each row comes out sorted and each
+    /// task writes only its own slices.
+    fn expand_rows<T: Value>(
+        &self,
+        row_ptr: &[usize],
+        last_col: &[u32],
+        col: &mut [u32],
+        val: &mut [T],
+    ) {
+        let (col_ptr, row_idx, values) = (self.col_ptr, self.row_idx, self.values);
+        let n = row_ptr.len() - 1;
+        let parts = (4 * rayon::current_num_threads()).clamp(1, n.max(1));
+        let bounds: Vec<usize> = (0..=parts).map(|k| n * k / parts).collect();
+        let lens = || bounds.windows(2).map(|w| row_ptr[w[1]] - row_ptr[w[0]]);
+        let slices: Vec<_> = split_mut(col, lens())
+            .into_iter()
+            .zip(split_mut(val, lens()))
+            .collect();
+        slices
+            .into_par_iter()
+            .enumerate()
+            .for_each(|(k, (col, val))| {
+                let rows = bounds[k]..bounds[k + 1];
+                let base = row_ptr[rows.start];
+                // Lower part and diagonal (column i of the upper triangle), and the write
+                // cursor of each row's upper part.
+                let mut next = Vec::with_capacity(rows.len());
+                for i in rows.clone() {
+                    let at = row_ptr[i] - base;
+                    let span = col_ptr[i]..col_ptr[i + 1];
+                    for (q, &r) in row_idx[span.clone()].iter().enumerate() {
+                        col[at + q] = r as u32;
+                        val[at + q] = T::from_f64(values[span.start + q]);
+                    }
+                    next.push(at + span.len());
+                }
+                let end = rows
+                    .clone()
+                    .map(|r| last_col[r] as usize + 1)
+                    .max()
+                    .unwrap_or(0);
+                for c in rows.start..end {
+                    for p in col_ptr[c]..col_ptr[c + 1] {
+                        let r = row_idx[p];
+                        if r != c && rows.contains(&r) {
+                            let at = &mut next[r - rows.start];
+                            col[*at] = c as u32;
+                            val[*at] = T::from_f64(values[p]);
+                            *at += 1;
+                        }
+                    }
+                }
+            });
+    }
+}
+
+/// `out` cut into consecutive slices of the lengths `lens`.
+fn split_mut<T>(mut out: &mut [T], lens: impl IntoIterator<Item = usize>) -> Vec<&mut [T]> {
+    let mut slices = Vec::new();
+    for len in lens {
+        let (head, tail) = out.split_at_mut(len);
+        slices.push(head);
+        out = tail;
+    }
+    slices
 }
 
 /// Error unless `values` has `upper_nnz` finite entries.
@@ -872,14 +916,11 @@ pub(crate) fn fill_from_upper(full: &mut CsrMatrix, col_ptr: &[usize], values: &
 fn fill_rows<T: Value>(f: &CsrMatrix, val: &mut [T], col_ptr: &[usize], values: &[f64]) {
     let row_ptr = &f.row_ptr;
     let n = f.nrows;
-    let mut slices = Vec::with_capacity(n.div_ceil(ROWS_PER_TASK));
-    let mut rest = val;
-    for start in (0..n).step_by(ROWS_PER_TASK) {
-        let end = (start + ROWS_PER_TASK).min(n);
-        let (head, tail) = rest.split_at_mut(row_ptr[end] - row_ptr[start]);
-        slices.push((start, head));
-        rest = tail;
-    }
+    let starts: Vec<usize> = (0..n).step_by(ROWS_PER_TASK).collect();
+    let lens = starts
+        .iter()
+        .map(|&s| row_ptr[(s + ROWS_PER_TASK).min(n)] - row_ptr[s]);
+    let slices: Vec<_> = starts.iter().copied().zip(split_mut(val, lens)).collect();
     slices.into_par_iter().for_each(|(start, out)| {
         let base = row_ptr[start];
         for i in start..(start + ROWS_PER_TASK).min(n) {
