@@ -229,8 +229,18 @@ pub(crate) fn symbolic_prolongator(
                 let rows = blk * ROWS_PER_TASK..((blk + 1) * ROWS_PER_TASK).min(n);
                 let mut counts = Vec::with_capacity(rows.len());
                 let mut aggs = Vec::new();
+                let mut last: Option<(u32, std::ops::Range<usize>)> = None;
                 for i in rows {
                     let start = aggs.len();
+                    // A row of the previous row's group has its columns, hence its blocks.
+                    let group = a.row_group(i);
+                    if let (Some(g), Some((lg, prev))) = (group, &last)
+                        && g == *lg
+                    {
+                        aggs.extend_from_within(prev.clone());
+                        counts.push(aggs.len() - start);
+                        continue;
+                    }
                     a.for_each_col(i, |j| {
                         let b = eq_agg[j as usize] as usize;
                         if mark[b] != stamp(i) && off[b + 1] > off[b] {
@@ -240,6 +250,7 @@ pub(crate) fn symbolic_prolongator(
                     });
                     aggs[start..].sort_unstable();
                     counts.push(aggs.len() - start);
+                    last = group.map(|g| (g, start..aggs.len()));
                 }
                 (counts, aggs)
             },
