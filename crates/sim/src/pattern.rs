@@ -95,13 +95,13 @@ fn offsets(counts: &[usize]) -> Vec<usize> {
 
 /// `out` cut into consecutive slices of the lengths `lens`.
 fn split_mut<T>(mut out: &mut [T], lens: impl IntoIterator<Item = usize>) -> Vec<&mut [T]> {
-    let mut slices = Vec::new();
-    for len in lens {
-        let (head, tail) = out.split_at_mut(len);
-        slices.push(head);
-        out = tail;
-    }
-    slices
+    lens.into_iter()
+        .map(|len| {
+            let (head, tail) = std::mem::take(&mut out).split_at_mut(len);
+            out = tail;
+            head
+        })
+        .collect()
 }
 
 /// Fill `out` in parallel: items `i` own `out[pos[i]..pos[i + 1]]`; `fill(items, slice)`
