@@ -820,15 +820,15 @@ impl UpperCsc<'_> {
         let n = row_ptr.len() - 1;
         let parts = (4 * rayon::current_num_threads()).clamp(1, n.max(1));
         let bounds: Vec<usize> = (0..=parts).map(|k| n * k / parts).collect();
-        let lens = || bounds.windows(2).map(|w| row_ptr[w[1]] - row_ptr[w[0]]);
-        let slices: Vec<_> = split_mut(col, lens())
+        let row_start = |i: usize| row_ptr[i];
+        let slices: Vec<_> = split_by_items(col, &bounds, row_start)
             .into_iter()
-            .zip(split_mut(val, lens()))
+            .zip(split_by_items(val, &bounds, row_start))
             .collect();
         slices
             .into_par_iter()
             .enumerate()
-            .for_each(|(k, (col, val))| {
+            .for_each(|(k, ((_, col), (_, val)))| {
                 let rows = bounds[k]..bounds[k + 1];
                 let base = row_ptr[rows.start];
                 // Lower part and diagonal (column i of the upper triangle), and the write
@@ -863,15 +863,26 @@ impl UpperCsc<'_> {
     }
 }
 
-/// `out` cut into consecutive slices of the lengths `lens`.
-fn split_mut<T>(mut out: &mut [T], lens: impl IntoIterator<Item = usize>) -> Vec<&mut [T]> {
-    let mut slices = Vec::new();
-    for len in lens {
-        let (head, tail) = out.split_at_mut(len);
-        slices.push(head);
-        out = tail;
+/// `v` cut into the slices of the consecutive item ranges `bounds[k]..bounds[k + 1]`, item
+/// `i` starting at `offset(i)` (counted from `offset(bounds[0])`), each with the first item
+/// of its range: the parts of a parallel pass that writes only its own slice.
+pub(crate) fn split_by_items<'a, T>(
+    mut v: &'a mut [T],
+    bounds: &[usize],
+    offset: impl Fn(usize) -> usize,
+) -> Vec<(usize, &'a mut [T])> {
+    let mut out = Vec::with_capacity(bounds.len().saturating_sub(1));
+    for w in bounds.windows(2) {
+        let (head, tail) = std::mem::take(&mut v).split_at_mut(offset(w[1]) - offset(w[0]));
+        out.push((w[0], head));
+        v = tail;
     }
-    slices
+    out
+}
+
+/// `0, size, 2·size, …, n`: the bounds of consecutive blocks of at most `size` items.
+pub(crate) fn block_bounds(n: usize, size: usize) -> Vec<usize> {
+    (0..n).step_by(size).chain(std::iter::once(n)).collect()
 }
 
 /// Error unless `values` has `upper_nnz` finite entries.
@@ -916,11 +927,7 @@ pub(crate) fn fill_from_upper(full: &mut CsrMatrix, col_ptr: &[usize], values: &
 fn fill_rows<T: Value>(f: &CsrMatrix, val: &mut [T], col_ptr: &[usize], values: &[f64]) {
     let row_ptr = &f.row_ptr;
     let n = f.nrows;
-    let starts: Vec<usize> = (0..n).step_by(ROWS_PER_TASK).collect();
-    let lens = starts
-        .iter()
-        .map(|&s| row_ptr[(s + ROWS_PER_TASK).min(n)] - row_ptr[s]);
-    let slices: Vec<_> = starts.iter().copied().zip(split_mut(val, lens)).collect();
+    let slices = split_by_items(val, &block_bounds(n, ROWS_PER_TASK), |i| row_ptr[i]);
     slices.into_par_iter().for_each(|(start, out)| {
         let base = row_ptr[start];
         for i in start..(start + ROWS_PER_TASK).min(n) {

@@ -60,7 +60,9 @@
 
 use rayon::prelude::*;
 
-use crate::csr::{CsrMatrix, ROWS_PER_TASK, par_rows, vec_bytes, zeros};
+use crate::csr::{
+    CsrMatrix, ROWS_PER_TASK, block_bounds, par_rows, split_by_items, vec_bytes, zeros,
+};
 use crate::error::{AmgError, Result};
 
 /// The marker of row (or aggregate) `i` in a dense accumulator. Markers start at zero
@@ -260,26 +262,6 @@ pub(crate) fn symbolic_prolongator(
     Blocked::from_blocks(n, off, &bptr, bagg)
 }
 
-/// Split `val` (row `i` at `row_start(i)..row_start(i + 1)`, `nrows` rows) into the value
-/// slices of consecutive groups of rows.
-fn row_blocks_mut<T>(
-    nrows: usize,
-    row_start: impl Fn(usize) -> usize,
-    val: &mut [T],
-) -> Vec<(usize, &mut [T])> {
-    let mut out = Vec::with_capacity(nrows.div_ceil(ROWS_PER_TASK));
-    let mut rest = val;
-    let mut start = 0;
-    while start < nrows {
-        let end = (start + ROWS_PER_TASK).min(nrows);
-        let (head, tail) = rest.split_at_mut(row_start(end) - row_start(start));
-        out.push((start, head));
-        rest = tail;
-        start = end;
-    }
-    out
-}
-
 /// `y += s x` on short slices of equal length, unrolled for the common block widths
 /// (6: 3D rigid modes, 3: 2D rigid modes).
 #[inline]
@@ -340,7 +322,7 @@ pub(crate) fn smooth_prolongator(
     } = p;
     let row_start = |i: usize| bpos[bptr[i] as usize] as usize;
     let tv = t.values();
-    let blocks = row_blocks_mut(n, row_start, vals);
+    let blocks = split_by_items(vals, &block_bounds(n, ROWS_PER_TASK), row_start);
     blocks.into_par_iter().for_each_init(
         || (vec![0usize; nagg], Vec::new()),
         |(pos, acc), (start, vals)| {
@@ -403,13 +385,8 @@ fn rows_of_aggregates(p: &Blocked, nagg: usize) -> (Vec<usize>, Vec<u32>) {
 /// fine rows `i` increasing (so the result does not depend on the parts).
 pub(crate) fn restrict(g: &Galerkin, p: &Blocked, off: &[usize], r: &[f64], out: &mut [f64]) {
     let pv = p.values();
-    part_slices_mut(
-        &g.part_aggs,
-        |k| off[g.part_aggs[k]]..off[g.part_aggs[k + 1]],
-        out,
-    )
-    .into_par_iter()
-    .for_each(|(k, out)| {
+    let parts = split_by_items(out, &g.part_aggs, |a| off[a]);
+    parts.into_par_iter().enumerate().for_each(|(k, (_, out))| {
         let (lo, hi) = (g.part_aggs[k], g.part_aggs[k + 1]);
         let base = off[lo];
         out.fill(0.0);
@@ -426,22 +403,6 @@ pub(crate) fn restrict(g: &Galerkin, p: &Blocked, off: &[usize], r: &[f64], out:
             }
         }
     });
-}
-
-/// Split `v` into the parts' slices `range(k)` (consecutive, covering `v`).
-fn part_slices_mut<'a, T>(
-    part_aggs: &[usize],
-    range: impl Fn(usize) -> std::ops::Range<usize>,
-    v: &'a mut [T],
-) -> Vec<(usize, &'a mut [T])> {
-    let mut out = Vec::with_capacity(part_aggs.len().saturating_sub(1));
-    let mut rest = v;
-    for k in 0..part_aggs.len().saturating_sub(1) {
-        let (head, tail) = rest.split_at_mut(range(k).len());
-        out.push((k, head));
-        rest = tail;
-    }
-    out
 }
 
 /// The block pattern of `A_c`, with the offsets and mirrors the numeric product needs, and
@@ -672,12 +633,8 @@ pub(crate) fn numeric_galerkin(
     let row_ptr = ac.row_ptr().to_vec();
     let pv = p.values();
     // Pass 1: blocks (a, b ≥ a); diagonal blocks symmetrized.
-    {
-        let part_values = |k: usize| row_ptr[off[g.part_aggs[k]]]..row_ptr[off[g.part_aggs[k + 1]]];
-        part_slices_mut(&g.part_aggs, part_values, ac.values_mut())
-    }
-    .into_par_iter()
-    .for_each_init(
+    let parts = split_by_items(ac.values_mut(), &g.part_aggs, |a| row_ptr[off[a]]);
+    parts.into_par_iter().enumerate().for_each_init(
         || {
             (
                 vec![u32::MAX; nagg],
@@ -686,7 +643,7 @@ pub(crate) fn numeric_galerkin(
                 Vec::new(),
             )
         },
-        |(slot, pos, waggs, wvals), (k, vals)| {
+        |(slot, pos, waggs, wvals), (k, (_, vals))| {
             let (lo, hi) = (g.part_aggs[k], g.part_aggs[k + 1]);
             let base = row_ptr[off[lo]];
             vals.fill(0.0);
@@ -749,55 +706,36 @@ pub(crate) fn numeric_galerkin(
     // A temporary copy of the upper blocks (freed at return: nothing kept between calls).
     let copy = ac.values().to_vec();
     let src = &copy[..];
-    agg_chunks_mut(&row_ptr, off, ac.values_mut())
-        .into_par_iter()
-        .for_each(|(a0, vals)| {
-            let base = row_ptr[off[a0]];
-            for ag in a0..(a0 + AGGS_PER_TASK).min(nagg) {
-                let ka = width(ag);
-                if ka == 0 {
-                    continue;
+    split_by_items(ac.values_mut(), &block_bounds(nagg, AGGS_PER_TASK), |a| {
+        row_ptr[off[a]]
+    })
+    .into_par_iter()
+    .for_each(|(a0, vals)| {
+        let base = row_ptr[off[a0]];
+        for ag in a0..(a0 + AGGS_PER_TASK).min(nagg) {
+            let ka = width(ag);
+            if ka == 0 {
+                continue;
+            }
+            let start = row_ptr[off[ag]] - base;
+            let len = row_ptr[off[ag] + 1] - row_ptr[off[ag]];
+            for q in g.bptr[ag]..g.bptr[ag + 1] {
+                let b = g.bagg[q] as usize;
+                if b >= ag {
+                    break;
                 }
-                let start = row_ptr[off[ag]] - base;
-                let len = row_ptr[off[ag] + 1] - row_ptr[off[ag]];
-                for q in g.bptr[ag]..g.bptr[ag + 1] {
-                    let b = g.bagg[q] as usize;
-                    if b >= ag {
-                        break;
-                    }
-                    let kb = width(b);
-                    let m = g.mirror[q];
-                    let sbase = row_ptr[off[b]] + g.boff[m];
-                    let slen = row_ptr[off[b] + 1] - row_ptr[off[b]];
-                    for r in 0..ka {
-                        for c in 0..kb {
-                            vals[start + r * len + g.boff[q] + c] = src[sbase + c * slen + r];
-                        }
+                let kb = width(b);
+                let m = g.mirror[q];
+                let sbase = row_ptr[off[b]] + g.boff[m];
+                let slen = row_ptr[off[b] + 1] - row_ptr[off[b]];
+                for r in 0..ka {
+                    for c in 0..kb {
+                        vals[start + r * len + g.boff[q] + c] = src[sbase + c * slen + r];
                     }
                 }
             }
-        });
-}
-
-/// Split the values of `ac` into those of consecutive groups of block rows.
-fn agg_chunks_mut<'a>(
-    ac_row_ptr: &[usize],
-    off: &[usize],
-    val: &'a mut [f64],
-) -> Vec<(usize, &'a mut [f64])> {
-    let nagg = off.len() - 1;
-    let mut out = Vec::with_capacity(nagg.div_ceil(AGGS_PER_TASK));
-    let mut rest = val;
-    let mut a = 0;
-    while a < nagg {
-        let e = (a + AGGS_PER_TASK).min(nagg);
-        let len = ac_row_ptr[off[e]] - ac_row_ptr[off[a]];
-        let (head, tail) = rest.split_at_mut(len);
-        out.push((a, head));
-        rest = tail;
-        a = e;
-    }
-    out
+        }
+    });
 }
 
 #[cfg(test)]
