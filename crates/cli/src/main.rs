@@ -41,6 +41,7 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    porofrac_sim::heap::retain_freed_memory();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Check { scene } => check::load(&scene)

@@ -13,7 +13,9 @@
 //! each (the peer's "best of" rule); `AMG_OPTS=theta=0.02,degree=3` overrides multigrid options (`theta`, `degree`,
 //! `upper`, `ratio`, `lanczos`, `omega`, `coarse`, `aggressive`: see `porofrac_amg::AmgOptions`);
 //! `AMG_PRECISION=double` stores the hierarchy's finest matrix in double instead of single
-//! precision (`AmgSolver::set_precision`).
+//! precision (`AmgSolver::set_precision`);
+//! `SYSTEM_HEAP=1` leaves glibc's heap policy as it is instead of keeping freed memory
+//! ([`porofrac_sim::heap`]).
 //!
 //! Grids: E2 = n × n squares split in two triangles, E3 = n³ cubes split in six
 //! tetrahedra (P1 = VEM on simplices), E = 1, ν = 0.3 (plane strain in 2D), Dirichlet on
@@ -199,6 +201,9 @@ fn run<const D: usize>(n: usize, solver: &str, tol: f64, problem: &Manufactured<
 }
 
 fn main() {
+    if std::env::var_os("SYSTEM_HEAP").is_none() {
+        porofrac_sim::heap::retain_freed_memory();
+    }
     let args: Vec<String> = std::env::args().skip(1).collect();
     if args.len() < 3 {
         eprintln!("usage: solvers e2|e3 n cholesky|cg-amg|none [tolerance]");

@@ -45,6 +45,7 @@ pub mod error;
 pub mod explicit;
 pub mod field;
 pub mod fracturing;
+pub mod heap;
 pub mod laws;
 pub mod linear;
 pub mod ordering;
