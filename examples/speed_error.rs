@@ -24,7 +24,9 @@
 //!   residual, though not the same quantity).
 //! * The time plotted is assembly + solve. Like the peer script (`common.best_of`), a
 //!   point is repeated (up to 3 passes) while one pass is cheap (below 20 s, and all
-//!   passes below 60 s), and each of the two times is the minimum over the passes.
+//!   passes below 60 s), and each of the two times is the minimum over the passes. The
+//!   process keeps freed memory, as the `porofrac` command does
+//!   ([`porofrac::sim::heap`]).
 //! * **L2 error** `‖u − u_h‖_L2`: the piecewise-linear reconstruction of the nodal field on
 //!   the face-facet / vertex-average sub-simplices of each cell (on simplices the P1 field
 //!   itself), degree-5 quadrature (`tests/common`, shared with `tests/convergence.rs`).
@@ -694,6 +696,7 @@ fn load_average() -> String {
 }
 
 fn main() -> Result<(), BoxError> {
+    porofrac::sim::heap::retain_freed_memory();
     let args = parse_args()?;
     let mut rows: Vec<Row> = Vec::new();
     if args.plot_only {
