@@ -12,11 +12,11 @@
 //!
 //! [`retain_freed_memory`] turns both off for the calling process: blocks come from the
 //! heap, and freed memory stays with the process for the next allocation instead of being
-//! trimmed. The peak resident size of one E2 n = 1000 run stayed at 1.57–1.60 GB; the
+//! trimmed. The peak resident size of one E2 n = 1000 run stayed at 1.56–1.60 GB; the
 //! resident size after a peak stays at the peak until the process ends, and repeated
 //! solves in one process can hold somewhat more than the largest live set (three E2 runs:
-//! 1.70–1.83 GB), which suits a batch simulation. Call it first thing in `main`, before threads start. Elsewhere than
-//! Linux with glibc it does nothing.
+//! 1.70–1.89 GB), which suits a batch simulation. Call it first thing in `main`, before
+//! threads start. Elsewhere than Linux with glibc it does nothing.
 
 /// Keep freed heap memory in the process (see the module docs). Returns whether the
 /// policy was applied (Linux with glibc).
