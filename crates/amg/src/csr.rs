@@ -326,7 +326,7 @@ impl CsrMatrix {
     #[inline(always)]
     fn for_each_in_row_of<T: Value>(&self, val: &[T], i: usize, mut f: impl FnMut(u32, f64)) {
         let (p0, p1) = (self.row_ptr[i], self.row_ptr[i + 1]);
-        prefetch(val, p0 + PREFETCH_AHEAD);
+        prefetch_ahead(val, p0);
         match &self.runs {
             Some(r) => {
                 let g = r.row_group[i] as usize;
@@ -640,7 +640,7 @@ fn group_dot<const M: usize, T: Value>(
 ) {
     let base = a.row_ptr[i0];
     let len = a.row_ptr[i0 + 1] - base;
-    prefetch(val, base + PREFETCH_AHEAD);
+    prefetch_ahead(val, base);
     let vals: [&[T]; M] = std::array::from_fn(|q| &val[base + q * len..base + (q + 1) * len]);
     let mut acc = [[0.0f64; 2]; M];
     let mut p = 0;
@@ -667,24 +667,24 @@ fn group_dot<const M: usize, T: Value>(
     }
 }
 
-/// Values ahead of the current row that the row kernels ([`group_dot`],
-/// [`CsrMatrix::for_each_in_row`]) ask the cache for: 2 kB of `f32`.
-const PREFETCH_AHEAD: usize = 512;
+/// How far ahead of the current position the row kernels ask the cache for values.
+const PREFETCH_BYTES: usize = 2048;
 
-/// Hint the cache to load the line holding `v[at]`; nothing when `at` is past the end or
-/// off x86-64.
+/// Hint the cache to load the line [`PREFETCH_BYTES`] after `v[at]`; nothing when that is
+/// past the end or off x86-64.
 ///
-/// The row kernels read the values in order, but do enough work per value (conversion,
-/// column runs, two rows at once) that the hardware prefetcher alone leaves a thread
-/// waiting on memory: at E2 n = 1000 the single-precision product ran at 15 GB/s on two
-/// threads where a plain streaming sum reads 25 GB/s. Asking for the line 2 kB ahead,
-/// once per row group, took the product from 9.7–10.0 ms to 8.1–8.3 ms and the strength
-/// pass from 0.13–0.16 s to 0.10–0.11 s (docs/BENCHMARKS.md).
+/// The row kernels ([`group_dot`], [`CsrMatrix::for_each_in_row`], the upper-triangle
+/// product of [`crate::upper`]) read the values in order, but do enough work per value
+/// (conversion, column runs, two rows at once) that the hardware prefetcher alone leaves
+/// a thread waiting on memory: at E2 n = 1000 the single-precision product took 18.4 ms
+/// on one thread and 9.7–10.0 ms on two. Asking for the line 2 kB ahead, once per row
+/// group, took it to 8.1–8.3 ms, the upper-triangle product from 12.5–13.0 to 12.2 ms and
+/// the strength pass from 0.13–0.16 s to 0.10–0.11 s (docs/BENCHMARKS.md).
 #[inline(always)]
 #[allow(unsafe_code)]
-pub(crate) fn prefetch<T>(v: &[T], at: usize) {
+pub(crate) fn prefetch_ahead<T>(v: &[T], at: usize) {
     #[cfg(target_arch = "x86_64")]
-    if let Some(p) = v.get(at) {
+    if let Some(p) = v.get(at + PREFETCH_BYTES / std::mem::size_of::<T>().max(1)) {
         // SAFETY: `_mm_prefetch` (SSE, part of the x86-64 baseline) only hints the cache;
         // it never faults and its load is not visible to the program. The address is that
         // of an element of `v`.

@@ -30,11 +30,7 @@
 
 use rayon::prelude::*;
 
-use crate::csr::{CsrMatrix, prefetch};
-
-/// Values ahead of the current rows that [`Part::group`] asks the cache for (2 kB; see
-/// [`crate::csr::prefetch`]): the product went from 12.5–13.0 to 12.2 ms at E2 n = 1000.
-const UPPER_PREFETCH_AHEAD: usize = 256;
+use crate::csr::{CsrMatrix, prefetch_ahead};
 
 /// Rows per part at least.
 const MIN_PART: usize = 4096;
@@ -165,7 +161,7 @@ impl Part<'_> {
         x: &[f64],
         i: usize,
     ) {
-        prefetch(upper, col_ptr[i] + UPPER_PREFETCH_AHEAD);
+        prefetch_ahead(upper, col_ptr[i]);
         let vals: [&[f64]; M] = std::array::from_fn(|r| &upper[col_ptr[i + r]..col_ptr[i + r + 1]]);
         let xr: [f64; M] = std::array::from_fn(|r| x[i + r]);
         let mut acc = [0.0; M];
