@@ -542,6 +542,28 @@ impl CsrMatrix {
             });
     }
 
+    /// `Σ_i f(i, (A x)_i, &mut y[i])` over every row, in parallel blocks of rows: a
+    /// product and a reduction in one pass. The block sums are added in block order, so
+    /// the result does not depend on the number of threads.
+    pub(crate) fn par_products_sum<F>(&self, x: &[f64], y: &mut [f64], f: F) -> f64
+    where
+        F: Fn(usize, f64, &mut f64) -> f64 + Sync + Send,
+    {
+        let parts: Vec<f64> = y
+            .par_chunks_mut(ROWS_PER_TASK)
+            .enumerate()
+            .map(|(b, ys)| {
+                let base = b * ROWS_PER_TASK;
+                let mut sum = 0.0;
+                self.rows_times(base..base + ys.len(), x, |i, ax| {
+                    sum += f(i, ax, &mut ys[i - base]);
+                });
+                sum
+            })
+            .collect();
+        parts.iter().sum()
+    }
+
     /// `f(i, (A x)_i, &mut y[i], &mut z[i])` for every row, in parallel blocks.
     pub(crate) fn par_products2<F>(&self, x: &[f64], y: &mut [f64], z: &mut [f64], f: F)
     where
@@ -712,6 +734,27 @@ where
                 f(base + k, yi);
             }
         });
+}
+
+/// `Σ_i f(i, &mut y[i])` over every row, in parallel blocks of rows; the block sums are
+/// added in block order (independent of the number of threads).
+pub(crate) fn par_rows_sum<F>(y: &mut [f64], f: F) -> f64
+where
+    F: Fn(usize, &mut f64) -> f64 + Sync + Send,
+{
+    let parts: Vec<f64> = y
+        .par_chunks_mut(ROWS_PER_TASK)
+        .enumerate()
+        .map(|(b, ys)| {
+            let base = b * ROWS_PER_TASK;
+            let mut sum = 0.0;
+            for (k, yi) in ys.iter_mut().enumerate() {
+                sum += f(base + k, yi);
+            }
+            sum
+        })
+        .collect();
+    parts.iter().sum()
 }
 
 /// A symmetric matrix given by its upper triangle in compressed sparse column form,
@@ -1096,21 +1139,26 @@ pub(crate) fn norm(a: &[f64]) -> f64 {
     dot(a, a).sqrt()
 }
 
-/// Run `f(i, &mut a[i], &mut b[i])` in parallel blocks.
-#[inline]
-pub(crate) fn par_zip2<F>(a: &mut [f64], b: &mut [f64], f: F)
+/// `Σ_i f(i, &mut a[i], &mut b[i])` in parallel blocks; the block sums are added in block
+/// order (independent of the number of threads).
+pub(crate) fn par_zip2_sum<F>(a: &mut [f64], b: &mut [f64], f: F) -> f64
 where
-    F: Fn(usize, &mut f64, &mut f64) + Sync + Send,
+    F: Fn(usize, &mut f64, &mut f64) -> f64 + Sync + Send,
 {
-    a.par_chunks_mut(ROWS_PER_TASK)
+    let parts: Vec<f64> = a
+        .par_chunks_mut(ROWS_PER_TASK)
         .zip(b.par_chunks_mut(ROWS_PER_TASK))
         .enumerate()
-        .for_each(|(blk, (xa, xb))| {
+        .map(|(blk, (xa, xb))| {
             let base = blk * ROWS_PER_TASK;
+            let mut sum = 0.0;
             for (k, (ai, bi)) in xa.iter_mut().zip(xb.iter_mut()).enumerate() {
-                f(base + k, ai, bi);
+                sum += f(base + k, ai, bi);
             }
-        });
+            sum
+        })
+        .collect();
+    parts.iter().sum()
 }
 
 #[cfg(test)]

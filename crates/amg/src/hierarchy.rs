@@ -555,11 +555,15 @@ impl Amg {
     }
 
     /// `y = A x` with the finest matrix as stored (`upper = None`) or with the caller's
-    /// double-precision upper triangle `upper` on the finest pattern.
-    pub(crate) fn fine_product(&mut self, upper: Option<&[f64]>, x: &[f64], y: &mut [f64]) {
+    /// double-precision upper triangle `upper` on the finest pattern; returns `xᵀ y`
+    /// (summed in the same pass).
+    pub(crate) fn fine_product(&mut self, upper: Option<&[f64]>, x: &[f64], y: &mut [f64]) -> f64 {
         let a = &self.levels[0].a;
         match upper {
-            None => a.spmv(x, y),
+            None => a.par_products_sum(x, y, |i, ax, yi| {
+                *yi = ax;
+                ax * x[i]
+            }),
             Some(values) => self
                 .upper
                 .get_or_insert_with(|| UpperProduct::new(a, &self.fine_col_ptr))

@@ -21,7 +21,7 @@
 //! the tolerance) is [`AmgError::Stagnation`], and the iteration limit is
 //! [`AmgError::NoConvergence`] with the residual reached.
 
-use crate::csr::{Precision, check_upper_values, dot, norm, par_rows, par_zip2};
+use crate::csr::{Precision, check_upper_values, dot, norm, par_rows, par_zip2_sum};
 use crate::error::{AmgError, Result, check_finite};
 use crate::hierarchy::Amg;
 
@@ -148,8 +148,7 @@ impl Amg {
         let mut since_best = 0;
         let mut restarts = 0;
         for it in 1..=max_iter {
-            self.fine_product(upper, p, q);
-            let pq = dot(p, q);
+            let pq = self.fine_product(upper, p, q);
             if pq.is_nan() || pq <= 0.0 {
                 return Err(AmgError::Breakdown {
                     iteration: it,
@@ -157,14 +156,15 @@ impl Amg {
                 });
             }
             let alpha = rz / pq;
-            {
+            let rn = {
                 let (pp, qq): (&[f64], &[f64]) = (p, q);
-                par_zip2(x, r, |i, xi, ri| {
+                par_zip2_sum(x, r, |i, xi, ri| {
                     *xi += alpha * pp[i];
                     *ri -= alpha * qq[i];
-                });
+                    *ri * *ri
+                })
             }
-            let rn = norm(r);
+            .sqrt();
             if !rn.is_finite() {
                 return Err(AmgError::Breakdown {
                     iteration: it,
@@ -231,7 +231,7 @@ impl Amg {
 
     /// `r = b − A x` with the operator of [`Self::fine_product`].
     fn fine_residual(&mut self, upper: Option<&[f64]>, b: &[f64], x: &[f64], r: &mut [f64]) {
-        self.fine_product(upper, x, r);
+        let _ = self.fine_product(upper, x, r);
         par_rows(r, |i, ri| *ri = b[i] - *ri);
     }
 

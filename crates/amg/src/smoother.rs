@@ -38,7 +38,7 @@
 
 use nalgebra::DMatrix;
 
-use crate::csr::{CsrMatrix, dot, norm, par_rows, zeros};
+use crate::csr::{CsrMatrix, par_rows, par_rows_sum, zeros};
 
 /// A pseudo-random number in `[-0.5, 0.5)` from an index (splitmix64).
 fn hash_unit(i: usize) -> f64 {
@@ -61,6 +61,13 @@ fn gershgorin(a: &CsrMatrix, s: &[f64]) -> f64 {
 }
 
 /// Estimate `ρ(D⁻¹A)` by `steps` Lanczos steps (capped by Gershgorin's bound).
+///
+/// Lanczos on the symmetric `S A S` (`S = D^{-1/2}`) with vectors `v = S⁻¹ q` is Lanczos on
+/// `D⁻¹A` in the `D` inner product `⟨x, y⟩_D = Σ a_ii x_i y_i`, which needs no `S` in the
+/// loop: `w = D⁻¹A q_j − β_j q_{j−1}`, `α_j = ⟨w, q_j⟩_D`, `w ← w − α_j q_j`,
+/// `β_{j+1} = ‖w‖_D`, `q_{j+1} = w / β_{j+1}`. Each step is two passes: the product with
+/// `α_j` summed alongside, and the update with `‖w‖_D²` summed alongside. The division by
+/// `β` is folded into the next step as a scale of the stored vector.
 pub(crate) fn spectral_radius(a: &CsrMatrix, dinv: &[f64], steps: usize) -> f64 {
     let n = a.nrows();
     let s: Vec<f64> = dinv.iter().map(|d| d.sqrt()).collect();
@@ -68,29 +75,38 @@ pub(crate) fn spectral_radius(a: &CsrMatrix, dinv: &[f64], steps: usize) -> f64 
     if n <= 1 {
         return bound;
     }
-    let mut v: Vec<f64> = (0..n).map(hash_unit).collect();
-    let nv = norm(&v);
-    v.iter_mut().for_each(|x| *x /= nv);
-    let mut v_prev = zeros(n);
-    let mut u = zeros(n);
+    // q₀ = S v₀ with v₀ a unit random vector (‖q₀‖_D = ‖v₀‖).
+    let mut q: Vec<f64> = (0..n).map(|i| s[i] * hash_unit(i)).collect();
+    drop(s);
+    let mut q_scale = 1.0 / (0..n).map(|i| hash_unit(i).powi(2)).sum::<f64>().sqrt();
+    let mut q_prev = zeros(n);
+    let mut prev_scale = 0.0;
     let mut w = zeros(n);
     let mut alpha = Vec::with_capacity(steps);
     let mut beta: Vec<f64> = Vec::with_capacity(steps);
     for j in 0..steps.min(n) {
-        // w = S v − β_j v_prev.
-        par_rows(&mut u, |i, ui| *ui = s[i] * v[i]);
         let bj = if j > 0 { beta[j - 1] } else { 0.0 };
-        a.par_products(&u, &mut w, |i, au, wi| *wi = s[i] * au - bj * v_prev[i]);
-        let aj = dot(&w, &v);
+        let (qs, ps) = (q_scale, bj * prev_scale);
+        let (qq, qp): (&[f64], &[f64]) = (&q, &q_prev);
+        let aj = a.par_products_sum(qq, &mut w, |i, aq, wi| {
+            *wi = dinv[i] * aq * qs - ps * qp[i];
+            *wi * qq[i] * qs / dinv[i]
+        });
         alpha.push(aj);
-        par_rows(&mut w, |i, wi| *wi -= aj * v[i]);
-        let bn = norm(&w);
+        let bn = par_rows_sum(&mut w, |i, wi| {
+            *wi -= aj * qs * qq[i];
+            *wi * *wi / dinv[i]
+        })
+        .sqrt();
         if bn.is_nan() || bn <= 1e-12 * aj.abs() || j + 1 == steps.min(n) {
             break;
         }
         beta.push(bn);
-        std::mem::swap(&mut v_prev, &mut v);
-        par_rows(&mut v, |i, vi| *vi = w[i] / bn);
+        // q_{j−1} ← q_j, q_j ← w / β (stored unscaled), w ← the old q_{j−1}'s storage.
+        std::mem::swap(&mut q_prev, &mut q);
+        std::mem::swap(&mut q, &mut w);
+        prev_scale = q_scale;
+        q_scale = 1.0 / bn;
     }
     let k = alpha.len();
     let t = DMatrix::<f64>::from_fn(k, k, |i, j| {

@@ -74,7 +74,12 @@ impl UpperProduct {
     }
 
     /// `y = A x` for the symmetric `A` with upper triangle `upper` (values in the layout of
-    /// `col_ptr`) on the pattern `full` (see the module docs).
+    /// `col_ptr`) on the pattern `full` (see the module docs); returns `xᵀ A x`.
+    ///
+    /// `xᵀ A x` comes from the gathers alone: with `g_i = Σ_{r ≤ i} u_ri x_r` (the sum
+    /// along column `i`, diagonal included), `xᵀ A x = Σ_i x_i (2 g_i − u_ii x_i)`. Each
+    /// part sums its rows; the part sums are added in part order, so the result does not
+    /// depend on the number of threads either.
     pub(crate) fn apply(
         &self,
         full: &CsrMatrix,
@@ -82,11 +87,12 @@ impl UpperProduct {
         upper: &[f64],
         x: &[f64],
         y: &mut [f64],
-    ) {
+    ) -> f64 {
         let n = full.nrows();
         let part = self.part.max(1);
         let parts = n.div_ceil(part);
         y.par_chunks_mut(part).for_each(|c| c.fill(0.0));
+        let mut energy = vec![0.0; parts];
         for phase in 0..2 {
             // Part `k` writes rows `(k − 1)·part..(k + 1)·part`.
             let mut jobs = Vec::with_capacity(parts / 2 + 1);
@@ -96,30 +102,45 @@ impl UpperProduct {
                 let end = ((k + 1) * part).min(n);
                 let (_, tail) = rest.split_at_mut(base - at);
                 let (mine, tail) = tail.split_at_mut(end - base);
-                jobs.push((k * part..end, Part { base, y: mine }));
+                jobs.push((
+                    k * part..end,
+                    Part {
+                        base,
+                        y: mine,
+                        energy: 0.0,
+                    },
+                ));
                 (rest, at) = (tail, end);
             }
-            jobs.into_par_iter().for_each(|(rows, mut p)| {
-                let mut i = rows.start;
-                while i < rows.end {
-                    let Some(g) = full.row_group(i) else {
-                        p.row(full, col_ptr, upper, x, i);
-                        i += 1;
-                        continue;
-                    };
-                    let mut m = 1;
-                    while i + m < rows.end && m < 3 && full.row_group(i + m) == Some(g) {
-                        m += 1;
+            let sums: Vec<f64> = jobs
+                .into_par_iter()
+                .map(|(rows, mut p)| {
+                    let mut i = rows.start;
+                    while i < rows.end {
+                        let Some(g) = full.row_group(i) else {
+                            p.row(full, col_ptr, upper, x, i);
+                            i += 1;
+                            continue;
+                        };
+                        let mut m = 1;
+                        while i + m < rows.end && m < 3 && full.row_group(i + m) == Some(g) {
+                            m += 1;
+                        }
+                        match m {
+                            1 => p.group::<1>(full, col_ptr, upper, x, i),
+                            2 => p.group::<2>(full, col_ptr, upper, x, i),
+                            _ => p.group::<3>(full, col_ptr, upper, x, i),
+                        }
+                        i += m;
                     }
-                    match m {
-                        1 => p.group::<1>(full, col_ptr, upper, x, i),
-                        2 => p.group::<2>(full, col_ptr, upper, x, i),
-                        _ => p.group::<3>(full, col_ptr, upper, x, i),
-                    }
-                    i += m;
-                }
-            });
+                    p.energy
+                })
+                .collect();
+            for (k, e) in (phase..parts).step_by(2).zip(sums) {
+                energy[k] = e;
+            }
         }
+        energy.iter().sum()
     }
 }
 
@@ -127,6 +148,8 @@ impl UpperProduct {
 struct Part<'a> {
     base: usize,
     y: &'a mut [f64],
+    /// `Σ x_i (2 g_i − u_ii x_i)` over the part's rows so far.
+    energy: f64,
 }
 
 impl Part<'_> {
@@ -135,6 +158,7 @@ impl Part<'_> {
         let vals = &upper[col_ptr[i]..col_ptr[i + 1]];
         let xi = x[i];
         let mut acc = 0.0;
+        let mut diag = 0.0;
         let mut q = 0;
         full.for_each_col_prefix(i, vals.len(), |c| {
             let c = c as usize;
@@ -143,9 +167,12 @@ impl Part<'_> {
             q += 1;
             if c < i {
                 self.y[c - self.base] += v * xi;
+            } else if c == i {
+                diag = v;
             }
         });
         self.y[i - self.base] += acc;
+        self.energy += xi * (2.0 * acc - diag * xi);
     }
 
     /// Gather and scatter of the `M` rows `i..i + M` of one group (same runs of columns).
@@ -194,6 +221,7 @@ impl Part<'_> {
         }
         for r in 0..M {
             let row = i + r;
+            let mut diag = 0.0;
             for (t, &c) in tail[..ntail].iter().enumerate() {
                 let Some(&v) = vals[r].get(q + t) else {
                     break;
@@ -201,9 +229,12 @@ impl Part<'_> {
                 acc[r] += v * x[c];
                 if c < row {
                     self.y[c - self.base] += v * xr[r];
+                } else if c == row {
+                    diag = v;
                 }
             }
             self.y[row - self.base] += acc[r];
+            self.energy += xr[r] * (2.0 * acc[r] - diag * xr[r]);
         }
     }
 }
@@ -295,7 +326,12 @@ mod tests {
         a.mul(&x, &mut want).unwrap();
         let up = UpperProduct::new(a.matrix(), &col_ptr);
         let mut y = vec![f64::NAN; n];
-        up.apply(a.matrix(), &col_ptr, &vals, &x, &mut y);
+        let energy = up.apply(a.matrix(), &col_ptr, &vals, &x, &mut y);
+        let want_energy: f64 = x.iter().zip(&want).map(|(a, b)| a * b).sum();
+        assert!(
+            (energy - want_energy).abs() <= 1e-12 * want_energy.abs(),
+            "xᵀAx {energy} vs {want_energy}"
+        );
         for i in 0..n {
             assert!(
                 (y[i] - want[i]).abs() <= 1e-13 * want[i].abs().max(1.0),
@@ -310,8 +346,9 @@ mod tests {
             .num_threads(1)
             .build()
             .unwrap();
-        pool.install(|| up.apply(a.matrix(), &col_ptr, &vals, &x, &mut y2));
+        let energy2 = pool.install(|| up.apply(a.matrix(), &col_ptr, &vals, &x, &mut y2));
         assert!(y.iter().zip(&y2).all(|(a, b)| a.to_bits() == b.to_bits()));
+        assert_eq!(energy.to_bits(), energy2.to_bits());
         up
     }
 

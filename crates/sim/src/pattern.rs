@@ -304,36 +304,35 @@ impl Pattern {
         let mut scatter = vec![0u32; scatter_pos[nc]];
         fill_blocks(&mut scatter, &scatter_pos, |cells, out| {
             let mut eqs = Vec::new();
+            // The cell's free equations with their local dofs, increasing.
+            let mut sorted: Vec<(usize, usize)> = Vec::new();
             let mut k = 0;
             for c in cells {
                 cell_equations(grid, dofs, c, &mut eqs);
-                for (j, &ej) in eqs.iter().enumerate() {
-                    // The last entry found and its (row, column): the next component of a
-                    // node usually sits right after it in the same column. (It never
-                    // runs into the next column: a column ends with its diagonal.)
-                    let mut last: Option<(usize, usize, usize)> = None;
-                    for (i, &ei) in eqs[..=j].iter().enumerate() {
-                        if ei != usize::MAX && ej != usize::MAX {
-                            let (r, col) = (ei.min(ej), ei.max(ej));
-                            let pos = if let Some((lr, lc, p)) = last
-                                && lc == col
-                                && r == lr + 1
-                                && row_idx[p + 1] == r
-                            {
-                                p + 1
-                            } else {
-                                let rows = &row_idx[col_ptr[col]..col_ptr[col + 1]];
-                                // Invariant: (r, col) was inserted above since both are
-                                // in cell c.
-                                col_ptr[col] + rows.binary_search(&r).unwrap_or(0)
-                            };
-                            last = Some((r, col, pos));
-                            let twice = if i != j && ei == ej { TWICE } else { 0 };
-                            out[k] = pos as u32 | twice;
-                        } else {
-                            out[k] = NONE;
+                let m = eqs.len();
+                let map = &mut out[k..k + m * (m + 1) / 2];
+                k += map.len();
+                map.fill(NONE);
+                sorted.clear();
+                sorted.extend(
+                    eqs.iter()
+                        .enumerate()
+                        .filter(|&(_, &e)| e != usize::MAX)
+                        .map(|(i, &e)| (e, i)),
+                );
+                sorted.sort_unstable();
+                // Column `e_j` holds the rows `e_i ≤ e_j` of the cell in increasing order,
+                // so one forward walk down the column finds them all.
+                for (jj, &(col, j)) in sorted.iter().enumerate() {
+                    let mut p = col_ptr[col];
+                    for &(r, i) in &sorted[..=jj] {
+                        // Invariant: (r, col) was inserted above since both are in cell c,
+                        // and the column ends with its diagonal.
+                        while row_idx[p] < r {
+                            p += 1;
                         }
-                        k += 1;
+                        let twice = if i != j && r == col { TWICE } else { 0 };
+                        map[upper_pair(i.min(j), i.max(j))] = p as u32 | twice;
                     }
                 }
             }
