@@ -347,6 +347,59 @@ impl CsrMatrix {
         }
     }
 
+    /// `f(column, [a_{i0+q, column}; M])` over the entries of the `M` rows `i0..i0 + M`,
+    /// which must be rows of one group ([`Self::row_group`]): they share their columns,
+    /// which are read once for all of them.
+    #[inline]
+    pub(crate) fn for_each_in_group<const M: usize>(
+        &self,
+        i0: usize,
+        f: impl FnMut(u32, [f64; M]),
+    ) {
+        with_values!(&self.val, v => self.for_each_in_group_of::<M, _>(v, i0, f))
+    }
+
+    #[inline(always)]
+    fn for_each_in_group_of<const M: usize, T: Value>(
+        &self,
+        val: &[T],
+        i0: usize,
+        mut f: impl FnMut(u32, [f64; M]),
+    ) {
+        let Some(r) = &self.runs else {
+            debug_assert!(false, "for_each_in_group on a matrix without row groups");
+            return;
+        };
+        let base = self.row_ptr[i0];
+        let len = self.row_ptr[i0 + 1] - base;
+        prefetch_ahead(val, base);
+        let rows: [&[T]; M] = std::array::from_fn(|q| &val[base + q * len..base + (q + 1) * len]);
+        let g = r.row_group[i0] as usize;
+        let mut p = 0;
+        for k in r.ptr[g]..r.ptr[g + 1] {
+            let c = r.start[k];
+            for t in 0..r.len[k] as usize {
+                f(c + t as u32, std::array::from_fn(|q| rows[q][p + t].get()));
+            }
+            p += r.len[k] as usize;
+        }
+    }
+
+    /// Number of rows from `i` on (at most `max`, all before `end`) in the group of row
+    /// `i`; 1 for a matrix with column indices.
+    #[inline]
+    pub(crate) fn group_run(&self, i: usize, end: usize, max: usize) -> usize {
+        let Some(r) = &self.runs else {
+            return 1;
+        };
+        let g = r.row_group[i];
+        let mut m = 1;
+        while m < max && i + m < end && r.row_group[i + m] == g {
+            m += 1;
+        }
+        m
+    }
+
     /// For a matrix stored as runs: the group of row `i` (`None` for a matrix with column
     /// indices).
     #[inline]

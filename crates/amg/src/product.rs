@@ -478,6 +478,53 @@ fn w_row(
     }
 }
 
+/// [`w_row`] for the `M` rows `i0..i0 + M` of one group of `A` (same columns, hence the
+/// same blocks of `P` and of `W`): the index work is done once for all of them. The
+/// values of block `b` are appended row after row (`M · k_b` of them); each row's values
+/// are summed in the same order as by [`w_row`], so the results are the same bits.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn w_rows<const M: usize>(
+    a: &CsrMatrix,
+    p: &Blocked,
+    off: &[usize],
+    i0: usize,
+    lo: usize,
+    slot: &mut [u32],
+    aggs: &mut Vec<u32>,
+    vals: &mut Vec<f64>,
+) {
+    let pv = p.values();
+    aggs.clear();
+    vals.clear();
+    a.for_each_in_group::<M>(i0, |j, aij| {
+        let (pb, pp) = p.blocks(j as usize);
+        for (&b, &s) in pb.iter().zip(pp) {
+            let (bu, s) = (b as usize, s as usize);
+            if bu < lo {
+                continue;
+            }
+            let k = off[bu + 1] - off[bu];
+            let pjb = &pv[s..s + k];
+            if slot[bu] == u32::MAX {
+                slot[bu] = vals.len() as u32;
+                aggs.push(b);
+                for aq in aij {
+                    vals.extend(pjb.iter().map(|&v| aq * f64::from(v)));
+                }
+            } else {
+                let d = slot[bu] as usize;
+                for (q, aq) in aij.into_iter().enumerate() {
+                    axpy(&mut vals[d + q * k..d + (q + 1) * k], aq, pjb);
+                }
+            }
+        }
+    });
+    for &b in aggs.iter() {
+        slot[b as usize] = u32::MAX;
+    }
+}
+
 /// The pattern of `A_c = Pᵀ A P` (block rows of the coarse aggregates), the parts of the
 /// numeric product, and `A_c` with zero values.
 pub(crate) fn symbolic_galerkin(
@@ -616,6 +663,88 @@ pub(crate) fn symbolic_galerkin(
     )
 }
 
+/// The data a part of [`numeric_galerkin`] works on.
+struct GalerkinRows<'a> {
+    a: &'a CsrMatrix,
+    p: &'a Blocked,
+    off: &'a [usize],
+    g: &'a Galerkin,
+    row_ptr: &'a [usize],
+    /// The part's aggregates.
+    lo: usize,
+    hi: usize,
+    /// Position in `A_c`'s values of the part's first value.
+    base: usize,
+}
+
+impl GalerkinRows<'_> {
+    /// Add `p_{i,a} w_{i,b}ᵀ` (`b ≥ a`, `a` in the part) for the `M` rows `i0..i0 + M` of
+    /// one group of `A` to the part's values `vals`. The rows have the same blocks in `P`
+    /// and `W`; the block lookups are done once for all of them, and every entry still
+    /// receives the rows' terms in increasing row order.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn add<const M: usize>(
+        &self,
+        i0: usize,
+        slot: &mut [u32],
+        pos: &mut [usize],
+        waggs: &mut Vec<u32>,
+        wvals: &mut Vec<f64>,
+        vals: &mut [f64],
+    ) {
+        let Self {
+            a,
+            p,
+            off,
+            g,
+            row_ptr,
+            lo,
+            hi,
+            base,
+        } = *self;
+        let width = |b: usize| off[b + 1] - off[b];
+        let pv = p.values();
+        if M == 1 {
+            w_row(a, p, off, i0, lo, slot, waggs, wvals);
+        } else {
+            w_rows::<M>(a, p, off, i0, lo, slot, waggs, wvals);
+        }
+        let blocks: [(&[u32], &[u32]); M] = std::array::from_fn(|q| p.blocks(i0 + q));
+        for (bi, &ag) in blocks[0].0.iter().enumerate() {
+            let ag = ag as usize;
+            if ag < lo || ag >= hi {
+                continue;
+            }
+            let ka = width(ag);
+            let start = row_ptr[off[ag]] - base;
+            let len = row_ptr[off[ag] + 1] - row_ptr[off[ag]];
+            for q in g.bptr[ag]..g.bptr[ag + 1] {
+                pos[g.bagg[q] as usize] = g.boff[q];
+            }
+            let block_row = &mut vals[start..start + ka * len];
+            for (q, (_, bp)) in blocks.iter().enumerate() {
+                let s = bp[bi] as usize;
+                let pia = &pv[s..s + ka];
+                let mut t = 0;
+                for &b in waggs.iter() {
+                    let b = b as usize;
+                    let kb = width(b);
+                    if b >= ag {
+                        let wib = &wvals[t + q * kb..t + (q + 1) * kb];
+                        let co = pos[b];
+                        for (r, &x) in pia.iter().enumerate() {
+                            let d = r * len + co;
+                            axpy(&mut block_row[d..d + kb], f64::from(x), wib);
+                        }
+                    }
+                    t += M * kb;
+                }
+            }
+        }
+    }
+}
+
 /// Fill `ac` (from [`symbolic_galerkin`]) with `Pᵀ A P`, exactly symmetric, without
 /// storing `A P`: every part computes the rows `w_i = (A P)_i` of its fine rows (the
 /// aggregates `≥` its first one) and adds `p_{i,a} w_{i,b}ᵀ` to its block rows `a`, for
@@ -631,7 +760,6 @@ pub(crate) fn numeric_galerkin(
     let nagg = off.len() - 1;
     let width = |b: usize| off[b + 1] - off[b];
     let row_ptr = ac.row_ptr().to_vec();
-    let pv = p.values();
     // Pass 1: blocks (a, b ≥ a); diagonal blocks symmetrized.
     let parts = split_by_items(ac.values_mut(), &g.part_aggs, |a| row_ptr[off[a]]);
     parts.into_par_iter().enumerate().for_each_init(
@@ -647,38 +775,31 @@ pub(crate) fn numeric_galerkin(
             let (lo, hi) = (g.part_aggs[k], g.part_aggs[k + 1]);
             let base = row_ptr[off[lo]];
             vals.fill(0.0);
-            for &i in &g.rows[g.rptr[k]..g.rptr[k + 1]] {
-                let i = i as usize;
-                w_row(a, p, off, i, lo, slot, waggs, wvals);
-                let (pb, pp) = p.blocks(i);
-                for (&ag, &s) in pb.iter().zip(pp) {
-                    let (ag, s) = (ag as usize, s as usize);
-                    if ag < lo || ag >= hi {
-                        continue;
-                    }
-                    let ka = width(ag);
-                    let pia = &pv[s..s + ka];
-                    let start = row_ptr[off[ag]] - base;
-                    let len = row_ptr[off[ag] + 1] - row_ptr[off[ag]];
-                    for q in g.bptr[ag]..g.bptr[ag + 1] {
-                        pos[g.bagg[q] as usize] = g.boff[q];
-                    }
-                    let block_row = &mut vals[start..start + ka * len];
-                    let mut t = 0;
-                    for &b in waggs.iter() {
-                        let b = b as usize;
-                        let kb = width(b);
-                        if b >= ag {
-                            let wib = &wvals[t..t + kb];
-                            let co = pos[b];
-                            for (r, &x) in pia.iter().enumerate() {
-                                let d = r * len + co;
-                                axpy(&mut block_row[d..d + kb], f64::from(x), wib);
-                            }
-                        }
-                        t += kb;
-                    }
+            let rows = &g.rows[g.rptr[k]..g.rptr[k + 1]];
+            let mut t = 0;
+            while t < rows.len() {
+                let i = rows[t] as usize;
+                // Rows of one group of `A` (consecutive in the part's list) go together.
+                let mut m = a.group_run(i, a.nrows(), 3);
+                m = (1..m)
+                    .find(|&q| rows.get(t + q) != Some(&((i + q) as u32)))
+                    .unwrap_or(m);
+                let cx = GalerkinRows {
+                    a,
+                    p,
+                    off,
+                    g,
+                    row_ptr: &row_ptr,
+                    lo,
+                    hi,
+                    base,
+                };
+                match m {
+                    1 => cx.add::<1>(i, slot, pos, waggs, wvals, vals),
+                    2 => cx.add::<2>(i, slot, pos, waggs, wvals, vals),
+                    _ => cx.add::<3>(i, slot, pos, waggs, wvals, vals),
                 }
+                t += m;
             }
             for ag in lo..hi {
                 let ka = width(ag);
@@ -782,6 +903,63 @@ mod tests {
         (0..a[0].len())
             .map(|j| a.iter().map(|r| r[j]).collect())
             .collect()
+    }
+
+    #[test]
+    fn node_groups_give_the_same_bits() {
+        // Two equations per node on a chain of 12 nodes (each node coupled to its
+        // neighbours: rows of a node share six consecutive columns), aggregates of three
+        // nodes with three coarse equations each. The matrix stored as runs takes the
+        // grouped paths; the same matrix with column indices the row-by-row ones.
+        let (nodes, k) = (12, 2);
+        let n = nodes * k;
+        let mut a = vec![vec![0.0; n]; n];
+        for i in 0..n {
+            for j in 0..n {
+                let (ni, nj) = (i / k, j / k);
+                if ni.abs_diff(nj) <= 1 {
+                    a[i][j] = if i == j {
+                        6.0 + 0.1 * i as f64
+                    } else {
+                        -0.5 - 0.01 * ((i * 7 + j * 7) % 5) as f64
+                    };
+                }
+            }
+        }
+        let plain = from_dense(&a);
+        let mut grouped = from_dense(&a);
+        grouped.compress_runs();
+        assert!(grouped.row_group(0).is_some() && grouped.row_group(0) == grouped.row_group(1));
+        let nagg = nodes / 3;
+        let off: Vec<usize> = (0..=nagg).map(|b| 3 * b).collect();
+        let eq_agg: Vec<u32> = (0..n).map(|i| (i / (3 * k)) as u32).collect();
+        let bptr: Vec<usize> = (0..=n).collect();
+        let mut t = Blocked::from_blocks(n, &off, &bptr, eq_agg.clone()).unwrap();
+        for (q, v) in t.values_mut().iter_mut().enumerate() {
+            *v = ((q * 13 % 7) as f32 - 3.0) / 4.0;
+        }
+        let dinv: Vec<f64> = (0..n).map(|i| 1.0 / a[i][i]).collect();
+        let galerkin = |am: &CsrMatrix| {
+            let mut p = symbolic_prolongator(am, &eq_agg, &off).unwrap();
+            smooth_prolongator(am, &dinv, 0.5, &t, &off, &mut p);
+            let (g, mut ac) = symbolic_galerkin(am, &p, &off);
+            numeric_galerkin(&g, am, &p, &off, &mut ac);
+            (dense(&p.to_csr(&off)), dense(&ac))
+        };
+        let (pd, want_bits) = galerkin(&plain);
+        let (pg, got) = galerkin(&grouped);
+        assert_eq!(pd, pg);
+        let want = matmul(&transpose(&pd), &matmul(&a, &pd));
+        for i in 0..off[nagg] {
+            for j in 0..off[nagg] {
+                assert_eq!(
+                    got[i][j].to_bits(),
+                    want_bits[i][j].to_bits(),
+                    "Ac[{i}][{j}]"
+                );
+                assert!((got[i][j] - want[i][j]).abs() < 1e-13, "Ac[{i}][{j}]");
+            }
+        }
     }
 
     #[test]
