@@ -159,37 +159,54 @@ impl Spa {
     }
 }
 
+/// `f(j, Σ_q a_{i_q j}²)` over the columns `j` of the rows `i_q` of node `node`. When the
+/// node's equations are consecutive rows of one group of `a` (the common case), their
+/// shared columns are read once for all of them ([`CsrMatrix::for_each_in_group`]).
+#[inline]
+fn node_columns(a: &CsrMatrix, blocks: &Blocks, node: usize, mut f: impl FnMut(u32, f64)) {
+    let eqs = blocks.node(node);
+    let m = eqs.len();
+    let i0 = eqs.first().map_or(0, |&e| e as usize);
+    let consecutive = eqs.iter().enumerate().all(|(q, &e)| e as usize == i0 + q);
+    if (2..=3).contains(&m) && consecutive && a.group_run(i0, a.nrows(), m) == m {
+        match m {
+            2 => a.for_each_in_group::<2>(i0, |j, v| f(j, v[0] * v[0] + v[1] * v[1])),
+            _ => a.for_each_in_group::<3>(i0, |j, v| f(j, v[0] * v[0] + v[1] * v[1] + v[2] * v[2])),
+        }
+    } else {
+        for &i in eqs {
+            a.for_each_in_row(i as usize, |j, v| f(j, v * v));
+        }
+    }
+}
+
 /// `‖A_IJ‖_F²` for every structural neighbour `J ≠ I` of node `I`, in `spa`.
 fn block_norms(a: &CsrMatrix, blocks: &Blocks, node: usize, spa: &mut Spa) {
     spa.list.clear();
     let stamp = node as u32 + 1;
-    for &i in blocks.node(node) {
-        a.for_each_in_row(i as usize, |j, v| {
-            let nj = blocks.node_of[j as usize];
-            let slot = nj as usize;
-            if slot == node {
-                return;
-            }
-            if spa.mark[slot] != stamp {
-                spa.mark[slot] = stamp;
-                spa.acc[slot] = 0.0;
-                spa.list.push(nj);
-            }
-            spa.acc[slot] += v * v;
-        });
-    }
+    node_columns(a, blocks, node, |j, v2| {
+        let nj = blocks.node_of[j as usize];
+        let slot = nj as usize;
+        if slot == node {
+            return;
+        }
+        if spa.mark[slot] != stamp {
+            spa.mark[slot] = stamp;
+            spa.acc[slot] = 0.0;
+            spa.list.push(nj);
+        }
+        spa.acc[slot] += v2;
+    });
 }
 
 /// `‖A_II‖_F`.
 fn diagonal_block_norm(a: &CsrMatrix, blocks: &Blocks, node: usize) -> f64 {
     let mut s = 0.0f64;
-    for &i in blocks.node(node) {
-        a.for_each_in_row(i as usize, |j, v| {
-            if blocks.node_of[j as usize] as usize == node {
-                s += v * v;
-            }
-        });
-    }
+    node_columns(a, blocks, node, |j, v2| {
+        if blocks.node_of[j as usize] as usize == node {
+            s += v2;
+        }
+    });
     s.sqrt()
 }
 
