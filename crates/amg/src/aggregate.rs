@@ -78,7 +78,10 @@ impl Blocks {
             .enumerate()
             .map(|(e, &id)| (id, e as u32))
             .collect();
-        order.sort_unstable();
+        // Equations numbered node by node come in order already.
+        if !order.is_sorted() {
+            order.par_sort_unstable();
+        }
         let mut node_of = vec![0u32; n];
         let mut ptr = vec![0usize];
         let mut eqs = Vec::with_capacity(n);

@@ -232,7 +232,7 @@ impl AmgSolver {
         let coords: Vec<f64> = grid
             .nodes()
             .iter()
-            .flat_map(|p| p.iter().copied().collect::<Vec<_>>())
+            .flat_map(|p| p.iter().copied())
             .collect();
         // (node, component) of every equation; a platen's shared equation takes its
         // first node.
