@@ -348,14 +348,18 @@ impl CsrMatrix {
     }
 
     /// `f(column, [a_{i0+q, column}; M])` over the entries of the `M` rows `i0..i0 + M`,
-    /// which must be rows of one group ([`Self::row_group`]): they share their columns,
-    /// which are read once for all of them.
+    /// which must be rows of one group ([`Self::row_group`]; any row for `M = 1`): they
+    /// share their columns, which are read once for all of them.
     #[inline]
     pub(crate) fn for_each_in_group<const M: usize>(
         &self,
         i0: usize,
-        f: impl FnMut(u32, [f64; M]),
+        mut f: impl FnMut(u32, [f64; M]),
     ) {
+        if M == 1 && self.runs.is_none() {
+            self.for_each_in_row(i0, |j, v| f(j, [v; M]));
+            return;
+        }
         with_values!(&self.val, v => self.for_each_in_group_of::<M, _>(v, i0, f))
     }
 
@@ -602,19 +606,13 @@ impl CsrMatrix {
     where
         F: Fn(usize, f64, &mut f64) -> f64 + Sync + Send,
     {
-        let parts: Vec<f64> = y
-            .par_chunks_mut(ROWS_PER_TASK)
-            .enumerate()
-            .map(|(b, ys)| {
-                let base = b * ROWS_PER_TASK;
-                let mut sum = 0.0;
-                self.rows_times(base..base + ys.len(), x, |i, ax| {
-                    sum += f(i, ax, &mut ys[i - base]);
-                });
-                sum
-            })
-            .collect();
-        parts.iter().sum()
+        par_block_sums(y, |base, ys| {
+            let mut sum = 0.0;
+            self.rows_times(base..base + ys.len(), x, |i, ax| {
+                sum += f(i, ax, &mut ys[i - base]);
+            });
+            sum
+        })
     }
 
     /// `f(i, (A x)_i, &mut y[i], &mut z[i])` for every row, in parallel blocks.
@@ -795,17 +793,26 @@ pub(crate) fn par_rows_sum<F>(y: &mut [f64], f: F) -> f64
 where
     F: Fn(usize, &mut f64) -> f64 + Sync + Send,
 {
+    par_block_sums(y, |base, ys| {
+        let mut sum = 0.0;
+        for (k, yi) in ys.iter_mut().enumerate() {
+            sum += f(base + k, yi);
+        }
+        sum
+    })
+}
+
+/// `Σ_b g(first row of b, y[b])` over the blocks `b` of [`ROWS_PER_TASK`] rows of `y`, in
+/// parallel; the block sums are added in block order, so the result does not depend on
+/// the number of threads.
+fn par_block_sums<G>(y: &mut [f64], g: G) -> f64
+where
+    G: Fn(usize, &mut [f64]) -> f64 + Sync + Send,
+{
     let parts: Vec<f64> = y
         .par_chunks_mut(ROWS_PER_TASK)
         .enumerate()
-        .map(|(b, ys)| {
-            let base = b * ROWS_PER_TASK;
-            let mut sum = 0.0;
-            for (k, yi) in ys.iter_mut().enumerate() {
-                sum += f(base + k, yi);
-            }
-            sum
-        })
+        .map(|(b, ys)| g(b * ROWS_PER_TASK, ys))
         .collect();
     parts.iter().sum()
 }

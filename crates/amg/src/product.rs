@@ -437,51 +437,13 @@ impl Galerkin {
     }
 }
 
-/// Row `i` of `W = A P` restricted to the aggregates `≥ lo`, in blocks: appends the
-/// aggregates to `aggs` and their values (`k_b` each, in the same order) to `vals`.
-/// `slot[b]` is `u32::MAX` on entry for every `b` and is restored before returning.
-#[allow(clippy::too_many_arguments)]
-#[inline]
-fn w_row(
-    a: &CsrMatrix,
-    p: &Blocked,
-    off: &[usize],
-    i: usize,
-    lo: usize,
-    slot: &mut [u32],
-    aggs: &mut Vec<u32>,
-    vals: &mut Vec<f64>,
-) {
-    let pv = p.values();
-    aggs.clear();
-    vals.clear();
-    a.for_each_in_row(i, |j, aij| {
-        let (pb, pp) = p.blocks(j as usize);
-        for (&b, &s) in pb.iter().zip(pp) {
-            let (bu, s) = (b as usize, s as usize);
-            if bu < lo {
-                continue;
-            }
-            let k = off[bu + 1] - off[bu];
-            if slot[bu] == u32::MAX {
-                slot[bu] = vals.len() as u32;
-                aggs.push(b);
-                vals.extend(pv[s..s + k].iter().map(|&v| aij * f64::from(v)));
-            } else {
-                let d = slot[bu] as usize;
-                axpy(&mut vals[d..d + k], aij, &pv[s..s + k]);
-            }
-        }
-    });
-    for &b in aggs.iter() {
-        slot[b as usize] = u32::MAX;
-    }
-}
-
-/// [`w_row`] for the `M` rows `i0..i0 + M` of one group of `A` (same columns, hence the
-/// same blocks of `P` and of `W`): the index work is done once for all of them. The
-/// values of block `b` are appended row after row (`M · k_b` of them); each row's values
-/// are summed in the same order as by [`w_row`], so the results are the same bits.
+/// Rows `i0..i0 + M` of `W = A P` restricted to the aggregates `≥ lo`, in blocks, for the
+/// `M` rows of one group of `A` (same columns, hence the same blocks of `P` and of `W`; a
+/// single row for `M = 1`): appends the aggregates to `aggs` and, per aggregate `b`, its
+/// values row after row (`M · k_b` of them) to `vals`. The index work is done once for
+/// all `M` rows, and each row's values are summed in column order, so grouping does not
+/// change the bits. `slot[b]` is `u32::MAX` on entry for every `b` and is restored before
+/// returning.
 #[allow(clippy::too_many_arguments)]
 #[inline]
 fn w_rows<const M: usize>(
@@ -705,11 +667,7 @@ impl GalerkinRows<'_> {
         } = *self;
         let width = |b: usize| off[b + 1] - off[b];
         let pv = p.values();
-        if M == 1 {
-            w_row(a, p, off, i0, lo, slot, waggs, wvals);
-        } else {
-            w_rows::<M>(a, p, off, i0, lo, slot, waggs, wvals);
-        }
+        w_rows::<M>(a, p, off, i0, lo, slot, waggs, wvals);
         let blocks: [(&[u32], &[u32]); M] = std::array::from_fn(|q| p.blocks(i0 + q));
         for (bi, &ag) in blocks[0].0.iter().enumerate() {
             let ag = ag as usize;
