@@ -11,6 +11,9 @@
 //!
 //! and `‖e_k‖_A ≤ 2 ((√κ − 1)/(√κ + 1))^k ‖e₀‖_A` with `κ = κ(M A)`: a multigrid
 //! preconditioner with a mesh-independent `κ` gives mesh-independent iteration counts.
+//! Besides the V-cycle an iteration makes four passes over the vectors: the product
+//! `A p_k` with `p_k·A p_k` summed in the same pass, the updates of `x` and `r` with
+//! `‖r_{k+1}‖²`, the dot product `r·z`, and the update of `p`.
 //!
 //! It stops when the recursively updated residual satisfies `‖r_k‖ ≤ tol ‖b‖`, then checks
 //! the true residual `‖b − A x_k‖` (the recursion drifts from it by rounding); if that is

@@ -46,7 +46,11 @@
 //! ```
 //!
 //! to its block rows `a`. A fine row next to two parts is visited by both; the memory of
-//! `W` (larger than `A` itself after aggressive coarsening) is never needed.
+//! `W` (larger than `A` itself after aggressive coarsening) is never needed. The rows of a
+//! node (a group of `A`: the same columns, hence the same blocks in `P` and `W`) are
+//! computed together, with one pass over their columns and one set of block lookups; every
+//! entry still receives its rows' terms in increasing row order, so grouping does not
+//! change the bits.
 //! Only the blocks `b ≥ a` are summed; the diagonal blocks are averaged with their
 //! transposes and the blocks `b < a` are copied from the transposed blocks `(b, a)`. This
 //! halves the arithmetic and makes `A_c` exactly symmetric, so the V-cycle is an exactly
