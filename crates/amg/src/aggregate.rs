@@ -297,23 +297,28 @@ pub(crate) fn aggregate(s: &Strength, distance_two: bool) -> (Vec<u32>, usize) {
         }
     }
     // Pass 2: attach to the most strongly connected pass-1 aggregate (equal strengths: the
-    // neighbour of the lowest number).
+    // neighbour of the lowest number). Every node reads only the pass-1 result, so the
+    // nodes are independent (in parallel, the same result).
     let first = agg.clone();
-    for i in 0..nn {
-        if agg[i] != FREE {
-            continue;
-        }
-        let mut best: Option<(f64, u32, u32)> = None;
-        s.visit(i, distance_two, |j, w| {
-            let a = first[j as usize];
-            if a != FREE && best.is_none_or(|(bw, bj, _)| w > bw || (w == bw && j < bj)) {
-                best = Some((w, j, a));
+    agg.par_chunks_mut(ROWS_PER_TASK)
+        .enumerate()
+        .for_each(|(blk, part)| {
+            for (k, slot) in part.iter_mut().enumerate() {
+                if *slot != FREE {
+                    continue;
+                }
+                let mut best: Option<(f64, u32, u32)> = None;
+                s.visit(blk * ROWS_PER_TASK + k, distance_two, |j, w| {
+                    let a = first[j as usize];
+                    if a != FREE && best.is_none_or(|(bw, bj, _)| w > bw || (w == bw && j < bj)) {
+                        best = Some((w, j, a));
+                    }
+                });
+                if let Some((_, _, a)) = best {
+                    *slot = a;
+                }
             }
         });
-        if let Some((_, _, a)) = best {
-            agg[i] = a;
-        }
-    }
     // Pass 3: the rest form aggregates with their free neighbours.
     for i in 0..nn {
         if agg[i] != FREE {

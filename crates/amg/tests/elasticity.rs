@@ -101,7 +101,7 @@ fn rollers_and_clamps_with_mdem() {
         components: [None, Some(ScalarField::Const(0.0))],
     };
     let loads = Loads {
-        body_force: Some([ScalarField::Const(0.1), ScalarField::Const(-1.0)]),
+        body_force: Some([ScalarField::Const(0.1), ScalarField::Const(-1.0)].into()),
         ..Loads::default()
     };
     let law = MdemLaw::new(&Stiffness::<2>::isotropic(1.0, 0.25).unwrap()).unwrap();

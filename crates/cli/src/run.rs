@@ -23,8 +23,8 @@ use porofrac_sim::{
     BiotState, Body, Displacement, DofMap, ExplicitOptions, ExplicitPressure, FixedStress,
     FractureFlow, FractureLaws, FractureSettings, FractureStep, Fracturing, Gravity, LawMap,
     LinearSolver, Loads, Monolithic, Pattern, Platen, ScalarField, Scheme, SimError, StaticOptions,
-    StaticProblem, StaticSolver, StressMeasure, Traction, cell_stresses, drained_bulk_modulus,
-    solve_explicit, solve_static,
+    StaticProblem, StaticSolver, StressMeasure, Traction, VectorField, cell_stresses,
+    drained_bulk_modulus, solve_explicit, solve_static,
 };
 
 use crate::check::{LoadedScene, SceneError, k, ki};
@@ -620,7 +620,9 @@ fn conditions<const D: usize>(
     }
     if let Some(l) = &s.loads {
         if let Some(b) = &l.body_force {
-            out.loads.body_force = Some(std::array::from_fn(|a| field(ls, &b[a])));
+            out.loads.body_force = Some(VectorField::Components(std::array::from_fn(|a| {
+                field(ls, &b[a])
+            })));
         }
         if let Some(g) = &l.gravity {
             let mut density = vec![0.0; grid.num_cells()];

@@ -32,14 +32,17 @@ fn bench(c: &mut Criterion) {
             ],
         };
         let loads = Loads {
-            body_force: Some([
-                ScalarField::from_fn(|x, _| {
-                    -x[0] / 52.0 + 9.0 * PI * PI * (PI * x[0]).sin() * (PI * x[1]).sin() / 520.0
-                }),
-                ScalarField::from_fn(|x, _| {
-                    -x[1] / 130.0 - PI * PI * (PI * x[0]).cos() * (PI * x[1]).cos() / 104.0
-                }),
-            ]),
+            body_force: Some(
+                [
+                    ScalarField::from_fn(|x, _| {
+                        -x[0] / 52.0 + 9.0 * PI * PI * (PI * x[0]).sin() * (PI * x[1]).sin() / 520.0
+                    }),
+                    ScalarField::from_fn(|x, _| {
+                        -x[1] / 130.0 - PI * PI * (PI * x[0]).cos() * (PI * x[1]).cos() / 104.0
+                    }),
+                ]
+                .into(),
+            ),
             ..Loads::default()
         };
         let dofs = DofMap::new(&grid, &[bc], &[]).unwrap();

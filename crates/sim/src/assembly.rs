@@ -364,9 +364,7 @@ fn body_load_cell<const D: usize>(
             let x: Point<D> = cn.iter().zip(l).map(|(&i, &li)| grid.node(i) * li).sum();
             let mut fv = rho_g;
             if let Some(b) = &loads.body_force {
-                for a in 0..D {
-                    fv[a] += b[a].eval(x.as_slice(), t);
-                }
+                fv += Point::<D>::from(b.eval(x.as_slice(), t));
             }
             fv *= w * vol;
             for (&i, &li) in cn.iter().zip(l) {
@@ -401,9 +399,7 @@ fn body_load_cell<const D: usize>(
                 let x: Point<D> = (0..D).map(|k| vert(k) * l[k]).sum::<Point<D>>() + xc * l[D];
                 let mut fv = rho_g;
                 if let Some(b) = &loads.body_force {
-                    for a in 0..D {
-                        fv[a] += b[a].eval(x.as_slice(), t);
-                    }
+                    fv += Point::<D>::from(b.eval(x.as_slice(), t));
                 }
                 fv *= w * vol;
                 centre += fv * l[D];

@@ -14,7 +14,7 @@
 
 use porofrac_grid::Point;
 
-use crate::field::ScalarField;
+use crate::field::{ScalarField, VectorField};
 
 /// Prescribed displacement components on the nodes of a set of faces.
 #[derive(Clone, Debug)]
@@ -62,8 +62,8 @@ pub struct Gravity<const D: usize> {
 /// The external loads of a mechanics problem.
 #[derive(Clone, Debug, Default)]
 pub struct Loads<const D: usize> {
-    /// Body force per unit volume (N/m³), per component.
-    pub body_force: Option<[ScalarField; D]>,
+    /// Body force per unit volume (N/m³).
+    pub body_force: Option<VectorField<D>>,
     /// Gravity with per-cell density.
     pub gravity: Option<Gravity<D>>,
     /// Tractions on boundary faces.

@@ -326,7 +326,7 @@ fn loads_constant<const D: usize>(loads: &crate::bc::Loads<D>) -> bool {
     let b = loads
         .body_force
         .as_ref()
-        .is_none_or(|b| b.iter().all(|f| f.as_const().is_some()));
+        .is_none_or(|b| b.as_const().is_some());
     let t = loads
         .tractions
         .iter()

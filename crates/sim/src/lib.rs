@@ -63,7 +63,7 @@ pub use biot::{
 pub use dofs::DofMap;
 pub use error::{Result, SimError};
 pub use explicit::{ExplicitOptions, ExplicitSolution, ExplicitState, solve_explicit};
-pub use field::{FieldFn, ScalarField};
+pub use field::{FieldFn, ScalarField, VectorField, VectorFn};
 pub use fracturing::{
     Body, FractureError, FractureFlow, FractureLaws, FractureSettings, FractureStep, Fracturing,
     Scheme, StressMeasure,

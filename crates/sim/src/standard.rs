@@ -18,7 +18,7 @@ use porofrac_grid::{Grid, Point};
 use porofrac_law::Tensor;
 
 use crate::bc::Displacement;
-use crate::field::ScalarField;
+use crate::field::{ScalarField, VectorField};
 
 /// A vector field of position.
 pub type VecFn<const D: usize> = Arc<dyn Fn(&Point<D>) -> Point<D> + Send + Sync>;
@@ -34,45 +34,35 @@ pub struct Manufactured<const D: usize> {
     pub grad: TenFn<D>,
     /// The body force.
     pub f: VecFn<D>,
-    /// The body force component by component (evaluated once per component and point by
-    /// the load integration).
-    f_parts: [Part; D],
+    /// The body force as one function of all components (the sines and cosines shared
+    /// between them), evaluated once per point by the load integration.
+    f_all: fn(&[f64]) -> [f64; D],
 }
 
-/// A scalar function of position (one component of a field).
-type Part = fn(&[f64]) -> f64;
-
-/// The vector field of the components `parts`.
-fn from_parts<const D: usize>(parts: [Part; D]) -> VecFn<D> {
-    Arc::new(move |p: &Point<D>| Point::<D>::from_fn(|a, _| parts[a](p.as_slice())))
+/// `(sin πs, cos πs)`.
+fn sin_cos_pi(s: f64) -> (f64, f64) {
+    (PI * s).sin_cos()
 }
 
-fn e2_fx(p: &[f64]) -> f64 {
+/// The E2 body force.
+fn e2_f(p: &[f64]) -> [f64; 2] {
     let (x, y) = (p[0], p[1]);
-    -x / 52.0 + 9.0 * PI * PI * (PI * x).sin() * (PI * y).sin() / 520.0
+    let ((sx, cx), (sy, cy)) = (sin_cos_pi(x), sin_cos_pi(y));
+    [
+        -x / 52.0 + 9.0 * PI * PI * sx * sy / 520.0,
+        -y / 130.0 - PI * PI * cx * cy / 104.0,
+    ]
 }
 
-fn e2_fy(p: &[f64]) -> f64 {
-    let (x, y) = (p[0], p[1]);
-    -y / 130.0 - PI * PI * (PI * x).cos() * (PI * y).cos() / 104.0
-}
-
-fn e3_fx(p: &[f64]) -> f64 {
+/// The E3 body force.
+fn e3_f(p: &[f64]) -> [f64; 3] {
     let (x, y, z) = (p[0], p[1], p[2]);
-    let (sx, sy, sz) = ((PI * x).sin(), (PI * y).sin(), (PI * z).sin());
-    -x * z / 52.0 + PI * y * sx / 104.0 + 11.0 * PI * PI * sx * sy * sz / 520.0
-}
-
-fn e3_fy(p: &[f64]) -> f64 {
-    let (x, y, z) = (p[0], p[1], p[2]);
-    let (cx, cy, sz) = ((PI * x).cos(), (PI * y).cos(), (PI * z).sin());
-    -y * z / 130.0 - PI * PI * sz * cx * cy / 104.0 - cx / 104.0
-}
-
-fn e3_fz(p: &[f64]) -> f64 {
-    let (x, y, z) = (p[0], p[1], p[2]);
-    let (cx, sy, cz) = ((PI * x).cos(), (PI * y).sin(), (PI * z).cos());
-    -x * x / 104.0 + PI * PI * y * z * cx / 260.0 - PI * PI * sy * cx * cz / 104.0
+    let ((sx, cx), (sy, cy), (sz, cz)) = (sin_cos_pi(x), sin_cos_pi(y), sin_cos_pi(z));
+    [
+        -x * z / 52.0 + PI * y * sx / 104.0 + 11.0 * PI * PI * sx * sy * sz / 520.0,
+        -y * z / 130.0 - PI * PI * sz * cx * cy / 104.0 - cx / 104.0,
+        -x * x / 104.0 + PI * PI * y * z * cx / 260.0 - PI * PI * sy * cx * cz / 104.0,
+    ]
 }
 
 /// E2: `u = (sin πx sin πy, x² y) / 100`.
@@ -91,8 +81,8 @@ pub fn e2() -> Manufactured<2> {
                 x * x,
             ) / 100.0
         }),
-        f: from_parts([e2_fx, e2_fy]),
-        f_parts: [e2_fx, e2_fy],
+        f: Arc::new(|p: &Point<2>| Point::<2>::from(e2_f(p.as_slice()))),
+        f_all: e2_f,
     }
 }
 
@@ -123,8 +113,8 @@ pub fn e3() -> Manufactured<3> {
                 y * cx,
             ) / 100.0
         }),
-        f: from_parts([e3_fx, e3_fy, e3_fz]),
-        f_parts: [e3_fx, e3_fy, e3_fz],
+        f: Arc::new(|p: &Point<3>| Point::<3>::from(e3_f(p.as_slice()))),
+        f_all: e3_f,
     }
 }
 
@@ -146,9 +136,10 @@ pub fn dirichlet<const D: usize>(name: &str, faces: Vec<usize>, f: &VecFn<D>) ->
 }
 
 impl<const D: usize> Manufactured<D> {
-    /// The body force as scalar fields ([`crate::Loads::body_force`]).
-    pub fn body_force(&self) -> [ScalarField; D] {
-        self.f_parts.map(|f| ScalarField::from_fn(move |x, _| f(x)))
+    /// The body force ([`crate::Loads::body_force`]).
+    pub fn body_force(&self) -> VectorField<D> {
+        let f = self.f_all;
+        VectorField::from_fn(move |x, _| f(x))
     }
 
     /// The exact displacement prescribed on the nodes of `faces`.
@@ -276,7 +267,7 @@ mod tests {
                     f[a],
                     -div[a]
                 );
-                assert_eq!(body[a].eval(x.as_slice(), 0.0), f[a]);
+                assert_eq!(body.eval(x.as_slice(), 0.0)[a], f[a]);
             }
         }
     }

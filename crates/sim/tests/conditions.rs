@@ -183,7 +183,7 @@ fn load_moments<const D: usize>(grid: &Grid<D>) {
         ScalarField::from_fn(move |x, _| c0[a] + (0..D).map(|j| cm[(a, j)] * x[j]).sum::<f64>())
     });
     let loads = Loads {
-        body_force: Some(body),
+        body_force: Some(body.into()),
         ..Loads::default()
     };
     let mut f = vec![0.0; D * grid.num_nodes()];
@@ -285,10 +285,13 @@ fn body_loads_do_not_depend_on_the_cell_order() {
     }
     let shuffled = Grid::from_polygons(grid.nodes().to_vec(), &pos, &conn).unwrap();
     let loads = Loads {
-        body_force: Some([
-            ScalarField::from_fn(|x, _| (3.0 * x[0]).sin() + x[1] * x[1]),
-            ScalarField::from_fn(|x, _| (2.0 * x[1]).cos() * x[0]),
-        ]),
+        body_force: Some(
+            [
+                ScalarField::from_fn(|x, _| (3.0 * x[0]).sin() + x[1] * x[1]),
+                ScalarField::from_fn(|x, _| (2.0 * x[1]).cos() * x[0]),
+            ]
+            .into(),
+        ),
         ..Loads::default()
     };
     let (mut f, mut g) = (

@@ -37,11 +37,14 @@ fn case<const D: usize>(n: usize) -> Case<D> {
     let dofs = DofMap::new(&grid, &[clamp], &[]).unwrap();
     let pattern = Pattern::new(&grid, &dofs).unwrap();
     let loads = Loads {
-        body_force: Some(std::array::from_fn(|a| {
-            ScalarField::from_fn(move |x, _| {
-                (3.0 * x[0] + a as f64).sin() + x[1] * x[1] - 0.5 * x[D - 1]
+        body_force: Some(
+            std::array::from_fn(|a| {
+                ScalarField::from_fn(move |x, _| {
+                    (3.0 * x[0] + a as f64).sin() + x[1] * x[1] - 0.5 * x[D - 1]
+                })
             })
-        })),
+            .into(),
+        ),
         tractions: vec![Traction {
             name: "xmax".into(),
             faces: grid.boundary("xmax").unwrap(),

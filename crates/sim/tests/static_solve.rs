@@ -294,7 +294,7 @@ fn gravity_column_2d() {
     assert!(worst < 1e-10, "gravity column: error {worst:.2e}");
     // The same load as a body-force expression gives the same answer.
     let loads_b = Loads {
-        body_force: Some([0.0.into(), ScalarField::from_fn(move |_, _| -rho * g)]),
+        body_force: Some([0.0.into(), ScalarField::from_fn(move |_, _| -rho * g)].into()),
         ..Loads::default()
     };
     let ub = run(&grid, &law, &bcs, &[], &loads_b).unwrap();
