@@ -51,7 +51,8 @@ use faer::dyn_stack::MemBuffer;
 use crate::aggregate::{Blocks, Tentative, aggregate, strength, tentative};
 use crate::coarse::CoarseSolver;
 use crate::csr::{
-    CsrMatrix, SymCsr, check_upper_values, equals_upper, fill_from_upper, vec_bytes, zeros,
+    CsrMatrix, SymCsr, check_upper_values, equals_upper, fill_from_upper, par_rows, vec_bytes,
+    zeros,
 };
 use crate::error::{AmgError, Result, check_finite};
 use crate::nullspace::NearNullSpace;
@@ -270,7 +271,9 @@ fn inverse_diagonal(a: &CsrMatrix, level: usize) -> Result<Vec<f64>> {
             value,
         });
     }
-    Ok(d.iter().map(|v| 1.0 / v).collect())
+    let mut dinv = zeros(d.len());
+    par_rows(&mut dinv, |i, v| *v = 1.0 / d[i]);
+    Ok(dinv)
 }
 
 impl Amg {

@@ -38,6 +38,8 @@
 
 use nalgebra::DMatrix;
 
+use rayon::prelude::*;
+
 use crate::csr::{CsrMatrix, par_rows, par_rows_sum, zeros};
 
 /// A pseudo-random number in `[-0.5, 0.5)` from an index (splitmix64).
@@ -57,7 +59,7 @@ fn gershgorin(a: &CsrMatrix, s: &[f64]) -> f64 {
         a.for_each_in_row(i, |j, v| sum += v.abs() * s[j as usize]);
         *ri = s[i] * sum;
     });
-    rows.iter().fold(0.0, |m: f64, &x| m.max(x))
+    rows.par_iter().copied().reduce(|| 0.0, f64::max)
 }
 
 /// Estimate `ρ(D⁻¹A)` by `steps` Lanczos steps (capped by Gershgorin's bound).
@@ -70,15 +72,20 @@ fn gershgorin(a: &CsrMatrix, s: &[f64]) -> f64 {
 /// `β` is folded into the next step as a scale of the stored vector.
 pub(crate) fn spectral_radius(a: &CsrMatrix, dinv: &[f64], steps: usize) -> f64 {
     let n = a.nrows();
-    let s: Vec<f64> = dinv.iter().map(|d| d.sqrt()).collect();
+    let s: Vec<f64> = dinv.par_iter().map(|d| d.sqrt()).collect();
     let bound = gershgorin(a, &s);
     if n <= 1 {
         return bound;
     }
     // q₀ = S v₀ with v₀ a unit random vector (‖q₀‖_D = ‖v₀‖).
-    let mut q: Vec<f64> = (0..n).map(|i| s[i] * hash_unit(i)).collect();
+    let mut q = zeros(n);
+    let v_norm2 = par_rows_sum(&mut q, |i, qi| {
+        let v = hash_unit(i);
+        *qi = s[i] * v;
+        v * v
+    });
     drop(s);
-    let mut q_scale = 1.0 / (0..n).map(|i| hash_unit(i).powi(2)).sum::<f64>().sqrt();
+    let mut q_scale = 1.0 / v_norm2.sqrt();
     let mut q_prev = zeros(n);
     let mut prev_scale = 0.0;
     let mut w = zeros(n);
