@@ -6,8 +6,9 @@
 //! real and positive for SPD `A`. A few steps of the Lanczos process on `S` from a fixed
 //! pseudo-random start vector give a tridiagonal `T_k` whose largest eigenvalue (a Ritz
 //! value) approaches `λ_max(S)` from below much faster than the power method; ten or so
-//! steps are usually within a percent or two. The estimate is capped by Gershgorin's
-//! bound `max_i Σ_j |a_ij| / √(a_ii a_jj)` (an upper bound, exact for some matrices).
+//! steps are usually within a percent or two. A Ritz value never exceeds `λ_max`; where
+//! Lanczos fails (a non-finite or non-positive value) Gershgorin's bound
+//! `max_i Σ_j |a_ij| / √(a_ii a_jj)` (an upper bound, exact for some matrices) stands in.
 //!
 //! # Chebyshev smoothing
 //!
@@ -62,7 +63,7 @@ fn gershgorin(a: &CsrMatrix, s: &[f64]) -> f64 {
     rows.par_iter().copied().reduce(|| 0.0, f64::max)
 }
 
-/// Estimate `ρ(D⁻¹A)` by `steps` Lanczos steps (capped by Gershgorin's bound).
+/// Estimate `ρ(D⁻¹A)` by `steps` Lanczos steps (Gershgorin's bound where Lanczos fails).
 ///
 /// Lanczos on the symmetric `S A S` (`S = D^{-1/2}`) with vectors `v = S⁻¹ q` is Lanczos on
 /// `D⁻¹A` in the `D` inner product `⟨x, y⟩_D = Σ a_ii x_i y_i`, which needs no `S` in the
@@ -73,9 +74,8 @@ fn gershgorin(a: &CsrMatrix, s: &[f64]) -> f64 {
 pub(crate) fn spectral_radius(a: &CsrMatrix, dinv: &[f64], steps: usize) -> f64 {
     let n = a.nrows();
     let s: Vec<f64> = dinv.par_iter().map(|d| d.sqrt()).collect();
-    let bound = gershgorin(a, &s);
     if n <= 1 {
-        return bound;
+        return gershgorin(a, &s);
     }
     // q₀ = S v₀ with v₀ a unit random vector (‖q₀‖_D = ‖v₀‖).
     let mut q = zeros(n);
@@ -127,11 +127,14 @@ pub(crate) fn spectral_radius(a: &CsrMatrix, dinv: &[f64], steps: usize) -> f64 
             0.0
         }
     });
+    // A Ritz value never exceeds λ_max ≤ the Gershgorin bound, so the bound (a pass over
+    // the matrix) is needed only where Lanczos failed.
     let ritz = t.symmetric_eigenvalues().max();
     if ritz.is_finite() && ritz > 0.0 {
-        ritz.min(bound)
+        ritz
     } else {
-        bound
+        let s: Vec<f64> = dinv.par_iter().map(|d| d.sqrt()).collect();
+        gershgorin(a, &s)
     }
 }
 
