@@ -13,7 +13,9 @@
 //! diagonal twice, which the map marks with its top bit ([`TWICE`]). Filling values is
 //! then a loop over cells with no searching and no triplet buffers, and new values (time
 //! steps, law switches) reuse the pattern. Half the local pairs are stored, and 32 bits
-//! each.
+//! each. A cell whose nodes each own `D` consecutive free equations (no prescribed
+//! component, no platen) is mapped node block by node block: the components of a node lie
+//! in the same cells, so one walk down a column places a whole `D × D` block.
 //!
 //! # Parallel fill
 //!
@@ -78,6 +80,65 @@ pub(crate) fn cell_equations<const D: usize>(
     let raw = dofs.raw();
     for &n in grid.cell_nodes(c) {
         out.extend_from_slice(&raw[D * n..D * n + D]);
+    }
+}
+
+/// Whether every node of a cell with the local equations `eqs` (node-major) has `D` free
+/// consecutive equations whose further components have the cells of the first
+/// (`same_cells`) — the usual case, without prescribed components or platens. Then
+/// `nodes` holds `(first equation, local node)`, sorted.
+fn node_blocks<const D: usize>(
+    eqs: &[usize],
+    same_cells: &[bool],
+    nodes: &mut Vec<(usize, usize)>,
+) -> bool {
+    nodes.clear();
+    for (k, e) in eqs.chunks_exact(D).enumerate() {
+        let e0 = e[0];
+        if e0 == usize::MAX || (1..D).any(|a| e[a] != e0.wrapping_add(a) || !same_cells[e0 + a]) {
+            return false;
+        }
+        nodes.push((e0, k));
+    }
+    nodes.sort_unstable();
+    nodes.windows(2).all(|w| w[1].0 >= w[0].0 + D)
+}
+
+/// The scatter map of a cell whose nodes passed [`node_blocks`], node block by node block.
+///
+/// The components `b` of node `k` (equations `e_k + b`) lie in the same cells, so column
+/// `e_k + b` holds the rows of column `e_k` below `e_k` at the same offsets, then `e_k …
+/// e_k + b` last: the rows `e_j + a` of an earlier node `j` are found by one walk down
+/// column `e_k` for the whole `D × D` block.
+fn scatter_by_nodes<const D: usize>(
+    nodes: &[(usize, usize)],
+    col_ptr: &[usize],
+    row_idx: &[usize],
+    map: &mut [u32],
+) {
+    for (jj, &(eb, kb)) in nodes.iter().enumerate() {
+        for b in 0..D {
+            let end = col_ptr[eb + b + 1];
+            for a in 0..=b {
+                map[upper_pair(D * kb + a, D * kb + b)] = (end - 1 - (b - a)) as u32;
+            }
+        }
+        let c0 = col_ptr[eb];
+        let mut p = c0;
+        for &(ea, ka) in &nodes[..jj] {
+            // Invariant: row ea is in column eb (a cell holds both), rows sorted.
+            while row_idx[p] < ea {
+                p += 1;
+            }
+            let delta = p - c0;
+            for b in 0..D {
+                let base = col_ptr[eb + b] + delta;
+                for a in 0..D {
+                    let (i, j) = (D * ka + a, D * kb + b);
+                    map[upper_pair(i.min(j), i.max(j))] = (base + a) as u32;
+                }
+            }
+        }
     }
 }
 
@@ -290,6 +351,18 @@ impl Pattern {
                 "{nnz} stiffness entries exceed the 31-bit scatter map"
             )));
         }
+        // Equations with the cells (hence the column rows below the node) of the equation
+        // before them: the further components of a node.
+        let mut same_cells = vec![false; n];
+        same_cells
+            .par_chunks_mut(BLOCK)
+            .enumerate()
+            .for_each(|(b, out)| {
+                for (k, same) in out.iter_mut().enumerate() {
+                    let c = b * BLOCK + k;
+                    *same = c > 0 && cells_of(c) == cells_of(c - 1);
+                }
+            });
         // Scatter maps, in parallel blocks of cells.
         let sizes: Vec<usize> = (0..nc)
             .map(|c| {
@@ -312,6 +385,10 @@ impl Pattern {
                 let m = eqs.len();
                 let map = &mut out[k..k + m * (m + 1) / 2];
                 k += map.len();
+                if node_blocks::<D>(&eqs, &same_cells, &mut sorted) {
+                    scatter_by_nodes::<D>(&sorted, &col_ptr, &row_idx, map);
+                    continue;
+                }
                 map.fill(NONE);
                 sorted.clear();
                 sorted.extend(
