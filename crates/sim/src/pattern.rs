@@ -83,6 +83,35 @@ pub(crate) fn cell_equations<const D: usize>(
     }
 }
 
+/// Sort the local equations `eqs` (node-major) node block by node block when every node
+/// has `D` free consecutive equations and the blocks do not overlap (then the result is
+/// sorted and unique); false, `eqs` unchanged, otherwise.
+fn sort_node_blocks<const D: usize>(eqs: &mut [usize]) -> bool {
+    const MAX_NODES: usize = 32;
+    let n = eqs.len() / D;
+    if n > MAX_NODES {
+        return false;
+    }
+    let mut first = [0usize; MAX_NODES];
+    for (k, e) in eqs.chunks_exact(D).enumerate() {
+        if e[0] == usize::MAX || (1..D).any(|a| e[a] != e[0].wrapping_add(a)) {
+            return false;
+        }
+        first[k] = e[0];
+    }
+    let first = &mut first[..n];
+    first.sort_unstable();
+    if first.windows(2).any(|w| w[1] < w[0] + D) {
+        return false;
+    }
+    for (e, &f) in eqs.chunks_exact_mut(D).zip(first.iter()) {
+        for (a, ea) in e.iter_mut().enumerate() {
+            *ea = f + a;
+        }
+    }
+    true
+}
+
 /// Whether every node of a cell with the local equations `eqs` (node-major) has `D` free
 /// consecutive equations whose further components have the cells of the first
 /// (`same_cells`) — the usual case, without prescribed components or platens. Then
@@ -215,9 +244,11 @@ impl Pattern {
         // Cell → sorted unique free equations: counts, then values, both in parallel.
         let sorted_free = |c: usize, buf: &mut Vec<usize>| {
             cell_equations(grid, dofs, c, buf);
-            buf.retain(|&e| e != usize::MAX);
-            buf.sort_unstable();
-            buf.dedup();
+            if !sort_node_blocks::<D>(buf) {
+                buf.retain(|&e| e != usize::MAX);
+                buf.sort_unstable();
+                buf.dedup();
+            }
         };
         let counts: Vec<usize> = (0..nc)
             .into_par_iter()
