@@ -85,10 +85,11 @@ impl<const D: usize> VectorField<D> {
     pub fn as_const(&self) -> Option<[f64; D]> {
         match self {
             Self::Components(c) => {
-                let v = c.each_ref().map(ScalarField::as_const);
-                v.iter()
-                    .all(Option::is_some)
-                    .then(|| v.map(|x| x.unwrap_or(0.0)))
+                let mut v = [0.0; D];
+                for (vi, f) in v.iter_mut().zip(c) {
+                    *vi = f.as_const()?;
+                }
+                Some(v)
             }
             Self::Fn(_) => None,
         }

@@ -83,54 +83,38 @@ pub(crate) fn cell_equations<const D: usize>(
     }
 }
 
-/// Sort the local equations `eqs` (node-major) node block by node block when every node
-/// has `D` free consecutive equations and the blocks do not overlap (then the result is
-/// sorted and unique); false, `eqs` unchanged, otherwise.
-fn sort_node_blocks<const D: usize>(eqs: &mut [usize]) -> bool {
-    const MAX_NODES: usize = 32;
+/// The most nodes of a cell the node-block paths handle.
+const MAX_NODES: usize = 32;
+
+/// `(first equation, local node)` of the nodes of a cell with the local equations `eqs`
+/// (node-major), sorted, when every node has `D` free consecutive equations and the blocks
+/// do not overlap — the usual case, without prescribed components or platens — and, with
+/// `same_cells`, each node's further components lie in the cells of its first; `None`
+/// otherwise.
+fn node_blocks<'a, const D: usize>(
+    eqs: &[usize],
+    same_cells: Option<&[bool]>,
+    nodes: &'a mut [(usize, usize); MAX_NODES],
+) -> Option<&'a [(usize, usize)]> {
     let n = eqs.len() / D;
     if n > MAX_NODES {
-        return false;
+        return None;
     }
-    let mut first = [0usize; MAX_NODES];
-    for (k, e) in eqs.chunks_exact(D).enumerate() {
-        if e[0] == usize::MAX || (1..D).any(|a| e[a] != e[0].wrapping_add(a)) {
-            return false;
-        }
-        first[k] = e[0];
-    }
-    let first = &mut first[..n];
-    first.sort_unstable();
-    if first.windows(2).any(|w| w[1] < w[0] + D) {
-        return false;
-    }
-    for (e, &f) in eqs.chunks_exact_mut(D).zip(first.iter()) {
-        for (a, ea) in e.iter_mut().enumerate() {
-            *ea = f + a;
-        }
-    }
-    true
-}
-
-/// Whether every node of a cell with the local equations `eqs` (node-major) has `D` free
-/// consecutive equations whose further components have the cells of the first
-/// (`same_cells`) — the usual case, without prescribed components or platens. Then
-/// `nodes` holds `(first equation, local node)`, sorted.
-fn node_blocks<const D: usize>(
-    eqs: &[usize],
-    same_cells: &[bool],
-    nodes: &mut Vec<(usize, usize)>,
-) -> bool {
-    nodes.clear();
     for (k, e) in eqs.chunks_exact(D).enumerate() {
         let e0 = e[0];
-        if e0 == usize::MAX || (1..D).any(|a| e[a] != e0.wrapping_add(a) || !same_cells[e0 + a]) {
-            return false;
+        let breaks =
+            |a: usize| e[a] != e0.wrapping_add(a) || same_cells.is_some_and(|same| !same[e0 + a]);
+        if e0 == usize::MAX || (1..D).any(breaks) {
+            return None;
         }
-        nodes.push((e0, k));
+        nodes[k] = (e0, k);
     }
+    let nodes = &mut nodes[..n];
     nodes.sort_unstable();
-    nodes.windows(2).all(|w| w[1].0 >= w[0].0 + D)
+    nodes
+        .windows(2)
+        .all(|w| w[1].0 >= w[0].0 + D)
+        .then_some(&*nodes)
 }
 
 /// The scatter map of a cell whose nodes passed [`node_blocks`], node block by node block.
@@ -242,29 +226,43 @@ impl Pattern {
         }
         let nc = grid.num_cells();
         // Cell → sorted unique free equations: counts, then values, both in parallel.
-        let sorted_free = |c: usize, buf: &mut Vec<usize>| {
+        // (Buffers: the equations, the node blocks.)
+        type Bufs = (Vec<usize>, [(usize, usize); MAX_NODES]);
+        let new_bufs = || -> Bufs { (Vec::new(), [(0, 0); MAX_NODES]) };
+        let sorted_free = |c: usize, (buf, blocks): &mut Bufs| {
             cell_equations(grid, dofs, c, buf);
-            if !sort_node_blocks::<D>(buf) {
-                buf.retain(|&e| e != usize::MAX);
-                buf.sort_unstable();
-                buf.dedup();
+            match node_blocks::<D>(buf, None, blocks) {
+                // Sorted node blocks are the sorted equations.
+                Some(nodes) => {
+                    for (e, &(first, _)) in buf.chunks_exact_mut(D).zip(nodes) {
+                        for (a, ea) in e.iter_mut().enumerate() {
+                            *ea = first + a;
+                        }
+                    }
+                }
+                None => {
+                    buf.retain(|&e| e != usize::MAX);
+                    buf.sort_unstable();
+                    buf.dedup();
+                }
             }
         };
         let counts: Vec<usize> = (0..nc)
             .into_par_iter()
-            .map_init(Vec::new, |buf, c| {
-                sorted_free(c, buf);
-                buf.len()
+            .map_init(new_bufs, |bufs, c| {
+                sorted_free(c, bufs);
+                bufs.0.len()
             })
             .collect();
         let cell_eq_pos = offsets(&counts);
         let mut cell_eqs = vec![0usize; cell_eq_pos[nc]];
         fill_blocks(&mut cell_eqs, &cell_eq_pos, |cells, out| {
-            let mut buf = Vec::new();
+            let mut bufs = new_bufs();
             let mut k = 0;
             for c in cells {
-                sorted_free(c, &mut buf);
-                out[k..k + buf.len()].copy_from_slice(&buf);
+                sorted_free(c, &mut bufs);
+                let buf = &bufs.0;
+                out[k..k + buf.len()].copy_from_slice(buf);
                 k += buf.len();
             }
         });
@@ -410,14 +408,15 @@ impl Pattern {
             let mut eqs = Vec::new();
             // The cell's free equations with their local dofs, increasing.
             let mut sorted: Vec<(usize, usize)> = Vec::new();
+            let mut blocks = [(0, 0); MAX_NODES];
             let mut k = 0;
             for c in cells {
                 cell_equations(grid, dofs, c, &mut eqs);
                 let m = eqs.len();
                 let map = &mut out[k..k + m * (m + 1) / 2];
                 k += map.len();
-                if node_blocks::<D>(&eqs, &same_cells, &mut sorted) {
-                    scatter_by_nodes::<D>(&sorted, &col_ptr, &row_idx, map);
+                if let Some(nodes) = node_blocks::<D>(&eqs, Some(&same_cells), &mut blocks) {
+                    scatter_by_nodes::<D>(nodes, &col_ptr, &row_idx, map);
                     continue;
                 }
                 map.fill(NONE);
