@@ -52,7 +52,7 @@ use crate::bc::Loads;
 use crate::dofs::DofMap;
 use crate::error::{AXES, Result, SimError, fmt_point};
 use crate::laws::LawMap;
-use crate::pattern::{NONE, Pattern, TWICE};
+use crate::pattern::{NONE, Pattern, ScatterBuffer, TWICE};
 use crate::quadrature::{cell_rule, facet_rule, simplex_rule};
 
 /// Per-thread buffers for evaluating cells.
@@ -63,6 +63,7 @@ pub(crate) struct Work<const D: usize> {
     pub(crate) k: DMatrix<f64>,
     pub(crate) u: Vec<f64>,
     pub(crate) f: Vec<f64>,
+    pub(crate) map: ScatterBuffer,
 }
 
 impl<const D: usize> Work<D> {
@@ -116,6 +117,15 @@ pub fn assemble<const D: usize>(
     values: &mut [f64],
     forces: &mut [f64],
 ) -> Result<()> {
+    if dofs.num_equations() != pattern.num_equations() || grid.num_cells() != pattern.num_cells() {
+        return Err(SimError::Input(format!(
+            "assemble: a pattern of {} equations and {} cells for {} equations and {} cells",
+            pattern.num_equations(),
+            pattern.num_cells(),
+            dofs.num_equations(),
+            grid.num_cells()
+        )));
+    }
     if u.len() != dofs.num_dofs()
         || values.len() != pattern.nnz()
         || forces.len() != pattern.num_equations()
@@ -168,7 +178,8 @@ pub fn assemble<const D: usize>(
                     return Err(cell_error(laws, c, "non-finite stiffness".into()));
                 }
                 let (v0, vlen) = (ch.vals.start, vals.len());
-                let (scatter, kv) = (pattern.cell_scatter(c), w.k.as_slice());
+                let scatter = pattern.cell_map(grid, dofs, c, &mut w.map);
+                let kv = w.k.as_slice();
                 let mut q = 0;
                 for j in 0..m {
                     for i in 0..=j {

@@ -17,6 +17,13 @@
 //! component, no platen) is mapped node block by node block: the components of a node lie
 //! in the same cells, so one walk down a column places a whole `D × D` block.
 //!
+//! The maps are a cache: [`Pattern::new`] stores them (4 bytes per local pair, 168 MB for
+//! the 2 M triangles of E2 n = 1000), which suits repeated fills; a pattern built by
+//! [`Pattern::without_stored_maps`] keeps only the columns and every fill computes each
+//! cell's map again by the same column walks ([`Pattern::cell_map`]), with the same values
+//! bit for bit. For a single fill, as in a linear solve, that is the cheaper choice: the
+//! walks cost about what building the stored maps does.
+//!
 //! # Parallel fill
 //!
 //! The columns are split into contiguous *chunks* of about equal numbers of entries
@@ -56,17 +63,36 @@ pub(crate) struct Chunk {
     pub(crate) cells: Range<usize>,
 }
 
-/// Upper-triangular CSC pattern of the reduced stiffness with per-cell scatter maps.
+/// Upper-triangular CSC pattern of the reduced stiffness, with per-cell scatter maps
+/// stored or computed on demand.
 #[derive(Clone, Debug)]
 pub struct Pattern {
     n: usize,
     col_ptr: Vec<usize>,
     row_idx: Vec<usize>,
-    scatter_pos: Vec<usize>,
-    scatter: Vec<u32>,
+    /// Whether equation `e` lies in the same cells as `e − 1` (another component of a node).
+    same_cells: Vec<bool>,
+    maps: Option<StoredMaps>,
     pub(crate) chunks: Vec<Chunk>,
     pub(crate) chunk_cells: Vec<usize>,
     num_cells: usize,
+}
+
+/// The scatter maps of all cells, one after the other.
+#[derive(Clone, Debug)]
+struct StoredMaps {
+    pos: Vec<usize>,
+    map: Vec<u32>,
+}
+
+/// Buffers for computing a cell's scatter map ([`Pattern::cell_map`]).
+#[derive(Debug, Default)]
+pub struct ScatterBuffer {
+    eqs: Vec<usize>,
+    /// The cell's free equations with their local dofs, increasing.
+    sorted: Vec<(usize, usize)>,
+    blocks: [(usize, usize); MAX_NODES],
+    map: Vec<u32>,
 }
 
 /// Equations of a cell's local dofs (`usize::MAX` for prescribed), node-major.
@@ -155,6 +181,52 @@ fn scatter_by_nodes<const D: usize>(
     }
 }
 
+/// The column structure a scatter map is read from: column offsets, row indices and
+/// [`Pattern::same_cells`].
+type Columns<'a> = (&'a [usize], &'a [usize], &'a [bool]);
+
+/// Write the scatter map of cell `c` into `map` (length `m(m + 1)/2` for `m` local dofs).
+fn map_cell<const D: usize>(
+    grid: &Grid<D>,
+    dofs: &DofMap<D>,
+    c: usize,
+    (col_ptr, row_idx, same_cells): Columns<'_>,
+    buf: &mut ScatterBuffer,
+    map: &mut [u32],
+) {
+    cell_equations(grid, dofs, c, &mut buf.eqs);
+    let eqs = &buf.eqs;
+    debug_assert_eq!(map.len(), eqs.len() * (eqs.len() + 1) / 2);
+    if let Some(nodes) = node_blocks::<D>(eqs, Some(same_cells), &mut buf.blocks) {
+        scatter_by_nodes::<D>(nodes, col_ptr, row_idx, map);
+        return;
+    }
+    map.fill(NONE);
+    let sorted = &mut buf.sorted;
+    sorted.clear();
+    sorted.extend(
+        eqs.iter()
+            .enumerate()
+            .filter(|&(_, &e)| e != usize::MAX)
+            .map(|(i, &e)| (e, i)),
+    );
+    sorted.sort_unstable();
+    // Column `e_j` holds the rows `e_i ≤ e_j` of the cell in increasing order, so one
+    // forward walk down the column finds them all.
+    for (jj, &(col, j)) in sorted.iter().enumerate() {
+        let mut p = col_ptr[col];
+        for &(r, i) in &sorted[..=jj] {
+            // Invariant: (r, col) is in the pattern since both are in cell c, and the
+            // column ends with its diagonal.
+            while row_idx[p] < r {
+                p += 1;
+            }
+            let twice = if i != j && r == col { TWICE } else { 0 };
+            map[upper_pair(i.min(j), i.max(j))] = p as u32 | twice;
+        }
+    }
+}
+
 /// Prefix sums `[0, n0, n0 + n1, …]` of `counts`.
 fn offsets(counts: &[usize]) -> Vec<usize> {
     let mut pos = Vec::with_capacity(counts.len() + 1);
@@ -210,6 +282,22 @@ impl Pattern {
         grid: &Grid<D>,
         dofs: &DofMap<D>,
         num_chunks: usize,
+    ) -> Result<Self> {
+        Self::build(grid, dofs, num_chunks, true)
+    }
+
+    /// As [`Self::new`] without storing the scatter maps: every fill computes them again,
+    /// cell by cell, from the columns (see the module docs). For a single fill, as in a
+    /// linear solve, this saves the maps' memory at little cost in time.
+    pub fn without_stored_maps<const D: usize>(grid: &Grid<D>, dofs: &DofMap<D>) -> Result<Self> {
+        Self::build(grid, dofs, 4 * rayon::current_num_threads(), false)
+    }
+
+    fn build<const D: usize>(
+        grid: &Grid<D>,
+        dofs: &DofMap<D>,
+        num_chunks: usize,
+        store_maps: bool,
     ) -> Result<Self> {
         if dofs.num_dofs() != D * grid.num_nodes() {
             return Err(SimError::Input(format!(
@@ -393,56 +481,30 @@ impl Pattern {
                 }
             });
         // Scatter maps, in parallel blocks of cells.
-        let sizes: Vec<usize> = (0..nc)
-            .map(|c| {
-                let m = D * grid.cell_nodes(c).len();
-                m * (m + 1) / 2
-            })
-            .collect();
-        let scatter_pos = offsets(&sizes);
-        drop(sizes);
-        // Zeroed memory comes from the kernel untouched, so the pages are first written
-        // by the parallel fill (which writes every entry) instead of a serial fill here.
-        let mut scatter = vec![0u32; scatter_pos[nc]];
-        fill_blocks(&mut scatter, &scatter_pos, |cells, out| {
-            let mut eqs = Vec::new();
-            // The cell's free equations with their local dofs, increasing.
-            let mut sorted: Vec<(usize, usize)> = Vec::new();
-            let mut blocks = [(0, 0); MAX_NODES];
-            let mut k = 0;
-            for c in cells {
-                cell_equations(grid, dofs, c, &mut eqs);
-                let m = eqs.len();
-                let map = &mut out[k..k + m * (m + 1) / 2];
-                k += map.len();
-                if let Some(nodes) = node_blocks::<D>(&eqs, Some(&same_cells), &mut blocks) {
-                    scatter_by_nodes::<D>(nodes, &col_ptr, &row_idx, map);
-                    continue;
+        let maps = store_maps.then(|| {
+            let sizes: Vec<usize> = (0..nc)
+                .map(|c| {
+                    let m = D * grid.cell_nodes(c).len();
+                    m * (m + 1) / 2
+                })
+                .collect();
+            let pos = offsets(&sizes);
+            drop(sizes);
+            // Zeroed memory comes from the kernel untouched, so the pages are first written
+            // by the parallel fill (which writes every entry) instead of a serial fill here.
+            let mut map = vec![0u32; pos[nc]];
+            fill_blocks(&mut map, &pos, |cells, out| {
+                let mut buf = ScatterBuffer::default();
+                let mut k = 0;
+                for c in cells {
+                    let m = D * grid.cell_nodes(c).len();
+                    let len = m * (m + 1) / 2;
+                    let cols = (&col_ptr[..], &row_idx[..], &same_cells[..]);
+                    map_cell(grid, dofs, c, cols, &mut buf, &mut out[k..k + len]);
+                    k += len;
                 }
-                map.fill(NONE);
-                sorted.clear();
-                sorted.extend(
-                    eqs.iter()
-                        .enumerate()
-                        .filter(|&(_, &e)| e != usize::MAX)
-                        .map(|(i, &e)| (e, i)),
-                );
-                sorted.sort_unstable();
-                // Column `e_j` holds the rows `e_i ≤ e_j` of the cell in increasing order,
-                // so one forward walk down the column finds them all.
-                for (jj, &(col, j)) in sorted.iter().enumerate() {
-                    let mut p = col_ptr[col];
-                    for &(r, i) in &sorted[..=jj] {
-                        // Invariant: (r, col) was inserted above since both are in cell c,
-                        // and the column ends with its diagonal.
-                        while row_idx[p] < r {
-                            p += 1;
-                        }
-                        let twice = if i != j && r == col { TWICE } else { 0 };
-                        map[upper_pair(i.min(j), i.max(j))] = p as u32 | twice;
-                    }
-                }
-            }
+            });
+            StoredMaps { pos, map }
         });
         // Fill chunks: contiguous columns with about nnz / num_chunks entries each.
         let num_chunks = num_chunks.clamp(1, n.max(1));
@@ -496,8 +558,8 @@ impl Pattern {
             n,
             col_ptr,
             row_idx,
-            scatter_pos,
-            scatter,
+            same_cells,
+            maps,
             chunks,
             chunk_cells,
             num_cells: nc,
@@ -520,10 +582,36 @@ impl Pattern {
     pub fn row_idx(&self) -> &[usize] {
         &self.row_idx
     }
-    /// The scatter map of cell `c`: for the local pair `i ≤ j` at [`upper_pair`]`(i, j)`,
-    /// the value position, with [`TWICE`] set when the pair adds twice; `u32::MAX` = none.
-    pub fn cell_scatter(&self, c: usize) -> &[u32] {
-        &self.scatter[self.scatter_pos[c]..self.scatter_pos[c + 1]]
+    /// Whether the scatter maps are stored ([`Self::new`]) rather than computed by every
+    /// fill ([`Self::without_stored_maps`]).
+    pub fn stores_maps(&self) -> bool {
+        self.maps.is_some()
+    }
+    /// The scatter map of cell `c` of the `grid` and `dofs` the pattern was built for: for
+    /// the local pair `i ≤ j` at [`upper_pair`]`(i, j)`, the value position, with
+    /// [`TWICE`] set when the pair adds twice; `u32::MAX` = none. The stored map, or the
+    /// map computed into `buf`.
+    pub fn cell_map<'a, const D: usize>(
+        &'a self,
+        grid: &Grid<D>,
+        dofs: &DofMap<D>,
+        c: usize,
+        buf: &'a mut ScatterBuffer,
+    ) -> &'a [u32] {
+        if let Some(maps) = &self.maps {
+            return &maps.map[maps.pos[c]..maps.pos[c + 1]];
+        }
+        let m = D * grid.cell_nodes(c).len();
+        let mut map = std::mem::take(&mut buf.map);
+        map.resize(m * (m + 1) / 2, 0);
+        let cols = (&self.col_ptr[..], &self.row_idx[..], &self.same_cells[..]);
+        map_cell(grid, dofs, c, cols, buf, &mut map);
+        buf.map = map;
+        &buf.map
+    }
+    /// Number of cells of the grid the pattern was built for.
+    pub fn num_cells(&self) -> usize {
+        self.num_cells
     }
     /// Number of fill chunks.
     pub fn num_chunks(&self) -> usize {

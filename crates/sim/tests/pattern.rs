@@ -4,7 +4,8 @@
 //! several nodes): every column holds exactly the rows `r ≤ c` that share a cell with `c`,
 //! sorted; and every cell's scatter entry for the local pair `i ≤ j` is the position of
 //! `(min(e_i, e_j), max(e_i, e_j))` when both are free (flagged to add twice when `i < j`
-//! and `e_i = e_j`), `u32::MAX` otherwise.
+//! and `e_i = e_j`), `u32::MAX` otherwise — the stored maps and the maps computed on
+//! demand alike.
 //! Grids: Voronoi polygons (2D), triangles, cubes and tetrahedra (3D) — node-major
 //! equations with 2–8 nodes per cell, which exercises the shortcuts of the builder (the
 //! next component of a node, columns of one node sharing their cells).
@@ -13,8 +14,10 @@ use std::collections::BTreeSet;
 
 use porofrac_grid::generate::{cartesian, simplices, voronoi};
 use porofrac_grid::{Grid, Point};
-use porofrac_sim::pattern::{TWICE, upper_pair};
-use porofrac_sim::{Displacement, DofMap, Pattern, Platen, ScalarField};
+use porofrac_law::Stiffness;
+use porofrac_sim::pattern::{ScatterBuffer, TWICE, upper_pair};
+use porofrac_sim::{Displacement, DofMap, LawMap, Pattern, Platen, ScalarField, assemble};
+use porofrac_vem::VemLaw;
 
 /// Local equations of cell `c` (node-major; `None` when prescribed).
 fn local_equations<const D: usize>(
@@ -34,7 +37,7 @@ fn check<const D: usize>(grid: &Grid<D>, what: &str) {
     let fix = |name: &str, comps: &[usize]| Displacement {
         name: name.into(),
         faces: grid.boundary(name).unwrap(),
-        components: std::array::from_fn(|a| comps.contains(&a).then(|| ScalarField::from(0.0))),
+        components: std::array::from_fn(|a| comps.contains(&a).then(|| ScalarField::from(0.01))),
     };
     let all: Vec<usize> = (0..D).collect();
     let bcs = [fix("xmin", &[0]), fix("ymin", &all)];
@@ -60,8 +63,13 @@ fn check<const D: usize>(grid: &Grid<D>, what: &str) {
             }
         }
     }
-    for chunks in [1, 5] {
-        let pattern = Pattern::with_chunks(grid, &dofs, chunks).unwrap();
+    let patterns = [
+        Pattern::with_chunks(grid, &dofs, 1).unwrap(),
+        Pattern::with_chunks(grid, &dofs, 5).unwrap(),
+        Pattern::without_stored_maps(grid, &dofs).unwrap(),
+    ];
+    let mut buf = ScatterBuffer::default();
+    for pattern in &patterns {
         let (ptr, rows) = (pattern.col_ptr(), pattern.row_idx());
         assert_eq!(pattern.num_equations(), n, "{what}");
         for (c, want) in cols.iter().enumerate() {
@@ -74,7 +82,7 @@ fn check<const D: usize>(grid: &Grid<D>, what: &str) {
         for c in 0..grid.num_cells() {
             let eqs = local_equations(grid, &dofs, c);
             let m = eqs.len();
-            let scatter = pattern.cell_scatter(c);
+            let scatter = pattern.cell_map(grid, &dofs, c, &mut buf);
             assert_eq!(scatter.len(), m * (m + 1) / 2, "{what}: cell {c}");
             for j in 0..m {
                 for i in 0..=j {
@@ -95,6 +103,28 @@ fn check<const D: usize>(grid: &Grid<D>, what: &str) {
                 }
             }
         }
+    }
+    // Fills with stored maps (1 and 5 chunks) and with maps computed on demand: the same
+    // values and forces bit for bit (every entry is summed by one chunk in cell order).
+    let law = VemLaw::new(Stiffness::<D>::isotropic(1.0, 0.3).unwrap());
+    let laws = LawMap::uniform(grid, &law).unwrap();
+    let mut u = vec![0.0; dofs.num_dofs()];
+    dofs.set_prescribed(grid, 0.0, &mut u);
+    let fill = |pattern: &Pattern| {
+        let (mut values, mut forces) = (vec![0.0; pattern.nnz()], vec![0.0; n]);
+        assemble(grid, &laws, &dofs, pattern, &u, &mut values, &mut forces).unwrap();
+        (values, forces)
+    };
+    let first = fill(&patterns[0]);
+    assert!(
+        first.1.iter().any(|&f| f != 0.0),
+        "{what}: prescribed values load"
+    );
+    for pattern in &patterns[1..] {
+        let (values, forces) = fill(pattern);
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&values), bits(&first.0), "{what}: values");
+        assert_eq!(bits(&forces), bits(&first.1), "{what}: forces");
     }
 }
 
