@@ -15,8 +15,6 @@
 //! `upper`, `ratio`, `lanczos`, `omega`, `coarse`, `aggressive`: see `porofrac_amg::AmgOptions`);
 //! `AMG_PRECISION=double` stores the hierarchy's finest matrix in double instead of single
 //! precision (`AmgSolver::set_precision`);
-//! `STORED_MAPS=1` builds the pattern with stored scatter maps ([`Pattern::new`]) instead
-//! of computing them in the one fill ([`Pattern::without_stored_maps`]);
 //! `SYSTEM_HEAP=1` leaves glibc's heap policy as it is instead of keeping freed memory
 //! ([`porofrac_sim::heap`]).
 //!
@@ -84,12 +82,7 @@ fn run<const D: usize>(n: usize, solver: &str, tol: f64, problem: &Manufactured<
     let bc = problem.boundary("boundary", grid.boundary_faces());
     let dofs = DofMap::new(&grid, &[bc], &[]).unwrap();
     trace("dofs");
-    // One fill: the scatter maps are computed by it rather than stored.
-    let pattern = if std::env::var_os("STORED_MAPS").is_some() {
-        Pattern::new(&grid, &dofs).unwrap()
-    } else {
-        Pattern::without_stored_maps(&grid, &dofs).unwrap()
-    };
+    let pattern = Pattern::new(&grid, &dofs).unwrap();
     trace("pattern");
     let law = VemLaw::new(Stiffness::<D>::isotropic(1.0, 0.3).unwrap());
     let laws = LawMap::uniform(&grid, &law).unwrap();

@@ -52,7 +52,7 @@ use crate::bc::Loads;
 use crate::dofs::DofMap;
 use crate::error::{AXES, Result, SimError, fmt_point};
 use crate::laws::LawMap;
-use crate::pattern::{NONE, Pattern, ScatterBuffer, TWICE};
+use crate::pattern::{Pattern, ScatterBuffer};
 use crate::quadrature::{cell_rule, facet_rule, simplex_rule};
 
 /// Per-thread buffers for evaluating cells.
@@ -177,24 +177,15 @@ pub fn assemble<const D: usize>(
                 if !w.k.iter().all(|v| v.is_finite()) {
                     return Err(cell_error(laws, c, "non-finite stiffness".into()));
                 }
-                let (v0, vlen) = (ch.vals.start, vals.len());
-                let scatter = pattern.cell_map(grid, dofs, c, &mut w.map);
-                let kv = w.k.as_slice();
-                let mut q = 0;
-                for j in 0..m {
-                    for i in 0..=j {
-                        let p = scatter[q];
-                        q += 1;
-                        if p == NONE {
-                            continue;
-                        }
-                        let k = ((p & !TWICE) as usize).wrapping_sub(v0);
-                        if k < vlen {
-                            let v = kv[i + m * j];
-                            vals[k] += if p & TWICE != 0 { 2.0 * v } else { v };
-                        }
-                    }
-                }
+                pattern.add_cell(
+                    grid,
+                    dofs,
+                    c,
+                    w.k.as_slice(),
+                    &mut w.map,
+                    ch.vals.start,
+                    vals,
+                );
                 // Internal forces: −K u for linear laws (nothing to do at u = 0), else the law's.
                 if law.is_linear() {
                     if w.u.iter().all(|&x| x == 0.0) {

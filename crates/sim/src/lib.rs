@@ -7,8 +7,7 @@
 //! 2. [`dofs::DofMap`]: dof → equation map; prescribed dofs are eliminated, platen nodes
 //!    share equations; conflicting conditions and free rigid-body modes are errors.
 //! 3. [`pattern::Pattern`]: the sparsity pattern of the reduced stiffness (upper triangle,
-//!    CSC), built once, with per-cell scatter maps (stored, or computed by each fill) for
-//!    a parallel, race-free fill.
+//!    CSC), built once, with per-cell scatter maps for a parallel, race-free fill.
 //! 4. [`assembly`]: reduced stiffness and internal forces from the cell laws
 //!    ([`porofrac_law::CellLaw`], chosen per cell by a [`LawMap`]), and the nodal loads.
 //! 5. [`solve`]: sparse Cholesky with the symbolic factorization reused

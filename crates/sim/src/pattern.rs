@@ -4,25 +4,24 @@
 //! triangle (row ≤ column) is stored, in compressed sparse column (CSC) form as faer
 //! expects it. Entry `(r, c)` is nonzero when equations `r` and `c` share a cell.
 //!
-//! The pattern is built once per grid and dof map. For every cell it stores a *scatter
-//! map* over the pairs `i ≤ j` of its local dofs (the upper triangle of the `D·n × D·n`
-//! local matrix, column by column: pair `(i, j)` at `i + j(j+1)/2`, see [`upper_pair`]):
-//! the position in the values array of global entry `(min(e_i, e_j), max(e_i, e_j))`, or
-//! none when a dof is prescribed. The local matrix is symmetric, so `K_ij` stands for
-//! `K_ji` as well; a pair `i < j` with `e_i = e_j` (two nodes of one platen) adds to the
-//! diagonal twice, which the map marks with its top bit ([`TWICE`]). Filling values is
-//! then a loop over cells with no searching and no triplet buffers, and new values (time
-//! steps, law switches) reuse the pattern. Half the local pairs are stored, and 32 bits
-//! each. A cell whose nodes each own `D` consecutive free equations (no prescribed
-//! component, no platen) is mapped node block by node block: the components of a node lie
-//! in the same cells, so one walk down a column places a whole `D × D` block.
+//! The pattern is built once per grid and dof map, with a *scatter map* for every cell
+//! over the pairs `i ≤ j` of its local dofs (the upper triangle of the `D·n × D·n` local
+//! matrix, column by column: pair `(i, j)` at `i + j(j+1)/2`, see [`upper_pair`]): the
+//! position in the values array of global entry `(min(e_i, e_j), max(e_i, e_j))`, or none
+//! when a dof is prescribed. The local matrix is symmetric, so `K_ij` stands for `K_ji` as
+//! well; a pair `i < j` with `e_i = e_j` (two nodes of one platen) adds to the diagonal
+//! twice, which the map marks with its top bit ([`TWICE`]). Filling values is then a loop
+//! over cells with no searching and no triplet buffers, and new values (time steps, law
+//! switches) reuse the pattern.
 //!
-//! The maps are a cache: [`Pattern::new`] stores them (4 bytes per local pair, 168 MB for
-//! the 2 M triangles of E2 n = 1000), which suits repeated fills; a pattern built by
-//! [`Pattern::without_stored_maps`] keeps only the columns and every fill computes each
-//! cell's map again by the same column walks ([`Pattern::cell_map`]), with the same values
-//! bit for bit. For a single fill, as in a linear solve, that is the cheaper choice: the
-//! walks cost about what building the stored maps does.
+//! A cell whose nodes each own `D` consecutive free equations (no prescribed component, no
+//! platen) is mapped node block by node block: the components of a node lie in the same
+//! cells, so one walk down a column places a whole `D × D` block, and only one column
+//! offset per pair of nodes is stored (the position of the first row of node `i` in the
+//! first column of node `j`; the rest of the block and the diagonal blocks follow from the
+//! column offsets): 3 entries for a triangle and 6 for a tetrahedron instead of 21 and 78
+//! pairs. The other cells store the full map, 32 bits per pair. At E2 n = 1000 (2 M
+//! triangles) the maps take 24 MB instead of 168 MB.
 //!
 //! # Parallel fill
 //!
@@ -63,29 +62,27 @@ pub(crate) struct Chunk {
     pub(crate) cells: Range<usize>,
 }
 
-/// Upper-triangular CSC pattern of the reduced stiffness, with per-cell scatter maps
-/// stored or computed on demand.
+/// Upper-triangular CSC pattern of the reduced stiffness with per-cell scatter maps.
 #[derive(Clone, Debug)]
 pub struct Pattern {
     n: usize,
     col_ptr: Vec<usize>,
     row_idx: Vec<usize>,
-    /// Whether equation `e` lies in the same cells as `e − 1` (another component of a node).
-    same_cells: Vec<bool>,
-    maps: Option<StoredMaps>,
+    maps: StoredMaps,
     pub(crate) chunks: Vec<Chunk>,
     pub(crate) chunk_cells: Vec<usize>,
     num_cells: usize,
 }
 
-/// The scatter maps of all cells, one after the other.
+/// The scatter maps of all cells, one after the other: a column offset per pair of nodes
+/// for a cell mapped by node blocks, the full upper triangle of positions otherwise.
 #[derive(Clone, Debug)]
 struct StoredMaps {
     pos: Vec<usize>,
     map: Vec<u32>,
 }
 
-/// Buffers for computing a cell's scatter map ([`Pattern::cell_map`]).
+/// Buffers for reading a cell's scatter map ([`Pattern::cell_map`]).
 #[derive(Debug, Default)]
 pub struct ScatterBuffer {
     eqs: Vec<usize>,
@@ -126,6 +123,9 @@ fn node_blocks<'a, const D: usize>(
     if n > MAX_NODES {
         return None;
     }
+    // Sort keys `e0 · 32 + k` (equations are below 2³¹, `k` below 32), sorted by
+    // insertion: a cell has a handful of nodes.
+    let mut keys = [0u64; MAX_NODES];
     for (k, e) in eqs.chunks_exact(D).enumerate() {
         let e0 = e[0];
         let breaks =
@@ -133,48 +133,79 @@ fn node_blocks<'a, const D: usize>(
         if e0 == usize::MAX || (1..D).any(breaks) {
             return None;
         }
-        nodes[k] = (e0, k);
+        let key = ((e0 as u64) << 5) | k as u64;
+        let mut j = k;
+        while j > 0 && keys[j - 1] > key {
+            keys[j] = keys[j - 1];
+            j -= 1;
+        }
+        keys[j] = key;
     }
     let nodes = &mut nodes[..n];
-    nodes.sort_unstable();
+    for (node, &key) in nodes.iter_mut().zip(&keys) {
+        *node = ((key >> 5) as usize, (key & 31) as usize);
+    }
     nodes
         .windows(2)
         .all(|w| w[1].0 >= w[0].0 + D)
         .then_some(&*nodes)
 }
 
-/// The scatter map of a cell whose nodes passed [`node_blocks`], node block by node block.
+/// The stored map of a cell whose nodes passed [`node_blocks`]: for each pair of nodes
+/// `ii < jj` (in the sorted order, at `jj(jj − 1)/2 + ii`), the offset of row `e_ii` in
+/// column `e_jj`.
 ///
 /// The components `b` of node `k` (equations `e_k + b`) lie in the same cells, so column
 /// `e_k + b` holds the rows of column `e_k` below `e_k` at the same offsets, then `e_k …
-/// e_k + b` last: the rows `e_j + a` of an earlier node `j` are found by one walk down
-/// column `e_k` for the whole `D × D` block.
-fn scatter_by_nodes<const D: usize>(
+/// e_k + b` last: one offset places the whole `D × D` block of a pair of nodes, and the
+/// diagonal blocks are the ends of the columns ([`for_each_by_nodes`]).
+fn offsets_by_nodes(
     nodes: &[(usize, usize)],
     col_ptr: &[usize],
     row_idx: &[usize],
-    map: &mut [u32],
+    out: &mut [u32],
 ) {
-    for (jj, &(eb, kb)) in nodes.iter().enumerate() {
-        for b in 0..D {
-            let end = col_ptr[eb + b + 1];
-            for a in 0..=b {
-                map[upper_pair(D * kb + a, D * kb + b)] = (end - 1 - (b - a)) as u32;
-            }
-        }
+    let mut q = 0;
+    for (jj, &(eb, _)) in nodes.iter().enumerate() {
         let c0 = col_ptr[eb];
         let mut p = c0;
-        for &(ea, ka) in &nodes[..jj] {
+        for &(ea, _) in &nodes[..jj] {
             // Invariant: row ea is in column eb (a cell holds both), rows sorted.
             while row_idx[p] < ea {
                 p += 1;
             }
-            let delta = p - c0;
+            out[q] = (p - c0) as u32;
+            q += 1;
+        }
+    }
+}
+
+/// `f(i, j, p)` for every local pair `i ≤ j` of a cell mapped by node blocks, with `p`
+/// the value position of its entry (see [`offsets_by_nodes`]). Every pair has its own
+/// entry: the equations of the cell are distinct.
+#[inline]
+fn for_each_by_nodes<const D: usize>(
+    nodes: &[(usize, usize)],
+    col_ptr: &[usize],
+    offsets: &[u32],
+    mut f: impl FnMut(usize, usize, usize),
+) {
+    let mut q = 0;
+    for (jj, &(eb, kb)) in nodes.iter().enumerate() {
+        for b in 0..D {
+            let end = col_ptr[eb + b + 1];
+            for a in 0..=b {
+                f(D * kb + a, D * kb + b, end - 1 - (b - a));
+            }
+        }
+        for &(_, ka) in &nodes[..jj] {
+            let delta = offsets[q] as usize;
+            q += 1;
             for b in 0..D {
                 let base = col_ptr[eb + b] + delta;
                 for a in 0..D {
                     let (i, j) = (D * ka + a, D * kb + b);
-                    map[upper_pair(i.min(j), i.max(j))] = (base + a) as u32;
+                    f(i.min(j), i.max(j), base + a);
                 }
             }
         }
@@ -182,26 +213,42 @@ fn scatter_by_nodes<const D: usize>(
 }
 
 /// The column structure a scatter map is read from: column offsets, row indices and
-/// [`Pattern::same_cells`].
+/// whether each equation lies in the same cells as the one before it.
 type Columns<'a> = (&'a [usize], &'a [usize], &'a [bool]);
 
-/// Write the scatter map of cell `c` into `map` (length `m(m + 1)/2` for `m` local dofs).
-fn map_cell<const D: usize>(
+/// Length of the stored map of cell `c` (`buf.eqs` receives its equations).
+fn stored_len<const D: usize>(
+    grid: &Grid<D>,
+    dofs: &DofMap<D>,
+    c: usize,
+    same_cells: &[bool],
+    buf: &mut ScatterBuffer,
+) -> usize {
+    cell_equations(grid, dofs, c, &mut buf.eqs);
+    let m = buf.eqs.len();
+    match node_blocks::<D>(&buf.eqs, Some(same_cells), &mut buf.blocks) {
+        Some(nodes) => nodes.len() * (nodes.len() - 1) / 2,
+        None => m * (m + 1) / 2,
+    }
+}
+
+/// Write the stored map of cell `c` into `out` (of [`stored_len`]).
+fn store_cell<const D: usize>(
     grid: &Grid<D>,
     dofs: &DofMap<D>,
     c: usize,
     (col_ptr, row_idx, same_cells): Columns<'_>,
     buf: &mut ScatterBuffer,
-    map: &mut [u32],
+    out: &mut [u32],
 ) {
     cell_equations(grid, dofs, c, &mut buf.eqs);
     let eqs = &buf.eqs;
-    debug_assert_eq!(map.len(), eqs.len() * (eqs.len() + 1) / 2);
     if let Some(nodes) = node_blocks::<D>(eqs, Some(same_cells), &mut buf.blocks) {
-        scatter_by_nodes::<D>(nodes, col_ptr, row_idx, map);
+        offsets_by_nodes(nodes, col_ptr, row_idx, out);
         return;
     }
-    map.fill(NONE);
+    debug_assert_eq!(out.len(), eqs.len() * (eqs.len() + 1) / 2);
+    out.fill(NONE);
     let sorted = &mut buf.sorted;
     sorted.clear();
     sorted.extend(
@@ -222,7 +269,7 @@ fn map_cell<const D: usize>(
                 p += 1;
             }
             let twice = if i != j && r == col { TWICE } else { 0 };
-            map[upper_pair(i.min(j), i.max(j))] = p as u32 | twice;
+            out[upper_pair(i.min(j), i.max(j))] = p as u32 | twice;
         }
     }
 }
@@ -282,22 +329,6 @@ impl Pattern {
         grid: &Grid<D>,
         dofs: &DofMap<D>,
         num_chunks: usize,
-    ) -> Result<Self> {
-        Self::build(grid, dofs, num_chunks, true)
-    }
-
-    /// As [`Self::new`] without storing the scatter maps: every fill computes them again,
-    /// cell by cell, from the columns (see the module docs). For a single fill, as in a
-    /// linear solve, this saves the maps' memory at little cost in time.
-    pub fn without_stored_maps<const D: usize>(grid: &Grid<D>, dofs: &DofMap<D>) -> Result<Self> {
-        Self::build(grid, dofs, 4 * rayon::current_num_threads(), false)
-    }
-
-    fn build<const D: usize>(
-        grid: &Grid<D>,
-        dofs: &DofMap<D>,
-        num_chunks: usize,
-        store_maps: bool,
     ) -> Result<Self> {
         if dofs.num_dofs() != D * grid.num_nodes() {
             return Err(SimError::Input(format!(
@@ -480,32 +511,28 @@ impl Pattern {
                     *same = c > 0 && cells_of(c) == cells_of(c - 1);
                 }
             });
-        // Scatter maps, in parallel blocks of cells.
-        let maps = store_maps.then(|| {
-            let sizes: Vec<usize> = (0..nc)
-                .map(|c| {
-                    let m = D * grid.cell_nodes(c).len();
-                    m * (m + 1) / 2
-                })
-                .collect();
-            let pos = offsets(&sizes);
-            drop(sizes);
-            // Zeroed memory comes from the kernel untouched, so the pages are first written
-            // by the parallel fill (which writes every entry) instead of a serial fill here.
-            let mut map = vec![0u32; pos[nc]];
-            fill_blocks(&mut map, &pos, |cells, out| {
-                let mut buf = ScatterBuffer::default();
-                let mut k = 0;
-                for c in cells {
-                    let m = D * grid.cell_nodes(c).len();
-                    let len = m * (m + 1) / 2;
-                    let cols = (&col_ptr[..], &row_idx[..], &same_cells[..]);
-                    map_cell(grid, dofs, c, cols, &mut buf, &mut out[k..k + len]);
-                    k += len;
-                }
-            });
-            StoredMaps { pos, map }
+        // Scatter maps: the lengths, then the maps, in parallel blocks of cells.
+        let sizes: Vec<usize> = (0..nc)
+            .into_par_iter()
+            .map_init(ScatterBuffer::default, |buf, c| {
+                stored_len(grid, dofs, c, &same_cells, buf)
+            })
+            .collect();
+        let pos = offsets(&sizes);
+        drop(sizes);
+        // Zeroed memory comes from the kernel untouched, so the pages are first written
+        // by the parallel fill (which writes every entry) instead of a serial fill here.
+        let mut map = vec![0u32; pos[nc]];
+        fill_blocks(&mut map, &pos, |cells, out| {
+            let mut buf = ScatterBuffer::default();
+            let cols = (&col_ptr[..], &row_idx[..], &same_cells[..]);
+            let first = pos[cells.start];
+            for c in cells {
+                let at = pos[c] - first..pos[c + 1] - first;
+                store_cell(grid, dofs, c, cols, &mut buf, &mut out[at]);
+            }
         });
+        let maps = StoredMaps { pos, map };
         // Fill chunks: contiguous columns with about nnz / num_chunks entries each.
         let num_chunks = num_chunks.clamp(1, n.max(1));
         let mut bounds = vec![0usize];
@@ -558,7 +585,6 @@ impl Pattern {
             n,
             col_ptr,
             row_idx,
-            same_cells,
             maps,
             chunks,
             chunk_cells,
@@ -582,32 +608,78 @@ impl Pattern {
     pub fn row_idx(&self) -> &[usize] {
         &self.row_idx
     }
-    /// Whether the scatter maps are stored ([`Self::new`]) rather than computed by every
-    /// fill ([`Self::without_stored_maps`]).
-    pub fn stores_maps(&self) -> bool {
-        self.maps.is_some()
-    }
-    /// The scatter map of cell `c` of the `grid` and `dofs` the pattern was built for: for
-    /// the local pair `i ≤ j` at [`upper_pair`]`(i, j)`, the value position, with
-    /// [`TWICE`] set when the pair adds twice; `u32::MAX` = none. The stored map, or the
-    /// map computed into `buf`.
+    /// The scatter map of cell `c` of the `grid` and `dofs` the pattern was built for,
+    /// written to `buf`: for the local pair `i ≤ j` at [`upper_pair`]`(i, j)`, the value
+    /// position, with [`TWICE`] set when the pair adds twice; `u32::MAX` = none.
     pub fn cell_map<'a, const D: usize>(
-        &'a self,
+        &self,
         grid: &Grid<D>,
         dofs: &DofMap<D>,
         c: usize,
         buf: &'a mut ScatterBuffer,
     ) -> &'a [u32] {
-        if let Some(maps) = &self.maps {
-            return &maps.map[maps.pos[c]..maps.pos[c + 1]];
-        }
-        let m = D * grid.cell_nodes(c).len();
+        let stored = &self.maps.map[self.maps.pos[c]..self.maps.pos[c + 1]];
+        cell_equations(grid, dofs, c, &mut buf.eqs);
+        let m = buf.eqs.len();
         let mut map = std::mem::take(&mut buf.map);
-        map.resize(m * (m + 1) / 2, 0);
-        let cols = (&self.col_ptr[..], &self.row_idx[..], &self.same_cells[..]);
-        map_cell(grid, dofs, c, cols, buf, &mut map);
+        map.clear();
+        let by_nodes = stored.len() != m * (m + 1) / 2;
+        match node_blocks::<D>(&buf.eqs, None, &mut buf.blocks).filter(|_| by_nodes) {
+            Some(nodes) => {
+                map.resize(m * (m + 1) / 2, NONE);
+                for_each_by_nodes::<D>(nodes, &self.col_ptr, stored, |i, j, p| {
+                    map[upper_pair(i, j)] = p as u32;
+                });
+            }
+            None => map.extend_from_slice(stored),
+        }
         buf.map = map;
         &buf.map
+    }
+    /// Add the upper triangle of cell `c`'s local matrix `k` (`m × m`, column-major) into
+    /// `vals`, which holds the values from position `v0` on; entries outside are skipped.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn add_cell<const D: usize>(
+        &self,
+        grid: &Grid<D>,
+        dofs: &DofMap<D>,
+        c: usize,
+        k: &[f64],
+        buf: &mut ScatterBuffer,
+        v0: usize,
+        vals: &mut [f64],
+    ) {
+        let stored = &self.maps.map[self.maps.pos[c]..self.maps.pos[c + 1]];
+        cell_equations(grid, dofs, c, &mut buf.eqs);
+        let m = buf.eqs.len();
+        let vlen = vals.len();
+        // A full map has m(m + 1)/2 entries, more than the n(n − 1)/2 of a node-block map
+        // (m = D n), and the builder checked the column structure of node-block cells.
+        let by_nodes = stored.len() != m * (m + 1) / 2;
+        if by_nodes && let Some(nodes) = node_blocks::<D>(&buf.eqs, None, &mut buf.blocks) {
+            for_each_by_nodes::<D>(nodes, &self.col_ptr, stored, |i, j, p| {
+                let at = p.wrapping_sub(v0);
+                if at < vlen {
+                    vals[at] += k[i + m * j];
+                }
+            });
+            return;
+        }
+        let mut q = 0;
+        for j in 0..m {
+            for i in 0..=j {
+                let p = stored[q];
+                q += 1;
+                if p == NONE {
+                    continue;
+                }
+                let at = ((p & !TWICE) as usize).wrapping_sub(v0);
+                if at < vlen {
+                    let v = k[i + m * j];
+                    vals[at] += if p & TWICE != 0 { 2.0 * v } else { v };
+                }
+            }
+        }
     }
     /// Number of cells of the grid the pattern was built for.
     pub fn num_cells(&self) -> usize {

@@ -4,17 +4,19 @@
 //! several nodes): every column holds exactly the rows `r ≤ c` that share a cell with `c`,
 //! sorted; and every cell's scatter entry for the local pair `i ≤ j` is the position of
 //! `(min(e_i, e_j), max(e_i, e_j))` when both are free (flagged to add twice when `i < j`
-//! and `e_i = e_j`), `u32::MAX` otherwise — the stored maps and the maps computed on
-//! demand alike.
+//! and `e_i = e_j`), `u32::MAX` otherwise. Fills with different chunk counts agree bit
+//! for bit.
 //! Grids: Voronoi polygons (2D), triangles, cubes and tetrahedra (3D) — node-major
 //! equations with 2–8 nodes per cell, which exercises the shortcuts of the builder (the
 //! next component of a node, columns of one node sharing their cells).
 
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
+
+use nalgebra::DMatrix;
 
 use porofrac_grid::generate::{cartesian, simplices, voronoi};
 use porofrac_grid::{Grid, Point};
-use porofrac_law::Stiffness;
+use porofrac_law::{CellLaw, GeometryBuffer, Scratch, Stiffness};
 use porofrac_sim::pattern::{ScatterBuffer, TWICE, upper_pair};
 use porofrac_sim::{Displacement, DofMap, LawMap, Pattern, Platen, ScalarField, assemble};
 use porofrac_vem::VemLaw;
@@ -66,7 +68,7 @@ fn check<const D: usize>(grid: &Grid<D>, what: &str) {
     let patterns = [
         Pattern::with_chunks(grid, &dofs, 1).unwrap(),
         Pattern::with_chunks(grid, &dofs, 5).unwrap(),
-        Pattern::without_stored_maps(grid, &dofs).unwrap(),
+        Pattern::with_chunks(grid, &dofs, 13).unwrap(),
     ];
     let mut buf = ScatterBuffer::default();
     for pattern in &patterns {
@@ -104,8 +106,8 @@ fn check<const D: usize>(grid: &Grid<D>, what: &str) {
             }
         }
     }
-    // Fills with stored maps (1 and 5 chunks) and with maps computed on demand: the same
-    // values and forces bit for bit (every entry is summed by one chunk in cell order).
+    // Fills with 1, 5 and 13 chunks: the same values and forces bit for bit (every entry
+    // is summed by one chunk in cell order).
     let law = VemLaw::new(Stiffness::<D>::isotropic(1.0, 0.3).unwrap());
     let laws = LawMap::uniform(grid, &law).unwrap();
     let mut u = vec![0.0; dofs.num_dofs()];
@@ -116,6 +118,39 @@ fn check<const D: usize>(grid: &Grid<D>, what: &str) {
         (values, forces)
     };
     let first = fill(&patterns[0]);
+    // The values against a brute-force sum of the local upper triangles.
+    let mut want: BTreeMap<(usize, usize), f64> = BTreeMap::new();
+    let (mut geo, mut scratch, mut k) = (
+        GeometryBuffer::default(),
+        Scratch::default(),
+        DMatrix::zeros(0, 0),
+    );
+    for c in 0..grid.num_cells() {
+        let eqs = local_equations(grid, &dofs, c);
+        let cell = geo.load(grid, c);
+        law.stiffness(&cell, &vec![0.0; eqs.len()], &mut k, &mut scratch);
+        for j in 0..eqs.len() {
+            for i in 0..=j {
+                if let (Some(ei), Some(ej)) = (eqs[i], eqs[j]) {
+                    let twice = if i != j && ei == ej { 2.0 } else { 1.0 };
+                    *want.entry((ei.min(ej), ei.max(ej))).or_default() += twice * k[(i, j)];
+                }
+            }
+        }
+    }
+    let (ptr, rows) = (patterns[0].col_ptr(), patterns[0].row_idx());
+    let scale = want.values().fold(0.0f64, |m, v| m.max(v.abs()));
+    for col in 0..n {
+        for p in ptr[col]..ptr[col + 1] {
+            let w = want.get(&(rows[p], col)).copied().unwrap_or(0.0);
+            assert!(
+                (first.0[p] - w).abs() <= 1e-13 * scale,
+                "{what}: entry ({}, {col}) = {}, brute force {w}",
+                rows[p],
+                first.0[p]
+            );
+        }
+    }
     assert!(
         first.1.iter().any(|&f| f != 0.0),
         "{what}: prescribed values load"
