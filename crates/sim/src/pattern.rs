@@ -106,6 +106,9 @@ pub(crate) fn cell_equations<const D: usize>(
     }
 }
 
+/// `(first equation, local node)` of a node whose components are consecutive equations.
+type NodeBlock = (usize, usize);
+
 /// The most nodes of a cell the node-block paths handle.
 const MAX_NODES: usize = 32;
 
@@ -618,13 +621,11 @@ impl Pattern {
         c: usize,
         buf: &'a mut ScatterBuffer,
     ) -> &'a [u32] {
-        let stored = &self.maps.map[self.maps.pos[c]..self.maps.pos[c + 1]];
-        cell_equations(grid, dofs, c, &mut buf.eqs);
+        let (stored, nodes) = self.stored_map(grid, dofs, c, &mut buf.eqs, &mut buf.blocks);
         let m = buf.eqs.len();
         let mut map = std::mem::take(&mut buf.map);
         map.clear();
-        let by_nodes = stored.len() != m * (m + 1) / 2;
-        match node_blocks::<D>(&buf.eqs, None, &mut buf.blocks).filter(|_| by_nodes) {
+        match nodes {
             Some(nodes) => {
                 map.resize(m * (m + 1) / 2, NONE);
                 for_each_by_nodes::<D>(nodes, &self.col_ptr, stored, |i, j, p| {
@@ -635,6 +636,28 @@ impl Pattern {
         }
         buf.map = map;
         &buf.map
+    }
+    /// The stored map of cell `c` and, for a cell mapped by node blocks, its sorted nodes;
+    /// `eqs` receives the cell's equations. A full map has `m(m + 1)/2` entries, more than
+    /// the `n(n − 1)/2` of a node-block map (`m = D n`), so the length tells the format;
+    /// the builder checked the column structure of node-block cells.
+    fn stored_map<'s, 'b, const D: usize>(
+        &'s self,
+        grid: &Grid<D>,
+        dofs: &DofMap<D>,
+        c: usize,
+        eqs: &mut Vec<usize>,
+        blocks: &'b mut [(usize, usize); MAX_NODES],
+    ) -> (&'s [u32], Option<&'b [NodeBlock]>) {
+        let stored = &self.maps.map[self.maps.pos[c]..self.maps.pos[c + 1]];
+        cell_equations(grid, dofs, c, eqs);
+        let m = eqs.len();
+        let nodes = if stored.len() == m * (m + 1) / 2 {
+            None
+        } else {
+            node_blocks::<D>(eqs, None, blocks)
+        };
+        (stored, nodes)
     }
     /// Add the upper triangle of cell `c`'s local matrix `k` (`m × m`, column-major) into
     /// `vals`, which holds the values from position `v0` on; entries outside are skipped.
@@ -649,14 +672,10 @@ impl Pattern {
         v0: usize,
         vals: &mut [f64],
     ) {
-        let stored = &self.maps.map[self.maps.pos[c]..self.maps.pos[c + 1]];
-        cell_equations(grid, dofs, c, &mut buf.eqs);
+        let (stored, nodes) = self.stored_map(grid, dofs, c, &mut buf.eqs, &mut buf.blocks);
         let m = buf.eqs.len();
         let vlen = vals.len();
-        // A full map has m(m + 1)/2 entries, more than the n(n − 1)/2 of a node-block map
-        // (m = D n), and the builder checked the column structure of node-block cells.
-        let by_nodes = stored.len() != m * (m + 1) / 2;
-        if by_nodes && let Some(nodes) = node_blocks::<D>(&buf.eqs, None, &mut buf.blocks) {
+        if let Some(nodes) = nodes {
             for_each_by_nodes::<D>(nodes, &self.col_ptr, stored, |i, j, p| {
                 let at = p.wrapping_sub(v0);
                 if at < vlen {
