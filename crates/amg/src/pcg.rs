@@ -232,8 +232,13 @@ impl Amg {
         })
     }
 
-    /// `r = b − A x` with the operator of [`Self::fine_product`].
+    /// `r = b − A x` with the operator of [`Self::fine_product`] (`r = b` without a
+    /// product when `x = 0`, the usual first guess).
     fn fine_residual(&mut self, upper: Option<&[f64]>, b: &[f64], x: &[f64], r: &mut [f64]) {
+        if x.iter().all(|&v| v == 0.0) {
+            r.copy_from_slice(b);
+            return;
+        }
         let _ = self.fine_product(upper, x, r);
         par_rows(r, |i, ri| *ri = b[i] - *ri);
     }

@@ -153,9 +153,21 @@ impl<const D: usize> Grid<D> {
     /// `Σ_i N_i ⊗ x_i = |K| I` holds exactly (the discrete divergence theorem behind the
     /// VEM consistency and the Biot `div_d`; seed eqs. 24–26).
     /// In 2D this is `N_i = ½ R(x_{i+1} − x_{i−1})`, R the clockwise rotation.
+    ///
+    /// On a simplex the face integrals have the closed form `N_i = |K| ∇λ_i` (λ the
+    /// barycentric coordinates), computed from the node coordinates alone.
     pub fn cell_node_normals(&self, c: usize, out: &mut [Point<D>]) {
         let cn = self.cell_nodes(c);
         assert_eq!(out.len(), cn.len(), "cell_node_normals: output length");
+        if cn.len() == D + 1 && self.simplex_node_normals(c, out) {
+            return;
+        }
+        self.face_node_normals(c, out);
+    }
+
+    /// [`Self::cell_node_normals`] by the facets of the cell's faces (any cell).
+    fn face_node_normals(&self, c: usize, out: &mut [Point<D>]) {
+        let cn = self.cell_nodes(c);
         out.iter_mut().for_each(|q| *q = Point::<D>::zeros());
         const STACK: usize = 32;
         let mut pts = [Point::<D>::zeros(); STACK];
@@ -199,6 +211,27 @@ impl<const D: usize> Grid<D> {
                 }
             });
         }
+    }
+
+    /// `N_i = |K| ∇λ_i` of simplex `c`: with the edge matrix `J = [x_1 − x_0, …, x_D − x_0]`,
+    /// `∇λ_k` is row `k − 1` of `J⁻¹` for `k ≥ 1` and `∇λ_0 = −Σ_k ∇λ_k`, so
+    /// `Σ_i N_i ⊗ x_i = |K| J⁻ᵀ Jᵀ = |K| I`. False (nothing written) for a singular `J`.
+    fn simplex_node_normals(&self, c: usize, out: &mut [Point<D>]) -> bool {
+        let cn = self.cell_nodes(c);
+        let x0 = self.nodes[cn[0]];
+        let j = nalgebra::SMatrix::<f64, D, D>::from_fn(|r, k| self.nodes[cn[k + 1]][r] - x0[r]);
+        let Some(inv) = j.try_inverse() else {
+            return false;
+        };
+        let vol = self.cell_volume(c);
+        let mut sum = Point::<D>::zeros();
+        for k in 0..D {
+            let nk = inv.row(k).transpose() * vol;
+            out[k + 1] = nk;
+            sum += nk;
+        }
+        out[0] = -sum;
+        true
     }
 
     /// Named cell tags (e.g. `well`, or the physical groups of an imported mesh).
@@ -295,5 +328,39 @@ impl<const D: usize> Grid<D> {
         n.sort_unstable();
         n.dedup();
         n
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::Point;
+    use crate::generate::{perturb, simplices};
+
+    /// The closed form on simplices agrees with the face integrals.
+    #[test]
+    fn simplex_node_normals_match_the_face_integrals() {
+        fn check<const D: usize>(g: &crate::Grid<D>) {
+            let (mut a, mut b) = (
+                vec![Point::<D>::zeros(); D + 1],
+                vec![Point::<D>::zeros(); D + 1],
+            );
+            for c in 0..g.num_cells() {
+                assert!(g.simplex_node_normals(c, &mut a));
+                g.face_node_normals(c, &mut b);
+                let scale = b.iter().map(|v| v.norm()).sum::<f64>();
+                for (x, y) in a.iter().zip(&b) {
+                    assert!((x - y).norm() <= 1e-13 * scale, "cell {c}: {x} against {y}");
+                }
+            }
+        }
+        let g2 = simplices(Point::<2>::zeros(), Point::<2>::new(2.0, 1.0), [7, 5]).unwrap();
+        check(&perturb(&g2, 0.3, 7).unwrap());
+        let g3 = simplices(
+            Point::<3>::zeros(),
+            Point::<3>::new(1.0, 2.0, 0.5),
+            [3, 4, 2],
+        )
+        .unwrap();
+        check(&perturb(&g3, 0.3, 11).unwrap());
     }
 }

@@ -338,6 +338,10 @@ impl<const D: usize> VemLaw<D> {
         out: &mut DMatrix<f64>,
         scratch: &mut Scratch,
     ) {
+        if let (true, Some((lam, mu))) = (cell.coords.len() == D + 1, self.lame) {
+            isotropic_simplex(cell, lam, mu, out);
+            return;
+        }
         let f = Frame::<D>::new(cell);
         let n = f.n;
         let nd = D * n;
@@ -349,6 +353,9 @@ impl<const D: usize> VemLaw<D> {
         // Isotropic materials skip T: (A_c)_jk = (λ N_j N_kᵀ + μ N_k N_jᵀ + μ (N_j·N_k) I)/|K|.
         let d3 = if self.lame.is_some() { 0 } else { D * D * D };
         let stride = 2 * D + d3;
+        // On a simplex `P = I` (module docs): no stabilization term, and its per-node
+        // data are not needed.
+        let simplex = n == D + 1;
         let buf = &mut scratch.vecs[0];
         buf.clear();
         buf.resize(n * stride, 0.0);
@@ -356,11 +363,13 @@ impl<const D: usize> VemLaw<D> {
         for j in 0..n {
             let sj = &mut buf[j * stride..(j + 1) * stride];
             let nj = &normals[j];
-            let dj = f.d(&cell.coords[j]);
-            let mn = f.m * nj * inv_vol2;
-            for a in 0..D {
-                sj[a] = dj[a];
-                sj[D + a] = mn[a];
+            if !simplex {
+                let dj = f.d(&cell.coords[j]);
+                let mn = f.m * nj * inv_vol2;
+                for a in 0..D {
+                    sj[a] = dj[a];
+                    sj[D + a] = mn[a];
+                }
             }
             if d3 > 0 {
                 let t = &mut sj[2 * D..];
@@ -377,7 +386,11 @@ impl<const D: usize> VemLaw<D> {
                 }
             }
         }
-        let w = self.weights(cell, &f);
+        let w = if simplex {
+            StabWeights::Uniform(0.0)
+        } else {
+            self.weights(cell, &f)
+        };
         let alpha = match w {
             StabWeights::Uniform(a) => a,
             StabWeights::Diagonal { .. } => 0.0,
@@ -395,14 +408,18 @@ impl<const D: usize> VemLaw<D> {
                 let nk = &normals[k];
                 // Uniform stabilization: α s_jk on the diagonal of the block,
                 // s_jk = δ_jk − 1/n − (d_j·N_k + d_k·N_j)/|K| + N_jᵀ M N_k/|K|².
-                let (mut djnk, mut dknj, mut mnk) = (0.0, 0.0, 0.0);
-                for c in 0..D {
-                    djnk += sj[c] * nk[c];
-                    dknj += sk[c] * nj[c];
-                    mnk += sj[D + c] * nk[c];
-                }
-                let delta = if j == k { 1.0 } else { 0.0 };
-                let stab = alpha * (delta - inv_n - (djnk + dknj) * f.inv_vol + mnk);
+                let stab = if simplex {
+                    0.0
+                } else {
+                    let (mut djnk, mut dknj, mut mnk) = (0.0, 0.0, 0.0);
+                    for c in 0..D {
+                        djnk += sj[c] * nk[c];
+                        dknj += sk[c] * nj[c];
+                        mnk += sj[D + c] * nk[c];
+                    }
+                    let delta = if j == k { 1.0 } else { 0.0 };
+                    alpha * (delta - inv_n - (djnk + dknj) * f.inv_vol + mnk)
+                };
                 let mut block = Tensor::<D>::zeros();
                 if d3 == 0 {
                     let nn = mu * nj.dot(nk) + stab;
@@ -556,6 +573,44 @@ impl<const D: usize> CellLaw<D> for VemLaw<D> {
         let f = Frame::new(cell);
         let (_, g) = Self::kinematics(cell, &f, u);
         from_kelvin::<D>(&self.material.stress_kelvin(&to_kelvin::<D>(&g)))
+    }
+}
+
+/// The local stiffness of an isotropic material on a simplex, where `P = I` leaves only
+/// the consistency part (the P1 element): blocks
+/// `(λ N_j N_kᵀ + μ N_k N_jᵀ + μ (N_j·N_k) I)/|K|`, each entry written once per pair
+/// `j ≤ k` and mirrored (the matrix is symmetric bit for bit).
+fn isotropic_simplex<const D: usize>(
+    cell: &CellGeometry<'_, D>,
+    lam: f64,
+    mu: f64,
+    out: &mut DMatrix<f64>,
+) {
+    let n = cell.coords.len();
+    let nd = D * n;
+    if out.nrows() != nd || out.ncols() != nd {
+        zero_matrix(out, nd, nd);
+    }
+    let inv_vol = 1.0 / cell.volume;
+    let (lam, mu) = (lam * inv_vol, mu * inv_vol);
+    let normals = cell.node_normals;
+    let o = out.as_mut_slice();
+    for j in 0..n {
+        let nj = &normals[j];
+        for k in j..n {
+            let nk = &normals[k];
+            let nn = mu * nj.dot(nk);
+            for b in 0..D {
+                for a in 0..D {
+                    let mut v = lam * nj[a] * nk[b] + mu * nk[a] * nj[b];
+                    if a == b {
+                        v += nn;
+                    }
+                    o[(D * k + b) * nd + D * j + a] = v;
+                    o[(D * j + a) * nd + D * k + b] = v;
+                }
+            }
+        }
     }
 }
 
