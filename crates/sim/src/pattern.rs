@@ -558,8 +558,19 @@ impl Pattern {
             .map(|b| {
                 let mut lists = vec![Vec::new(); nch];
                 for c in b * BLOCK..((b + 1) * BLOCK).min(nc) {
+                    let eqs = eqs_of(c);
+                    // The equations are sorted: a cell inside one chunk (most) is seen
+                    // from its first and last equation.
+                    let (Some(&lo), Some(&hi)) = (eqs.first(), eqs.last()) else {
+                        continue;
+                    };
+                    let k = chunk_of(lo);
+                    if hi < bounds[k + 1] {
+                        lists[k].push(c);
+                        continue;
+                    }
                     let mut last = usize::MAX;
-                    for &e in eqs_of(c) {
+                    for &e in eqs {
                         let k = chunk_of(e);
                         if k != last {
                             lists[k].push(c);
