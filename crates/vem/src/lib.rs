@@ -422,13 +422,7 @@ impl<const D: usize> VemLaw<D> {
                 };
                 let mut block = Tensor::<D>::zeros();
                 if d3 == 0 {
-                    let nn = mu * nj.dot(nk) + stab;
-                    for b in 0..D {
-                        for a in 0..D {
-                            block[(a, b)] = lam * nj[a] * nk[b] + mu * nk[a] * nj[b];
-                        }
-                        block[(b, b)] += nn;
-                    }
+                    block = isotropic_block(nj, nk, lam, mu, mu * nj.dot(nk) + stab);
                 } else {
                     let t = &sj[2 * D..];
                     for b in 0..D {
@@ -442,13 +436,7 @@ impl<const D: usize> VemLaw<D> {
                         block[(b, b)] += stab;
                     }
                 }
-                for b in 0..D {
-                    for a in 0..D {
-                        let v = block[(a, b)];
-                        o[(D * k + b) * nd + D * j + a] = v;
-                        o[(D * j + a) * nd + D * k + b] = v;
-                    }
-                }
+                put_block(o, nd, j, k, &block);
             }
         }
         if let StabWeights::Diagonal { .. } = w {
@@ -599,17 +587,41 @@ fn isotropic_simplex<const D: usize>(
         let nj = &normals[j];
         for k in j..n {
             let nk = &normals[k];
-            let nn = mu * nj.dot(nk);
-            for b in 0..D {
-                for a in 0..D {
-                    let mut v = lam * nj[a] * nk[b] + mu * nk[a] * nj[b];
-                    if a == b {
-                        v += nn;
-                    }
-                    o[(D * k + b) * nd + D * j + a] = v;
-                    o[(D * j + a) * nd + D * k + b] = v;
-                }
-            }
+            let block = isotropic_block(nj, nk, lam, mu, mu * nj.dot(nk));
+            put_block(o, nd, j, k, &block);
+        }
+    }
+}
+
+/// The isotropic consistency block of nodes `j`, `k` with `λ`, `μ` already divided by
+/// `|K|`: `λ N_j N_kᵀ + μ N_k N_jᵀ` plus `diag` on the diagonal.
+#[inline]
+fn isotropic_block<const D: usize>(
+    nj: &Point<D>,
+    nk: &Point<D>,
+    lam: f64,
+    mu: f64,
+    diag: f64,
+) -> Tensor<D> {
+    let mut block = Tensor::<D>::zeros();
+    for b in 0..D {
+        for a in 0..D {
+            block[(a, b)] = lam * nj[a] * nk[b] + mu * nk[a] * nj[b];
+        }
+        block[(b, b)] += diag;
+    }
+    block
+}
+
+/// Write block `(j, k)` of an `nd × nd` column-major matrix `o` and its transpose at
+/// `(k, j)` (the same values, so the matrix is symmetric bit for bit).
+#[inline]
+fn put_block<const D: usize>(o: &mut [f64], nd: usize, j: usize, k: usize, block: &Tensor<D>) {
+    for b in 0..D {
+        for a in 0..D {
+            let v = block[(a, b)];
+            o[(D * k + b) * nd + D * j + a] = v;
+            o[(D * j + a) * nd + D * k + b] = v;
         }
     }
 }
