@@ -417,7 +417,7 @@ fn register_font() {
     let _ = plotters::style::register_font(
         "sans-serif",
         FontStyle::Normal,
-        include_bytes!("../crates/cli/assets/DejaVuSans.ttf"),
+        include_bytes!("../crates/scene/assets/DejaVuSans.ttf"),
     );
 }
 

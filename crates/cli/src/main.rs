@@ -1,14 +1,19 @@
 //! The `porofrac` command: runs a scene file and writes ParaView files, CSV and plots.
+//! Everything but the arguments, the progress display and the exit status is in
+//! `porofrac-scene`.
 //!
 //! Exit status: 0 on success, 1 for an error in the scene or the run (one line naming the
-//! file, line and key), 2 for command-line misuse.
+//! file, line and key), 2 for command-line misuse, 130 when interrupted by Ctrl-C (the
+//! finished steps' files are complete and `summary.json` says
+//! `"status": "interrupted at t = …"`).
 
-use porofrac_cli::check;
-
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use clap::{Parser, Subcommand};
+use porofrac_scene::{Observer, Scene, StepReport};
 
 /// Simulate fracturing of porous rock: run scene files, write ParaView files, CSV and plots.
 #[derive(Parser, Debug)]
@@ -40,61 +45,111 @@ enum Command {
     },
 }
 
+/// Exit status of an interrupted run (128 + SIGINT, as shells report it).
+const INTERRUPTED: u8 = 130;
+
 fn main() -> ExitCode {
     porofrac_sim::heap::retain_freed_memory();
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Check { scene } => check::load(&scene)
-            .and_then(|ls| {
-                check::check(&ls)?;
-                Ok(ls)
-            })
-            .map(|ls| {
+        Command::Check { scene } => Scene::load(&scene)
+            .map(|s| {
                 println!(
                     "{}: ok ({}D, grid {})",
-                    ls.path.display(),
-                    ls.scene.scene.dim,
-                    ls.scene.grid.kind
+                    s.path().display(),
+                    s.file().scene.dim,
+                    s.file().grid.kind.as_str()
                 );
+                ExitCode::SUCCESS
             })
             .map_err(|e| e.to_string()),
         Command::Run { scene, out } => run(&scene, out),
     };
-    match result {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(msg) => {
-            eprintln!("error: {msg}");
-            ExitCode::from(1)
+    result.unwrap_or_else(|msg| {
+        eprintln!("error: {msg}");
+        ExitCode::from(1)
+    })
+}
+
+fn run(path: &Path, out: Option<PathBuf>) -> Result<ExitCode, String> {
+    let scene = Scene::load(path).map_err(|e| e.to_string())?;
+    let out = out.unwrap_or_else(|| scene.default_out());
+    // Ctrl-C: finish the current step, keep what was written, exit with 130.
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    let _ = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed));
+    let mut progress = Progress::new(stop);
+    let summary = scene.run(&out, &mut progress).map_err(|e| e.to_string())?;
+    progress.finish();
+    eprintln!(
+        "{}: {} cells, {} dofs, {} steps in {:.2} s; output in {}{}",
+        summary.scene,
+        summary.cells,
+        summary.dofs,
+        summary.steps,
+        summary.wall_seconds.total,
+        out.display(),
+        if summary.interrupted() {
+            format!(" ({})", summary.status)
+        } else {
+            String::new()
+        }
+    );
+    Ok(if summary.interrupted() {
+        ExitCode::from(INTERRUPTED)
+    } else {
+        ExitCode::SUCCESS
+    })
+}
+
+/// Progress of a run: an indicatif bar when stderr is a terminal, plain lines otherwise;
+/// the Ctrl-C flag.
+struct Progress {
+    bar: Option<indicatif::ProgressBar>,
+    stop: Arc<AtomicBool>,
+}
+
+impl Progress {
+    fn new(stop: Arc<AtomicBool>) -> Self {
+        Self { bar: None, stop }
+    }
+
+    fn finish(&self) {
+        if let Some(bar) = &self.bar {
+            bar.finish_and_clear();
         }
     }
 }
 
-fn run(scene: &std::path::Path, out: Option<PathBuf>) -> Result<(), String> {
-    let ls = check::load(scene).map_err(|e| e.to_string())?;
-    check::check(&ls).map_err(|e| e.to_string())?;
-    let out = out.unwrap_or_else(|| porofrac_cli::run::default_out(&ls));
-    // Ctrl-C: finish the current step, keep what was written.
-    let _ = ctrlc::set_handler(|| {
-        porofrac_cli::run::STOP.store(true, std::sync::atomic::Ordering::Relaxed)
-    });
-    let start = std::time::Instant::now();
-    match porofrac_cli::run::run(&ls, &out) {
-        Ok(summary) => {
-            eprintln!(
-                "{}: {} cells, {} dofs, {} steps in {:.2} s; output in {}",
-                summary.scene,
-                summary.cells,
-                summary.dofs,
-                summary.steps,
-                summary.wall_seconds.total,
-                out.display()
-            );
-            Ok(())
+impl Observer for Progress {
+    fn step(&mut self, r: &StepReport) {
+        use std::io::IsTerminal;
+        if r.total <= 1 {
+            return;
         }
-        Err(e) => {
-            let msg = e.to_string();
-            porofrac_cli::run::write_failed_summary(&ls, &out, &msg, start);
-            Err(msg)
+        let msg = format!(
+            "t = {:.4e} s, solver iterations {} (total {}), fractured {}",
+            r.time, r.iterations, r.total_iterations, r.failed
+        );
+        if self.bar.is_none() && std::io::stderr().is_terminal() {
+            let bar = indicatif::ProgressBar::new(r.total as u64);
+            if let Ok(style) = indicatif::ProgressStyle::with_template(
+                "{bar:30} step {pos}/{len}  {msg}  ETA {eta}",
+            ) {
+                bar.set_style(style);
+            }
+            self.bar = Some(bar);
         }
+        match &self.bar {
+            Some(bar) => {
+                bar.set_position(r.step as u64 + 1);
+                bar.set_message(msg);
+            }
+            None => eprintln!("step {}/{}: {msg}", r.step + 1, r.total),
+        }
+    }
+
+    fn stop_requested(&self) -> bool {
+        self.stop.load(Ordering::Relaxed)
     }
 }

@@ -35,7 +35,7 @@
 //! of cells in proportion to their volumes; wells ([`problem::Well`], [`well`]) use
 //! Peaceman's well index and are controlled by bottom-hole pressure or rate; boundary
 //! faces take a pressure or an outward Darcy flux that may depend on position and time
-//! ([`problem::Value`]); other boundary faces are no-flow.
+//! ([`problem::ScalarField`]); other boundary faces are no-flow.
 //!
 //! # Example
 //!
@@ -68,8 +68,8 @@ pub use error::{FlowError, Result};
 pub use model::{FlowLinearSolver, FlowModel, StepResult};
 pub use perm::{Permeability, Tensor};
 pub use problem::{
-    BoundaryCondition, BoundaryKind, FieldFn, FlowProblem, Fluid, Rock, Source, SourceRate, Value,
-    Well, WellControl,
+    BoundaryCondition, BoundaryKind, FieldFn, FlowProblem, Fluid, Rock, ScalarField, Source,
+    SourceRate, Well, WellControl,
 };
 pub use trans::Transmissibilities;
 pub use well::peaceman_well_index;

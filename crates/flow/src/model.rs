@@ -38,7 +38,7 @@ use rayon::prelude::*;
 
 use crate::error::{FlowError, Result, cell_err};
 use crate::perm::Permeability;
-use crate::problem::{BoundaryKind, FlowProblem, SourceRate, Value, WellControl};
+use crate::problem::{BoundaryKind, FlowProblem, ScalarField, SourceRate, WellControl};
 use crate::trans::Transmissibilities;
 use crate::well::peaceman_well_index;
 
@@ -94,7 +94,7 @@ pub struct FlowModel<const D: usize> {
     flux_vals: Vec<f64>,
     dirichlet: Vec<BcFace<D>>,
     neumann: Vec<BcFace<D>>,
-    bc_values: Vec<Value>,
+    bc_values: Vec<ScalarField>,
     source_cell_rate: Vec<f64>,
     source_names: Vec<String>,
     source_totals: Vec<f64>,
@@ -204,7 +204,7 @@ impl<const D: usize> FlowModel<D> {
             if bc.faces.is_empty() {
                 return Err(err("empty face set".into()));
             }
-            if let Value::Const(v) = bc.value
+            if let ScalarField::Const(v) = bc.value
                 && !v.is_finite()
             {
                 return Err(err(format!("value must be finite, got {v}")));
@@ -961,7 +961,10 @@ mod tests {
                 compressibility: 0.0,
             },
         )
-        .pressure_bc(grid.boundary("xmin").unwrap(), Value::func(|_, t| 1e5 * t));
+        .pressure_bc(
+            grid.boundary("xmin").unwrap(),
+            ScalarField::from_fn(|_, t| 1e5 * t),
+        );
         let mut m = FlowModel::new(&grid, &problem).unwrap();
         let r = m.step(&[0.0, 0.0], 2.0, 3.0).unwrap();
         assert!(

@@ -3,54 +3,9 @@
 //! These are plain values; [`crate::FlowModel::new`] validates them against a grid and
 //! returns an error naming the offending cell, face, condition, source or well.
 
-use std::fmt;
-use std::sync::Arc;
-
 use crate::perm::Permeability;
 
-/// A function of position `x` (length D) and time `t`.
-pub type FieldFn = Arc<dyn Fn(&[f64], f64) -> f64 + Send + Sync>;
-
-/// A scalar field `v(x, t)`: a constant (the cheap common case) or a function of the
-/// position `x` (length D) and the time `t`.
-#[derive(Clone)]
-pub enum Value {
-    /// The same value everywhere and always.
-    Const(f64),
-    /// A function of position and time.
-    Fn(FieldFn),
-}
-
-impl Value {
-    /// Wrap a function of position and time.
-    pub fn func(f: impl Fn(&[f64], f64) -> f64 + Send + Sync + 'static) -> Self {
-        Self::Fn(Arc::new(f))
-    }
-
-    /// The value at position `x` and time `t`.
-    #[inline]
-    pub fn eval(&self, x: &[f64], t: f64) -> f64 {
-        match self {
-            Self::Const(v) => *v,
-            Self::Fn(f) => f(x, t),
-        }
-    }
-}
-
-impl From<f64> for Value {
-    fn from(v: f64) -> Self {
-        Self::Const(v)
-    }
-}
-
-impl fmt::Debug for Value {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Self::Const(v) => write!(f, "Const({v})"),
-            Self::Fn(_) => write!(f, "Fn(..)"),
-        }
-    }
-}
+pub use porofrac_grid::field::{FieldFn, ScalarField};
 
 /// Rock properties per cell.
 ///
@@ -129,7 +84,7 @@ pub struct BoundaryCondition {
     /// Pressure or flux.
     pub kind: BoundaryKind,
     /// The value, evaluated at the face centroid and at the end of the time step.
-    pub value: Value,
+    pub value: ScalarField,
 }
 
 /// The rate of a volumetric source.
@@ -220,7 +175,7 @@ impl<const D: usize> FlowProblem<D> {
     }
 
     /// Prescribe the pressure on `faces`.
-    pub fn pressure_bc(mut self, faces: Vec<usize>, value: impl Into<Value>) -> Self {
+    pub fn pressure_bc(mut self, faces: Vec<usize>, value: impl Into<ScalarField>) -> Self {
         self.boundary_conditions.push(BoundaryCondition {
             faces,
             kind: BoundaryKind::Pressure,
@@ -230,7 +185,7 @@ impl<const D: usize> FlowProblem<D> {
     }
 
     /// Prescribe the outward Darcy flux `u·n` (m/s) on `faces`.
-    pub fn flux_bc(mut self, faces: Vec<usize>, value: impl Into<Value>) -> Self {
+    pub fn flux_bc(mut self, faces: Vec<usize>, value: impl Into<ScalarField>) -> Self {
         self.boundary_conditions.push(BoundaryCondition {
             faces,
             kind: BoundaryKind::Flux,

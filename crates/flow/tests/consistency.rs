@@ -2,8 +2,8 @@
 //! known flux, anisotropic diagonal permeability.
 
 use porofrac_flow::{
-    FlowModel, FlowProblem, Fluid, Permeability, Rock, StepResult, Tensor, Transmissibilities,
-    Value,
+    FlowModel, FlowProblem, Fluid, Permeability, Rock, ScalarField, StepResult, Tensor,
+    Transmissibilities,
 };
 use porofrac_grid::generate::{cartesian, simplices};
 use porofrac_grid::{Grid, Point};
@@ -27,8 +27,10 @@ fn linear_patch<const D: usize>(
 ) -> (StepResult, f64) {
     let n = grid.num_cells();
     let exact = move |x: &[f64]| b + (0..D).map(|a| g[a] * x[a]).sum::<f64>();
-    let problem = FlowProblem::new(Rock::new(vec![0.3; n], perm), incompressible())
-        .pressure_bc(grid.boundary_faces(), Value::func(move |x, _| exact(x)));
+    let problem = FlowProblem::new(Rock::new(vec![0.3; n], perm), incompressible()).pressure_bc(
+        grid.boundary_faces(),
+        ScalarField::from_fn(move |x, _| exact(x)),
+    );
     let mut model = FlowModel::new(grid, &problem).unwrap();
     let r = model.solve_steady(0.0).unwrap();
     let range: f64 = (0..D)

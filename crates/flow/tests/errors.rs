@@ -1,8 +1,8 @@
 //! Bad input gives an error that names what is wrong and where, never a panic.
 
 use porofrac_flow::{
-    FlowError, FlowModel, FlowProblem, Fluid, Permeability, Rock, SourceRate, Tensor, Value, Well,
-    WellControl,
+    FlowError, FlowModel, FlowProblem, Fluid, Permeability, Rock, ScalarField, SourceRate, Tensor,
+    Well, WellControl,
 };
 use porofrac_grid::generate::cartesian;
 use porofrac_grid::{Grid, Point};
@@ -194,7 +194,7 @@ fn bad_sources_wells_and_boundaries() {
     // A function returning NaN is reported at solve time with the face.
     let p = base(&g).pressure_bc(
         xmin.clone(),
-        Value::func(|x, _| if x[1] > 2.0 { f64::NAN } else { 0.0 }),
+        ScalarField::from_fn(|x, _| if x[1] > 2.0 { f64::NAN } else { 0.0 }),
     );
     let mut m = FlowModel::new(&g, &p).unwrap();
     let e = m.solve_steady(0.0).unwrap_err();

@@ -10,7 +10,7 @@
 //! the pressure drop `p_w − p_ref`.
 
 use porofrac_flow::{
-    FlowModel, FlowProblem, Fluid, Permeability, Rock, Value, Well, WellControl,
+    FlowModel, FlowProblem, Fluid, Permeability, Rock, ScalarField, Well, WellControl,
     peaceman_well_index,
 };
 use porofrac_grid::Point;
@@ -54,7 +54,7 @@ fn run(kx: f64, ky: f64, n: usize, q: f64) -> Outcome {
         viscosity: MU,
         compressibility: 0.0,
     };
-    let bc = Value::func(move |x, _| exact(x[0], x[1]));
+    let bc = ScalarField::from_fn(move |x, _| exact(x[0], x[1]));
     // Rate control: compare the bottom-hole pressure.
     let problem = FlowProblem::new(rock.clone(), fluid)
         .pressure_bc(grid.boundary_faces(), bc.clone())
@@ -160,7 +160,7 @@ fn peaceman_3d_vertical_well() {
             compressibility: 0.0,
         },
     )
-    .pressure_bc(sides, Value::func(move |x, _| exact(x)));
+    .pressure_bc(sides, ScalarField::from_fn(move |x, _| exact(x)));
     for l in 0..nz {
         let c = l * n * n + (n / 2) * n + n / 2;
         problem = problem.well(Well::new(

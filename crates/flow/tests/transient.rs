@@ -2,7 +2,7 @@
 //! Δt and h), and the discrete mass balance with every kind of source and boundary condition.
 
 use porofrac_flow::{
-    FlowModel, FlowProblem, Fluid, Permeability, Rock, SourceRate, Value, Well, WellControl,
+    FlowModel, FlowProblem, Fluid, Permeability, Rock, ScalarField, SourceRate, Well, WellControl,
 };
 use porofrac_grid::Point;
 use porofrac_grid::generate::{cartesian, simplices};
@@ -110,12 +110,12 @@ fn mass_balance_all_terms() {
     let problem = FlowProblem::new(rock, fluid)
         .pressure_bc(
             grid.boundary("xmax").unwrap(),
-            Value::func(|x, t| 1e6 + 1e4 * x[1] + 1e3 * t),
+            ScalarField::from_fn(|x, t| 1e6 + 1e4 * x[1] + 1e3 * t),
         )
         .pressure_bc(grid.boundary("ymin").unwrap(), 2e6)
         .flux_bc(
             grid.boundary("xmin").unwrap(),
-            Value::func(|x, _| -1e-7 * (1.0 + x[2])),
+            ScalarField::from_fn(|x, _| -1e-7 * (1.0 + x[2])),
         )
         .flux_bc(grid.boundary("zmax").unwrap(), 3e-8)
         .source("inj", vec![0, 5, 17], SourceRate::Total(2e-3))

@@ -59,22 +59,11 @@ pub enum FracError {
     },
 }
 
-/// Principal stresses in decreasing order (tension positive), `D` of them.
+/// Principal stresses in decreasing order (tension positive), `D` of them followed by
+/// zeros ([`porofrac_law::principal`]).
 pub fn principal_stresses<const D: usize>(s: &Tensor<D>) -> [f64; 3] {
     let mut e = [0.0; 3];
-    if D == 2 {
-        let (a, b, c) = (s[(0, 0)], s[(1, 1)], s[(0, 1)]);
-        let m = 0.5 * (a + b);
-        let r = (0.25 * (a - b) * (a - b) + c * c).sqrt();
-        e[0] = m + r;
-        e[1] = m - r;
-    } else {
-        let m = nalgebra::Matrix3::from_fn(|i, j| s[(i, j)]);
-        let v = m.symmetric_eigenvalues();
-        let mut v = [v[0], v[1], v[2]];
-        v.sort_by(|a, b| b.total_cmp(a));
-        e = v;
-    }
+    e[..D].copy_from_slice(&porofrac_law::principal(s).values);
     e
 }
 

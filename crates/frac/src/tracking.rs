@@ -109,22 +109,10 @@ impl<const D: usize> CrackTracking<D> {
     }
 }
 
-/// Unit eigenvector of the largest eigenvalue of a symmetric tensor.
+/// Unit eigenvector of the largest eigenvalue of a symmetric tensor
+/// ([`porofrac_law::principal`]).
 pub fn largest_principal_direction<const D: usize>(s: &Tensor<D>) -> Point<D> {
-    // Embedded in 3×3 (zeros outside D×D) so one symmetric eigen-solver serves 2D and 3D;
-    // the in-plane eigenvectors of a 2D tensor have a zero third component.
-    let m = nalgebra::Matrix3::from_fn(|i, j| if i < D && j < D { s[(i, j)] } else { 0.0 });
-    let e = m.symmetric_eigen();
-    let mut k = None;
-    for i in 0..3 {
-        let v = e.eigenvectors.column(i);
-        let in_plane = (D..3).all(|j| v[j].abs() < 0.5);
-        if in_plane && k.is_none_or(|b: usize| e.eigenvalues[i] > e.eigenvalues[b]) {
-            k = Some(i);
-        }
-    }
-    let k = k.unwrap_or(0);
-    Point::<D>::from_fn(|i, _| e.eigenvectors[(i, k)])
+    porofrac_law::principal(s).directions[0]
 }
 
 #[cfg(test)]

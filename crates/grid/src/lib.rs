@@ -28,6 +28,7 @@
 
 pub mod builder;
 pub mod error;
+pub mod field;
 pub mod generate;
 pub mod grid;
 /// Mesh files: Gmsh `.msh` import, VTK `.vtu` import/export, `.pvd` time series.
@@ -36,5 +37,6 @@ pub mod point;
 
 pub use builder::CellFaceLoops;
 pub use error::{GridError, Result};
+pub use field::ScalarField;
 pub use grid::{Grid, NO_CELL, SIDE_NAMES};
 pub use point::Point;

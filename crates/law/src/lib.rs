@@ -22,15 +22,17 @@
 //! * [`stiffness`] — [`Stiffness`]: isotropic (3D, plane strain, plane stress) and
 //!   general anisotropic elastic stiffness in Kelvin form, validated.
 //! * [`testkit`] — the invariants every cell law must satisfy, as checks usable from any
-//!   crate's tests (see `examples/user_law.rs` for a law defined outside this crate).
+//!   crate's tests (the `user_law` example of `porofrac-scene` defines a law outside porofrac and uses it in a scene).
 
 pub mod error;
 pub mod kelvin;
+pub mod principal;
 pub mod stiffness;
 pub mod testkit;
 
 pub use error::LawError;
 pub use kelvin::{Kelvin, KelvinMatrix, kelvin_len};
+pub use principal::{Principal, principal};
 pub use stiffness::Stiffness;
 
 use nalgebra::{DMatrix, SMatrix};

@@ -173,6 +173,106 @@ impl FractureSettings {
     }
 }
 
+/// Failure resolution within a step, shared by every driver that fractures (the coupled
+/// [`Fracturing`] and the static mechanics of the scenes): the settings, the stress
+/// measure (cell or recovered), crack tracking and the round limit live here once.
+pub struct FailureResolution<const D: usize> {
+    settings: FractureSettings,
+    adjacency: Option<NodeCells>,
+    tracking: Option<CrackTracking<D>>,
+}
+
+/// A step with its failures resolved: the solution and its cell stresses, the cells
+/// failed in the step and the solves done.
+pub struct Resolved<S, const D: usize> {
+    /// The solution of the last solve and its cell stresses (effective, tension positive).
+    pub solution: (S, Vec<Tensor<D>>),
+    /// Cells failed in this step.
+    pub new_failures: usize,
+    /// Solves done (1: nothing failed).
+    pub rounds: usize,
+}
+
+/// The error of [`FailureResolution::resolve`]: the solver's, or failures that did not
+/// settle within [`FractureSettings::max_rounds`].
+pub type ResolutionError<E> = ResolveError<E>;
+
+impl<const D: usize> FailureResolution<D> {
+    /// Resolution with `settings` on `grid`; an error describes an invalid tracking angle.
+    pub fn new(grid: &Grid<D>, settings: FractureSettings) -> Result<Self, String> {
+        let can_fail = settings.criteria.iter().any(|c| !c.is_empty());
+        let adjacency =
+            (can_fail && settings.stress == StressMeasure::Recovered).then(|| NodeCells::new(grid));
+        let tracking = match (can_fail, settings.tracking_angle) {
+            (true, Some(a)) => Some(CrackTracking::new(grid, a).map_err(|e| e.to_string())?),
+            _ => None,
+        };
+        Ok(Self {
+            settings,
+            adjacency,
+            tracking,
+        })
+    }
+
+    /// The settings.
+    pub fn settings(&self) -> &FractureSettings {
+        &self.settings
+    }
+
+    /// Solve, check the criteria on the chosen stress measure, fail and re-solve at time
+    /// `t` until no cell fails ([`porofrac_frac::resolve()`]). `solve` gets the failure
+    /// state and returns a solution and its cell stresses.
+    pub fn resolve<S, E>(
+        &mut self,
+        grid: &Grid<D>,
+        failures: &mut FailureState,
+        t: f64,
+        mut solve: impl FnMut(&FailureState) -> Result<(S, Vec<Tensor<D>>), E>,
+    ) -> Result<Resolved<S, D>, ResolutionError<E>> {
+        let can_fail = self.settings.criteria.iter().any(|c| !c.is_empty());
+        let adjacency = &self.adjacency;
+        let ((solution, stress), _, new_failures, rounds) = resolve(
+            failures,
+            t,
+            &self.settings.criteria,
+            &self.settings.class_of_cell,
+            self.settings.policy,
+            self.tracking.as_mut(),
+            if can_fail {
+                self.settings.max_rounds
+            } else {
+                1
+            },
+            |fs| {
+                let (sol, stress) = solve(fs)?;
+                let measure = match adjacency {
+                    Some(adj) => cell_average(grid, &recover_nodal(grid, adj, &stress)),
+                    None => stress.clone(),
+                };
+                Ok(((sol, stress), measure))
+            },
+        )?;
+        Ok(Resolved {
+            solution: (solution, stress),
+            new_failures,
+            rounds,
+        })
+    }
+}
+
+/// What the linear solves of a coupled run did, for reports.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct CouplingStats {
+    /// The linear solver of the coupled systems.
+    pub linear: &'static str,
+    /// Numeric factorizations done.
+    pub numeric_factorizations: usize,
+    /// Symbolic factorizations (analyses) done.
+    pub symbolic_factorizations: usize,
+    /// Nonzeros of the factor (0 where nothing was factorized).
+    pub factor_nnz: usize,
+}
+
 /// The coupling scheme of a [`Fracturing`] run.
 pub enum Scheme {
     /// Fully implicit monolithic (seed eq. 30).
@@ -242,12 +342,10 @@ pub struct FractureStep<const D: usize> {
 pub struct Fracturing<'a, const D: usize> {
     body: Body<'a, D>,
     laws: FractureLaws<'a, D>,
-    settings: FractureSettings,
     flow: FractureFlow<D>,
     scheme: Scheme,
     failures: FailureState,
-    adjacency: Option<NodeCells>,
-    tracking: Option<CrackTracking<D>>,
+    resolution: FailureResolution<D>,
     perm_of_failed: Vec<bool>,
 }
 
@@ -310,24 +408,15 @@ impl<'a, const D: usize> Fracturing<'a, D> {
         )?;
         let scheme = scheme(&system)?;
         drop(system);
-        let adjacency =
-            (settings.stress == StressMeasure::Recovered).then(|| NodeCells::new(body.grid));
-        let tracking = match settings.tracking_angle {
-            Some(a) => Some(
-                CrackTracking::new(body.grid, a)
-                    .map_err(|e| FractureError::Input(e.to_string()))?,
-            ),
-            None => None,
-        };
+        let resolution =
+            FailureResolution::new(body.grid, settings).map_err(FractureError::Input)?;
         Ok(Self {
             body,
             laws,
-            settings,
             flow,
             scheme,
             failures: FailureState::new(nc),
-            adjacency,
-            tracking,
+            resolution,
             perm_of_failed: vec![false; nc],
         })
     }
@@ -343,6 +432,21 @@ impl<'a, const D: usize> Fracturing<'a, D> {
     /// The initial pressure `p₀` of every cell.
     pub fn initial_pressure(&self) -> &[f64] {
         &self.flow.p0
+    }
+    /// What the linear solves did so far.
+    pub fn stats(&self) -> CouplingStats {
+        match &self.scheme {
+            Scheme::Monolithic(m) => CouplingStats {
+                linear: "ldlt",
+                numeric_factorizations: m.numeric_factorizations(),
+                symbolic_factorizations: 1,
+                factor_nnz: 0,
+            },
+            _ => CouplingStats {
+                linear: "cholesky",
+                ..CouplingStats::default()
+            },
+        }
     }
     /// The name of the coupling scheme.
     pub fn scheme_name(&self) -> &'static str {
@@ -373,19 +477,21 @@ impl<'a, const D: usize> Fracturing<'a, D> {
         let Self {
             body,
             laws,
-            settings,
             flow,
             scheme,
             failures,
-            adjacency,
-            tracking,
+            resolution,
             perm_of_failed,
         } = self;
         let grid = body.grid;
         let t1 = t + dt;
+        let limits = ActiveSetLimits {
+            iterations: resolution.settings().max_active_set,
+            tolerance: resolution.settings().active_set_tolerance,
+        };
         let mut solves = 0;
         let mut worst = 0.0f64;
-        let solve = |fs: &FailureState| -> FractureResult<(Solved<D>, Vec<Tensor<D>>)> {
+        let solve = |fs: &FailureState| -> FractureResult<(BiotState, Vec<Tensor<D>>)> {
             let map = laws.law_map(grid, fs.flags())?;
             update_permeability(grid, flow, fs.flags(), perm_of_failed)?;
             let mut system = BiotSystem::new(
@@ -405,51 +511,37 @@ impl<'a, const D: usize> Fracturing<'a, D> {
                     .map(|(a, b)| *a || *b)
                     .collect();
             }
-            let (new, residual, n) = active_set_solve(&mut system, scheme, state, t, dt, settings)?;
+            let (new, residual, n) = active_set_solve(&mut system, scheme, state, t, dt, limits)?;
             solves += n;
             worst = worst.max(residual);
             let stress = cell_stresses(grid, &map, &new.displacement)?;
-            let measure = match adjacency {
-                Some(adj) => cell_average(grid, &recover_nodal(grid, adj, &stress)),
-                None => stress.clone(),
-            };
-            Ok(((new, stress), measure))
+            Ok((new, stress))
         };
-        let ((state, stress), _, new_failures, rounds) = resolve(
-            failures,
-            t1,
-            &settings.criteria,
-            &settings.class_of_cell,
-            settings.policy,
-            tracking.as_mut(),
-            settings.max_rounds,
-            solve,
-        )
-        .map_err(|e| match e {
-            ResolveError::Solve(e) => e,
-            ResolveError::NotSettled {
-                rounds,
-                time,
-                failed,
-            } => FractureError::NotSettled {
-                rounds,
-                time,
-                failed,
-            },
-        })?;
+        let done = resolution
+            .resolve(grid, failures, t1, solve)
+            .map_err(|e| match e {
+                ResolveError::Solve(e) => e,
+                ResolveError::NotSettled {
+                    rounds,
+                    time,
+                    failed,
+                } => FractureError::NotSettled {
+                    rounds,
+                    time,
+                    failed,
+                },
+            })?;
+        let (state, stress) = done.solution;
         Ok(FractureStep {
             state,
             stress,
-            new_failures,
-            rounds,
+            new_failures: done.new_failures,
+            rounds: done.rounds,
             solves,
             residual: worst,
         })
     }
 }
-
-/// A coupled solution and its cell stresses.
-type Solved<const D: usize> = (BiotState, Vec<Tensor<D>>);
 
 fn problem<'b, const D: usize>(
     body: &Body<'b, D>,
@@ -488,6 +580,14 @@ fn update_permeability<const D: usize>(
     Ok(())
 }
 
+/// Limits of the active-set iteration ([`FractureSettings::max_active_set`],
+/// [`FractureSettings::active_set_tolerance`]).
+#[derive(Clone, Copy)]
+struct ActiveSetLimits {
+    iterations: usize,
+    tolerance: f64,
+}
+
 /// One coupled step (or the initial equilibrium when `state` is `None`) iterated over the
 /// active set of the piecewise-linear laws. Returns the state, the accepted residual and
 /// the number of linear solves.
@@ -497,7 +597,7 @@ fn active_set_solve<const D: usize>(
     state: Option<&BiotState>,
     t: f64,
     dt: f64,
-    settings: &FractureSettings,
+    limits: ActiveSetLimits,
 ) -> FractureResult<(BiotState, f64, usize)> {
     let t1 = t + dt;
     let p0 = system.initial_pressure().to_vec();
@@ -508,7 +608,7 @@ fn active_set_solve<const D: usize>(
     // The best iterate so far: state, the pressure its mechanics balances, residual.
     let mut best: Option<(BiotState, Vec<f64>, f64)> = None;
     let mut residual = f64::INFINITY;
-    for it in 1..=settings.max_active_set.max(1) {
+    for it in 1..=limits.iterations.max(1) {
         let (new, p_used) = match state {
             None => {
                 let st = system.initial_state(t)?;
@@ -530,7 +630,7 @@ fn active_set_solve<const D: usize>(
         };
         let lin = system.linearize(&new.displacement, &p_used, t1)?;
         residual = lin.residual;
-        if !lin.changed || residual <= settings.active_set_tolerance {
+        if !lin.changed || residual <= limits.tolerance {
             return Ok((new, residual, it));
         }
         let Some((b_state, b_p, b_res)) = best.take() else {
@@ -559,7 +659,7 @@ fn active_set_solve<const D: usize>(
             let cand_p = mix(&b_p, &p_used);
             let l = system.linearize(&cand.displacement, &cand_p, t1)?;
             residual = l.residual;
-            if residual <= settings.active_set_tolerance {
+            if residual <= limits.tolerance {
                 return Ok((cand, residual, it));
             }
             let descent = residual < b_res;
@@ -573,8 +673,8 @@ fn active_set_solve<const D: usize>(
     }
     Err(FractureError::ActiveSet {
         time: t1,
-        iterations: settings.max_active_set,
+        iterations: limits.iterations,
         residual,
-        tolerance: settings.active_set_tolerance,
+        tolerance: limits.tolerance,
     })
 }

@@ -6,7 +6,7 @@
 mod common;
 
 use common::perturb;
-use porofrac_flow::{FlowModel, FlowProblem, Fluid, Permeability, Rock, Value};
+use porofrac_flow::{FlowModel, FlowProblem, Fluid, Permeability, Rock, ScalarField};
 use porofrac_grid::{Grid, Point, generate};
 use porofrac_law::stiffness::Stiffness;
 use porofrac_sim::*;
@@ -124,7 +124,7 @@ fn small<const D: usize>(n: usize) -> Setup<D> {
         )
         .pressure_bc(
             g.boundary("xmax").unwrap(),
-            Value::func(|x, _| 1e7 + 1e5 * x[1]),
+            ScalarField::from_fn(|x, _| 1e7 + 1e5 * x[1]),
         )
     })
 }

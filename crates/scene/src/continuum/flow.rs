@@ -1,13 +1,18 @@
 //! The flow model of a scene: rock properties per cell from the materials, the fluid,
-//! pressure and flux conditions, sources and the initial pressure.
+//! pressure and flux conditions, sources, Peaceman wells and the initial pressure.
 
-use porofrac_flow::{FlowModel, FlowProblem, Fluid, Permeability, Rock, SourceRate, Value};
+use porofrac_flow::{
+    FlowModel, FlowProblem, Fluid, Permeability, Rock, SourceRate, Well, WellControl,
+};
 use porofrac_grid::Grid;
 
 use crate::check::{LoadedScene, k, ki};
-use crate::expr::Expr;
-use crate::run::{RunError, select_cells};
-use crate::scene::{NumOrExpr, Permeability as ScenePerm};
+use crate::file::Permeability as ScenePerm;
+use crate::model::RunError;
+use crate::sample::locate;
+
+use super::compose::boundary_faces;
+use super::grid::{point, select_cells};
 
 /// Flow model, initial pressure per cell and Biot coefficient per cell.
 pub struct FlowSetup<const D: usize> {
@@ -21,19 +26,6 @@ pub struct FlowSetup<const D: usize> {
     pub permeability: Permeability<D>,
     /// Cells of a fluid source (injection or production region).
     pub source_cells: Vec<bool>,
-}
-
-fn value(v: &NumOrExpr) -> Value {
-    match v {
-        NumOrExpr::Num(x) => Value::Const(*x),
-        NumOrExpr::Expr(s) => {
-            let e = Expr::parse(s).expect("expression checked");
-            match e.as_constant() {
-                Some(c) => Value::Const(c),
-                None => Value::func(move |x, t| e.eval(x, t)),
-            }
-        }
-    }
 }
 
 /// Build the flow model. `material_of_cell[c]` names the material of cell `c`.
@@ -99,17 +91,12 @@ pub fn flow_setup<const D: usize>(
         if bc.pressure.is_none() && bc.flux.is_none() {
             continue;
         }
-        let faces = grid.boundary(&bc.boundary).map_err(|e| {
-            ls.error(
-                &ki("bc", i, &["boundary"]),
-                format!("= \"{}\": {e}", bc.boundary),
-            )
-        })?;
+        let faces = boundary_faces(ls, grid, i)?;
         if let Some(p) = &bc.pressure {
-            problem = problem.pressure_bc(faces.clone(), value(p));
+            problem = problem.pressure_bc(faces.clone(), p.to_field());
         }
         if let Some(q) = &bc.flux {
-            problem = problem.flux_bc(faces, value(q));
+            problem = problem.flux_bc(faces, q.to_field());
         }
     }
     let mut source_cells = vec![false; n];
@@ -135,9 +122,46 @@ pub fn flow_setup<const D: usize>(
         }
         problem = problem.source(src.region.clone(), cells, rate);
     }
+    for (i, w) in s.well.iter().enumerate() {
+        let cell = match (&w.at, w.cell) {
+            (Some(at), _) => locate(grid, &point(at)).map(|l| l.cell).ok_or_else(|| {
+                ls.error(
+                    &ki("well", i, &["at"]),
+                    format!("= {at:?} is outside the grid"),
+                )
+            })?,
+            (None, Some(c)) if (0..grid.num_cells() as i64).contains(&c) => c as usize,
+            (None, c) => {
+                return Err(ls
+                    .error(
+                        &ki("well", i, &["cell"]),
+                        format!(
+                            "= {c:?} is not a cell of the grid (0 to {})",
+                            grid.num_cells() - 1
+                        ),
+                    )
+                    .into());
+            }
+        };
+        let control = match (w.rate, w.bottom_hole_pressure) {
+            (Some(q), None) => WellControl::Rate(q),
+            (None, Some(p)) => WellControl::Bhp(p),
+            _ => {
+                return Err(ls
+                    .error(
+                        &ki("well", i, &[]),
+                        "needs exactly one of rate and bottom_hole_pressure",
+                    )
+                    .into());
+            }
+        };
+        let mut well = Well::new(w.name.clone(), cell, w.radius, control);
+        well.skin = w.skin.unwrap_or(0.0);
+        problem = problem.well(well);
+    }
     let p0: Vec<f64> = match s.initial.as_ref().and_then(|i| i.pressure.as_ref()) {
         Some(v) => {
-            let f = value(v);
+            let f = v.to_field();
             grid.cell_centroids()
                 .iter()
                 .map(|x| f.eval(x.as_slice(), 0.0))
@@ -145,7 +169,14 @@ pub fn flow_setup<const D: usize>(
         }
         None => vec![0.0; n],
     };
-    let model = FlowModel::new(grid, &problem).map_err(|e| RunError::Flow(e.to_string()))?;
+    let model = FlowModel::new(grid, &problem).map_err(|e| {
+        // Well errors (no positive well index, ...) name the well.
+        let text = e.to_string();
+        match s.well.iter().position(|w| text.contains(&w.name)) {
+            Some(i) => RunError::from(ls.error(&ki("well", i, &[]), text)),
+            None => RunError::Flow(text),
+        }
+    })?;
     Ok(FlowSetup {
         model,
         p0,

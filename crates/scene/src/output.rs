@@ -31,32 +31,82 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
     std::fs::rename(&tmp, path).map_err(err)
 }
 
-/// A CSV table kept in memory and rewritten atomically after every row.
-#[derive(Clone, Debug)]
+/// A CSV table kept in memory and rewritten atomically: when it is created, after a row
+/// if the last rewrite is older than [`CsvTable::FLUSH_INTERVAL`], and when it is dropped
+/// (the end of a run, an error or an interruption). The file on disk always holds whole
+/// rows, and long runs do not rewrite it after every step.
+#[derive(Debug)]
 pub struct CsvTable {
     path: PathBuf,
     text: String,
+    flushed: std::time::Instant,
+    dirty: bool,
 }
 
 impl CsvTable {
-    /// A table with a header line.
+    /// Longest time rows stay in memory only.
+    pub const FLUSH_INTERVAL: std::time::Duration = std::time::Duration::from_millis(500);
+
+    /// A table with a header line (not yet written: see [`CsvTable::flush`]).
     pub fn new(path: PathBuf, header: &[String]) -> Self {
         let mut text = header.join(",");
         text.push('\n');
-        Self { path, text }
+        Self {
+            path,
+            text,
+            flushed: std::time::Instant::now(),
+            dirty: true,
+        }
     }
-    /// Append a row of numbers and rewrite the file.
+    /// Append a row of numbers (shortest round-trip form).
     pub fn push(&mut self, row: &[f64]) -> Result<(), OutputError> {
-        self.push_text(&row.iter().map(|v| format!("{v}")).collect::<Vec<_>>())
+        self.append(row);
+        self.maybe_flush()
     }
-    /// Append a row of already formatted cells and rewrite the file.
+    /// Append several rows of numbers.
+    pub fn push_rows(&mut self, rows: &[Vec<f64>]) -> Result<(), OutputError> {
+        for r in rows {
+            self.append(r);
+        }
+        self.maybe_flush()
+    }
+    /// Append a row of already formatted cells.
     pub fn push_text(&mut self, row: &[String]) -> Result<(), OutputError> {
         let _ = writeln!(self.text, "{}", row.join(","));
-        self.flush()
+        self.dirty = true;
+        self.maybe_flush()
     }
-    /// Write the file as it is.
-    pub fn flush(&self) -> Result<(), OutputError> {
-        write_atomic(&self.path, self.text.as_bytes())
+    fn append(&mut self, row: &[f64]) {
+        for (i, v) in row.iter().enumerate() {
+            if i > 0 {
+                self.text.push(',');
+            }
+            let _ = write!(self.text, "{v}");
+        }
+        self.text.push('\n');
+        self.dirty = true;
+    }
+    fn maybe_flush(&mut self) -> Result<(), OutputError> {
+        if self.flushed.elapsed() >= Self::FLUSH_INTERVAL {
+            self.flush()?;
+        }
+        Ok(())
+    }
+    /// Write the file as it is now.
+    pub fn flush(&mut self) -> Result<(), OutputError> {
+        write_atomic(&self.path, self.text.as_bytes())?;
+        self.flushed = std::time::Instant::now();
+        self.dirty = false;
+        Ok(())
+    }
+}
+
+impl Drop for CsvTable {
+    fn drop(&mut self) {
+        if self.dirty {
+            // Best effort: the error of a run that already failed wins.
+            let _ = self.flush();
+        }
     }
 }
 
@@ -99,6 +149,8 @@ pub struct SolverStats {
 pub struct Summary {
     /// Scene name.
     pub scene: String,
+    /// The model (`[scene] model`).
+    pub model: String,
     /// 2 or 3.
     pub dim: usize,
     /// Number of cells.
@@ -109,8 +161,11 @@ pub struct Summary {
     pub dofs: usize,
     /// Number of written steps after t = 0.
     pub steps: usize,
-    /// `"ok"` or the error text.
+    /// `"ok"`, `"interrupted at t = …"` or the error text.
     pub status: String,
+    /// The last finished time of an interrupted run.
+    #[serde(skip)]
+    pub interrupted_at: Option<f64>,
     /// Number of failed cells.
     pub fractured_cells: usize,
     /// Wall time per phase.
@@ -119,11 +174,17 @@ pub struct Summary {
     pub peak_memory_bytes: u64,
     /// Solver statistics.
     pub solver: SolverStats,
+    /// `[min, max]` of every field at the last written step.
+    pub field_extrema: std::collections::BTreeMap<String, [f64; 2]>,
     /// porofrac version.
     pub version: String,
 }
 
 impl Summary {
+    /// Whether the run was interrupted (its files hold the finished steps).
+    pub fn interrupted(&self) -> bool {
+        self.interrupted_at.is_some()
+    }
     /// Write `summary.json` into `dir`.
     pub fn write(&self, dir: &Path) -> Result<(), OutputError> {
         let json = serde_json::to_string_pretty(self).expect("summary serializes");
@@ -143,4 +204,35 @@ pub fn peak_memory_bytes() -> u64 {
             })
         })
         .map_or(0, |kb| kb * 1024)
+}
+
+/// Write an error status into `summary.json` of a failed run (best effort: the run's own
+/// error is what the caller reports).
+pub(crate) fn write_failed_summary(
+    ls: &crate::check::LoadedScene,
+    out: &Path,
+    error: &str,
+    start: std::time::Instant,
+) {
+    let summary = Summary {
+        scene: ls.scene.scene.name.clone(),
+        model: ls.model().to_string(),
+        dim: ls.scene.scene.dim.clamp(0, 3) as usize,
+        cells: 0,
+        nodes: 0,
+        dofs: 0,
+        steps: 0,
+        status: error.to_string(),
+        interrupted_at: None,
+        fractured_cells: 0,
+        wall_seconds: WallSeconds {
+            total: start.elapsed().as_secs_f64(),
+            ..WallSeconds::default()
+        },
+        peak_memory_bytes: peak_memory_bytes(),
+        solver: SolverStats::default(),
+        field_extrema: Default::default(),
+        version: env!("CARGO_PKG_VERSION").into(),
+    };
+    let _ = summary.write(out);
 }

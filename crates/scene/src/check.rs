@@ -5,10 +5,11 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 
 use crate::expr::Expr;
-use crate::scene::{
-    Bc, CellCount, Component, KeyPart, NumOrExpr, Permeability, Scene, Select, key_text,
-    line_of_offset, locate,
+use crate::file::{
+    Bc, CellCount, Component, GridKind, KeyPart, NumOrExpr, Permeability, SceneFile, Select,
+    key_text, line_of_offset, locate,
 };
+use crate::laws::LawRegistry;
 
 /// A problem in a scene file.
 #[derive(Clone, Debug, PartialEq)]
@@ -37,7 +38,7 @@ impl std::error::Error for SceneError {}
 #[derive(Clone, Debug)]
 pub struct LoadedScene {
     /// The typed scene.
-    pub scene: Scene,
+    pub scene: SceneFile,
     /// The file it came from.
     pub path: PathBuf,
     /// Its text.
@@ -52,6 +53,10 @@ impl LoadedScene {
             line: locate(&self.text, path),
             message: format!("{} {}", key_text(path), message),
         }
+    }
+    /// The model of the scene (`[scene] model`, default `"continuum"`).
+    pub fn model(&self) -> &str {
+        self.scene.scene.model.as_deref().unwrap_or("continuum")
     }
     /// Resolve a path written in the scene (relative to the scene file's directory).
     pub fn resolve(&self, p: &str) -> PathBuf {
@@ -77,14 +82,46 @@ pub fn ki(table: &str, index: usize, rest: &[&str]) -> Vec<KeyPart> {
     v
 }
 
+/// Largest scene file read (bytes): a scene is a page of text, not data.
+pub const MAX_SCENE_BYTES: u64 = 16 << 20;
+
 /// Read and parse a scene file (syntax, types, unknown keys).
 pub fn load(path: &Path) -> Result<LoadedScene, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|e| SceneError {
+    let cannot = |e: String| SceneError {
         file: path.to_path_buf(),
         line: 0,
         message: format!("cannot read the scene file: {e}"),
-    })?;
-    let scene: Scene = toml::from_str(&text).map_err(|e| SceneError {
+    };
+    let size = std::fs::metadata(path)
+        .map_err(|e| cannot(e.to_string()))?
+        .len();
+    if size > MAX_SCENE_BYTES {
+        return Err(cannot(format!(
+            "it has {size} bytes, more than the {MAX_SCENE_BYTES} a scene file may have"
+        )));
+    }
+    let text = std::fs::read_to_string(path).map_err(|e| cannot(e.to_string()))?;
+    parse(&text, path)
+}
+
+/// Deepest nesting of TOML arrays and tables in a scene file. The TOML parser recurses
+/// per level, so deeper text is refused before it is parsed.
+pub const MAX_TOML_NESTING: usize = 32;
+
+/// Parse scene text (syntax, types, unknown keys); `path` names it in errors.
+pub fn parse(text: &str, path: &Path) -> Result<LoadedScene, SceneError> {
+    if let Some((offset, depth)) = too_deep(text) {
+        return Err(SceneError {
+            file: path.to_path_buf(),
+            line: line_of_offset(text, offset),
+            message: format!(
+                "arrays and tables nest {depth} levels deep here, more than the \
+                 {MAX_TOML_NESTING} a scene may use"
+            ),
+        });
+    }
+    let text = text.to_string();
+    let scene: SceneFile = toml::from_str(&text).map_err(|e| SceneError {
         file: path.to_path_buf(),
         line: e.span().map_or(1, |s| line_of_offset(&text, s.start)),
         message: e.message().trim().replace('\n', " "),
@@ -94,6 +131,56 @@ pub fn load(path: &Path) -> Result<LoadedScene, SceneError> {
         path: path.to_path_buf(),
         text,
     })
+}
+
+/// The offset and depth where `[`/`{` nesting (outside strings and comments) first
+/// exceeds [`MAX_TOML_NESTING`].
+fn too_deep(text: &str) -> Option<(usize, usize)> {
+    let bytes = text.as_bytes();
+    let mut depth = 0usize;
+    let mut i = 0;
+    let mut at_line_start = true;
+    while i < bytes.len() {
+        let b = bytes[i];
+        match b {
+            b'#' => {
+                while i < bytes.len() && bytes[i] != b'\n' {
+                    i += 1;
+                }
+                continue;
+            }
+            b'"' | b'\'' => {
+                // Skip a string (basic strings honour backslash escapes; triple quotes
+                // are three empty-or-not strings in a row, which skips the same way).
+                let quote = b;
+                i += 1;
+                while i < bytes.len() && bytes[i] != quote {
+                    if quote == b'"' && bytes[i] == b'\\' {
+                        i += 1;
+                    }
+                    i += 1;
+                }
+            }
+            b'[' | b'{' if depth > 0 || !(at_line_start && b == b'[') => {
+                depth += 1;
+                if depth > MAX_TOML_NESTING {
+                    return Some((i, depth));
+                }
+            }
+            b']' | b'}' => depth = depth.saturating_sub(1),
+            b'\n' => {
+                at_line_start = true;
+                i += 1;
+                continue;
+            }
+            _ => {}
+        }
+        if !b.is_ascii_whitespace() {
+            at_line_start = false;
+        }
+        i += 1;
+    }
+    None
 }
 
 fn positive(ls: &LoadedScene, path: &[KeyPart], v: f64) -> Result<(), SceneError> {
@@ -128,25 +215,23 @@ fn expr_ok(
     }
 }
 
-/// Fields a probe or line may sample.
-pub const FIELDS: [&str; 13] = [
-    "pressure",
-    "ux",
-    "uy",
-    "uz",
-    "sxx",
-    "syy",
-    "szz",
-    "sxy",
-    "syz",
-    "sxz",
-    "smax",
-    "smin",
-    "fractured",
-];
+/// Number of steps of a schedule (before the [`crate::limits::MAX_STEPS`] bound; as
+/// a float so absurd requests do not overflow).
+pub fn step_count_f64(sch: &crate::file::Schedule) -> f64 {
+    match (sch.dt, sch.steps) {
+        (Some(dt), _) => (sch.end_time / dt - 1e-9).ceil().max(1.0),
+        (None, Some(n)) => n.max(1) as f64,
+        _ => 1.0,
+    }
+}
+
+/// Number of steps of a checked schedule.
+pub fn step_count(sch: &crate::file::Schedule) -> u64 {
+    step_count_f64(sch) as u64
+}
 
 /// Check every value of a parsed scene. Returns the first problem found.
-pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
+pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
     let s = &ls.scene;
     let dim = s.scene.dim;
     if dim != 2 && dim != 3 {
@@ -159,16 +244,17 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
             "must be a non-empty name without slashes",
         ));
     }
-    if let Some(p) = &s.scene.plane {
-        if d == 3 {
-            return Err(ls.error(&k(&["scene", "plane"]), "applies to 2D scenes only"));
-        }
-        if p != "strain" && p != "stress" {
-            return Err(ls.error(
-                &k(&["scene", "plane"]),
-                format!("= \"{p}\" must be \"strain\" or \"stress\""),
-            ));
-        }
+    if s.scene.plane.is_some() && d == 3 {
+        return Err(ls.error(&k(&["scene", "plane"]), "applies to 2D scenes only"));
+    }
+    if ls.model() != "continuum" {
+        return Err(ls.error(
+            &k(&["scene", "model"]),
+            format!(
+                "= \"{}\" is not available in this version of porofrac (available: continuum)",
+                ls.model()
+            ),
+        ));
     }
     check_grid(ls, d)?;
     // Materials.
@@ -245,13 +331,16 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
                 ));
             }
         }
-        if let Some(l) = &r.law {
-            if !["vem", "mdem", "dem"].contains(&l.as_str()) {
-                return Err(ls.error(
-                    &ki("region", i, &["law"]),
-                    format!("= \"{l}\" must be one of vem, mdem, dem"),
-                ));
-            }
+        if let Some(l) = &r.law
+            && !laws.contains(l)
+        {
+            return Err(ls.error(
+                &ki("region", i, &["law"]),
+                format!(
+                    "= \"{l}\" is not a known law (known: {})",
+                    laws.names().join(", ")
+                ),
+            ));
         }
         match &r.select {
             Select::All(false) => {
@@ -338,32 +427,8 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
         }
     }
     if let Some(init) = &s.initial {
-        if let Some(m) = &init.mechanics {
-            if m != "equilibrium" && m != "zero" {
-                return Err(ls.error(
-                    &k(&["initial", "mechanics"]),
-                    format!("= \"{m}\" must be \"equilibrium\" or \"zero\""),
-                ));
-            }
-        }
         if let Some(p) = &init.pressure {
             expr_ok(ls, &k(&["initial", "pressure"]), p, false)?;
-        }
-    }
-    if let Some(c) = &s.physics.coupling {
-        if !["monolithic", "fixed-stress", "explicit-pressure", "none"].contains(&c.as_str()) {
-            return Err(ls.error(
-                &k(&["physics", "coupling"]),
-                format!("= \"{c}\" must be monolithic, fixed-stress, explicit-pressure or none"),
-            ));
-        }
-    }
-    if let Some(f) = &s.physics.failure_stress {
-        if f != "cell" && f != "recovered" {
-            return Err(ls.error(
-                &k(&["physics", "failure_stress"]),
-                format!("= \"{f}\" must be \"cell\" or \"recovered\""),
-            ));
         }
     }
     if let Some(kf) = s.physics.fracture_permeability {
@@ -385,22 +450,6 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
             format!("= {r} must be in [0, 1)"),
         ));
     }
-    if let Some(m) = &s.solver.mechanics {
-        if m != "direct" && m != "explicit" {
-            return Err(ls.error(
-                &k(&["solver", "mechanics"]),
-                format!("= \"{m}\" must be \"direct\" or \"explicit\""),
-            ));
-        }
-    }
-    if let Some(l) = &s.solver.linear {
-        if !["auto", "cholesky", "cg-amg"].contains(&l.as_str()) {
-            return Err(ls.error(
-                &k(&["solver", "linear"]),
-                format!("= \"{l}\" must be auto, cholesky or cg-amg"),
-            ));
-        }
-    }
     if let Some(t) = s.solver.tolerance {
         positive(ls, &k(&["solver", "tolerance"]), t)?;
     }
@@ -415,18 +464,15 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
             format!("= {} must be ≥ 1", s.output.every),
         ));
     }
+    let flow = s.physics.flow == Some(true);
+    let field_ok = |name: &str, key: Vec<KeyPart>| {
+        crate::continuum::fields::Field::parse(name, d, flow)
+            .map(|_| ())
+            .map_err(|e| ls.error(&key, e))
+    };
     let mut names = std::collections::BTreeSet::new();
     for (i, p) in s.output.probe.iter().enumerate() {
-        if !FIELDS.contains(&p.field.as_str()) {
-            return Err(ls.error(
-                &ki("output.probe", i, &["field"]),
-                format!(
-                    "= \"{}\" is not a field (known: {})",
-                    p.field,
-                    FIELDS.join(", ")
-                ),
-            ));
-        }
+        field_ok(&p.field, ki("output.probe", i, &["field"]))?;
         len_is(ls, &ki("output.probe", i, &["at"]), p.at.len(), d)?;
         if !names.insert(p.name.clone()) || p.name == "time" || p.name.contains(',') {
             return Err(ls.error(
@@ -436,22 +482,23 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
         }
     }
     for (i, l) in s.output.line.iter().enumerate() {
-        if !FIELDS.contains(&l.field.as_str()) {
-            return Err(ls.error(
-                &ki("output.line", i, &["field"]),
-                format!(
-                    "= \"{}\" is not a field (known: {})",
-                    l.field,
-                    FIELDS.join(", ")
-                ),
-            ));
-        }
+        field_ok(&l.field, ki("output.line", i, &["field"]))?;
         len_is(ls, &ki("output.line", i, &["from"]), l.from.len(), d)?;
         len_is(ls, &ki("output.line", i, &["to"]), l.to.len(), d)?;
         if l.points < 2 {
             return Err(ls.error(
                 &ki("output.line", i, &["points"]),
                 format!("= {} must be ≥ 2", l.points),
+            ));
+        }
+        if l.points as u64 > crate::limits::MAX_LINE_POINTS {
+            return Err(ls.error(
+                &ki("output.line", i, &["points"]),
+                format!(
+                    "= {} is more than the {} points a line may have",
+                    l.points,
+                    crate::limits::MAX_LINE_POINTS
+                ),
             ));
         }
         if l.name.is_empty() || l.name.contains(['/', '\\']) {
@@ -461,39 +508,27 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
             ));
         }
     }
+    check_wells(ls, d)?;
+    check_sizes(ls, d)?;
     Ok(())
 }
 
 fn check_grid(ls: &LoadedScene, d: usize) -> Result<(), SceneError> {
     let g = &ls.scene.grid;
     let key = |f: &str| k(&["grid", f]);
-    let kinds = [
-        "cartesian",
-        "triangles",
-        "tetrahedra",
-        "voronoi",
-        "file",
-        "composite",
-    ];
-    if !kinds.contains(&g.kind.as_str()) {
+    if matches!(g.kind, GridKind::Triangles | GridKind::Voronoi) && d != 2 {
         return Err(ls.error(
             &key("kind"),
-            format!("= \"{}\" must be one of {}", g.kind, kinds.join(", ")),
+            format!("= \"{}\" is a 2D grid, the scene is {d}D", g.kind.as_str()),
         ));
     }
-    if (g.kind == "triangles" || g.kind == "voronoi") && d != 2 {
-        return Err(ls.error(
-            &key("kind"),
-            format!("= \"{}\" is a 2D grid, the scene is {d}D", g.kind),
-        ));
-    }
-    if g.kind == "tetrahedra" && d != 3 {
+    if g.kind == GridKind::Tetrahedra && d != 3 {
         return Err(ls.error(
             &key("kind"),
             "= \"tetrahedra\" is a 3D grid, the scene is 2D",
         ));
     }
-    if g.kind == "file" {
+    if g.kind == GridKind::File {
         if g.path.is_none() {
             return Err(ls.error(&key("path"), "is required for kind = \"file\""));
         }
@@ -502,7 +537,7 @@ fn check_grid(ls: &LoadedScene, d: usize) -> Result<(), SceneError> {
     let Some(ext) = &g.extent else {
         return Err(ls.error(
             &key("extent"),
-            format!("is required for kind = \"{}\"", g.kind),
+            format!("is required for kind = \"{}\"", g.kind.as_str()),
         ));
     };
     len_is(ls, &key("extent"), ext[0].len(), d)?;
@@ -512,17 +547,17 @@ fn check_grid(ls: &LoadedScene, d: usize) -> Result<(), SceneError> {
             return Err(ls.error(&key("extent"), format!("needs min < max on axis {a}")));
         }
     }
-    match (&g.cells, g.kind.as_str()) {
+    match (&g.cells, g.kind) {
         (None, _) => return Err(ls.error(&key("cells"), "is required")),
-        (Some(CellCount::One(n)), "voronoi") if *n >= 1 => {}
-        (Some(CellCount::PerAxis(v)), kind) if kind != "voronoi" => {
+        (Some(CellCount::One(n)), GridKind::Voronoi) if *n >= 1 => {}
+        (Some(CellCount::PerAxis(v)), kind) if kind != GridKind::Voronoi => {
             len_is(ls, &key("cells"), v.len(), d)?;
             if v.iter().any(|&n| n < 1) {
                 return Err(ls.error(&key("cells"), format!("= {v:?} must all be ≥ 1")));
             }
         }
         (Some(c), kind) => {
-            return Err(ls.error(&key("cells"), format!("= {c:?} does not fit kind = \"{kind}\" (one number for voronoi, one per axis otherwise)")));
+            return Err(ls.error(&key("cells"), format!("= {c:?} does not fit kind = \"{}\" (one number for voronoi, one per axis otherwise)", kind.as_str())));
         }
     }
     if let Some(p) = g.perturb {
@@ -530,15 +565,10 @@ fn check_grid(ls: &LoadedScene, d: usize) -> Result<(), SceneError> {
             return Err(ls.error(&key("perturb"), format!("= {p} must be in [0, 0.5)")));
         }
     }
-    if let Some(d) = &g.diagonals
-        && (g.kind != "composite" || (d != "structured" && d != "alternating"))
-    {
-        return Err(ls.error(
-            &key("diagonals"),
-            format!("= \"{d}\" must be \"structured\" or \"alternating\" (composite grids)"),
-        ));
+    if g.diagonals.is_some() && g.kind != GridKind::Composite {
+        return Err(ls.error(&key("diagonals"), "applies to composite grids only"));
     }
-    if g.kind == "composite" {
+    if g.kind == GridKind::Composite {
         for f in ["center", "zone_half_width", "refine", "well_radius"] {
             let present = match f {
                 "center" => g.center.is_some(),
@@ -620,4 +650,133 @@ fn check_bc(ls: &LoadedScene, i: usize, bc: &Bc, d: usize) -> Result<(), SceneEr
         }
     }
     Ok(())
+}
+
+fn check_wells(ls: &LoadedScene, d: usize) -> Result<(), SceneError> {
+    let mut names = std::collections::BTreeSet::new();
+    for (i, w) in ls.scene.well.iter().enumerate() {
+        let key = |f: &str| ki("well", i, &[f]);
+        if w.name.is_empty() || !names.insert(w.name.as_str()) {
+            return Err(ls.error(&key("name"), "must be a non-empty name used once"));
+        }
+        match (&w.at, w.cell) {
+            (Some(at), None) => len_is(ls, &key("at"), at.len(), d)?,
+            (None, Some(_)) => {}
+            _ => {
+                return Err(ls.error(
+                    &ki("well", i, &[]),
+                    "needs exactly one of at (a point) and cell (a cell index)",
+                ));
+            }
+        }
+        positive(ls, &key("radius"), w.radius)?;
+        if let Some(sk) = w.skin
+            && !sk.is_finite()
+        {
+            return Err(ls.error(&key("skin"), format!("= {sk} must be finite")));
+        }
+        match (w.rate, w.bottom_hole_pressure) {
+            (Some(q), None) if q.is_finite() => {}
+            (None, Some(p)) if p.is_finite() => {}
+            (Some(_), None) => return Err(ls.error(&key("rate"), "must be finite")),
+            (None, Some(_)) => {
+                return Err(ls.error(&key("bottom_hole_pressure"), "must be finite"));
+            }
+            _ => {
+                return Err(ls.error(
+                    &ki("well", i, &[]),
+                    "needs exactly one of rate and bottom_hole_pressure",
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Bound steps, output series and generated grids before anything is allocated
+/// ([`crate::limits`]).
+fn check_sizes(ls: &LoadedScene, d: usize) -> Result<(), SceneError> {
+    use crate::limits::{MAX_CELLS, MAX_STEPS, fits_in_memory, run_bytes};
+    let s = &ls.scene;
+    if let Some(sch) = &s.schedule {
+        let n = step_count_f64(sch);
+        let key = if sch.dt.is_some() {
+            k(&["schedule", "dt"])
+        } else {
+            k(&["schedule", "steps"])
+        };
+        if n > MAX_STEPS as f64 {
+            return Err(ls.error(
+                &key,
+                format!(
+                    "gives {n:.3e} steps up to end_time = {}, more than the {MAX_STEPS} a run \
+                     may take",
+                    sch.end_time
+                ),
+            ));
+        }
+        // Output series kept in memory: the written times, probe columns and line rows
+        // (8 bytes per number, about 24 in the CSV text).
+        let written = n / s.output.every.max(1) as f64 + 2.0;
+        let numbers: f64 = 1.0
+            + s.output.probe.len() as f64
+            + s.output
+                .line
+                .iter()
+                .map(|l| l.points as f64 * (d as f64 + 2.0))
+                .sum::<f64>();
+        fits_in_memory(
+            written * numbers * 32.0,
+            &format!("{n:.3e} steps with these probes and lines"),
+        )
+        .map_err(|e| ls.error(&key, e))?;
+    }
+    let g = &s.grid;
+    let per_axis: Vec<f64> = match &g.cells {
+        Some(CellCount::PerAxis(v)) => v.iter().map(|&n| n as f64).collect(),
+        Some(CellCount::One(n)) => vec![*n as f64],
+        None => return Ok(()),
+    };
+    let boxes: f64 = per_axis.iter().product();
+    let corners: f64 = per_axis.iter().map(|n| n + 1.0).product();
+    let (cells, nodes) = match g.kind {
+        GridKind::Cartesian => (boxes, corners),
+        GridKind::Triangles => (2.0 * boxes, corners),
+        GridKind::Tetrahedra => (6.0 * boxes, corners),
+        GridKind::Voronoi => (boxes, 2.0 * boxes),
+        GridKind::Composite => {
+            // The far field plus the refined zone (about (2 w / h · refine)² squares of
+            // two triangles), extruded over cells[2] layers in 3D.
+            let (nx, ny) = (per_axis[0], per_axis.get(1).copied().unwrap_or(1.0));
+            let refine = g.refine.unwrap_or(1).max(1) as f64;
+            let ext = g.extent.as_ref();
+            let hx = ext.map_or(1.0, |e| (e[1][0] - e[0][0]) / nx);
+            let zone = (2.0 * g.zone_half_width.unwrap_or(0.0) / hx).ceil() + 1.0;
+            let fine = (zone * refine) * (zone * refine);
+            let (layers, per_layer) = if d == 3 {
+                (per_axis.get(2).copied().unwrap_or(1.0), 3.0)
+            } else {
+                (1.0, 1.0)
+            };
+            (
+                (nx * ny + 2.0 * fine) * layers * per_layer,
+                (nx * ny + fine) * (layers + 1.0),
+            )
+        }
+        GridKind::File => return Ok(()),
+    };
+    let key = k(&["grid", "cells"]);
+    if cells > MAX_CELLS as f64 {
+        return Err(ls.error(
+            &key,
+            format!("asks for {cells:.3e} cells, more than the {MAX_CELLS} a grid may have"),
+        ));
+    }
+    let flow = s.physics.flow == Some(true);
+    let unknowns = d as f64 * nodes + if flow { cells } else { 0.0 };
+    fits_in_memory(
+        run_bytes(cells, unknowns),
+        &format!("asks for {cells:.3e} cells and {unknowns:.3e} unknowns"),
+    )
+    .map_err(|e| ls.error(&key, e))
 }

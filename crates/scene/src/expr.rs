@@ -26,6 +26,10 @@ pub struct Expr {
 
 const STACK: usize = 64;
 
+/// Deepest nesting the parser accepts (parentheses, function arguments, signs and powers
+/// together); deeper text is an error, never a stack overflow.
+pub const MAX_NESTING: usize = 100;
+
 /// One-argument functions.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Func {
@@ -147,6 +151,8 @@ struct Parser {
     pos: usize,
     end: usize,
     ops: Vec<Op>,
+    /// Current nesting depth (see [`MAX_NESTING`]).
+    depth: usize,
 }
 
 impl Parser {
@@ -198,16 +204,24 @@ impl Parser {
             }
         }
     }
+    /// Every nesting (parentheses, arguments, unary signs, powers) passes through here,
+    /// so the depth guard here bounds the recursion of the whole parser.
     fn unary(&mut self) -> Result<(), ExprError> {
-        if self.eat('-') {
-            self.unary()?;
-            self.ops.push(Op::Neg);
-            Ok(())
+        self.depth += 1;
+        if self.depth > MAX_NESTING {
+            return self.err(format!(
+                "the expression nests more than {MAX_NESTING} levels deep"
+            ));
+        }
+        let result = if self.eat('-') {
+            self.unary().map(|()| self.ops.push(Op::Neg))
         } else if self.eat('+') {
             self.unary()
         } else {
             self.power()
-        }
+        };
+        self.depth -= 1;
+        result
     }
     fn power(&mut self) -> Result<(), ExprError> {
         self.atom()?;
@@ -321,6 +335,7 @@ impl Expr {
             pos: 0,
             end: text.chars().count() + 1,
             ops: Vec::new(),
+            depth: 0,
         };
         p.expr()?;
         if p.pos != p.toks.len() {
@@ -421,6 +436,22 @@ mod tests {
 
     fn ev(s: &str, x: &[f64], t: f64) -> f64 {
         Expr::parse(s).unwrap().eval(x, t)
+    }
+
+    #[test]
+    fn hostile_nesting_is_an_error_not_a_stack_overflow() {
+        for text in [
+            format!("{}x{}", "(".repeat(100_000), ")".repeat(100_000)),
+            format!("{}x", "-".repeat(100_000)),
+            format!("{}x{}", "sin(".repeat(100_000), ")".repeat(100_000)),
+            vec!["x"; 100_000].join("^"),
+        ] {
+            let e = Expr::parse(&text).unwrap_err();
+            assert!(e.what.contains("nests more than 100"), "{}", e.what);
+        }
+        // 40 levels are fine and evaluate correctly.
+        let e = Expr::parse(&format!("{}x{}", "(".repeat(40), ")".repeat(40))).unwrap();
+        assert_eq!(e.eval(&[2.5, 0.0, 0.0], 0.0), 2.5);
     }
 
     #[test]

@@ -1,8 +1,10 @@
 //! The scene file: typed TOML sections of `SCENE.md`, and the locations of keys for error
 //! messages.
 //!
-//! Parsing is strict: unknown keys and wrong types are errors that name the file, line and
-//! key; values are checked in [`crate::check`].
+//! Parsing is strict: unknown keys, wrong types and choices that are not one of the
+//! listed words are errors that name the file, line and key; values are checked in
+//! [`crate::check`]. Every choice is an enum here, so nothing downstream compares
+//! strings.
 
 use std::collections::BTreeMap;
 
@@ -18,13 +20,155 @@ pub enum NumOrExpr {
     Expr(String),
 }
 
+impl NumOrExpr {
+    /// The value as a field of position and time (expressions compiled once; a constant
+    /// expression becomes a constant). Checked scenes only: an expression that does not
+    /// parse here would have been refused by [`crate::check`], and gives NaN.
+    pub fn to_field(&self) -> porofrac_grid::ScalarField {
+        use porofrac_grid::ScalarField;
+        match self {
+            Self::Num(x) => ScalarField::Const(*x),
+            Self::Expr(s) => match crate::expr::Expr::parse(s) {
+                Ok(e) => match e.as_constant() {
+                    Some(c) => ScalarField::Const(c),
+                    None => ScalarField::from_fn(move |x, t| e.eval(x, t)),
+                },
+                Err(_) => ScalarField::Const(f64::NAN),
+            },
+        }
+    }
+
+    /// A component that may be `"free"`: `None` for free, else [`NumOrExpr::to_field`].
+    pub fn to_component(&self) -> Option<porofrac_grid::ScalarField> {
+        match self {
+            Self::Expr(s) if s == "free" => None,
+            v => Some(v.to_field()),
+        }
+    }
+}
+
 /// One component of a displacement condition: a number, an expression, or `"free"`.
 pub type Component = NumOrExpr;
+
+/// `[scene] plane`: the 2D idealization.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum Plane {
+    /// Plane strain (`ε_zz = 0`), the default.
+    #[default]
+    Strain,
+    /// Plane stress (`σ_zz = 0`): `λ* = 2λμ/(λ + 2μ)`.
+    Stress,
+}
+
+/// `[grid] kind`.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum GridKind {
+    /// Axis-aligned boxes.
+    Cartesian,
+    /// Boxes split into two triangles (2D).
+    Triangles,
+    /// Boxes split into six tetrahedra (3D).
+    Tetrahedra,
+    /// A centroidal Voronoi grid (2D).
+    Voronoi,
+    /// A Gmsh or VTK file.
+    File,
+    /// A far field with a refined simplex zone around a well.
+    Composite,
+}
+
+impl GridKind {
+    /// The word of the scene file.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Cartesian => "cartesian",
+            Self::Triangles => "triangles",
+            Self::Tetrahedra => "tetrahedra",
+            Self::Voronoi => "voronoi",
+            Self::File => "file",
+            Self::Composite => "composite",
+        }
+    }
+}
+
+/// `[grid] diagonals` of composite grids.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum DiagonalsChoice {
+    /// All fine squares split along the same diagonal.
+    #[default]
+    Structured,
+    /// A checkerboard of diagonals.
+    Alternating,
+}
+
+/// `[initial] mechanics`.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum InitialMechanics {
+    /// Solve the mechanics at t = 0 before the schedule starts.
+    #[default]
+    Equilibrium,
+    /// Start from rest: the loads switch on at t = 0+.
+    Zero,
+}
+
+/// `[physics] coupling`.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum CouplingChoice {
+    /// Fully implicit (seed eq. 30).
+    #[default]
+    Monolithic,
+    /// Fixed-stress split.
+    FixedStress,
+    /// The seed's explicit-pressure update (§2.5).
+    ExplicitPressure,
+    /// Flow on a fixed skeleton.
+    None,
+}
+
+/// `[physics] failure_stress`.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum FailureStress {
+    /// The cell law's stress.
+    #[default]
+    Cell,
+    /// The cell average of the patch-recovered nodal stress.
+    Recovered,
+}
+
+/// `[solver] mechanics`.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum MechanicsSolver {
+    /// A static solve at every output time.
+    #[default]
+    Direct,
+    /// Damped dynamic relaxation.
+    Explicit,
+}
+
+/// `[solver] linear`.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum LinearChoice {
+    /// By dimension and size (measured in docs/BENCHMARKS.md).
+    #[default]
+    Auto,
+    /// Sparse Cholesky.
+    Cholesky,
+    /// CG preconditioned by smoothed-aggregation AMG.
+    CgAmg,
+}
 
 /// A whole scene file.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct Scene {
+pub struct SceneFile {
     /// `[scene]`.
     pub scene: SceneSection,
     /// `[grid]`.
@@ -45,6 +189,9 @@ pub struct Scene {
     /// `[[source]]`.
     #[serde(default)]
     pub source: Vec<Source>,
+    /// `[[well]]`: Peaceman wells.
+    #[serde(default)]
+    pub well: Vec<WellSection>,
     /// `[initial]`.
     pub initial: Option<Initial>,
     /// `[schedule]`: absent means one static solve.
@@ -68,16 +215,18 @@ pub struct SceneSection {
     pub name: String,
     /// 2 or 3.
     pub dim: i64,
-    /// 2D only: `"strain"` (default) or `"stress"`.
-    pub plane: Option<String>,
+    /// 2D only: plane strain (default) or plane stress.
+    pub plane: Option<Plane>,
+    /// The model: `"continuum"` (default); see ../SCENE-MODELS.md for the others.
+    pub model: Option<String>,
 }
 
 /// `[grid]`.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct GridSection {
-    /// `cartesian | triangles | tetrahedra | voronoi | file | composite`.
-    pub kind: String,
+    /// The generator or reader.
+    pub kind: GridKind,
     /// Min and max corner.
     pub extent: Option<[Vec<f64>; 2]>,
     /// Cells per axis (one number for voronoi).
@@ -98,8 +247,8 @@ pub struct GridSection {
     pub well_radius: Option<f64>,
     /// Composite: name of the well tag (default `well`).
     pub well_tag: Option<String>,
-    /// Composite: split of the fine squares, `"structured"` (default) or `"alternating"`.
-    pub diagonals: Option<String>,
+    /// Composite: split of the fine squares.
+    pub diagonals: Option<DiagonalsChoice>,
     /// Voronoi: Lloyd iterations.
     pub lloyd: Option<i64>,
 }
@@ -248,14 +397,34 @@ pub struct Source {
     pub pore_volumes_per_hour: Option<f64>,
 }
 
+/// `[[well]]`: a Peaceman well in one cell, controlled by rate or bottom-hole pressure.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WellSection {
+    /// Name (for messages).
+    pub name: String,
+    /// The point the well passes through (its cell is the well's cell).
+    pub at: Option<Vec<f64>>,
+    /// Or the index of the well's cell.
+    pub cell: Option<i64>,
+    /// Wellbore radius (m).
+    pub radius: f64,
+    /// Skin factor (default 0).
+    pub skin: Option<f64>,
+    /// Volumetric rate (m³/s; 2D: per metre), positive for injection.
+    pub rate: Option<f64>,
+    /// Or the bottom-hole pressure (Pa).
+    pub bottom_hole_pressure: Option<f64>,
+}
+
 /// `[initial]`.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Initial {
     /// Initial pressure (Pa).
     pub pressure: Option<NumOrExpr>,
-    /// `"equilibrium"` (default) or `"zero"`.
-    pub mechanics: Option<String>,
+    /// Equilibrium (default) or rest at t = 0.
+    pub mechanics: Option<InitialMechanics>,
 }
 
 /// `[schedule]`.
@@ -276,13 +445,13 @@ pub struct Schedule {
 pub struct Physics {
     /// Solve flow.
     pub flow: Option<bool>,
-    /// `monolithic | fixed-stress | explicit-pressure | none`.
-    pub coupling: Option<String>,
+    /// The poroelastic coupling.
+    pub coupling: Option<CouplingChoice>,
     /// Check failure criteria.
     pub fracture: Option<bool>,
-    /// Stress the failure criteria see: `"cell"` (default, the cell law's stress) or
-    /// `"recovered"` (patch-recovered nodal stress averaged over the cell).
-    pub failure_stress: Option<String>,
+    /// Stress the failure criteria see: the cell law's stress (default) or the
+    /// patch-recovered nodal stress averaged over the cell.
+    pub failure_stress: Option<FailureStress>,
     /// Isotropic permeability (m²) of failed cells with flow (default 1e-12).
     pub fracture_permeability: Option<f64>,
     /// Residual stiffness ratio of open edges of failed cells (default 1e-6).
@@ -295,10 +464,10 @@ pub struct Physics {
 #[derive(Clone, Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Solver {
-    /// `direct | explicit`.
-    pub mechanics: Option<String>,
-    /// `auto | cholesky | cg-amg`.
-    pub linear: Option<String>,
+    /// Static solves or damped dynamic relaxation.
+    pub mechanics: Option<MechanicsSolver>,
+    /// The linear solver.
+    pub linear: Option<LinearChoice>,
     /// Relative residual / unbalanced-force ratio.
     pub tolerance: Option<f64>,
     /// Threads (0: default).

@@ -1,0 +1,777 @@
+//! The continuum model (seed 000, `[scene] model = "continuum"`): VEM, MDEM and DEM cell
+//! laws, TPFA flow, Biot coupling and fracturing on a polyhedral grid.
+//!
+//! - *build*: the grid ([`grid`]), the law and material of every cell and the conditions
+//!   ([`compose`]), the flow model ([`flow`]), the dof map, the stiffness pattern and the
+//!   solver;
+//! - *step*: one of three drivers, chosen by the scene: static mechanics at every output
+//!   time (direct or damped explicit relaxation; conditions may depend on `t`), flow on a
+//!   fixed skeleton after it, or the coupled poroelastic step
+//!   ([`porofrac_sim::Fracturing`]). Failures are resolved within a step by
+//!   [`porofrac_sim::resolve_failures`] in all of them, with the same settings;
+//! - *fields*: displacement, stress, principal stresses, pressure and the failure flag
+//!   ([`fields`]) for probes, lines, VTK and `field_extrema`, and the plots ([`plots`]).
+
+pub mod compose;
+pub mod fields;
+pub mod flow;
+pub mod grid;
+pub mod plots;
+
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::time::Instant;
+
+use porofrac_frac::FailureState;
+use porofrac_grid::io::{Field as VtkField, write_vtu};
+use porofrac_grid::{Grid, Point};
+use porofrac_law::{CellLaw, Tensor};
+use porofrac_sim::{
+    BiotState, Body, DofMap, ExplicitOptions, ExplicitPressure, FailureResolution, FixedStress,
+    FractureFlow, FractureLaws, FractureSettings, Fracturing, LawMap, LinearSolver, Monolithic,
+    Pattern, Scheme, StaticOptions, StaticProblem, StaticSolver, StressMeasure, cell_stresses,
+    drained_bulk_modulus, solve_explicit, solve_static,
+};
+
+use crate::check::{LoadedScene, k, ki};
+use crate::driver::{Observer, drive};
+use crate::file::{
+    CouplingChoice, FailureStress, InitialMechanics, LinearChoice, MechanicsSolver, Plane,
+};
+use crate::laws::LawRegistry;
+use crate::model::{Model, RunError, Sizes, StepStats};
+use crate::output::{CsvTable, SolverStats, Summary, WallSeconds};
+use crate::sample::{Location, locate};
+
+use compose::{Composition, Conditions, compose, conditions, material_stiffness};
+use fields::Field;
+use flow::{FlowSetup, flow_setup};
+use grid::{AnyGrid, build_grid, point};
+
+/// Run a checked continuum scene.
+pub(crate) fn run(
+    ls: &LoadedScene,
+    registry: &LawRegistry,
+    out: &Path,
+    observer: &mut dyn Observer,
+) -> Result<Summary, RunError> {
+    let start = Instant::now();
+    check_supported(ls)?;
+    let grid = build_grid(ls)?;
+    let grid_seconds = start.elapsed().as_secs_f64();
+    match grid {
+        AnyGrid::Two(g) => run_dim(ls, registry, &g, out, observer, start, grid_seconds),
+        AnyGrid::Three(g) => run_dim(ls, registry, &g, out, observer, start, grid_seconds),
+    }
+}
+
+fn run_dim<const D: usize>(
+    ls: &LoadedScene,
+    registry: &LawRegistry,
+    grid: &Grid<D>,
+    out: &Path,
+    observer: &mut dyn Observer,
+    start: Instant,
+    grid_seconds: f64,
+) -> Result<Summary, RunError> {
+    // Mesh files are counted only once read: bound the run before assembling it.
+    let flow_on = ls.scene.physics.flow == Some(true);
+    let unknowns = (D * grid.num_nodes() + if flow_on { grid.num_cells() } else { 0 }) as f64;
+    crate::limits::fits_in_memory(
+        crate::limits::run_bytes(grid.num_cells() as f64, unknowns),
+        &format!(
+            "the grid has {} cells and {} unknowns",
+            grid.num_cells(),
+            unknowns
+        ),
+    )
+    .map_err(|e| ls.error(&k(&["grid"]), e))?;
+    let t_asm = Instant::now();
+    let comp = compose(ls, registry, grid)?;
+    let cond = conditions(ls, grid, &comp)?;
+    let law_refs: Vec<&dyn CellLaw<D>> = comp.laws.iter().map(|l| l.as_ref()).collect();
+    // Checks every cell against its law once (e.g. MDEM on a polygon is an error).
+    LawMap::new(grid, law_refs.clone(), comp.law_of_cell.clone())?;
+    let dofs = DofMap::new(grid, &cond.displacements, &cond.platens)?;
+    let pattern = Pattern::new(grid, &dofs)?;
+    let assembly = t_asm.elapsed().as_secs_f64();
+    let body = Body {
+        grid,
+        dofs: &dofs,
+        pattern: &pattern,
+        loads: &cond.loads,
+    };
+    let mut stepper = Stepper::new(ls, body, &comp, &cond, law_refs, out)?;
+    stepper.wall.assembly += assembly;
+    drive(ls, &mut stepper, out, observer, start, grid_seconds, D)
+}
+
+/// Physics this version does not model yet is an error, not silently ignored.
+fn check_supported(ls: &LoadedScene) -> Result<(), RunError> {
+    let s = &ls.scene;
+    let flow = s.physics.flow == Some(true);
+    let coupling = s.physics.coupling.unwrap_or_default();
+    let explicit = s.solver.mechanics == Some(MechanicsSolver::Explicit);
+    // CG-AMG solves the static mechanics (SPD); the Biot system is indefinite.
+    if s.solver.linear == Some(LinearChoice::CgAmg) {
+        let coupled = flow && coupling != CouplingChoice::None;
+        if coupled || explicit {
+            return Err(ls
+                .error(
+                    &k(&["solver", "linear"]),
+                    "= \"cg-amg\" solves static mechanics only; coupled flow (an indefinite \
+                     Biot system) and explicit mechanics need \"cholesky\" or \"auto\"",
+                )
+                .into());
+        }
+    }
+    for (i, bc) in s.bc.iter().enumerate() {
+        if !flow && (bc.pressure.is_some() || bc.flux.is_some()) {
+            return Err(ls
+                .error(
+                    &ki("bc", i, &["pressure"]),
+                    "is a flow condition: set [physics] flow = true",
+                )
+                .into());
+        }
+    }
+    if !flow && !s.source.is_empty() {
+        return Err(ls
+            .error(&ki("source", 0, &[]), "needs [physics] flow = true")
+            .into());
+    }
+    if !flow && !s.well.is_empty() {
+        return Err(ls
+            .error(&ki("well", 0, &[]), "needs [physics] flow = true")
+            .into());
+    }
+    if flow && coupling != CouplingChoice::None && explicit {
+        return Err(ls
+            .error(
+                &k(&["solver", "mechanics"]),
+                "= \"explicit\" with coupled flow is not available in this version of porofrac",
+            )
+            .into());
+    }
+    Ok(())
+}
+
+/// The output times: 0, then every step of the schedule (bounded by the checks).
+fn output_times(ls: &LoadedScene) -> Vec<f64> {
+    let mut t = vec![0.0];
+    if let Some(sch) = &ls.scene.schedule {
+        let n = crate::check::step_count(sch).min(crate::limits::MAX_STEPS) as usize;
+        let dt = sch.dt.unwrap_or(sch.end_time / n as f64);
+        t.reserve(n);
+        for k in 1..=n {
+            t.push((k as f64 * dt).min(sch.end_time));
+        }
+    }
+    t
+}
+
+/// How the mechanics advances (one value per run: the size of the variants does not
+/// matter).
+#[allow(clippy::large_enum_variant)]
+enum Driver<'a, const D: usize> {
+    /// Static (or damped explicit) mechanics at every output time.
+    Static {
+        solver: StaticSolver,
+        /// Density per cell for damped explicit relaxation.
+        explicit: Option<Vec<f64>>,
+        resolution: FailureResolution<D>,
+    },
+    /// Coupled poroelasticity with fracturing.
+    Coupled {
+        frac: Box<Fracturing<'a, D>>,
+        state: Option<BiotState>,
+    },
+}
+
+/// Sample points along an output line: arc length from its start, position, location.
+type LinePoints<const D: usize> = Vec<(f64, Point<D>, Location)>;
+
+/// The continuum model stepping through its output times.
+struct Stepper<'a, const D: usize> {
+    ls: &'a LoadedScene,
+    body: Body<'a, D>,
+    comp: &'a Composition<D>,
+    law_refs: Vec<&'a dyn CellLaw<D>>,
+    times: Vec<f64>,
+    driver: Driver<'a, D>,
+    /// Flow on a fixed skeleton (`coupling = "none"`).
+    fixed_flow: Option<FlowSetup<D>>,
+    zero_start: bool,
+    static_options: StaticOptions,
+    // The state at the current time.
+    u: Vec<f64>,
+    stress: Vec<Tensor<D>>,
+    pressure: Option<Vec<f64>>,
+    failures: FailureState,
+    // Outputs.
+    probes: Vec<(Field, Location)>,
+    lines: Vec<(Field, LinePoints<D>)>,
+    fracture_csv: CsvTable,
+    logged: usize,
+    nu_of_cell: Vec<f64>,
+    plane_strain: bool,
+    law_ids: Vec<i32>,
+    stats: SolverStats,
+    wall: WallSeconds,
+}
+
+impl<'a, const D: usize> Stepper<'a, D> {
+    fn new(
+        ls: &'a LoadedScene,
+        body: Body<'a, D>,
+        comp: &'a Composition<D>,
+        cond: &'a Conditions<D>,
+        law_refs: Vec<&'a dyn CellLaw<D>>,
+        out: &Path,
+    ) -> Result<Self, RunError> {
+        let _ = cond;
+        let s = &ls.scene;
+        let grid = body.grid;
+        let mut wall = WallSeconds::default();
+        let flow_on = s.physics.flow == Some(true);
+        let coupling = s.physics.coupling.unwrap_or_default();
+        let tolerance = s.solver.tolerance;
+        let mut flow = if flow_on {
+            let t_flow = Instant::now();
+            let f = flow_setup(ls, grid, &comp.material_of_cell())?;
+            wall.flow += t_flow.elapsed().as_secs_f64();
+            Some(f)
+        } else {
+            None
+        };
+        let pressure = flow.as_ref().map(|f| f.p0.clone());
+        let settings = fracture_settings(ls, comp);
+        let t_asm = Instant::now();
+        let (driver, linear_name) = match flow.take_if(|_| coupling != CouplingChoice::None) {
+            Some(f) => {
+                let frac = coupled(ls, body, comp, &law_refs, f, settings)?;
+                (
+                    Driver::Coupled {
+                        frac: Box::new(frac),
+                        state: None,
+                    },
+                    "ldlt",
+                )
+            }
+            None => {
+                let explicit = match s.solver.mechanics.unwrap_or_default() {
+                    MechanicsSolver::Explicit => Some(densities(ls, comp)?),
+                    MechanicsSolver::Direct => None,
+                };
+                let cg = LinearSolver::CgAmg {
+                    tolerance: tolerance.unwrap_or(1e-8),
+                };
+                // Cholesky with nested dissection in 3D and AMD in 2D, or CG-AMG; "auto"
+                // picks by size (docs/BENCHMARKS.md).
+                let linear = match s.solver.linear.unwrap_or_default() {
+                    LinearChoice::Cholesky => LinearSolver::Cholesky,
+                    LinearChoice::CgAmg => cg,
+                    LinearChoice::Auto => {
+                        match LinearSolver::Auto.resolve(D, body.dofs.num_equations()) {
+                            LinearSolver::CgAmg { .. } => cg,
+                            other => other,
+                        }
+                    }
+                };
+                let solver = StaticSolver::new(grid, body.dofs, body.pattern, linear)?;
+                let name = if explicit.is_some() {
+                    "explicit"
+                } else {
+                    solver.name()
+                };
+                let resolution = FailureResolution::new(grid, settings)
+                    .map_err(|e| ls.error(&k(&["physics", "crack_tracking"]), e))?;
+                (
+                    Driver::Static {
+                        solver,
+                        explicit,
+                        resolution,
+                    },
+                    name,
+                )
+            }
+        };
+        wall.assembly += t_asm.elapsed().as_secs_f64();
+        // Flow on a fixed skeleton: `linear = "cg-amg"` solves the pressure systems with
+        // CG-AMG too ("auto" keeps Cholesky for them).
+        if let (Some(f), Some(LinearChoice::CgAmg)) = (flow.as_mut(), s.solver.linear) {
+            f.model
+                .set_linear_solver(porofrac_flow::FlowLinearSolver::CgAmg {
+                    tolerance: tolerance.unwrap_or(1e-8),
+                })
+                .map_err(|e| ls.error(&k(&["solver", "tolerance"]), e.to_string()))?;
+        }
+        let (probes, lines) = locate_outputs(ls, grid)?;
+        let axes = ["x", "y", "z"];
+        let mut header = vec!["cell".to_string()];
+        header.extend(axes[..D].iter().map(|a| a.to_string()));
+        header.extend(["time".to_string(), "mode".to_string()]);
+        let mut fracture_csv = CsvTable::new(out.join("fracture.csv"), &header);
+        fracture_csv.flush()?;
+        let nu_of_cell = comp
+            .material_of_cell()
+            .into_iter()
+            .map(|m| s.material[m].poisson_ratio)
+            .collect();
+        Ok(Self {
+            ls,
+            body,
+            comp,
+            law_refs,
+            times: output_times(ls),
+            driver,
+            fixed_flow: flow,
+            zero_start: s.initial.as_ref().and_then(|i| i.mechanics)
+                == Some(InitialMechanics::Zero),
+            static_options: StaticOptions {
+                tolerance: tolerance.unwrap_or(1e-10),
+                ..StaticOptions::default()
+            },
+            u: vec![0.0; D * grid.num_nodes()],
+            stress: vec![Tensor::<D>::zeros(); grid.num_cells()],
+            pressure,
+            failures: FailureState::new(grid.num_cells()),
+            probes,
+            lines,
+            fracture_csv,
+            logged: 0,
+            nu_of_cell,
+            plane_strain: D == 2 && s.scene.plane.unwrap_or_default() == Plane::Strain,
+            law_ids: comp.law_of_cell.iter().map(|&l| l as i32).collect(),
+            stats: SolverStats {
+                linear: linear_name.into(),
+                ..SolverStats::default()
+            },
+            wall,
+        })
+    }
+
+    /// The static (or explicit) mechanics at time `t` with failures resolved.
+    fn static_step(&mut self, t: f64) -> Result<usize, RunError> {
+        let Driver::Static {
+            solver,
+            explicit,
+            resolution,
+        } = &mut self.driver
+        else {
+            return Ok(0);
+        };
+        let (grid, comp, body) = (self.body.grid, self.comp, self.body);
+        let (ls, options, law_refs) = (self.ls, &self.static_options, &self.law_refs);
+        let previous = explicit.is_some().then(|| self.u.clone());
+        let mut iterations = 0;
+        let mut worst = 0.0f64;
+        let mut solve_seconds = 0.0;
+        let mut solve = |failed: &[bool]| -> Result<(Vec<f64>, Vec<Tensor<D>>), RunError> {
+            let laws = LawMap::new(grid, law_refs.clone(), comp.law_of_cell_after(failed))?;
+            let problem = StaticProblem {
+                grid,
+                laws: &laws,
+                dofs: body.dofs,
+                pattern: body.pattern,
+                loads: body.loads,
+            };
+            let t_solve = Instant::now();
+            let u = match explicit.as_ref() {
+                None => {
+                    let sol = solve_static(&problem, solver, t, options)?;
+                    worst = worst.max(sol.residual);
+                    iterations += sol.linear_iterations;
+                    sol.displacement
+                }
+                Some(density) => {
+                    // Damped dynamic relaxation from the previous state.
+                    let opts = ExplicitOptions {
+                        tolerance: ls.scene.solver.tolerance.unwrap_or(1e-8),
+                        density_scaling: Some(1.0),
+                        ..ExplicitOptions::default()
+                    };
+                    let sol = solve_explicit(&problem, density, t, &opts, previous.as_deref())?;
+                    iterations += sol.steps;
+                    worst = worst.max(sol.unbalanced_ratio);
+                    sol.displacement
+                }
+            };
+            solve_seconds += t_solve.elapsed().as_secs_f64();
+            let stress = cell_stresses(grid, &laws, &u)?;
+            Ok((u, stress))
+        };
+        let t0 = Instant::now();
+        let done = resolution
+            .resolve(grid, &mut self.failures, t, |fs| solve(fs.flags()))
+            .map_err(|e| match e {
+                porofrac_sim::ResolutionError::Solve(e) => e,
+                other => RunError::Fracture(other.to_string()),
+            })?;
+        let total = t0.elapsed().as_secs_f64();
+        self.wall.solve += solve_seconds;
+        self.wall.assembly += total - solve_seconds;
+        (self.u, self.stress) = done.solution;
+        self.stats.iterations += iterations;
+        self.stats.max_relative_residual = self.stats.max_relative_residual.max(worst);
+        self.stats.factorizations = solver.numeric_factorizations();
+        self.stats.symbolic_factorizations = solver.symbolic_factorizations();
+        self.stats.factor_nnz = solver.factor_nnz();
+        Ok(iterations)
+    }
+
+    /// The coupled step to `times[step]`.
+    fn coupled_step(&mut self, step: usize) -> Result<usize, RunError> {
+        let Driver::Coupled { frac, state } = &mut self.driver else {
+            return Ok(0);
+        };
+        let t = self.times[step];
+        let t_solve = Instant::now();
+        let next = match state.as_ref() {
+            None if self.zero_start => {
+                *state = Some(BiotState {
+                    displacement: vec![0.0; self.u.len()],
+                    pressure: frac.initial_pressure().to_vec(),
+                });
+                self.pressure = state.as_ref().map(|s| s.pressure.clone());
+                return Ok(0);
+            }
+            None => frac.initial_state(t)?,
+            Some(st) => {
+                let t_prev = self.times[step - 1];
+                frac.step(st, t_prev, t - t_prev)?
+            }
+        };
+        self.wall.solve += t_solve.elapsed().as_secs_f64();
+        self.stats.iterations += next.solves;
+        self.stats.max_relative_residual = self.stats.max_relative_residual.max(next.residual);
+        let coupling = frac.stats();
+        self.stats.linear = coupling.linear.into();
+        self.stats.factorizations = coupling.numeric_factorizations;
+        self.stats.symbolic_factorizations = coupling.symbolic_factorizations;
+        self.stats.factor_nnz = coupling.factor_nnz;
+        self.failures = frac.failures().clone();
+        self.pressure = Some(next.state.pressure.clone());
+        self.u.clone_from(&next.state.displacement);
+        self.stress = next.stress;
+        *state = Some(next.state);
+        Ok(next.solves)
+    }
+
+    /// The value of `field` at a located point.
+    fn sample(&self, field: Field, loc: &Location) -> f64 {
+        let c = loc.cell;
+        match field {
+            Field::Displacement(a) => loc.nodal(&self.u, D, a),
+            Field::Pressure => self.pressure.as_ref().map_or(f64::NAN, |p| p[c]),
+            Field::Fractured => f64::from(u8::from(self.failures.flags()[c])),
+            f => f
+                .of_stress(&self.stress[c], self.nu_of_cell[c], self.plane_strain)
+                .unwrap_or(f64::NAN),
+        }
+    }
+}
+
+impl<const D: usize> Model for Stepper<'_, D> {
+    fn times(&self) -> &[f64] {
+        &self.times
+    }
+
+    fn step(&mut self, step: usize) -> Result<StepStats, RunError> {
+        let t = self.times[step];
+        let iterations = if matches!(self.driver, Driver::Coupled { .. }) {
+            self.coupled_step(step)?
+        } else if step == 0 && self.zero_start {
+            0
+        } else {
+            self.static_step(t)?
+        };
+        if let (Some(f), Some(p), true) =
+            (self.fixed_flow.as_mut(), self.pressure.as_mut(), step > 0)
+        {
+            let t_flow = Instant::now();
+            let t_prev = self.times[step - 1];
+            let res = f
+                .model
+                .step(p, t - t_prev, t_prev)
+                .map_err(|e| RunError::Flow(e.to_string()))?;
+            *p = res.pressure;
+            self.wall.flow += t_flow.elapsed().as_secs_f64();
+        }
+        Ok(StepStats {
+            iterations,
+            failed: self.failures.count(),
+        })
+    }
+
+    fn probes(&self, values: &mut Vec<f64>) {
+        values.extend(self.probes.iter().map(|(f, loc)| self.sample(*f, loc)));
+    }
+
+    fn line(&self, line: usize, rows: &mut Vec<Vec<f64>>) {
+        let (field, points) = &self.lines[line];
+        for (s, x, loc) in points {
+            let mut r = Vec::with_capacity(D + 2);
+            r.push(*s);
+            r.extend(x.iter().copied());
+            r.push(self.sample(*field, loc));
+            rows.push(r);
+        }
+    }
+
+    fn after_step(&mut self, _out: &Path) -> Result<(), RunError> {
+        let grid = self.body.grid;
+        for f in &self.failures.log()[self.logged..] {
+            let x = grid.cell_centroid(f.cell);
+            let mut row = vec![f.cell.to_string()];
+            row.extend(x.iter().map(|v| v.to_string()));
+            row.push(f.time.to_string());
+            row.push(f.mode.as_str().to_string());
+            self.fracture_csv.push_text(&row)?;
+        }
+        self.logged = self.failures.count();
+        Ok(())
+    }
+
+    fn write_vtk(&self, dir: &Path, index: usize) -> Result<String, RunError> {
+        let grid = self.body.grid;
+        let name = format!("step_{index:04}.vtu");
+        let disp: Vec<Point<D>> = (0..grid.num_nodes())
+            .map(|n| Point::<D>::from_column_slice(&self.u[D * n..D * n + D]))
+            .collect();
+        let sym: Vec<[f64; 6]> = self
+            .stress
+            .iter()
+            .zip(&self.nu_of_cell)
+            .map(|(s, &nu)| {
+                let c = |i, j| {
+                    Field::Stress(i, j)
+                        .of_stress(s, nu, self.plane_strain)
+                        .unwrap_or(0.0)
+                };
+                [c(0, 0), c(1, 1), c(2, 2), c(0, 1), c(1, 2), c(0, 2)]
+            })
+            .collect();
+        let fractured: Vec<i32> = self.failures.flags().iter().map(|&f| f as i32).collect();
+        let mut cell_data = vec![
+            ("stress", VtkField::SymTensors(&sym)),
+            ("law", VtkField::Ints(&self.law_ids)),
+            ("fractured", VtkField::Ints(&fractured)),
+        ];
+        if let Some(p) = self.pressure.as_deref() {
+            cell_data.push(("pressure", VtkField::Scalars(p)));
+        }
+        write_vtu(
+            dir.join(&name),
+            grid,
+            &[("displacement", VtkField::Vectors(&disp))],
+            &cell_data,
+        )?;
+        Ok(name)
+    }
+
+    fn field_extrema(&self) -> BTreeMap<String, [f64; 2]> {
+        let grid = self.body.grid;
+        let mut out = BTreeMap::new();
+        let mut put = |name: &str, values: &mut dyn Iterator<Item = f64>| {
+            let mut r = [f64::INFINITY, f64::NEG_INFINITY];
+            for v in values {
+                r[0] = r[0].min(v);
+                r[1] = r[1].max(v);
+            }
+            if r[0] <= r[1] {
+                out.insert(name.to_string(), r);
+            }
+        };
+        for (a, name) in ["ux", "uy", "uz"].iter().enumerate().take(D) {
+            put(name, &mut (0..grid.num_nodes()).map(|n| self.u[D * n + a]));
+        }
+        for name in ["sxx", "syy", "szz", "sxy", "syz", "sxz", "smax", "smin"] {
+            let Ok(f) = Field::parse(name, D, false) else {
+                continue;
+            };
+            put(
+                name,
+                &mut self
+                    .stress
+                    .iter()
+                    .zip(&self.nu_of_cell)
+                    .filter_map(|(s, &nu)| f.of_stress(s, nu, self.plane_strain)),
+            );
+        }
+        if let Some(p) = &self.pressure {
+            put("pressure", &mut p.iter().copied());
+        }
+        put(
+            "fractured",
+            &mut self
+                .failures
+                .flags()
+                .iter()
+                .map(|&f| f64::from(u8::from(f))),
+        );
+        out
+    }
+
+    fn plots(&self, dir: &Path, written: &[f64], series: &[Vec<f64>]) -> Result<(), RunError> {
+        plots::write_plots(
+            self.ls,
+            dir,
+            self.body.grid,
+            plots::PlotInputs {
+                series,
+                written_times: written,
+                u: &self.u,
+                stress: &self.stress,
+                failures: &self.failures,
+                pressure: self.pressure.as_deref(),
+            },
+        )
+    }
+
+    fn sizes(&self) -> Sizes {
+        Sizes {
+            cells: self.body.grid.num_cells(),
+            nodes: self.body.grid.num_nodes(),
+            dofs: self.body.dofs.num_equations(),
+        }
+    }
+
+    fn failed(&self) -> usize {
+        self.failures.count()
+    }
+
+    fn solver_stats(&self) -> SolverStats {
+        self.stats.clone()
+    }
+
+    fn wall_seconds(&self) -> WallSeconds {
+        self.wall
+    }
+}
+
+/// Failure criteria, stress measure, tracking and limits of the scene: the same for the
+/// static and the coupled drivers.
+fn fracture_settings<const D: usize>(ls: &LoadedScene, comp: &Composition<D>) -> FractureSettings {
+    let s = &ls.scene;
+    let mut settings = FractureSettings::new(comp.criteria.clone(), comp.law_of_cell.clone());
+    if comp.can_fail() {
+        if s.physics.failure_stress == Some(FailureStress::Recovered) {
+            settings.stress = StressMeasure::Recovered;
+        }
+        settings.tracking_angle = s.physics.crack_tracking;
+    }
+    settings
+}
+
+/// Density of every cell, for explicit mechanics.
+fn densities<const D: usize>(
+    ls: &LoadedScene,
+    comp: &Composition<D>,
+) -> Result<Vec<f64>, RunError> {
+    comp.material_of_cell()
+        .into_iter()
+        .map(|mat| {
+            ls.scene.material[mat].density.ok_or_else(|| {
+                ls.error(
+                    &k(&["material", mat, "density"]),
+                    "is required by solver.mechanics = \"explicit\"",
+                )
+                .into()
+            })
+        })
+        .collect()
+}
+
+/// The coupled flow–mechanics driver of a scene ([`Fracturing`]: with failure criteria
+/// when a material has a strength, without them it is plain poroelasticity).
+fn coupled<'a, const D: usize>(
+    ls: &LoadedScene,
+    body: Body<'a, D>,
+    comp: &Composition<D>,
+    law_refs: &[&'a dyn CellLaw<D>],
+    f: FlowSetup<D>,
+    settings: FractureSettings,
+) -> Result<Fracturing<'a, D>, RunError> {
+    let s = &ls.scene;
+    let coupling = s.physics.coupling.unwrap_or_default();
+    let laws = FractureLaws {
+        laws: law_refs.to_vec(),
+        law_of_cell: comp.law_of_cell.clone(),
+        post_failure: comp.post_failure.clone(),
+    };
+    let source_cells = f.source_cells.clone();
+    let flow = FractureFlow {
+        model: f.model,
+        permeability: f.permeability,
+        fracture_permeability: comp
+            .can_fail()
+            .then(|| s.physics.fracture_permeability.unwrap_or(1e-12)),
+        alpha: f.alpha,
+        p0: f.p0,
+    };
+    let mut k_dr = Vec::new();
+    if coupling == CouplingChoice::FixedStress {
+        for mat in comp.material_of_cell() {
+            let st = material_stiffness::<D>(ls, mat, &s.material[mat])?;
+            k_dr.push(drained_bulk_modulus(&st));
+        }
+    }
+    let tolerance = s.solver.tolerance.unwrap_or(1e-10);
+    Ok(Fracturing::new(body, laws, settings, flow, |sys| {
+        let sys: &porofrac_sim::BiotSystem<'_, D> = sys;
+        Ok(match coupling {
+            CouplingChoice::FixedStress => {
+                Scheme::FixedStress(FixedStress::new(tolerance, 500), k_dr)
+            }
+            CouplingChoice::ExplicitPressure => {
+                Scheme::ExplicitPressure(ExplicitPressure::new(source_cells.clone()), source_cells)
+            }
+            _ => Scheme::Monolithic(Monolithic::new(sys, None)?),
+        })
+    })?)
+}
+
+/// The cells holding the probes and the points of the output lines, with their fields;
+/// errors name the probe or line that lies outside the grid.
+#[allow(clippy::type_complexity)]
+fn locate_outputs<const D: usize>(
+    ls: &LoadedScene,
+    grid: &Grid<D>,
+) -> Result<(Vec<(Field, Location)>, Vec<(Field, LinePoints<D>)>), RunError> {
+    let s = &ls.scene;
+    let flow = s.physics.flow == Some(true);
+    let field = |name: &str, key: Vec<crate::file::KeyPart>| {
+        Field::parse(name, D, flow).map_err(|e| RunError::from(ls.error(&key, e)))
+    };
+    let mut probes = Vec::new();
+    for (i, p) in s.output.probe.iter().enumerate() {
+        let f = field(&p.field, ki("output.probe", i, &["field"]))?;
+        let loc = locate(grid, &point(&p.at)).ok_or_else(|| {
+            ls.error(
+                &ki("output.probe", i, &["at"]),
+                format!("= {:?} is outside the grid", p.at),
+            )
+        })?;
+        probes.push((f, loc));
+    }
+    let mut lines = Vec::new();
+    for (i, l) in s.output.line.iter().enumerate() {
+        let f = field(&l.field, ki("output.line", i, &["field"]))?;
+        let (a, b): (Point<D>, Point<D>) = (point(&l.from), point(&l.to));
+        let mut pts = Vec::new();
+        for j in 0..l.points as usize {
+            let frac = j as f64 / (l.points as f64 - 1.0);
+            let x = a + (b - a) * frac;
+            let loc = locate(grid, &x).ok_or_else(|| {
+                ls.error(
+                    &ki("output.line", i, &["from"]),
+                    format!("point {:?} of the line is outside the grid", x.as_slice()),
+                )
+            })?;
+            pts.push(((b - a).norm() * frac, x, loc));
+        }
+        lines.push((f, pts));
+    }
+    Ok((probes, lines))
+}

@@ -1,0 +1,117 @@
+//! porofrac scenes as a library: read a scene file into a validated, typed [`Scene`],
+//! compose its model and run it, writing the outputs of `SCENE.md` (summary, probes,
+//! lines, fracture log, VTK, plots). The `porofrac` command is a thin layer over this
+//! crate (arguments, progress, exit codes); a Rust program gets the same outputs with
+//!
+//! ```no_run
+//! use porofrac_scene::{Scene, Silent};
+//!
+//! let scene = Scene::load("scenes/patch_test.toml".as_ref())?;
+//! let summary = scene.run("out/patch_test".as_ref(), &mut Silent)?;
+//! println!("{} cells in {:.2} s", summary.cells, summary.wall_seconds.total);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
+//! # Shape
+//!
+//! A scene names its model (`[scene] model`, default `"continuum"`). Every model is one
+//! module of the same shape: its section of the file is parsed into typed values
+//! ([`file`]) and validated ([`check`]); it *builds* its state from them, *steps* from
+//! one output time to the next, and offers *fields* to the shared outputs
+//! ([`model::Model`]). The loop that writes `probes.csv`, `lines/`, VTK and
+//! `summary.json`, reports progress and honours interruption ([`driver`]) is the same
+//! for every model. Cell laws are chosen by name through one [`laws::LawRegistry`], to
+//! which a user adds their own laws.
+//!
+//! # Hostile input
+//!
+//! A scene is refused with an error naming the key before anything big is allocated:
+//! expressions nest at most [`expr::MAX_NESTING`] deep, and the number of steps, cells
+//! and unknowns a scene asks for is bounded by what the machine has ([`limits`]).
+
+pub mod check;
+pub mod continuum;
+pub mod driver;
+pub mod expr;
+pub mod file;
+pub mod laws;
+pub mod limits;
+pub mod model;
+pub mod output;
+pub mod plots;
+pub mod sample;
+
+use std::path::{Path, PathBuf};
+
+pub use check::SceneError;
+pub use driver::{Observer, Silent, StepReport};
+pub use laws::LawRegistry;
+pub use model::RunError;
+pub use output::Summary;
+
+use check::LoadedScene;
+
+/// A scene file read and validated: every key known, every value checked, every
+/// expression compiled once.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    loaded: LoadedScene,
+    laws: LawRegistry,
+}
+
+impl Scene {
+    /// Read, parse and validate a scene file with the built-in laws.
+    pub fn load(path: &Path) -> Result<Self, SceneError> {
+        Self::load_with(path, LawRegistry::default())
+    }
+
+    /// Read, parse and validate a scene file whose regions may use the laws of `laws`
+    /// (the built-in ones and the user's, [`LawRegistry::register`]).
+    pub fn load_with(path: &Path, laws: LawRegistry) -> Result<Self, SceneError> {
+        let loaded = check::load(path)?;
+        check::check(&loaded, &laws)?;
+        Ok(Self { loaded, laws })
+    }
+
+    /// Parse and validate scene text; `path` names it in errors and anchors relative
+    /// paths (mesh files).
+    pub fn parse(text: &str, path: &Path, laws: LawRegistry) -> Result<Self, SceneError> {
+        let loaded = check::parse(text, path)?;
+        check::check(&loaded, &laws)?;
+        Ok(Self { loaded, laws })
+    }
+
+    /// The typed content of the file.
+    pub fn file(&self) -> &file::SceneFile {
+        &self.loaded.scene
+    }
+
+    /// Where the scene came from.
+    pub fn path(&self) -> &Path {
+        &self.loaded.path
+    }
+
+    /// The scene name (`[scene] name`).
+    pub fn name(&self) -> &str {
+        &self.loaded.scene.scene.name
+    }
+
+    /// The default output directory, `out/<name>`.
+    pub fn default_out(&self) -> PathBuf {
+        PathBuf::from("out").join(self.name())
+    }
+
+    /// Run the scene and write its outputs into `out`.
+    ///
+    /// A run that fails still writes `summary.json` with the error as its `status`; an
+    /// interrupted run ([`Observer::stop_requested`]) ends after the current step with
+    /// complete files and `"status": "interrupted at t = …"` ([`Summary::interrupted`]).
+    pub fn run(&self, out: &Path, observer: &mut dyn Observer) -> Result<Summary, RunError> {
+        let start = std::time::Instant::now();
+        let result = model::run(&self.loaded, &self.laws, out, observer);
+        if let Err(e) = &result {
+            output::write_failed_summary(&self.loaded, out, &e.to_string(), start);
+        }
+        result
+    }
+}
