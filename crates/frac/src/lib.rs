@@ -60,7 +60,7 @@ pub enum FracError {
 }
 
 /// Principal stresses in decreasing order (tension positive), `D` of them followed by
-/// zeros ([`porofrac_law::principal`]).
+/// zeros ([`porofrac_law::principal()`]).
 pub fn principal_stresses<const D: usize>(s: &Tensor<D>) -> [f64; 3] {
     let mut e = [0.0; 3];
     e[..D].copy_from_slice(&porofrac_law::principal(s).values);

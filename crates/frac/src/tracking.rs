@@ -110,7 +110,7 @@ impl<const D: usize> CrackTracking<D> {
 }
 
 /// Unit eigenvector of the largest eigenvalue of a symmetric tensor
-/// ([`porofrac_law::principal`]).
+/// ([`porofrac_law::principal()`]).
 pub fn largest_principal_direction<const D: usize>(s: &Tensor<D>) -> Point<D> {
     porofrac_law::principal(s).directions[0]
 }

@@ -16,7 +16,7 @@
 //!
 //! A scene names its model (`[scene] model`, default `"continuum"`). Every model is one
 //! module of the same shape: its section of the file is parsed into typed values
-//! ([`file`]) and validated ([`check`]); it *builds* its state from them, *steps* from
+//! ([`mod@file`]) and validated ([`mod@check`]); it *builds* its state from them, *steps* from
 //! one output time to the next, and offers *fields* to the shared outputs
 //! ([`model::Model`]). The loop that writes `probes.csv`, `lines/`, VTK and
 //! `summary.json`, reports progress and honours interruption ([`driver`]) is the same

@@ -4,7 +4,7 @@
 //! state from one output time to the next (*step*), and answers what the shared outputs
 //! ask of it (*fields*): the value of each probe and of each line point, the VTK file of
 //! a written step, the extrema of its fields, its plots and its part of `summary.json`.
-//! [`crate::driver::drive`] does the rest the same way for every model.
+//! The loop of [`crate::driver`] does the rest the same way for every model.
 
 use std::collections::BTreeMap;
 use std::path::Path;

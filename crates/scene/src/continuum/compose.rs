@@ -284,3 +284,43 @@ pub fn boundary_faces<const D: usize>(
     }
     Ok(faces)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scene(plane: &str) -> LoadedScene {
+        let text = format!(
+            "[scene]\nname = \"s\"\ndim = 2\nplane = \"{plane}\"\n[grid]\nkind = \"triangles\"\n\
+             extent = [[0.0, 0.0], [1.0, 1.0]]\ncells = [2, 2]\n[[region]]\nname = \"a\"\n\
+             select = {{ all = true }}\nlaw = \"mdem\"\nmaterial = \"m\"\n[material.m]\n\
+             youngs_modulus = 1.0e9\npoisson_ratio = 0.3\n"
+        );
+        crate::check::parse(&text, std::path::Path::new("s.toml")).unwrap()
+    }
+
+    #[test]
+    fn plane_stress_reaches_every_stiffness_of_a_material() {
+        let (e, nu) = (1.0e9, 0.3);
+        let lambda = e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
+        let mu = e / (2.0 * (1.0 + nu));
+        for (plane, want) in [
+            ("strain", lambda),
+            ("stress", 2.0 * lambda * mu / (lambda + 2.0 * mu)),
+        ] {
+            let ls = scene(plane);
+            let m = &ls.scene.material["m"];
+            let s = material_stiffness::<2>(&ls, "m", m).unwrap();
+            let (l, g) = s.lame().unwrap();
+            assert!((l - want).abs() <= 1e-12 * want, "{plane}: λ = {l}");
+            assert!((g - mu).abs() <= 1e-12 * mu);
+            // The drained bulk modulus of the fixed-stress split uses the same stiffness:
+            // plane strain K = λ + μ, plane stress K = λ* + μ.
+            let k_dr = porofrac_sim::drained_bulk_modulus(&s);
+            assert!(
+                (k_dr - (want + mu)).abs() <= 1e-9 * k_dr,
+                "{plane}: K = {k_dr}"
+            );
+        }
+    }
+}

@@ -11,7 +11,7 @@
 //!   Poisson ratio of the cell's material (isotropic elasticity; a failed DEM cell
 //!   reports it from its in-plane stress the same way).
 //! - `smax smin` are the largest and smallest principal stress of the cell
-//!   ([`porofrac_law::principal`]); in 2D the in-plane ones.
+//!   ([`porofrac_law::principal()`]); in 2D the in-plane ones.
 //! - `pressure` needs flow; `fractured` is 0 or 1.
 
 use porofrac_law::Tensor;

@@ -1,14 +1,14 @@
 //! The continuum model (seed 000, `[scene] model = "continuum"`): VEM, MDEM and DEM cell
 //! laws, TPFA flow, Biot coupling and fracturing on a polyhedral grid.
 //!
-//! - *build*: the grid ([`grid`]), the law and material of every cell and the conditions
-//!   ([`compose`]), the flow model ([`flow`]), the dof map, the stiffness pattern and the
+//! - *build*: the grid ([`mod@grid`]), the law and material of every cell and the conditions
+//!   ([`mod@compose`]), the flow model ([`mod@flow`]), the dof map, the stiffness pattern and the
 //!   solver;
 //! - *step*: one of three drivers, chosen by the scene: static mechanics at every output
 //!   time (direct or damped explicit relaxation; conditions may depend on `t`), flow on a
 //!   fixed skeleton after it, or the coupled poroelastic step
 //!   ([`porofrac_sim::Fracturing`]). Failures are resolved within a step by
-//!   [`porofrac_sim::resolve_failures`] in all of them, with the same settings;
+//!   [`porofrac_sim::FailureResolution`] in all of them, with the same settings;
 //! - *fields*: displacement, stress, principal stresses, pressure and the failure flag
 //!   ([`fields`]) for probes, lines, VTK and `field_extrema`, and the plots ([`plots`]).
 
