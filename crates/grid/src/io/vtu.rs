@@ -520,7 +520,7 @@ impl Ctx<'_> {
                 v
             }
             "binary" => {
-                let raw = base64::decode(el.text)
+                let raw = base64::decode(el.text.as_bytes())
                     .map_err(|w| self.err(el.text_offset, format!("DataArray `{name}`: {w}")))?;
                 let hs = if self.header64 { 8 } else { 4 };
                 if raw.len() < hs {
