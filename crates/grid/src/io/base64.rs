@@ -31,7 +31,7 @@ pub(crate) fn decode(text: &[u8]) -> Result<Vec<u8>, String> {
     };
     if rest.len() % 4 != 0 {
         return Err(format!(
-            "base64 text of {} characters is not a multiple of 4 (cut short?)",
+            "base64 text of {} characters is not a multiple of 4",
             rest.len()
         ));
     }

@@ -1,5 +1,6 @@
-//! Mesh import and export: Gmsh 4.1 ASCII `.msh` (read), VTK XML `.vtu` (read and write)
-//! and ParaView `.pvd` time series (write).
+//! Mesh import and export: Gmsh 4.1 `.msh`, ASCII or binary (read), VTK XML `.vtu` (read
+//! and write; ASCII, base64, appended and zlib-compressed data) and ParaView `.pvd` time
+//! series (write).
 //!
 //! # Cells and face orientation
 //!
@@ -32,6 +33,48 @@
 //! Nodes that no cell uses (geometry points, nodes of boundary-only elements) are dropped
 //! and the rest renumbered compactly in file order. A 2D mesh must lie in a plane
 //! `z = const`.
+//!
+//! # Reading VTK files
+//!
+//! [`read_vtu`](crate::io::read_vtu) reads `VTK_TRIANGLE` (5), `VTK_QUAD` (9) and `VTK_POLYGON` (7) cells in 2D,
+//! `VTK_TETRA` (10), `VTK_HEXAHEDRON` (12), `VTK_WEDGE` (13), `VTK_PYRAMID` (14) and
+//! `VTK_POLYHEDRON` (42) cells in 3D, from one `<Piece>`. Cell tags come from the
+//! `tag:<name>` cell-data arrays, or, if there are none, from an integer `tag` array as
+//! `tag_<value>`; face tags from `facetag:<name>` field data.
+//!
+//! Data arrays may be stored in any of the ways VTK writes them, which covers ParaView's
+//! default save (appended raw data compressed with zlib):
+//!
+//! * `format="ascii"`: numbers as text;
+//! * `format="binary"`: a binary block (below) encoded inline as base64. VTK encodes the
+//!   header and the data as one base64 stream, or, when compressed, as two streams back to
+//!   back; both are read;
+//! * `format="appended"` with `offset="…"`: the binary block lies in the file's
+//!   `<AppendedData encoding="raw">` (the bytes after its `_` marker; `offset` counts
+//!   bytes from the one after `_`) or `<AppendedData encoding="base64">` (`offset` counts
+//!   base64 characters after `_`, and each array is its own base64 text).
+//!
+//! A binary block is made of integers of the file's `header_type` (`UInt32`, the
+//! default, or `UInt64`) followed by data, all in the file's `byte_order`
+//! (`LittleEndian` or `BigEndian`):
+//!
+//! * without compression: one integer, the number of data bytes, then the data;
+//! * with `compressor="vtkZLibDataCompressor"`: the header
+//!   `[nblocks, block_size, last_block_size, csize_0, …, csize_{nblocks−1}]`, then the
+//!   `nblocks` zlib streams of `csize_k` bytes each, back to back. The data was cut into
+//!   blocks of `block_size` bytes before compression; the last block has
+//!   `last_block_size` bytes, or `block_size` when `last_block_size` is 0. An empty array
+//!   has `nblocks = 0`.
+//!
+//! Other compressors (`vtkLZ4DataCompressor`, `vtkLZMADataCompressor`) are refused.
+//! Every size in a header is checked against the bytes actually present before a buffer
+//! is allocated: a size or block count larger than the data, an offset past the appended
+//! data, a block that cannot inflate to its declared size (zlib inflates at most
+//! 1032-fold), a corrupt zlib stream, or an array whose size disagrees with
+//! `NumberOfPoints` / `NumberOfCells` is a [`GridError::Parse`] naming the file, the line
+//! of the `<DataArray>`, the array, where its data is, and what is wrong. A file that ends
+//! inside `<AppendedData>` is read up to the first array it cuts, and the error says the
+//! file looks cut short.
 //!
 //! # Errors
 //!

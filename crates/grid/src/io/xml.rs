@@ -38,6 +38,13 @@ impl<'a> Element<'a> {
     ) -> impl Iterator<Item = &'s Element<'a>> + 's {
         self.children.iter().filter(move |c| c.name == name)
     }
+    /// This element and all its descendants, depth first.
+    pub(crate) fn walk(&self, f: &mut impl FnMut(&Element<'a>)) {
+        f(self);
+        for c in &self.children {
+            c.walk(f);
+        }
+    }
 }
 
 /// Maps byte offsets to 1-based line numbers.
