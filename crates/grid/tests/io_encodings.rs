@@ -9,7 +9,7 @@
 
 use std::path::{Path, PathBuf};
 
-use porofrac_grid::io::read_vtu;
+use porofrac_grid::io::{parse_msh_bytes, read_msh, read_vtu};
 use porofrac_grid::{Grid, GridError};
 
 fn data(name: &str) -> PathBuf {
@@ -43,6 +43,10 @@ fn volume<const D: usize>(g: &Grid<D>, cells: &[usize]) -> f64 {
 
 fn total<const D: usize>(g: &Grid<D>) -> f64 {
     g.cell_volumes().iter().sum()
+}
+
+fn face_area<const D: usize>(g: &Grid<D>, name: &str) -> f64 {
+    g.face_tags()[name].iter().map(|&f| g.face_area(f)).sum()
 }
 
 /// The same grid, with node coordinates equal bit for bit.
@@ -94,6 +98,21 @@ fn vtu_3d_every_encoding_equals_ascii() {
         let g: Grid<3> = read_vtu(data(&format!("enc3d_{enc}.vtu"))).unwrap();
         assert_same(&g, &ascii, enc);
     }
+}
+
+/// VTK's grid holds Gmsh's nodes and cells in Gmsh's order.
+#[test]
+fn vtu_and_msh_of_one_mesh_agree() {
+    let v: Grid<2> = read_vtu(data("enc2d_appended_zlib.vtu")).unwrap();
+    let m: Grid<2> = read_msh(data("enc2d_binary.msh")).unwrap();
+    assert_eq!(v.nodes(), m.nodes());
+    assert_eq!(v.cell_volumes(), m.cell_volumes());
+    assert_eq!(v.cell_tags()["tag_1"], m.cell_tags()["tri"]);
+    let v: Grid<3> = read_vtu(data("enc3d_appended_zlib.vtu")).unwrap();
+    let m: Grid<3> = read_msh(data("enc3d_binary.msh")).unwrap();
+    assert_eq!(v.nodes(), m.nodes());
+    assert_eq!(v.cell_volumes(), m.cell_volumes());
+    assert_eq!(v.cell_tags()["tag_2"], m.cell_tags()["upper"]);
 }
 
 /// Byte position of the first byte after the `_` marker of `<AppendedData>`.
@@ -279,6 +298,19 @@ fn rng(mut state: u64) -> impl FnMut() -> u64 {
 #[test]
 fn damaged_binary_files_never_panic() {
     let mut next = rng(0x9e37_79b9_7f4a_7c15);
+    for name in ["enc2d_binary.msh", "enc3d_binary.msh"] {
+        let bytes = std::fs::read(data(name)).unwrap();
+        let start = section_data(&bytes, "Entities").start;
+        for _ in 0..400 {
+            let mut b = bytes.clone();
+            for _ in 0..1 + next() % 4 {
+                let at = start + (next() as usize) % (b.len() - start);
+                b[at] = next() as u8;
+            }
+            let _ = parse_msh_bytes::<2>(&b, "fuzz.msh");
+            let _ = parse_msh_bytes::<3>(&b, "fuzz.msh");
+        }
+    }
     for name in [
         "enc2d_appended_raw.vtu",
         "enc2d_appended_zlib.vtu",
@@ -312,4 +344,200 @@ fn appended_start_or_zero(bytes: &[u8]) -> usize {
     } else {
         0
     }
+}
+
+// ------------------------------------------------------------------ Gmsh
+
+#[test]
+fn msh_2d_binary_equals_ascii() {
+    let ascii: Grid<2> = read_msh(data("enc2d_ascii.msh")).unwrap();
+    let binary: Grid<2> = read_msh(data("enc2d_binary.msh")).unwrap();
+    assert_same(&binary, &ascii, "enc2d_binary.msh");
+    let g = &binary;
+    assert_eq!(g.num_nodes(), 49);
+    assert_eq!(g.num_cells(), 53);
+    assert_eq!(g.cell_tags().len(), 2);
+    assert_eq!(g.cell_tags()["tri"].len(), 31);
+    assert_eq!(g.cell_tags()["quad"].len(), 22);
+    assert!(rel(total(g), 2.0) <= 1e-12, "{}", total(g));
+    assert!(rel(volume(g, &g.cell_tags()["tri"]), 1.0) <= 1e-12);
+    assert!(rel(volume(g, &g.cell_tags()["quad"]), 1.0) <= 1e-12);
+    assert_eq!(g.face_tags().len(), 1);
+    assert_eq!(g.face_tags()["left"].len(), 3);
+    assert!(rel(face_area(g, "left"), 1.0) <= 1e-12);
+    assert_eq!(g.face_tags()["left"], g.boundary("xmin").unwrap());
+}
+
+#[test]
+fn msh_3d_binary_equals_ascii() {
+    let ascii: Grid<3> = read_msh(data("enc3d_ascii.msh")).unwrap();
+    let binary: Grid<3> = read_msh(data("enc3d_binary.msh")).unwrap();
+    assert_same(&binary, &ascii, "enc3d_binary.msh");
+    let g = &binary;
+    assert_eq!(g.num_nodes(), 52);
+    assert_eq!(g.num_cells(), 138);
+    assert_eq!(g.cell_tags().len(), 2);
+    assert_eq!(g.cell_tags()["lower"].len(), 70);
+    assert_eq!(g.cell_tags()["upper"].len(), 68);
+    assert!(rel(total(g), 1.0) <= 1e-12, "{}", total(g));
+    assert!(rel(volume(g, &g.cell_tags()["lower"]), 0.5) <= 1e-12);
+    assert!(rel(volume(g, &g.cell_tags()["upper"]), 0.5) <= 1e-12);
+    assert_eq!(g.face_tags().len(), 1);
+    assert_eq!(g.face_tags()["bottom"].len(), 14);
+    assert!(rel(face_area(g, "bottom"), 1.0) <= 1e-12);
+    assert_eq!(g.face_tags()["bottom"], g.boundary("zmin").unwrap());
+}
+
+/// Byte range of the binary data of section `name` (after its header line, before the
+/// newline that precedes `$End…`).
+fn section_data(bytes: &[u8], name: &str) -> std::ops::Range<usize> {
+    let start = find(bytes, &format!("${name}\n")) + name.len() + 2;
+    let end = start + find(&bytes[start..], &format!("\n$End{name}\n"));
+    start..end
+}
+
+fn u64_at(b: &[u8], at: usize) -> u64 {
+    u64::from_le_bytes(b[at..at + 8].try_into().unwrap())
+}
+
+fn i32_at(b: &[u8], at: usize) -> i32 {
+    i32::from_le_bytes(b[at..at + 4].try_into().unwrap())
+}
+
+/// Every cut of a binary file is a parse error naming the file; cuts inside the binary
+/// data of a section name that section.
+#[test]
+fn msh_binary_cut_short() {
+    const FILE: &str = "cut.msh";
+    for name in ["enc2d_binary.msh", "enc3d_binary.msh"] {
+        let bytes = std::fs::read(data(name)).unwrap();
+        let sections: Vec<_> = ["Entities", "Nodes", "Elements"]
+            .iter()
+            .map(|s| (*s, section_data(&bytes, s)))
+            .collect();
+        // The final newline is not needed.
+        for k in 0..bytes.len() - 1 {
+            let r = if name.starts_with("enc2d") {
+                parse_msh_bytes::<2>(&bytes[..k], FILE).map(|_| ())
+            } else {
+                parse_msh_bytes::<3>(&bytes[..k], FILE).map(|_| ())
+            };
+            let m = match r {
+                Err(e @ GridError::Parse { .. }) => e.to_string(),
+                Err(e) => panic!("{name} cut at {k}: {e}"),
+                Ok(_) => panic!("{name} cut at {k}: read"),
+            };
+            assert!(m.starts_with(FILE), "{m}");
+            for (s, r) in &sections {
+                if r.start < k && k < r.end {
+                    assert!(m.contains(&format!("${s} (binary data, byte")), "{k}: {m}");
+                }
+            }
+        }
+    }
+    // One message in full.
+    let bytes = std::fs::read(data("enc2d_binary.msh")).unwrap();
+    let r = section_data(&bytes, "Elements");
+    let p = write("cut.msh", &bytes[..r.start + 100]);
+    let m = parse_err(read_msh::<2>(&p), &p);
+    assert!(m.contains("$Elements") && m.contains("cut short"), "{m}");
+}
+
+#[test]
+fn msh_binary_absurd_counts() {
+    const HUGE: u64 = 1_000_000_000_000_000;
+    let bytes = std::fs::read(data("enc3d_binary.msh")).unwrap();
+    let nodes = section_data(&bytes, "Nodes").start;
+    let elements = section_data(&bytes, "Elements").start;
+    let entities = section_data(&bytes, "Entities").start;
+    let cases = [
+        (nodes + 8, "1000000000000000 nodes cannot fit"),
+        (nodes, "1000000000000000 node blocks cannot fit"),
+        // The number of nodes of the first block.
+        (nodes + 32 + 12, "more nodes than the 52 declared"),
+        (elements + 8, "1000000000000000 elements cannot fit"),
+        (elements + 32 + 12, "more elements than the"),
+        (entities, "entities cannot fit"),
+    ];
+    for (at, what) in cases {
+        let mut b = bytes.clone();
+        b[at..at + 8].copy_from_slice(&HUGE.to_le_bytes());
+        let p = write("counts.msh", &b);
+        let m = parse_err(read_msh::<3>(&p), &p);
+        assert!(m.contains(what), "{m}");
+        let section = if at >= elements {
+            "$Elements"
+        } else if at >= nodes {
+            "$Nodes"
+        } else {
+            "$Entities"
+        };
+        assert!(m.contains(section), "{m}");
+    }
+    // The number of elements in a block, once the header total is large enough.
+    let mut b = bytes.clone();
+    b[elements + 8..elements + 16].copy_from_slice(&HUGE.to_le_bytes());
+    b[elements + 32 + 12..elements + 32 + 20].copy_from_slice(&HUGE.to_le_bytes());
+    let p = write("counts.msh", &b);
+    let m = parse_err(read_msh::<3>(&p), &p);
+    assert!(m.contains("$Elements") && m.contains("cannot fit"), "{m}");
+}
+
+#[test]
+fn msh_binary_byte_order_check() {
+    let bytes = std::fs::read(data("enc2d_binary.msh")).unwrap();
+    let b = replace(
+        &bytes,
+        "4.1 1 8\n\x01\x00\x00\x00",
+        "4.1 1 8\n\x02\x00\x00\x00",
+    );
+    let p = write("order.msh", &b);
+    let m = parse_err(read_msh::<2>(&p), &p);
+    assert!(m.contains(":2:") && m.contains("byte order"), "{m}");
+    // An ASCII file declared binary.
+    let text = std::fs::read(data("enc2d_ascii.msh")).unwrap();
+    let p = write("declared.msh", &replace(&text, "4.1 0 8", "4.1 1 8"));
+    let m = parse_err(read_msh::<2>(&p), &p);
+    assert!(m.contains(":2:") && m.contains("binary"), "{m}");
+}
+
+/// Binary elements are named by tag (no line); the first triangle turned over is an
+/// inverted cell.
+#[test]
+fn msh_binary_inverted_element() {
+    let mut b = std::fs::read(data("enc2d_binary.msh")).unwrap();
+    let mut at = section_data(&b, "Elements").start;
+    let blocks = u64_at(&b, at);
+    at += 32;
+    for _ in 0..blocks {
+        let etype = i32_at(&b, at + 8);
+        let n = u64_at(&b, at + 12) as usize;
+        at += 20;
+        let nn = match etype {
+            1 => 2,
+            2 => 3,
+            3 => 4,
+            t => panic!("type {t}"),
+        };
+        if etype == 2 {
+            // Swap the second and third node tags of the first triangle.
+            let (n1, n2) = (at + 16, at + 24);
+            let t = b[n1..n1 + 8].to_vec();
+            b.copy_within(n2..n2 + 8, n1);
+            b[n2..n2 + 8].copy_from_slice(&t);
+            let tag = u64_at(&b, at);
+            let p = write("inverted.msh", &b);
+            match read_msh::<2>(&p) {
+                Err(e @ GridError::InFile { .. }) => {
+                    let m = e.to_string();
+                    assert!(m.contains("inverted"), "{m}");
+                    assert!(m.contains(&format!("Gmsh element {tag})")), "{m}");
+                }
+                other => panic!("{:?}", other.map(|g| g.num_cells())),
+            }
+            return;
+        }
+        at += n * (1 + nn) * 8;
+    }
+    panic!("no triangle block");
 }
