@@ -147,12 +147,12 @@ pub(crate) fn parse(text: &str) -> Result<Element<'_>, XmlError> {
             Event::Text(_) | Event::GeneralRef(_) | Event::CData(_) => match stack.last_mut() {
                 Some(top) => {
                     if top.children.is_empty() && top.text.is_empty() {
-                        top.text = &text[at..end];
+                        top.text = text.get(at..end).unwrap_or_default();
                         top.text_offset = at;
                     }
                 }
                 None => {
-                    if !text[at..end].trim().is_empty() {
+                    if !text.get(at..end).unwrap_or_default().trim().is_empty() {
                         return err(at, "text outside the root element");
                     }
                 }
