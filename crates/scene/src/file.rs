@@ -235,7 +235,8 @@ pub struct GridSection {
     pub seed: Option<u64>,
     /// Interior node jitter, fraction of the local cell size.
     pub perturb: Option<f64>,
-    /// Mesh file for `kind = "file"`, relative to the scene file.
+    /// Mesh file for `kind = "file"`, relative to the scene file: `.vtu` (any VTK encoding:
+    /// ASCII, base64, appended, zlib) or else Gmsh 4.1 `.msh` (ASCII or binary).
     pub path: Option<String>,
     /// Composite: centre of the refined zone.
     pub center: Option<Vec<f64>>,

@@ -1,5 +1,6 @@
-//! Mesh import and export: Gmsh 4.1 ASCII `.msh` (read), VTK XML `.vtu` (read and write)
-//! and ParaView `.pvd` time series (write).
+//! Mesh import and export: Gmsh 4.1 `.msh`, ASCII or binary (read), VTK XML `.vtu` (read
+//! and write; ASCII, base64, appended and zlib-compressed data) and ParaView `.pvd` time
+//! series (write).
 //!
 //! # Cells and face orientation
 //!
@@ -33,10 +34,91 @@
 //! and the rest renumbered compactly in file order. A 2D mesh must lie in a plane
 //! `z = const`.
 //!
+//! # Reading Gmsh files
+//!
+//! [`read_msh`](crate::io::read_msh) reads MSH 4.1 files, ASCII (`$MeshFormat` line
+//! `4.1 0 8`) or binary (`4.1 1 8`). Sections read: `$MeshFormat`, `$PhysicalNames`,
+//! `$Entities` (entity → physical groups), `$Nodes` and `$Elements` (entity blocks).
+//! Other sections (`$Periodic`, `$NodeData`, …) are skipped; `$PartitionedEntities` and
+//! `$Parametrizations` are refused.
+//!
+//! * Cells are the elements of dimension `D`: triangles (2) and quadrangles (3) in 2D;
+//!   tetrahedra (4), hexahedra (5), prisms (6) and pyramids (7) in 3D, in file order.
+//! * A physical group of dimension `D` becomes a cell tag, named by `$PhysicalNames` or
+//!   `physical_<tag>`. A physical group of dimension `D − 1` (lines in 2D, triangles and
+//!   quadrangles in 3D) becomes a face tag: each of its elements is matched to the grid
+//!   face with the same node set.
+//! * Points (15), and lines (1) in 3D, are accepted and ignored. Any other element type
+//!   (second order, …) is an error naming the line and the type.
+//!
+//! A binary file differs from an ASCII one only in the data of `$Entities`, `$Nodes` and
+//! `$Elements`: section headers, `$End…` lines, `$MeshFormat` and `$PhysicalNames` stay
+//! text. The line `4.1 1 8` is followed by the integer 1 in 4 binary bytes and a newline;
+//! it gives the byte order of every binary number (Gmsh writes the machine's; both orders
+//! are read). The binary data hold the numbers of the ASCII lines in the same order, back
+//! to back, as `int` (4-byte signed), `size_t` (8-byte unsigned: data size 8) and `double`
+//! (8-byte IEEE), and end with a newline before `$End…`:
+//!
+//! | section | binary data |
+//! |---|---|
+//! | `$Entities` | `numPoints numCurves numSurfaces numVolumes` (`size_t`); per point `tag` (`int`), `x y z` (`double`), `numPhysicalTags` (`size_t`), the physical tags (`int`); per curve, surface and volume `tag` (`int`), `minX minY minZ maxX maxY maxZ` (`double`), `numPhysicalTags` (`size_t`), the physical tags (`int`), `numBoundingEntities` (`size_t`), the bounding entity tags (`int`) |
+//! | `$Nodes` | `numEntityBlocks numNodes minNodeTag maxNodeTag` (`size_t`); per block `entityDim entityTag parametric` (`int`) and `numNodesInBlock` (`size_t`), the block's node tags (`size_t`), then per node `x y z`, and `entityDim` parametric coordinates if `parametric` is 1 (`double`) |
+//! | `$Elements` | `numEntityBlocks numElements minElementTag maxElementTag` (`size_t`); per block `entityDim entityTag elementType` (`int`) and `numElementsInBlock` (`size_t`), then per element its tag and its node tags (`size_t`) |
+//!
+//! Physical groups become tags exactly as in an ASCII file, and a mesh saved both ways
+//! gives the same grid bit for bit. Every count (entities, blocks, nodes, elements,
+//! physical tags) is checked against the bytes left in the file before anything is
+//! allocated for it. Errors in ASCII data give the line; errors in binary data give the
+//! line of the section header, the section and the byte offset
+//! (`mesh.msh:21: $Nodes (binary data, byte 3247): …`). Cells and nodes read from binary
+//! data are named by their Gmsh tag only.
+//!
+//! # Reading VTK files
+//!
+//! [`read_vtu`](crate::io::read_vtu) reads `VTK_TRIANGLE` (5), `VTK_QUAD` (9) and `VTK_POLYGON` (7) cells in 2D,
+//! `VTK_TETRA` (10), `VTK_HEXAHEDRON` (12), `VTK_WEDGE` (13), `VTK_PYRAMID` (14) and
+//! `VTK_POLYHEDRON` (42) cells in 3D, from one `<Piece>`. Cell tags come from the
+//! `tag:<name>` cell-data arrays, or, if there are none, from an integer `tag` array as
+//! `tag_<value>`; face tags from `facetag:<name>` field data.
+//!
+//! Data arrays may be stored in any of the ways VTK writes them, which covers ParaView's
+//! default save (appended raw data compressed with zlib):
+//!
+//! * `format="ascii"`: numbers as text;
+//! * `format="binary"`: a binary block (below) encoded inline as base64. VTK encodes the
+//!   header and the data as one base64 stream, or, when compressed, as two streams back to
+//!   back; both are read;
+//! * `format="appended"` with `offset="…"`: the binary block lies in the file's
+//!   `<AppendedData encoding="raw">` (the bytes after its `_` marker; `offset` counts
+//!   bytes from the one after `_`) or `<AppendedData encoding="base64">` (`offset` counts
+//!   base64 characters after `_`, and each array is its own base64 text).
+//!
+//! A binary block is made of integers of the file's `header_type` (`UInt32`, the
+//! default, or `UInt64`) followed by data, all in the file's `byte_order`
+//! (`LittleEndian` or `BigEndian`):
+//!
+//! * without compression: one integer, the number of data bytes, then the data;
+//! * with `compressor="vtkZLibDataCompressor"`: the header
+//!   `[nblocks, block_size, last_block_size, csize_0, …, csize_{nblocks−1}]`, then the
+//!   `nblocks` zlib streams of `csize_k` bytes each, back to back. The data was cut into
+//!   blocks of `block_size` bytes before compression; the last block has
+//!   `last_block_size` bytes, or `block_size` when `last_block_size` is 0. An empty array
+//!   has `nblocks = 0`.
+//!
+//! Other compressors (`vtkLZ4DataCompressor`, `vtkLZMADataCompressor`) are refused.
+//! Every size in a header is checked against the bytes actually present before a buffer
+//! is allocated: a size or block count larger than the data, an offset past the appended
+//! data, a block that cannot inflate to its declared size (zlib inflates at most
+//! 1032-fold), a corrupt zlib stream, or an array whose size disagrees with
+//! `NumberOfPoints` / `NumberOfCells` is a [`GridError::Parse`] naming the file, the line
+//! of the `<DataArray>`, the array, where its data is, and what is wrong. A file that ends
+//! inside `<AppendedData>` is read up to the first array it cuts, and the error says the
+//! file looks cut short.
+//!
 //! # Errors
 //!
-//! A missing or unreadable file is [`GridError::Io`] with its path; malformed text is
-//! [`GridError::Parse`] with the 1-based line; a well-formed file whose grid is invalid
+//! A missing or unreadable file is [`GridError::Io`] with its path; a malformed file is
+//! [`GridError::Parse`] with the 1-based line (and, as above, the array or section); a well-formed file whose grid is invalid
 //! (degenerate or inverted cells, non-matching faces) is [`GridError::InFile`] wrapping the
 //! grid error, whose cell index is the cell's position among the file's cells.
 
@@ -46,7 +128,7 @@ mod pvd;
 mod vtu;
 mod xml;
 
-pub use gmsh::{parse_msh, read_msh};
+pub use gmsh::{parse_msh, parse_msh_bytes, read_msh};
 pub use pvd::PvdWriter;
 pub use vtu::{Encoding, Field, kelvin_to_vtk_sym, read_vtu, write_vtu, write_vtu_with};
 
@@ -147,7 +229,7 @@ impl Shape {
 /// Where a cell came from, for error messages.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Origin {
-    /// 1-based line of the element (Gmsh) or of the cell arrays (VTK).
+    /// 1-based line of the element (Gmsh) or of the cell arrays (VTK); 0 in binary data.
     pub line: usize,
     /// Element tag (Gmsh) or cell index (VTK).
     pub tag: u64,
@@ -159,7 +241,7 @@ pub(crate) struct Origin {
 pub(crate) struct RawMesh<const D: usize> {
     /// All nodes in file order.
     pub nodes: Vec<Point<D>>,
-    /// File label (Gmsh tag or VTK point index) and line of each node.
+    /// File label (Gmsh tag or VTK point index) and line of each node (0 in binary data).
     pub node_label: Vec<(u64, usize)>,
     /// Cells as outward loops in `nodes` numbering.
     pub loops: CellFaceLoops,
@@ -236,8 +318,10 @@ impl<const D: usize> RawMesh<D> {
                     GridError::Node { node, what } if node < labels.len() => GridError::Node {
                         node,
                         what: format!(
-                            "{what} ({} {}, line {})",
-                            self.what_node, labels[node].0, labels[node].1
+                            "{what} ({} {}{})",
+                            self.what_node,
+                            labels[node].0,
+                            at_line(labels[node].1)
                         ),
                     },
                     other => other,
@@ -248,7 +332,16 @@ impl<const D: usize> RawMesh<D> {
 
     fn describe(&self, c: usize) -> String {
         let o = self.origin[c];
-        format!("{} {}, line {}", self.what_cell, o.tag, o.line)
+        format!("{} {}{}", self.what_cell, o.tag, at_line(o.line))
+    }
+}
+
+/// `", line N"`, or nothing for line 0 (binary data has no lines).
+fn at_line(line: usize) -> String {
+    if line == 0 {
+        String::new()
+    } else {
+        format!(", line {line}")
     }
 }
 

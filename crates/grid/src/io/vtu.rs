@@ -26,14 +26,20 @@
 //!
 //! `VTK_TRIANGLE` (5), `VTK_QUAD` (9), `VTK_POLYGON` (7) in 2D (all points at one `z`);
 //! `VTK_TETRA` (10), `VTK_HEXAHEDRON` (12), `VTK_WEDGE` (13), `VTK_PYRAMID` (14),
-//! `VTK_POLYHEDRON` (42) in 3D. ASCII or inline base64 data (`UInt32`/`UInt64` headers,
-//! either byte order); compressed or appended data are refused. Cell tags come from the
-//! `tag:<name>` arrays, or, if there are none, from an integer `tag` array as
-//! `tag_<value>`; face tags from `facetag:<name>` field data.
+//! `VTK_POLYHEDRON` (42) in 3D. Cell tags come from the `tag:<name>` arrays, or, if there
+//! are none, from an integer `tag` array as `tag_<value>`; face tags from `facetag:<name>`
+//! field data. One `<Piece>`.
+//!
+//! Data arrays may be ASCII, inline base64 or appended (raw or base64), uncompressed or
+//! zlib-compressed: see "Reading VTK files" in the [`crate::io`] module docs.
 
+use std::borrow::Cow;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
+use std::io::Read as _;
 use std::path::Path;
+
+use flate2::read::ZlibDecoder;
 
 use crate::builder::CellFaceLoops;
 use crate::error::{GridError, Result};
@@ -433,11 +439,81 @@ fn polyhedron_faces<const D: usize>(grid: &Grid<D>) -> (Vec<i64>, Vec<i64>) {
 
 // ---------------------------------------------------------------------------- reading
 
+/// Value types of VTK data arrays.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Ty {
+    F32,
+    F64,
+    I8,
+    U8,
+    I16,
+    U16,
+    I32,
+    U32,
+    I64,
+    U64,
+}
+
+impl Ty {
+    fn parse(s: &str) -> Option<Ty> {
+        Some(match s {
+            "Float32" => Ty::F32,
+            "Float64" => Ty::F64,
+            "Int8" => Ty::I8,
+            "UInt8" => Ty::U8,
+            "Int16" => Ty::I16,
+            "UInt16" => Ty::U16,
+            "Int32" => Ty::I32,
+            "UInt32" => Ty::U32,
+            "Int64" => Ty::I64,
+            "UInt64" => Ty::U64,
+            _ => return None,
+        })
+    }
+    fn size(self) -> usize {
+        match self {
+            Ty::I8 | Ty::U8 => 1,
+            Ty::I16 | Ty::U16 => 2,
+            Ty::F32 | Ty::I32 | Ty::U32 => 4,
+            Ty::F64 | Ty::I64 | Ty::U64 => 8,
+        }
+    }
+    fn is_float(self) -> bool {
+        matches!(self, Ty::F32 | Ty::F64)
+    }
+}
+
+/// The bytes after the `_` marker of `<AppendedData>`.
+struct Appended<'a> {
+    data: &'a [u8],
+    /// `encoding="base64"` (else `raw`).
+    base64: bool,
+    /// Whether `</AppendedData>` follows the data (else the file ends inside it).
+    closed: bool,
+    /// Sorted offsets of all appended arrays: a base64 array ends where the next begins.
+    starts: Vec<usize>,
+}
+
+/// Largest ratio of inflated to deflated size that zlib can reach (a deflate block of
+/// repeated bytes codes 258 bytes in 2 bits, i.e. at most 1032 : 1), with slack for the
+/// stream header and checksum.
+const ZLIB_MAX_RATIO: u64 = 1032;
+
 struct Ctx<'a> {
     path: &'a Path,
     lines: LineIndex,
     big_endian: bool,
     header64: bool,
+    /// `compressor="vtkZLibDataCompressor"`: binary arrays are zlib blocks.
+    zlib: bool,
+    appended: Option<Appended<'a>>,
+}
+
+/// Which array is being decoded, for error messages.
+struct ArrayAt<'e> {
+    name: &'e str,
+    offset: usize,
+    how: String,
 }
 
 impl Ctx<'_> {
@@ -447,6 +523,23 @@ impl Ctx<'_> {
             line: self.lines.line(offset),
             what: what.into(),
         }
+    }
+
+    fn zlib_note(&self) -> &'static str {
+        if self.zlib { ", zlib" } else { "" }
+    }
+
+    fn array_err(&self, at: &ArrayAt<'_>, what: impl std::fmt::Display) -> GridError {
+        let cut = match &self.appended {
+            Some(a) if !a.closed && at.how.starts_with("appended") => {
+                "; the file ends inside <AppendedData> (no </AppendedData>): is it cut short?"
+            }
+            _ => "",
+        };
+        self.err(
+            at.offset,
+            format!("DataArray `{}` ({}): {what}{cut}", at.name, at.how),
+        )
     }
 
     /// Decode a DataArray as f64 (`want_int`: refuse float types) with `ncomp`
@@ -459,31 +552,19 @@ impl Ctx<'_> {
         want_int: bool,
     ) -> Result<Vec<f64>> {
         let name = el.attr("Name").unwrap_or("(unnamed)");
-        let ty = el
+        let ty_name = el
             .attr("type")
             .ok_or_else(|| self.err(el.offset, format!("DataArray `{name}` has no type")))?;
-        let (size, is_float, signed) = match ty {
-            "Float32" => (4, true, true),
-            "Float64" => (8, true, true),
-            "Int8" => (1, false, true),
-            "UInt8" => (1, false, false),
-            "Int16" => (2, false, true),
-            "UInt16" => (2, false, false),
-            "Int32" => (4, false, true),
-            "UInt32" => (4, false, false),
-            "Int64" => (8, false, true),
-            "UInt64" => (8, false, false),
-            _ => {
-                return Err(self.err(
-                    el.offset,
-                    format!("DataArray `{name}`: unsupported type `{ty}`"),
-                ));
-            }
-        };
-        if want_int && is_float {
+        let ty = Ty::parse(ty_name).ok_or_else(|| {
+            self.err(
+                el.offset,
+                format!("DataArray `{name}`: unsupported type `{ty_name}`"),
+            )
+        })?;
+        if want_int && ty.is_float() {
             return Err(self.err(
                 el.offset,
-                format!("DataArray `{name}` must be an integer array, found {ty}"),
+                format!("DataArray `{name}` must be an integer array, found {ty_name}"),
             ));
         }
         let nc: usize = match el.attr("NumberOfComponents") {
@@ -501,55 +582,101 @@ impl Ctx<'_> {
                 format!("DataArray `{name}` has {nc} components, expected {ncomp}"),
             ));
         }
+        // Expected size in bytes, when the number of tuples is known.
+        let expected = match tuples {
+            None => None,
+            Some(t) => Some(
+                t.checked_mul(ncomp)
+                    .and_then(|n| n.checked_mul(ty.size()))
+                    .ok_or_else(|| {
+                        self.err(
+                            el.offset,
+                            format!(
+                                "DataArray `{name}`: {t} tuples of {ncomp} {ty_name} values \
+                                 do not fit in memory"
+                            ),
+                        )
+                    })?,
+            ),
+        };
         let format = el.attr("format").unwrap_or("ascii");
         let values: Vec<f64> = match format {
             "ascii" => {
                 let mut v = Vec::new();
                 for tok in el.text.split_ascii_whitespace() {
                     let off = el.text_offset + (tok.as_ptr() as usize - el.text.as_ptr() as usize);
-                    let x: f64 = if is_float {
+                    let x: f64 = if ty.is_float() {
                         tok.parse().ok()
                     } else {
                         tok.parse::<i64>().ok().map(|i| i as f64)
                     }
                     .ok_or_else(|| {
-                        self.err(off, format!("DataArray `{name}`: bad {ty} value `{tok}`"))
+                        self.err(
+                            off,
+                            format!("DataArray `{name}`: bad {ty_name} value `{tok}`"),
+                        )
                     })?;
                     v.push(x);
                 }
                 v
             }
             "binary" => {
-                let raw = base64::decode(el.text)
+                let at = ArrayAt {
+                    name,
+                    offset: el.offset,
+                    how: format!("inline base64{}", self.zlib_note()),
+                };
+                let raw = base64::decode(el.text.as_bytes())
                     .map_err(|w| self.err(el.text_offset, format!("DataArray `{name}`: {w}")))?;
-                let hs = if self.header64 { 8 } else { 4 };
-                if raw.len() < hs {
-                    return Err(
-                        self.err(el.offset, format!("DataArray `{name}`: no binary header"))
-                    );
-                }
-                let count = self.uint(&raw[..hs]) as usize;
-                let data = &raw[hs..];
-                if count > data.len() || count % size != 0 {
-                    return Err(self.err(
+                let payload = self.unpack(&raw, &at, ty, expected)?;
+                self.convert(&payload, ty)
+            }
+            "appended" => {
+                let ap = self.appended.as_ref().ok_or_else(|| {
+                    self.err(
                         el.offset,
                         format!(
-                            "DataArray `{name}`: header says {count} bytes, {} present \
-                             (values of {size} bytes)",
-                            data.len()
+                            "DataArray `{name}` has format=\"appended\" but the file has no \
+                             <AppendedData> block"
+                        ),
+                    )
+                })?;
+                let off_text = el.attr("offset").unwrap_or("");
+                let off: usize = off_text.trim().parse().map_err(|_| {
+                    self.err(
+                        el.offset,
+                        format!("DataArray `{name}`: bad or missing appended offset `{off_text}`"),
+                    )
+                })?;
+                let at = ArrayAt {
+                    name,
+                    offset: el.offset,
+                    how: format!(
+                        "appended {}, offset {off}{}",
+                        if ap.base64 { "base64" } else { "raw" },
+                        self.zlib_note()
+                    ),
+                };
+                if off >= ap.data.len() {
+                    return Err(self.array_err(
+                        &at,
+                        format!(
+                            "the offset is past the end of the appended data ({} bytes)",
+                            ap.data.len()
                         ),
                     ));
                 }
-                data[..count]
-                    .chunks_exact(size)
-                    .map(|b| self.decode(b, is_float, signed))
-                    .collect()
-            }
-            "appended" => {
-                return Err(self.err(
-                    el.offset,
-                    format!("DataArray `{name}`: appended data is not supported (write inline ascii or binary)"),
-                ));
+                if ap.base64 {
+                    let next = ap.starts.partition_point(|&s| s <= off);
+                    let end = ap.starts.get(next).copied().unwrap_or(ap.data.len());
+                    let raw = base64::decode(&ap.data[off..end.min(ap.data.len())])
+                        .map_err(|w| self.array_err(&at, w))?;
+                    let payload = self.unpack(&raw, &at, ty, expected)?;
+                    self.convert(&payload, ty)
+                } else {
+                    let payload = self.unpack(&ap.data[off..], &at, ty, expected)?;
+                    self.convert(&payload, ty)
+                }
             }
             _ => {
                 return Err(self.err(
@@ -568,7 +695,7 @@ impl Ctx<'_> {
             ));
         }
         if let Some(t) = tuples
-            && values.len() != t * ncomp
+            && values.len() / ncomp != t
         {
             return Err(self.err(
                 el.offset,
@@ -587,6 +714,185 @@ impl Ctx<'_> {
         Ok(values)
     }
 
+    /// The data bytes of a binary array that starts (with its header) at `src[0]`:
+    /// uncompressed, one size word then the bytes; with zlib, VTK's block header then the
+    /// compressed blocks (see the module docs). `expected` is the size in bytes if known.
+    /// Every size is checked against the bytes present before anything is allocated.
+    fn unpack<'s>(
+        &self,
+        src: &'s [u8],
+        at: &ArrayAt<'_>,
+        ty: Ty,
+        expected: Option<usize>,
+    ) -> Result<Cow<'s, [u8]>> {
+        let hs = if self.header64 { 8 } else { 4 };
+        let word = |k: usize| -> Option<u64> {
+            let b = src.get(k * hs..(k + 1) * hs)?;
+            Some(self.uint(b))
+        };
+        let size = ty.size() as u64;
+        let check_total = |total: u64| -> Result<()> {
+            if total % size != 0 {
+                return Err(self.array_err(
+                    at,
+                    format!("{total} bytes is not a whole number of {size}-byte values"),
+                ));
+            }
+            if let Some(e) = expected
+                && total != e as u64
+            {
+                return Err(self.array_err(
+                    at,
+                    format!(
+                        "the header gives {total} bytes ({} values), expected {e} bytes ({} values)",
+                        total / size,
+                        e as u64 / size
+                    ),
+                ));
+            }
+            Ok(())
+        };
+        if !self.zlib {
+            let count = word(0).ok_or_else(|| {
+                self.array_err(
+                    at,
+                    format!("no {hs}-byte size header ({} bytes present)", src.len()),
+                )
+            })?;
+            let avail = (src.len() - hs) as u64;
+            if count > avail {
+                return Err(self.array_err(
+                    at,
+                    format!("the header gives {count} bytes, only {avail} follow"),
+                ));
+            }
+            check_total(count)?;
+            return Ok(Cow::Borrowed(&src[hs..hs + count as usize]));
+        }
+        let [Some(nb), Some(bs), Some(last)] = [word(0), word(1), word(2)] else {
+            return Err(self.array_err(
+                at,
+                format!(
+                    "no compression header (3 words of {hs} bytes; {} bytes present)",
+                    src.len()
+                ),
+            ));
+        };
+        let room = (src.len() / hs - 3) as u64;
+        if nb > room {
+            return Err(self.array_err(
+                at,
+                format!(
+                    "the compression header gives {nb} blocks, but the {} bytes present \
+                     hold at most {room} block sizes",
+                    src.len()
+                ),
+            ));
+        }
+        let nb = nb as usize;
+        if nb > 0 && (bs == 0 || last > bs) {
+            return Err(self.array_err(
+                at,
+                format!(
+                    "bad compression header: block size {bs}, last block size {last} \
+                     ({nb} blocks)"
+                ),
+            ));
+        }
+        // The last block is full when its size is given as 0.
+        let block_size = |k: usize| if k + 1 < nb || last == 0 { bs } else { last };
+        let total = match nb {
+            0 => Some(0),
+            _ => (nb as u64 - 1)
+                .checked_mul(bs)
+                .and_then(|t| t.checked_add(block_size(nb - 1))),
+        }
+        .ok_or_else(|| self.array_err(at, format!("{nb} blocks of {bs} bytes overflow")))?;
+        check_total(total)?;
+        let mut compressed = 0u64;
+        for k in 0..nb {
+            let cs = word(3 + k).unwrap_or(0);
+            let us = block_size(k);
+            if us > cs.saturating_mul(ZLIB_MAX_RATIO).saturating_add(64) {
+                return Err(self.array_err(
+                    at,
+                    format!(
+                        "block {k} of {nb}: {cs} compressed bytes cannot inflate to the \
+                         {us} bytes the header gives"
+                    ),
+                ));
+            }
+            compressed = compressed.saturating_add(cs);
+        }
+        let header = (3 + nb) * hs;
+        let avail = (src.len() - header) as u64;
+        if compressed > avail {
+            return Err(self.array_err(
+                at,
+                format!(
+                    "the header gives {nb} compressed blocks of {compressed} bytes in all, \
+                     only {avail} bytes follow"
+                ),
+            ));
+        }
+        // `total` is now bounded by the bytes present (ratio above).
+        let mut out = Vec::with_capacity(total as usize);
+        let mut pos = header;
+        for k in 0..nb {
+            let cs = word(3 + k).unwrap_or(0) as usize;
+            let us = block_size(k);
+            let block = &src[pos..pos + cs];
+            let before = out.len();
+            ZlibDecoder::new(block)
+                .take(us + 1)
+                .read_to_end(&mut out)
+                .map_err(|e| {
+                    self.array_err(at, format!("block {k} of {nb}: corrupt zlib data ({e})"))
+                })?;
+            let got = (out.len() - before) as u64;
+            if got != us {
+                return Err(self.array_err(
+                    at,
+                    format!("block {k} of {nb} inflates to {got} bytes, the header gives {us}"),
+                ));
+            }
+            pos += cs;
+        }
+        Ok(Cow::Owned(out))
+    }
+
+    /// Binary values in the file's byte order as f64.
+    fn convert(&self, b: &[u8], ty: Ty) -> Vec<f64> {
+        macro_rules! conv {
+            ($t:ty) => {{
+                const N: usize = std::mem::size_of::<$t>();
+                b.chunks_exact(N)
+                    .map(|c| {
+                        let a: [u8; N] = c.try_into().unwrap_or([0; N]);
+                        let v = if self.big_endian {
+                            <$t>::from_be_bytes(a)
+                        } else {
+                            <$t>::from_le_bytes(a)
+                        };
+                        v as f64
+                    })
+                    .collect()
+            }};
+        }
+        match ty {
+            Ty::F32 => conv!(f32),
+            Ty::F64 => conv!(f64),
+            Ty::I8 => conv!(i8),
+            Ty::U8 => conv!(u8),
+            Ty::I16 => conv!(i16),
+            Ty::U16 => conv!(u16),
+            Ty::I32 => conv!(i32),
+            Ty::U32 => conv!(u32),
+            Ty::I64 => conv!(i64),
+            Ty::U64 => conv!(u64),
+        }
+    }
+
     fn uint(&self, b: &[u8]) -> u64 {
         let mut x = 0u64;
         for k in 0..b.len() {
@@ -598,22 +904,6 @@ impl Ctx<'_> {
             x = (x << 8) | u64::from(byte);
         }
         x
-    }
-
-    fn decode(&self, b: &[u8], is_float: bool, signed: bool) -> f64 {
-        let u = self.uint(b);
-        if is_float {
-            if b.len() == 4 {
-                f64::from(f32::from_bits(u as u32))
-            } else {
-                f64::from_bits(u)
-            }
-        } else if signed {
-            let shift = 64 - 8 * b.len() as u32;
-            (((u << shift) as i64) >> shift) as f64
-        } else {
-            u as f64
-        }
     }
 
     fn ints(&self, el: &Element<'_>, tuples: Option<usize>) -> Result<Vec<i64>> {
@@ -631,35 +921,85 @@ fn named<'e, 'a>(parent: &'e Element<'a>, name: &str) -> Option<&'e Element<'a>>
         .find(|d| d.attr("Name") == Some(name))
 }
 
-/// Read a `.vtu` file as a `D`-dimensional grid (see the module docs).
+/// Read a `.vtu` file as a `D`-dimensional grid: any cell types, tags and data encodings
+/// listed in the [`io`](crate::io) module docs (ASCII, inline base64, appended raw or
+/// base64, with or without zlib compression).
 pub fn read_vtu<const D: usize>(path: impl AsRef<Path>) -> Result<Grid<D>> {
     const { assert_dim::<D>() };
     let path = path.as_ref();
     let bytes = read_file(path)?;
-    let text = match std::str::from_utf8(&bytes) {
-        Ok(t) => t,
-        Err(e) => {
-            let line = bytes[..e.valid_up_to()]
-                .iter()
-                .filter(|&&b| b == b'\n')
-                .count()
-                + 1;
-            return Err(GridError::Parse {
-                path: path.to_path_buf(),
-                line,
-                what: "not UTF-8 text (raw appended binary data is not supported)".into(),
-            });
-        }
-    };
-    parse_vtu(text, path)
+    let (text, appended) = split_appended(&bytes, path)?;
+    parse_vtu(&text, appended, path)
 }
 
-fn parse_vtu<const D: usize>(text: &str, path: &Path) -> Result<Grid<D>> {
+/// The appended data of a `.vtu` file: `(data, closed)`, the bytes after the `_` marker
+/// up to `</AppendedData>` (or to the end of the file, `closed == false`).
+type AppendedBytes<'b> = Option<(&'b [u8], bool)>;
+
+/// Split a `.vtu` file into its XML text and its appended data. The XML text is the file
+/// with the bytes from the `_` marker to `</AppendedData>` cut out (byte offsets before
+/// the marker are unchanged, so line numbers of errors are exact); a file that ends inside
+/// the appended data gets the closing tags added.
+fn split_appended<'b>(bytes: &'b [u8], path: &Path) -> Result<(Cow<'b, str>, AppendedBytes<'b>)> {
+    let err = |at: usize, what: String| GridError::Parse {
+        path: path.to_path_buf(),
+        line: memchr::memchr_iter(b'\n', &bytes[..at.min(bytes.len())]).count() + 1,
+        what,
+    };
+    let text = |from: usize, to: usize| -> Result<&'b str> {
+        std::str::from_utf8(&bytes[from..to]).map_err(|e| {
+            err(
+                from + e.valid_up_to(),
+                "not UTF-8 text (outside of <AppendedData>)".into(),
+            )
+        })
+    };
+    let Some(start) = memchr::memmem::find(bytes, b"<AppendedData") else {
+        return Ok((Cow::Borrowed(text(0, bytes.len())?), None));
+    };
+    let Some(gt) = memchr::memchr(b'>', &bytes[start..]).map(|p| start + p) else {
+        return Err(err(start, "unterminated <AppendedData> start tag".into()));
+    };
+    if bytes[gt - 1] == b'/' {
+        // `<AppendedData/>`: no data.
+        return Ok((Cow::Borrowed(text(0, bytes.len())?), None));
+    }
+    let marker = gt
+        + 1
+        + bytes[gt + 1..]
+            .iter()
+            .position(|b| !b.is_ascii_whitespace())
+            .unwrap_or(bytes.len() - gt - 1);
+    if bytes.get(marker) != Some(&b'_') {
+        return Err(err(
+            marker,
+            "<AppendedData> must begin with the `_` marker".into(),
+        ));
+    }
+    let data = marker + 1;
+    let end = memchr::memmem::rfind(&bytes[data..], b"</AppendedData>").map(|p| data + p);
+    let mut xml = String::with_capacity(marker + 64);
+    xml.push_str(text(0, marker)?);
+    match end {
+        Some(e) => xml.push_str(text(e, bytes.len())?),
+        None => xml.push_str("</AppendedData></VTKFile>"),
+    }
+    let slice = &bytes[data..end.unwrap_or(bytes.len())];
+    Ok((Cow::Owned(xml), Some((slice, end.is_some()))))
+}
+
+fn parse_vtu<const D: usize>(
+    text: &str,
+    appended: AppendedBytes<'_>,
+    path: &Path,
+) -> Result<Grid<D>> {
     let mut cx = Ctx {
         path,
         lines: LineIndex::new(text),
         big_endian: false,
         header64: false,
+        zlib: false,
+        appended: None,
     };
     let root = xml::parse(text).map_err(|e| cx.err(e.offset, format!("XML: {}", e.what)))?;
     if root.name != "VTKFile" || root.attr("type") != Some("UnstructuredGrid") {
@@ -668,14 +1008,19 @@ fn parse_vtu<const D: usize>(text: &str, path: &Path) -> Result<Grid<D>> {
             "not a VTK UnstructuredGrid file (<VTKFile type=\"UnstructuredGrid\">)",
         ));
     }
-    if let Some(c) = root.attr("compressor")
-        && !c.is_empty()
-    {
-        return Err(cx.err(
-            root.offset,
-            format!("compressed data ({c}) is not supported"),
-        ));
-    }
+    cx.zlib = match root.attr("compressor").unwrap_or("") {
+        "" => false,
+        "vtkZLibDataCompressor" => true,
+        c => {
+            return Err(cx.err(
+                root.offset,
+                format!(
+                    "compressor `{c}` is not supported (only vtkZLibDataCompressor; save \
+                     with zlib or without compression)"
+                ),
+            ));
+        }
+    };
     cx.big_endian = match root.attr("byte_order").unwrap_or("LittleEndian") {
         "LittleEndian" => false,
         "BigEndian" => true,
@@ -686,11 +1031,37 @@ fn parse_vtu<const D: usize>(text: &str, path: &Path) -> Result<Grid<D>> {
         "UInt64" => true,
         o => return Err(cx.err(root.offset, format!("unsupported header_type `{o}`"))),
     };
-    if let Some(a) = root.child("AppendedData") {
-        return Err(cx.err(
-            a.offset,
-            "appended data is not supported (write inline ascii or binary)",
-        ));
+    if let Some((data, closed)) = appended {
+        let a = root
+            .child("AppendedData")
+            .ok_or_else(|| cx.err(root.offset, "<AppendedData> is not a child of <VTKFile>"))?;
+        let base64 = match a.attr("encoding").unwrap_or("") {
+            "raw" => false,
+            "base64" => true,
+            e => {
+                return Err(cx.err(
+                    a.offset,
+                    format!("<AppendedData> encoding `{e}` (expected raw or base64)"),
+                ));
+            }
+        };
+        let mut starts = Vec::new();
+        root.walk(&mut |el| {
+            if el.name == "DataArray"
+                && el.attr("format") == Some("appended")
+                && let Some(o) = el.attr("offset").and_then(|s| s.trim().parse().ok())
+            {
+                starts.push(o);
+            }
+        });
+        starts.sort_unstable();
+        starts.dedup();
+        cx.appended = Some(Appended {
+            data,
+            base64,
+            closed,
+            starts,
+        });
     }
     let ug = root
         .child("UnstructuredGrid")
@@ -1019,6 +1390,8 @@ mod tests {
                 lines: LineIndex::new(&text),
                 big_endian: false,
                 header64: true,
+                zlib: false,
+                appended: None,
             };
             let root = xml::parse(&text).ok().unwrap();
             let cdel = root
@@ -1064,6 +1437,8 @@ mod tests {
             lines: LineIndex::new(&doc),
             big_endian: true,
             header64: false,
+            zlib: false,
+            appended: None,
         };
         assert_eq!(cx.array(&el, 1, Some(3), false).unwrap(), vals.to_vec());
         // A header claiming more bytes than present is an error.
@@ -1072,6 +1447,130 @@ mod tests {
         let doc = doc.replacen(&text[..8], &h, 1);
         let el = xml::parse(&doc).ok().unwrap();
         assert!(cx.array(&el, 1, None, false).is_err());
+    }
+
+    fn ctx(big_endian: bool, header64: bool, zlib: bool) -> Ctx<'static> {
+        Ctx {
+            path: Path::new("x.vtu"),
+            lines: LineIndex::new(""),
+            big_endian,
+            header64,
+            zlib,
+            appended: None,
+        }
+    }
+
+    fn word(v: u64, cx: &Ctx<'_>, out: &mut Vec<u8>) {
+        match (cx.header64, cx.big_endian) {
+            (true, true) => out.extend_from_slice(&v.to_be_bytes()),
+            (true, false) => out.extend_from_slice(&v.to_le_bytes()),
+            (false, true) => out.extend_from_slice(&(v as u32).to_be_bytes()),
+            (false, false) => out.extend_from_slice(&(v as u32).to_le_bytes()),
+        }
+    }
+
+    /// VTK's zlib layout: header, then one zlib stream per block.
+    fn zlib_block(cx: &Ctx<'_>, data: &[u8], bs: usize) -> Vec<u8> {
+        use std::io::Write as _;
+        let blocks: Vec<Vec<u8>> = data
+            .chunks(bs)
+            .map(|c| {
+                let mut e =
+                    flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::default());
+                e.write_all(c).unwrap();
+                e.finish().unwrap()
+            })
+            .collect();
+        let mut out = Vec::new();
+        word(blocks.len() as u64, cx, &mut out);
+        word(bs as u64, cx, &mut out);
+        word((data.len() % bs) as u64, cx, &mut out);
+        for b in &blocks {
+            word(b.len() as u64, cx, &mut out);
+        }
+        for b in &blocks {
+            out.extend_from_slice(b);
+        }
+        out
+    }
+
+    fn at() -> ArrayAt<'static> {
+        ArrayAt {
+            name: "x",
+            offset: 0,
+            how: "inline binary".into(),
+        }
+    }
+
+    fn unpack_err(cx: &Ctx<'_>, src: &[u8], expected: Option<usize>) -> String {
+        match cx.unpack(src, &at(), Ty::F64, expected) {
+            Err(e) => e.to_string(),
+            Ok(v) => panic!("expected an error, got {} bytes", v.len()),
+        }
+    }
+
+    /// zlib blocks in both byte orders and header types, with a partial last block, a
+    /// full last block (size 0 in the header) and no block at all.
+    #[test]
+    fn zlib_blocks() {
+        for (be, h64) in [(false, false), (false, true), (true, false), (true, true)] {
+            let cx = ctx(be, h64, true);
+            for n in [1000usize, 512, 0] {
+                let vals: Vec<f64> = (0..n).map(|k| (k as f64).sqrt() - 7.25).collect();
+                let mut bytes = Vec::new();
+                for v in &vals {
+                    bytes.extend_from_slice(&if be { v.to_be_bytes() } else { v.to_le_bytes() });
+                }
+                let src = zlib_block(&cx, &bytes, 1024);
+                let out = cx.unpack(&src, &at(), Ty::F64, Some(8 * n)).unwrap();
+                assert_eq!(cx.convert(&out, Ty::F64), vals);
+            }
+        }
+    }
+
+    #[test]
+    fn zlib_errors_before_allocation() {
+        let cx = ctx(false, true, true);
+        let bytes: Vec<u8> = (0..4000u32)
+            .flat_map(|k| (k as f64).to_le_bytes())
+            .collect();
+        let good = zlib_block(&cx, &bytes, 4096);
+        assert!(cx.unpack(&good, &at(), Ty::F64, Some(32000)).is_ok());
+        // A header claiming 10^15 blocks.
+        let mut bad = good.clone();
+        bad[..8].copy_from_slice(&1_000_000_000_000_000u64.to_le_bytes());
+        let m = unpack_err(&cx, &bad, None);
+        assert!(m.contains("1000000000000000 blocks"), "{m}");
+        // A block claiming 10^15 bytes from a few compressed ones.
+        let mut bad = good.clone();
+        bad[8..16].copy_from_slice(&1_000_000_000_000_000u64.to_le_bytes());
+        let m = unpack_err(&cx, &bad, None);
+        assert!(m.contains("cannot inflate"), "{m}");
+        // Compressed sizes past the end (the data cut short).
+        let m = unpack_err(&cx, &good[..good.len() - 10], None);
+        assert!(m.contains("only"), "{m}");
+        // Fewer bytes than the header itself.
+        let m = unpack_err(&cx, &good[..20], None);
+        assert!(m.contains("no compression header"), "{m}");
+        // A corrupt stream: bytes of the first block overwritten.
+        let mut bad = good.clone();
+        let h = 8 * (3 + 8);
+        for b in &mut bad[h + 2..h + 40] {
+            *b = 0xa5;
+        }
+        let m = unpack_err(&cx, &bad, None);
+        assert!(m.contains("block 0 of 8"), "{m}");
+        // The expected size disagrees with the header.
+        let m = unpack_err(&cx, &good, Some(8 * 3999));
+        assert!(m.contains("expected 31992 bytes"), "{m}");
+        // Uncompressed: a size header past the data.
+        let cx = ctx(false, false, false);
+        let mut raw = 800u32.to_le_bytes().to_vec();
+        raw.extend_from_slice(&[0; 16]);
+        let m = unpack_err(&cx, &raw, None);
+        assert!(m.contains("800 bytes, only 16 follow"), "{m}");
+        let m = unpack_err(&cx, &raw[..3], None);
+        assert!(m.contains("no 4-byte size header"), "{m}");
     }
 
     #[test]

@@ -1,15 +1,21 @@
-//! A small XML reader for VTK files: elements, attributes, text; comments, the `<?xml?>`
-//! declaration and `<!DOCTYPE>` are skipped. No namespaces, no entities beyond the five
-//! predefined ones and numeric character references.
+//! The element tree of a VTK XML file, read with `quick-xml`: elements, attributes (with
+//! entities and character references replaced) and the text directly inside each element.
+//! Comments, the `<?xml?>` declaration, processing instructions and `<!DOCTYPE>` are
+//! skipped. Text is borrowed from the document, so large ASCII or base64 arrays are not
+//! copied.
+
+use quick_xml::XmlVersion;
+use quick_xml::events::{BytesStart, Event};
+use quick_xml::reader::Reader;
 
 /// One XML element.
 #[derive(Debug)]
 pub(crate) struct Element<'a> {
     pub name: &'a str,
-    pub attrs: Vec<(&'a str, String)>,
+    pub attrs: Vec<(String, String)>,
     pub children: Vec<Element<'a>>,
     /// The text directly inside the element (from the end of the start tag to the first
-    /// child or the end tag).
+    /// child, comment or end tag).
     pub text: &'a str,
     /// Byte offset of the start tag and of `text`.
     pub offset: usize,
@@ -20,7 +26,7 @@ impl<'a> Element<'a> {
     pub(crate) fn attr(&self, name: &str) -> Option<&str> {
         self.attrs
             .iter()
-            .find(|(k, _)| *k == name)
+            .find(|(k, _)| k == name)
             .map(|(_, v)| v.as_str())
     }
     pub(crate) fn child(&self, name: &str) -> Option<&Element<'a>> {
@@ -32,6 +38,13 @@ impl<'a> Element<'a> {
     ) -> impl Iterator<Item = &'s Element<'a>> + 's {
         self.children.iter().filter(move |c| c.name == name)
     }
+    /// This element and all its descendants, depth first.
+    pub(crate) fn walk(&self, f: &mut impl FnMut(&Element<'a>)) {
+        f(self);
+        for c in &self.children {
+            c.walk(f);
+        }
+    }
 }
 
 /// Maps byte offsets to 1-based line numbers.
@@ -42,12 +55,7 @@ pub(crate) struct LineIndex {
 impl LineIndex {
     pub(crate) fn new(text: &str) -> Self {
         let mut starts = vec![0];
-        starts.extend(
-            text.bytes()
-                .enumerate()
-                .filter(|&(_, b)| b == b'\n')
-                .map(|(i, _)| i + 1),
-        );
+        starts.extend(memchr::memchr_iter(b'\n', text.as_bytes()).map(|i| i + 1));
         Self { starts }
     }
     pub(crate) fn line(&self, offset: usize) -> usize {
@@ -68,192 +76,89 @@ fn err<T>(offset: usize, what: impl Into<String>) -> Result<T, XmlError> {
     })
 }
 
-fn is_name_byte(b: u8) -> bool {
-    b.is_ascii_alphanumeric() || matches!(b, b'_' | b'-' | b'.' | b':') || b >= 0x80
-}
-
-fn unescape(s: &str, offset: usize) -> Result<String, XmlError> {
-    if !s.contains('&') {
-        return Ok(s.to_string());
-    }
-    let mut out = String::with_capacity(s.len());
-    let mut rest = s;
-    while let Some(p) = rest.find('&') {
-        out.push_str(&rest[..p]);
-        let Some(e) = rest[p..].find(';') else {
-            return err(offset, "unterminated `&` entity in attribute");
+/// The element of a start (or empty-element) tag that begins at byte `at` and ends before
+/// byte `end`.
+fn element<'a>(
+    text: &'a str,
+    at: usize,
+    end: usize,
+    tag: &BytesStart<'_>,
+) -> Result<Element<'a>, XmlError> {
+    // The raw tag is `<` followed by the name.
+    let n = tag.name().as_ref().len();
+    let name = text.get(at + 1..at + 1 + n).unwrap_or_default();
+    let mut attrs = Vec::new();
+    for a in tag.attributes() {
+        let bad = |e: &dyn std::fmt::Display| XmlError {
+            offset: at,
+            what: format!("in start tag `<{name}`: {e}"),
         };
-        let ent = &rest[p + 1..p + e];
-        let ch = match ent {
-            "amp" => '&',
-            "lt" => '<',
-            "gt" => '>',
-            "quot" => '"',
-            "apos" => '\'',
-            _ => {
-                let code = if let Some(h) = ent.strip_prefix("#x") {
-                    u32::from_str_radix(h, 16).ok()
-                } else if let Some(d) = ent.strip_prefix('#') {
-                    d.parse().ok()
-                } else {
-                    None
-                };
-                match code.and_then(char::from_u32) {
-                    Some(c) => c,
-                    None => return err(offset, format!("unknown entity `&{ent};`")),
-                }
-            }
-        };
-        out.push(ch);
-        rest = &rest[p + e + 1..];
+        let a = a.map_err(|e| bad(&e))?;
+        let key = std::str::from_utf8(a.key.as_ref()).map_err(|e| bad(&e))?;
+        let value = a
+            .normalized_value(XmlVersion::Implicit1_0)
+            .map_err(|e| bad(&e))?;
+        attrs.push((key.to_string(), value.into_owned()));
     }
-    out.push_str(rest);
-    Ok(out)
+    Ok(Element {
+        name,
+        attrs,
+        children: Vec::new(),
+        text: "",
+        offset: at,
+        text_offset: end,
+    })
 }
 
 /// Parse a document and return its root element.
 pub(crate) fn parse(text: &str) -> Result<Element<'_>, XmlError> {
-    let b = text.as_bytes();
-    let mut pos = 0;
+    let mut reader = Reader::from_str(text);
     let mut stack: Vec<Element<'_>> = Vec::new();
     let mut root: Option<Element<'_>> = None;
     loop {
-        // Text up to the next tag.
-        let next = text[pos..].find('<').map(|p| pos + p);
-        let Some(lt) = next else {
-            if !text[pos..].trim().is_empty() && stack.is_empty() {
-                return err(pos, "text after the root element");
-            }
-            break;
+        let at = reader.buffer_position() as usize;
+        let event = match reader.read_event() {
+            Ok(e) => e,
+            Err(e) => return err(reader.error_position() as usize, e.to_string()),
         };
-        if let Some(top) = stack.last_mut()
-            && top.children.is_empty()
-            && top.text.is_empty()
-        {
-            top.text = &text[pos..lt];
-            top.text_offset = pos;
-        }
-        pos = lt;
-        let rest = &text[pos..];
-        if rest.starts_with("<!--") {
-            let Some(e) = rest.find("-->") else {
-                return err(pos, "unterminated comment");
-            };
-            pos += e + 3;
-        } else if rest.starts_with("<?") {
-            let Some(e) = rest.find("?>") else {
-                return err(pos, "unterminated `<?`");
-            };
-            pos += e + 2;
-        } else if rest.starts_with("<!") {
-            let Some(e) = rest.find('>') else {
-                return err(pos, "unterminated `<!`");
-            };
-            pos += e + 1;
-        } else if rest.starts_with("</") {
-            let start = pos + 2;
-            let mut q = start;
-            while q < b.len() && is_name_byte(b[q]) {
-                q += 1;
+        let end = reader.buffer_position() as usize;
+        match event {
+            Event::Start(_) | Event::Empty(_) if stack.is_empty() && root.is_some() => {
+                return err(at, "a second root element");
             }
-            let name = &text[start..q];
-            while q < b.len() && b[q].is_ascii_whitespace() {
-                q += 1;
-            }
-            if q >= b.len() || b[q] != b'>' {
-                return err(pos, format!("malformed end tag `</{name}`"));
-            }
-            let Some(el) = stack.pop() else {
-                return err(pos, format!("end tag `</{name}>` without a start tag"));
-            };
-            if el.name != name {
-                return err(
-                    pos,
-                    format!("end tag `</{name}>` does not match `<{}>`", el.name),
-                );
-            }
-            pos = q + 1;
-            match stack.last_mut() {
-                Some(parent) => parent.children.push(el),
-                None => root = Some(el),
-            }
-        } else {
-            if root.is_some() {
-                return err(pos, "a second root element");
-            }
-            let start = pos + 1;
-            let mut q = start;
-            while q < b.len() && is_name_byte(b[q]) {
-                q += 1;
-            }
-            if q == start {
-                return err(pos, "`<` not followed by an element name");
-            }
-            let mut el = Element {
-                name: &text[start..q],
-                attrs: Vec::new(),
-                children: Vec::new(),
-                text: "",
-                offset: pos,
-                text_offset: q,
-            };
-            let closed;
-            loop {
-                while q < b.len() && b[q].is_ascii_whitespace() {
-                    q += 1;
-                }
-                if q >= b.len() {
-                    return err(pos, format!("unterminated start tag `<{}`", el.name));
-                }
-                if b[q] == b'>' {
-                    q += 1;
-                    closed = false;
-                    break;
-                }
-                if text[q..].starts_with("/>") {
-                    q += 2;
-                    closed = true;
-                    break;
-                }
-                let a0 = q;
-                while q < b.len() && is_name_byte(b[q]) {
-                    q += 1;
-                }
-                if a0 == q {
-                    return err(q, format!("bad character in start tag `<{}`", el.name));
-                }
-                let key = &text[a0..q];
-                while q < b.len() && b[q].is_ascii_whitespace() {
-                    q += 1;
-                }
-                if q >= b.len() || b[q] != b'=' {
-                    return err(q, format!("attribute `{key}` has no value"));
-                }
-                q += 1;
-                while q < b.len() && b[q].is_ascii_whitespace() {
-                    q += 1;
-                }
-                if q >= b.len() || (b[q] != b'"' && b[q] != b'\'') {
-                    return err(q, format!("attribute `{key}`: value must be quoted"));
-                }
-                let quote = b[q] as char;
-                let v0 = q + 1;
-                let Some(v1) = text[v0..].find(quote).map(|p| v0 + p) else {
-                    return err(q, format!("attribute `{key}`: unterminated value"));
-                };
-                el.attrs.push((key, unescape(&text[v0..v1], v0)?));
-                q = v1 + 1;
-            }
-            el.text_offset = q;
-            pos = q;
-            if closed {
+            Event::Start(tag) => stack.push(element(text, at, end, &tag)?),
+            Event::Empty(tag) => {
+                let el = element(text, at, end, &tag)?;
                 match stack.last_mut() {
                     Some(parent) => parent.children.push(el),
                     None => root = Some(el),
                 }
-            } else {
-                stack.push(el);
             }
+            Event::End(_) => {
+                // quick-xml checks that the names match.
+                let Some(el) = stack.pop() else {
+                    return err(at, "end tag without a start tag");
+                };
+                match stack.last_mut() {
+                    Some(parent) => parent.children.push(el),
+                    None => root = Some(el),
+                }
+            }
+            Event::Text(_) | Event::GeneralRef(_) | Event::CData(_) => match stack.last_mut() {
+                Some(top) => {
+                    if top.children.is_empty() && top.text.is_empty() {
+                        top.text = text.get(at..end).unwrap_or_default();
+                        top.text_offset = at;
+                    }
+                }
+                None => {
+                    if !text.get(at..end).unwrap_or_default().trim().is_empty() {
+                        return err(at, "text outside the root element");
+                    }
+                }
+            },
+            Event::Eof => break,
+            Event::Comment(_) | Event::Decl(_) | Event::PI(_) | Event::DocType(_) => {}
         }
     }
     if let Some(open) = stack.last() {
@@ -274,18 +179,24 @@ mod tests {
 
     #[test]
     fn tree_text_attrs_lines() {
-        let t = "<?xml version=\"1.0\"?>\n<!-- c -->\n<A x='1' y=\"a&amp;b\">\n <B>  12 3\n</B><C/>\n</A>\n";
+        let t = "<?xml version=\"1.0\"?>\n<!-- c -->\n<A x='1' y=\"a&amp;b&#x41;\">\n <B>  12 3\n</B><C/>\n</A>\n";
         let r = parse(t).ok().unwrap();
         assert_eq!(r.name, "A");
-        assert_eq!(r.attr("y"), Some("a&b"));
+        assert_eq!(r.attr("x"), Some("1"));
+        assert_eq!(r.attr("y"), Some("a&bA"));
         assert_eq!(r.children.len(), 2);
         let bb = r.child("B").unwrap();
         assert_eq!(bb.text.trim(), "12 3");
+        assert_eq!(&t[bb.text_offset..bb.text_offset + 4], "  12");
+        assert!(r.child("C").unwrap().children.is_empty());
         let li = LineIndex::new(t);
         assert_eq!(li.line(bb.offset), 4);
         assert_eq!(li.line(r.offset), 3);
         let e = parse("<A>\n<B>\n</A>").err().unwrap();
         assert_eq!(LineIndex::new("<A>\n<B>\n</A>").line(e.offset), 3);
         assert!(parse("<A>").is_err());
+        assert!(parse("<A/><B/>").is_err());
+        assert!(parse("<A/>x").is_err());
+        assert!(parse("<A x=1/>").is_err());
     }
 }
