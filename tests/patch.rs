@@ -92,7 +92,7 @@ fn mixed_grid(n: usize) -> Grid<3> {
             }
         }
     }
-    let split = |c: [usize; 3]| (c[0] + c[1] + c[2]) % 4 == 0;
+    let split = |c: [usize; 3]| (c[0] + c[1] + c[2]).is_multiple_of(4);
     let corner = |c: [usize; 3], bits: usize| {
         id(
             c[0] + (bits & 1),

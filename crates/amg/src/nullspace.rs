@@ -32,7 +32,7 @@ impl NearNullSpace {
     /// entry `i` of vector `k`). Errors: no vectors, a length that is not a multiple of
     /// `n`, non-finite entries.
     pub fn from_vectors(n: usize, data: Vec<f64>) -> Result<Self> {
-        if n == 0 || data.is_empty() || data.len() % n != 0 {
+        if n == 0 || data.is_empty() || !data.len().is_multiple_of(n) {
             return Err(AmgError::Input(format!(
                 "near-null space of {} entries for vectors of length {n}",
                 data.len()
@@ -70,7 +70,7 @@ impl NearNullSpace {
                 "rigid-body modes in dimension {dim} (want 1, 2 or 3)"
             )));
         }
-        if coords.is_empty() || coords.len() % dim != 0 {
+        if coords.is_empty() || !coords.len().is_multiple_of(dim) {
             return Err(AmgError::Input(format!(
                 "{} coordinates are not a multiple of dimension {dim}",
                 coords.len()

@@ -285,23 +285,23 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
                 return Err(ls.error(&key("cohesion"), "needs friction_angle (Mohr–Coulomb)"));
             }
         }
-        if let Some(a) = m.friction_angle {
-            if !(0.0..90.0).contains(&a) {
-                return Err(ls.error(
-                    &key("friction_angle"),
-                    format!("= {a} must be in [0, 90) degrees"),
-                ));
-            }
+        if let Some(a) = m.friction_angle
+            && !(0.0..90.0).contains(&a)
+        {
+            return Err(ls.error(
+                &key("friction_angle"),
+                format!("= {a} must be in [0, 90) degrees"),
+            ));
         }
-        if let Some(a) = m.biot_alpha {
-            if !(0.0..=1.0).contains(&a) {
-                return Err(ls.error(&key("biot_alpha"), format!("= {a} must be in [0, 1]")));
-            }
+        if let Some(a) = m.biot_alpha
+            && !(0.0..=1.0).contains(&a)
+        {
+            return Err(ls.error(&key("biot_alpha"), format!("= {a} must be in [0, 1]")));
         }
-        if let Some(phi) = m.porosity {
-            if !(phi > 0.0 && phi <= 1.0) {
-                return Err(ls.error(&key("porosity"), format!("= {phi} must be in (0, 1]")));
-            }
+        if let Some(phi) = m.porosity
+            && !(phi > 0.0 && phi <= 1.0)
+        {
+            return Err(ls.error(&key("porosity"), format!("= {phi} must be in (0, 1]")));
         }
         match &m.permeability {
             Some(Permeability::Scalar(v)) => positive(ls, &key("permeability"), *v)?,
@@ -319,17 +319,17 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
         return Err(ls.error(&k(&["region"]), "is missing: at least one [[region]] must select cells and give them a law and a material"));
     }
     for (i, r) in s.region.iter().enumerate() {
-        if let Some(m) = &r.material {
-            if !s.material.contains_key(m) {
-                let known: Vec<_> = s.material.keys().cloned().collect();
-                return Err(ls.error(
-                    &ki("region", i, &["material"]),
-                    format!(
-                        "= \"{m}\" is not a defined material (known: {})",
-                        known.join(", ")
-                    ),
-                ));
-            }
+        if let Some(m) = &r.material
+            && !s.material.contains_key(m)
+        {
+            let known: Vec<_> = s.material.keys().cloned().collect();
+            return Err(ls.error(
+                &ki("region", i, &["material"]),
+                format!(
+                    "= \"{m}\" is not a defined material (known: {})",
+                    known.join(", ")
+                ),
+            ));
         }
         if let Some(l) = &r.law
             && !laws.contains(l)
@@ -426,10 +426,10 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
             _ => return Err(ls.error(&k(&["schedule"]), "needs exactly one of dt and steps")),
         }
     }
-    if let Some(init) = &s.initial {
-        if let Some(p) = &init.pressure {
-            expr_ok(ls, &k(&["initial", "pressure"]), p, false)?;
-        }
+    if let Some(init) = &s.initial
+        && let Some(p) = &init.pressure
+    {
+        expr_ok(ls, &k(&["initial", "pressure"]), p, false)?;
     }
     if let Some(kf) = s.physics.fracture_permeability {
         positive(ls, &k(&["physics", "fracture_permeability"]), kf)?;
@@ -453,10 +453,10 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
     if let Some(t) = s.solver.tolerance {
         positive(ls, &k(&["solver", "tolerance"]), t)?;
     }
-    if let Some(t) = s.solver.threads {
-        if t < 0 {
-            return Err(ls.error(&k(&["solver", "threads"]), format!("= {t} must be ≥ 0")));
-        }
+    if let Some(t) = s.solver.threads
+        && t < 0
+    {
+        return Err(ls.error(&k(&["solver", "threads"]), format!("= {t} must be ≥ 0")));
     }
     if s.output.every < 1 {
         return Err(ls.error(
@@ -560,10 +560,10 @@ fn check_grid(ls: &LoadedScene, d: usize) -> Result<(), SceneError> {
             return Err(ls.error(&key("cells"), format!("= {c:?} does not fit kind = \"{}\" (one number for voronoi, one per axis otherwise)", kind.as_str())));
         }
     }
-    if let Some(p) = g.perturb {
-        if !(0.0..0.5).contains(&p) {
-            return Err(ls.error(&key("perturb"), format!("= {p} must be in [0, 0.5)")));
-        }
+    if let Some(p) = g.perturb
+        && !(0.0..0.5).contains(&p)
+    {
+        return Err(ls.error(&key("perturb"), format!("= {p} must be in [0, 0.5)")));
     }
     if g.diagonals.is_some() && g.kind != GridKind::Composite {
         return Err(ls.error(&key("diagonals"), "applies to composite grids only"));
@@ -612,13 +612,13 @@ fn check_bc(ls: &LoadedScene, i: usize, bc: &Bc, d: usize) -> Result<(), SceneEr
     if let Some(p) = &bc.platen {
         len_is(ls, &ki("bc", i, &["platen", "force"]), p.force.len(), d)?;
         for c in &p.force {
-            if let Component::Expr(s) = c {
-                if s != "free" {
-                    return Err(ls.error(
-                        &ki("bc", i, &["platen", "force"]),
-                        format!("= \"{s}\": platen forces are numbers or \"free\""),
-                    ));
-                }
+            if let Component::Expr(s) = c
+                && s != "free"
+            {
+                return Err(ls.error(
+                    &ki("bc", i, &["platen", "force"]),
+                    format!("= \"{s}\": platen forces are numbers or \"free\""),
+                ));
             }
         }
         if bc.displacement.is_some() || bc.traction.is_some() {
@@ -641,13 +641,13 @@ fn check_bc(ls: &LoadedScene, i: usize, bc: &Bc, d: usize) -> Result<(), SceneEr
         }
     }
     let sides = ["xmin", "xmax", "ymin", "ymax", "zmin", "zmax"];
-    if let Some(pos) = sides.iter().position(|&s| s == bc.boundary) {
-        if pos >= 2 * d {
-            return Err(ls.error(
-                &key("boundary"),
-                format!("= \"{}\" does not exist in {d}D", bc.boundary),
-            ));
-        }
+    if let Some(pos) = sides.iter().position(|&s| s == bc.boundary)
+        && pos >= 2 * d
+    {
+        return Err(ls.error(
+            &key("boundary"),
+            format!("= \"{}\" does not exist in {d}D", bc.boundary),
+        ));
     }
     Ok(())
 }

@@ -51,11 +51,11 @@ pub fn nested_dissection<const D: usize>(grid: &Grid<D>, dofs: &DofMap<D>) -> Ve
     let mut perm = Vec::with_capacity(dofs.num_equations());
     for &v in &ctx.order {
         for a in 0..D {
-            if let Some(e) = dofs.equation(v, a) {
-                if !seen[e] {
-                    seen[e] = true;
-                    perm.push(e);
-                }
+            if let Some(e) = dofs.equation(v, a)
+                && !seen[e]
+            {
+                seen[e] = true;
+                perm.push(e);
             }
         }
     }

@@ -138,7 +138,7 @@ fn data_array<T: Scalar>(
     if ncomp != 1 {
         let _ = write!(out, " NumberOfComponents=\"{ncomp}\"");
     }
-    if ncomp > 0 && values.len() % ncomp == 0 {
+    if ncomp > 0 && values.len().is_multiple_of(ncomp) {
         let _ = write!(out, " NumberOfTuples=\"{}\"", values.len() / ncomp);
     }
     match enc {
@@ -685,7 +685,7 @@ impl Ctx<'_> {
                 ));
             }
         };
-        if values.len() % ncomp != 0 {
+        if !values.len().is_multiple_of(ncomp) {
             return Err(self.err(
                 el.offset,
                 format!(
@@ -732,7 +732,7 @@ impl Ctx<'_> {
         };
         let size = ty.size() as u64;
         let check_total = |total: u64| -> Result<()> {
-            if total % size != 0 {
+            if !total.is_multiple_of(size) {
                 return Err(self.array_err(
                     at,
                     format!("{total} bytes is not a whole number of {size}-byte values"),
