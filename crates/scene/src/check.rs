@@ -464,6 +464,13 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
             format!("= {} must be ≥ 1", s.output.every),
         ));
     }
+    if let Some(u) = &s.output.exact_displacement {
+        let key = k(&["output", "exact_displacement"]);
+        len_is(ls, &key, u.len(), d)?;
+        for c in u {
+            expr_ok(ls, &key, c, false)?;
+        }
+    }
     let flow = s.physics.flow == Some(true);
     let field_ok = |name: &str, key: Vec<KeyPart>| {
         crate::continuum::fields::Field::parse(name, d, flow)

@@ -153,6 +153,9 @@ pub(crate) fn drive(
             break;
         }
     }
+    let t_out = Instant::now();
+    let errors = model.errors()?;
+    output_seconds += t_out.elapsed().as_secs_f64();
     if s.output.plots {
         let t_out = Instant::now();
         model.plots(&out.join("plots"), &written, &series)?;
@@ -181,6 +184,7 @@ pub(crate) fn drive(
         peak_memory_bytes: peak_memory_bytes(),
         solver: model.solver_stats(),
         field_extrema: extrema,
+        errors,
         version: env!("CARGO_PKG_VERSION").into(),
     })
 }

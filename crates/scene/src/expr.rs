@@ -66,6 +66,8 @@ enum Op {
     Mul,
     Div,
     Pow,
+    /// `a^2` as `a·a` (the common power, exact to rounding).
+    Square,
     Call1(Func),
     Min(usize),
     Max(usize),
@@ -358,7 +360,7 @@ impl Expr {
             }
         }
         Ok(Self {
-            ops: p.ops,
+            ops: fold_constants(p.ops),
             text: text.to_string(),
         })
     }
@@ -371,6 +373,14 @@ impl Expr {
     /// Whether the expression depends on time.
     pub fn depends_on_time(&self) -> bool {
         self.ops.contains(&Op::Var(3))
+    }
+
+    /// The constant `v` as an expression.
+    pub fn constant(v: f64) -> Self {
+        Self {
+            ops: vec![Op::Num(v)],
+            text: format!("{v}"),
+        }
     }
 
     /// The value if the expression is a constant.
@@ -401,6 +411,7 @@ impl Expr {
                     sp += 1;
                 }
                 Op::Neg => stack[sp - 1] = -stack[sp - 1],
+                Op::Square => stack[sp - 1] *= stack[sp - 1],
                 Op::Call1(f) => stack[sp - 1] = f.apply(stack[sp - 1]),
                 Op::Min(n) | Op::Max(n) => {
                     let args = &stack[sp - n..sp];
@@ -430,12 +441,401 @@ impl Expr {
     }
 }
 
+/// Several expressions compiled into one program that evaluates every common
+/// subexpression once (the components of a body force share `sin(pi*x)`, ...).
+///
+/// Each expression's stack program becomes nodes of a DAG: a node is an operation on
+/// earlier nodes, and identical operations on identical operands are one node. The
+/// nodes are evaluated in order into a scratch array; every node computes exactly what
+/// [`Expr::eval`] computes for that subexpression, so the values are the same bit for bit.
+#[derive(Clone, Debug)]
+pub struct Program {
+    nodes: Vec<Node>,
+    /// Arguments of `min`/`max` nodes.
+    args: Vec<u32>,
+    outputs: Vec<u32>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Node {
+    Num(f64),
+    Var(usize),
+    Neg(u32),
+    Square(u32),
+    Call1(Func, u32),
+    Add(u32, u32),
+    Sub(u32, u32),
+    Mul(u32, u32),
+    Div(u32, u32),
+    Pow(u32, u32),
+    /// `a + c`, `a − c`, `c − a`, `a · c`, `a / c`, `c / a` with a constant `c`: the
+    /// same operations as with a constant node, without loading it.
+    AddC(u32, f64),
+    SubC(u32, f64),
+    CSub(f64, u32),
+    MulC(u32, f64),
+    DivC(u32, f64),
+    CDiv(f64, u32),
+    /// `min`/`max` over `args[start..start + len]`.
+    Min(u32, u32),
+    Max(u32, u32),
+}
+
+impl Program {
+    /// Compile `exprs` together (output `i` is `exprs[i]`).
+    pub fn new(exprs: &[&Expr]) -> Self {
+        let mut p = Self {
+            nodes: Vec::new(),
+            args: Vec::new(),
+            outputs: Vec::new(),
+        };
+        let mut index: std::collections::HashMap<NodeKey, u32> = std::collections::HashMap::new();
+        for e in exprs {
+            let mut stack: Vec<u32> = Vec::new();
+            for op in &e.ops {
+                let node = match *op {
+                    Op::Num(v) => Node::Num(v),
+                    Op::Var(k) => Node::Var(k),
+                    Op::Neg => Node::Neg(stack.pop().unwrap_or(0)),
+                    Op::Square => Node::Square(stack.pop().unwrap_or(0)),
+                    Op::Call1(f) => Node::Call1(f, stack.pop().unwrap_or(0)),
+                    Op::Min(n) | Op::Max(n) => {
+                        let from = stack.len().saturating_sub(n);
+                        let start = p.args.len() as u32;
+                        p.args.extend(stack.drain(from..));
+                        if matches!(op, Op::Min(_)) {
+                            Node::Min(start, n as u32)
+                        } else {
+                            Node::Max(start, n as u32)
+                        }
+                    }
+                    Op::Add | Op::Sub | Op::Mul | Op::Div | Op::Pow => {
+                        let b = stack.pop().unwrap_or(0);
+                        let a = stack.pop().unwrap_or(0);
+                        let num = |k: u32| match p.nodes[k as usize] {
+                            Node::Num(c) => Some(c),
+                            _ => None,
+                        };
+                        match (op, num(a), num(b)) {
+                            (Op::Add, _, Some(c)) => Node::AddC(a, c),
+                            (Op::Add, Some(c), _) => Node::AddC(b, c),
+                            (Op::Sub, _, Some(c)) => Node::SubC(a, c),
+                            (Op::Sub, Some(c), _) => Node::CSub(c, b),
+                            (Op::Mul, _, Some(c)) => Node::MulC(a, c),
+                            (Op::Mul, Some(c), _) => Node::MulC(b, c),
+                            (Op::Div, _, Some(c)) => Node::DivC(a, c),
+                            (Op::Div, Some(c), _) => Node::CDiv(c, b),
+                            (Op::Add, ..) => Node::Add(a, b),
+                            (Op::Sub, ..) => Node::Sub(a, b),
+                            (Op::Mul, ..) => Node::Mul(a, b),
+                            (Op::Div, ..) => Node::Div(a, b),
+                            _ => Node::Pow(a, b),
+                        }
+                    }
+                };
+                let key = NodeKey::of(&node, &p.args);
+                let id = *index.entry(key).or_insert_with(|| {
+                    p.nodes.push(node);
+                    (p.nodes.len() - 1) as u32
+                });
+                stack.push(id);
+            }
+            p.outputs.push(stack.pop().unwrap_or(0));
+        }
+        p.drop_unused();
+        p
+    }
+
+    /// The operands of a node.
+    fn operands(&self, node: &Node) -> Vec<u32> {
+        match *node {
+            Node::Num(_) | Node::Var(_) => vec![],
+            Node::Neg(a)
+            | Node::Square(a)
+            | Node::Call1(_, a)
+            | Node::AddC(a, _)
+            | Node::SubC(a, _)
+            | Node::CSub(_, a)
+            | Node::MulC(a, _)
+            | Node::DivC(a, _)
+            | Node::CDiv(_, a) => vec![a],
+            Node::Add(a, b)
+            | Node::Sub(a, b)
+            | Node::Mul(a, b)
+            | Node::Div(a, b)
+            | Node::Pow(a, b) => vec![a, b],
+            Node::Min(s, n) | Node::Max(s, n) => self.args[s as usize..(s + n) as usize].to_vec(),
+        }
+    }
+
+    /// Remove the nodes no output needs (constants fused into their operations) and
+    /// renumber the rest, keeping their order.
+    fn drop_unused(&mut self) {
+        let mut used = vec![false; self.nodes.len()];
+        for &o in &self.outputs {
+            used[o as usize] = true;
+        }
+        for i in (0..self.nodes.len()).rev() {
+            if used[i] {
+                for k in self.operands(&self.nodes[i]) {
+                    used[k as usize] = true;
+                }
+            }
+        }
+        let mut new_id = vec![0u32; self.nodes.len()];
+        let mut nodes = Vec::with_capacity(self.nodes.len());
+        for (i, node) in self.nodes.iter().enumerate() {
+            if used[i] {
+                new_id[i] = nodes.len() as u32;
+                nodes.push(*node);
+            }
+        }
+        let map = |k: u32| new_id[k as usize];
+        for node in &mut nodes {
+            *node = match *node {
+                Node::Neg(a) => Node::Neg(map(a)),
+                Node::Square(a) => Node::Square(map(a)),
+                Node::Call1(f, a) => Node::Call1(f, map(a)),
+                Node::AddC(a, c) => Node::AddC(map(a), c),
+                Node::SubC(a, c) => Node::SubC(map(a), c),
+                Node::CSub(c, a) => Node::CSub(c, map(a)),
+                Node::MulC(a, c) => Node::MulC(map(a), c),
+                Node::DivC(a, c) => Node::DivC(map(a), c),
+                Node::CDiv(c, a) => Node::CDiv(c, map(a)),
+                Node::Add(a, b) => Node::Add(map(a), map(b)),
+                Node::Sub(a, b) => Node::Sub(map(a), map(b)),
+                Node::Mul(a, b) => Node::Mul(map(a), map(b)),
+                Node::Div(a, b) => Node::Div(map(a), map(b)),
+                Node::Pow(a, b) => Node::Pow(map(a), map(b)),
+                other => other,
+            };
+        }
+        for a in &mut self.args {
+            *a = map(*a);
+        }
+        for o in &mut self.outputs {
+            *o = map(*o);
+        }
+        self.nodes = nodes;
+    }
+
+    /// Number of distinct operations.
+    pub fn len(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// Whether the program computes nothing.
+    pub fn is_empty(&self) -> bool {
+        self.nodes.is_empty()
+    }
+
+    /// Evaluate every output at `x` (missing coordinates count as 0) and time `t`.
+    pub fn eval(&self, x: &[f64], t: f64, out: &mut [f64]) {
+        // One scratch array per thread, grown once (every node is written before it is
+        // read, so it needs no clearing).
+        thread_local! {
+            static SCRATCH: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) };
+        }
+        SCRATCH.with(|cell| match cell.try_borrow_mut() {
+            Ok(mut v) => {
+                if v.len() < self.nodes.len() {
+                    v.resize(self.nodes.len(), 0.0);
+                }
+                self.eval_with(x, t, &mut v, out);
+            }
+            // Re-entered on this thread (a program evaluated inside another's caller).
+            Err(_) => self.eval_with(x, t, &mut vec![0.0; self.nodes.len()], out),
+        });
+    }
+
+    fn eval_with(&self, x: &[f64], t: f64, v: &mut [f64], out: &mut [f64]) {
+        for (i, node) in self.nodes.iter().enumerate() {
+            let g = |k: u32| v[k as usize];
+            v[i] = match *node {
+                Node::Num(c) => c,
+                Node::Var(3) => t,
+                Node::Var(k) => x.get(k).copied().unwrap_or(0.0),
+                Node::Neg(a) => -g(a),
+                Node::Square(a) => g(a) * g(a),
+                Node::Call1(f, a) => f.apply(g(a)),
+                Node::Add(a, b) => g(a) + g(b),
+                Node::Sub(a, b) => g(a) - g(b),
+                Node::Mul(a, b) => g(a) * g(b),
+                Node::Div(a, b) => g(a) / g(b),
+                Node::Pow(a, b) => g(a).powf(g(b)),
+                Node::AddC(a, c) => g(a) + c,
+                Node::SubC(a, c) => g(a) - c,
+                Node::CSub(c, a) => c - g(a),
+                Node::MulC(a, c) => g(a) * c,
+                Node::DivC(a, c) => g(a) / c,
+                Node::CDiv(c, a) => c / g(a),
+                Node::Min(s, n) => self.args[s as usize..(s + n) as usize]
+                    .iter()
+                    .map(|&k| g(k))
+                    .fold(f64::INFINITY, f64::min),
+                Node::Max(s, n) => self.args[s as usize..(s + n) as usize]
+                    .iter()
+                    .map(|&k| g(k))
+                    .fold(f64::NEG_INFINITY, f64::max),
+            };
+        }
+        for (o, &k) in out.iter_mut().zip(&self.outputs) {
+            *o = v[k as usize];
+        }
+    }
+}
+
+/// Identity of a node for common-subexpression elimination (constants by their bits).
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+enum NodeKey {
+    Num(u64),
+    Var(usize),
+    Un(u8, u32),
+    Bin(u8, u32, u32),
+    Const(u8, u32, u64),
+    Many(bool, Vec<u32>),
+}
+
+impl NodeKey {
+    fn of(node: &Node, args: &[u32]) -> Self {
+        match *node {
+            Node::Num(c) => Self::Num(c.to_bits()),
+            Node::Var(k) => Self::Var(k),
+            Node::Neg(a) => Self::Un(0, a),
+            Node::Square(a) => Self::Un(1, a),
+            Node::Call1(f, a) => Self::Un(2 + f as u8, a),
+            Node::Add(a, b) => Self::Bin(0, a, b),
+            Node::Sub(a, b) => Self::Bin(1, a, b),
+            Node::Mul(a, b) => Self::Bin(2, a, b),
+            Node::Div(a, b) => Self::Bin(3, a, b),
+            Node::Pow(a, b) => Self::Bin(4, a, b),
+            Node::AddC(a, c) => Self::Const(0, a, c.to_bits()),
+            Node::SubC(a, c) => Self::Const(1, a, c.to_bits()),
+            Node::CSub(c, a) => Self::Const(2, a, c.to_bits()),
+            Node::MulC(a, c) => Self::Const(3, a, c.to_bits()),
+            Node::DivC(a, c) => Self::Const(4, a, c.to_bits()),
+            Node::CDiv(c, a) => Self::Const(5, a, c.to_bits()),
+            Node::Min(s, n) | Node::Max(s, n) => Self::Many(
+                matches!(node, Node::Min(..)),
+                args[s as usize..(s + n) as usize].to_vec(),
+            ),
+        }
+    }
+}
+
+/// Fold every operation whose operands are all constants into one constant (`9*pi^2`
+/// becomes one number), and `a^2` into [`Op::Square`]. The folded constants are computed
+/// by the same arithmetic as [`Expr::eval`], so values do not change; this only removes
+/// work from every evaluation.
+fn fold_constants(ops: Vec<Op>) -> Vec<Op> {
+    let mut out: Vec<Op> = Vec::with_capacity(ops.len());
+    // Whether each entry of the evaluation stack is a constant (then it is one `Num` op at
+    // the end of `out`, since constants are folded as soon as they appear).
+    let mut constant: Vec<bool> = Vec::new();
+    for op in ops {
+        let arity = match op {
+            Op::Num(_) | Op::Var(_) => 0,
+            Op::Neg | Op::Call1(_) | Op::Square => 1,
+            Op::Min(n) | Op::Max(n) => n,
+            Op::Add | Op::Sub | Op::Mul | Op::Div | Op::Pow => 2,
+        };
+        if op == Op::Pow && out.last() == Some(&Op::Num(2.0)) && constant.last() == Some(&true) {
+            // a^2 → a·a (folded below if a is a constant too).
+            out.pop();
+            constant.pop();
+            return_square(&mut out, &mut constant);
+            continue;
+        }
+        let all_constant = arity > 0 && constant[constant.len() - arity..].iter().all(|&c| c);
+        out.push(op);
+        if all_constant {
+            let start = out.len() - 1 - arity;
+            let value = Expr {
+                ops: out[start..].to_vec(),
+                text: String::new(),
+            }
+            .eval(&[], 0.0);
+            out.truncate(start);
+            out.push(Op::Num(value));
+            constant.truncate(constant.len() - arity);
+            constant.push(true);
+        } else {
+            let n = constant.len() - arity;
+            constant.truncate(n);
+            constant.push(matches!(op, Op::Num(_)));
+        }
+    }
+    out
+}
+
+/// Apply [`Op::Square`] to the top of the stack, folding it if that is a constant.
+fn return_square(out: &mut Vec<Op>, constant: &mut [bool]) {
+    match (out.last().copied(), constant.last()) {
+        (Some(Op::Num(v)), Some(true)) => {
+            out.pop();
+            out.push(Op::Num(v * v));
+        }
+        _ => {
+            out.push(Op::Square);
+            if let Some(c) = constant.last_mut() {
+                *c = false;
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn ev(s: &str, x: &[f64], t: f64) -> f64 {
         Expr::parse(s).unwrap().eval(x, t)
+    }
+
+    #[test]
+    fn programs_share_subexpressions_and_give_the_same_values() {
+        let texts = [
+            "-x*z/52 + pi*y*sin(pi*x)/104 + 11*pi^2*sin(pi*x)*sin(pi*y)*sin(pi*z)/520",
+            "-y*z/130 - pi^2*sin(pi*z)*cos(pi*x)*cos(pi*y)/104 - cos(pi*x)/104",
+            "-x^2/104 + pi^2*y*z*cos(pi*x)/260 - pi^2*sin(pi*y)*cos(pi*x)*cos(pi*z)/104",
+            "min(x, y, 0.5) + max(t, z)^2",
+        ];
+        let exprs: Vec<Expr> = texts.iter().map(|t| Expr::parse(t).unwrap()).collect();
+        let refs: Vec<&Expr> = exprs.iter().collect();
+        let p = Program::new(&refs);
+        let trig = p
+            .nodes
+            .iter()
+            .filter(|n| matches!(n, Node::Call1(..)))
+            .count();
+        assert_eq!(trig, 6, "sin and cos of pi x, pi y, pi z, once each");
+        // Constants are fused into their operations: no constant node is left but the
+        // `0.5` argument of `min`.
+        let nums = p.nodes.iter().filter(|n| matches!(n, Node::Num(_))).count();
+        assert_eq!(nums, 1);
+        let mut out = [0.0; 4];
+        for (x, t) in [([0.1, 0.7, 0.3], 0.0), ([0.9, 0.2, 0.55], 1.5)] {
+            p.eval(&x, t, &mut out);
+            for (e, v) in exprs.iter().zip(out) {
+                assert_eq!(e.eval(&x, t).to_bits(), v.to_bits());
+            }
+        }
+    }
+
+    #[test]
+    fn constants_are_folded_without_changing_values() {
+        let text = "-x/52 + 9*pi^2*sin(pi*x)*sin(pi*y)/520";
+        let e = Expr::parse(text).unwrap();
+        // 9*pi^2 and pi are single numbers; x/52 stays.
+        assert_eq!(e.ops.iter().filter(|o| matches!(o, Op::Num(_))).count(), 5);
+        assert!(!e.ops.iter().any(|o| matches!(o, Op::Pow)));
+        let (x, y) = (0.3, 0.7);
+        let pi = std::f64::consts::PI;
+        let want = -x / 52.0 + 9.0 * (pi * pi) * (pi * x).sin() * (pi * y).sin() / 520.0;
+        assert_eq!(e.eval(&[x, y], 0.0), want);
+        assert_eq!(ev("x^2 + 2^3 - max(1, 2, x)", &[3.0], 0.0), 9.0 + 8.0 - 3.0);
+        assert_eq!(ev("(1 + 2)^2 * t", &[], 2.0), 18.0);
+        assert_eq!(Expr::parse("2^2^3").unwrap().as_constant(), Some(256.0));
     }
 
     #[test]

@@ -47,6 +47,33 @@ impl NumOrExpr {
     }
 }
 
+/// The components of a vector given as numbers or expressions (body force, exact
+/// displacement) as one field: the expressions are compiled together
+/// ([`crate::expr::Program`]), so subexpressions the components share are evaluated once.
+pub fn vector_field<const D: usize>(values: &[NumOrExpr]) -> porofrac_sim::VectorField<D> {
+    use crate::expr::{Expr, Program};
+    use porofrac_sim::VectorField;
+    if values
+        .iter()
+        .all(|v| matches!(v.to_field(), porofrac_grid::ScalarField::Const(_)))
+    {
+        return VectorField::Components(std::array::from_fn(|a| values[a].to_field()));
+    }
+    let exprs: Vec<Expr> = values
+        .iter()
+        .map(|v| match v {
+            NumOrExpr::Num(x) => Expr::constant(*x),
+            NumOrExpr::Expr(s) => Expr::parse(s).unwrap_or_else(|_| Expr::constant(f64::NAN)),
+        })
+        .collect();
+    let program = Program::new(&exprs.iter().collect::<Vec<_>>());
+    VectorField::from_fn(move |x, t| {
+        let mut out = [0.0; D];
+        program.eval(x, t, &mut out);
+        out
+    })
+}
+
 /// One component of a displacement condition: a number, an expression, or `"free"`.
 pub type Component = NumOrExpr;
 
@@ -494,6 +521,9 @@ pub struct Output {
     /// `[[output.line]]`.
     #[serde(default)]
     pub line: Vec<Line>,
+    /// An exact displacement (numbers or expressions in x, y, z, t): `summary.json` then
+    /// reports the L2 error of the last written displacement against it.
+    pub exact_displacement: Option<Vec<NumOrExpr>>,
 }
 
 impl Default for Output {
@@ -504,6 +534,7 @@ impl Default for Output {
             every: 1,
             probe: Vec::new(),
             line: Vec::new(),
+            exact_displacement: None,
         }
     }
 }

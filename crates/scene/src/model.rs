@@ -96,6 +96,9 @@ pub trait Model {
     fn failed(&self) -> usize;
     /// Solver statistics of the run so far.
     fn solver_stats(&self) -> SolverStats;
+    /// Error norms against the exact solution the scene gives, at the current state
+    /// (e.g. `"l2_displacement"`); empty without one.
+    fn errors(&self) -> Result<BTreeMap<String, f64>, RunError>;
     /// Wall time of the model's phases so far (assembly, solve, flow, its own output).
     fn wall_seconds(&self) -> WallSeconds;
 }

@@ -176,6 +176,10 @@ pub struct Summary {
     pub solver: SolverStats,
     /// `[min, max]` of every field at the last written step.
     pub field_extrema: std::collections::BTreeMap<String, [f64; 2]>,
+    /// Error norms against `[output] exact_displacement` at the last step (absent
+    /// without it).
+    #[serde(skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub errors: std::collections::BTreeMap<String, f64>,
     /// porofrac version.
     pub version: String,
 }
@@ -232,6 +236,7 @@ pub(crate) fn write_failed_summary(
         peak_memory_bytes: peak_memory_bytes(),
         solver: SolverStats::default(),
         field_extrema: Default::default(),
+        errors: Default::default(),
         version: env!("CARGO_PKG_VERSION").into(),
     };
     let _ = summary.write(out);

@@ -151,26 +151,47 @@ impl<const D: usize> Manufactured<D> {
     /// interpolant on a grid of simplices, with the degree-5 rules of
     /// [`simplex_rule5`]. `None` if a cell is not a simplex.
     pub fn l2_error_simplices(&self, grid: &Grid<D>, u: &[f64]) -> Option<f64> {
-        let rule = simplex_rule5::<D>();
-        let mut sum = 0.0;
-        for c in 0..grid.num_cells() {
-            let nodes = grid.cell_nodes(c);
-            if nodes.len() != D + 1 {
-                return None;
-            }
-            let vol = grid.cell_volume(c);
-            for (w, l) in &rule {
-                let mut x = Point::<D>::zeros();
-                let mut uh = Point::<D>::zeros();
-                for (k, &n) in nodes.iter().enumerate() {
-                    x += grid.node(n) * l[k];
-                    uh += Point::<D>::from_column_slice(&u[D * n..D * n + D]) * l[k];
-                }
-                sum += w * vol * ((self.u)(&x) - uh).norm_squared();
-            }
-        }
-        Some(sum.sqrt())
+        l2_error_p1(grid, u, |x| (self.u)(x))
     }
+}
+
+/// `‖u − u_h‖_L2` of the nodal field `u` (`D` per node, node-major) as the P1
+/// interpolant on a grid of simplices against `exact`, with the degree-5 rules of
+/// [`simplex_rule5`]. `None` if a cell is not a simplex.
+pub fn l2_error_p1<const D: usize>(
+    grid: &Grid<D>,
+    u: &[f64],
+    exact: impl Fn(&Point<D>) -> Point<D> + Sync,
+) -> Option<f64> {
+    use rayon::prelude::*;
+    let rule = simplex_rule5::<D>();
+    // Fixed chunks summed in order: the same value on any number of threads.
+    const CHUNK: usize = 4096;
+    let n = grid.num_cells();
+    let partial: Option<Vec<f64>> = (0..n.div_ceil(CHUNK))
+        .into_par_iter()
+        .map(|k| {
+            let mut sum = 0.0;
+            for c in k * CHUNK..((k + 1) * CHUNK).min(n) {
+                let nodes = grid.cell_nodes(c);
+                if nodes.len() != D + 1 {
+                    return None;
+                }
+                let vol = grid.cell_volume(c);
+                for (w, l) in &rule {
+                    let mut x = Point::<D>::zeros();
+                    let mut uh = Point::<D>::zeros();
+                    for (k, &n) in nodes.iter().enumerate() {
+                        x += grid.node(n) * l[k];
+                        uh += Point::<D>::from_column_slice(&u[D * n..D * n + D]) * l[k];
+                    }
+                    sum += w * vol * (exact(&x) - uh).norm_squared();
+                }
+            }
+            Some(sum)
+        })
+        .collect();
+    Some(partial?.iter().sum::<f64>().sqrt())
 }
 
 /// A quadrature point on a simplex: weight (summing to 1) and barycentric coordinates.

@@ -8,7 +8,7 @@
 use porofrac_frac::{Combined, MohrCoulomb, Tensile};
 use porofrac_grid::Grid;
 use porofrac_law::{CellLaw, Stiffness};
-use porofrac_sim::{Displacement, Gravity, Loads, Platen, ScalarField, Traction, VectorField};
+use porofrac_sim::{Displacement, Gravity, Loads, Platen, Traction};
 
 use crate::check::{LoadedScene, k, ki};
 use crate::file::{Material, Plane};
@@ -112,8 +112,15 @@ pub fn compose<const D: usize>(
     let mut key_region: Vec<usize> = Vec::new();
     let mut laws: Vec<Box<dyn CellLaw<D>>> = Vec::new();
     let mut law_of_cell = vec![0; n];
+    // The law instance of each (law region, material region) pair, built on first use.
+    let nr = s.region.len();
+    let mut instance_of_pair: Vec<Option<usize>> = vec![None; nr * nr];
     for c in 0..n {
         let (lr, mr) = (law_region[c].unwrap_or(0), mat_region[c].unwrap_or(0));
+        if let Some(i) = instance_of_pair[lr * nr + mr] {
+            law_of_cell[c] = i;
+            continue;
+        }
         let key = (
             s.region[lr].law.clone().unwrap_or_default(),
             s.region[mr].material.clone().unwrap_or_default(),
@@ -131,6 +138,7 @@ pub fn compose<const D: usize>(
                 keys.len() - 1
             }
         };
+        instance_of_pair[lr * nr + mr] = Some(idx);
         law_of_cell[c] = idx;
     }
     let fracture = s.physics.fracture == Some(true);
@@ -239,8 +247,7 @@ pub fn conditions<const D: usize>(
     }
     if let Some(l) = &s.loads {
         if let Some(b) = &l.body_force {
-            let components: [ScalarField; D] = std::array::from_fn(|a| b[a].to_field());
-            out.loads.body_force = Some(VectorField::Components(components));
+            out.loads.body_force = Some(crate::file::vector_field::<D>(b));
         }
         if let Some(g) = &l.gravity {
             let mut density = vec![0.0; grid.num_cells()];

@@ -218,6 +218,8 @@ struct Stepper<'a, const D: usize> {
     law_ids: Vec<i32>,
     stats: SolverStats,
     wall: WallSeconds,
+    /// Index of the last computed output time.
+    done: usize,
 }
 
 impl<'a, const D: usize> Stepper<'a, D> {
@@ -348,6 +350,7 @@ impl<'a, const D: usize> Stepper<'a, D> {
                 ..SolverStats::default()
             },
             wall,
+            done: 0,
         })
     }
 
@@ -479,6 +482,7 @@ impl<const D: usize> Model for Stepper<'_, D> {
 
     fn step(&mut self, step: usize) -> Result<StepStats, RunError> {
         let t = self.times[step];
+        self.done = step;
         let iterations = if matches!(self.driver, Driver::Coupled { .. }) {
             self.coupled_step(step)?
         } else if step == 0 && self.zero_start {
@@ -586,7 +590,18 @@ impl<const D: usize> Model for Stepper<'_, D> {
         for (a, name) in ["ux", "uy", "uz"].iter().enumerate().take(D) {
             put(name, &mut (0..grid.num_nodes()).map(|n| self.u[D * n + a]));
         }
-        for name in ["sxx", "syy", "szz", "sxy", "syz", "sxz", "smax", "smin"] {
+        // Principal stresses once per cell for both extrema.
+        let principal: Vec<[f64; 2]> = self
+            .stress
+            .iter()
+            .map(|s| {
+                let p = porofrac_law::principal(s);
+                [p.values[0], p.values[D - 1]]
+            })
+            .collect();
+        put("smax", &mut principal.iter().map(|p| p[0]));
+        put("smin", &mut principal.iter().map(|p| p[1]));
+        for name in ["sxx", "syy", "szz", "sxy", "syz", "sxz"] {
             let Ok(f) = Field::parse(name, D, false) else {
                 continue;
             };
@@ -643,6 +658,27 @@ impl<const D: usize> Model for Stepper<'_, D> {
 
     fn solver_stats(&self) -> SolverStats {
         self.stats.clone()
+    }
+
+    fn errors(&self) -> Result<BTreeMap<String, f64>, RunError> {
+        let mut out = BTreeMap::new();
+        let Some(exact) = &self.ls.scene.output.exact_displacement else {
+            return Ok(out);
+        };
+        let t = self.times.get(self.done).copied().unwrap_or(0.0);
+        let exact = crate::file::vector_field::<D>(exact);
+        let l2 = porofrac_sim::standard::l2_error_p1(self.body.grid, &self.u, |x| {
+            Point::<D>::from(exact.eval(x.as_slice(), t))
+        })
+        .ok_or_else(|| {
+            self.ls.error(
+                &k(&["output", "exact_displacement"]),
+                "needs a grid of triangles or tetrahedra (the error is that of the P1 \
+                 interpolant of the nodal displacement)",
+            )
+        })?;
+        out.insert("l2_displacement".into(), l2);
+        Ok(out)
     }
 
     fn wall_seconds(&self) -> WallSeconds {
