@@ -107,6 +107,14 @@ fn absurd_sizes_are_refused_before_allocating() {
         "{err}"
     );
 
+    let text = format!("{}\n[solver]\nthreads = 1000000000\n", patch_text());
+    let (code, err, _) = run_limited("threads", &text);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("solver.threads = 1000000000 must be in 0..=1024"),
+        "{err}"
+    );
+
     let text = patch_text().replace("points = 11", "points = 1000000000000");
     let (code, err, _) = run_limited("points", &text);
     assert_eq!(code, 1, "{err}");

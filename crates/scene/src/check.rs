@@ -454,9 +454,12 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
         positive(ls, &k(&["solver", "tolerance"]), t)?;
     }
     if let Some(t) = s.solver.threads
-        && t < 0
+        && !(0..=1024).contains(&t)
     {
-        return Err(ls.error(&k(&["solver", "threads"]), format!("= {t} must be ≥ 0")));
+        return Err(ls.error(
+            &k(&["solver", "threads"]),
+            format!("= {t} must be in 0..=1024 (0: one thread per core)"),
+        ));
     }
     if s.output.every < 1 {
         return Err(ls.error(
