@@ -47,6 +47,7 @@ pub mod field;
 pub mod fracturing;
 pub mod heap;
 pub mod laws;
+mod ldlt;
 pub mod linear;
 pub mod ordering;
 pub mod pattern;
@@ -57,8 +58,8 @@ pub mod standard;
 pub use assembly::{assemble, nodal_loads};
 pub use bc::{Displacement, Gravity, Loads, Platen, Traction};
 pub use biot::{
-    BiotCoupling, BiotError, BiotState, BiotStep, BiotSystem, ExplicitPressure, FixedStress,
-    Linearization, Monolithic, drained_bulk_modulus,
+    BiotCoupling, BiotError, BiotState, BiotStep, BiotSystem, CouplingStats, ExplicitPressure,
+    FixedStress, Linearization, Monolithic, drained_bulk_modulus,
 };
 pub use dofs::DofMap;
 pub use error::{Result, SimError};
