@@ -558,8 +558,12 @@ impl<const D: usize> CellLaw<D> for VemLaw<D> {
     }
 
     fn stress(&self, cell: &CellGeometry<'_, D>, u: &[f64], _scratch: &mut Scratch) -> Tensor<D> {
-        let f = Frame::new(cell);
-        let (_, g) = Self::kinematics(cell, &f, u);
+        // G = (1/|K|) Σ_j u_j ⊗ N_j, as in `kinematics` (no frame needed).
+        let mut g = Tensor::<D>::zeros();
+        for (j, nj) in cell.node_normals.iter().enumerate() {
+            g += node_vec::<D>(u, j) * nj.transpose();
+        }
+        let g = g * (1.0 / cell.volume);
         from_kelvin::<D>(&self.material.stress_kelvin(&to_kelvin::<D>(&g)))
     }
 }
