@@ -516,6 +516,29 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
         }
     }
 
+    /// In one pass over the cells: `mech[e] += Σ α_K (p_K − p₀_K) N_{i,a}` (the reduced
+    /// `Cᵀ (p − p₀)`, as [`Self::add_pore_pressure_equations`]) and
+    /// `cells[K] = α_K ΔV_K(u)` (as [`Self::alpha_volume_change`]; `u` of length
+    /// `D · nodes`, `cells` one per cell).
+    fn coupling_terms(&self, p: &[f64], u: &[f64], mech: &mut [f64], cells: &mut [f64]) {
+        let ops = &*self.ops;
+        let cols = ops.free_ptr.windows(2).zip(ops.node_ptr.windows(2));
+        for (((q, k), (pc, p0)), o) in cols.zip(p.iter().zip(&ops.p0)).zip(cells.iter_mut()) {
+            let dp = pc - p0;
+            if dp != 0.0 {
+                for (&e, w) in ops.free_eq[q[0]..q[1]].iter().zip(&ops.free_w[q[0]..q[1]]) {
+                    mech[e] += w * dp;
+                }
+            }
+            let k = D * k[0]..D * k[1];
+            let mut s = 0.0;
+            for (w, &d) in ops.weights[k.clone()].iter().zip(&ops.dofs[k]) {
+                s += w * u[d];
+            }
+            *o = s;
+        }
+    }
+
     /// The prescribed displacements at `t` (free entries zero) into `u_fixed`, and the
     /// reduced mechanical right-hand side without pore pressure,
     /// `g = Tᵀ (f_f − K_fp u_p) + F_platen`, into `rhs`; `full` is scratch. Returns
@@ -558,9 +581,9 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
         self.flow.forcing(t, out)?;
         let a = self.flow.flux_matrix();
         let (cp, ri, v) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
-        for k in 0..self.num_cells() {
-            for q in cp[k]..cp[k + 1] {
-                out[ri[q]] -= v[q] * p_old[k];
+        for (q, pk) in cp.windows(2).zip(p_old) {
+            for (&i, a) in ri[q[0]..q[1]].iter().zip(&v[q[0]..q[1]]) {
+                out[i] -= a * pk;
             }
         }
         out.iter_mut().for_each(|x| *x *= dt);
@@ -1097,16 +1120,22 @@ impl<const D: usize> BiotCoupling<D> for Monolithic {
         w.cv.resize(nc, 0.0);
         w.cvo.resize(nc, 0.0);
         let moved = self.mechanics_base(sys, t1, &mut w)?;
-        sys.add_pore_pressure_equations(&state.pressure, &mut w.rhs[..nm]);
+        sys.coupling_terms(
+            &state.pressure,
+            &state.displacement,
+            &mut w.rhs[..nm],
+            &mut w.cvo,
+        );
         sys.flow_residual(&state.pressure, t1, dt, &mut w.flow)?;
         if moved {
             sys.alpha_volume_change(&w.uf, &mut w.cv)?;
+            for c in 0..nc {
+                w.rhs[nm + c] = s * (-w.flow[c] + w.cv[c] - w.cvo[c]);
+            }
         } else {
-            w.cv.fill(0.0);
-        }
-        sys.alpha_volume_change(&state.displacement, &mut w.cvo)?;
-        for c in 0..nc {
-            w.rhs[nm + c] = s * (-w.flow[c] + w.cv[c] - w.cvo[c]);
+            for ((r, f), v) in w.rhs[nm..].iter_mut().zip(&w.flow).zip(&w.cvo) {
+                *r = s * (-f - v);
+            }
         }
         w.z.clone_from(&w.rhs);
         let solved = self.ldlt.solve_in_place(&mut w.z);
