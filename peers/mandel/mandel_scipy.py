@@ -38,6 +38,9 @@ FORCE, DT, STEPS = 1e6, 0.01, 200
 PROBE_X = [0.0125, 0.1375, 0.2625, 0.3875, 0.5125, 0.6375, 0.7625, 0.8875, 0.9875]
 PROBE_Y = 0.5125
 REPORT_EVERY = 10
+# "symmetric": minimum degree on A + A^T, no pivoting (the matrix is symmetric
+# quasi-definite); "default": SuperLU's defaults (COLAMD, partial pivoting).
+SPLU = sys.argv[sys.argv.index("--splu") + 1] if "--splu" in sys.argv else "symmetric"
 
 
 def local_vem(h, lam, mu):
@@ -121,8 +124,11 @@ def main():
     g[platen] = -FORCE
     t_assembled = time.perf_counter()
 
-    lu = splu(system, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
-              options={"SymmetricMode": True})
+    if SPLU == "symmetric":
+        lu = splu(system, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                  options={"SymmetricMode": True})
+    else:
+        lu = splu(system)
     t_factored = time.perf_counter()
 
     probe_cells = [int(PROBE_Y / h) * NX + int(x / h) for x in PROBE_X]
@@ -139,6 +145,7 @@ def main():
     t_solved = time.perf_counter()
     res = np.linalg.norm(system @ z - rhs) / np.linalg.norm(rhs)
     result = {
+        "splu": SPLU,
         "cells": nc,
         "unknowns": nm + nc,
         "factor_nnz": int(lu.L.nnz + lu.U.nnz - (nm + nc)),
