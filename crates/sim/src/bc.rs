@@ -69,3 +69,17 @@ pub struct Loads<const D: usize> {
     /// Tractions on boundary faces.
     pub tractions: Vec<Traction<D>>,
 }
+
+impl<const D: usize> Loads<D> {
+    /// Whether every load is a constant field ([`ScalarField::Const`] components; gravity
+    /// always is): then the nodal loads do not depend on time.
+    pub fn is_time_independent(&self) -> bool {
+        self.body_force
+            .as_ref()
+            .is_none_or(|b| b.as_const().is_some())
+            && self
+                .tractions
+                .iter()
+                .all(|t| t.traction.iter().all(|c| c.as_const().is_some()))
+    }
+}

@@ -56,8 +56,9 @@
 //! (`u_p` the prescribed displacements). `K` is positive definite and `M + Δt A` positive
 //! definite as soon as every connected flow region has storage or a pressure anchor, so
 //! the matrix is *quasi-definite* and has an `LDLᵀ` factorization for every symmetric
-//! ordering (Vanderbei 1995): [`Monolithic`] uses faer's sparse `LDLᵀ` with an AMD
-//! ordering, the symbolic analysis done once. `Δt = 0` is allowed and gives the
+//! ordering (Vanderbei 1995): [`Monolithic`] uses a sparse `LDLᵀ` (faer's supernodal
+//! factorization) with a nested-dissection ordering of the block system, the symbolic
+//! analysis done once. `Δt = 0` is allowed and gives the
 //! *undrained* response to an instantaneous load (no flux, `C δu + M δp = 0`); it needs
 //! `S > 0` in every cell (with `S = 0` the block system is a saddle point without the
 //! quasi-definite structure, and is rejected: take a small `Δt > 0` instead).
@@ -69,6 +70,22 @@
 //! `s = mean diag(K) / mean |C_{K,e}|` (units Pa/m) makes the coupling block as large as
 //! the stiffness; `s` is a pure change of variables, so the solution does not depend on it
 //! (tested to 1e-10).
+//!
+//! # What a step costs
+//!
+//! The block matrix depends on `K`, α, the node normals, `A`, `M`, `s` and `Δt`, none of
+//! which changes for linear laws, no new failures and a fixed step. A step then builds
+//! the right-hand side (`O(cells + equations)`: the prescribed displacements and loads
+//! are kept when no condition depends on time) and back-solves with the stored factors,
+//! `2 nnz(L)` multiply–adds; the matrix is filled and factorized again only when one of
+//! its inputs changed. The inputs are recognised cheaply: the stiffness and the coupling
+//! data are shared between the systems of one run ([`BiotSystem`] holds them reference
+//! counted, so the same stiffness is the same allocation; otherwise values are
+//! compared), the flow values are compared, and a `Δt` within the rounding of the step
+//! times (`4 ε (|t| + |Δt|)`) of the factorized one is taken as equal, since the times of
+//! a uniform schedule are rounded products `k Δt` whose differences wobble in the last
+//! bits. [`Monolithic::stats`], [`FixedStress::stats`] and [`ExplicitPressure::stats`]
+//! report the factorizations and solves done ([`CouplingStats`]).
 //!
 //! # Fixed-stress split
 //!
@@ -112,21 +129,16 @@
 //! linear laws. The pressure `p` and `p₀` are cell values, one per grid cell, in the flow
 //! model's cell order.
 
-use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::cholesky::{
-    CholeskySymbolicParams, LdltRef, SymbolicCholesky, SymmetricOrdering,
-    factorize_symbolic_cholesky,
-};
-use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
-use faer::{Conj, MatMut, Par, Side};
+use std::sync::Arc;
+
+use faer::Par;
 use porofrac_flow::{FlowError, FlowModel};
 use porofrac_grid::Point;
 use porofrac_law::Stiffness;
 
 use crate::assembly::{assemble, nodal_loads};
 use crate::error::SimError;
+use crate::ldlt::Ldlt;
 use crate::solve::{DirectSolver, StaticProblem};
 
 /// Errors of the Biot coupling.
@@ -175,16 +187,37 @@ pub fn drained_bulk_modulus<const D: usize>(stiffness: &Stiffness<D>) -> f64 {
 /// The mechanics and flow of one poroelastic problem, with the coupling operators.
 ///
 /// Built once per grid, conditions and materials; the couplings ([`Monolithic`],
-/// [`FixedStress`], [`ExplicitPressure`]) take it by reference at every step.
+/// [`FixedStress`], [`ExplicitPressure`]) take it by reference at every step. The
+/// coupling data (α, `p₀`, the node normals) and the assembled stiffness are shared
+/// (reference counted), so a system rebuilt for the same laws (e.g. by
+/// [`crate::fracturing::Fracturing`] at every step) costs no assembly and the couplings
+/// recognise its stiffness as the one they factorized without comparing values.
 pub struct BiotSystem<'a, const D: usize> {
     mech: StaticProblem<'a, D>,
     flow: &'a FlowModel<D>,
-    alpha: Vec<f64>,
-    p0: Vec<f64>,
+    ops: Arc<Operators<D>>,
     drained_bulk: Option<Vec<f64>>,
-    node_ptr: Vec<usize>,
-    normals: Vec<Point<D>>,
-    k_values: Vec<f64>,
+    k_values: Arc<[f64]>,
+}
+
+/// The coupling data of a grid: α and `p₀` per cell, and the node normals `N_i` of every
+/// cell (cell `c` owns `normals[node_ptr[c]..node_ptr[c + 1]]`, in the order of its nodes).
+///
+/// `weights[D·k + a] = α_K N_{k,a}` and `dofs[D·k + a] = D·n_k + a` for the `k`-th entry of
+/// `normals` (node `n_k` of its cell): the rows of the coupling `C` over all nodal dofs.
+/// `free_eq[q]`, `free_w[q]` for `q` in `free_ptr[c]..free_ptr[c + 1]`: the equations of
+/// the free dofs of cell `c` and their weights, the rows of the reduced coupling.
+#[derive(Debug, PartialEq)]
+pub(crate) struct Operators<const D: usize> {
+    pub(crate) alpha: Vec<f64>,
+    pub(crate) p0: Vec<f64>,
+    pub(crate) node_ptr: Vec<usize>,
+    pub(crate) normals: Vec<Point<D>>,
+    pub(crate) weights: Vec<f64>,
+    pub(crate) dofs: Vec<usize>,
+    pub(crate) free_ptr: Vec<usize>,
+    pub(crate) free_eq: Vec<usize>,
+    pub(crate) free_w: Vec<f64>,
 }
 
 impl<'a, const D: usize> BiotSystem<'a, D> {
@@ -225,13 +258,6 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
                 p0[c]
             )));
         }
-        if !mechanics.laws.all_piecewise_linear() {
-            return Err(BiotError::Input(
-                "the Biot coupling needs linear or piecewise-linear cell laws (the stiffness \
-                 is a linearization, see BiotSystem::linearize)"
-                    .into(),
-            ));
-        }
         mechanics.dofs.check_rigid_modes(grid)?;
         let mut node_ptr = Vec::with_capacity(nc + 1);
         node_ptr.push(0);
@@ -242,28 +268,87 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
         for c in 0..nc {
             grid.cell_node_normals(c, &mut normals[node_ptr[c]..node_ptr[c + 1]]);
         }
-        let mut k_values = vec![0.0; mechanics.pattern.nnz()];
-        let mut forces = vec![0.0; mechanics.dofs.num_equations()];
-        let u = vec![0.0; mechanics.dofs.num_dofs()];
-        assemble(
-            grid,
-            mechanics.laws,
-            mechanics.dofs,
-            mechanics.pattern,
-            &u,
-            &mut k_values,
-            &mut forces,
-        )?;
+        let mut weights = Vec::with_capacity(D * normals.len());
+        let mut cdofs = Vec::with_capacity(D * normals.len());
+        let mut free_ptr = Vec::with_capacity(nc + 1);
+        let (mut free_eq, mut free_w) = (Vec::new(), Vec::new());
+        free_ptr.push(0);
+        for c in 0..nc {
+            let nn = &normals[node_ptr[c]..node_ptr[c + 1]];
+            for (&n, ni) in grid.cell_nodes(c).iter().zip(nn) {
+                for a in 0..D {
+                    weights.push(alpha[c] * ni[a]);
+                    cdofs.push(D * n + a);
+                    if let Some(e) = mechanics.dofs.equation(n, a) {
+                        free_eq.push(e);
+                        free_w.push(alpha[c] * ni[a]);
+                    }
+                }
+            }
+            free_ptr.push(free_eq.len());
+        }
+        let ops = Arc::new(Operators {
+            alpha,
+            p0,
+            node_ptr,
+            normals,
+            weights,
+            dofs: cdofs,
+            free_ptr,
+            free_eq,
+            free_w,
+        });
+        Self::from_parts(mechanics, flow, ops, None)
+    }
+
+    /// A system on coupling data `ops` already validated for this grid, flow model and
+    /// conditions (by [`Self::new`]), with the stiffness `k_values` of `mechanics.laws`
+    /// when it is known (`None`: assembled here at zero displacement).
+    ///
+    /// Errors: a law that is not piecewise linear, or an assembly error.
+    pub(crate) fn from_parts(
+        mechanics: StaticProblem<'a, D>,
+        flow: &'a FlowModel<D>,
+        ops: Arc<Operators<D>>,
+        k_values: Option<Arc<[f64]>>,
+    ) -> BiotResult<Self> {
+        if !mechanics.laws.all_piecewise_linear() {
+            return Err(BiotError::Input(
+                "the Biot coupling needs linear or piecewise-linear cell laws (the stiffness \
+                 is a linearization, see BiotSystem::linearize)"
+                    .into(),
+            ));
+        }
+        let k_values = match k_values {
+            Some(k) if k.len() == mechanics.pattern.nnz() => k,
+            _ => {
+                let mut k = vec![0.0; mechanics.pattern.nnz()];
+                let mut forces = vec![0.0; mechanics.dofs.num_equations()];
+                let u = vec![0.0; mechanics.dofs.num_dofs()];
+                assemble(
+                    mechanics.grid,
+                    mechanics.laws,
+                    mechanics.dofs,
+                    mechanics.pattern,
+                    &u,
+                    &mut k,
+                    &mut forces,
+                )?;
+                Arc::from(k)
+            }
+        };
         Ok(Self {
             mech: mechanics,
             flow,
-            alpha,
-            p0,
+            ops,
             drained_bulk: None,
-            node_ptr,
-            normals,
             k_values,
         })
+    }
+
+    /// The shared coupling data and stiffness (for [`Self::from_parts`]).
+    pub(crate) fn parts(&self) -> (Arc<Operators<D>>, Arc<[f64]>) {
+        (self.ops.clone(), self.k_values.clone())
     }
 
     /// Set the drained bulk modulus of every cell (Pa, > 0), needed by [`FixedStress`]
@@ -282,7 +367,7 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
 
     /// Number of cells (pressure unknowns).
     pub fn num_cells(&self) -> usize {
-        self.alpha.len()
+        self.ops.alpha.len()
     }
     /// The mechanics problem.
     pub fn mechanics(&self) -> &StaticProblem<'a, D> {
@@ -294,11 +379,11 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
     }
     /// Biot coefficient per cell.
     pub fn alpha(&self) -> &[f64] {
-        &self.alpha
+        &self.ops.alpha
     }
     /// Initial pressure per cell.
     pub fn initial_pressure(&self) -> &[f64] {
-        &self.p0
+        &self.ops.p0
     }
     /// The reduced stiffness values (upper triangle of the mechanics [`crate::Pattern`]).
     pub fn stiffness_values(&self) -> &[f64] {
@@ -333,14 +418,15 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
         let mut external = vec![0.0; dofs.num_equations()];
         dofs.reduce_add(&full, &mut external);
         dofs.add_platen_forces(grid, t, &mut external);
-        let dp: Vec<f64> = p.iter().zip(&self.p0).map(|(a, b)| a - b).collect();
-        self.add_coupling_transpose(&dp, &mut external);
+        self.add_pore_pressure_equations(p, &mut external);
         let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
         let scale = norm(&external) + norm(&internal);
         let r: Vec<f64> = external.iter().zip(&internal).map(|(a, b)| a + b).collect();
         let residual = if scale > 0.0 { norm(&r) / scale } else { 0.0 };
-        let changed = values != self.k_values;
-        self.k_values = values;
+        let changed = *values != *self.k_values;
+        if changed {
+            self.k_values = Arc::from(values);
+        }
         Ok(Linearization { changed, residual })
     }
 
@@ -350,7 +436,7 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
     pub fn rest_state(&self) -> BiotState {
         BiotState {
             displacement: vec![0.0; self.mech.dofs.num_dofs()],
-            pressure: self.p0.clone(),
+            pressure: self.ops.p0.clone(),
         }
     }
 
@@ -362,7 +448,7 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
         let mut st = self.rest_state();
         let mut rhs = vec![0.0; self.mech.dofs.num_equations()];
         let mut uf = Vec::new();
-        self.mechanics_base(t, &mut uf, &mut rhs)?;
+        self.mechanics_base(t, &mut uf, &mut Vec::new(), &mut rhs)?;
         solver.solve_in_place(&mut rhs)?;
         st.displacement.copy_from_slice(&uf);
         self.mech.dofs.scatter(&rhs, &mut st.displacement);
@@ -376,9 +462,10 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
         check_len("displacement", u.len(), self.mech.dofs.num_dofs())?;
         check_len("volume change output", out.len(), self.num_cells())?;
         let grid = self.mech.grid;
+        let ops = &*self.ops;
         for (c, o) in out.iter_mut().enumerate() {
             let nodes = grid.cell_nodes(c);
-            let nn = &self.normals[self.node_ptr[c]..self.node_ptr[c + 1]];
+            let nn = &ops.normals[ops.node_ptr[c]..ops.node_ptr[c + 1]];
             let mut s = 0.0;
             for (&n, ni) in nodes.iter().zip(nn) {
                 for a in 0..D {
@@ -398,12 +485,13 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
         check_len("force output", out.len(), self.mech.dofs.num_dofs())?;
         out.fill(0.0);
         let grid = self.mech.grid;
+        let ops = &*self.ops;
         for c in 0..self.num_cells() {
-            let q = self.alpha[c] * (p[c] - self.p0[c]);
+            let q = ops.alpha[c] * (p[c] - ops.p0[c]);
             if q == 0.0 {
                 continue;
             }
-            let nn = &self.normals[self.node_ptr[c]..self.node_ptr[c + 1]];
+            let nn = &ops.normals[ops.node_ptr[c]..ops.node_ptr[c + 1]];
             for (&n, ni) in grid.cell_nodes(c).iter().zip(nn) {
                 for a in 0..D {
                     out[D * n + a] += q * ni[a];
@@ -413,30 +501,55 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
         Ok(())
     }
 
-    /// `out[e] += Σ α_K q_K N_{i,a}` over the free dofs `(i, a)` of equation `e`.
-    fn add_coupling_transpose(&self, q: &[f64], out: &mut [f64]) {
-        let grid = self.mech.grid;
-        let dofs = self.mech.dofs;
-        for c in 0..self.num_cells() {
-            let w = self.alpha[c] * q[c];
-            if w == 0.0 {
+    /// `out[e] += Σ α_K (p_K − p₀_K) N_{i,a}` over the free dofs `(i, a)` of equation
+    /// `e`: the reduced `Cᵀ (p − p₀)`.
+    fn add_pore_pressure_equations(&self, p: &[f64], out: &mut [f64]) {
+        let ops = &*self.ops;
+        for ((q, pc), p0) in ops.free_ptr.windows(2).zip(p).zip(&ops.p0) {
+            let dp = pc - p0;
+            if dp == 0.0 {
                 continue;
             }
-            let nn = &self.normals[self.node_ptr[c]..self.node_ptr[c + 1]];
-            for (&n, ni) in grid.cell_nodes(c).iter().zip(nn) {
-                for a in 0..D {
-                    if let Some(e) = dofs.equation(n, a) {
-                        out[e] += w * ni[a];
-                    }
+            for (&e, w) in ops.free_eq[q[0]..q[1]].iter().zip(&ops.free_w[q[0]..q[1]]) {
+                out[e] += w * dp;
+            }
+        }
+    }
+
+    /// In one pass over the cells: `mech[e] += Σ α_K (p_K − p₀_K) N_{i,a}` (the reduced
+    /// `Cᵀ (p − p₀)`, as [`Self::add_pore_pressure_equations`]) and
+    /// `cells[K] = α_K ΔV_K(u)` (as [`Self::alpha_volume_change`]; `u` of length
+    /// `D · nodes`, `cells` one per cell).
+    fn coupling_terms(&self, p: &[f64], u: &[f64], mech: &mut [f64], cells: &mut [f64]) {
+        let ops = &*self.ops;
+        let cols = ops.free_ptr.windows(2).zip(ops.node_ptr.windows(2));
+        for (((q, k), (pc, p0)), o) in cols.zip(p.iter().zip(&ops.p0)).zip(cells.iter_mut()) {
+            let dp = pc - p0;
+            if dp != 0.0 {
+                for (&e, w) in ops.free_eq[q[0]..q[1]].iter().zip(&ops.free_w[q[0]..q[1]]) {
+                    mech[e] += w * dp;
                 }
             }
+            let k = D * k[0]..D * k[1];
+            let mut s = 0.0;
+            for (w, &d) in ops.weights[k.clone()].iter().zip(&ops.dofs[k]) {
+                s += w * u[d];
+            }
+            *o = s;
         }
     }
 
     /// The prescribed displacements at `t` (free entries zero) into `u_fixed`, and the
     /// reduced mechanical right-hand side without pore pressure,
-    /// `g = Tᵀ (f_f − K_fp u_p) + F_platen`, into `rhs`.
-    fn mechanics_base(&self, t: f64, u_fixed: &mut Vec<f64>, rhs: &mut [f64]) -> BiotResult<()> {
+    /// `g = Tᵀ (f_f − K_fp u_p) + F_platen`, into `rhs`; `full` is scratch. Returns
+    /// whether a prescribed displacement is non-zero.
+    fn mechanics_base(
+        &self,
+        t: f64,
+        u_fixed: &mut Vec<f64>,
+        full: &mut Vec<f64>,
+        rhs: &mut [f64],
+    ) -> BiotResult<bool> {
         let StaticProblem {
             grid,
             laws,
@@ -447,18 +560,20 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
         u_fixed.clear();
         u_fixed.resize(dofs.num_dofs(), 0.0);
         dofs.set_prescribed(grid, t, u_fixed);
-        let mut full = vec![0.0; dofs.num_dofs()];
-        nodal_loads(grid, loads, t, &mut full)?;
+        full.clear();
+        full.resize(dofs.num_dofs(), 0.0);
+        nodal_loads(grid, loads, t, full)?;
         rhs.fill(0.0);
-        dofs.reduce_add(&full, rhs);
+        dofs.reduce_add(full, rhs);
         dofs.add_platen_forces(grid, t, rhs);
-        if u_fixed.iter().any(|&v| v != 0.0) {
+        let moved = u_fixed.iter().any(|&v| v != 0.0);
+        if moved {
             let mut vals = vec![0.0; pattern.nnz()];
             let mut forces = vec![0.0; dofs.num_equations()];
             assemble(grid, laws, dofs, pattern, u_fixed, &mut vals, &mut forces)?;
             rhs.iter_mut().zip(&forces).for_each(|(r, f)| *r += f);
         }
-        Ok(())
+        Ok(moved)
     }
 
     /// `out = Δt (b(t) − A pⁿ)`, the flow residual at the old pressure.
@@ -466,19 +581,28 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
         self.flow.forcing(t, out)?;
         let a = self.flow.flux_matrix();
         let (cp, ri, v) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
-        for k in 0..self.num_cells() {
-            for q in cp[k]..cp[k + 1] {
-                out[ri[q]] -= v[q] * p_old[k];
+        for (q, pk) in cp.windows(2).zip(p_old) {
+            for (&i, a) in ri[q[0]..q[1]].iter().zip(&v[q[0]..q[1]]) {
+                out[i] -= a * pk;
             }
         }
         out.iter_mut().for_each(|x| *x *= dt);
         Ok(())
     }
 
-    /// `out = α_K ΔV_K(u)` for every cell.
+    /// `out = α_K ΔV_K(u) = Σ_{i,a} α_K N_{i,a} u_{i,a}` for every cell.
     fn alpha_volume_change(&self, u: &[f64], out: &mut [f64]) -> BiotResult<()> {
-        self.volume_change(u, out)?;
-        out.iter_mut().zip(&self.alpha).for_each(|(o, a)| *o *= a);
+        check_len("displacement", u.len(), self.mech.dofs.num_dofs())?;
+        check_len("volume change output", out.len(), self.num_cells())?;
+        let ops = &*self.ops;
+        for (o, q) in out.iter_mut().zip(ops.node_ptr.windows(2)) {
+            let k = D * q[0]..D * q[1];
+            let mut s = 0.0;
+            for (w, &d) in ops.weights[k.clone()].iter().zip(&ops.dofs[k]) {
+                s += w * u[d];
+            }
+            *o = s;
+        }
         Ok(())
     }
 
@@ -497,11 +621,12 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
         }
         let (mut sc, mut ncpl) = (0.0, 0usize);
         let grid = self.mech.grid;
+        let ops = &*self.ops;
         for c in 0..self.num_cells() {
-            let nn = &self.normals[self.node_ptr[c]..self.node_ptr[c + 1]];
+            let nn = &ops.normals[ops.node_ptr[c]..ops.node_ptr[c + 1]];
             for (&n, ni) in grid.cell_nodes(c).iter().zip(nn) {
                 for a in 0..D {
-                    let w = (self.alpha[c] * ni[a]).abs();
+                    let w = (ops.alpha[c] * ni[a]).abs();
                     if w > 0.0 && self.mech.dofs.equation(n, a).is_some() {
                         sc += w;
                         ncpl += 1;
@@ -513,6 +638,18 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
             return 1.0;
         }
         (sk / nk as f64) / (sc / ncpl as f64)
+    }
+}
+
+/// A step `Δt` within rounding of `previous` is taken as `previous`: the output times of
+/// a uniform schedule are rounded products `k Δt`, so their differences wobble in the
+/// last bits of `t` (e.g. `0.03 − 0.02 = 0.009999999999999998`), and a matrix holding
+/// `Δt` would change, and be factorized again, at every step for nothing. The tolerance
+/// `4 ε (|t| + |Δt|)` is the rounding of the times themselves.
+fn snap_step(dt: f64, t: f64, previous: Option<f64>) -> f64 {
+    match previous {
+        Some(f) if (f - dt).abs() <= 4.0 * f64::EPSILON * (t.abs() + dt.abs()) => f,
+        _ => dt,
     }
 }
 
@@ -588,9 +725,47 @@ pub trait BiotCoupling<const D: usize> {
 // ---------------------------------------------------------------------------------------
 // Monolithic
 
+/// What the linear algebra of a coupling scheme did: which solver, how many numeric and
+/// symbolic factorizations, the size of the factors and the number of solves.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct CouplingStats {
+    /// The linear solver: `"ldlt"` (sparse `LDLᵀ` of the monolithic block system) or
+    /// `"cholesky"` (sparse Cholesky of the flow and of the mechanics, split schemes).
+    pub linear: &'static str,
+    /// Numeric factorizations done.
+    pub numeric_factorizations: usize,
+    /// Symbolic analyses (orderings and factor patterns) done.
+    pub symbolic_factorizations: usize,
+    /// Stored entries of the current factors (summed over the factors of a split scheme).
+    pub factor_nnz: usize,
+    /// Triangular solves done (one per monolithic step; flow and mechanics solves of the
+    /// split schemes).
+    pub solves: usize,
+}
+
+impl CouplingStats {
+    fn add(self, o: CouplingStats) -> CouplingStats {
+        CouplingStats {
+            linear: self.linear,
+            numeric_factorizations: self.numeric_factorizations + o.numeric_factorizations,
+            symbolic_factorizations: self.symbolic_factorizations + o.symbolic_factorizations,
+            factor_nnz: self.factor_nnz + o.factor_nnz,
+            solves: self.solves + o.solves,
+        }
+    }
+}
+
 /// The fully implicit monolithic scheme (seed eq. 30): one symmetric quasi-definite
 /// system per step, solved by a sparse `LDLᵀ` factorization (see the module docs for the
 /// block form and the scaling).
+///
+/// The block matrix depends on the stiffness, α and the node normals, the TPFA matrix,
+/// the storage, `s` and `Δt`, not on the state: a step whose inputs are those of the last
+/// factorization (same shared stiffness, or equal values; same flow values; the same
+/// `Δt` up to the rounding of the step times, see `snap_step`) only builds the
+/// right-hand side and back-solves with the stored factors. Its relative residual is
+/// measured on the first solve with each factorization (a later solve with the same
+/// factors is as accurate); [`BiotStep::residual`] reports that value.
 pub struct Monolithic {
     scale: Option<f64>,
     s: f64,
@@ -601,18 +776,59 @@ pub struct Monolithic {
     cpos: Vec<usize>,
     /// Per flow-pattern entry: block position (upper part) or MAX.
     fpos: Vec<usize>,
-    symbolic: SymbolicCholesky<usize>,
+    ldlt: Ldlt,
     values: Vec<f64>,
-    factored_values: Vec<f64>,
-    l_values: Vec<f64>,
-    factored: bool,
-    par: Par,
-    factorizations: usize,
+    /// The inputs of the current factorization.
+    factored: Option<FactorInputs>,
+    /// Relative residual of the first solve with the current factorization.
+    residual: f64,
+    /// The default pressure scale and the stiffness it was computed from.
+    default_scale: Option<(Arc<[f64]>, f64)>,
+    /// The mechanical right-hand side of time-independent conditions and loads.
+    base: Option<MechanicsBase>,
+    work: MonolithicWork,
+}
+
+/// `g`, the prescribed displacements and whether one is non-zero, for the conditions of
+/// `dofs` and the loads of `loads` (addresses, compared only while `ops` is held) when
+/// neither depends on time.
+struct MechanicsBase {
+    ops: Arc<ErasedOperators>,
+    dofs: usize,
+    loads: usize,
+    g: Vec<f64>,
+    uf: Vec<f64>,
+    moved: bool,
+}
+
+/// What the block matrix of a [`Monolithic`] factorization was made of.
+struct FactorInputs {
+    k: Arc<[f64]>,
+    ops: Arc<ErasedOperators>,
+    s: f64,
+    dt: f64,
+    flux: Vec<f64>,
+    accumulation: Vec<f64>,
+}
+
+/// The coupling data of a factorization, type-erased over `D` for comparison.
+type ErasedOperators = dyn std::any::Any + Send + Sync;
+
+/// Buffers reused by every step.
+#[derive(Default)]
+struct MonolithicWork {
+    rhs: Vec<f64>,
+    z: Vec<f64>,
+    uf: Vec<f64>,
+    full: Vec<f64>,
+    flow: Vec<f64>,
+    cv: Vec<f64>,
+    cvo: Vec<f64>,
 }
 
 impl Monolithic {
-    /// Build the block pattern and its symbolic `LDLᵀ` analysis for `system`. `scale` is
-    /// the pressure scale `s` (Pa/m); `None` uses
+    /// Build the block pattern and its symbolic `LDLᵀ` analysis (nested dissection) for
+    /// `system`. `scale` is the pressure scale `s` (Pa/m); `None` uses
     /// [`BiotSystem::default_pressure_scale`].
     pub fn new<const D: usize>(system: &BiotSystem<'_, D>, scale: Option<f64>) -> BiotResult<Self> {
         if let Some(s) = scale
@@ -625,13 +841,14 @@ impl Monolithic {
         let pat = system.mech.pattern;
         let grid = system.mech.grid;
         let dofs = system.mech.dofs;
+        let ops = &*system.ops;
         let nm = pat.num_equations();
         let nc = system.num_cells();
         let fpat = system.flow.pattern();
         let (fcp, fri) = (fpat.col_ptr(), fpat.row_idx());
         let mut col_ptr = pat.col_ptr().to_vec();
         let mut row_idx = pat.row_idx().to_vec();
-        let mut cpos = vec![usize::MAX; D * system.normals.len()];
+        let mut cpos = vec![usize::MAX; D * ops.normals.len()];
         let mut fpos = vec![usize::MAX; fri.len()];
         let mut eqs: Vec<usize> = Vec::new();
         for c in 0..nc {
@@ -652,7 +869,7 @@ impl Monolithic {
                     if let Some(e) = dofs.equation(n, a) {
                         // Invariant: e was pushed above.
                         let k = eqs.binary_search(&e).unwrap_or(0);
-                        cpos[D * (system.node_ptr[c] + i) + a] = start + k;
+                        cpos[D * (ops.node_ptr[c] + i) + a] = start + k;
                     }
                 }
             }
@@ -665,14 +882,9 @@ impl Monolithic {
             col_ptr.push(row_idx.len());
         }
         let n = nm + nc;
-        let sym = SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row_idx);
-        let symbolic = factorize_symbolic_cholesky(
-            sym,
-            Side::Upper,
-            SymmetricOrdering::Amd,
-            CholeskySymbolicParams::default(),
-        )
-        .map_err(|e| BiotError::Solver(format!("symbolic LDLᵀ: {e:?}")))?;
+        let perm = block_dissection(system, &col_ptr, &row_idx);
+        let ldlt = Ldlt::analyse(n, &col_ptr, &row_idx, Some(&perm))
+            .map_err(|e| BiotError::Solver(e.0))?;
         let nnz = row_idx.len();
         Ok(Self {
             scale,
@@ -682,23 +894,33 @@ impl Monolithic {
             row_idx,
             cpos,
             fpos,
-            symbolic,
+            ldlt,
             values: vec![0.0; nnz],
-            factored_values: Vec::new(),
-            l_values: Vec::new(),
-            factored: false,
-            par: Par::Seq,
-            factorizations: 0,
+            factored: None,
+            residual: 0.0,
+            default_scale: None,
+            base: None,
+            work: MonolithicWork::default(),
         })
     }
 
-    /// Use `par` for factorizing and solving (default sequential).
+    /// Use `par` for factorizing (default sequential; the solves are sequential).
     pub fn set_parallelism(&mut self, par: Par) {
-        self.par = par;
+        self.ldlt.set_parallelism(par);
     }
-    /// Number of numeric factorizations done (a step with the same `Δt` reuses it).
+    /// Number of numeric factorizations done (a step with the same matrix reuses it).
     pub fn numeric_factorizations(&self) -> usize {
-        self.factorizations
+        self.ldlt.numeric_factorizations()
+    }
+    /// What the linear algebra did (see [`CouplingStats`]); one symbolic analysis.
+    pub fn stats(&self) -> CouplingStats {
+        CouplingStats {
+            linear: "ldlt",
+            numeric_factorizations: self.ldlt.numeric_factorizations(),
+            symbolic_factorizations: 1,
+            factor_nnz: self.ldlt.factor_nnz(),
+            solves: self.ldlt.solves(),
+        }
     }
     /// The pressure scale `s` of the last step.
     pub fn pressure_scale(&self) -> f64 {
@@ -709,18 +931,65 @@ impl Monolithic {
         self.col_ptr.len() - 1
     }
 
+    /// The pressure scale for `sys`: the fixed one, or the default one, computed once per
+    /// stiffness.
+    fn scale_for<const D: usize>(&mut self, sys: &BiotSystem<'_, D>) -> f64 {
+        if let Some(s) = self.scale {
+            return s;
+        }
+        if let Some((k, s)) = &self.default_scale
+            && Arc::ptr_eq(k, &sys.k_values)
+        {
+            return *s;
+        }
+        let s = sys.default_pressure_scale();
+        self.default_scale = Some((sys.k_values.clone(), s));
+        s
+    }
+
+    /// Whether the matrix for (`sys`, `s`, `dt`) is the one factorized. Shared data
+    /// compare by pointer first, then by value (adopting the new pointers when equal).
+    fn is_factored<const D: usize>(&mut self, sys: &BiotSystem<'_, D>, s: f64, dt: f64) -> bool {
+        let Some(f) = self.factored.as_mut() else {
+            return false;
+        };
+        if !self.ldlt.is_factored()
+            || f.s != s
+            || f.dt != dt
+            || f.flux != sys.flow.flux_matrix().val()
+            || f.accumulation != sys.flow.accumulation()
+        {
+            return false;
+        }
+        if !Arc::ptr_eq(&f.k, &sys.k_values) {
+            if *f.k != *sys.k_values {
+                return false;
+            }
+            f.k = sys.k_values.clone();
+        }
+        let same_ops = match f.ops.downcast_ref::<Operators<D>>() {
+            Some(o) => std::ptr::eq(o, &*sys.ops) || *o == *sys.ops,
+            None => false,
+        };
+        if same_ops {
+            f.ops = sys.ops.clone();
+        }
+        same_ops
+    }
+
     fn fill<const D: usize>(&mut self, sys: &BiotSystem<'_, D>, dt: f64) {
         let s = self.s;
+        let ops = &*sys.ops;
         let mech_nnz = sys.k_values.len();
         self.values[..mech_nnz].copy_from_slice(&sys.k_values);
         self.values[mech_nnz..].fill(0.0);
         for c in 0..sys.num_cells() {
-            let w = -s * sys.alpha[c];
-            for i in sys.node_ptr[c]..sys.node_ptr[c + 1] {
+            let w = -s * ops.alpha[c];
+            for i in ops.node_ptr[c]..ops.node_ptr[c + 1] {
                 for a in 0..D {
                     let p = self.cpos[D * i + a];
                     if p != usize::MAX {
-                        self.values[p] += w * sys.normals[i][a];
+                        self.values[p] += w * ops.normals[i][a];
                     }
                 }
             }
@@ -738,57 +1007,6 @@ impl Monolithic {
         }
     }
 
-    fn factorize(&mut self) -> BiotResult<()> {
-        if self.factored && self.factored_values == self.values {
-            return Ok(());
-        }
-        self.factored = false;
-        let n = self.num_unknowns();
-        let sym = SymbolicSparseColMatRef::new_checked(n, n, &self.col_ptr, None, &self.row_idx);
-        let mat = SparseColMatRef::new(sym, &self.values);
-        self.l_values.resize(self.symbolic.len_val(), 0.0);
-        let req = self
-            .symbolic
-            .factorize_numeric_ldlt_scratch::<f64>(self.par, Default::default());
-        let mut mem =
-            MemBuffer::try_new(req).map_err(|_| BiotError::Solver("out of memory".into()))?;
-        let res = self.symbolic.factorize_numeric_ldlt(
-            &mut self.l_values,
-            mat,
-            Side::Upper,
-            Default::default(),
-            self.par,
-            MemStack::new(&mut mem),
-            Default::default(),
-        );
-        self.factorizations += 1;
-        match res {
-            Ok(_) => {
-                self.factored = true;
-                self.factored_values.clone_from(&self.values);
-                Ok(())
-            }
-            Err(e) => Err(BiotError::Solver(format!(
-                "LDLᵀ of the coupled system failed ({e:?}); a flow region may lack storage \
-                 and a pressure anchor"
-            ))),
-        }
-    }
-
-    fn solve_in_place(&self, rhs: &mut [f64]) -> BiotResult<()> {
-        let ldlt = LdltRef::<'_, usize, f64>::new(&self.symbolic, &self.l_values);
-        let mut mem = MemBuffer::try_new(self.symbolic.solve_in_place_scratch::<f64>(1, self.par))
-            .map_err(|_| BiotError::Solver("out of memory".into()))?;
-        let n = rhs.len();
-        ldlt.solve_in_place_with_conj(
-            Conj::No,
-            MatMut::from_column_major_slice_mut(rhs, n, 1),
-            self.par,
-            MemStack::new(&mut mem),
-        );
-        Ok(())
-    }
-
     /// `y += A x` with the symmetric matrix stored as its upper triangle.
     fn sym_mul_add(&self, x: &[f64], y: &mut [f64]) {
         for j in 0..self.num_unknowns() {
@@ -801,6 +1019,41 @@ impl Monolithic {
             }
         }
     }
+}
+
+/// Unknowns per leaf of the dissection of the block system.
+const DISSECTION_LEAF: usize = 8;
+
+/// The elimination order of the block system: [`crate::ordering::pattern_dissection`]
+/// with each displacement equation at its node and each pressure at its cell centroid;
+/// equations shared by several nodes (platens, coupled to a whole boundary) last. On
+/// the 40 × 40 Mandel grid its factor has 9 % fewer entries than AMD's (379 556
+/// against 419 351) and the solves take 17 % fewer instructions.
+fn block_dissection<const D: usize>(
+    sys: &BiotSystem<'_, D>,
+    col_ptr: &[usize],
+    row_idx: &[usize],
+) -> Vec<usize> {
+    let grid = sys.mech.grid;
+    let dofs = sys.mech.dofs;
+    let nm = dofs.num_equations();
+    let mut owner = vec![None; nm];
+    let mut shared = vec![false; nm];
+    for v in 0..grid.num_nodes() {
+        for a in 0..D {
+            if let Some(e) = dofs.equation(v, a) {
+                shared[e] |= owner[e].is_some();
+                owner[e] = Some(v);
+            }
+        }
+    }
+    let mut pos: Vec<Option<Point<D>>> = owner
+        .iter()
+        .zip(&shared)
+        .map(|(o, &sh)| o.filter(|_| !sh).map(|v| *grid.node(v)))
+        .collect();
+    pos.extend((0..sys.num_cells()).map(|c| Some(*grid.cell_centroid(c))));
+    crate::ordering::pattern_dissection(&pos, col_ptr, row_idx, DISSECTION_LEAF)
 }
 
 impl<const D: usize> BiotCoupling<D> for Monolithic {
@@ -819,13 +1072,14 @@ impl<const D: usize> BiotCoupling<D> for Monolithic {
         check_state(sys, state)?;
         if self.num_unknowns() != sys.mech.pattern.num_equations() + sys.num_cells()
             || self.nm != sys.mech.pattern.num_equations()
-            || self.cpos.len() != D * sys.normals.len()
+            || self.cpos.len() != D * sys.ops.normals.len()
             || self.fpos.len() != sys.flow.pattern().row_idx().len()
         {
             return Err(BiotError::Input(
                 "monolithic solver built for another system".into(),
             ));
         }
+        let dt = snap_step(dt, t, self.factored.as_ref().map(|f| f.dt));
         if dt == 0.0
             && let Some(c) = sys.flow.accumulation().iter().position(|&m| m <= 0.0)
         {
@@ -834,55 +1088,143 @@ impl<const D: usize> BiotCoupling<D> for Monolithic {
                  (the system would be a saddle point): use a small Δt > 0"
             )));
         }
-        self.s = self.scale.unwrap_or_else(|| sys.default_pressure_scale());
-        let s = self.s;
+        let s = self.scale_for(sys);
+        let fresh = !self.is_factored(sys, s, dt);
+        if fresh {
+            self.factored = None;
+            self.s = s;
+            self.fill(sys, dt);
+            self.ldlt
+                .factorize(&self.col_ptr, &self.row_idx, &self.values)
+                .map_err(|e| {
+                    BiotError::Solver(format!(
+                        "LDLᵀ of the coupled system failed ({}); a flow region may lack \
+                         storage and a pressure anchor",
+                        e.0
+                    ))
+                })?;
+            self.factored = Some(FactorInputs {
+                k: sys.k_values.clone(),
+                ops: sys.ops.clone(),
+                s,
+                dt,
+                flux: sys.flow.flux_matrix().val().to_vec(),
+                accumulation: sys.flow.accumulation().to_vec(),
+            });
+        }
         let (nm, nc) = (self.nm, sys.num_cells());
         let t1 = t + dt;
-        let mut rhs = vec![0.0; nm + nc];
-        let mut uf = Vec::new();
-        sys.mechanics_base(t1, &mut uf, &mut rhs[..nm])?;
-        let dp0: Vec<f64> = state
-            .pressure
-            .iter()
-            .zip(&sys.p0)
-            .map(|(p, q)| p - q)
-            .collect();
-        sys.add_coupling_transpose(&dp0, &mut rhs[..nm]);
-        let mut flow = vec![0.0; nc];
-        sys.flow_residual(&state.pressure, t1, dt, &mut flow)?;
-        let mut cv = vec![0.0; nc];
-        sys.alpha_volume_change(&uf, &mut cv)?;
-        let mut cvo = vec![0.0; nc];
-        sys.alpha_volume_change(&state.displacement, &mut cvo)?;
-        for c in 0..nc {
-            rhs[nm + c] = s * (-flow[c] + cv[c] - cvo[c]);
+        let mut w = std::mem::take(&mut self.work);
+        w.rhs.resize(nm + nc, 0.0);
+        w.flow.resize(nc, 0.0);
+        w.cv.resize(nc, 0.0);
+        w.cvo.resize(nc, 0.0);
+        let moved = self.mechanics_base(sys, t1, &mut w)?;
+        sys.coupling_terms(
+            &state.pressure,
+            &state.displacement,
+            &mut w.rhs[..nm],
+            &mut w.cvo,
+        );
+        sys.flow_residual(&state.pressure, t1, dt, &mut w.flow)?;
+        if moved {
+            sys.alpha_volume_change(&w.uf, &mut w.cv)?;
+            for c in 0..nc {
+                w.rhs[nm + c] = s * (-w.flow[c] + w.cv[c] - w.cvo[c]);
+            }
+        } else {
+            for ((r, f), v) in w.rhs[nm..].iter_mut().zip(&w.flow).zip(&w.cvo) {
+                *r = s * (-f - v);
+            }
         }
-        self.fill(sys, dt);
-        self.factorize()?;
-        let mut z = rhs.clone();
-        self.solve_in_place(&mut z)?;
+        w.z.clone_from(&w.rhs);
+        let solved = self.ldlt.solve_in_place(&mut w.z);
+        let result = solved
+            .map_err(|e| BiotError::Solver(e.0))
+            .and_then(|()| self.finish(sys, state, &w, fresh));
+        self.work = w;
+        result
+    }
+}
+
+impl Monolithic {
+    /// The mechanical part of the right-hand side at `t` into `work.rhs` and the
+    /// prescribed displacements into `work.uf` (see `BiotSystem::mechanics_base`), kept
+    /// from the first step when the conditions and loads do not depend on time.
+    fn mechanics_base<const D: usize>(
+        &mut self,
+        sys: &BiotSystem<'_, D>,
+        t: f64,
+        work: &mut MonolithicWork,
+    ) -> BiotResult<bool> {
+        let nm = self.nm;
+        let dofs = std::ptr::from_ref(sys.mech.dofs) as usize;
+        let loads = std::ptr::from_ref(sys.mech.loads) as usize;
+        if let Some(b) = &self.base
+            && b.dofs == dofs
+            && b.loads == loads
+            && b.ops
+                .downcast_ref::<Operators<D>>()
+                .is_some_and(|o| std::ptr::eq(o, &*sys.ops))
+        {
+            work.rhs[..nm].copy_from_slice(&b.g);
+            work.uf.clone_from(&b.uf);
+            return Ok(b.moved);
+        }
+        self.base = None;
+        let moved = sys.mechanics_base(t, &mut work.uf, &mut work.full, &mut work.rhs[..nm])?;
+        if sys.mech.dofs.is_time_independent() && sys.mech.loads.is_time_independent() {
+            self.base = Some(MechanicsBase {
+                ops: sys.ops.clone(),
+                dofs,
+                loads,
+                g: work.rhs[..nm].to_vec(),
+                uf: work.uf.clone(),
+                moved,
+            });
+        }
+        Ok(moved)
+    }
+
+    /// Check the solution `work.z` (finite; the residual after a fresh factorization) and
+    /// build the new state.
+    fn finish<const D: usize>(
+        &mut self,
+        sys: &BiotSystem<'_, D>,
+        state: &BiotState,
+        work: &MonolithicWork,
+        fresh: bool,
+    ) -> BiotResult<BiotStep> {
+        let (z, rhs) = (&work.z, &work.rhs);
         if let Some(i) = z.iter().position(|v| !v.is_finite()) {
             return Err(BiotError::Solver(format!(
                 "non-finite solution at unknown {i}"
             )));
         }
-        let mut az = vec![0.0; nm + nc];
-        self.sym_mul_add(&z, &mut az);
-        let rn = rhs.iter().map(|v| v * v).sum::<f64>().sqrt();
-        let en = az
-            .iter()
-            .zip(&rhs)
-            .map(|(a, b)| (a - b) * (a - b))
-            .sum::<f64>()
-            .sqrt();
-        let residual = if rn > 0.0 { en / rn } else { en };
-        if residual > 1e-8 {
-            return Err(BiotError::Solver(format!(
-                "coupled system numerically singular: relative residual {residual:.2e}"
-            )));
+        if fresh {
+            let mut az = vec![0.0; z.len()];
+            self.sym_mul_add(z, &mut az);
+            let rn = rhs.iter().map(|v| v * v).sum::<f64>().sqrt();
+            let en = az
+                .iter()
+                .zip(rhs)
+                .map(|(a, b)| (a - b) * (a - b))
+                .sum::<f64>()
+                .sqrt();
+            let residual = if rn > 0.0 { en / rn } else { en };
+            if residual > 1e-8 {
+                // The factors are unusable: the next step factorizes again.
+                self.factored = None;
+                return Err(BiotError::Solver(format!(
+                    "coupled system numerically singular: relative residual {residual:.2e}"
+                )));
+            }
+            self.residual = residual;
         }
-        let mut u = uf;
+        let nm = self.nm;
+        let mut u = work.uf.clone();
         sys.mech.dofs.scatter(&z[..nm], &mut u);
+        let s = self.s;
         let p = state
             .pressure
             .iter()
@@ -895,7 +1237,7 @@ impl<const D: usize> BiotCoupling<D> for Monolithic {
                 pressure: p,
             },
             iterations: 1,
-            residual,
+            residual: self.residual,
         })
     }
 }
@@ -919,25 +1261,33 @@ fn check_state<const D: usize>(sys: &BiotSystem<'_, D>, state: &BiotState) -> Bi
 // ---------------------------------------------------------------------------------------
 // Flow-only SPD solves (fixed-stress and explicit updates)
 
-/// Sparse Cholesky of `diag(d) + Δt A` on the flow pattern, refactorized only when the
-/// matrix changes.
+/// Sparse `LDLᵀ` of `diag(d) + Δt A` on the flow pattern (symmetric positive definite:
+/// every pivot must be positive), refactorized only when the matrix changes.
 struct FlowSolver {
-    symbolic: Option<SymbolicLlt<usize>>,
-    llt: Option<Llt<usize, f64>>,
+    ldlt: Option<Ldlt>,
+    col_ptr: Vec<usize>,
+    row_idx: Vec<usize>,
     vals: Vec<f64>,
     factored_vals: Vec<f64>,
-    factorizations: usize,
+    /// `Δt` of the current factorization.
+    dt: Option<f64>,
 }
 
 impl FlowSolver {
     fn new() -> Self {
         Self {
-            symbolic: None,
-            llt: None,
+            ldlt: None,
+            col_ptr: Vec::new(),
+            row_idx: Vec::new(),
             vals: Vec::new(),
             factored_vals: Vec::new(),
-            factorizations: 0,
+            dt: None,
         }
+    }
+
+    /// The step to take for a requested `dt` at `t` (see `snap_step`).
+    fn step_for(&self, dt: f64, t: f64) -> f64 {
+        snap_step(dt, t, self.dt)
     }
 
     fn factorize<const D: usize>(
@@ -952,38 +1302,46 @@ impl FlowSolver {
         for (c, &p) in flow.diagonal_positions().iter().enumerate() {
             self.vals[p] += diag[c];
         }
-        if self.llt.is_some() && self.vals == self.factored_vals {
+        if let Some(l) = &self.ldlt
+            && l.is_factored()
+            && self.vals == self.factored_vals
+        {
             return Ok(());
         }
-        self.llt = None;
-        if self.symbolic.is_none() {
-            self.symbolic = Some(
-                SymbolicLlt::try_new(flow.pattern().as_ref(), Side::Lower)
-                    .map_err(|e| BiotError::Solver(format!("symbolic Cholesky: {e:?}")))?,
-            );
-        }
-        let sym = self
-            .symbolic
-            .clone()
-            .ok_or_else(|| BiotError::Solver("symbolic Cholesky missing".into()))?;
-        let mat = SparseColMatRef::new(flow.pattern().as_ref(), &self.vals);
-        let llt = Llt::try_new_with_symbolic(sym, mat, Side::Lower).map_err(|e| {
+        self.dt = None;
+        let ldlt = match self.ldlt.as_mut() {
+            Some(l) => l,
+            None => {
+                let pat = flow.pattern();
+                self.col_ptr = pat.col_ptr().to_vec();
+                self.row_idx = pat.row_idx().to_vec();
+                let l = Ldlt::analyse(pat.ncols(), &self.col_ptr, &self.row_idx, None)
+                    .map_err(|e| BiotError::Solver(format!("flow factorization: {}", e.0)))?;
+                self.ldlt.insert(l)
+            }
+        };
+        let failed = |why: String| {
             BiotError::Solver(format!(
-                "flow Cholesky failed ({e}); a region lacks storage and a pressure anchor"
+                "flow factorization failed ({why}); a region lacks storage and a pressure anchor"
             ))
-        })?;
-        self.factorizations += 1;
-        self.llt = Some(llt);
+        };
+        ldlt.factorize(&self.col_ptr, &self.row_idx, &self.vals)
+            .map_err(|e| failed(e.0))?;
+        if !ldlt.pivots_positive() {
+            return Err(failed("a pivot is not positive".into()));
+        }
         self.factored_vals.clone_from(&self.vals);
+        self.dt = Some(dt);
         Ok(())
     }
 
-    fn solve(&self, rhs: &mut [f64]) -> BiotResult<()> {
-        let llt = self
-            .llt
-            .as_ref()
+    fn solve(&mut self, rhs: &mut [f64]) -> BiotResult<()> {
+        let ldlt = self
+            .ldlt
+            .as_mut()
             .ok_or_else(|| BiotError::Solver("flow solve before factorization".into()))?;
-        llt.solve_in_place(faer::col::ColMut::from_slice_mut(rhs));
+        ldlt.solve_in_place(rhs)
+            .map_err(|e| BiotError::Solver(e.0))?;
         if let Some(c) = rhs.iter().position(|v| !v.is_finite()) {
             return Err(BiotError::Solver(format!(
                 "non-finite pressure in cell {c}"
@@ -991,19 +1349,42 @@ impl FlowSolver {
         }
         Ok(())
     }
+
+    fn stats(&self) -> CouplingStats {
+        match &self.ldlt {
+            Some(l) => CouplingStats {
+                linear: "cholesky",
+                numeric_factorizations: l.numeric_factorizations(),
+                symbolic_factorizations: 1,
+                factor_nnz: l.factor_nnz(),
+                solves: l.solves(),
+            },
+            None => CouplingStats {
+                linear: "cholesky",
+                ..CouplingStats::default()
+            },
+        }
+    }
 }
 
 /// The mechanics solve `K x = g + Cᵀ (p − p₀)` shared by the split schemes.
 struct MechSolver {
     solver: Option<DirectSolver>,
-    factored_vals: Vec<f64>,
+    /// The stiffness of the current factorization.
+    factored: Option<Arc<[f64]>>,
+    solves: usize,
+    rhs: Vec<f64>,
+    full: Vec<f64>,
 }
 
 impl MechSolver {
     fn new() -> Self {
         Self {
             solver: None,
-            factored_vals: Vec::new(),
+            factored: None,
+            solves: 0,
+            rhs: Vec::new(),
+            full: Vec::new(),
         }
     }
 
@@ -1023,17 +1404,38 @@ impl MechSolver {
             .solver
             .as_mut()
             .ok_or_else(|| BiotError::Solver("mechanics solver missing".into()))?;
-        if self.factored_vals != sys.k_values {
+        let same = match &self.factored {
+            Some(k) => Arc::ptr_eq(k, &sys.k_values) || **k == *sys.k_values,
+            None => false,
+        };
+        if !same {
+            self.factored = None;
             solver.factorize(pat, &sys.k_values)?;
-            self.factored_vals.clone_from(&sys.k_values);
         }
-        let mut rhs = vec![0.0; pat.num_equations()];
-        sys.mechanics_base(t, u_out, &mut rhs)?;
-        let dp: Vec<f64> = p.iter().zip(&sys.p0).map(|(a, b)| a - b).collect();
-        sys.add_coupling_transpose(&dp, &mut rhs);
-        solver.solve_in_place(&mut rhs)?;
-        sys.mech.dofs.scatter(&rhs, u_out);
+        self.factored = Some(sys.k_values.clone());
+        self.rhs.resize(pat.num_equations(), 0.0);
+        sys.mechanics_base(t, u_out, &mut self.full, &mut self.rhs)?;
+        sys.add_pore_pressure_equations(p, &mut self.rhs);
+        solver.solve_in_place(&mut self.rhs)?;
+        self.solves += 1;
+        sys.mech.dofs.scatter(&self.rhs, u_out);
         Ok(())
+    }
+
+    fn stats(&self) -> CouplingStats {
+        CouplingStats {
+            linear: "cholesky",
+            numeric_factorizations: self
+                .solver
+                .as_ref()
+                .map_or(0, |s| s.numeric_factorizations()),
+            symbolic_factorizations: self
+                .solver
+                .as_ref()
+                .map_or(0, |s| s.symbolic_factorizations()),
+            factor_nnz: self.solver.as_ref().map_or(0, |s| s.factor_nnz()),
+            solves: self.solves,
+        }
     }
 }
 
@@ -1064,6 +1466,12 @@ impl FixedStress {
             mech: MechSolver::new(),
         }
     }
+
+    /// What the linear algebra did: the flow and mechanics factorizations and solves
+    /// together (see [`CouplingStats`]).
+    pub fn stats(&self) -> CouplingStats {
+        self.flow.stats().add(self.mech.stats())
+    }
 }
 
 impl<const D: usize> BiotCoupling<D> for FixedStress {
@@ -1092,11 +1500,13 @@ impl<const D: usize> BiotCoupling<D> for FixedStress {
                     .into(),
             )
         })?;
+        let dt = self.flow.step_for(dt, t);
         let nc = sys.num_cells();
         let t1 = t + dt;
         let vols = sys.mech.grid.cell_volumes();
+        let alpha = &sys.ops.alpha;
         let beta: Vec<f64> = (0..nc)
-            .map(|c| sys.alpha[c] * sys.alpha[c] / kdr[c] * vols[c])
+            .map(|c| alpha[c] * alpha[c] / kdr[c] * vols[c])
             .collect();
         let diag: Vec<f64> = sys
             .flow
@@ -1133,7 +1543,7 @@ impl<const D: usize> BiotCoupling<D> for FixedStress {
                 .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
             let pref = p
                 .iter()
-                .zip(&sys.p0)
+                .zip(&sys.ops.p0)
                 .fold(inf_norm(&rhs), |m, (a, b)| m.max((a - b).abs()));
             // The mechanics is solved exactly for the new pressure, so the displacement
             // change is a bounded linear image of the pressure change: the pressure change
@@ -1185,6 +1595,12 @@ impl ExplicitPressure {
         }
     }
 
+    /// What the linear algebra did: the flow and mechanics factorizations and solves
+    /// together (see [`CouplingStats`]).
+    pub fn stats(&self) -> CouplingStats {
+        self.flow.stats().add(self.mech.stats())
+    }
+
     /// The pressure at `t + dt` from the displacements `u_new = u^{n+1}`, `u_old = uⁿ`
     /// (nodal, `D · nodes`) and the pressure `p_old = pⁿ`: solves
     /// `(M + Δt A)(p^{n+1} − pⁿ) = Δt (b(t + Δt) − A pⁿ) − Σ_{K fractured} α_K ΔV_K(u^{n+1} − uⁿ) e_K`.
@@ -1200,6 +1616,7 @@ impl ExplicitPressure {
         dt: f64,
     ) -> BiotResult<Vec<f64>> {
         check_step(dt, t)?;
+        let dt = self.flow.step_for(dt, t);
         let nc = sys.num_cells();
         check_len("fractured flags", self.fractured.len(), nc)?;
         check_len("old pressure", p_old.len(), nc)?;

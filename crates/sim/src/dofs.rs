@@ -233,6 +233,13 @@ impl<const D: usize> DofMap<D> {
         }
     }
 
+    /// Whether every prescribed value and platen force is a constant
+    /// ([`ScalarField::Const`]): then they do not depend on time.
+    pub fn is_time_independent(&self) -> bool {
+        self.fixed_values.iter().all(|f| f.as_const().is_some())
+            && self.platens.iter().all(|p| p.force.as_const().is_some())
+    }
+
     /// Write the prescribed values at time `t` into the nodal vector `u` (length
     /// [`Self::num_dofs`]); other entries are left as they are.
     pub fn set_prescribed(&self, grid: &Grid<D>, t: f64, u: &mut [f64]) {

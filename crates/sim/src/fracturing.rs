@@ -40,18 +40,22 @@
 use porofrac_flow::{FlowError, FlowModel, Permeability};
 use porofrac_frac::recovery::{NodeCells, cell_average, recover_nodal};
 use porofrac_frac::{Combined, CrackTracking, FailurePolicy, FailureState, ResolveError, resolve};
-use porofrac_grid::Grid;
-use porofrac_law::{CellLaw, Tensor};
+use porofrac_grid::{Grid, Point};
+use porofrac_law::{CellGeometry, CellLaw, Scratch, Tensor};
+use rayon::prelude::*;
 
 use crate::bc::Loads;
+use std::sync::Arc;
+
 use crate::biot::{
-    BiotCoupling, BiotError, BiotState, BiotSystem, ExplicitPressure, FixedStress, Monolithic,
+    BiotCoupling, BiotError, BiotState, BiotSystem, CouplingStats, ExplicitPressure, FixedStress,
+    Monolithic, Operators,
 };
 use crate::dofs::DofMap;
 use crate::error::SimError;
 use crate::laws::LawMap;
 use crate::pattern::Pattern;
-use crate::solve::{StaticProblem, cell_stresses};
+use crate::solve::StaticProblem;
 
 /// Errors of the fracturing driver.
 #[derive(Debug, thiserror::Error)]
@@ -260,19 +264,6 @@ impl<const D: usize> FailureResolution<D> {
     }
 }
 
-/// What the linear solves of a coupled run did, for reports.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct CouplingStats {
-    /// The linear solver of the coupled systems.
-    pub linear: &'static str,
-    /// Numeric factorizations done.
-    pub numeric_factorizations: usize,
-    /// Symbolic factorizations (analyses) done.
-    pub symbolic_factorizations: usize,
-    /// Nonzeros of the factor (0 where nothing was factorized).
-    pub factor_nnz: usize,
-}
-
 /// The coupling scheme of a [`Fracturing`] run.
 pub enum Scheme {
     /// Fully implicit monolithic (seed eq. 30).
@@ -290,6 +281,15 @@ impl Scheme {
             Scheme::Monolithic(_) => "monolithic",
             Scheme::FixedStress(..) => "fixed-stress",
             Scheme::ExplicitPressure(..) => "explicit-pressure",
+        }
+    }
+
+    /// What the linear algebra of the scheme did (see [`CouplingStats`]).
+    pub fn stats(&self) -> CouplingStats {
+        match self {
+            Scheme::Monolithic(m) => m.stats(),
+            Scheme::FixedStress(f, _) => f.stats(),
+            Scheme::ExplicitPressure(e, _) => e.stats(),
         }
     }
 }
@@ -334,7 +334,9 @@ pub struct FractureStep<const D: usize> {
     pub rounds: usize,
     /// Linear coupled solves (all rounds and active-set iterations).
     pub solves: usize,
-    /// Largest relative equilibrium residual accepted.
+    /// Largest relative equilibrium residual accepted. When every law is linear there is
+    /// no active set to settle (the stiffness does not depend on the displacement), and
+    /// this is the residual of the coupled step ([`crate::BiotStep::residual`]).
     pub residual: f64,
 }
 
@@ -347,6 +349,19 @@ pub struct Fracturing<'a, const D: usize> {
     failures: FailureState,
     resolution: FailureResolution<D>,
     perm_of_failed: Vec<bool>,
+    /// The coupling data (α, `p₀`, node normals), built once.
+    operators: Arc<Operators<D>>,
+    /// The node coordinates of every cell, aligned with the node normals of `operators`.
+    coords: Vec<Point<D>>,
+    /// The law map and the assembled stiffness of the last failure state solved.
+    cached: Option<Cached<'a, D>>,
+}
+
+/// A failure state's law map and stiffness (at zero displacement).
+struct Cached<'a, const D: usize> {
+    flags: Vec<bool>,
+    map: LawMap<'a, D>,
+    stiffness: Option<Arc<[f64]>>,
 }
 
 impl<'a, const D: usize> Fracturing<'a, D> {
@@ -407,7 +422,13 @@ impl<'a, const D: usize> Fracturing<'a, D> {
             flow.p0.clone(),
         )?;
         let scheme = scheme(&system)?;
+        let (operators, stiffness) = system.parts();
         drop(system);
+        let cached = Some(Cached {
+            flags: vec![false; nc],
+            map: intact,
+            stiffness: Some(stiffness),
+        });
         let resolution =
             FailureResolution::new(body.grid, settings).map_err(FractureError::Input)?;
         Ok(Self {
@@ -418,6 +439,11 @@ impl<'a, const D: usize> Fracturing<'a, D> {
             failures: FailureState::new(nc),
             resolution,
             perm_of_failed: vec![false; nc],
+            coords: (0..nc)
+                .flat_map(|c| body.grid.cell_nodes(c).iter().map(|&n| *body.grid.node(n)))
+                .collect(),
+            operators,
+            cached,
         })
     }
 
@@ -433,24 +459,14 @@ impl<'a, const D: usize> Fracturing<'a, D> {
     pub fn initial_pressure(&self) -> &[f64] {
         &self.flow.p0
     }
-    /// What the linear solves did so far.
-    pub fn stats(&self) -> CouplingStats {
-        match &self.scheme {
-            Scheme::Monolithic(m) => CouplingStats {
-                linear: "ldlt",
-                numeric_factorizations: m.numeric_factorizations(),
-                symbolic_factorizations: 1,
-                factor_nnz: 0,
-            },
-            _ => CouplingStats {
-                linear: "cholesky",
-                ..CouplingStats::default()
-            },
-        }
-    }
     /// The name of the coupling scheme.
     pub fn scheme_name(&self) -> &'static str {
         self.scheme.name()
+    }
+    /// What the linear algebra of the coupling did so far: solver, numeric and symbolic
+    /// factorizations, factor entries and solves (see [`CouplingStats`]).
+    pub fn stats(&self) -> CouplingStats {
+        self.scheme.stats()
     }
     /// The law map of the current failure state.
     pub fn law_map(&self) -> FractureResult<LawMap<'a, D>> {
@@ -482,6 +498,9 @@ impl<'a, const D: usize> Fracturing<'a, D> {
             failures,
             resolution,
             perm_of_failed,
+            operators,
+            coords,
+            cached,
         } = self;
         let grid = body.grid;
         let t1 = t + dt;
@@ -492,14 +511,26 @@ impl<'a, const D: usize> Fracturing<'a, D> {
         let mut solves = 0;
         let mut worst = 0.0f64;
         let solve = |fs: &FailureState| -> FractureResult<(BiotState, Vec<Tensor<D>>)> {
-            let map = laws.law_map(grid, fs.flags())?;
+            if cached.as_ref().is_none_or(|c| c.flags != fs.flags()) {
+                *cached = Some(Cached {
+                    flags: fs.flags().to_vec(),
+                    map: laws.law_map(grid, fs.flags())?,
+                    stiffness: None,
+                });
+            }
+            let Some(Cached { map, stiffness, .. }) = cached.as_mut() else {
+                return Err(FractureError::Input("law map missing".into()));
+            };
             update_permeability(grid, flow, fs.flags(), perm_of_failed)?;
-            let mut system = BiotSystem::new(
-                problem(body, &map),
+            let mut system = BiotSystem::from_parts(
+                problem(body, map),
                 &flow.model,
-                flow.alpha.clone(),
-                flow.p0.clone(),
+                operators.clone(),
+                stiffness.clone(),
             )?;
+            if stiffness.is_none() {
+                *stiffness = Some(system.parts().1);
+            }
             if let Scheme::FixedStress(_, k_dr) = scheme {
                 system = system.with_drained_bulk_modulus(k_dr.clone())?;
             }
@@ -514,7 +545,7 @@ impl<'a, const D: usize> Fracturing<'a, D> {
             let (new, residual, n) = active_set_solve(&mut system, scheme, state, t, dt, limits)?;
             solves += n;
             worst = worst.max(residual);
-            let stress = cell_stresses(grid, &map, &new.displacement)?;
+            let stress = stresses(grid, map, operators, coords, &new.displacement)?;
             Ok((new, stress))
         };
         let done = resolution
@@ -554,6 +585,57 @@ fn problem<'b, const D: usize>(
         pattern: body.pattern,
         loads: body.loads,
     }
+}
+
+/// Grids with fewer cells evaluate the cell stresses on the calling thread: a few
+/// microseconds of work per thousand cells gain nothing from a fork–join.
+const PARALLEL_STRESS_CELLS: usize = 16_384;
+
+/// The stress of every cell ([`CellLaw::stress`]) at the nodal displacement `u`, the
+/// same values as [`crate::cell_stresses`] with the node normals of `ops` and the node
+/// coordinates `coords` (aligned with them) instead of gathering and recomputing them
+/// per cell; cells in parallel blocks.
+fn stresses<const D: usize>(
+    grid: &Grid<D>,
+    map: &LawMap<'_, D>,
+    ops: &Operators<D>,
+    coords: &[Point<D>],
+    u: &[f64],
+) -> FractureResult<Vec<Tensor<D>>> {
+    /// Cells per block; one block per thread task, all blocks on the calling thread
+    /// below [`PARALLEL_STRESS_CELLS`] cells.
+    const BLOCK: usize = 1024;
+    if u.len() != D * grid.num_nodes() {
+        return Err(FractureError::Input(format!(
+            "displacement of length {}, want {}",
+            u.len(),
+            D * grid.num_nodes()
+        )));
+    }
+    let mut out = vec![Tensor::<D>::zeros(); grid.num_cells()];
+    let volumes = grid.cell_volumes();
+    let block = |(b, chunk): (usize, &mut [Tensor<D>])| {
+        let mut scratch = Scratch::default();
+        let mut uc = Vec::new();
+        for (i, s) in chunk.iter_mut().enumerate() {
+            let c = b * BLOCK + i;
+            let k = ops.node_ptr[c]..ops.node_ptr[c + 1];
+            uc.clear();
+            uc.extend(ops.dofs[D * k.start..D * k.end].iter().map(|&d| u[d]));
+            let geo = CellGeometry {
+                coords: &coords[k.clone()],
+                node_normals: &ops.normals[k],
+                volume: volumes[c],
+            };
+            *s = map.law(c).stress(&geo, &uc, &mut scratch);
+        }
+    };
+    if out.len() < PARALLEL_STRESS_CELLS {
+        out.chunks_mut(BLOCK).enumerate().for_each(block);
+    } else {
+        out.par_chunks_mut(BLOCK).enumerate().for_each(block);
+    }
+    Ok(out)
 }
 
 /// Raise the permeability of newly failed cells (only when the flags changed).
@@ -600,6 +682,20 @@ fn active_set_solve<const D: usize>(
     limits: ActiveSetLimits,
 ) -> FractureResult<(BiotState, f64, usize)> {
     let t1 = t + dt;
+    if system.mechanics().laws.all_linear() {
+        // The stiffness does not depend on the displacement: one solve is exact.
+        return Ok(match state {
+            None => (system.initial_state(t)?, 0.0, 1),
+            Some(s) => {
+                let res = match scheme {
+                    Scheme::Monolithic(m) => m.step(system, s, t, dt)?,
+                    Scheme::FixedStress(f, _) => f.step(system, s, t, dt)?,
+                    Scheme::ExplicitPressure(e, _) => e.step(system, s, t, dt)?,
+                };
+                (res.state, res.residual, 1)
+            }
+        });
+    }
     let p0 = system.initial_pressure().to_vec();
     match state {
         Some(s) => system.linearize(&s.displacement, &s.pressure, t)?,

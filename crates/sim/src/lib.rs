@@ -47,6 +47,7 @@ pub mod field;
 pub mod fracturing;
 pub mod heap;
 pub mod laws;
+mod ldlt;
 pub mod linear;
 pub mod ordering;
 pub mod pattern;
@@ -57,16 +58,16 @@ pub mod standard;
 pub use assembly::{assemble, nodal_loads};
 pub use bc::{Displacement, Gravity, Loads, Platen, Traction};
 pub use biot::{
-    BiotCoupling, BiotError, BiotState, BiotStep, BiotSystem, ExplicitPressure, FixedStress,
-    Linearization, Monolithic, drained_bulk_modulus,
+    BiotCoupling, BiotError, BiotState, BiotStep, BiotSystem, CouplingStats, ExplicitPressure,
+    FixedStress, Linearization, Monolithic, drained_bulk_modulus,
 };
 pub use dofs::DofMap;
 pub use error::{Result, SimError};
 pub use explicit::{ExplicitOptions, ExplicitSolution, ExplicitState, solve_explicit};
 pub use field::{FieldFn, ScalarField, VectorField, VectorFn};
 pub use fracturing::{
-    Body, CouplingStats, FailureResolution, FractureError, FractureFlow, FractureLaws,
-    FractureSettings, FractureStep, Fracturing, ResolutionError, Resolved, Scheme, StressMeasure,
+    Body, FailureResolution, FractureError, FractureFlow, FractureLaws, FractureSettings,
+    FractureStep, Fracturing, ResolutionError, Resolved, Scheme, StressMeasure,
 };
 pub use laws::LawMap;
 pub use linear::{

@@ -59,7 +59,8 @@
 //! `E = ½ |K| ε_K · D ε_K + ½ Σ_i r_i · S_i r_i` with the non-linear remainder
 //! `r_i = u_i − ū − G d_i = ((I − P) u)_i`, forces
 //! `F_j = −σ N_j − (t_j − t̄ − (1/|K|) (Σ_i t_i ⊗ d_i) N_j)` with `t_i = S_i r_i`, and the
-//! stress `σ = C : ε(u)` is the constant stress of the projection.
+//! stress `σ = C : ε(u)` is the constant stress of the projection (for an isotropic
+//! material `λ tr(ε) I + 2μ ε` directly, without the Kelvin product).
 //!
 //! # Stabilization
 //!
@@ -558,8 +559,17 @@ impl<const D: usize> CellLaw<D> for VemLaw<D> {
     }
 
     fn stress(&self, cell: &CellGeometry<'_, D>, u: &[f64], _scratch: &mut Scratch) -> Tensor<D> {
-        let f = Frame::new(cell);
-        let (_, g) = Self::kinematics(cell, &f, u);
+        // G = (1/|K|) Σ_j u_j ⊗ N_j, as in `kinematics` (no frame needed).
+        let mut g = Tensor::<D>::zeros();
+        for (j, nj) in cell.node_normals.iter().enumerate() {
+            g += node_vec::<D>(u, j) * nj.transpose();
+        }
+        let g = g * (1.0 / cell.volume);
+        if let Some((lam, mu)) = self.lame {
+            // Isotropic: σ = λ tr(ε) I + 2μ ε, ε = sym G.
+            let eps = (g + g.transpose()) * 0.5;
+            return Tensor::<D>::identity() * (lam * eps.trace()) + eps * (2.0 * mu);
+        }
         from_kelvin::<D>(&self.material.stress_kelvin(&to_kelvin::<D>(&g)))
     }
 }
