@@ -24,10 +24,11 @@ pub fn nested_dissection<const D: usize>(grid: &Grid<D>, dofs: &DofMap<D>) -> Ve
     for &v in &order {
         for a in 0..D {
             if let Some(e) = dofs.equation(v, a)
-                && !seen[e] {
-                    seen[e] = true;
-                    perm.push(e);
-                }
+                && !seen[e]
+            {
+                seen[e] = true;
+                perm.push(e);
+            }
         }
     }
     perm
