@@ -1,10 +1,10 @@
 #!/usr/bin/env python3
 """Back-to-back rounds: porofrac on scenes/mandel.toml, then mandel_scipy.py.
 
-    python peers/mandel/rounds.py [ROUNDS] [--porofrac target/release/porofrac]
+    python peers/mandel/rounds.py [ROUNDS] [--porofrac target/release/porofrac] [--out /tmp/m]
 
 Run from the repository root with the venv's python. Each round runs, in this order,
-`porofrac run scenes/mandel.toml --out /tmp/mandel-rounds` (stdout and stderr to
+`porofrac run scenes/mandel.toml --out /tmp/m` (stdout and stderr to
 /dev/null), `mandel_scipy.py` (symmetric splu) and `mandel_scipy.py --splu default`, and
 records for each the process wall time (perf_counter around the child process) and the
 time the program reports (porofrac: summary.json wall_seconds.total; the peer: total_s),
@@ -58,7 +58,7 @@ def main():
     if "--porofrac" in args:
         exe = args[args.index("--porofrac") + 1]
     rounds = int(args[0]) if args and args[0].isdigit() else 5
-    out = "/tmp/mandel-rounds"
+    out = args[args.index("--out") + 1] if "--out" in args else "/tmp/m"
     peer = [sys.executable, os.path.join(HERE, "mandel_scipy.py")]
     table = []
     for k in range(1, rounds + 1):
@@ -67,9 +67,11 @@ def main():
                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         summary = json.load(open(os.path.join(out, "summary.json")))
         ours = summary["wall_seconds"]["total"]
+        phases = summary["wall_seconds"]
         err_ours = max_error(os.path.join(out, "probes.csv"), None)
         row = {"round": k, "load": load, "porofrac_total": ours, "porofrac_wall": wall,
-               "porofrac_err": err_ours}
+               "porofrac_err": err_ours, "porofrac_solve": phases["solve"],
+               "porofrac_output": phases["output"]}
         for name, extra in [("peer", []), ("peer_default", ["--splu", "default"])]:
             pw, res = timed(peer + extra, capture_output=True, text=True)
             result = json.loads(next(line for line in res.stdout.splitlines()
@@ -81,11 +83,13 @@ def main():
         row["ratio_wall"] = row["peer_wall"] / wall
         row["ratio_default"] = row["peer_default_total"] / ours
         table.append(row)
-    print("| round | load | porofrac total (wall) s | peer total (wall) s | ratio (wall) "
-          "| peer, splu defaults, total s | ratio | max error/p0: porofrac, peer |")
-    print("|---|---|---|---|---|---|---|---|")
+    print("| round | load | porofrac total (wall) s | of which solve, output s "
+          "| peer total (wall) s | ratio (wall) | peer, splu defaults, total s | ratio "
+          "| max error/p0: porofrac, peer |")
+    print("|---|---|---|---|---|---|---|---|---|")
     for r in table:
         print(f"| {r['round']} | {r['load']:.2f} | {r['porofrac_total']:.4f} ({r['porofrac_wall']:.4f}) "
+              f"| {r['porofrac_solve']:.4f}, {r['porofrac_output']:.4f} "
               f"| {r['peer_total']:.4f} ({r['peer_wall']:.3f}) | {r['ratio']:.2f} ({r['ratio_wall']:.2f}) "
               f"| {r['peer_default_total']:.4f} | {r['ratio_default']:.2f} "
               f"| {r['porofrac_err']:.4%}, {r['peer_err']:.4%} |")

@@ -602,7 +602,7 @@ fn stresses<const D: usize>(
     coords: &[Point<D>],
     u: &[f64],
 ) -> FractureResult<Vec<Tensor<D>>> {
-    /// Cells per block; one block per thread task, all blocks on the calling thread
+    /// Cells per block, each block evaluated by one thread; all on the calling thread
     /// below [`PARALLEL_STRESS_CELLS`] cells.
     const BLOCK: usize = 1024;
     if u.len() != D * grid.num_nodes() {
