@@ -43,7 +43,7 @@ use crate::model::{Model, RunError, Sizes, StepStats};
 use crate::output::{CsvTable, SolverStats, Summary, WallSeconds};
 use crate::sample::{Location, locate};
 
-use compose::{Composition, Conditions, compose, conditions, material_stiffness};
+use compose::{Composition, compose, conditions, material_stiffness};
 use fields::Field;
 use flow::{FlowSetup, flow_setup};
 use grid::{AnyGrid, build_grid, point};
@@ -101,7 +101,7 @@ fn run_dim<const D: usize>(
         pattern: &pattern,
         loads: &cond.loads,
     };
-    let mut stepper = Stepper::new(ls, body, &comp, &cond, law_refs, out)?;
+    let mut stepper = Stepper::new(ls, body, &comp, law_refs, out)?;
     stepper.wall.assembly += assembly;
     drive(ls, &mut stepper, out, observer, start, grid_seconds, D)
 }
@@ -227,11 +227,9 @@ impl<'a, const D: usize> Stepper<'a, D> {
         ls: &'a LoadedScene,
         body: Body<'a, D>,
         comp: &'a Composition<D>,
-        cond: &'a Conditions<D>,
         law_refs: Vec<&'a dyn CellLaw<D>>,
         out: &Path,
     ) -> Result<Self, RunError> {
-        let _ = cond;
         let s = &ls.scene;
         let grid = body.grid;
         let mut wall = WallSeconds::default();
