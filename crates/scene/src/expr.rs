@@ -43,6 +43,19 @@ enum Func {
 }
 
 impl Func {
+    /// [`Func::apply`] on every lane, the function chosen once.
+    fn apply_lanes(self, a: &[f64; LANES]) -> [f64; LANES] {
+        match self {
+            Func::Sin => lanes1(a, f64::sin),
+            Func::Cos => lanes1(a, f64::cos),
+            Func::Tan => lanes1(a, f64::tan),
+            Func::Exp => lanes1(a, f64::exp),
+            Func::Ln => lanes1(a, f64::ln),
+            Func::Sqrt => lanes1(a, f64::sqrt),
+            Func::Abs => lanes1(a, f64::abs),
+        }
+    }
+
     fn apply(self, v: f64) -> f64 {
         match self {
             Func::Sin => v.sin(),
@@ -441,6 +454,9 @@ impl Expr {
     }
 }
 
+/// Points evaluated together by [`Program::eval_points`].
+pub const LANES: usize = 8;
+
 /// Several expressions compiled into one program that evaluates every common
 /// subexpression once (the components of a body force share `sin(pi*x)`, ...).
 ///
@@ -479,6 +495,11 @@ enum Node {
     /// `min`/`max` over `args[start..start + len]`.
     Min(u32, u32),
     Max(u32, u32),
+    /// `sin a` into the first node given and `cos a` into the second, in one `sin_cos`
+    /// call, at the first of the two.
+    SinCos(u32, u32, u32),
+    /// A value a [`Node::SinCos`] before it wrote.
+    Written,
 }
 
 impl Program {
@@ -543,13 +564,15 @@ impl Program {
             p.outputs.push(stack.pop().unwrap_or(0));
         }
         p.drop_unused();
+        p.pair_sin_cos();
         p
     }
 
     /// The operands of a node.
     fn operands(&self, node: &Node) -> Vec<u32> {
         match *node {
-            Node::Num(_) | Node::Var(_) => vec![],
+            Node::Num(_) | Node::Var(_) | Node::Written => vec![],
+            Node::SinCos(a, ..) => vec![a],
             Node::Neg(a)
             | Node::Square(a)
             | Node::Call1(_, a)
@@ -619,6 +642,28 @@ impl Program {
         self.nodes = nodes;
     }
 
+    /// Where a program takes both `sin a` and `cos a` (a manufactured load's `sin(pi*x)`
+    /// and `cos(pi*x)`), compute them in one `f64::sin_cos` call at the first of the two
+    /// nodes: the argument reduction is shared, which makes the pair about as cheap as
+    /// one. `sin_cos` gives the same values as `sin` and `cos` (checked by the tests).
+    fn pair_sin_cos(&mut self) {
+        let mut first: std::collections::HashMap<u32, (Option<usize>, Option<usize>)> =
+            std::collections::HashMap::new();
+        for (i, node) in self.nodes.iter().enumerate() {
+            if let Node::Call1(f @ (Func::Sin | Func::Cos), a) = *node {
+                let e = first.entry(a).or_default();
+                let slot = if f == Func::Sin { &mut e.0 } else { &mut e.1 };
+                slot.get_or_insert(i);
+            }
+        }
+        for (a, pair) in first {
+            if let (Some(si), Some(ci)) = pair {
+                self.nodes[si.min(ci)] = Node::SinCos(a, si as u32, ci as u32);
+                self.nodes[si.max(ci)] = Node::Written;
+            }
+        }
+    }
+
     /// Number of distinct operations.
     pub fn len(&self) -> usize {
         self.nodes.len()
@@ -648,10 +693,117 @@ impl Program {
         });
     }
 
+    /// Evaluate every output at each point of `xs` and time `t`: `out` holds
+    /// `xs.len() × len(outputs)` values, point after point. The points go through the
+    /// program [`LANES`] at a time, each operation over all lanes in one loop, so the
+    /// interpretation costs once per lane group instead of once per point; every lane
+    /// computes exactly what [`Program::eval`] computes, bit for bit.
+    pub fn eval_points<const D: usize>(&self, xs: &[[f64; D]], t: f64, out: &mut [f64]) {
+        let m = self.outputs.len();
+        assert_eq!(out.len(), xs.len() * m, "eval_points: output length");
+        thread_local! {
+            static LANE_SCRATCH: std::cell::RefCell<Vec<[f64; LANES]>> =
+                const { std::cell::RefCell::new(Vec::new()) };
+        }
+        let mut run = |v: &mut [[f64; LANES]]| {
+            for (pts, vals) in xs.chunks(LANES).zip(out.chunks_mut(LANES * m)) {
+                self.eval_lanes(pts, t, v);
+                for (p, row) in vals.chunks_mut(m).enumerate() {
+                    for (o, &k) in row.iter_mut().zip(&self.outputs) {
+                        *o = v[k as usize][p];
+                    }
+                }
+            }
+        };
+        LANE_SCRATCH.with(|cell| match cell.try_borrow_mut() {
+            Ok(mut v) => {
+                if v.len() < self.nodes.len() {
+                    v.resize(self.nodes.len(), [0.0; LANES]);
+                }
+                run(&mut v)
+            }
+            Err(_) => run(&mut vec![[0.0; LANES]; self.nodes.len()]),
+        });
+    }
+
+    /// Every node at up to [`LANES`] points (lanes past `pts.len()` repeat the last point).
+    fn eval_lanes<const D: usize>(&self, pts: &[[f64; D]], t: f64, v: &mut [[f64; LANES]]) {
+        let coord = |k: usize| -> [f64; LANES] {
+            std::array::from_fn(|l| {
+                let p = &pts[l.min(pts.len() - 1)];
+                if k == 3 {
+                    t
+                } else {
+                    p.get(k).copied().unwrap_or(0.0)
+                }
+            })
+        };
+        for (i, node) in self.nodes.iter().enumerate() {
+            // Operands are earlier nodes: split so they can be read while `i` is written.
+            let (done, rest) = v.split_at_mut(i);
+            let g = |k: u32| &done[k as usize];
+            rest[0] = match *node {
+                Node::SinCos(a, si, ci) => {
+                    let a = g(a);
+                    let (mut sin, mut cos) = ([0.0; LANES], [0.0; LANES]);
+                    for l in 0..LANES {
+                        (sin[l], cos[l]) = a[l].sin_cos();
+                    }
+                    let later = si.max(ci) as usize - i;
+                    (rest[0], rest[later]) = if si < ci { (sin, cos) } else { (cos, sin) };
+                    continue;
+                }
+                Node::Written => continue,
+                Node::Num(c) => [c; LANES],
+                Node::Var(k) => coord(k),
+                Node::Neg(a) => lanes1(g(a), |a| -a),
+                Node::Square(a) => lanes1(g(a), |a| a * a),
+                Node::Call1(f, a) => f.apply_lanes(g(a)),
+                Node::Add(a, b) => lanes2(g(a), g(b), |a, b| a + b),
+                Node::Sub(a, b) => lanes2(g(a), g(b), |a, b| a - b),
+                Node::Mul(a, b) => lanes2(g(a), g(b), |a, b| a * b),
+                Node::Div(a, b) => lanes2(g(a), g(b), |a, b| a / b),
+                Node::Pow(a, b) => lanes2(g(a), g(b), f64::powf),
+                Node::AddC(a, c) => lanes1(g(a), |a| a + c),
+                Node::SubC(a, c) => lanes1(g(a), |a| a - c),
+                Node::CSub(c, a) => lanes1(g(a), |a| c - a),
+                Node::MulC(a, c) => lanes1(g(a), |a| a * c),
+                Node::DivC(a, c) => lanes1(g(a), |a| a / c),
+                Node::CDiv(c, a) => lanes1(g(a), |a| c / a),
+                Node::Min(s, n) | Node::Max(s, n) => {
+                    let min = matches!(node, Node::Min(..));
+                    let mut acc = [if min {
+                        f64::INFINITY
+                    } else {
+                        f64::NEG_INFINITY
+                    }; LANES];
+                    for &k in &self.args[s as usize..(s + n) as usize] {
+                        let a = g(k);
+                        for l in 0..LANES {
+                            acc[l] = if min {
+                                acc[l].min(a[l])
+                            } else {
+                                acc[l].max(a[l])
+                            };
+                        }
+                    }
+                    acc
+                }
+            };
+        }
+    }
+
     fn eval_with(&self, x: &[f64], t: f64, v: &mut [f64], out: &mut [f64]) {
         for (i, node) in self.nodes.iter().enumerate() {
             let g = |k: u32| v[k as usize];
-            v[i] = match *node {
+            let value = match *node {
+                Node::SinCos(a, si, ci) => {
+                    let (sin, cos) = g(a).sin_cos();
+                    v[si as usize] = sin;
+                    v[ci as usize] = cos;
+                    continue;
+                }
+                Node::Written => continue,
                 Node::Num(c) => c,
                 Node::Var(3) => t,
                 Node::Var(k) => x.get(k).copied().unwrap_or(0.0),
@@ -678,11 +830,24 @@ impl Program {
                     .map(|&k| g(k))
                     .fold(f64::NEG_INFINITY, f64::max),
             };
+            v[i] = value;
         }
         for (o, &k) in out.iter_mut().zip(&self.outputs) {
             *o = v[k as usize];
         }
     }
+}
+
+/// `f` applied lane by lane (generic, so it inlines into a loop the compiler vectorizes).
+#[inline(always)]
+fn lanes1(a: &[f64; LANES], f: impl Fn(f64) -> f64) -> [f64; LANES] {
+    std::array::from_fn(|l| f(a[l]))
+}
+
+/// `f` applied lane by lane to two operands.
+#[inline(always)]
+fn lanes2(a: &[f64; LANES], b: &[f64; LANES], f: impl Fn(f64, f64) -> f64) -> [f64; LANES] {
+    std::array::from_fn(|l| f(a[l], b[l]))
 }
 
 /// Identity of a node for common-subexpression elimination (constants by their bits).
@@ -715,6 +880,8 @@ impl NodeKey {
             Node::MulC(a, c) => Self::Const(3, a, c.to_bits()),
             Node::DivC(a, c) => Self::Const(4, a, c.to_bits()),
             Node::CDiv(c, a) => Self::Const(5, a, c.to_bits()),
+            Node::SinCos(a, si, ci) => Self::Const(6, a, (u64::from(si) << 32) | u64::from(ci)),
+            Node::Written => Self::Num(u64::MAX),
             Node::Min(s, n) | Node::Max(s, n) => Self::Many(
                 matches!(node, Node::Min(..)),
                 args[s as usize..(s + n) as usize].to_vec(),
@@ -803,12 +970,21 @@ mod tests {
         let exprs: Vec<Expr> = texts.iter().map(|t| Expr::parse(t).unwrap()).collect();
         let refs: Vec<&Expr> = exprs.iter().collect();
         let p = Program::new(&refs);
-        let trig = p
+        let pairs = p
+            .nodes
+            .iter()
+            .filter(|n| matches!(n, Node::SinCos(..)))
+            .count();
+        let single = p
             .nodes
             .iter()
             .filter(|n| matches!(n, Node::Call1(..)))
             .count();
-        assert_eq!(trig, 6, "sin and cos of pi x, pi y, pi z, once each");
+        assert_eq!(
+            (pairs, single),
+            (3, 0),
+            "sin and cos of pi x, pi y, pi z, once each, in pairs"
+        );
         // Constants are fused into their operations: no constant node is left but the
         // `0.5` argument of `min`.
         let nums = p.nodes.iter().filter(|n| matches!(n, Node::Num(_))).count();
@@ -818,6 +994,38 @@ mod tests {
             p.eval(&x, t, &mut out);
             for (e, v) in exprs.iter().zip(out) {
                 assert_eq!(e.eval(&x, t).to_bits(), v.to_bits());
+            }
+        }
+    }
+
+    /// Points evaluated together, in lane groups with a partial last group, give every
+    /// expression's own value bit for bit, including `sin` and `cos` taken in one call
+    /// (over arguments from 0 to far outside a period, where argument reduction matters).
+    #[test]
+    fn batched_points_give_the_same_values_bit_for_bit() {
+        let texts = [
+            "sin(pi*x)*cos(pi*y) + cos(pi*x) - sin(3*z)^2 + x^2*y",
+            "cos(x*y*1e3) + sin(x*y*1e3) + exp(-z) + tan(y) + sqrt(abs(x - z))",
+            "min(x, y, 0.5) + max(t, z)^2 - ln(1 + x) / (1 + y^2)",
+            "x - 2*y^0.5 + 3 / (1 + z) + 1e6*sin(1e6*x)*cos(1e6*x)",
+        ];
+        let exprs: Vec<Expr> = texts.iter().map(|t| Expr::parse(t).unwrap()).collect();
+        let refs: Vec<&Expr> = exprs.iter().collect();
+        let p = Program::new(&refs);
+        for n in [1, 7, 8, 9, 61] {
+            let xs: Vec<[f64; 3]> = (0..n)
+                .map(|i| {
+                    let s = i as f64 + 0.5;
+                    [0.37 * s, (1.3 * s).sin().abs(), 0.11 * s * s]
+                })
+                .collect();
+            let t = 0.25;
+            let mut out = vec![0.0; n * texts.len()];
+            p.eval_points(&xs, t, &mut out);
+            for (x, row) in xs.iter().zip(out.chunks(texts.len())) {
+                for (e, v) in exprs.iter().zip(row) {
+                    assert_eq!(e.eval(x, t).to_bits(), v.to_bits(), "{} at {x:?}", e.text());
+                }
             }
         }
     }

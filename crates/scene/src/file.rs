@@ -67,11 +67,7 @@ pub fn vector_field<const D: usize>(values: &[NumOrExpr]) -> porofrac_sim::Vecto
         })
         .collect();
     let program = Program::new(&exprs.iter().collect::<Vec<_>>());
-    VectorField::from_fn(move |x, t| {
-        let mut out = [0.0; D];
-        program.eval(x, t, &mut out);
-        out
-    })
+    VectorField::from_batch_fn(move |xs, t, out| program.eval_points(xs, t, out.as_flattened_mut()))
 }
 
 /// One component of a displacement condition: a number, an expression, or `"free"`.

@@ -267,9 +267,18 @@ pub fn nodal_loads<const D: usize>(
                 let last = nodes().max().unwrap_or(0);
                 let mut acc = vec![0.0; D * (last + 1 - first)];
                 let (mut pts, mut ids) = (Vec::new(), Vec::new());
+                let mut simplices = SimplexBatch::<D>::default();
                 for c in cells.clone() {
-                    body_load_cell(grid, loads, t, c, first, &mut acc, &mut pts, &mut ids);
+                    if grid.cell_nodes(c).len() == D + 1 {
+                        simplices.cells.push(c);
+                        if simplices.cells.len() == SimplexBatch::<D>::CELLS {
+                            simplices.load(grid, loads, t, first, &mut acc);
+                        }
+                    } else {
+                        body_load_cell(grid, loads, t, c, first, &mut acc, &mut pts, &mut ids);
+                    }
                 }
+                simplices.load(grid, loads, t, first, &mut acc);
                 (D * first, acc)
             })
             .collect();
@@ -341,7 +350,62 @@ pub fn nodal_loads<const D: usize>(
     Ok(())
 }
 
-/// Body force and gravity of cell `c`, added to `acc`, the nodal vector from node `first`
+/// Simplices whose body force and gravity are added together: their quadrature points
+/// go to the body force in one call ([`crate::VectorField::eval_many`]), so an interpreted
+/// expression pays its dispatch once per batch rather than once per point.
+#[derive(Default)]
+struct SimplexBatch<const D: usize> {
+    cells: Vec<usize>,
+    points: Vec<[f64; D]>,
+    values: Vec<[f64; D]>,
+}
+
+impl<const D: usize> SimplexBatch<D> {
+    /// Cells per batch.
+    const CELLS: usize = 64;
+
+    /// Add the loads of the pending cells to `acc` (the nodal vector from node `first`
+    /// on) and empty the batch. On a simplex `φ_i = λ_i` on the whole cell.
+    fn load(&mut self, grid: &Grid<D>, loads: &Loads<D>, t: f64, first: usize, acc: &mut [f64]) {
+        let rule = simplex_rule::<D>();
+        self.points.clear();
+        self.values.clear();
+        if let Some(b) = &loads.body_force {
+            for &c in &self.cells {
+                let cn = grid.cell_nodes(c);
+                for (_, l) in rule {
+                    let x: Point<D> = cn.iter().zip(l).map(|(&i, &li)| grid.node(i) * li).sum();
+                    self.points.push(x.into());
+                }
+            }
+            self.values.resize(self.points.len(), [0.0; D]);
+            b.eval_many(&self.points, t, &mut self.values);
+        }
+        for (j, &c) in self.cells.iter().enumerate() {
+            let cn = grid.cell_nodes(c);
+            let vol = grid.cell_volume(c);
+            let rho_g = loads
+                .gravity
+                .as_ref()
+                .map_or(Point::<D>::zeros(), |g| g.g * g.density[c]);
+            for (q, (w, l)) in rule.iter().enumerate() {
+                let mut fv = rho_g;
+                if let Some(v) = self.values.get(j * rule.len() + q) {
+                    fv += Point::<D>::from(*v);
+                }
+                fv *= w * vol;
+                for (&i, &li) in cn.iter().zip(l) {
+                    for a in 0..D {
+                        acc[D * (i - first) + a] += li * fv[a];
+                    }
+                }
+            }
+        }
+        self.cells.clear();
+    }
+}
+
+/// Body force and gravity of cell `c` (not a simplex: see [`SimplexBatch`]), added to `acc`, the nodal vector from node `first`
 /// on (see the module docs).
 fn body_load_cell<const D: usize>(
     grid: &Grid<D>,
@@ -359,24 +423,6 @@ fn body_load_cell<const D: usize>(
         .gravity
         .as_ref()
         .map_or(Point::<D>::zeros(), |g| g.g * g.density[c]);
-    if n == D + 1 {
-        // A simplex: φ_i = λ_i on the whole cell.
-        let vol = grid.cell_volume(c);
-        for (w, l) in simplex_rule::<D>() {
-            let x: Point<D> = cn.iter().zip(l).map(|(&i, &li)| grid.node(i) * li).sum();
-            let mut fv = rho_g;
-            if let Some(b) = &loads.body_force {
-                fv += Point::<D>::from(b.eval(x.as_slice(), t));
-            }
-            fv *= w * vol;
-            for (&i, &li) in cn.iter().zip(l) {
-                for a in 0..D {
-                    acc[D * (i - first) + a] += li * fv[a];
-                }
-            }
-        }
-        return;
-    }
     let xc = cn.iter().map(|&i| grid.node(i)).sum::<Point<D>>() / n as f64;
     let rule = cell_rule::<D>();
     let mut centre = Point::<D>::zeros();

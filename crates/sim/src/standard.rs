@@ -163,6 +163,30 @@ pub fn l2_error_p1<const D: usize>(
     u: &[f64],
     exact: impl Fn(&Point<D>) -> Point<D> + Sync,
 ) -> Option<f64> {
+    l2_error_p1_many(grid, u, |xs, out| {
+        for (o, x) in out.iter_mut().zip(xs) {
+            *o = exact(&Point::<D>::from(*x)).into();
+        }
+    })
+}
+
+/// [`l2_error_p1`] against a field at time `t`, evaluated at all quadrature points of a
+/// cell in one call ([`VectorField::eval_many`]).
+pub fn l2_error_p1_field<const D: usize>(
+    grid: &Grid<D>,
+    u: &[f64],
+    exact: &VectorField<D>,
+    t: f64,
+) -> Option<f64> {
+    l2_error_p1_many(grid, u, |xs, out| exact.eval_many(xs, t, out))
+}
+
+/// [`l2_error_p1`] with `exact(xs, out)` giving the exact values at many points.
+fn l2_error_p1_many<const D: usize>(
+    grid: &Grid<D>,
+    u: &[f64],
+    exact: impl Fn(&[[f64; D]], &mut [[f64; D]]) + Sync,
+) -> Option<f64> {
     use rayon::prelude::*;
     let rule = simplex_rule5::<D>();
     // Fixed chunks summed in order: the same value on any number of threads.
@@ -172,20 +196,27 @@ pub fn l2_error_p1<const D: usize>(
         .into_par_iter()
         .map(|k| {
             let mut sum = 0.0;
+            let mut xs = vec![[0.0; D]; rule.len()];
+            let mut uh = vec![Point::<D>::zeros(); rule.len()];
+            let mut values = vec![[0.0; D]; rule.len()];
             for c in k * CHUNK..((k + 1) * CHUNK).min(n) {
                 let nodes = grid.cell_nodes(c);
                 if nodes.len() != D + 1 {
                     return None;
                 }
                 let vol = grid.cell_volume(c);
-                for (w, l) in &rule {
+                for (q, (_, l)) in rule.iter().enumerate() {
                     let mut x = Point::<D>::zeros();
-                    let mut uh = Point::<D>::zeros();
+                    uh[q] = Point::<D>::zeros();
                     for (k, &n) in nodes.iter().enumerate() {
                         x += grid.node(n) * l[k];
-                        uh += Point::<D>::from_column_slice(&u[D * n..D * n + D]) * l[k];
+                        uh[q] += Point::<D>::from_column_slice(&u[D * n..D * n + D]) * l[k];
                     }
-                    sum += w * vol * (exact(&x) - uh).norm_squared();
+                    xs[q] = x.into();
+                }
+                exact(&xs, &mut values);
+                for (q, (w, _)) in rule.iter().enumerate() {
+                    sum += w * vol * (Point::<D>::from(values[q]) - uh[q]).norm_squared();
                 }
             }
             Some(sum)
@@ -212,29 +243,30 @@ pub fn triangle_rule5() -> Vec<QPoint> {
     r
 }
 
-/// Tetrahedron rule of degree 5: the collapsed (Duffy) product of 4-point Gauss rules,
-/// 64 points. With `x = s`, `y = t (1 − s)`, `z = r (1 − s)(1 − t)` a polynomial of degree
-/// `p` becomes one of degree `p + 2` in `s` (Jacobian `(1 − s)²(1 − t)`), integrated exactly
-/// by 4-point Gauss (degree 7) for `p ≤ 5`.
+/// Tetrahedron rule of degree 5 with 14 points and positive weights (Walkington,
+/// *Quadrature on simplices of arbitrary dimension*, 2000; also in Keast 1986): two orbits
+/// of 4 points `(a, a, a, 1 − 3a)` and one of 6 points `(b, b, ½ − b, ½ − b)`. Exact for
+/// every polynomial of degree 5 (checked by the tests against `∫ λ₁^i λ₂^j λ₃^k`).
 pub fn tetrahedron_rule5() -> Vec<QPoint> {
-    let g = [
-        (-0.861_136_311_594_052_6, 0.347_854_845_137_453_9),
-        (-0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
-        (0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
-        (0.861_136_311_594_052_6, 0.347_854_845_137_453_9),
-    ];
-    let g01: Vec<(f64, f64)> = g.iter().map(|&(x, w)| (0.5 * (1.0 + x), 0.5 * w)).collect();
-    let mut r = Vec::with_capacity(64);
-    for &(s, ws) in &g01 {
-        for &(t, wt) in &g01 {
-            for &(q, wq) in &g01 {
-                let x = s;
-                let y = t * (1.0 - s);
-                let z = q * (1.0 - s) * (1.0 - t);
-                let w = 6.0 * ws * wt * wq * (1.0 - s) * (1.0 - s) * (1.0 - t);
-                r.push((w, [1.0 - x - y - z, x, y, z]));
-            }
+    let mut r = Vec::with_capacity(14);
+    for (a, w) in [
+        (0.310_885_919_263_300_6, 0.112_687_925_718_015_85),
+        (0.092_735_250_310_891_23, 0.073_493_043_116_361_95),
+    ] {
+        let b = 1.0 - 3.0 * a;
+        for k in 0..4 {
+            let mut l = [a; 4];
+            l[k] = b;
+            r.push((w, l));
         }
+    }
+    let (b, w) = (0.045_503_704_125_649_65, 0.042_546_020_777_081_466);
+    let c = 0.5 - b;
+    for (i, j) in [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)] {
+        let mut l = [c; 4];
+        l[i] = b;
+        l[j] = b;
+        r.push((w, l));
     }
     r
 }
@@ -289,6 +321,36 @@ mod tests {
                     -div[a]
                 );
                 assert_eq!(body.eval(x.as_slice(), 0.0)[a], f[a]);
+            }
+        }
+    }
+
+    #[test]
+    fn degree_five_rules_integrate_degree_five_exactly() {
+        // ∫ over the unit simplex of λ₁^i λ₂^j (λ₃^k) = i! j! k! D! / (i + j + k + D)!, as
+        // a fraction of the volume.
+        let fact = |n: usize| (1..=n).map(|v| v as f64).product::<f64>();
+        for (d, rule) in [(2usize, triangle_rule5()), (3, tetrahedron_rule5())] {
+            let w: f64 = rule.iter().map(|(w, _)| w).sum();
+            assert!((w - 1.0).abs() < 1e-15, "weights sum to {w}");
+            for i in 0..=5 {
+                for j in 0..=5 - i {
+                    for k in 0..=(5 - i - j) * (d - 2) {
+                        let q: f64 = rule
+                            .iter()
+                            .map(|(w, l)| {
+                                w * l[1].powi(i as i32)
+                                    * l[2].powi(j as i32)
+                                    * if d == 3 { l[3].powi(k as i32) } else { 1.0 }
+                            })
+                            .sum();
+                        let exact = fact(i) * fact(j) * fact(k) * fact(d) / fact(i + j + k + d);
+                        assert!(
+                            (q - exact).abs() < 1e-15,
+                            "D = {d}, λ^({i},{j},{k}): {q} against {exact}"
+                        );
+                    }
+                }
             }
         }
     }

@@ -665,16 +665,14 @@ impl<const D: usize> Model for Stepper<'_, D> {
         };
         let t = self.times.get(self.done).copied().unwrap_or(0.0);
         let exact = crate::file::vector_field::<D>(exact);
-        let l2 = porofrac_sim::standard::l2_error_p1(self.body.grid, &self.u, |x| {
-            Point::<D>::from(exact.eval(x.as_slice(), t))
-        })
-        .ok_or_else(|| {
-            self.ls.error(
-                &k(&["output", "exact_displacement"]),
-                "needs a grid of triangles or tetrahedra (the error is that of the P1 \
+        let l2 = porofrac_sim::standard::l2_error_p1_field(self.body.grid, &self.u, &exact, t)
+            .ok_or_else(|| {
+                self.ls.error(
+                    &k(&["output", "exact_displacement"]),
+                    "needs a grid of triangles or tetrahedra (the error is that of the P1 \
                  interpolant of the nodal displacement)",
-            )
-        })?;
+                )
+            })?;
         out.insert("l2_displacement".into(), l2);
         Ok(out)
     }
