@@ -1,0 +1,592 @@
+//! Reading the keywords of an Eclipse grid deck (see the [module docs](super)).
+
+use std::fs::File;
+use std::io::{BufRead, BufReader, Read};
+use std::path::{Path, PathBuf};
+
+use crate::error::{GridError, Result};
+
+/// Unit system of a deck. Lengths are converted to metres and permeabilities to m²
+/// when read, whatever the deck's units.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Units {
+    /// Metres (the default).
+    #[default]
+    Metric,
+    /// Feet (× 0.3048).
+    Field,
+    /// Centimetres (× 0.01).
+    Lab,
+}
+
+impl Units {
+    /// Metres per length unit of the deck.
+    pub fn metres(self) -> f64 {
+        match self {
+            Units::Metric => 1.0,
+            Units::Field => 0.3048,
+            Units::Lab => 0.01,
+        }
+    }
+}
+
+/// One millidarcy in m² (the permeability unit of all three unit systems).
+pub const MILLIDARCY: f64 = 9.869_233e-16;
+
+/// The cell properties read from a deck, one value per cell of the deck (inactive cells
+/// included), `i` fastest, then `j`, then `k`. Permeabilities are in m².
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct CellProperties {
+    /// `PORO`.
+    pub poro: Option<Vec<f64>>,
+    /// `PERMX`, `PERMY`, `PERMZ` (m²).
+    pub perm: [Option<Vec<f64>>; 3],
+    /// `NTG`, net-to-gross.
+    pub ntg: Option<Vec<f64>>,
+    /// `MULTPV`, pore-volume multipliers.
+    pub multpv: Option<Vec<f64>>,
+}
+
+/// The grid keywords of a deck, in SI units.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Deck {
+    /// `[nx, ny, nz]` from `SPECGRID` or `DIMENS`.
+    pub dims: [usize; 3],
+    /// `COORD`: per pillar (`i` fastest over `nx + 1`, then `j` over `ny + 1`) the top and
+    /// bottom points `x y z x y z` (m).
+    pub coord: Vec<f64>,
+    /// `ZCORN`: the eight corner depths of every cell in Eclipse's order (m).
+    pub zcorn: Vec<f64>,
+    /// `ACTNUM` (all active without it).
+    pub actnum: Option<Vec<bool>>,
+    /// `MAPAXES` (three points `x1 y1 x0 y0 x2 y2` of the map axes, in the deck's map
+    /// units): reported, not applied; the grid stays in the deck's coordinates.
+    pub mapaxes: Option<[f64; 6]>,
+    /// The unit system (`METRIC`, `FIELD`, `LAB`).
+    pub units: Units,
+    /// Cell properties.
+    pub properties: CellProperties,
+    /// Keywords read but not used (their data skipped), in order of appearance.
+    pub skipped: Vec<String>,
+}
+
+impl Deck {
+    /// Number of cells of the deck, `nx · ny · nz`.
+    pub fn num_cells(&self) -> usize {
+        self.dims.iter().product()
+    }
+}
+
+/// Largest number of cells a deck may declare (2³¹: Eclipse's own limit on indices).
+pub const MAX_DECK_CELLS: usize = 1 << 31;
+/// Deepest chain of `INCLUDE`s.
+const MAX_INCLUDE_DEPTH: usize = 16;
+
+/// Read a GRDECL deck (following `INCLUDE`s relative to the including file).
+pub fn read_deck(path: impl AsRef<Path>) -> Result<Deck> {
+    let mut reader = DeckReader::default();
+    reader.read_file(path.as_ref(), 0)?;
+    reader.finish()
+}
+
+/// Keywords that take no data record (section headers, switches).
+const NO_DATA: &[&str] = &[
+    "RUNSPEC", "GRID", "EDIT", "PROPS", "REGIONS", "SOLUTION", "SUMMARY", "SCHEDULE", "ECHO",
+    "NOECHO", "METRIC", "FIELD", "LAB", "PVT-M", "NONNC", "OIL", "WATER", "GAS", "DISGAS",
+    "VAPOIL", "END", "ENDBOX", "NEWTRAN", "OLDTRAN",
+];
+
+#[derive(Default)]
+struct DeckReader {
+    deck: Deck,
+    /// Where `SPECGRID`/`DIMENS` was given (file, line), to name in count errors.
+    dims_at: Option<(PathBuf, usize)>,
+    /// Where each array keyword was read, for count errors found at the end.
+    arrays_at: Vec<(String, PathBuf, usize, usize)>,
+    /// Raw length arrays in deck units, scaled once the units are known.
+    gridunit_scale: Option<f64>,
+    /// Files being read (to refuse an `INCLUDE` cycle).
+    open: Vec<PathBuf>,
+}
+
+/// A token of the deck: a word or number, a quoted string, or the record end `/`.
+#[derive(Clone, Debug, PartialEq)]
+enum Token {
+    Word(String),
+    Quoted(String),
+    Slash,
+}
+
+/// Splits a deck into tokens, streaming from a reader, keeping the line number.
+struct Lexer<R: BufRead> {
+    input: R,
+    line: usize,
+    buf: Vec<u8>,
+    pos: usize,
+    path: PathBuf,
+    /// A token read ahead and given back.
+    pushback: Option<Token>,
+}
+
+impl<R: BufRead> Lexer<R> {
+    fn new(input: R, path: &Path) -> Self {
+        Self {
+            input,
+            line: 0,
+            buf: Vec::new(),
+            pos: 0,
+            path: path.to_path_buf(),
+            pushback: None,
+        }
+    }
+
+    fn error(&self, what: impl Into<String>) -> GridError {
+        GridError::Parse {
+            path: self.path.clone(),
+            line: self.line,
+            what: what.into(),
+        }
+    }
+
+    /// The next token, or `None` at the end of the input.
+    fn next(&mut self) -> Result<Option<Token>> {
+        if let Some(t) = self.pushback.take() {
+            return Ok(Some(t));
+        }
+        loop {
+            while self.pos < self.buf.len() && self.buf[self.pos].is_ascii_whitespace() {
+                self.pos += 1;
+            }
+            let rest = &self.buf[self.pos..];
+            if rest.is_empty() || rest.starts_with(b"--") {
+                self.buf.clear();
+                self.pos = 0;
+                let n = self
+                    .input
+                    .read_until(b'\n', &mut self.buf)
+                    .map_err(|e| self.error(format!("cannot read: {e}")))?;
+                if n == 0 {
+                    return Ok(None);
+                }
+                self.line += 1;
+                continue;
+            }
+            if rest[0] == b'/' {
+                self.pos += 1;
+                return Ok(Some(Token::Slash));
+            }
+            if rest[0] == b'\'' || rest[0] == b'"' {
+                let quote = rest[0];
+                let Some(end) = rest[1..].iter().position(|&b| b == quote) else {
+                    return Err(self.error("a quoted string is not closed on its line"));
+                };
+                let text = String::from_utf8_lossy(&rest[1..1 + end]).into_owned();
+                self.pos += end + 2;
+                return Ok(Some(Token::Quoted(text)));
+            }
+            let len = rest
+                .iter()
+                .position(|&b| b.is_ascii_whitespace() || b == b'/' || b == b'\'')
+                .unwrap_or(rest.len());
+            let word = String::from_utf8_lossy(&rest[..len]).into_owned();
+            self.pos += len;
+            return Ok(Some(Token::Word(word)));
+        }
+    }
+}
+
+/// Parse one number of a data record, `n*value` repeats expanded into `out`.
+fn push_values(word: &str, out: &mut Vec<f64>, limit: usize) -> std::result::Result<(), String> {
+    let (count, value) = match word.split_once('*') {
+        Some((n, v)) => {
+            let n: usize = n
+                .parse()
+                .map_err(|_| format!("`{word}` is not a repeat count `n*value`"))?;
+            if v.is_empty() {
+                return Err(format!(
+                    "`{word}`: a default (`n*` without a value) has no meaning in a grid array"
+                ));
+            }
+            (n, v)
+        }
+        None => (1, word),
+    };
+    let v: f64 = value
+        .parse()
+        .map_err(|_| format!("`{word}` is not a number"))?;
+    if !v.is_finite() {
+        return Err(format!("`{word}` is not a finite number"));
+    }
+    if out.len() + count > limit {
+        return Err(format!(
+            "more than the {limit} values this keyword can have"
+        ));
+    }
+    out.extend(std::iter::repeat_n(v, count));
+    Ok(())
+}
+
+impl DeckReader {
+    fn read_file(&mut self, path: &Path, depth: usize) -> Result<()> {
+        if depth > MAX_INCLUDE_DEPTH {
+            return Err(GridError::Parse {
+                path: path.to_path_buf(),
+                line: 0,
+                what: format!("INCLUDE nested deeper than {MAX_INCLUDE_DEPTH} files"),
+            });
+        }
+        let canonical = path.canonicalize().unwrap_or_else(|_| path.to_path_buf());
+        if self.open.contains(&canonical) {
+            return Err(GridError::Parse {
+                path: path.to_path_buf(),
+                line: 0,
+                what: "INCLUDE cycle: the file includes itself".into(),
+            });
+        }
+        let file = File::open(path).map_err(|source| GridError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        self.open.push(canonical);
+        let mut lexer = Lexer::new(BufReader::with_capacity(1 << 16, file), path);
+        let result = self.read_tokens(&mut lexer, path, depth);
+        self.open.pop();
+        result
+    }
+
+    fn read_tokens<R: Read>(
+        &mut self,
+        lx: &mut Lexer<BufReader<R>>,
+        path: &Path,
+        depth: usize,
+    ) -> Result<()> {
+        while let Some(tok) = lx.next()? {
+            let word = match tok {
+                Token::Word(w) => w.to_ascii_uppercase(),
+                Token::Slash => continue,
+                Token::Quoted(q) => {
+                    return Err(lx.error(format!(
+                        "'{q}': a quoted string where a keyword is expected"
+                    )));
+                }
+            };
+            let line = lx.line;
+            match word.as_str() {
+                "SPECGRID" | "DIMENS" => {
+                    // `nx ny nz` (then, for SPECGRID, the number of reservoirs and the
+                    // coordinate type: F for Cartesian, T for radial, refused).
+                    let mut words = Vec::new();
+                    while let Some(t) = lx.next()? {
+                        match t {
+                            Token::Slash => break,
+                            Token::Word(w) | Token::Quoted(w) if words.len() < 8 => words.push(w),
+                            _ => return Err(lx.error(format!("{word}: too many values"))),
+                        }
+                    }
+                    if words.get(4).is_some_and(|w| w.eq_ignore_ascii_case("T")) {
+                        return Err(lx.error(format!(
+                            "{word}: radial coordinates (T) are not supported; Cartesian (F) only"
+                        )));
+                    }
+                    let mut vals = Vec::new();
+                    for w in words.iter().take(3) {
+                        push_values(w, &mut vals, 3)
+                            .map_err(|e| lx.error(format!("{word}: {e}")))?;
+                    }
+                    let count = vals.len();
+                    if count < 3 {
+                        return Err(
+                            lx.error(format!("{word}: needs nx ny nz, found {count} values"))
+                        );
+                    }
+                    let mut dims = [0usize; 3];
+                    for (d, v) in dims.iter_mut().zip(&vals) {
+                        if *v < 1.0 || v.fract() != 0.0 || *v > MAX_DECK_CELLS as f64 {
+                            return Err(lx.error(format!(
+                                "{word}: `{v}` is not a positive whole number of cells"
+                            )));
+                        }
+                        *d = *v as usize;
+                    }
+                    let n = dims.iter().try_fold(1usize, |a, &d| a.checked_mul(d));
+                    if n.is_none_or(|n| n > MAX_DECK_CELLS) {
+                        return Err(lx.error(format!(
+                            "{word}: {} × {} × {} cells is more than the {MAX_DECK_CELLS} a deck may have",
+                            dims[0], dims[1], dims[2]
+                        )));
+                    }
+                    self.deck.dims = dims;
+                    self.dims_at = Some((path.to_path_buf(), line));
+                }
+                "COORD" | "ZCORN" | "ACTNUM" | "PORO" | "PERMX" | "PERMY" | "PERMZ" | "NTG"
+                | "MULTPV" => {
+                    let Some(limit) = self.expected(&word) else {
+                        return Err(lx.error(format!(
+                            "{word} before SPECGRID or DIMENS: the grid size must come first"
+                        )));
+                    };
+                    let mut vals = Vec::with_capacity(limit.min(1 << 24));
+                    let (count, _) = self.record(lx, &word, &mut vals, limit)?;
+                    self.arrays_at
+                        .push((word.clone(), path.to_path_buf(), line, count));
+                    self.store(&word, vals);
+                }
+                "MAPAXES" => {
+                    let mut vals = Vec::new();
+                    let (count, _) = self.record(lx, &word, &mut vals, 6)?;
+                    if count != 6 {
+                        return Err(lx.error(format!("MAPAXES: needs 6 values, found {count}")));
+                    }
+                    self.deck.mapaxes = Some(std::array::from_fn(|k| vals[k]));
+                }
+                "GRIDUNIT" => {
+                    let unit = match lx.next()? {
+                        Some(Token::Word(w) | Token::Quoted(w)) => w.to_ascii_uppercase(),
+                        _ => return Err(lx.error("GRIDUNIT: needs a unit (METRES, FEET or CM)")),
+                    };
+                    self.gridunit_scale = Some(match unit.as_str() {
+                        "METRES" | "METERS" | "M" => 1.0,
+                        "FEET" | "FT" => 0.3048,
+                        "CM" => 0.01,
+                        other => {
+                            return Err(lx.error(format!(
+                                "GRIDUNIT: unit `{other}` is not METRES, FEET or CM"
+                            )));
+                        }
+                    });
+                    self.skip_record(lx)?;
+                }
+                "METRIC" => self.deck.units = Units::Metric,
+                "FIELD" => self.deck.units = Units::Field,
+                "LAB" => self.deck.units = Units::Lab,
+                "INCLUDE" => {
+                    let name = match lx.next()? {
+                        Some(Token::Word(w) | Token::Quoted(w)) => w,
+                        _ => return Err(lx.error("INCLUDE: needs a file name")),
+                    };
+                    self.skip_record(lx)?;
+                    let target = resolve_include(path, &name).ok_or_else(|| {
+                        lx.error(format!(
+                            "INCLUDE '{name}': no such file next to {} (tried the name as given, \
+                             upper- and lower-case)",
+                            path.display()
+                        ))
+                    })?;
+                    self.read_file(&target, depth + 1)?;
+                }
+                w if NO_DATA.contains(&w) => {}
+                w if is_keyword(w) => {
+                    // An unknown keyword: skip its record, unless the next keyword comes
+                    // first (a keyword without data).
+                    self.deck.skipped.push(w.to_string());
+                    self.skip_unknown(lx)?;
+                }
+                other => {
+                    return Err(lx.error(format!(
+                        "`{other}` where a keyword is expected (is a record missing its `/`?)"
+                    )));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The number of values an array keyword must have, once the size is known.
+    fn expected(&self, word: &str) -> Option<usize> {
+        let [nx, ny, nz] = self.deck.dims;
+        if nx == 0 {
+            return None;
+        }
+        Some(match word {
+            "COORD" => 6 * (nx + 1) * (ny + 1),
+            "ZCORN" => 8 * nx * ny * nz,
+            _ => nx * ny * nz,
+        })
+    }
+
+    fn store(&mut self, word: &str, vals: Vec<f64>) {
+        let p = &mut self.deck.properties;
+        match word {
+            "COORD" => self.deck.coord = vals,
+            "ZCORN" => self.deck.zcorn = vals,
+            "ACTNUM" => self.deck.actnum = Some(vals.iter().map(|&v| v != 0.0).collect()),
+            "PORO" => p.poro = Some(vals),
+            "PERMX" => p.perm[0] = Some(vals),
+            "PERMY" => p.perm[1] = Some(vals),
+            "PERMZ" => p.perm[2] = Some(vals),
+            "NTG" => p.ntg = Some(vals),
+            _ => p.multpv = Some(vals),
+        }
+    }
+
+    /// Read a data record up to its `/` into `out` (at most `limit` values); returns the
+    /// number of values and the line of the `/`.
+    fn record<R: BufRead>(
+        &self,
+        lx: &mut Lexer<R>,
+        word: &str,
+        out: &mut Vec<f64>,
+        limit: usize,
+    ) -> Result<(usize, usize)> {
+        loop {
+            match lx.next()? {
+                Some(Token::Slash) => return Ok((out.len(), lx.line)),
+                Some(Token::Word(w)) => {
+                    if let Err(e) = push_values(&w, out, limit) {
+                        let hint =
+                            if is_keyword(&w.to_ascii_uppercase()) && w.parse::<f64>().is_err() {
+                                " (is the `/` ending the record missing?)"
+                            } else {
+                                ""
+                            };
+                        return Err(lx.error(format!("{word}: {e}{hint}")));
+                    }
+                }
+                Some(Token::Quoted(q)) => {
+                    return Err(lx.error(format!("{word}: '{q}' is not a number")));
+                }
+                None => {
+                    return Err(lx.error(format!(
+                        "{word}: the file ends before the `/` ending its data ({} values read)",
+                        out.len()
+                    )));
+                }
+            }
+        }
+    }
+
+    fn skip_record<R: BufRead>(&self, lx: &mut Lexer<R>) -> Result<()> {
+        while let Some(t) = lx.next()? {
+            if t == Token::Slash {
+                return Ok(());
+            }
+        }
+        Ok(())
+    }
+
+    /// Skip an unknown keyword's data: tokens up to `/`. A keyword this reader knows met
+    /// first means the unknown keyword had no data; reading goes on from that keyword.
+    fn skip_unknown<R: BufRead>(&self, lx: &mut Lexer<R>) -> Result<()> {
+        loop {
+            match lx.next()? {
+                None | Some(Token::Slash) => return Ok(()),
+                Some(Token::Word(w)) => {
+                    let up = w.to_ascii_uppercase();
+                    if NO_DATA.contains(&up.as_str()) || known(&up) {
+                        lx.pushback = Some(Token::Word(w));
+                        return Ok(());
+                    }
+                }
+                Some(Token::Quoted(_)) => {}
+            }
+        }
+    }
+
+    fn finish(self) -> Result<Deck> {
+        let mut deck = self.deck;
+        let Some((dims_file, dims_line)) = self.dims_at else {
+            return Err(GridError::Parse {
+                path: self.open.first().cloned().unwrap_or_default(),
+                line: 0,
+                what: "no SPECGRID or DIMENS: the grid size is missing".into(),
+            });
+        };
+        let [nx, ny, nz] = deck.dims;
+        for (word, file, line, count) in &self.arrays_at {
+            let need = match word.as_str() {
+                "COORD" => 6 * (nx + 1) * (ny + 1),
+                "ZCORN" => 8 * nx * ny * nz,
+                _ => nx * ny * nz,
+            };
+            if *count != need {
+                let how = match word.as_str() {
+                    "COORD" => format!("6 × (nx + 1) × (ny + 1) = 6 × {} × {}", nx + 1, ny + 1),
+                    "ZCORN" => format!("8 × nx × ny × nz = 8 × {nx} × {ny} × {nz}"),
+                    _ => format!("nx × ny × nz = {nx} × {ny} × {nz}"),
+                };
+                return Err(GridError::Parse {
+                    path: file.clone(),
+                    line: *line,
+                    what: format!(
+                        "{word} has {count} values, needs {need} ({how}, the size given at {}:{dims_line})",
+                        dims_file.display()
+                    ),
+                });
+            }
+        }
+        for (word, present) in [
+            ("COORD", !deck.coord.is_empty()),
+            ("ZCORN", !deck.zcorn.is_empty()),
+        ] {
+            if !present {
+                return Err(GridError::Parse {
+                    path: dims_file.clone(),
+                    line: 0,
+                    what: format!("no {word}: a corner-point grid needs COORD and ZCORN"),
+                });
+            }
+        }
+        let scale = self.gridunit_scale.unwrap_or(1.0) * deck.units.metres();
+        if scale != 1.0 {
+            deck.coord.iter_mut().for_each(|v| *v *= scale);
+            deck.zcorn.iter_mut().for_each(|v| *v *= scale);
+        }
+        for perm in deck.properties.perm.iter_mut().flatten() {
+            perm.iter_mut().for_each(|v| *v *= MILLIDARCY);
+        }
+        Ok(deck)
+    }
+}
+
+/// Keywords this reader knows (their records are parsed, not skipped).
+fn known(w: &str) -> bool {
+    matches!(
+        w,
+        "SPECGRID"
+            | "DIMENS"
+            | "COORD"
+            | "ZCORN"
+            | "ACTNUM"
+            | "PORO"
+            | "PERMX"
+            | "PERMY"
+            | "PERMZ"
+            | "NTG"
+            | "MULTPV"
+            | "MAPAXES"
+            | "GRIDUNIT"
+            | "INCLUDE"
+    )
+}
+
+/// Whether a word has the shape of a keyword: up to 8 characters, a letter first, then
+/// letters, digits, `_` or `-`.
+fn is_keyword(w: &str) -> bool {
+    let b = w.as_bytes();
+    !b.is_empty()
+        && b.len() <= 8
+        && b[0].is_ascii_uppercase()
+        && b.iter()
+            .all(|c| c.is_ascii_uppercase() || c.is_ascii_digit() || *c == b'_' || *c == b'-')
+}
+
+/// The file an `INCLUDE` names, relative to the including file's folder: as written,
+/// then upper-case, then lower-case (decks written on Windows name files in any case).
+fn resolve_include(from: &Path, name: &str) -> Option<PathBuf> {
+    let dir = from.parent().unwrap_or(Path::new("."));
+    let given = Path::new(name);
+    let base = if given.is_absolute() {
+        given.to_path_buf()
+    } else {
+        dir.join(given)
+    };
+    if base.is_file() {
+        return Some(base);
+    }
+    let file = base.file_name()?.to_string_lossy().into_owned();
+    let parent = base.parent()?.to_path_buf();
+    [file.to_ascii_uppercase(), file.to_ascii_lowercase()]
+        .into_iter()
+        .map(|f| parent.join(f))
+        .find(|p| p.is_file())
+}

@@ -1,0 +1,81 @@
+//! Corner-point grids from Eclipse GRDECL decks.
+//!
+//! # Reading ([`read_deck`])
+//!
+//! Keywords, in any order and any case: `SPECGRID` or `DIMENS` (`nx ny nz`, before the
+//! arrays), `COORD`, `ZCORN`, `ACTNUM`, `MAPAXES` (kept in [`Deck::mapaxes`], not
+//! applied: the grid stays in the deck's coordinates), `GRIDUNIT`, the unit systems
+//! `METRIC` (default), `FIELD` (feet) and `LAB` (centimetres), and the cell properties
+//! `PORO`, `PERMX`, `PERMY`, `PERMZ` (millidarcy), `NTG`, `MULTPV`. `INCLUDE` reads a file
+//! relative to the including one (the name as written, then in upper and in lower case),
+//! at most 16 deep, refusing cycles. Records end with `/`; `--` starts a comment; `n*v`
+//! repeats `v` `n` times. Other keywords are skipped (listed in [`Deck::skipped`]): their
+//! record up to `/`, or nothing when a known keyword follows first. Lengths are converted
+//! to metres and permeabilities to m² ([`MILLIDARCY`]).
+//!
+//! The file is read through a buffer, token by token, straight into the arrays: the text
+//! is never held whole. Errors name the file, the line and the keyword; a wrong count
+//! says how many values the keyword needs and why (`ZCORN has 7 values, needs 8 (8 × nx ×
+//! ny × nz = 8 × 1 × 1 × 1, …)`). The size is checked (at most 2³¹ cells) before anything
+//! is allocated for it, and no array grows past its keyword's count.
+//!
+//! # Processing ([`corner_point_grid`])
+//!
+//! The way reservoir codes process corner-point grids, into a [`Grid<3>`](crate::Grid):
+//!
+//! * **Pillars.** Every pillar is the line through its two `COORD` points; a corner at
+//!   depth `z` is the point of its pillar at that depth. The corner depths of the active
+//!   cells around a pillar, merged within the tolerance, are the pillar's nodes.
+//! * **Cells.** Cells with `ACTNUM = 0` are left out, and so are cells whose thickness is
+//!   within the tolerance at all four pillars (*pinched*). Cells are numbered in deck
+//!   order (`i` fastest, then `j`, then `k`) and keep their `(i, j, k)`
+//!   ([`CornerPointGrid::ijk`]). A cell whose bottom is above its top, or two cells of a
+//!   column that overlap, is an error naming them in the deck's 1-based indices.
+//! * **Faces between layers.** Each cell has its top and bottom faces; two cells of a
+//!   column whose faces have the same corners share them — also across pinched layers,
+//!   whose cells have vanished between them.
+//! * **Faces between columns, and faults.** The side faces of two neighbouring columns lie
+//!   on the surface between their two common pillars, parametrized by `s ∈ [0, 1]` from
+//!   one pillar to the other and the depth `z`. There a cell's side is the quadrilateral
+//!   between its top and bottom lines, linear in `s`. Each column's cells and the gaps
+//!   between them (inactive cells, the space above and below) split the surface; the
+//!   overlap of an element of one side with one of the other is a convex polygon in
+//!   `(s, z)` (between `max` of the two tops and `min` of the two bottoms), found by a
+//!   sweep down both columns. An overlap of two cells is a face they share; an overlap of
+//!   a cell with a gap is a boundary face of the cell. Where the columns match, each
+//!   overlap is the whole side face; across a fault (corners that differ) the side faces
+//!   split into the overlapping sub-faces, whose corners inside the surface are new nodes
+//!   at `(1 − s) P₀(z) + s P₁(z)`.
+//! * **Closed cells.** A node lying on the edge of a face is a node of that face: the
+//!   pillar nodes between two corners of a side face, and the nodes inside a pillar-pair
+//!   surface on the top or bottom line of a cell. So every cell is a closed polyhedron and
+//!   every sub-face has its two cells. Faces are polygons of any number of nodes, split
+//!   into triangles about their vertex average like every grid face (non-planar faces as
+//!   in reservoir codes). The grid is validated as every grid is.
+//! * **Outer faces** are tagged by the ijk side they face: `imin`, `imax`, `jmin`, `jmax`,
+//!   `kmin` (top, Eclipse's convention of depth growing with `k`) and `kmax` (bottom),
+//!   including faces towards inactive cells and across a fault's throw.
+//!
+//! Depths are kept as they are (`z` grows downwards, as in the deck). The tolerance is
+//! [`RELATIVE_TOLERANCE`] times the largest coordinate of the deck.
+
+mod deck;
+mod process;
+
+pub use deck::{CellProperties, Deck, MAX_DECK_CELLS, MILLIDARCY, Units, read_deck};
+pub use process::{CornerPointGrid, IJK_SIDES, RELATIVE_TOLERANCE, corner_point_grid};
+
+use std::path::Path;
+
+use crate::error::{GridError, Result};
+
+/// Read a deck and process it into a grid; grid errors name the file.
+pub fn read_grdecl(path: impl AsRef<Path>) -> Result<(Deck, CornerPointGrid)> {
+    let path = path.as_ref();
+    let deck = read_deck(path)?;
+    let grid = corner_point_grid(&deck).map_err(|e| GridError::InFile {
+        path: path.to_path_buf(),
+        source: Box::new(e),
+    })?;
+    Ok((deck, grid))
+}

@@ -1,0 +1,693 @@
+//! Turning a deck's pillars and corner depths into a polyhedral grid (see the
+//! [module docs](super)).
+
+use std::collections::BTreeMap;
+
+use crate::builder::CellFaceLoops;
+use crate::error::{GridError, Result};
+use crate::grid::Grid;
+use crate::point::Point;
+
+use super::deck::Deck;
+
+/// Tolerance of the processing, relative to the size of the deck (the largest extent of
+/// its corner points): depths closer than this on a pillar are one node, and a cell
+/// thinner than this at all four pillars is pinched out.
+pub const RELATIVE_TOLERANCE: f64 = 1e-9;
+
+/// A corner-point grid as a polyhedral grid, with each cell's place in the deck.
+#[derive(Clone, Debug)]
+pub struct CornerPointGrid {
+    /// The grid: faces split where neighbouring columns do not match, outer faces tagged
+    /// `imin` … `kmax`.
+    pub grid: Grid<3>,
+    /// `(i, j, k)` of every cell (0-based).
+    pub ijk: Vec<[usize; 3]>,
+    /// The deck index `i + nx (j + ny k)` of every cell (to pick its properties).
+    pub deck_cell: Vec<usize>,
+    /// Active deck cells left out because their thickness is zero.
+    pub pinched: usize,
+    /// Deck cells with `ACTNUM = 0`.
+    pub inactive: usize,
+}
+
+/// Names of the six ijk sides, tagged on the boundary faces that face them.
+pub const IJK_SIDES: [&str; 6] = ["imin", "imax", "jmin", "jmax", "kmin", "kmax"];
+
+/// An element of a column's stack along a pillar pair: a cell, or the gap between two
+/// cells (or above the first, below the last). `top` and `bot` are the depths at the
+/// pair's two pillars (`s = 0`, `s = 1`); along the pair they vary linearly in `s`.
+#[derive(Clone, Copy, Debug)]
+struct Elem {
+    cell: Option<usize>,
+    top: [f64; 2],
+    bot: [f64; 2],
+}
+
+/// Depth of a line given at `s = 0` and `s = 1`, at `s`.
+fn at(line: [f64; 2], s: f64) -> f64 {
+    line[0] + (line[1] - line[0]) * s
+}
+
+/// Where two lines cross in `0 < s < 1`.
+fn crossing(f: [f64; 2], g: [f64; 2]) -> Option<f64> {
+    let den = (f[1] - f[0]) - (g[1] - g[0]);
+    if den == 0.0 {
+        return None;
+    }
+    let s = (g[0] - f[0]) / den;
+    (s > 0.0 && s < 1.0).then_some(s)
+}
+
+/// A depth far above or below any cell (the ends of a column's stack).
+const FAR: f64 = 1e30;
+
+/// A sub-face: the overlap of two stack elements on a pillar pair.
+struct SubFace {
+    pair: usize,
+    /// The cell on the side of lower `i` (or `j`) and the one on the other side.
+    cells: [Option<usize>; 2],
+    /// Vertices `verts[start..end]`.
+    start: usize,
+    end: usize,
+}
+
+/// A vertex of a sub-face on its pillar pair.
+#[derive(Clone, Copy, Debug)]
+struct Vertex {
+    s: f64,
+    z: f64,
+    node: usize,
+}
+
+struct Builder<'a> {
+    deck: &'a Deck,
+    nx: usize,
+    ny: usize,
+    tol: f64,
+    nodes: Vec<Point<3>>,
+    /// Per pillar: its nodes as `(depth, node)` sorted by depth.
+    pillar_pos: Vec<usize>,
+    pillar_nodes: Vec<(f64, usize)>,
+    /// Per pillar pair: the nodes inside the pair's surface (`0 < s < 1`).
+    crossing_pos: Vec<usize>,
+    crossings: Vec<Vertex>,
+    subfaces: Vec<SubFace>,
+    verts: Vec<Vertex>,
+}
+
+/// Process a deck into a polyhedral grid.
+pub fn corner_point_grid(deck: &Deck) -> Result<CornerPointGrid> {
+    let [nx, ny, nz] = deck.dims;
+    let n = nx * ny * nz;
+    if deck.coord.len() != 6 * (nx + 1) * (ny + 1) || deck.zcorn.len() != 8 * n {
+        return Err(GridError::Input(format!(
+            "corner-point grid {nx} × {ny} × {nz}: COORD has {} values (needs {}), ZCORN {} \
+             (needs {})",
+            deck.coord.len(),
+            6 * (nx + 1) * (ny + 1),
+            deck.zcorn.len(),
+            8 * n
+        )));
+    }
+    let scale = deck
+        .coord
+        .chunks(3)
+        .flat_map(|p| p.iter().copied())
+        .chain(deck.zcorn.iter().copied())
+        .fold(0.0f64, |m, v| m.max(v.abs()))
+        .max(f64::MIN_POSITIVE);
+    let tol = RELATIVE_TOLERANCE * scale;
+    let mut b = Builder {
+        deck,
+        nx,
+        ny,
+        tol,
+        nodes: Vec::new(),
+        pillar_pos: Vec::new(),
+        pillar_nodes: Vec::new(),
+        crossing_pos: vec![0],
+        crossings: Vec::new(),
+        subfaces: Vec::new(),
+        verts: Vec::new(),
+    };
+    // --- Active cells (ACTNUM, not pinched), numbered in deck order. ---
+    let mut cell_of = vec![usize::MAX; n];
+    let mut ijk = Vec::new();
+    let mut deck_cell = Vec::new();
+    let (mut pinched, mut inactive) = (0, 0);
+    for k in 0..nz {
+        for j in 0..ny {
+            for i in 0..nx {
+                let d = i + nx * (j + ny * k);
+                if deck.actnum.as_ref().is_some_and(|a| !a[d]) {
+                    inactive += 1;
+                    continue;
+                }
+                let mut thick = false;
+                for c in 0..4 {
+                    let (t, bt) = (b.z(i, j, k, c, 0), b.z(i, j, k, c, 1));
+                    if bt < t - tol {
+                        return Err(GridError::Input(format!(
+                            "cell (i, j, k) = ({}, {}, {}) (1-based): the bottom is above the \
+                             top at corner {} (ZCORN {} above {})",
+                            i + 1,
+                            j + 1,
+                            k + 1,
+                            c + 1,
+                            bt,
+                            t
+                        )));
+                    }
+                    thick |= bt - t > tol;
+                }
+                if !thick {
+                    pinched += 1;
+                    continue;
+                }
+                cell_of[d] = ijk.len();
+                ijk.push([i, j, k]);
+                deck_cell.push(d);
+            }
+        }
+    }
+    if ijk.is_empty() {
+        return Err(GridError::Input(
+            "corner-point grid: no active cell of non-zero thickness".into(),
+        ));
+    }
+    // --- Columns: their active cells from top to bottom, checked for overlaps. ---
+    let mut column_pos = vec![0usize; nx * ny + 1];
+    for &[i, j, _] in &ijk {
+        column_pos[i + nx * j + 1] += 1;
+    }
+    for c in 0..nx * ny {
+        column_pos[c + 1] += column_pos[c];
+    }
+    let mut column_cells = vec![0usize; ijk.len()];
+    {
+        let mut fill = column_pos.clone();
+        for (c, &[i, j, _]) in ijk.iter().enumerate() {
+            column_cells[fill[i + nx * j]] = c;
+            fill[i + nx * j] += 1;
+        }
+    }
+    for col in 0..nx * ny {
+        for w in column_cells[column_pos[col]..column_pos[col + 1]].windows(2) {
+            let ([i, j, k1], [_, _, k2]) = (ijk[w[0]], ijk[w[1]]);
+            for c in 0..4 {
+                if b.z(i, j, k2, c, 0) < b.z(i, j, k1, c, 1) - tol {
+                    return Err(GridError::Input(format!(
+                        "cells (i, j, k) = ({0}, {1}, {2}) and ({0}, {1}, {3}) (1-based) \
+                         overlap at corner {4}: the top of the lower one is above the bottom \
+                         of the upper one",
+                        i + 1,
+                        j + 1,
+                        k1 + 1,
+                        k2 + 1,
+                        c + 1
+                    )));
+                }
+            }
+        }
+    }
+    // --- Pillar nodes: the corner depths of the active cells around each pillar. ---
+    let mut depths: Vec<f64> = Vec::new();
+    b.pillar_pos.push(0);
+    for pj in 0..=ny {
+        for pi in 0..=nx {
+            depths.clear();
+            for (ci, di) in [(pi.wrapping_sub(1), 1), (pi, 0)] {
+                for (cj, dj) in [(pj.wrapping_sub(1), 1), (pj, 0)] {
+                    if ci >= nx || cj >= ny {
+                        continue;
+                    }
+                    let col = ci + nx * cj;
+                    for &c in &column_cells[column_pos[col]..column_pos[col + 1]] {
+                        let k = ijk[c][2];
+                        depths.push(b.z(ci, cj, k, di + 2 * dj, 0));
+                        depths.push(b.z(ci, cj, k, di + 2 * dj, 1));
+                    }
+                }
+            }
+            depths.sort_by(f64::total_cmp);
+            let p = pi + (nx + 1) * pj;
+            let mut last = f64::NEG_INFINITY;
+            for &z in &depths {
+                if z - last > tol {
+                    let node = b.nodes.len();
+                    b.nodes.push(b.pillar_point(p, z)?);
+                    b.pillar_nodes.push((z, node));
+                    last = z;
+                }
+            }
+            b.pillar_pos.push(b.pillar_nodes.len());
+        }
+    }
+    // --- Pillar pairs: overlaps of the two columns' stacks. ---
+    let (mut minus, mut plus) = (Vec::new(), Vec::new());
+    let num_pairs = (nx + 1) * ny + nx * (ny + 1);
+    for pair in 0..num_pairs {
+        let (p0, p1, cols) = b.pair_geometry(pair);
+        for (side, stack) in [(0, &mut minus), (1, &mut plus)] {
+            stack.clear();
+            let mut above = [-FAR, -FAR];
+            if let Some((ci, cj, corners)) = cols[side] {
+                let col = ci + nx * cj;
+                for &c in &column_cells[column_pos[col]..column_pos[col + 1]] {
+                    let k = ijk[c][2];
+                    let top = corners.map(|q| b.z(ci, cj, k, q, 0));
+                    let bot = corners.map(|q| b.z(ci, cj, k, q, 1));
+                    push_gap(stack, above, top, tol);
+                    stack.push(Elem {
+                        cell: Some(c),
+                        top,
+                        bot,
+                    });
+                    above = bot;
+                }
+            }
+            push_gap(stack, above, [FAR, FAR], tol);
+        }
+        let mut start = 0;
+        for m in &minus {
+            while start < plus.len()
+                && plus[start].bot[0] <= m.top[0] + tol
+                && plus[start].bot[1] <= m.top[1] + tol
+            {
+                start += 1;
+            }
+            for q in &plus[start..] {
+                if q.top[0] >= m.bot[0] - tol && q.top[1] >= m.bot[1] - tol {
+                    break;
+                }
+                if m.cell.is_none() && q.cell.is_none() {
+                    continue;
+                }
+                b.overlap(pair, [p0, p1], m, q)?;
+            }
+        }
+        b.crossing_pos.push(b.crossings.len());
+    }
+    // --- Face loops, cell by cell. ---
+    let num_cells = ijk.len();
+    let mut sub_pos = vec![0usize; num_cells + 1];
+    for sf in &b.subfaces {
+        for c in sf.cells.iter().flatten() {
+            sub_pos[c + 1] += 1;
+        }
+    }
+    for c in 0..num_cells {
+        sub_pos[c + 1] += sub_pos[c];
+    }
+    let mut sub_of_cell = vec![(0usize, 0usize); sub_pos[num_cells]];
+    {
+        let mut fill = sub_pos.clone();
+        for (f, sf) in b.subfaces.iter().enumerate() {
+            for (side, c) in sf.cells.iter().enumerate() {
+                if let Some(c) = *c {
+                    sub_of_cell[fill[c]] = (f, side);
+                    fill[c] += 1;
+                }
+            }
+        }
+    }
+    let mut loops = CellFaceLoops::new();
+    let mut loop_side: Vec<u8> = Vec::new();
+    let mut face = Vec::new();
+    for c in 0..num_cells {
+        let [i, j, k] = ijk[c];
+        let centre = b.cell_centre(i, j, k)?;
+        for bottom in [0, 1] {
+            b.horizontal_loop(i, j, k, bottom, &mut face)?;
+            if b.emit(&mut loops, &mut face, &centre, false) {
+                loop_side.push(4 + bottom as u8);
+            }
+        }
+        for &(f, side) in &sub_of_cell[sub_pos[c]..sub_pos[c + 1]] {
+            let sf = &b.subfaces[f];
+            b.sub_face_loop(sf, &mut face);
+            // Orientation from the cell on the minus side (or the only one), so that the
+            // two cells of a shared sub-face see it in opposite orientations.
+            let (ref_centre, flip) = match sf.cells {
+                [Some(m), _] if side == 1 => {
+                    let [mi, mj, mk] = ijk[m];
+                    (b.cell_centre(mi, mj, mk)?, true)
+                }
+                _ => (centre, false),
+            };
+            if b.emit(&mut loops, &mut face, &ref_centre, flip) {
+                // The side this face looks at: the pair's direction, + for the minus cell.
+                let dir = if sf.pair < (nx + 1) * ny { 0 } else { 2 };
+                loop_side.push(dir + if side == 0 { 1 } else { 0 });
+            }
+        }
+        loops.finish_cell();
+    }
+    let Builder { nodes, .. } = b;
+    let mut grid = Grid::from_cell_faces(nodes, &loops)?;
+    let mut tags: BTreeMap<&str, Vec<usize>> = BTreeMap::new();
+    for c in 0..num_cells {
+        let faces = grid.cell_faces(c);
+        for (local, &f) in faces.iter().enumerate() {
+            if grid.is_boundary_face(f) {
+                let side = loop_side[loops.cell_pos[c] + local];
+                tags.entry(IJK_SIDES[side as usize]).or_default().push(f);
+            }
+        }
+    }
+    for (name, faces) in tags {
+        grid.set_face_tag(name, faces)?;
+    }
+    Ok(CornerPointGrid {
+        grid,
+        ijk,
+        deck_cell,
+        pinched,
+        inactive,
+    })
+}
+
+/// Push the gap between `above` and `below` onto a stack unless it is thinner than `tol`.
+fn push_gap(stack: &mut Vec<Elem>, above: [f64; 2], below: [f64; 2], tol: f64) {
+    if below[0] - above[0] > tol || below[1] - above[1] > tol {
+        stack.push(Elem {
+            cell: None,
+            top: above,
+            bot: below,
+        });
+    }
+}
+
+/// Columns of a pillar pair's side: `(i, j, [corner at s = 0, corner at s = 1])`.
+type PairSide = Option<(usize, usize, [usize; 2])>;
+
+impl Builder<'_> {
+    /// Depth of corner `c` (0..4: `di + 2 dj`) of cell `(i, j, k)`, top (`dk = 0`) or
+    /// bottom (`dk = 1`).
+    fn z(&self, i: usize, j: usize, k: usize, c: usize, dk: usize) -> f64 {
+        let (di, dj) = (c % 2, c / 2);
+        let (nx, ny) = (self.nx, self.ny);
+        self.deck.zcorn[(2 * k + dk) * 4 * nx * ny + (2 * j + dj) * 2 * nx + 2 * i + di]
+    }
+
+    /// The point of pillar `p` at depth `z` (on the line through its two COORD points).
+    fn pillar_point(&self, p: usize, z: f64) -> Result<Point<3>> {
+        let c = &self.deck.coord[6 * p..6 * p + 6];
+        let (top, bot) = (
+            Point::<3>::new(c[0], c[1], c[2]),
+            Point::<3>::new(c[3], c[4], c[5]),
+        );
+        let dz = bot[2] - top[2];
+        if dz.abs() <= self.tol {
+            if (bot - top).norm() > self.tol {
+                return Err(GridError::Input(format!(
+                    "pillar {} (i, j) = ({}, {}) (1-based) of COORD is horizontal: its top and \
+                     bottom points have the same depth",
+                    p + 1,
+                    p % (self.nx + 1) + 1,
+                    p / (self.nx + 1) + 1
+                )));
+            }
+            return Ok(Point::<3>::new(top[0], top[1], z));
+        }
+        Ok(top + (bot - top) * ((z - top[2]) / dz))
+    }
+
+    /// The pillars of a pair (at `s = 0` and `s = 1`) and the columns on its two sides.
+    fn pair_geometry(&self, pair: usize) -> (usize, usize, [PairSide; 2]) {
+        let (nx, ny) = (self.nx, self.ny);
+        let pillar = |i: usize, j: usize| i + (nx + 1) * j;
+        if pair < (nx + 1) * ny {
+            // Between columns i − 1 and i, pillars (i, j) and (i, j + 1).
+            let (i, j) = (pair % (nx + 1), pair / (nx + 1));
+            let minus = (i > 0).then(|| (i - 1, j, [1, 3]));
+            let plus = (i < nx).then_some((i, j, [0, 2]));
+            (pillar(i, j), pillar(i, j + 1), [minus, plus])
+        } else {
+            // Between columns j − 1 and j, pillars (i, j) and (i + 1, j).
+            let q = pair - (nx + 1) * ny;
+            let (i, j) = (q % nx, q / nx);
+            let minus = (j > 0).then(|| (i, j - 1, [2, 3]));
+            let plus = (j < ny).then_some((i, j, [0, 1]));
+            (pillar(i, j), pillar(i + 1, j), [minus, plus])
+        }
+    }
+
+    /// The pair holding the edge of column `(i, j)` on its side `side` (0: j-min, 1:
+    /// i-max, 2: j-max, 3: i-min), and whether the edge runs from `s = 1` to `s = 0` when
+    /// the top face is traversed `(i,j) → (i+1,j) → (i+1,j+1) → (i,j+1)`.
+    fn column_edge(&self, i: usize, j: usize, side: usize) -> (usize, bool) {
+        let (nx, ny) = (self.nx, self.ny);
+        let ipair = |i: usize, j: usize| i + (nx + 1) * j;
+        let jpair = |i: usize, j: usize| (nx + 1) * ny + i + nx * j;
+        match side {
+            0 => (jpair(i, j), false),
+            1 => (ipair(i + 1, j), false),
+            2 => (jpair(i, j + 1), true),
+            _ => (ipair(i, j), true),
+        }
+    }
+
+    /// Node of pillar `p` at depth `z`.
+    fn pillar_node(&self, p: usize, z: f64) -> Result<usize> {
+        let list = &self.pillar_nodes[self.pillar_pos[p]..self.pillar_pos[p + 1]];
+        let k = list.partition_point(|&(d, _)| d < z - self.tol);
+        match list.get(k) {
+            Some(&(d, node)) if (d - z).abs() <= self.tol => Ok(node),
+            _ => Err(GridError::Input(format!(
+                "corner-point processing: no node at depth {z} on pillar {}",
+                p + 1
+            ))),
+        }
+    }
+
+    /// The overlap of stack elements `m` (minus side) and `q` (plus side) on pair `pair`:
+    /// the region `max(top) ≤ z ≤ min(bot)`, a convex polygon in `(s, z)`, recorded as a
+    /// sub-face if it is thicker than the tolerance.
+    fn overlap(&mut self, pair: usize, pillars: [usize; 2], m: &Elem, q: &Elem) -> Result<()> {
+        let mut cand = [0.0f64; 8];
+        let mut nc = 0;
+        for s in [Some(0.0), Some(1.0)]
+            .into_iter()
+            .chain([
+                crossing(m.top, q.top),
+                crossing(m.bot, q.bot),
+                crossing(m.top, q.bot),
+                crossing(q.top, m.bot),
+                crossing(m.top, m.bot),
+                crossing(q.top, q.bot),
+            ])
+            .flatten()
+        {
+            cand[nc] = s;
+            nc += 1;
+        }
+        let cand = &mut cand[..nc];
+        cand.sort_by(f64::total_cmp);
+        let upper = |s: f64| at(m.top, s).max(at(q.top, s));
+        let lower = |s: f64| at(m.bot, s).min(at(q.bot, s));
+        let tol = self.tol;
+        let feasible: Vec<f64> = cand
+            .iter()
+            .copied()
+            .filter(|&s| lower(s) - upper(s) >= -tol)
+            .collect();
+        let thickest = feasible
+            .iter()
+            .map(|&s| lower(s) - upper(s))
+            .fold(f64::NEG_INFINITY, f64::max);
+        if feasible.len() < 2 || thickest <= tol {
+            return Ok(());
+        }
+        // Top chain left to right, bottom chain right to left.
+        let mut poly: Vec<(f64, f64)> = feasible.iter().map(|&s| (s, upper(s))).collect();
+        for &s in feasible.iter().rev() {
+            if lower(s) - upper(s) > tol {
+                poly.push((s, lower(s)));
+            }
+        }
+        // Drop vertices inside an edge (not on a pillar, on the line of their neighbours).
+        let mut k = 0;
+        while poly.len() > 3 && k < poly.len() {
+            let n = poly.len();
+            let (a, v, w) = (poly[(k + n - 1) % n], poly[k], poly[(k + 1) % n]);
+            let between = (a.0 < v.0 && v.0 < w.0) || (w.0 < v.0 && v.0 < a.0);
+            if between && (at([a.1, w.1], (v.0 - a.0) / (w.0 - a.0)) - v.1).abs() <= tol {
+                poly.remove(k);
+            } else {
+                k += 1;
+            }
+        }
+        let start = self.verts.len();
+        for &(s, z) in &poly {
+            let node = if s == 0.0 {
+                self.pillar_node(pillars[0], z)?
+            } else if s == 1.0 {
+                self.pillar_node(pillars[1], z)?
+            } else {
+                self.crossing_node(pair, pillars, s, z)?
+            };
+            if self.verts[start..].last().map(|v| v.node) != Some(node) {
+                self.verts.push(Vertex { s, z, node });
+            }
+        }
+        if self.verts.len() > start + 1
+            && self.verts[start].node == self.verts[self.verts.len() - 1].node
+        {
+            self.verts.pop();
+        }
+        if self.verts.len() - start < 3 {
+            self.verts.truncate(start);
+            return Ok(());
+        }
+        self.subfaces.push(SubFace {
+            pair,
+            cells: [m.cell, q.cell],
+            start,
+            end: self.verts.len(),
+        });
+        Ok(())
+    }
+
+    /// The node at `(s, z)` inside pair `pair` (the pair being processed), made once.
+    fn crossing_node(&mut self, pair: usize, pillars: [usize; 2], s: f64, z: f64) -> Result<usize> {
+        let from = self.crossing_pos[pair];
+        let s_tol = RELATIVE_TOLERANCE;
+        if let Some(v) = self.crossings[from..]
+            .iter()
+            .find(|v| (v.s - s).abs() <= s_tol && (v.z - z).abs() <= self.tol)
+        {
+            return Ok(v.node);
+        }
+        let x =
+            self.pillar_point(pillars[0], z)? * (1.0 - s) + self.pillar_point(pillars[1], z)? * s;
+        let node = self.nodes.len();
+        self.nodes.push(x);
+        self.crossings.push(Vertex { s, z, node });
+        Ok(node)
+    }
+
+    /// Nodes of pair `pair` strictly inside the segment from `a` to `b` (`0 < s < 1`), in
+    /// order from `a` to `b`.
+    fn nodes_on_segment(&self, pair: usize, a: (f64, f64), b: (f64, f64), out: &mut Vec<usize>) {
+        let list = &self.crossings[self.crossing_pos[pair]..self.crossing_pos[pair + 1]];
+        let before = out.len();
+        let (lo, hi) = (a.0.min(b.0), a.0.max(b.0));
+        for v in list {
+            if v.s > lo + RELATIVE_TOLERANCE
+                && v.s < hi - RELATIVE_TOLERANCE
+                && (at([a.1, b.1], (v.s - a.0) / (b.0 - a.0)) - v.z).abs() <= self.tol
+            {
+                out.push(v.node);
+            }
+        }
+        // Sort the new nodes by their distance from `a` along s.
+        let key = |n: usize| {
+            list.iter()
+                .find(|v| v.node == n)
+                .map_or(0.0, |v| (v.s - a.0).abs())
+        };
+        out[before..].sort_by(|&x, &y| key(x).total_cmp(&key(y)));
+    }
+
+    /// The loop of a sub-face with every node on its edges: nodes of the pillars between
+    /// two vertices on one pillar, nodes of the pair on its other edges.
+    fn sub_face_loop(&self, sf: &SubFace, out: &mut Vec<usize>) {
+        out.clear();
+        let verts = &self.verts[sf.start..sf.end];
+        let (p0, p1, _) = self.pair_geometry(sf.pair);
+        for (k, v) in verts.iter().enumerate() {
+            let w = verts[(k + 1) % verts.len()];
+            out.push(v.node);
+            if v.s == w.s && (v.s == 0.0 || v.s == 1.0) {
+                let p = if v.s == 0.0 { p0 } else { p1 };
+                let list = &self.pillar_nodes[self.pillar_pos[p]..self.pillar_pos[p + 1]];
+                let (lo, hi) = (v.z.min(w.z), v.z.max(w.z));
+                let inner = list
+                    .iter()
+                    .filter(|&&(d, _)| d > lo + self.tol && d < hi - self.tol)
+                    .map(|&(_, n)| n);
+                if w.z > v.z {
+                    out.extend(inner);
+                } else {
+                    let from = out.len();
+                    out.extend(inner);
+                    out[from..].reverse();
+                }
+            } else {
+                self.nodes_on_segment(sf.pair, (v.s, v.z), (w.s, w.z), out);
+            }
+        }
+    }
+
+    /// The top (`bottom = 0`) or bottom face loop of cell `(i, j, k)`, corners in the order
+    /// `(i,j) (i+1,j) (i+1,j+1) (i,j+1)` with the nodes of the pairs on its edges.
+    fn horizontal_loop(
+        &self,
+        i: usize,
+        j: usize,
+        k: usize,
+        bottom: usize,
+        out: &mut Vec<usize>,
+    ) -> Result<()> {
+        out.clear();
+        let corner_order = [0, 1, 3, 2];
+        let pillar = |c: usize| (i + c % 2) + (self.nx + 1) * (j + c / 2);
+        for side in 0..4 {
+            let (c0, c1) = (corner_order[side], corner_order[(side + 1) % 4]);
+            let (z0, z1) = (self.z(i, j, k, c0, bottom), self.z(i, j, k, c1, bottom));
+            out.push(self.pillar_node(pillar(c0), z0)?);
+            let (pair, reversed) = self.column_edge(i, j, side);
+            let (a, b) = if reversed {
+                ((1.0, z0), (0.0, z1))
+            } else {
+                ((0.0, z0), (1.0, z1))
+            };
+            self.nodes_on_segment(pair, a, b, out);
+        }
+        Ok(())
+    }
+
+    /// The mean of the eight corners of cell `(i, j, k)`.
+    fn cell_centre(&self, i: usize, j: usize, k: usize) -> Result<Point<3>> {
+        let mut c = Point::<3>::zeros();
+        for q in 0..4 {
+            let p = (i + q % 2) + (self.nx + 1) * (j + q / 2);
+            for dk in 0..2 {
+                c += self.pillar_point(p, self.z(i, j, k, q, dk))?;
+            }
+        }
+        Ok(c / 8.0)
+    }
+
+    /// Append a face loop, oriented outward from `centre` (reversed if `flip`), without
+    /// repeated nodes; a loop of fewer than three nodes is dropped (returns whether the
+    /// loop was added).
+    fn emit(
+        &self,
+        loops: &mut CellFaceLoops,
+        face: &mut Vec<usize>,
+        centre: &Point<3>,
+        flip: bool,
+    ) -> bool {
+        face.dedup();
+        while face.len() > 1 && face.first() == face.last() {
+            face.pop();
+        }
+        if face.len() < 3 {
+            return false;
+        }
+        let m = face.len();
+        let mid = face.iter().map(|&n| self.nodes[n]).sum::<Point<3>>() / m as f64;
+        let mut normal = Point::<3>::zeros();
+        for k in 0..m {
+            normal += (self.nodes[face[k]] - mid).cross(&(self.nodes[face[(k + 1) % m]] - mid));
+        }
+        if (normal.dot(&(mid - centre)) < 0.0) != flip {
+            face.reverse();
+        }
+        loops.push_face(face);
+        true
+    }
+}

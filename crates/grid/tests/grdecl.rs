@@ -1,0 +1,316 @@
+//! Corner-point decks: reading (keywords, repeats, includes, units, errors) and
+//! processing (regular blocks, faults with and without crossing layers, pinched layers)
+//! against volumes and connections computed independently.
+
+use std::path::PathBuf;
+
+use porofrac_grid::io::grdecl::{IJK_SIDES, corner_point_grid, read_deck};
+use porofrac_grid::io::read_grdecl;
+use porofrac_grid::{Grid, GridError};
+
+/// A deck of `nx × ny × nz` cells on vertical pillars at `x = i dx`, `y = j dy`, with the
+/// top of cell `(i, j, k)` at corner `(x, y)` at depth `depth(i, x, y, k)` and the bottom at
+/// `depth(i, x, y, k + 1)`.
+fn deck_text(
+    dims: [usize; 3],
+    dx: f64,
+    dy: f64,
+    depth: impl Fn(usize, f64, f64, usize) -> f64,
+    extra: &str,
+) -> String {
+    let [nx, ny, nz] = dims;
+    let mut s = format!("-- a synthetic deck\nSPECGRID\n {nx} {ny} {nz} 1 F /\n\nCOORD\n");
+    for j in 0..=ny {
+        for i in 0..=nx {
+            let (x, y) = (i as f64 * dx, j as f64 * dy);
+            s += &format!("{x} {y} 0 {x} {y} 100\n");
+        }
+    }
+    s += "/\nZCORN\n";
+    for k in 0..nz {
+        for dk in 0..2 {
+            for j in 0..ny {
+                for dj in 0..2 {
+                    for i in 0..nx {
+                        for di in 0..2 {
+                            let (x, y) = ((i + di) as f64 * dx, (j + dj) as f64 * dy);
+                            s += &format!("{} ", depth(i, x, y, k + dk));
+                        }
+                    }
+                    s += "\n";
+                }
+            }
+        }
+    }
+    s += "/\n";
+    s += extra;
+    s
+}
+
+fn write(name: &str, text: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("porofrac-grdecl-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// Every cell closed: the outward area vectors of its faces sum to zero.
+fn assert_closed(grid: &Grid<3>) {
+    for c in 0..grid.num_cells() {
+        let mut sum = porofrac_grid::Point::<3>::zeros();
+        for (&f, &out) in grid.cell_faces(c).iter().zip(grid.cell_face_outward(c)) {
+            let a = grid.face_normal(f) * grid.face_area(f);
+            sum += if out { a } else { -a };
+        }
+        let scale = grid.cell_volume(c).powf(2.0 / 3.0);
+        assert!(
+            sum.norm() < 1e-9 * scale,
+            "cell {c}: area vectors sum to {sum:?}"
+        );
+    }
+}
+
+/// Interior faces as pairs of (i, j, k), sorted.
+fn connections(cp: &porofrac_grid::io::grdecl::CornerPointGrid) -> Vec<([usize; 3], [usize; 3])> {
+    let g = &cp.grid;
+    let mut out: Vec<_> = (0..g.num_faces())
+        .filter_map(|f| {
+            let (a, b) = g.face_cells(f);
+            b.map(|b| {
+                let (x, y) = (cp.ijk[a], cp.ijk[b]);
+                if x < y { (x, y) } else { (y, x) }
+            })
+        })
+        .collect();
+    out.sort();
+    out
+}
+
+#[test]
+fn a_regular_block_is_the_cartesian_grid() {
+    let (dx, dy, dz) = (10.0, 20.0, 2.0);
+    let text = deck_text(
+        [3, 2, 2],
+        dx,
+        dy,
+        |_, x, _, k| 1000.0 + k as f64 * dz + 0.1 * x,
+        "",
+    );
+    let deck = read_deck(write("regular.grdecl", &text)).unwrap();
+    let cp = corner_point_grid(&deck).unwrap();
+    let g = &cp.grid;
+    assert_eq!(g.num_cells(), 12);
+    assert_eq!(g.num_nodes(), 4 * 3 * 3);
+    // Faces of a 3 × 2 × 2 block of hexahedra: 4·2·2 + 3·3·2 + 3·2·3.
+    assert_eq!(g.num_faces(), 16 + 18 + 18);
+    for c in 0..12 {
+        assert!((g.cell_volume(c) - dx * dy * dz).abs() < 1e-9 * dx * dy * dz);
+    }
+    assert_closed(g);
+    // Outer faces by side: imin/imax 2·2 each, jmin/jmax 3·2, kmin/kmax 3·2.
+    let counts: Vec<usize> = IJK_SIDES
+        .iter()
+        .map(|s| g.boundary(s).unwrap().len())
+        .collect();
+    assert_eq!(counts, [4, 4, 6, 6, 6, 6]);
+    assert_eq!(cp.ijk[5], [2, 1, 0]);
+}
+
+#[test]
+fn a_fault_with_half_a_layer_of_throw_splits_the_faces() {
+    // Columns i = 2.. thrown down by dz / 2; the layers tilted by 0.1 in x.
+    let (dx, dy, dz) = (10.0, 20.0, 2.0);
+    let depth = |i: usize, x: f64, _y: f64, k: usize| {
+        1000.0 + k as f64 * dz + 0.1 * x + if i >= 2 { dz / 2.0 } else { 0.0 }
+    };
+    let text = deck_text([3, 2, 3], dx, dy, depth, "");
+    let (_, cp) = read_grdecl(write("fault.grdecl", &text)).unwrap();
+    let g = &cp.grid;
+    assert_eq!(g.num_cells(), 18);
+    let total: f64 = g.cell_volumes().iter().sum();
+    for c in 0..18 {
+        assert!((g.cell_volume(c) - dx * dy * dz).abs() < 1e-9 * dx * dy * dz);
+    }
+    assert!((total - 18.0 * dx * dy * dz).abs() < 1e-9 * total);
+    assert_closed(g);
+    // Across the fault (i = 1 | i = 2), cell k meets k − 1 and k of the other side.
+    let across: Vec<_> = connections(&cp)
+        .into_iter()
+        .filter(|(a, b)| a[0] == 1 && b[0] == 2)
+        .collect();
+    let mut expected = Vec::new();
+    for j in 0..2 {
+        for k in 0..3 {
+            expected.push(([1, j, k], [2, j, k]));
+            if k + 1 < 3 {
+                expected.push(([1, j, k + 1], [2, j, k]));
+            }
+        }
+    }
+    expected.sort();
+    assert_eq!(across, expected);
+    // Each sub-face across the fault is half a side face.
+    for f in 0..g.num_faces() {
+        if let (a, Some(b)) = g.face_cells(f)
+            && cp.ijk[a][0] != cp.ijk[b][0]
+            && (cp.ijk[a][0] == 2 || cp.ijk[b][0] == 2)
+        {
+            let side = dy * dz;
+            assert!(
+                (g.face_area(f) - side / 2.0).abs() < 1e-9 * side,
+                "face {f}"
+            );
+        }
+    }
+    // The uncovered halves on the fault are outer faces facing it.
+    let imax_on_fault = g
+        .boundary("imax")
+        .unwrap()
+        .into_iter()
+        .filter(|&f| (g.face_centroid(f)[0] - 2.0 * dx).abs() < 1e-9)
+        .count();
+    let imin_on_fault = g
+        .boundary("imin")
+        .unwrap()
+        .into_iter()
+        .filter(|&f| (g.face_centroid(f)[0] - 2.0 * dx).abs() < 1e-9)
+        .count();
+    assert_eq!((imax_on_fault, imin_on_fault), (2, 2));
+    // Bounding-box sides touch no face of the thrown top: a tag-free grid still works.
+    assert!(!g.boundary("kmin").unwrap().is_empty());
+}
+
+#[test]
+fn a_scissor_fault_whose_layers_cross_gets_nodes_inside_the_fault() {
+    // The throw grows along the fault from 0 to 1.5 layers: layer lines cross inside.
+    let (dx, dy, dz) = (10.0, 20.0, 2.0);
+    let depth = |i: usize, x: f64, y: f64, k: usize| {
+        500.0 + k as f64 * dz + 0.05 * x + if i >= 1 { 1.5 * dz * y / dy } else { 0.0 }
+    };
+    let text = deck_text([2, 1, 4], dx, dy, depth, "");
+    let (_, cp) = read_grdecl(write("scissor.grdecl", &text)).unwrap();
+    let g = &cp.grid;
+    assert_eq!(g.num_cells(), 8);
+    assert!(
+        g.num_nodes() > 2 * 2 * 5 + 2 * 5,
+        "nodes inside the fault surface"
+    );
+    for c in 0..8 {
+        let v = g.cell_volume(c);
+        assert!((v - dx * dy * dz).abs() < 1e-9 * v, "cell {c}: {v}");
+    }
+    assert_closed(g);
+    // The fault face of each cell is covered: shared sub-faces plus outer ones add up to
+    // the cell's side area.
+    let mut covered = [0.0f64; 8];
+    for f in 0..g.num_faces() {
+        let x = g.face_centroid(f)[0];
+        if (x - dx).abs() > 1e-9 {
+            continue;
+        }
+        let (a, b) = g.face_cells(f);
+        covered[a] += g.face_area(f);
+        if let Some(b) = b {
+            covered[b] += g.face_area(f);
+        }
+    }
+    // A side face between vertical pillars dy apart with vertical sides dz long has area
+    // dy dz, however the layer slopes.
+    for (c, &a) in covered.iter().enumerate() {
+        assert!(
+            (a - dy * dz).abs() < 1e-9 * a,
+            "cell {c}: fault faces cover {a}"
+        );
+    }
+}
+
+#[test]
+fn pinched_layers_are_removed_and_the_layers_around_them_connected() {
+    let tops = [0.0, 2.0, 2.0, 5.0];
+    let text = deck_text([2, 1, 3], 10.0, 10.0, |_, _, _, k| 100.0 + tops[k], "");
+    let deck = read_deck(write("pinch.grdecl", &text)).unwrap();
+    let cp = corner_point_grid(&deck).unwrap();
+    assert_eq!(cp.grid.num_cells(), 4);
+    assert_eq!(cp.pinched, 2);
+    let conn = connections(&cp);
+    assert!(conn.contains(&([0, 0, 0], [0, 0, 2])));
+    assert!(conn.contains(&([1, 0, 0], [1, 0, 2])));
+    assert_eq!(conn.len(), 4);
+}
+
+#[test]
+fn actnum_repeats_includes_and_units() {
+    let (dx, dy, dz) = (10.0, 10.0, 1.0);
+    let body = deck_text([2, 2, 2], dx, dy, |_, _, _, k| k as f64 * dz, "");
+    // The arrays in an included file named in another case; ACTNUM with repeats.
+    write("ARRAYS.INC", &body.replace("SPECGRID\n 2 2 2 1 F /", ""));
+    let main = "FIELD\nSPECGRID\n2 2 2 1 F /\nMAPAXES\n 0 1 0 0 1 0 /\nECHO\n\
+                UNKNOWN1\n 3*1 'x' /\ninclude\n 'arrays.inc' /\nACTNUM\n 4*1 3*0 1 /\n\
+                PERMX\n 8*100 /\nPORO\n 8*0.2 /\n";
+    let path = write("main.grdecl", main);
+    let deck = read_deck(&path).unwrap();
+    assert_eq!(deck.dims, [2, 2, 2]);
+    assert_eq!(deck.mapaxes, Some([0.0, 1.0, 0.0, 0.0, 1.0, 0.0]));
+    assert_eq!(deck.skipped, vec!["UNKNOWN1".to_string()]);
+    let perm = deck.properties.perm[0].as_ref().unwrap();
+    assert!((perm[0] - 100.0 * 9.869_233e-16).abs() < 1e-25);
+    let cp = corner_point_grid(&deck).unwrap();
+    assert_eq!(cp.grid.num_cells(), 5);
+    assert_eq!(cp.inactive, 3);
+    let ft: f64 = 0.3048;
+    let v = dx * dy * dz * ft.powi(3);
+    assert!(
+        (cp.grid.cell_volume(0) - v).abs() < 1e-9 * v,
+        "feet converted to metres"
+    );
+}
+
+fn error_of(name: &str, text: &str) -> String {
+    let path = write(name, text);
+    match read_grdecl(&path) {
+        Err(e) => e.to_string(),
+        Ok(_) => panic!("{name}: read without error"),
+    }
+}
+
+#[test]
+fn bad_decks_are_errors_naming_file_line_and_keyword() {
+    let good = deck_text([1, 1, 1], 1.0, 1.0, |_, _, _, k| k as f64, "");
+    let short = good.replacen("1 1 \n", "1 \n", 1);
+    let e = error_of("short.grdecl", &short);
+    assert!(e.contains("ZCORN has 7 values, needs 8"), "{e}");
+    assert!(e.contains("short.grdecl:"), "{e}");
+
+    let e = error_of("noslash.grdecl", &good.replacen("/\nZCORN", "\nZCORN", 1));
+    assert!(e.contains("COORD") && e.contains("missing"), "{e}");
+
+    let e = error_of("first.grdecl", "COORD\n 1 2 3 /\n");
+    assert!(e.contains("COORD before SPECGRID"), "{e}");
+
+    let e = error_of("huge.grdecl", "DIMENS\n 100000 100000 100000 /\n");
+    assert!(e.contains("more than"), "{e}");
+
+    let e = error_of("word.grdecl", &good.replacen("1 1 \n", "1 zero \n", 1));
+    assert!(
+        e.contains("ZCORN") && e.contains("`zero` is not a number"),
+        "{e}"
+    );
+
+    let e = error_of("inc.grdecl", "INCLUDE\n 'nowhere.inc' /\n");
+    assert!(e.contains("nowhere.inc") && e.contains(":2:"), "{e}");
+
+    let e = error_of("self.grdecl", "INCLUDE\n 'self.grdecl' /\n");
+    assert!(e.contains("cycle"), "{e}");
+
+    let upside = deck_text([1, 1, 1], 1.0, 1.0, |_, _, _, k| -(k as f64), "");
+    let e = error_of("upside.grdecl", &upside);
+    assert!(e.contains("bottom is above the top"), "{e}");
+
+    let e = error_of("nozcorn.grdecl", "SPECGRID\n 1 1 1 /\nCOORD\n 24*0 /\n");
+    assert!(matches!(
+        read_deck(write("nz.grdecl", "SPECGRID\n 1 1 1 /\n")),
+        Err(GridError::Parse { .. })
+    ));
+    assert!(e.contains("ZCORN"), "{e}");
+}
