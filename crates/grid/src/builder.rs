@@ -57,6 +57,15 @@ impl CellFaceLoops {
     pub fn num_cells(&self) -> usize {
         self.cell_pos.len().saturating_sub(1)
     }
+    /// Append the cells of `other` after these (node indices unchanged).
+    pub fn append(&mut self, other: &CellFaceLoops) {
+        let (loops, nodes) = (self.loop_pos.len() - 1, self.loop_nodes.len());
+        self.loop_nodes.extend_from_slice(&other.loop_nodes);
+        self.loop_pos
+            .extend(other.loop_pos.iter().skip(1).map(|&p| p + nodes));
+        self.cell_pos
+            .extend(other.cell_pos.iter().skip(1).map(|&p| p + loops));
+    }
     fn face_loop(&self, k: usize) -> &[usize] {
         &self.loop_nodes[self.loop_pos[k]..self.loop_pos[k + 1]]
     }

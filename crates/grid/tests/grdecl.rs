@@ -4,13 +4,13 @@
 
 use std::path::PathBuf;
 
-use porofrac_grid::io::grdecl::{IJK_SIDES, corner_point_grid, read_deck};
+use porofrac_grid::io::grdecl::{Deck, IJK_SIDES, corner_point_grid, read_deck};
 use porofrac_grid::io::read_grdecl;
 use porofrac_grid::{Grid, GridError};
 
 /// A deck of `nx × ny × nz` cells on vertical pillars at `x = i dx`, `y = j dy`, with the
 /// top of cell `(i, j, k)` at corner `(x, y)` at depth `depth(i, x, y, k)` and the bottom at
-/// `depth(i, x, y, k + 1)`.
+/// `depth(i, x, y, k + 1)`, as GRDECL text followed by `extra`.
 fn deck_text(
     dims: [usize; 3],
     dx: f64,
@@ -18,33 +18,10 @@ fn deck_text(
     depth: impl Fn(usize, f64, f64, usize) -> f64,
     extra: &str,
 ) -> String {
-    let [nx, ny, nz] = dims;
-    let mut s = format!("-- a synthetic deck\nSPECGRID\n {nx} {ny} {nz} 1 F /\n\nCOORD\n");
-    for j in 0..=ny {
-        for i in 0..=nx {
-            let (x, y) = (i as f64 * dx, j as f64 * dy);
-            s += &format!("{x} {y} 0 {x} {y} 100\n");
-        }
-    }
-    s += "/\nZCORN\n";
-    for k in 0..nz {
-        for dk in 0..2 {
-            for j in 0..ny {
-                for dj in 0..2 {
-                    for i in 0..nx {
-                        for di in 0..2 {
-                            let (x, y) = ((i + di) as f64 * dx, (j + dj) as f64 * dy);
-                            s += &format!("{} ", depth(i, x, y, k + dk));
-                        }
-                    }
-                    s += "\n";
-                }
-            }
-        }
-    }
-    s += "/\n";
-    s += extra;
-    s
+    let deck = Deck::on_vertical_pillars(dims, [dx, dy], |[i, _], x, y, k| depth(i, x, y, k));
+    let mut out = b"-- a synthetic deck\n".to_vec();
+    deck.write_text(&mut out).unwrap();
+    String::from_utf8(out).unwrap() + extra
 }
 
 fn write(name: &str, text: &str) -> PathBuf {
@@ -277,7 +254,7 @@ fn error_of(name: &str, text: &str) -> String {
 #[test]
 fn bad_decks_are_errors_naming_file_line_and_keyword() {
     let good = deck_text([1, 1, 1], 1.0, 1.0, |_, _, _, k| k as f64, "");
-    let short = good.replacen("1 1 \n", "1 \n", 1);
+    let short = good.replacen(" 1.0 1.0 1.0 1.0\n/", " 1.0 1.0 1.0\n/", 1);
     let e = error_of("short.grdecl", &short);
     assert!(e.contains("ZCORN has 7 values, needs 8"), "{e}");
     assert!(e.contains("short.grdecl:"), "{e}");
@@ -291,7 +268,10 @@ fn bad_decks_are_errors_naming_file_line_and_keyword() {
     let e = error_of("huge.grdecl", "DIMENS\n 100000 100000 100000 /\n");
     assert!(e.contains("more than"), "{e}");
 
-    let e = error_of("word.grdecl", &good.replacen("1 1 \n", "1 zero \n", 1));
+    let e = error_of(
+        "word.grdecl",
+        &good.replacen(" 1.0 1.0 1.0 1.0\n/", " 1.0 1.0 1.0 zero\n/", 1),
+    );
     assert!(
         e.contains("ZCORN") && e.contains("`zero` is not a number"),
         "{e}"

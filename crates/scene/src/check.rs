@@ -353,6 +353,13 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
                 len_is(ls, &ki("region", i, &["select"]), b[0].len(), d)?;
                 len_is(ls, &ki("region", i, &["select"]), b[1].len(), d)?;
             }
+            Select::Ijk(r) if d != 3 || r.iter().any(|a| a[0] < 1 || a[0] > a[1]) => {
+                return Err(ls.error(
+                    &ki("region", i, &["select"]),
+                    "= { ijk = [[i0, i1], [j0, j1], [k0, k1]] } needs 1 ≤ lower ≤ upper on \
+                     each axis (1-based, inclusive) in a 3D scene",
+                ));
+            }
             Select::Circle(b) | Select::Sphere(b) => {
                 let want = if matches!(r.select, Select::Circle(_)) {
                     2

@@ -315,6 +315,9 @@ pub enum Select {
     Sphere(Ball),
     /// `{ tag = "name" }`.
     Tag(String),
+    /// `{ ijk = [[i0, i1], [j0, j1], [k0, k1]] }`: cells of a corner-point deck by their
+    /// 1-based indices, ranges inclusive (Eclipse's `BOX`).
+    Ijk([[u64; 2]; 3]),
 }
 
 /// Centre and radius.

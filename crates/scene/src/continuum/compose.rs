@@ -15,7 +15,7 @@ use crate::file::{Material, Plane};
 use crate::laws::{LawRegistry, PostFailure};
 use crate::model::RunError;
 
-use super::grid::{point, select_cells};
+use super::grid::{DeckCells, point, select_cells};
 
 /// The stiffness of a material in the scene's setting (3D, 2D plane strain or plane
 /// stress).
@@ -79,13 +79,14 @@ pub fn compose<const D: usize>(
     ls: &LoadedScene,
     registry: &LawRegistry,
     grid: &Grid<D>,
+    deck: &DeckCells,
 ) -> Result<Composition<D>, RunError> {
     let s = &ls.scene;
     let n = grid.num_cells();
     let mut law_region: Vec<Option<usize>> = vec![None; n];
     let mut mat_region: Vec<Option<usize>> = vec![None; n];
     for (i, r) in s.region.iter().enumerate() {
-        let cells = select_cells(ls, i, grid, &r.select)?;
+        let cells = select_cells(ls, i, grid, deck, &r.select)?;
         for c in cells {
             if r.law.is_some() {
                 law_region[c] = Some(i);
@@ -285,7 +286,18 @@ pub fn boundary_faces<const D: usize>(
         return Err(ls
             .error(
                 &ki("bc", i, &["boundary"]),
-                format!("= \"{}\" has no faces on this grid", bc.boundary),
+                if porofrac_grid::SIDE_NAMES.contains(&bc.boundary.as_str())
+                    && grid.face_tags().contains_key("imin")
+                {
+                    format!(
+                        "= \"{}\" has no faces on this grid: it is a side of the bounding box, \
+                     which the faces of a corner-point grid need not lie on; use the ijk \
+                     sides imin, imax, jmin, jmax, kmin (top), kmax (bottom)",
+                        bc.boundary
+                    )
+                } else {
+                    format!("= \"{}\" has no faces on this grid", bc.boundary)
+                },
             )
             .into());
     }

@@ -12,7 +12,7 @@ use crate::model::RunError;
 use crate::sample::locate;
 
 use super::compose::boundary_faces;
-use super::grid::{point, select_cells};
+use super::grid::{DeckCells, point, select_cells};
 
 /// Flow model, initial pressure per cell and Biot coefficient per cell.
 pub struct FlowSetup<const D: usize> {
@@ -32,6 +32,7 @@ pub struct FlowSetup<const D: usize> {
 pub fn flow_setup<const D: usize>(
     ls: &LoadedScene,
     grid: &Grid<D>,
+    deck: &DeckCells,
     material_of_cell: &[&str],
 ) -> Result<FlowSetup<D>, RunError> {
     let s = &ls.scene;
@@ -47,13 +48,24 @@ pub fn flow_setup<const D: usize>(
     for c in 0..n {
         let name = material_of_cell[c];
         let m = &s.material[name];
-        porosity[c] = m
-            .porosity
-            .ok_or_else(|| ls.error(&k(&["material", name, "porosity"]), "is required by flow"))?;
+        // The material's value, else the deck's (PORO × NTG × MULTPV).
+        porosity[c] = match (m.porosity, &deck.porosity) {
+            (Some(v), _) => v,
+            (None, Some(p)) => p[c],
+            (None, None) => {
+                return Err(ls
+                    .error(&k(&["material", name, "porosity"]), "is required by flow")
+                    .into());
+            }
+        };
         alpha[c] = m.biot_alpha.unwrap_or(1.0);
         diag[c] = match &m.permeability {
             Some(ScenePerm::Scalar(v)) => [*v; D],
             Some(ScenePerm::Diagonal(v)) => std::array::from_fn(|a| v[a]),
+            None if deck.permeability.is_some() => {
+                let k = deck.permeability.as_ref().expect("checked")[c];
+                std::array::from_fn(|a| k[a])
+            }
             None => {
                 return Err(ls
                     .error(
@@ -107,7 +119,7 @@ pub fn flow_setup<const D: usize>(
             .enumerate()
             .find(|(_, r)| r.name == src.region)
             .expect("source regions checked");
-        let cells = select_cells(ls, r, grid, &region.select)?;
+        let cells = select_cells(ls, r, grid, deck, &region.select)?;
         let rate = match (src.rate, src.pore_volumes_per_hour) {
             (Some(q), _) => SourceRate::Total(q),
             (None, Some(v)) => SourceRate::PoreVolumesPerHour(v),

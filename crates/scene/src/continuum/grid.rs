@@ -4,12 +4,56 @@
 use porofrac_grid::generate::{
     CompositeSpec, Diagonals, cartesian, composite, extrude, perturb, simplices, voronoi,
 };
-use porofrac_grid::io::{read_msh, read_vtu};
+use porofrac_grid::io::grdecl::CornerPointGrid;
+use porofrac_grid::io::{read_grdecl, read_msh, read_vtu};
 use porofrac_grid::{Grid, GridError, Point};
 
 use crate::check::{LoadedScene, k, ki};
 use crate::file::{CellCount, DiagonalsChoice, GridKind, Select};
 use crate::model::RunError;
+
+/// What a grid read from a corner-point deck brings besides its cells: each cell's
+/// `(i, j, k)` (0-based) and the deck's rock properties, per grid cell.
+#[derive(Clone, Debug, Default)]
+pub struct DeckCells {
+    /// `(i, j, k)` of every cell; empty for other grids.
+    pub ijk: Vec<[usize; 3]>,
+    /// Porosity from `PORO`, times `NTG` and `MULTPV` where given (the pore volume).
+    pub porosity: Option<Vec<f64>>,
+    /// `[PERMX, PERMY, PERMZ]` (m²); `NTG` multiplies the horizontal ones. `PERMY`
+    /// defaults to `PERMX`, `PERMZ` to `PERMX` too.
+    pub permeability: Option<Vec<[f64; 3]>>,
+}
+
+impl DeckCells {
+    fn from_deck(deck: &porofrac_grid::io::grdecl::Deck, cp: &CornerPointGrid) -> Self {
+        let p = &deck.properties;
+        let at =
+            |v: &Option<Vec<f64>>, d: usize, default: f64| v.as_ref().map_or(default, |v| v[d]);
+        let porosity = p.poro.as_ref().map(|poro| {
+            cp.deck_cell
+                .iter()
+                .map(|&d| poro[d] * at(&p.ntg, d, 1.0) * at(&p.multpv, d, 1.0))
+                .collect()
+        });
+        let permeability = p.perm[0].as_ref().map(|kx| {
+            cp.deck_cell
+                .iter()
+                .map(|&d| {
+                    let ntg = at(&p.ntg, d, 1.0);
+                    let ky = at(&p.perm[1], d, kx[d]);
+                    let kz = at(&p.perm[2], d, kx[d]);
+                    [kx[d] * ntg, ky * ntg, kz]
+                })
+                .collect()
+        });
+        Self {
+            ijk: cp.ijk.clone(),
+            porosity,
+            permeability,
+        }
+    }
+}
 
 /// A grid of either dimension.
 pub enum AnyGrid {
@@ -25,7 +69,35 @@ pub(crate) fn point<const D: usize>(v: &[f64]) -> Point<D> {
 }
 
 /// Build (or read) the grid of a checked scene.
-pub fn build_grid(ls: &LoadedScene) -> Result<AnyGrid, RunError> {
+pub fn build_grid(ls: &LoadedScene) -> Result<(AnyGrid, DeckCells), RunError> {
+    let g = &ls.scene.grid;
+    if g.kind == GridKind::File {
+        let path = ls.resolve(g.path.as_deref().unwrap_or(""));
+        let is_deck = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("grdecl") || e.eq_ignore_ascii_case("data"));
+        if is_deck {
+            let at_path = |e: GridError| {
+                RunError::Scene(ls.error(
+                    &k(&["grid", "path"]),
+                    format!("= \"{}\": {e}", path.display()),
+                ))
+            };
+            if ls.scene.scene.dim != 3 {
+                return Err(ls
+                    .error(&k(&["grid", "path"]), "a corner-point deck needs dim = 3")
+                    .into());
+            }
+            let (deck, cp) = read_grdecl(&path).map_err(at_path)?;
+            let cells = DeckCells::from_deck(&deck, &cp);
+            return Ok((AnyGrid::Three(cp.grid), cells));
+        }
+    }
+    Ok((build_plain_grid(ls)?, DeckCells::default()))
+}
+
+/// Build (or read) a grid that is not a corner-point deck.
+fn build_plain_grid(ls: &LoadedScene) -> Result<AnyGrid, RunError> {
     let g = &ls.scene.grid;
     let d = ls.scene.scene.dim as usize;
     let seed = g.seed.unwrap_or(0);
@@ -161,6 +233,7 @@ pub(crate) fn select_cells<const D: usize>(
     ls: &LoadedScene,
     i: usize,
     grid: &Grid<D>,
+    deck: &DeckCells,
     sel: &Select,
 ) -> Result<Vec<usize>, RunError> {
     let centroids = grid.cell_centroids();
@@ -175,6 +248,21 @@ pub(crate) fn select_cells<const D: usize>(
         Select::Circle(ball) | Select::Sphere(ball) => {
             let c: Point<D> = point(&ball.center);
             pick(&|x| (x - c).norm() <= ball.radius)
+        }
+        Select::Ijk(r) => {
+            if deck.ijk.is_empty() {
+                return Err(ls
+                    .error(
+                        &ki("region", i, &["select"]),
+                        "= { ijk = … } needs a grid read from a corner-point deck",
+                    )
+                    .into());
+            }
+            let inside =
+                |c: &[usize; 3]| (0..3).all(|a| (r[a][0]..=r[a][1]).contains(&(c[a] as u64 + 1)));
+            (0..grid.num_cells())
+                .filter(|&c| inside(&deck.ijk[c]))
+                .collect()
         }
         Select::Tag(name) => {
             match grid.cell_tags().get(name) {

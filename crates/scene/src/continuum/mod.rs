@@ -46,7 +46,7 @@ use crate::sample::{Location, locate};
 use compose::{Composition, compose, conditions, material_stiffness};
 use fields::Field;
 use flow::{FlowSetup, flow_setup};
-use grid::{AnyGrid, build_grid, point};
+use grid::{AnyGrid, DeckCells, build_grid, point};
 
 /// Run a checked continuum scene.
 pub(crate) fn run(
@@ -57,11 +57,11 @@ pub(crate) fn run(
 ) -> Result<Summary, RunError> {
     let start = Instant::now();
     check_supported(ls)?;
-    let grid = build_grid(ls)?;
+    let (grid, deck) = build_grid(ls)?;
     let grid_seconds = start.elapsed().as_secs_f64();
     match grid {
-        AnyGrid::Two(g) => run_dim(ls, registry, &g, out, observer, start, grid_seconds),
-        AnyGrid::Three(g) => run_dim(ls, registry, &g, out, observer, start, grid_seconds),
+        AnyGrid::Two(g) => run_dim(ls, registry, &g, &deck, out, observer, start, grid_seconds),
+        AnyGrid::Three(g) => run_dim(ls, registry, &g, &deck, out, observer, start, grid_seconds),
     }
 }
 
@@ -69,6 +69,7 @@ fn run_dim<const D: usize>(
     ls: &LoadedScene,
     registry: &LawRegistry,
     grid: &Grid<D>,
+    deck: &DeckCells,
     out: &Path,
     observer: &mut dyn Observer,
     start: Instant,
@@ -87,7 +88,7 @@ fn run_dim<const D: usize>(
     )
     .map_err(|e| ls.error(&k(&["grid"]), e))?;
     let t_asm = Instant::now();
-    let comp = compose(ls, registry, grid)?;
+    let comp = compose(ls, registry, grid, deck)?;
     let cond = conditions(ls, grid, &comp)?;
     let law_refs: Vec<&dyn CellLaw<D>> = comp.laws.iter().map(|l| l.as_ref()).collect();
     // Checks every cell against its law once (e.g. MDEM on a polygon is an error).
@@ -101,7 +102,7 @@ fn run_dim<const D: usize>(
         pattern: &pattern,
         loads: &cond.loads,
     };
-    let mut stepper = Stepper::new(ls, body, &comp, law_refs, out)?;
+    let mut stepper = Stepper::new(ls, body, deck, &comp, law_refs, out)?;
     stepper.wall.assembly += assembly;
     drive(ls, &mut stepper, out, observer, start, grid_seconds, D)
 }
@@ -195,6 +196,8 @@ type LinePoints<const D: usize> = Vec<(f64, Point<D>, Location)>;
 struct Stepper<'a, const D: usize> {
     ls: &'a LoadedScene,
     body: Body<'a, D>,
+    /// Each cell's (i, j, k) when the grid is a corner-point deck.
+    deck: &'a DeckCells,
     comp: &'a Composition<D>,
     law_refs: Vec<&'a dyn CellLaw<D>>,
     times: Vec<f64>,
@@ -226,6 +229,7 @@ impl<'a, const D: usize> Stepper<'a, D> {
     fn new(
         ls: &'a LoadedScene,
         body: Body<'a, D>,
+        deck: &'a DeckCells,
         comp: &'a Composition<D>,
         law_refs: Vec<&'a dyn CellLaw<D>>,
         out: &Path,
@@ -238,7 +242,7 @@ impl<'a, const D: usize> Stepper<'a, D> {
         let tolerance = s.solver.tolerance;
         let mut flow = if flow_on {
             let t_flow = Instant::now();
-            let f = flow_setup(ls, grid, &comp.material_of_cell())?;
+            let f = flow_setup(ls, grid, deck, &comp.material_of_cell())?;
             wall.flow += t_flow.elapsed().as_secs_f64();
             Some(f)
         } else {
@@ -321,6 +325,7 @@ impl<'a, const D: usize> Stepper<'a, D> {
         Ok(Self {
             ls,
             body,
+            deck,
             comp,
             law_refs,
             times: output_times(ls),
@@ -562,6 +567,17 @@ impl<const D: usize> Model for Stepper<'_, D> {
         ];
         if let Some(p) = self.pressure.as_deref() {
             cell_data.push(("pressure", VtkField::Scalars(p)));
+        }
+        // Corner-point grids: each cell's 1-based (i, j, k) and its volume.
+        let ijk: Vec<Point<D>> = self
+            .deck
+            .ijk
+            .iter()
+            .map(|c| Point::<D>::from_fn(|a, _| (c[a] + 1) as f64))
+            .collect();
+        if !ijk.is_empty() {
+            cell_data.push(("ijk", VtkField::Vectors(&ijk)));
+            cell_data.push(("volume", VtkField::Scalars(grid.cell_volumes())));
         }
         write_vtu(
             dir.join(&name),

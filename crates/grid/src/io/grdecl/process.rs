@@ -3,6 +3,8 @@
 
 use std::collections::BTreeMap;
 
+use rayon::prelude::*;
+
 use crate::builder::CellFaceLoops;
 use crate::error::{GridError, Result};
 use crate::grid::Grid;
@@ -94,6 +96,8 @@ struct Builder<'a> {
     crossings: Vec<Vertex>,
     subfaces: Vec<SubFace>,
     verts: Vec<Vertex>,
+    /// Scratch: the polygon of an overlap in `(s, z)`.
+    polygon: Vec<(f64, f64)>,
 }
 
 /// Process a deck into a polyhedral grid.
@@ -118,7 +122,7 @@ pub fn corner_point_grid(deck: &Deck) -> Result<CornerPointGrid> {
         .fold(0.0f64, |m, v| m.max(v.abs()))
         .max(f64::MIN_POSITIVE);
     let tol = RELATIVE_TOLERANCE * scale;
-    let mut b = Builder {
+    let mut builder = Builder {
         deck,
         nx,
         ny,
@@ -130,7 +134,9 @@ pub fn corner_point_grid(deck: &Deck) -> Result<CornerPointGrid> {
         crossings: Vec::new(),
         subfaces: Vec::new(),
         verts: Vec::new(),
+        polygon: Vec::new(),
     };
+    let b = &mut builder;
     // --- Active cells (ACTNUM, not pinched), numbered in deck order. ---
     let mut cell_of = vec![usize::MAX; n];
     let mut ijk = Vec::new();
@@ -312,39 +318,57 @@ pub fn corner_point_grid(deck: &Deck) -> Result<CornerPointGrid> {
             }
         }
     }
-    let mut loops = CellFaceLoops::new();
-    let mut loop_side: Vec<u8> = Vec::new();
-    let mut face = Vec::new();
-    for c in 0..num_cells {
-        let [i, j, k] = ijk[c];
-        let centre = b.cell_centre(i, j, k)?;
-        for bottom in [0, 1] {
-            b.horizontal_loop(i, j, k, bottom, &mut face)?;
-            if b.emit(&mut loops, &mut face, &centre, false) {
-                loop_side.push(4 + bottom as u8);
-            }
-        }
-        for &(f, side) in &sub_of_cell[sub_pos[c]..sub_pos[c + 1]] {
-            let sf = &b.subfaces[f];
-            b.sub_face_loop(sf, &mut face);
-            // Orientation from the cell on the minus side (or the only one), so that the
-            // two cells of a shared sub-face see it in opposite orientations.
-            let (ref_centre, flip) = match sf.cells {
-                [Some(m), _] if side == 1 => {
-                    let [mi, mj, mk] = ijk[m];
-                    (b.cell_centre(mi, mj, mk)?, true)
+    // Chunks of cells in parallel, joined in order.
+    const CHUNK: usize = 4096;
+    let b = &b;
+    let parts: Vec<(CellFaceLoops, Vec<u8>)> = (0..num_cells.div_ceil(CHUNK))
+        .into_par_iter()
+        .map(|ch| {
+            let mut loops = CellFaceLoops::new();
+            let mut loop_side: Vec<u8> = Vec::new();
+            let mut face = Vec::new();
+            for c in ch * CHUNK..((ch + 1) * CHUNK).min(num_cells) {
+                let [i, j, k] = ijk[c];
+                let centre = b.cell_centre(i, j, k)?;
+                for bottom in [0, 1] {
+                    b.horizontal_loop(i, j, k, bottom, &mut face)?;
+                    if b.emit(&mut loops, &mut face, &centre, false) {
+                        loop_side.push(4 + bottom as u8);
+                    }
                 }
-                _ => (centre, false),
-            };
-            if b.emit(&mut loops, &mut face, &ref_centre, flip) {
-                // The side this face looks at: the pair's direction, + for the minus cell.
-                let dir = if sf.pair < (nx + 1) * ny { 0 } else { 2 };
-                loop_side.push(dir + if side == 0 { 1 } else { 0 });
+                for &(f, side) in &sub_of_cell[sub_pos[c]..sub_pos[c + 1]] {
+                    let sf = &b.subfaces[f];
+                    b.sub_face_loop(sf, &mut face);
+                    // Orientation from the cell on the minus side (or the only one), so
+                    // that the two cells of a shared sub-face see it in opposite
+                    // orientations.
+                    let (ref_centre, flip) = match sf.cells {
+                        [Some(m), _] if side == 1 => {
+                            let [mi, mj, mk] = ijk[m];
+                            (b.cell_centre(mi, mj, mk)?, true)
+                        }
+                        _ => (centre, false),
+                    };
+                    if b.emit(&mut loops, &mut face, &ref_centre, flip) {
+                        // The side this face looks at: the pair's direction, + for the
+                        // minus cell.
+                        let dir = if sf.pair < (nx + 1) * ny { 0 } else { 2 };
+                        loop_side.push(dir + if side == 0 { 1 } else { 0 });
+                    }
+                }
+                loops.finish_cell();
             }
-        }
-        loops.finish_cell();
+            Ok((loops, loop_side))
+        })
+        .collect::<Result<_>>()?;
+    let mut loops = CellFaceLoops::new();
+    let mut loop_side = Vec::new();
+    for (part, sides) in &parts {
+        loops.append(part);
+        loop_side.extend_from_slice(sides);
     }
-    let Builder { nodes, .. } = b;
+    drop(parts);
+    let nodes = std::mem::take(&mut builder.nodes);
     let mut grid = Grid::from_cell_faces(nodes, &loops)?;
     let mut tags: BTreeMap<&str, Vec<usize>> = BTreeMap::new();
     for c in 0..num_cells {
@@ -488,11 +512,15 @@ impl Builder<'_> {
         let upper = |s: f64| at(m.top, s).max(at(q.top, s));
         let lower = |s: f64| at(m.bot, s).min(at(q.bot, s));
         let tol = self.tol;
-        let feasible: Vec<f64> = cand
-            .iter()
-            .copied()
-            .filter(|&s| lower(s) - upper(s) >= -tol)
-            .collect();
+        let mut feasible = [0.0f64; 8];
+        let mut nf = 0;
+        for &s in cand.iter() {
+            if lower(s) - upper(s) >= -tol {
+                feasible[nf] = s;
+                nf += 1;
+            }
+        }
+        let feasible = &feasible[..nf];
         let thickest = feasible
             .iter()
             .map(|&s| lower(s) - upper(s))
@@ -501,7 +529,9 @@ impl Builder<'_> {
             return Ok(());
         }
         // Top chain left to right, bottom chain right to left.
-        let mut poly: Vec<(f64, f64)> = feasible.iter().map(|&s| (s, upper(s))).collect();
+        let poly = &mut self.polygon;
+        poly.clear();
+        poly.extend(feasible.iter().map(|&s| (s, upper(s))));
         for &s in feasible.iter().rev() {
             if lower(s) - upper(s) > tol {
                 poly.push((s, lower(s)));
@@ -520,6 +550,7 @@ impl Builder<'_> {
             }
         }
         let start = self.verts.len();
+        let poly = std::mem::take(&mut self.polygon);
         for &(s, z) in &poly {
             let node = if s == 0.0 {
                 self.pillar_node(pillars[0], z)?
@@ -532,6 +563,7 @@ impl Builder<'_> {
                 self.verts.push(Vertex { s, z, node });
             }
         }
+        self.polygon = poly;
         if self.verts.len() > start + 1
             && self.verts[start].node == self.verts[self.verts.len() - 1].node
         {
@@ -604,10 +636,9 @@ impl Builder<'_> {
                 let p = if v.s == 0.0 { p0 } else { p1 };
                 let list = &self.pillar_nodes[self.pillar_pos[p]..self.pillar_pos[p + 1]];
                 let (lo, hi) = (v.z.min(w.z), v.z.max(w.z));
-                let inner = list
-                    .iter()
-                    .filter(|&&(d, _)| d > lo + self.tol && d < hi - self.tol)
-                    .map(|&(_, n)| n);
+                let from = list.partition_point(|&(d, _)| d <= lo + self.tol);
+                let to = list.partition_point(|&(d, _)| d < hi - self.tol);
+                let inner = list[from..to.max(from)].iter().map(|&(_, n)| n);
                 if w.z > v.z {
                     out.extend(inner);
                 } else {
