@@ -9,6 +9,10 @@
 //!   `c_f Σ φ_c V_c Δp_c`, summed over one probe per cell, equals it to 1e-9 relative,
 //!   with `φ_c V_c` known independently from the deck's construction (every cell a
 //!   20 × 20 × 5 m³ planar hexahedron, NTG 0.9, PORO 0.1 in layer 3 and 0.2 elsewhere);
+//! * a sealed fault (`FAULTS` + `MULTFLT 0`, added to the same deck): nothing crosses it,
+//!   the cells east of it keep their initial pressure exactly, and the west side stores
+//!   all that was injected (1e-9 relative); a multiplier of a fault the deck does not
+//!   define is an error naming it;
 //! * the bounding-box side `zmin`, which touches no face of the dipping top, is an error
 //!   that points to the ijk sides; `select = { ijk = … }` on a generated grid is an error.
 
@@ -72,6 +76,10 @@ fn the_bundled_injection_scene_runs_on_the_faulted_deck() {
 }
 
 fn balance_scene(probes: &str, boundary: &str) -> String {
+    balance_scene_on(&deck(), probes, boundary)
+}
+
+fn balance_scene_on(deck_path: &str, probes: &str, boundary: &str) -> String {
     format!(
         r#"
 [scene]
@@ -102,7 +110,7 @@ displacement = [0.0, 0.0, 0.0]
 
 [[well]]
 name = "injector"
-at = [100.0, 80.0, 1016.0]
+at = [90.0, 90.0, 1016.0]
 radius = 0.1
 rate = 0.001
 
@@ -119,14 +127,12 @@ vtk = false
 plots = false
 {probes}
 "#,
-        deck()
+        deck_path
     )
 }
 
-#[test]
-fn a_rate_well_fills_the_faulted_block_by_its_deck_pore_volume() {
-    let (_, cp) = porofrac_grid::io::read_grdecl(deck()).unwrap();
-    let g = &cp.grid;
+/// One pressure probe at the centroid of every cell.
+fn cell_probes(g: &porofrac_grid::Grid<3>) -> String {
     let mut probes = String::new();
     for c in 0..g.num_cells() {
         let x = g.cell_centroid(c);
@@ -135,16 +141,28 @@ fn a_rate_well_fills_the_faulted_block_by_its_deck_pore_volume() {
             x[0], x[1], x[2]
         );
     }
-    let (code, err, out) = run("cp_balance", &balance_scene(&probes, "kmax"));
-    assert_eq!(code, 0, "{err}");
+    probes
+}
+
+/// The last row of `probes.csv`.
+fn last_probes(out: &std::path::Path) -> Vec<f64> {
     let text = std::fs::read_to_string(out.join("probes.csv")).unwrap();
-    let last: Vec<f64> = text
-        .lines()
+    text.lines()
         .last()
         .unwrap()
         .split(',')
         .map(|v| v.parse().unwrap())
-        .collect();
+        .collect()
+}
+
+#[test]
+fn a_rate_well_fills_the_faulted_block_by_its_deck_pore_volume() {
+    let (_, cp) = porofrac_grid::io::read_grdecl(deck()).unwrap();
+    let g = &cp.grid;
+    let probes = cell_probes(g);
+    let (code, err, out) = run("cp_balance", &balance_scene(&probes, "kmax"));
+    assert_eq!(code, 0, "{err}");
+    let last = last_probes(&out);
     assert_eq!(last[0], 864000.0);
     let stored: f64 = (0..g.num_cells())
         .map(|c| {
@@ -164,6 +182,48 @@ fn a_rate_well_fills_the_faulted_block_by_its_deck_pore_volume() {
         hi > 1.01 * lo,
         "the deck's permeability leaves a pressure gradient"
     );
+}
+
+#[test]
+fn a_sealed_fault_lets_nothing_through() {
+    let dir = tmp_dir("cp_sealed_deck");
+    let sealed = dir.join("sealed.grdecl");
+    let text = std::fs::read_to_string(deck()).unwrap()
+        + "FAULTS\n 'F1' 5 5 1 8 1 6 'X' /\n/\nMULTFLT\n 'F1' 0.0 /\n/\n";
+    std::fs::write(&sealed, text).unwrap();
+    let (_, cp) = porofrac_grid::io::read_grdecl(&sealed).unwrap();
+    let g = &cp.grid;
+    let (code, err, out) = run(
+        "cp_sealed",
+        &balance_scene_on(sealed.to_str().unwrap(), &cell_probes(g), "kmax"),
+    );
+    assert_eq!(code, 0, "{err}");
+    let last = last_probes(&out);
+    let mut west = 0.0;
+    for c in 0..g.num_cells() {
+        let p = last[1 + c];
+        if cp.ijk[c][0] >= 5 {
+            assert_eq!(p, 0.0, "cell {:?} east of the sealed fault", cp.ijk[c]);
+        } else {
+            let poro = if cp.ijk[c][2] == 2 { 0.1 } else { 0.2 };
+            west += 4.5e-10 * poro * 0.9 * 2000.0 * p;
+        }
+    }
+    let injected = 0.001 * 864000.0;
+    assert!(
+        (west - injected).abs() <= 1e-9 * injected,
+        "west stores {west} m³ of {injected}"
+    );
+
+    let bad = dir.join("bad.grdecl");
+    let text = std::fs::read_to_string(deck()).unwrap() + "MULTFLT\n 'F9' 0.0 /\n/\n";
+    std::fs::write(&bad, text).unwrap();
+    let (code, err, _) = run(
+        "cp_badfault",
+        &balance_scene_on(bad.to_str().unwrap(), "", "kmax"),
+    );
+    assert_eq!(code, 1);
+    assert!(err.contains("no fault named 'F9'"), "{err}");
 }
 
 #[test]

@@ -88,6 +88,8 @@ pub struct FlowModel<const D: usize> {
     accumulation: Vec<f64>,
     viscosity: f64,
     trans: Transmissibilities,
+    /// Transmissibility multipliers, applied whenever the transmissibilities are computed.
+    multipliers: Vec<(Vec<usize>, f64)>,
     pattern: SymbolicSparseColMat<usize>,
     diag_pos: Vec<usize>,
     face_pos: Vec<[usize; 2]>,
@@ -186,7 +188,27 @@ impl<const D: usize> FlowModel<D> {
         }
         let volumes = grid.cell_volumes().to_vec();
         let accumulation = volumes.iter().zip(&storage).map(|(v, s)| v * s).collect();
-        let trans = Transmissibilities::new(grid, &rock.permeability)?;
+        for (faces, m) in &problem.transmissibility_multipliers {
+            if !(m.is_finite() && *m >= 0.0) {
+                return Err(FlowError::Face {
+                    face: faces.first().copied().unwrap_or(0),
+                    what: format!("transmissibility multiplier {m} is not a finite number ≥ 0"),
+                });
+            }
+            if let Some(&f) = faces
+                .iter()
+                .find(|&&f| f >= grid.num_faces() || grid.is_boundary_face(f))
+            {
+                return Err(FlowError::Face {
+                    face: f,
+                    what: "a transmissibility multiplier needs an interior face".into(),
+                });
+            }
+        }
+        let mut trans = Transmissibilities::new(grid, &rock.permeability)?;
+        for (faces, m) in &problem.transmissibility_multipliers {
+            trans.multiply(faces, *m);
+        }
         let (pattern, diag_pos, face_pos) = build_pattern(n, trans.all_face_cells());
 
         // Boundary conditions.
@@ -333,6 +355,7 @@ impl<const D: usize> FlowModel<D> {
             accumulation,
             viscosity: fluid.viscosity,
             trans,
+            multipliers: problem.transmissibility_multipliers.clone(),
             flux_vals: vec![0.0; pattern.row_idx().len()],
             sys_vals: vec![0.0; pattern.row_idx().len()],
             pattern,
@@ -445,7 +468,10 @@ impl<const D: usize> FlowModel<D> {
     /// pattern and the symbolic factorization are kept.
     pub fn set_permeability(&mut self, grid: &Grid<D>, perm: &Permeability<D>) -> Result<()> {
         check_len("grid cells", grid.num_cells(), self.num_cells())?;
-        let trans = Transmissibilities::new(grid, perm)?;
+        let mut trans = Transmissibilities::new(grid, perm)?;
+        for (faces, m) in &self.multipliers {
+            trans.multiply(faces, *m);
+        }
         for w in &mut self.wells {
             w.wi = well_index(grid, perm, w)?;
         }

@@ -158,6 +158,9 @@ pub struct FlowProblem<const D: usize> {
     pub boundary_conditions: Vec<BoundaryCondition>,
     /// Volumetric sources.
     pub sources: Vec<Source>,
+    /// Transmissibility multipliers of interior faces (faults): `(faces, m)`, applied in
+    /// order; `m = 0` seals the faces.
+    pub transmissibility_multipliers: Vec<(Vec<usize>, f64)>,
     /// Wells.
     pub wells: Vec<Well>,
 }
@@ -171,7 +174,14 @@ impl<const D: usize> FlowProblem<D> {
             boundary_conditions: Vec::new(),
             sources: Vec::new(),
             wells: Vec::new(),
+            transmissibility_multipliers: Vec::new(),
         }
+    }
+
+    /// Multiply the transmissibility of the interior `faces` by `m ≥ 0` (a fault).
+    pub fn transmissibility_multiplier(mut self, faces: Vec<usize>, m: f64) -> Self {
+        self.transmissibility_multipliers.push((faces, m));
+        self
     }
 
     /// Prescribe the pressure on `faces`.

@@ -110,6 +110,14 @@ impl Transmissibilities {
         })
     }
 
+    /// Multiply the transmissibility of each face of `faces` by `m` (a fault's
+    /// transmissibility multiplier, Eclipse's `MULTFLT`).
+    pub fn multiply(&mut self, faces: &[usize], m: f64) {
+        for &f in faces {
+            self.face[f] *= m;
+        }
+    }
+
     /// Number of faces.
     pub fn num_faces(&self) -> usize {
         self.face.len()

@@ -99,6 +99,9 @@ pub fn flow_setup<const D: usize>(
             compressibility: fluid.compressibility,
         },
     );
+    for (faces, m) in &deck.fault_multipliers {
+        problem = problem.transmissibility_multiplier(faces.clone(), *m);
+    }
     for (i, bc) in s.bc.iter().enumerate() {
         if bc.pressure.is_none() && bc.flux.is_none() {
             continue;

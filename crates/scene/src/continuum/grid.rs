@@ -23,6 +23,9 @@ pub struct DeckCells {
     /// `[PERMX, PERMY, PERMZ]` (m²); `NTG` multiplies the horizontal ones. `PERMY`
     /// defaults to `PERMX`, `PERMZ` to `PERMX` too.
     pub permeability: Option<Vec<[f64; 3]>>,
+    /// Transmissibility multipliers of the deck's faults (`FAULTS` + `MULTFLT`): the
+    /// faces of each fault and its multiplier.
+    pub fault_multipliers: Vec<(Vec<usize>, f64)>,
 }
 
 impl DeckCells {
@@ -47,10 +50,16 @@ impl DeckCells {
                 })
                 .collect()
         });
+        let fault_multipliers = deck
+            .fault_multipliers
+            .iter()
+            .map(|(name, m)| (cp.fault_faces(&deck.faults, name), *m))
+            .collect();
         Self {
             ijk: cp.ijk.clone(),
             porosity,
             permeability,
+            fault_multipliers,
         }
     }
 }

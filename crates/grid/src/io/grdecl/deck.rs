@@ -47,6 +47,50 @@ pub struct CellProperties {
     pub multpv: Option<Vec<f64>>,
 }
 
+/// The cell face a `FAULTS` segment names: `X` is the face towards `i + 1`, `X-` towards
+/// `i − 1` (`I`, `I-` are the same), and so on for `Y` (`j`) and `Z` (`k`, depth).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FaultFace {
+    /// Towards `i + 1`.
+    XPlus,
+    /// Towards `i − 1`.
+    XMinus,
+    /// Towards `j + 1`.
+    YPlus,
+    /// Towards `j − 1`.
+    YMinus,
+    /// Towards `k + 1` (down).
+    ZPlus,
+    /// Towards `k − 1` (up).
+    ZMinus,
+}
+
+impl FaultFace {
+    fn parse(word: &str) -> Option<Self> {
+        Some(match word.to_ascii_uppercase().as_str() {
+            "X" | "I" | "X+" | "I+" => Self::XPlus,
+            "X-" | "I-" => Self::XMinus,
+            "Y" | "J" | "Y+" | "J+" => Self::YPlus,
+            "Y-" | "J-" => Self::YMinus,
+            "Z" | "K" | "Z+" | "K+" => Self::ZPlus,
+            "Z-" | "K-" => Self::ZMinus,
+            _ => return None,
+        })
+    }
+}
+
+/// One record of `FAULTS`: the faces of the cells `i, j, k` (1-based ranges, inclusive)
+/// on the side `face` belong to the fault `name`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FaultSegment {
+    /// The fault's name (upper case).
+    pub name: String,
+    /// `[i1, i2]`, `[j1, j2]`, `[k1, k2]`, 1-based, inclusive.
+    pub ijk: [[usize; 2]; 3],
+    /// The side of those cells.
+    pub face: FaultFace,
+}
+
 /// The grid keywords of a deck, in SI units.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Deck {
@@ -66,6 +110,10 @@ pub struct Deck {
     pub units: Units,
     /// Cell properties.
     pub properties: CellProperties,
+    /// `FAULTS`: the segments of every named fault.
+    pub faults: Vec<FaultSegment>,
+    /// `MULTFLT`: transmissibility multipliers by fault name (upper case), in order.
+    pub fault_multipliers: Vec<(String, f64)>,
     /// Keywords read but not used (their data skipped), in order of appearance.
     pub skipped: Vec<String>,
 }
@@ -436,6 +484,7 @@ impl DeckReader {
                     });
                     self.skip_record(lx)?;
                 }
+                "FAULTS" | "MULTFLT" => self.fault_records(lx, &word)?,
                 "METRIC" => self.deck.units = Units::Metric,
                 "FIELD" => self.deck.units = Units::Field,
                 "LAB" => self.deck.units = Units::Lab,
@@ -469,6 +518,66 @@ impl DeckReader {
             }
         }
         Ok(())
+    }
+
+    /// `FAULTS` (`'name' i1 i2 j1 j2 k1 k2 'face' /` …) or `MULTFLT` (`'name' m /` …), up to
+    /// the empty record `/`.
+    fn fault_records<R: BufRead>(&mut self, lx: &mut Lexer<R>, word: &str) -> Result<()> {
+        loop {
+            let mut items: Vec<String> = Vec::new();
+            loop {
+                match lx.next()? {
+                    Some(Token::Slash) => break,
+                    Some(Token::Word(w) | Token::Quoted(w)) if items.len() < 16 => items.push(w),
+                    Some(_) => return Err(lx.error(format!("{word}: a record has too many items"))),
+                    None => {
+                        return Err(lx.error(format!(
+                            "{word}: the file ends before the `/` ending the keyword"
+                        )));
+                    }
+                }
+            }
+            if items.is_empty() {
+                return Ok(());
+            }
+            let name = items[0].to_ascii_uppercase();
+            if word == "MULTFLT" {
+                let m = items
+                    .get(1)
+                    .and_then(|v| v.parse::<f64>().ok())
+                    .filter(|m| m.is_finite() && *m >= 0.0);
+                let Some(m) = m else {
+                    return Err(lx.error(format!(
+                        "MULTFLT: fault '{name}' needs a multiplier ≥ 0 (record: {})",
+                        items.join(" ")
+                    )));
+                };
+                self.deck.fault_multipliers.push((name, m));
+                continue;
+            }
+            let bad = || {
+                lx.error(format!(
+                    "FAULTS: record `{}` is not 'name' i1 i2 j1 j2 k1 k2 'face' with 1 ≤ i1 ≤ i2 ≤ nx \
+                     (and so for j, k) and face X, X-, Y, Y-, Z or Z-",
+                    items.join(" ")
+                ))
+            };
+            if items.len() < 8 {
+                return Err(bad());
+            }
+            let mut ijk = [[0usize; 2]; 3];
+            for a in 0..3 {
+                for b in 0..2 {
+                    let v: usize = items[1 + 2 * a + b].parse().map_err(|_| bad())?;
+                    ijk[a][b] = v;
+                }
+                if ijk[a][0] < 1 || ijk[a][0] > ijk[a][1] || ijk[a][1] > self.deck.dims[a] {
+                    return Err(bad());
+                }
+            }
+            let face = FaultFace::parse(&items[7]).ok_or_else(bad)?;
+            self.deck.faults.push(FaultSegment { name, ijk, face });
+        }
     }
 
     /// The number of values an array keyword must have, once the size is known.
@@ -606,6 +715,17 @@ impl DeckReader {
                 });
             }
         }
+        if let Some((name, _)) = deck
+            .fault_multipliers
+            .iter()
+            .find(|(n, _)| !deck.faults.iter().any(|s| &s.name == n))
+        {
+            return Err(GridError::Parse {
+                path: dims_file.clone(),
+                line: 0,
+                what: format!("MULTFLT: no fault named '{name}' in FAULTS"),
+            });
+        }
         let scale = self.gridunit_scale.unwrap_or(1.0) * deck.units.metres();
         if scale != 1.0 {
             deck.coord.iter_mut().for_each(|v| *v *= scale);
@@ -636,6 +756,8 @@ fn known(w: &str) -> bool {
             | "MAPAXES"
             | "GRIDUNIT"
             | "INCLUDE"
+            | "FAULTS"
+            | "MULTFLT"
     )
 }
 

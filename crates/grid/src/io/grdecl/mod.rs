@@ -6,7 +6,10 @@
 //! arrays), `COORD`, `ZCORN`, `ACTNUM`, `MAPAXES` (kept in [`Deck::mapaxes`], not
 //! applied: the grid stays in the deck's coordinates), `GRIDUNIT`, the unit systems
 //! `METRIC` (default), `FIELD` (feet) and `LAB` (centimetres), and the cell properties
-//! `PORO`, `PERMX`, `PERMY`, `PERMZ` (millidarcy), `NTG`, `MULTPV`. `INCLUDE` reads a file
+//! `PORO`, `PERMX`, `PERMY`, `PERMZ` (millidarcy), `NTG`, `MULTPV`, and the faults:
+//! `FAULTS` (named segments `'name' i1 i2 j1 j2 k1 k2 'face'`) with `MULTFLT`
+//! (transmissibility multipliers by fault name; [`CornerPointGrid::fault_faces`] gives a
+//! fault's faces). `INCLUDE` reads a file
 //! relative to the including one (the name as written, then in upper and in lower case),
 //! at most 16 deep, refusing cycles. Records end with `/`; `--` starts a comment; `n*v`
 //! repeats `v` `n` times. Other keywords are skipped (listed in [`Deck::skipped`]): their
@@ -62,7 +65,9 @@
 mod deck;
 mod process;
 
-pub use deck::{CellProperties, Deck, MAX_DECK_CELLS, MILLIDARCY, Units, read_deck};
+pub use deck::{
+    CellProperties, Deck, FaultFace, FaultSegment, MAX_DECK_CELLS, MILLIDARCY, Units, read_deck,
+};
 pub use process::{CornerPointGrid, IJK_SIDES, RELATIVE_TOLERANCE, corner_point_grid};
 
 use std::path::Path;

@@ -33,6 +33,44 @@ pub struct CornerPointGrid {
     pub inactive: usize,
 }
 
+impl CornerPointGrid {
+    /// The interior faces of the fault `name` (its `FAULTS` segments: each segment's
+    /// cells' faces on its side, towards the neighbouring column or the next cell of the
+    /// column). Empty if the deck has no such fault.
+    pub fn fault_faces(&self, faults: &[super::deck::FaultSegment], name: &str) -> Vec<usize> {
+        use super::deck::FaultFace::*;
+        let segments: Vec<_> = faults.iter().filter(|s| s.name == name).collect();
+        let g = &self.grid;
+        let inside = |c: [usize; 3], r: &[[usize; 2]; 3]| {
+            (0..3).all(|a| (r[a][0]..=r[a][1]).contains(&(c[a] + 1)))
+        };
+        // Whether `b` lies across face `face` of `a`.
+        let across = |a: [usize; 3], b: [usize; 3], face: super::deck::FaultFace| {
+            let (di, dj) = (b[0] as isize - a[0] as isize, b[1] as isize - a[1] as isize);
+            match face {
+                XPlus => di == 1 && dj == 0,
+                XMinus => di == -1 && dj == 0,
+                YPlus => di == 0 && dj == 1,
+                YMinus => di == 0 && dj == -1,
+                ZPlus => di == 0 && dj == 0 && b[2] > a[2],
+                ZMinus => di == 0 && dj == 0 && b[2] < a[2],
+            }
+        };
+        (0..g.num_faces())
+            .filter(|&f| {
+                let (a, Some(b)) = g.face_cells(f) else {
+                    return false;
+                };
+                let (a, b) = (self.ijk[a], self.ijk[b]);
+                segments.iter().any(|s| {
+                    (inside(a, &s.ijk) && across(a, b, s.face))
+                        || (inside(b, &s.ijk) && across(b, a, s.face))
+                })
+            })
+            .collect()
+    }
+}
+
 /// Names of the six ijk sides, tagged on the boundary faces that face them.
 pub const IJK_SIDES: [&str; 6] = ["imin", "imax", "jmin", "jmax", "kmin", "kmax"];
 
