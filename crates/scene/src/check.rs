@@ -353,6 +353,20 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
                 len_is(ls, &ki("region", i, &["select"]), b[0].len(), d)?;
                 len_is(ls, &ki("region", i, &["select"]), b[1].len(), d)?;
             }
+            Select::Around(pb)
+                if pb.path.is_empty()
+                    || pb.path.iter().any(|p| p.len() != d)
+                    || pb.radius.is_nan()
+                    || pb.radius <= 0.0 =>
+            {
+                return Err(ls.error(
+                    &ki("region", i, &["select"]),
+                    format!(
+                        "= {{ around = {{ path, radius }} }} needs points of {d} coordinates and \
+                         a radius > 0"
+                    ),
+                ));
+            }
             Select::Ijk(r) if d != 3 || r.iter().any(|a| a[0] < 1 || a[0] > a[1]) => {
                 return Err(ls.error(
                     &ki("region", i, &["select"]),
@@ -584,6 +598,41 @@ fn check_grid(ls: &LoadedScene, d: usize) -> Result<(), SceneError> {
     }
     if g.diagonals.is_some() && g.kind != GridKind::Composite {
         return Err(ls.error(&key("diagonals"), "applies to composite grids only"));
+    }
+    if let Some(zone) = &g.mdem_zone {
+        if g.kind != GridKind::File || d != 3 {
+            return Err(ls.error(
+                &key("mdem_zone"),
+                "applies to 3D grids read from a file or a corner-point deck",
+            ));
+        }
+        if let Select::Around(pb) = zone
+            && (pb.path.is_empty()
+                || pb.path.iter().any(|p| p.len() != 3)
+                || pb.radius.is_nan()
+                || pb.radius <= 0.0)
+        {
+            return Err(ls.error(
+                &key("mdem_zone"),
+                "= { around = { path = [[x, y, z], …], radius = r } } needs points of 3 \
+                 coordinates and r > 0",
+            ));
+        }
+        if let Some(r) = g.refine
+            && !(0..=3).contains(&r)
+        {
+            return Err(ls.error(
+                &key("refine"),
+                format!("= {r}: the MDEM zone is refined 0 to 3 times (each ×8 tetrahedra)"),
+            ));
+        }
+    } else if g.well_path.is_some() {
+        return Err(ls.error(&key("well_path"), "needs mdem_zone"));
+    }
+    if let Some(p) = &g.well_path
+        && p.iter().any(|p| p.len() != 3)
+    {
+        return Err(ls.error(&key("well_path"), "needs points of 3 coordinates"));
     }
     if g.kind == GridKind::Composite {
         for f in ["center", "zone_half_width", "refine", "well_radius"] {

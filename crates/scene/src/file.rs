@@ -275,6 +275,12 @@ pub struct GridSection {
     pub diagonals: Option<DiagonalsChoice>,
     /// Voronoi: Lloyd iterations.
     pub lloyd: Option<i64>,
+    /// 3D files and decks: cells replaced by conforming tetrahedra (an MDEM zone), refined
+    /// `refine` times; tagged `refined`.
+    pub mdem_zone: Option<Select>,
+    /// With `mdem_zone`: the well trajectory (points); zone cells whose centroid is
+    /// within `well_radius` of it are tagged `well` (or `well_tag`).
+    pub well_path: Option<Vec<Vec<f64>>>,
 }
 
 /// `cells = [nx, ny(, nz)]` or, for Voronoi, one number.
@@ -318,6 +324,19 @@ pub enum Select {
     /// `{ ijk = [[i0, i1], [j0, j1], [k0, k1]] }`: cells of a corner-point deck by their
     /// 1-based indices, ranges inclusive (Eclipse's `BOX`).
     Ijk([[u64; 2]; 3]),
+    /// `{ around = { path = [[x, y, z], …], radius = r } }`: cells whose centroid lies
+    /// within `r` of a polyline (a well trajectory).
+    Around(PathBall),
+}
+
+/// A polyline and a distance.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct PathBall {
+    /// The polyline's points.
+    pub path: Vec<Vec<f64>>,
+    /// Distance (m).
+    pub radius: f64,
 }
 
 /// Centre and radius.

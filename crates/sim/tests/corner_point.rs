@@ -1,20 +1,25 @@
-//! The VEM patch test on corner-point grids: a faulted deck whose layers cross inside the
+//! The patch test on corner-point grids: a faulted deck whose layers cross inside the
 //! fault (nodes inside the fault surface, split sub-faces) on skewed, non-parallel pillars
-//! (non-planar faces). `u = A x + b` prescribed on the boundary is reproduced at every
-//! node and every cell stress is the exact constant stress, to 1e-9 relative.
+//! (non-planar faces), with VEM everywhere, and with an MDEM zone of tetrahedra (cells on
+//! both sides of the fault, refined 0 and 1 times) conforming with the VEM cells around
+//! it (split faces, hanging nodes). `u = A x + b` prescribed on the boundary is
+//! reproduced at every node and every cell stress is the exact constant stress, to 1e-9
+//! relative; the zone keeps the volume of the cells it replaces.
 
 mod common;
 
 use common::rel;
 use nalgebra::SMatrix;
-use porofrac_grid::Point;
+use porofrac_grid::generate::tetrahedralize;
 use porofrac_grid::io::grdecl::{Deck, corner_point_grid};
+use porofrac_grid::{Grid, Point};
+use porofrac_law::CellLaw;
 use porofrac_law::stiffness::Stiffness;
+use porofrac_mdem::MdemLaw;
 use porofrac_sim::*;
 use porofrac_vem::VemLaw;
 
-#[test]
-fn vem_patch_test_on_a_faulted_corner_point_grid() {
+fn faulted_deck() -> Deck {
     let (dx, dy, dz) = (10.0, 20.0, 2.0);
     let mut deck = Deck::on_vertical_pillars([3, 2, 3], [dx, dy], |[i, _], x, y, k| {
         100.0
@@ -31,12 +36,23 @@ fn vem_patch_test_on_a_faulted_corner_point_grid() {
         c[3] += 0.003 * ((p * 7) % 5) as f64;
         c[4] -= 0.002 * ((p * 3) % 4) as f64;
     }
-    let cp = corner_point_grid(&deck).unwrap();
-    let grid = &cp.grid;
-    assert_eq!(grid.num_cells(), 18);
-    assert!(grid.max_cell_nodes() > 8, "split faces add nodes to cells");
+    deck
+}
+
+/// Solve the patch test on `grid` with MDEM on the cells tagged `refined` and VEM on the
+/// others; return the largest relative displacement and stress errors.
+fn patch(grid: &Grid<3>) -> (f64, f64) {
     let (e, nu) = (2.0e10, 0.25);
-    let law = VemLaw::<3>::new(Stiffness::<3>::isotropic(e, nu).unwrap());
+    let stiffness = Stiffness::<3>::isotropic(e, nu).unwrap();
+    let vem = VemLaw::<3>::new(stiffness.clone());
+    let mdem = MdemLaw::<3>::new(&stiffness).unwrap();
+    let mut law_of_cell = vec![0; grid.num_cells()];
+    if let Some(zone) = grid.cell_tags().get("refined") {
+        for &c in zone {
+            law_of_cell[c] = 1;
+        }
+    }
+    let laws = LawMap::new(grid, vec![&vem as &dyn CellLaw<3>, &mdem], law_of_cell).unwrap();
     let a = SMatrix::<f64, 3, 3>::from_fn(|i, j| 1e-4 * (0.4 + i as f64 - 0.9 * j as f64));
     let b = Point::<3>::new(1e-3, -2e-3, 5e-4);
     let exact = move |x: &[f64], c: usize| b[c] + (0..3).map(|j| a[(c, j)] * x[j]).sum::<f64>();
@@ -48,7 +64,6 @@ fn vem_patch_test_on_a_faulted_corner_point_grid() {
     let dofs = DofMap::new(grid, &[bc], &[]).unwrap();
     assert!(dofs.num_equations() > 0, "interior nodes are free");
     let pattern = Pattern::new(grid, &dofs).unwrap();
-    let laws = LawMap::uniform(grid, &law).unwrap();
     let mut solver = DirectSolver::new(&pattern).unwrap();
     let loads = Loads::default();
     let problem = StaticProblem {
@@ -65,7 +80,6 @@ fn vem_patch_test_on_a_faulted_corner_point_grid() {
     let worst = (0..3 * grid.num_nodes())
         .map(|k| rel(u[k], exact(grid.node(k / 3).as_slice(), k % 3), scale))
         .fold(0.0, f64::max);
-    assert!(worst < 1e-9, "displacement error {worst:.2e}");
     let lambda = e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
     let mu = e / (2.0 * (1.0 + nu));
     let eps = (a + a.transpose()) * 0.5;
@@ -75,6 +89,47 @@ fn vem_patch_test_on_a_faulted_corner_point_grid() {
         .iter()
         .map(|t| (t - sig).amax() / sig.amax())
         .fold(0.0, f64::max);
-    assert!(worst_s < 1e-9, "stress error {worst_s:.2e}");
-    eprintln!("corner-point VEM patch test: displacement {worst:.2e}, stress {worst_s:.2e}");
+    (worst, worst_s)
+}
+
+#[test]
+fn vem_patch_test_on_a_faulted_corner_point_grid() {
+    let cp = corner_point_grid(&faulted_deck()).unwrap();
+    let grid = &cp.grid;
+    assert_eq!(grid.num_cells(), 18);
+    assert!(grid.max_cell_nodes() > 8, "split faces add nodes to cells");
+    let (du, ds) = patch(grid);
+    eprintln!("corner-point VEM patch test: displacement {du:.2e}, stress {ds:.2e}");
+    assert!(du < 1e-9, "displacement error {du:.2e}");
+    assert!(ds < 1e-9, "stress error {ds:.2e}");
+}
+
+#[test]
+fn mdem_zone_in_a_faulted_corner_point_grid_passes_the_patch_test() {
+    let cp = corner_point_grid(&faulted_deck()).unwrap();
+    // The middle layer of the two columns on either side of the fault, j = 0.
+    let zone: Vec<usize> = (0..cp.grid.num_cells())
+        .filter(|&c| matches!(cp.ijk[c], [1 | 2, 0, 1]))
+        .collect();
+    assert_eq!(zone.len(), 2);
+    let before: f64 = zone.iter().map(|&c| cp.grid.cell_volume(c)).sum();
+    for levels in [0, 1] {
+        let t = tetrahedralize(&cp.grid, &zone, levels).unwrap();
+        let g = &t.grid;
+        let tets = &g.cell_tags()["refined"];
+        assert!(tets.iter().all(|&c| g.cell_nodes(c).len() == 4));
+        let after: f64 = tets.iter().map(|&c| g.cell_volume(c)).sum();
+        assert!(
+            (after - before).abs() < 1e-12 * before,
+            "zone volume {after} vs {before}"
+        );
+        assert_eq!(g.num_cells(), 16 + tets.len());
+        let (du, ds) = patch(g);
+        eprintln!(
+            "MDEM zone, {levels} refinements ({} tetrahedra): displacement {du:.2e}, stress {ds:.2e}",
+            tets.len()
+        );
+        assert!(du < 1e-9, "displacement error {du:.2e}");
+        assert!(ds < 1e-9, "stress error {ds:.2e}");
+    }
 }

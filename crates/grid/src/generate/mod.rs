@@ -10,15 +10,20 @@
 //!   iterations.
 //! * [`composite`]: a 2D Cartesian far field with a refined triangle zone around a point,
 //!   joined by hanging nodes, with `refined` and well cell tags.
+//! * [`tetrahedralize`]: some cells of any 3D grid replaced by tetrahedra (refined by
+//!   edge splits) that conform with the cells around them: an MDEM zone in a VEM far
+//!   field, e.g. around a well in a corner-point grid.
 
 mod composite;
 mod extrude;
 mod perturb;
 mod structured;
+mod tetrahedralize;
 mod voronoi;
 
 pub use composite::{CompositeSpec, Diagonals, REFINED_TAG, composite};
 pub use extrude::extrude;
 pub use perturb::{MAX_PERTURB, perturb};
 pub use structured::{cartesian, simplices};
+pub use tetrahedralize::{Tetrahedralized, tetrahedralize};
 pub use voronoi::{DEFAULT_LLOYD, voronoi};

@@ -86,7 +86,7 @@ pub fn compose<const D: usize>(
     let mut law_region: Vec<Option<usize>> = vec![None; n];
     let mut mat_region: Vec<Option<usize>> = vec![None; n];
     for (i, r) in s.region.iter().enumerate() {
-        let cells = select_cells(ls, i, grid, deck, &r.select)?;
+        let cells = select_cells(ls, &ki("region", i, &["select"]), grid, deck, &r.select)?;
         for c in cells {
             if r.law.is_some() {
                 law_region[c] = Some(i);

@@ -122,7 +122,13 @@ pub fn flow_setup<const D: usize>(
             .enumerate()
             .find(|(_, r)| r.name == src.region)
             .expect("source regions checked");
-        let cells = select_cells(ls, r, grid, deck, &region.select)?;
+        let cells = select_cells(
+            ls,
+            &ki("region", r, &["select"]),
+            grid,
+            deck,
+            &region.select,
+        )?;
         let rate = match (src.rate, src.pore_volumes_per_hour) {
             (Some(q), _) => SourceRate::Total(q),
             (None, Some(v)) => SourceRate::PoreVolumesPerHour(v),

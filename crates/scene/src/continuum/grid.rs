@@ -1,14 +1,15 @@
 //! The grid of a continuum scene: generated from `[grid]` or read from a mesh file, and
 //! the cell selections of `[[region]]`.
 
+use porofrac_grid::generate::tetrahedralize;
 use porofrac_grid::generate::{
     CompositeSpec, Diagonals, cartesian, composite, extrude, perturb, simplices, voronoi,
 };
-use porofrac_grid::io::grdecl::CornerPointGrid;
+use porofrac_grid::io::grdecl::{CornerPointGrid, fault_faces};
 use porofrac_grid::io::{read_grdecl, read_msh, read_vtu};
 use porofrac_grid::{Grid, GridError, Point};
 
-use crate::check::{LoadedScene, k, ki};
+use crate::check::{LoadedScene, k};
 use crate::file::{CellCount, DiagonalsChoice, GridKind, Select};
 use crate::model::RunError;
 
@@ -50,16 +51,11 @@ impl DeckCells {
                 })
                 .collect()
         });
-        let fault_multipliers = deck
-            .fault_multipliers
-            .iter()
-            .map(|(name, m)| (cp.fault_faces(&deck.faults, name), *m))
-            .collect();
         Self {
             ijk: cp.ijk.clone(),
             porosity,
             permeability,
-            fault_multipliers,
+            fault_multipliers: Vec::new(),
         }
     }
 }
@@ -99,10 +95,78 @@ pub fn build_grid(ls: &LoadedScene) -> Result<(AnyGrid, DeckCells), RunError> {
             }
             let (deck, cp) = read_grdecl(&path).map_err(at_path)?;
             let cells = DeckCells::from_deck(&deck, &cp);
-            return Ok((AnyGrid::Three(cp.grid), cells));
+            let (grid, mut cells) = with_mdem_zone(ls, cp.grid, cells)?;
+            if let AnyGrid::Three(g3) = &grid {
+                // Fault faces of the grid as it is now (zone faces split).
+                cells.fault_multipliers = deck
+                    .fault_multipliers
+                    .iter()
+                    .map(|(name, m)| (fault_faces(g3, &cells.ijk, &deck.faults, name), *m))
+                    .collect();
+            }
+            return Ok((grid, cells));
         }
     }
-    Ok((build_plain_grid(ls)?, DeckCells::default()))
+    let grid = build_plain_grid(ls)?;
+    match (grid, &g.mdem_zone) {
+        (AnyGrid::Three(g3), Some(_)) => with_mdem_zone(ls, g3, DeckCells::default()),
+        (grid, _) => Ok((grid, DeckCells::default())),
+    }
+}
+
+/// Replace the cells of `[grid] mdem_zone` by conforming tetrahedra (refined `refine`
+/// times, tagged `refined`), tag those within `well_radius` of `well_path` `well`, and
+/// give the new cells their parents' deck data.
+fn with_mdem_zone(
+    ls: &LoadedScene,
+    grid: Grid<3>,
+    deck: DeckCells,
+) -> Result<(AnyGrid, DeckCells), RunError> {
+    let g = &ls.scene.grid;
+    let Some(sel) = &g.mdem_zone else {
+        return Ok((AnyGrid::Three(grid), deck));
+    };
+    let zone = select_cells(ls, &k(&["grid", "mdem_zone"]), &grid, &deck, sel)?;
+    let levels = g.refine.unwrap_or(0).max(0) as usize;
+    let t = tetrahedralize(&grid, &zone, levels)
+        .map_err(|e| RunError::Scene(ls.error(&k(&["grid", "mdem_zone"]), e.to_string())))?;
+    let mut out = t.grid;
+    if let (Some(path), Some(r)) = (&g.well_path, g.well_radius) {
+        let path: Vec<Point<3>> = path.iter().map(|p| point(p)).collect();
+        let well: Vec<usize> = out.cell_tags()[porofrac_grid::generate::REFINED_TAG]
+            .iter()
+            .copied()
+            .filter(|&c| distance_to_path(out.cell_centroid(c), &path) <= r)
+            .collect();
+        if well.is_empty() {
+            return Err(ls
+                .error(
+                    &k(&["grid", "well_radius"]),
+                    format!(
+                        "= {r}: no tetrahedron of the zone has its centroid that close to well_path"
+                    ),
+                )
+                .into());
+        }
+        let tag = g.well_tag.clone().unwrap_or_else(|| "well".into());
+        out.set_cell_tag(tag, well).map_err(RunError::Grid)?;
+    }
+    let by_parent = |v: &[[usize; 3]]| t.parent.iter().map(|&p| v[p]).collect::<Vec<_>>();
+    let deck = DeckCells {
+        ijk: if deck.ijk.is_empty() {
+            Vec::new()
+        } else {
+            by_parent(&deck.ijk)
+        },
+        porosity: deck
+            .porosity
+            .map(|v| t.parent.iter().map(|&p| v[p]).collect()),
+        permeability: deck
+            .permeability
+            .map(|v| t.parent.iter().map(|&p| v[p]).collect()),
+        fault_multipliers: Vec::new(),
+    };
+    Ok((AnyGrid::Three(out), deck))
 }
 
 /// Build (or read) a grid that is not a corner-point deck.
@@ -237,10 +301,29 @@ fn build_plain_grid(ls: &LoadedScene) -> Result<AnyGrid, RunError> {
     Ok(grid)
 }
 
+/// Distance from `x` to the polyline through `path`.
+pub(crate) fn distance_to_path<const D: usize>(x: &Point<D>, path: &[Point<D>]) -> f64 {
+    if path.len() == 1 {
+        return (x - path[0]).norm();
+    }
+    path.windows(2)
+        .map(|w| {
+            let (a, b) = (w[0], w[1]);
+            let ab = b - a;
+            let t = if ab.norm_squared() > 0.0 {
+                ((x - a).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            (x - (a + ab * t)).norm()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
 /// Which cells a selection picks (by centroid).
 pub(crate) fn select_cells<const D: usize>(
     ls: &LoadedScene,
-    i: usize,
+    key: &[crate::file::KeyPart],
     grid: &Grid<D>,
     deck: &DeckCells,
     sel: &Select,
@@ -262,7 +345,7 @@ pub(crate) fn select_cells<const D: usize>(
             if deck.ijk.is_empty() {
                 return Err(ls
                     .error(
-                        &ki("region", i, &["select"]),
+                        key,
                         "= { ijk = … } needs a grid read from a corner-point deck",
                     )
                     .into());
@@ -273,13 +356,17 @@ pub(crate) fn select_cells<const D: usize>(
                 .filter(|&c| inside(&deck.ijk[c]))
                 .collect()
         }
+        Select::Around(pb) => {
+            let path: Vec<Point<D>> = pb.path.iter().map(|p| point(p)).collect();
+            pick(&|x| distance_to_path(x, &path) <= pb.radius)
+        }
         Select::Tag(name) => {
             match grid.cell_tags().get(name) {
                 Some(v) => v.clone(),
                 None => {
                     let known: Vec<_> = grid.cell_tags().keys().cloned().collect();
                     return Err(ls
-                    .error(&ki("region", i, &["select"]), format!("= {{ tag = \"{name}\" }}: the grid has no such cell tag (known: {})", if known.is_empty() { "none".into() } else { known.join(", ") }))
+                    .error(key, format!("= {{ tag = \"{name}\" }}: the grid has no such cell tag (known: {})", if known.is_empty() { "none".into() } else { known.join(", ") }))
                     .into());
                 }
             }
@@ -288,7 +375,7 @@ pub(crate) fn select_cells<const D: usize>(
     if cells.is_empty() {
         return Err(ls
             .error(
-                &ki("region", i, &["select"]),
+                key,
                 "selects no cell (cells are selected by their centroid)",
             )
             .into());

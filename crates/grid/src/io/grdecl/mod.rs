@@ -68,7 +68,7 @@ mod process;
 pub use deck::{
     CellProperties, Deck, FaultFace, FaultSegment, MAX_DECK_CELLS, MILLIDARCY, Units, read_deck,
 };
-pub use process::{CornerPointGrid, IJK_SIDES, RELATIVE_TOLERANCE, corner_point_grid};
+pub use process::{CornerPointGrid, IJK_SIDES, RELATIVE_TOLERANCE, corner_point_grid, fault_faces};
 
 use std::path::Path;
 

@@ -34,41 +34,52 @@ pub struct CornerPointGrid {
 }
 
 impl CornerPointGrid {
-    /// The interior faces of the fault `name` (its `FAULTS` segments: each segment's
-    /// cells' faces on its side, towards the neighbouring column or the next cell of the
-    /// column). Empty if the deck has no such fault.
+    /// The interior faces of the fault `name`; see [`fault_faces`].
     pub fn fault_faces(&self, faults: &[super::deck::FaultSegment], name: &str) -> Vec<usize> {
-        use super::deck::FaultFace::*;
-        let segments: Vec<_> = faults.iter().filter(|s| s.name == name).collect();
-        let g = &self.grid;
-        let inside = |c: [usize; 3], r: &[[usize; 2]; 3]| {
-            (0..3).all(|a| (r[a][0]..=r[a][1]).contains(&(c[a] + 1)))
-        };
-        // Whether `b` lies across face `face` of `a`.
-        let across = |a: [usize; 3], b: [usize; 3], face: super::deck::FaultFace| {
-            let (di, dj) = (b[0] as isize - a[0] as isize, b[1] as isize - a[1] as isize);
-            match face {
-                XPlus => di == 1 && dj == 0,
-                XMinus => di == -1 && dj == 0,
-                YPlus => di == 0 && dj == 1,
-                YMinus => di == 0 && dj == -1,
-                ZPlus => di == 0 && dj == 0 && b[2] > a[2],
-                ZMinus => di == 0 && dj == 0 && b[2] < a[2],
-            }
-        };
-        (0..g.num_faces())
-            .filter(|&f| {
-                let (a, Some(b)) = g.face_cells(f) else {
-                    return false;
-                };
-                let (a, b) = (self.ijk[a], self.ijk[b]);
-                segments.iter().any(|s| {
-                    (inside(a, &s.ijk) && across(a, b, s.face))
-                        || (inside(b, &s.ijk) && across(b, a, s.face))
-                })
-            })
-            .collect()
+        fault_faces(&self.grid, &self.ijk, faults, name)
     }
+}
+
+/// The interior faces of the fault `name` of a grid whose cells have the deck indices
+/// `ijk` (several cells may share one, e.g. the tetrahedra of an MDEM zone): for each of
+/// its `FAULTS` segments, the faces between the segment's cells and the cells across
+/// its side (the neighbouring column, or a deeper or shallower cell of the column).
+/// Empty if the deck has no such fault.
+pub fn fault_faces(
+    grid: &Grid<3>,
+    ijk: &[[usize; 3]],
+    faults: &[super::deck::FaultSegment],
+    name: &str,
+) -> Vec<usize> {
+    use super::deck::FaultFace::*;
+    let segments: Vec<_> = faults.iter().filter(|s| s.name == name).collect();
+    let inside = |c: [usize; 3], r: &[[usize; 2]; 3]| {
+        (0..3).all(|a| (r[a][0]..=r[a][1]).contains(&(c[a] + 1)))
+    };
+    // Whether `b` lies across face `face` of `a`.
+    let across = |a: [usize; 3], b: [usize; 3], face: super::deck::FaultFace| {
+        let (di, dj) = (b[0] as isize - a[0] as isize, b[1] as isize - a[1] as isize);
+        match face {
+            XPlus => di == 1 && dj == 0,
+            XMinus => di == -1 && dj == 0,
+            YPlus => di == 0 && dj == 1,
+            YMinus => di == 0 && dj == -1,
+            ZPlus => di == 0 && dj == 0 && b[2] > a[2],
+            ZMinus => di == 0 && dj == 0 && b[2] < a[2],
+        }
+    };
+    (0..grid.num_faces())
+        .filter(|&f| {
+            let (a, Some(b)) = grid.face_cells(f) else {
+                return false;
+            };
+            let (a, b) = (ijk[a], ijk[b]);
+            segments.iter().any(|s| {
+                (inside(a, &s.ijk) && across(a, b, s.face))
+                    || (inside(b, &s.ijk) && across(b, a, s.face))
+            })
+        })
+        .collect()
 }
 
 /// Names of the six ijk sides, tagged on the boundary faces that face them.
