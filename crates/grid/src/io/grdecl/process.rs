@@ -370,6 +370,10 @@ pub fn corner_point_grid(deck: &Deck) -> Result<CornerPointGrid> {
     // Chunks of cells in parallel, joined in order.
     const CHUNK: usize = 4096;
     let b = &b;
+    let centres: Vec<Point<3>> = ijk
+        .par_iter()
+        .map(|&[i, j, k]| b.cell_centre(i, j, k))
+        .collect::<Result<_>>()?;
     let parts: Vec<(CellFaceLoops, Vec<u8>)> = (0..num_cells.div_ceil(CHUNK))
         .into_par_iter()
         .map(|ch| {
@@ -378,7 +382,7 @@ pub fn corner_point_grid(deck: &Deck) -> Result<CornerPointGrid> {
             let mut face = Vec::new();
             for c in ch * CHUNK..((ch + 1) * CHUNK).min(num_cells) {
                 let [i, j, k] = ijk[c];
-                let centre = b.cell_centre(i, j, k)?;
+                let centre = centres[c];
                 for bottom in [0, 1] {
                     b.horizontal_loop(i, j, k, bottom, &mut face)?;
                     if b.emit(&mut loops, &mut face, &centre, false) {
@@ -392,10 +396,7 @@ pub fn corner_point_grid(deck: &Deck) -> Result<CornerPointGrid> {
                     // that the two cells of a shared sub-face see it in opposite
                     // orientations.
                     let (ref_centre, flip) = match sf.cells {
-                        [Some(m), _] if side == 1 => {
-                            let [mi, mj, mk] = ijk[m];
-                            (b.cell_centre(mi, mj, mk)?, true)
-                        }
+                        [Some(m), _] if side == 1 => (centres[m], true),
                         _ => (centre, false),
                     };
                     if b.emit(&mut loops, &mut face, &ref_centre, flip) {
