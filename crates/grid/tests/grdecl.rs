@@ -287,6 +287,36 @@ fn bad_decks_are_errors_naming_file_line_and_keyword() {
     let e = error_of("upside.grdecl", &upside);
     assert!(e.contains("bottom is above the top"), "{e}");
 
+    let e = error_of("radial.grdecl", "SPECGRID\n 1 1 1 1 T /\n");
+    assert!(e.contains("radial"), "{e}");
+
+    let e = error_of(
+        "default.grdecl",
+        &good.replacen(" 1.0 1.0 1.0 1.0\n/", " 1.0 1.0 2*\n/", 1),
+    );
+    assert!(e.contains("`2*`") && e.contains("default"), "{e}");
+
+    let e = error_of("quote.grdecl", "INCLUDE\n 'open.inc /\n");
+    assert!(e.contains("not closed"), "{e}");
+
+    let e = error_of(
+        "faults.grdecl",
+        &format!("{good}FAULTS\n 'F1' 1 2 1 1 1 1 'X' /\n/\n"),
+    );
+    assert!(e.contains("FAULTS: record `F1 1 2 1 1 1 1 X`"), "{e}");
+
+    // Two cells of a column that overlap; a horizontal pillar.
+    let two = deck_text([1, 1, 2], 1.0, 1.0, |_, _, _, k| k as f64, "");
+    let mut deck = read_deck(write("two.grdecl", &two)).unwrap();
+    deck.zcorn[8] = 0.5; // the top of cell k = 2 above the bottom of k = 1 at corner 1
+    let e = corner_point_grid(&deck).unwrap_err().to_string();
+    assert!(e.contains("overlap at corner 1"), "{e}");
+    let mut flat = read_deck(write("flat.grdecl", &good)).unwrap();
+    flat.coord[3] += 5.0;
+    flat.coord[5] = flat.coord[2];
+    let e = corner_point_grid(&flat).unwrap_err().to_string();
+    assert!(e.contains("horizontal"), "{e}");
+
     let e = error_of("nozcorn.grdecl", "SPECGRID\n 1 1 1 /\nCOORD\n 24*0 /\n");
     assert!(matches!(
         read_deck(write("nz.grdecl", "SPECGRID\n 1 1 1 /\n")),
