@@ -19,6 +19,8 @@
 //!   affine displacement prescribed on all outer faces (imin … kmax) gives the exact
 //!   constant stress in every cell, VEM and MDEM (field extrema within 1e-8 of the
 //!   largest stress);
+//! * a deck declaring 1e9 cells and a ZCORN of 8e9 repeated values is refused at its
+//!   `DIMENS`, naming the memory, before anything is allocated;
 //! * the bounding-box side `zmin`, which touches no face of the dipping top, is an error
 //!   that points to the ijk sides; `select = { ijk = … }` on a generated grid is an error.
 
@@ -320,6 +322,22 @@ poisson_ratio = 0.25
 boundary = "zmin"
 displacement = [0.0, 0.0, 0.0]
 "#;
+    let dir = tmp_dir("cp_huge_deck");
+    let huge = dir.join("huge.grdecl");
+    std::fs::write(
+        &huge,
+        "DIMENS\n 1000 1000 1000 /\nZCORN\n 8000000000*1.0 /\n",
+    )
+    .unwrap();
+    let (code, err, _) = run(
+        "cp_huge",
+        &balance_scene_on(huge.to_str().unwrap(), "", "kmax"),
+    );
+    assert_eq!(code, 1);
+    assert!(
+        err.contains("DIMENS") && err.contains("kB per deck cell") && err.contains("GB"),
+        "{err}"
+    );
     let (code, err, _) = run("cp_ijk", generated);
     assert_eq!(code, 1);
     assert!(

@@ -25,6 +25,11 @@ pub const MAX_CELLS: u64 = 1_000_000_000;
 /// Largest number of points of one output line.
 pub const MAX_LINE_POINTS: u64 = 1_000_000;
 
+/// Estimated peak memory per cell of a corner-point deck (bytes): reading and processing
+/// take about 1.4 kB per cell (1.3 GB for the faulted 100³ deck of
+/// `porofrac-grid/examples/grdecl_speed.rs`), the run about as much again.
+pub const BYTES_PER_DECK_CELL: u64 = 3000;
+
 /// Estimated peak memory per cell and per unknown of a run (bytes).
 pub const BYTES_PER_ITEM: u64 = 600;
 

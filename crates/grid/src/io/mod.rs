@@ -130,7 +130,7 @@ mod vtu;
 mod xml;
 
 pub use gmsh::{parse_msh, parse_msh_bytes, read_msh};
-pub use grdecl::read_grdecl;
+pub use grdecl::{read_grdecl, read_grdecl_with};
 pub use pvd::PvdWriter;
 pub use vtu::{Encoding, Field, kelvin_to_vtk_sym, read_vtu, write_vtu, write_vtu_with};
 

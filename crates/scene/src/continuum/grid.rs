@@ -5,8 +5,8 @@ use porofrac_grid::generate::tetrahedralize;
 use porofrac_grid::generate::{
     CompositeSpec, Diagonals, cartesian, composite, extrude, perturb, simplices, voronoi,
 };
-use porofrac_grid::io::grdecl::{CornerPointGrid, fault_faces};
-use porofrac_grid::io::{read_grdecl, read_msh, read_vtu};
+use porofrac_grid::io::grdecl::{CornerPointGrid, DeckLimit, fault_faces};
+use porofrac_grid::io::{read_grdecl_with, read_msh, read_vtu};
 use porofrac_grid::{Grid, GridError, Point};
 
 use crate::check::{LoadedScene, k};
@@ -93,7 +93,17 @@ pub fn build_grid(ls: &LoadedScene) -> Result<(AnyGrid, DeckCells), RunError> {
                     .error(&k(&["grid", "path"]), "a corner-point deck needs dim = 3")
                     .into());
             }
-            let (deck, cp) = read_grdecl(&path).map_err(at_path)?;
+            let limit =
+                crate::limits::machine_memory().map_or_else(DeckLimit::default, |m| DeckLimit {
+                    cells: (m / crate::limits::BYTES_PER_DECK_CELL) as usize,
+                    why: format!(
+                        "a corner-point grid and its run need about {} kB per deck cell; this \
+                         machine has {} for a run",
+                        crate::limits::BYTES_PER_DECK_CELL / 1000,
+                        crate::limits::bytes_text(m as f64)
+                    ),
+                });
+            let (deck, cp) = read_grdecl_with(&path, &limit).map_err(at_path)?;
             let cells = DeckCells::from_deck(&deck, &cp);
             let (grid, mut cells) = with_mdem_zone(ls, cp.grid, cells)?;
             if let AnyGrid::Three(g3) = &grid {

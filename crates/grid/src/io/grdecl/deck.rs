@@ -212,7 +212,34 @@ const MAX_INCLUDE_DEPTH: usize = 16;
 
 /// Read a GRDECL deck (following `INCLUDE`s relative to the including file).
 pub fn read_deck(path: impl AsRef<Path>) -> Result<Deck> {
-    let mut reader = DeckReader::default();
+    read_deck_with(path, &DeckLimit::default())
+}
+
+/// The largest deck a reader accepts, and why (the caller's memory, say): a larger
+/// `SPECGRID` is an error before anything is allocated for it.
+#[derive(Clone, Debug)]
+pub struct DeckLimit {
+    /// Largest number of cells (at most [`MAX_DECK_CELLS`]).
+    pub cells: usize,
+    /// Why, for the error message.
+    pub why: String,
+}
+
+impl Default for DeckLimit {
+    fn default() -> Self {
+        Self {
+            cells: MAX_DECK_CELLS,
+            why: "the most a deck may have".into(),
+        }
+    }
+}
+
+/// [`read_deck`] with a bound on the deck's size.
+pub fn read_deck_with(path: impl AsRef<Path>, limit: &DeckLimit) -> Result<Deck> {
+    let mut reader = DeckReader {
+        limit: limit.clone(),
+        ..DeckReader::default()
+    };
     reader.read_file(path.as_ref(), 0)?;
     reader.finish()
 }
@@ -235,6 +262,8 @@ struct DeckReader {
     gridunit_scale: Option<f64>,
     /// Files being read (to refuse an `INCLUDE` cycle).
     open: Vec<PathBuf>,
+    /// The largest deck accepted.
+    limit: DeckLimit,
 }
 
 /// A token of the deck: a word or number, a quoted string, or the record end `/`.
@@ -437,10 +466,11 @@ impl DeckReader {
                         *d = *v as usize;
                     }
                     let n = dims.iter().try_fold(1usize, |a, &d| a.checked_mul(d));
-                    if n.is_none_or(|n| n > MAX_DECK_CELLS) {
+                    let most = self.limit.cells.min(MAX_DECK_CELLS);
+                    if n.is_none_or(|n| n > most) {
                         return Err(lx.error(format!(
-                            "{word}: {} × {} × {} cells is more than the {MAX_DECK_CELLS} a deck may have",
-                            dims[0], dims[1], dims[2]
+                            "{word}: {} × {} × {} cells is more than the {most} allowed ({})",
+                            dims[0], dims[1], dims[2], self.limit.why
                         )));
                     }
                     self.deck.dims = dims;

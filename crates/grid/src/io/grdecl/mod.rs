@@ -66,7 +66,8 @@ mod deck;
 mod process;
 
 pub use deck::{
-    CellProperties, Deck, FaultFace, FaultSegment, MAX_DECK_CELLS, MILLIDARCY, Units, read_deck,
+    CellProperties, Deck, DeckLimit, FaultFace, FaultSegment, MAX_DECK_CELLS, MILLIDARCY, Units,
+    read_deck, read_deck_with,
 };
 pub use process::{CornerPointGrid, IJK_SIDES, RELATIVE_TOLERANCE, corner_point_grid, fault_faces};
 
@@ -76,8 +77,16 @@ use crate::error::{GridError, Result};
 
 /// Read a deck and process it into a grid; grid errors name the file.
 pub fn read_grdecl(path: impl AsRef<Path>) -> Result<(Deck, CornerPointGrid)> {
+    read_grdecl_with(path, &DeckLimit::default())
+}
+
+/// [`read_grdecl`] with a bound on the deck's size.
+pub fn read_grdecl_with(
+    path: impl AsRef<Path>,
+    limit: &DeckLimit,
+) -> Result<(Deck, CornerPointGrid)> {
     let path = path.as_ref();
-    let deck = read_deck(path)?;
+    let deck = read_deck_with(path, limit)?;
     let grid = corner_point_grid(&deck).map_err(|e| GridError::InFile {
         path: path.to_path_buf(),
         source: Box::new(e),
