@@ -223,9 +223,16 @@ impl<const D: usize> FailureResolution<D> {
         &self.settings
     }
 
+    /// Whether any cell has a failure criterion (else [`Self::resolve`] solves once and
+    /// needs no stresses).
+    pub fn can_fail(&self) -> bool {
+        self.settings.criteria.iter().any(|c| !c.is_empty())
+    }
+
     /// Solve, check the criteria on the chosen stress measure, fail and re-solve at time
     /// `t` until no cell fails ([`porofrac_frac::resolve()`]). `solve` gets the failure
-    /// state and returns a solution and its cell stresses.
+    /// state and returns a solution and its cell stresses (which may be empty when
+    /// [`Self::can_fail`] is false).
     pub fn resolve<S, E>(
         &mut self,
         grid: &Grid<D>,
@@ -233,7 +240,16 @@ impl<const D: usize> FailureResolution<D> {
         t: f64,
         mut solve: impl FnMut(&FailureState) -> Result<(S, Vec<Tensor<D>>), E>,
     ) -> Result<Resolved<S, D>, ResolutionError<E>> {
-        let can_fail = self.settings.criteria.iter().any(|c| !c.is_empty());
+        let can_fail = self.can_fail();
+        if !can_fail {
+            // Nothing can fail: one solve, its stresses (if any) passed on as they are.
+            let solution = solve(failures).map_err(ResolutionError::Solve)?;
+            return Ok(Resolved {
+                solution,
+                new_failures: 0,
+                rounds: 1,
+            });
+        }
         let adjacency = &self.adjacency;
         let ((solution, stress), _, new_failures, rounds) = resolve(
             failures,

@@ -223,6 +223,8 @@ struct Stepper<'a, const D: usize> {
     wall: WallSeconds,
     /// Index of the last computed output time.
     done: usize,
+    /// The static step left the stresses to be recovered after it (nothing could fail).
+    stress_stale: bool,
 }
 
 impl<'a, const D: usize> Stepper<'a, D> {
@@ -354,6 +356,7 @@ impl<'a, const D: usize> Stepper<'a, D> {
             },
             wall,
             done: 0,
+            stress_stale: false,
         })
     }
 
@@ -370,6 +373,7 @@ impl<'a, const D: usize> Stepper<'a, D> {
         let (grid, comp, body) = (self.body.grid, self.comp, self.body);
         let (ls, options, law_refs) = (self.ls, &self.static_options, &self.law_refs);
         let previous = explicit.is_some().then(|| self.u.clone());
+        let can_fail = resolution.can_fail();
         let mut iterations = 0;
         let mut worst = 0.0f64;
         let mut solve_seconds = 0.0;
@@ -404,7 +408,13 @@ impl<'a, const D: usize> Stepper<'a, D> {
                 }
             };
             solve_seconds += t_solve.elapsed().as_secs_f64();
-            let stress = cell_stresses(grid, &laws, &u)?;
+            // Without failure criteria the stresses are for the outputs only: they are
+            // recovered after the step ([`Model::after_step`]), as output work.
+            let stress = if can_fail {
+                cell_stresses(grid, &laws, &u)?
+            } else {
+                Vec::new()
+            };
             Ok((u, stress))
         };
         let t0 = Instant::now();
@@ -417,7 +427,12 @@ impl<'a, const D: usize> Stepper<'a, D> {
         let total = t0.elapsed().as_secs_f64();
         self.wall.solve += solve_seconds;
         self.wall.assembly += total - solve_seconds;
-        (self.u, self.stress) = done.solution;
+        let stress;
+        (self.u, stress) = done.solution;
+        self.stress_stale = stress.is_empty();
+        if !self.stress_stale {
+            self.stress = stress;
+        }
         self.stats.iterations += iterations;
         self.stats.max_relative_residual = self.stats.max_relative_residual.max(worst);
         self.stats.factorizations = solver.numeric_factorizations();
@@ -528,6 +543,17 @@ impl<const D: usize> Model for Stepper<'_, D> {
 
     fn after_step(&mut self, _out: &Path) -> Result<(), RunError> {
         let grid = self.body.grid;
+        if self.stress_stale {
+            let t_out = Instant::now();
+            let laws = LawMap::new(
+                grid,
+                self.law_refs.clone(),
+                self.comp.law_of_cell_after(self.failures.flags()),
+            )?;
+            self.stress = cell_stresses(grid, &laws, &self.u)?;
+            self.stress_stale = false;
+            self.wall.output += t_out.elapsed().as_secs_f64();
+        }
         for f in &self.failures.log()[self.logged..] {
             let x = grid.cell_centroid(f.cell);
             let mut row = vec![f.cell.to_string()];
