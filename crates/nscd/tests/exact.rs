@@ -163,8 +163,9 @@ fn column_carries_the_weight_above_each_contact() {
         let mut worst = 0.0f64;
         for (k, f) in forces.iter().enumerate() {
             let exact = (k + 1) as f64 * m * G;
-            // NLGS stops on the change per sweep; on a chain the error left is the change
-            // divided by the contraction gap, O(n²): a bound of tol·n² relative to n m g.
+            // NLGS stops on the change per sweep, which on a chain can sit an O(n²) factor
+            // below the error; after three warm-started steps the error is below the
+            // tolerance itself (relative to the floor load n m g).
             let err = (f - exact).abs() / (n as f64 * m * G);
             worst = worst.max(err);
             assert!(
