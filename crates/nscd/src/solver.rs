@@ -514,7 +514,7 @@ impl Nscd {
                 h * (theta * d.v[i][1] + (1.0 - theta) * self.v_old[i][1]),
             ];
             let dist = (u[0] * u[0] + u[1] * u[1]).sqrt();
-            if !(dist <= d.r[i]) || !d.omega[i].is_finite() {
+            if dist.is_nan() || dist > d.r[i] || !d.omega[i].is_finite() {
                 // Restore the state of the start of the step.
                 d.v.clone_from(&self.v_old);
                 d.omega.clone_from(&self.omega_old);

@@ -9,6 +9,8 @@
 //! * [`cells`]: neighbour search by cell lists with an alert distance;
 //! * [`tracked`]: tracked cells and their stress, fabric and dilatations (Renouf et al.
 //!   2006, eqs. 7–11);
+//! * [`trishear`]: the analytic trishear velocity field and its mismatch with particle
+//!   velocities;
 //! * [`vtk`]: particle and contact VTK PolyData files (`.vtp`).
 //!
 //! Per unit thickness (1 m): a disk of radius r and density ρ has m = ρπr² and
@@ -19,6 +21,7 @@ pub mod disks;
 pub mod packing;
 pub mod rng;
 pub mod tracked;
+pub mod trishear;
 pub mod vtk;
 
 pub use cells::CellList;

@@ -38,9 +38,9 @@ fn write_atomic(path: &Path, text: &str) -> Result<(), ParticleError> {
 }
 
 fn array(s: &mut String, kind: &str, name: &str, comps: usize, values: impl Iterator<Item = f64>) {
-    let _ = write!(
+    let _ = writeln!(
         s,
-        "<DataArray type=\"{kind}\" Name=\"{name}\" NumberOfComponents=\"{comps}\" format=\"ascii\">\n"
+        "<DataArray type=\"{kind}\" Name=\"{name}\" NumberOfComponents=\"{comps}\" format=\"ascii\">"
     );
     for v in values {
         if kind == "Float64" {
