@@ -144,3 +144,13 @@ fn continuum_scene_refuses_nscd_sections() {
         .to_string();
     assert!(e.contains("grid is missing"), "{e}");
 }
+
+/// Every bundled NSCD scene passes the checks (running them takes seconds each: see
+/// docs/BENCHMARKS.md).
+#[test]
+fn bundled_nscd_scenes_check() {
+    for name in ["column", "pile", "forced_fold", "fault"] {
+        Scene::load(&scene_dir().join(format!("{name}.toml")))
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+    }
+}

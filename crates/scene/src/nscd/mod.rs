@@ -12,10 +12,12 @@
 //!   point), `vtk/particles_NNNN.vtp` + `vtk/contacts_NNNN.vtp` with `<name>.pvd` and
 //!   `<name>_contacts.pvd`, field extrema, and `summary.json` with `particles`,
 //!   `contacts`, `sweeps` (mean, max), `final_residual`, `not_converged_steps` and
-//!   `contact_updates_per_second` (local solves per second of NLGS wall time).
+//!   `contact_updates_per_second` (local solves per second of NLGS wall time);
+//! - *plots* ([`plots`]): probe series and the disks coloured by initial layer.
 
 pub mod check;
 pub mod file;
+pub mod plots;
 
 use std::cell::RefCell;
 use std::collections::BTreeMap;
@@ -475,7 +477,18 @@ impl Model for NscdModel<'_> {
         out
     }
 
-    fn plots(&self, _dir: &Path, _written: &[f64], _series: &[Vec<f64>]) -> Result<(), RunError> {
+    fn plots(&self, dir: &Path, written: &[f64], series: &[Vec<f64>]) -> Result<(), RunError> {
+        let probes: Vec<(String, String, Vec<f64>)> = self
+            .ls
+            .scene
+            .output
+            .probe
+            .iter()
+            .zip(series)
+            .map(|(p, v)| (p.name.clone(), p.field.clone(), v.clone()))
+            .collect();
+        plots::probe_plots(dir, &self.ls.scene.scene.name, written, &probes)?;
+        plots::layers(&dir.join("layers.png"), &self.sys.disks)?;
         Ok(())
     }
 
