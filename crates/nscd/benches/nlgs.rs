@@ -4,12 +4,14 @@
 //! 100 m wide box with a floor and two side walls, settled under gravity for 20 steps.
 //! Each measured iteration is one time step of h = 1e-3 s with exactly 100 sweeps
 //! (min = max = 100); criterion reports elements per second = contacts × 100 / time.
+//! Two variants: the sequential sweep in sorted order, and the coloured parallel sweep
+//! in rayon's default pool (one thread per core).
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use porofrac_nscd::{ContactLaw, Nscd, RigidBody, SolverParams};
+use porofrac_nscd::{ContactLaw, Nscd, Ordering, RigidBody, SolverParams};
 use porofrac_particles::{Disks, RandomPacking};
 
-fn pile() -> Nscd {
+fn pile(ordering: Ordering) -> Nscd {
     let (w, h) = (100.0, 99.5);
     let p = RandomPacking::new([0.0, 0.0], [w, h], 0.4, 0.6, 0.8, 1)
         .generate()
@@ -24,6 +26,7 @@ fn pile() -> Nscd {
         min_sweeps: 100,
         max_sweeps: 100,
         tolerance: 1e-30,
+        ordering,
         ..SolverParams::default()
     };
     let mut s = Nscd::new(d, walls, ContactLaw::frictional(0.4), params, [0.0, -9.81]).unwrap();

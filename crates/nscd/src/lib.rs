@@ -12,12 +12,14 @@
 //!   alert distance, into local frames;
 //! * [`solver`]: the θ-scheme on velocities (eq. 3) and the non-linear Gauss–Seidel
 //!   sweeps over the contacts (eq. 5, Table 1) with body-velocity accumulation, warm
-//!   start and the convergence test.
+//!   start and the convergence test;
+//! * [`colour`]: the coloured parallel sweep (deterministic for any thread count).
 //!
 //! Disks are [`porofrac_particles::Disks`]; a disk of infinite mass (or inertia) does
 //! not move (or rotate).
 
 pub mod body;
+pub mod colour;
 pub mod detect;
 pub mod law;
 pub mod solver;

@@ -29,7 +29,9 @@
 //!
 //! **Ordering** ([`Ordering`]): by default the contacts are swept in their sorted order
 //! (candidate, then antagonist), the same every sweep; [`Ordering::Random`] draws a new
-//! permutation for every sweep from a seed and the step number, reproducible too.
+//! permutation for every sweep from a seed and the step number, reproducible too;
+//! [`Ordering::Coloured`] sweeps colour groups of independent contacts in parallel
+//! ([`crate::colour`]), with a result that does not depend on the thread count.
 
 use porofrac_particles::Disks;
 use porofrac_particles::rng::SplitMix64;
@@ -52,6 +54,9 @@ pub enum Ordering {
         /// Seed of the permutations.
         seed: u64,
     },
+    /// Colour groups swept in parallel ([`crate::colour`]): the same result for any
+    /// number of threads.
+    Coloured,
 }
 
 /// Options of the time stepping and of NLGS.
@@ -176,6 +181,9 @@ pub struct Nscd {
     detector: Detector,
     order: Vec<u32>,
     h_last: f64,
+    shared: crate::colour::SharedVelocities,
+    masks: Vec<u64>,
+    starts: Vec<usize>,
 }
 
 impl Nscd {
@@ -227,6 +235,9 @@ impl Nscd {
             detector: Detector::default(),
             order: Vec::new(),
             h_last: 0.0,
+            shared: Default::default(),
+            masks: Vec::new(),
+            starts: Vec::new(),
         };
         let offsets: Vec<[f64; 2]> = s.bodies.iter().map(|b| b.offset).collect();
         let mut found = Vec::new();
@@ -451,40 +462,68 @@ impl Nscd {
             ..StepStats::default()
         };
         let mut rng = match self.params.ordering {
-            Ordering::Sorted => None,
             Ordering::Random { seed } => Some(SplitMix64::new(
                 seed ^ self.steps.wrapping_mul(0x9E37_79B9_7F4A_7C15),
             )),
+            _ => None,
         };
+        let coloured = self.params.ordering == Ordering::Coloured && !self.contacts.is_empty();
+        let mut serial_last = false;
+        if coloured {
+            let moving: Vec<bool> = (0..n)
+                .map(|i| self.inv_m[i] > 0.0 || self.inv_i[i] > 0.0)
+                .collect();
+            let body_moving: Vec<bool> = self.body_inv.iter().map(|b| *b != [0.0, 0.0]).collect();
+            serial_last = crate::colour::colour(
+                &mut self.contacts,
+                &moving,
+                &body_moving,
+                &mut self.masks,
+                &mut self.starts,
+            );
+            self.shared.load(&d.v, &d.omega, &self.body_v);
+        }
         if !self.contacts.is_empty() {
             for k in 1..=self.params.max_sweeps {
-                let (num, den) = match rng.as_mut() {
-                    None => sweep(
+                let (num, den) = if coloured {
+                    crate::colour::sweep(
                         &mut self.contacts,
-                        None,
-                        &mut d.v,
-                        &mut d.omega,
+                        &self.starts,
+                        serial_last,
+                        &self.shared,
                         &self.inv_m,
                         &self.inv_i,
-                        &mut self.body_v,
                         &self.body_inv,
-                    ),
-                    Some(rng) => {
-                        self.order.clear();
-                        self.order.extend(0..self.contacts.len() as u32);
-                        for a in (1..self.order.len()).rev() {
-                            self.order.swap(a, rng.below(a + 1));
-                        }
-                        sweep(
+                    )
+                } else {
+                    match rng.as_mut() {
+                        None => sweep(
                             &mut self.contacts,
-                            Some(&self.order),
+                            None,
                             &mut d.v,
                             &mut d.omega,
                             &self.inv_m,
                             &self.inv_i,
                             &mut self.body_v,
                             &self.body_inv,
-                        )
+                        ),
+                        Some(rng) => {
+                            self.order.clear();
+                            self.order.extend(0..self.contacts.len() as u32);
+                            for a in (1..self.order.len()).rev() {
+                                self.order.swap(a, rng.below(a + 1));
+                            }
+                            sweep(
+                                &mut self.contacts,
+                                Some(&self.order),
+                                &mut d.v,
+                                &mut d.omega,
+                                &self.inv_m,
+                                &self.inv_i,
+                                &mut self.body_v,
+                                &self.body_inv,
+                            )
+                        }
                     }
                 };
                 stats.sweeps = k;
@@ -504,6 +543,9 @@ impl Nscd {
             }
         } else {
             stats.converged = true;
+        }
+        if coloured {
+            self.shared.store(&mut d.v, &mut d.omega, &mut self.body_v);
         }
         stats.updates = stats.sweeps as u64 * self.contacts.len() as u64;
         stats.solve_seconds = t0.elapsed().as_secs_f64();
@@ -549,6 +591,8 @@ impl Nscd {
                 stick: pn > 0.0 && c.p[1].abs() < c.mu * pn * (1.0 - 1e-9),
             }
         }));
+        // Sorted by key for the merge of the next warm start (colouring permutes).
+        self.previous.sort_unstable_by_key(|q| q.key);
         self.time += h;
         self.steps += 1;
         self.h_last = h;

@@ -335,6 +335,10 @@ fn cohesion_closes_a_gap_within_the_attraction_distance() {
 
 #[test]
 fn cell_stress_of_a_square_packing_is_the_wall_load() {
+    square_packing(Ordering::Sorted);
+}
+
+fn square_packing(ordering: Ordering) {
     let (n, r) = (4usize, 0.5);
     let l = 2.0 * r * n as f64;
     let (sxx, syy) = (2.0e4, 5.0e3);
@@ -432,4 +436,60 @@ fn bad_input_is_refused_with_its_name() {
     s.disks.v[0] = [100.0, 0.0];
     let e = s.step(0.01).unwrap_err();
     assert!(e.to_string().contains("particle 0"), "{e}");
+}
+
+/// The coloured parallel sweep: the same exact answers (column, square packing with
+/// loaded walls, which go to the ordered group), and bit-identical results in pools of
+/// one and two threads on a random pile.
+#[test]
+fn coloured_sweep_is_exact_and_independent_of_threads() {
+    for n in [5usize, 20] {
+        let (forces, _, m) = column(n, Ordering::Coloured, 1e-10, 3);
+        for (k, f) in forces.iter().enumerate() {
+            let exact = (k + 1) as f64 * m * G;
+            assert!(
+                (f - exact).abs() < 1e-10 * n as f64 * m * G,
+                "n = {n}, contact {}: {f}",
+                k + 1
+            );
+        }
+    }
+    square_packing(Ordering::Coloured);
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let p =
+                porofrac_particles::RandomPacking::new([0.0, 0.0], [30.0, 15.0], 0.3, 0.5, 0.75, 5)
+                    .generate()
+                    .unwrap();
+            let d = Disks::new(&p.centres, &p.radii, 2000.0).unwrap();
+            let walls = vec![
+                RigidBody::segment([-1.0, 0.0], [31.0, 0.0]),
+                RigidBody::segment([0.0, 30.0], [0.0, 0.0]),
+                RigidBody::segment([30.0, 0.0], [30.0, 30.0]).moving([-0.2, 0.0]),
+            ];
+            let params = SolverParams {
+                ordering: Ordering::Coloured,
+                ..SolverParams::default()
+            };
+            let mut s =
+                Nscd::new(d, walls, ContactLaw::frictional(0.4), params, [0.0, -G]).unwrap();
+            let mut sweeps = 0;
+            for _ in 0..20 {
+                sweeps += s.step(1e-2).unwrap().sweeps;
+            }
+            (
+                s.disks.x.clone(),
+                s.disks.omega.clone(),
+                sweeps,
+                s.contacts().len(),
+            )
+        })
+    };
+    let (a, b) = (run(1), run(2));
+    assert!(a.3 > 500, "a dense pile: {} contacts", a.3);
+    assert_eq!(a, b, "one and two threads give the same state");
 }

@@ -115,6 +115,9 @@ pub enum OrderingChoice {
     Sorted,
     /// A new random permutation every sweep (seed `ordering_seed`).
     Random,
+    /// Colour groups of independent contacts swept in parallel (the same result for
+    /// any number of threads).
+    Coloured,
 }
 
 /// `[nscd]`: time stepping and NLGS.
