@@ -37,15 +37,20 @@ fn pile(ordering: Ordering) -> Nscd {
 }
 
 fn bench(c: &mut Criterion) {
-    let mut s = pile();
-    let contacts = s.step(1e-3).unwrap().contacts;
     let mut g = c.benchmark_group("nlgs");
     g.sample_size(10);
-    g.throughput(Throughput::Elements(100 * contacts as u64));
-    g.bench_function(
-        format!("pile 1e4 disks, {contacts} contacts, one step of 100 sweeps"),
-        |b| b.iter(|| s.step(1e-3).unwrap()),
-    );
+    for (name, ordering) in [
+        ("sorted, 1 thread", Ordering::Sorted),
+        ("coloured, rayon pool", Ordering::Coloured),
+    ] {
+        let mut s = pile(ordering);
+        let contacts = s.step(1e-3).unwrap().contacts;
+        g.throughput(Throughput::Elements(100 * contacts as u64));
+        g.bench_function(
+            format!("pile 1e4 disks, {contacts} contacts, 100 sweeps, {name}"),
+            |b| b.iter(|| s.step(1e-3).unwrap()),
+        );
+    }
     g.finish();
 }
 
