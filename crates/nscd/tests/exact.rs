@@ -360,6 +360,7 @@ fn square_packing(ordering: Ordering) {
     let p = SolverParams {
         min_sweeps: 1,
         max_sweeps: 100_000,
+        ordering,
         ..params(0.5, 1e-13)
     };
     let mut s = Nscd::new(
