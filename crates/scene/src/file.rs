@@ -85,10 +85,11 @@ pub enum Plane {
 }
 
 /// `[grid] kind`.
-#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum GridKind {
     /// Axis-aligned boxes.
+    #[default]
     Cartesian,
     /// Boxes split into two triangles (2D).
     Triangles,
@@ -194,7 +195,9 @@ pub enum LinearChoice {
 pub struct SceneFile {
     /// `[scene]`.
     pub scene: SceneSection,
-    /// `[grid]`.
+    /// `[grid]` (required by the continuum model, [`crate::check`]; other models have
+    /// none).
+    #[serde(default)]
     pub grid: GridSection,
     /// `[[region]]`: later regions override earlier ones.
     #[serde(default)]
@@ -228,6 +231,15 @@ pub struct SceneFile {
     /// `[output]`.
     #[serde(default)]
     pub output: Output,
+    /// `[particles]` (model `nscd`).
+    pub particles: Option<crate::nscd::file::ParticlesSection>,
+    /// `[[wall]]`: rigid bodies (model `nscd`).
+    #[serde(default)]
+    pub wall: Vec<crate::nscd::file::WallSection>,
+    /// `[contact]`: the contact law (model `nscd`).
+    pub contact: Option<crate::nscd::file::ContactSection>,
+    /// `[nscd]`: the solver (model `nscd`).
+    pub nscd: Option<crate::nscd::file::NscdSection>,
 }
 
 /// `[scene]`.
@@ -245,7 +257,7 @@ pub struct SceneSection {
 }
 
 /// `[grid]`.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct GridSection {
     /// The generator or reader.
@@ -572,8 +584,13 @@ pub struct Probe {
     pub name: String,
     /// Field name.
     pub field: String,
-    /// Position.
+    /// Position (grid and lattice models).
+    #[serde(default)]
     pub at: Vec<f64>,
+    /// Particle index (particle models).
+    pub particle: Option<i64>,
+    /// Tracked cell (particle models).
+    pub cell: Option<Ball>,
 }
 
 /// `[[output.line]]`.

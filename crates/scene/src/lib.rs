@@ -37,6 +37,7 @@ pub mod file;
 pub mod laws;
 pub mod limits;
 pub mod model;
+pub mod nscd;
 pub mod output;
 pub mod plots;
 pub mod sample;

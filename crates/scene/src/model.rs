@@ -133,6 +133,8 @@ fn run_model(
 ) -> Result<Summary, RunError> {
     let summary = match ls.model() {
         "continuum" => crate::continuum::run(ls, laws, out, observer)?,
+        // Writes its own summary.json (the particle statistics on top of the shared keys).
+        "nscd" => return crate::nscd::run(ls, out, observer),
         other => {
             return Err(ls
                 .error(

@@ -1,0 +1,84 @@
+//! Non-smooth contact dynamics (NSCD) of rigid disks and driven rigid bodies, after
+//! Renouf, Dubois & Alart (2006), the method of LMGC90 (Moreau–Jean).
+//!
+//! The stages of a step, each in its own module:
+//!
+//! * [`body`]: rigid bodies (segments and convex polygons) that translate at a
+//!   prescribed velocity, or under a prescribed force along an axis left free;
+//! * [`law`]: the contact law (Signorini, Coulomb with static and dynamic friction, the
+//!   cohesive "non-smooth Lennard-Jones" law) and the exact solution of one local 2×2
+//!   problem;
+//! * [`detect`]: contact detection at the predicted configuration, by cell lists with an
+//!   alert distance, into local frames;
+//! * [`solver`]: the θ-scheme on velocities (eq. 3) and the non-linear Gauss–Seidel
+//!   sweeps over the contacts (eq. 5, Table 1) with body-velocity accumulation, warm
+//!   start and the convergence test;
+//! * [`colour`]: the coloured parallel sweep (deterministic for any thread count).
+//!
+//! Disks are [`porofrac_particles::Disks`]; a disk of infinite mass (or inertia) does
+//! not move (or rotate).
+
+pub mod body;
+pub mod colour;
+pub mod detect;
+pub mod law;
+pub mod solver;
+
+pub use body::{Axis, RigidBody};
+pub use law::ContactLaw;
+pub use solver::{Nscd, Ordering, SolverParams, StepStats};
+
+/// Anything that stops an NSCD computation. Each variant names the parameter,
+/// particle or body at fault.
+#[derive(Debug, thiserror::Error, Clone, PartialEq)]
+pub enum NscdError {
+    /// A parameter out of range.
+    #[error("{name} = {value}: {message}")]
+    BadParameter {
+        /// The parameter.
+        name: &'static str,
+        /// Its value.
+        value: f64,
+        /// What is allowed.
+        message: &'static str,
+    },
+    /// A bad rigid body.
+    #[error("body {index}: {message}")]
+    BadBody {
+        /// Body index.
+        index: usize,
+        /// What is wrong.
+        message: &'static str,
+    },
+    /// A bad particle set.
+    #[error(transparent)]
+    Particles(#[from] porofrac_particles::ParticleError),
+    /// Two bodies overlap by more than the alert distance at the start.
+    #[error(
+        "particle {i} overlaps {with} by {overlap:.3e} m, more than the alert distance {alert:.3e} m"
+    )]
+    InitialOverlap {
+        /// The particle.
+        i: usize,
+        /// What it overlaps (`particle j` or `body b`).
+        with: String,
+        /// The overlap (m).
+        overlap: f64,
+        /// The alert distance (m).
+        alert: f64,
+    },
+    /// A step would move a disk by more than its radius.
+    #[error(
+        "at t = {time} s the step would move particle {particle} by {distance:.3e} m, more than its radius {radius:.3e} m: lower the time step"
+    )]
+    StepTooLarge {
+        /// The time at the start of the step (s).
+        time: f64,
+        /// The particle.
+        particle: usize,
+        /// How far it would move (m).
+        distance: f64,
+        /// Its radius (m).
+        radius: f64,
+    },
+}

@@ -1,0 +1,192 @@
+//! Checks of the particle crate: cell-list neighbours equal the brute-force ones, the
+//! packings do not overlap and are reproducible, the tracked cell and VTK files.
+
+use porofrac_particles::cells::{CellList, brute_force_pairs, max_radius};
+use porofrac_particles::packing::hexagonal;
+use porofrac_particles::{CellContact, Disks, RandomPacking, TrackedCell, vtk};
+use proptest::prelude::*;
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+    /// Every pair with gap below the alert distance, no other, for random clouds of disks
+    /// (some of them far away, which makes the cell side grow).
+    #[test]
+    fn cell_list_pairs_equal_brute_force(
+        pts in prop::collection::vec((-5.0f64..5.0, -5.0f64..5.0, 0.05f64..0.6), 0..200),
+        alert in 0.0f64..0.5,
+        far in prop::bool::ANY,
+    ) {
+        let mut x: Vec<[f64; 2]> = pts.iter().map(|p| [p.0, p.1]).collect();
+        let r: Vec<f64> = pts.iter().map(|p| p.2).collect();
+        if far && !x.is_empty() {
+            x[0] = [1e6, -3e5];
+        }
+        let mut cells = CellList::new();
+        cells.build(&x, 2.0 * max_radius(&r) + alert);
+        let mut got = Vec::new();
+        cells.pairs(&x, &r, alert, &mut got);
+        prop_assert_eq!(got, brute_force_pairs(&x, &r, alert));
+    }
+}
+
+#[test]
+fn hexagonal_packing_touches_without_overlap() {
+    let p = hexagonal([0.0, 0.0], [10.0, 10.0], 0.5).unwrap();
+    let (o, _) = p.max_overlap();
+    assert!(o < 1e-12, "overlap {o}");
+    // Interior disks of a triangular lattice touch six neighbours.
+    let z = p.coordination(1e-9);
+    assert!(z > 5.0 && z < 6.0, "coordination {z}");
+    // Ten per even row, nine per odd row, rows √3/2 apart.
+    assert_eq!(p.len(), 6 * 10 + 5 * 9);
+}
+
+#[test]
+fn random_packing_is_dense_without_overlap_and_reproducible() {
+    let spec = RandomPacking::new([0.0, 0.0], [20.0, 10.0], 0.13, 0.26, 0.8, 7);
+    let a = spec.generate().unwrap();
+    let b = spec.generate().unwrap();
+    assert_eq!(a, b, "same seed, same packing");
+    let tol = spec.tolerance * spec.r_min;
+    a.check_overlap(tol).unwrap();
+    let phi = a.packing_fraction([0.0, 0.0], [20.0, 10.0]);
+    assert!(phi > 0.79 && phi <= 0.8, "packing fraction {phi}");
+    // Every disk inside the box.
+    for (c, r) in a.centres.iter().zip(&a.radii) {
+        assert!(c[0] - r >= -1e-12 && c[0] + r <= 20.0 + 1e-12);
+        assert!(c[1] - r >= -1e-12 && c[1] + r <= 10.0 + 1e-12);
+    }
+    // A jammed-like packing: most disks touch (within 1 % of r_min) three or more.
+    let z = a.coordination(0.01 * spec.r_min);
+    assert!(z > 3.0, "coordination {z}");
+    let c = RandomPacking { seed: 8, ..spec }.generate().unwrap();
+    assert_ne!(a, c, "another seed, another packing");
+}
+
+#[test]
+fn random_packing_refuses_impossible_fraction() {
+    let spec = RandomPacking::new([0.0, 0.0], [5.0, 5.0], 0.1, 0.2, 0.9, 1);
+    assert!(spec.generate().is_err());
+    let spec = RandomPacking::new([0.0, 0.0], [5.0, 5.0], 0.0, 0.2, 0.5, 1);
+    assert!(spec.generate().is_err());
+}
+
+#[test]
+fn disks_refuse_zero_radius() {
+    let e = Disks::new(&[[0.0, 0.0]], &[0.0], 1.0).unwrap_err();
+    assert!(e.to_string().contains("particle 0"), "{e}");
+}
+
+/// Eq. 7 on a hand-computed case: two contacts of a pair along x and along y.
+#[test]
+fn tracked_cell_stress_and_fabric() {
+    let x = [[0.0, 0.0], [2.0, 0.0], [0.0, 2.0], [50.0, 50.0]];
+    let cell = TrackedCell::new(&x, [0.0, 0.0], 3.0);
+    assert_eq!(cell.count, 3);
+    let contacts = [
+        // Disk 1 pushed by 0 along +x with 10 N, branch 2 m.
+        CellContact {
+            i: 1,
+            j: Some(0),
+            normal: [1.0, 0.0],
+            branch: [2.0, 0.0],
+            force: [10.0, 0.0],
+        },
+        CellContact {
+            i: 2,
+            j: Some(0),
+            normal: [0.0, 1.0],
+            branch: [0.0, 2.0],
+            force: [0.0, 4.0],
+        },
+        // Not counted: 3 is outside.
+        CellContact {
+            i: 3,
+            j: Some(0),
+            normal: [1.0, 0.0],
+            branch: [1.0, 0.0],
+            force: [1e9, 0.0],
+        },
+    ];
+    let s = cell.measure(&x, &contacts);
+    let v = std::f64::consts::PI * 9.0;
+    assert!((s.sigma[0][0] - 20.0 / v).abs() < 1e-14);
+    assert!((s.sigma[1][1] - 8.0 / v).abs() < 1e-14);
+    assert!((s.p - 14.0 / v).abs() < 1e-14);
+    assert!((s.q - 6.0 / v).abs() < 1e-14);
+    assert_eq!(s.contacts, 2);
+    // One contact along x, one along y: isotropic fabric.
+    assert!(s.anisotropy.abs() < 1e-15);
+    assert_eq!(s.dilation_x, 1.0);
+}
+
+#[test]
+fn vtk_files_are_written() {
+    let dir = std::env::temp_dir().join(format!("porofrac-particles-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let d = Disks::new(&[[0.0, 0.0], [1.0, 0.0]], &[0.5, 0.5], 1000.0).unwrap();
+    vtk::write_particles(&dir.join("p.vtp"), &d).unwrap();
+    let text = std::fs::read_to_string(dir.join("p.vtp")).unwrap();
+    for name in ["radius", "velocity", "omega", "displacement", "id"] {
+        assert!(text.contains(&format!("Name=\"{name}\"")), "{name}");
+    }
+    vtk::write_contacts(&dir.join("c.vtp"), &[vtk::ContactLine::default()]).unwrap();
+    let text = std::fs::read_to_string(dir.join("c.vtp")).unwrap();
+    for name in ["normal_force", "tangential_force", "bonded"] {
+        assert!(text.contains(&format!("Name=\"{name}\"")), "{name}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The trishear field: rigid above, fixed below, divergence-free and continuous in the
+/// triangle (central differences, h = 1e-5 m: error O(h²) of a smooth field).
+#[test]
+fn trishear_field_is_incompressible_and_continuous() {
+    use porofrac_particles::trishear::Trishear;
+    let t = Trishear {
+        tip: [75.0, 0.0],
+        dip: 30f64.to_radians(),
+        half_apex: 30f64.to_radians(),
+        v0: 0.325,
+    };
+    let e = [t.dip.cos(), t.dip.sin()];
+    let n = [-e[1], e[0]];
+    let at = |x: f64, y: f64| {
+        [
+            t.tip[0] + x * e[0] + y * n[0],
+            t.tip[1] + x * e[1] + y * n[1],
+        ]
+    };
+    let tan = t.half_apex.tan();
+    // Zones I and III.
+    let v = t.velocity(at(-3.0, 1.0));
+    assert!((v[0] - t.v0 * e[0]).abs() < 1e-15 && (v[1] - t.v0 * e[1]).abs() < 1e-15);
+    assert_eq!(t.velocity(at(-3.0, -1.0)), [0.0, 0.0]);
+    assert_eq!(t.velocity(at(5.0, -5.0 * tan - 0.1)), [0.0, 0.0]);
+    // Continuity across both sides of zone II.
+    for x in [1.0, 4.0, 10.0] {
+        let up = t.velocity(at(x, x * tan * (1.0 - 1e-12)));
+        let above = t.velocity(at(x, x * tan * (1.0 + 1e-12)));
+        let low = t.velocity(at(x, -x * tan * (1.0 - 1e-12)));
+        for a in 0..2 {
+            assert!((up[a] - above[a]).abs() < 1e-11, "upper side at x′ = {x}");
+            assert!(low[a].abs() < 1e-11, "lower side at x′ = {x}");
+        }
+    }
+    // Divergence-free inside.
+    let h = 1e-5;
+    for (x, y) in [(2.0, 0.3), (5.0, -1.0), (8.0, 2.0)] {
+        let p = at(x, y);
+        let vx1 = t.velocity([p[0] + h, p[1]])[0];
+        let vx0 = t.velocity([p[0] - h, p[1]])[0];
+        let vy1 = t.velocity([p[0], p[1] + h])[1];
+        let vy0 = t.velocity([p[0], p[1] - h])[1];
+        let div = (vx1 - vx0 + vy1 - vy0) / (2.0 * h);
+        assert!(div.abs() < 1e-8, "div v = {div} at ({x}, {y})");
+    }
+    // The mismatch of the field with itself is 0, with a field at rest 1.
+    let pts = [at(2.0, 0.3), at(-1.0, 1.0)];
+    let v: Vec<[f64; 2]> = pts.iter().map(|p| t.velocity(*p)).collect();
+    assert_eq!(t.l2_mismatch(&pts, &v), 0.0);
+    assert!((t.l2_mismatch(&pts, &[[0.0; 2]; 2]) - 1.0).abs() < 1e-15);
+}

@@ -1,0 +1,482 @@
+//! Validation of an NSCD scene: every value checked, every key of another model refused
+//! with the key and the model named.
+
+use crate::check::{LoadedScene, SceneError, k, ki, step_count_f64};
+use crate::file::KeyPart;
+
+use super::file::{ParticleKind, RadiusSpec, WallComponent};
+
+/// Top-level sections of the NSCD model.
+pub const SECTIONS: [&str; 4] = ["particles", "wall", "contact", "nscd"];
+/// Top-level sections every model reads.
+const SHARED: [&str; 4] = ["scene", "schedule", "output", "solver"];
+/// Top-level sections of the continuum model.
+const CONTINUUM: [&str; 10] = [
+    "grid", "region", "material", "fluid", "bc", "loads", "source", "well", "initial", "physics",
+];
+
+/// Fields of one particle (`particle = N` probes, lines).
+pub const PARTICLE_FIELDS: [&str; 8] = ["x", "y", "vx", "vy", "omega", "fx", "fy", "radius"];
+/// Fields of a tracked cell (`cell = { center, radius }` probes).
+pub const CELL_FIELDS: [&str; 8] = [
+    "p",
+    "q",
+    "anisotropy",
+    "anisotropy_volume",
+    "dilation_x",
+    "dilation_y",
+    "contacts",
+    "broken_bonds",
+];
+
+fn top_level(ls: &LoadedScene) -> Vec<String> {
+    toml::from_str::<toml::Table>(&ls.text)
+        .map(|t| t.keys().cloned().collect())
+        .unwrap_or_default()
+}
+
+/// Whether the scene text has the top-level section `name`.
+pub fn has_section(ls: &LoadedScene, name: &str) -> bool {
+    top_level(ls).iter().any(|s| s == name)
+}
+
+/// Refuse the NSCD sections in a scene of another `model`.
+pub fn refuse_sections(ls: &LoadedScene, model: &str) -> Result<(), SceneError> {
+    for key in top_level(ls) {
+        if SECTIONS.contains(&key.as_str()) {
+            return Err(ls.error(
+                &k(&[&key]),
+                format!("belongs to model \"nscd\", not \"{model}\""),
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn finite(ls: &LoadedScene, key: &[KeyPart], v: f64) -> Result<(), SceneError> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(ls.error(key, format!("= {v} is not a finite number")))
+    }
+}
+
+fn positive(ls: &LoadedScene, key: &[KeyPart], v: f64) -> Result<(), SceneError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(ls.error(key, format!("= {v} must be a positive number")))
+    }
+}
+
+fn non_negative(ls: &LoadedScene, key: &[KeyPart], v: f64) -> Result<(), SceneError> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(())
+    } else {
+        Err(ls.error(key, format!("= {v} must be a number ≥ 0")))
+    }
+}
+
+/// Most disks a scene may generate.
+pub const MAX_PARTICLES: f64 = 2.0e7;
+
+/// Check an NSCD scene.
+pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
+    let s = &ls.scene;
+    for key in top_level(ls) {
+        if SECTIONS.contains(&key.as_str()) || SHARED.contains(&key.as_str()) {
+            continue;
+        }
+        let msg = if CONTINUUM.contains(&key.as_str()) {
+            "belongs to model \"continuum\", not \"nscd\"".to_string()
+        } else {
+            "belongs to another model, not \"nscd\"".to_string()
+        };
+        return Err(ls.error(&k(&[&key]), msg));
+    }
+    if s.scene.dim != 2 {
+        return Err(ls.error(
+            &k(&["scene", "dim"]),
+            format!("= {} must be 2: model \"nscd\" has disks", s.scene.dim),
+        ));
+    }
+    if s.scene.name.is_empty() || s.scene.name.contains(['/', '\\']) {
+        return Err(ls.error(
+            &k(&["scene", "name"]),
+            "must be a non-empty name without slashes",
+        ));
+    }
+    if s.scene.plane.is_some() {
+        return Err(ls.error(
+            &k(&["scene", "plane"]),
+            "belongs to model \"continuum\", not \"nscd\"",
+        ));
+    }
+    for (name, set) in [
+        ("mechanics", s.solver.mechanics.is_some()),
+        ("linear", s.solver.linear.is_some()),
+        ("tolerance", s.solver.tolerance.is_some()),
+    ] {
+        if set {
+            return Err(ls.error(
+                &k(&["solver", name]),
+                "belongs to model \"continuum\", not \"nscd\" (the NLGS keys are in [nscd])",
+            ));
+        }
+    }
+    if let Some(t) = s.solver.threads
+        && !(0..=1024).contains(&t)
+    {
+        return Err(ls.error(
+            &k(&["solver", "threads"]),
+            format!("= {t} must be in 0..=1024"),
+        ));
+    }
+    if s.output.exact_displacement.is_some() {
+        return Err(ls.error(
+            &k(&["output", "exact_displacement"]),
+            "belongs to model \"continuum\", not \"nscd\"",
+        ));
+    }
+    check_particles(ls)?;
+    check_walls(ls)?;
+    if let Some(c) = &s.contact {
+        let key = |f: &str| k(&["contact", f]);
+        for (f, v) in [
+            ("mu", c.mu),
+            ("mu_static", c.mu_static),
+            ("cohesion", c.cohesion),
+            ("d_w", c.d_w),
+        ] {
+            if let Some(v) = v {
+                non_negative(ls, &key(f), v)?;
+            }
+        }
+    }
+    if let Some(n) = &s.nscd {
+        let key = |f: &str| k(&["nscd", f]);
+        if let Some(t) = n.theta
+            && !(0.5..=1.0).contains(&t)
+        {
+            return Err(ls.error(&key("theta"), format!("= {t} must be in [0.5, 1]")));
+        }
+        if let Some(t) = n.tolerance {
+            positive(ls, &key("tolerance"), t)?;
+        }
+        if let Some(m) = n.min_sweeps
+            && m < 0
+        {
+            return Err(ls.error(&key("min_sweeps"), format!("= {m} must be ≥ 0")));
+        }
+        if let Some(m) = n.max_sweeps
+            && !(1..=100_000_000).contains(&m)
+        {
+            return Err(ls.error(&key("max_sweeps"), format!("= {m} must be in 1..=1e8")));
+        }
+        let (lo, hi) = (n.min_sweeps.unwrap_or(100), n.max_sweeps.unwrap_or(10_000));
+        if lo > hi {
+            return Err(ls.error(
+                &key(if n.min_sweeps.is_some() {
+                    "min_sweeps"
+                } else {
+                    "max_sweeps"
+                }),
+                format!("min_sweeps = {lo} must not exceed max_sweeps = {hi}"),
+            ));
+        }
+        if let Some(a) = n.alert {
+            non_negative(ls, &key("alert"), a)?;
+        }
+        if let Some(g) = n.gravity {
+            for v in g {
+                finite(ls, &key("gravity"), v)?;
+            }
+        }
+    }
+    // Schedule.
+    let Some(sch) = &s.schedule else {
+        return Err(ls.error(
+            &k(&["schedule"]),
+            "is missing: model \"nscd\" needs end_time and dt or steps",
+        ));
+    };
+    positive(ls, &k(&["schedule", "end_time"]), sch.end_time)?;
+    match (sch.dt, sch.steps) {
+        (Some(dt), _) => positive(ls, &k(&["schedule", "dt"]), dt)?,
+        (None, Some(n)) if n >= 1 => {}
+        (None, Some(n)) => {
+            return Err(ls.error(&k(&["schedule", "steps"]), format!("= {n} must be ≥ 1")));
+        }
+        (None, None) => {
+            return Err(ls.error(&k(&["schedule", "dt"]), "is missing: give dt or steps"));
+        }
+    }
+    let n = step_count_f64(sch);
+    if n > crate::limits::MAX_STEPS as f64 {
+        return Err(ls.error(
+            &k(&["schedule", if sch.dt.is_some() { "dt" } else { "steps" }]),
+            format!(
+                "gives {n:.3e} steps, more than the {} a run may take",
+                crate::limits::MAX_STEPS
+            ),
+        ));
+    }
+    check_output(ls)
+}
+
+fn check_particles(ls: &LoadedScene) -> Result<(), SceneError> {
+    let Some(p) = &ls.scene.particles else {
+        return Err(ls.error(
+            &k(&["particles"]),
+            "is missing: model \"nscd\" needs [particles]",
+        ));
+    };
+    let key = |f: &str| k(&["particles", f]);
+    positive(ls, &key("density"), p.density)?;
+    match p.kind {
+        ParticleKind::Random | ParticleKind::Hexagonal => {
+            let Some(region) = p.region else {
+                return Err(ls.error(&key("region"), "is required for this kind"));
+            };
+            for a in 0..2 {
+                if !(region[0][a].is_finite()
+                    && region[1][a].is_finite()
+                    && region[1][a] > region[0][a])
+                {
+                    return Err(ls.error(
+                        &key("region"),
+                        "must be [[x0, y0], [x1, y1]] with x1 > x0, y1 > y0",
+                    ));
+                }
+            }
+            let Some(radius) = p.radius else {
+                return Err(ls.error(&key("radius"), "is required for this kind"));
+            };
+            let [r0, r1] = radius.range();
+            positive(ls, &key("radius"), r0)?;
+            if !(r1.is_finite() && r1 >= r0) {
+                return Err(ls.error(&key("radius"), "must be [min, max] with max ≥ min"));
+            }
+            if p.kind == ParticleKind::Hexagonal
+                && matches!(radius, RadiusSpec::Range(_))
+                && r1 != r0
+            {
+                return Err(ls.error(
+                    &key("radius"),
+                    "must be one number for kind = \"hexagonal\"",
+                ));
+            }
+            for a in 0..2 {
+                if region[1][a] - region[0][a] < 2.0 * r1 {
+                    return Err(ls.error(&key("region"), "is narrower than one largest diameter"));
+                }
+            }
+            let phi = p.packing_fraction.unwrap_or(0.8);
+            if p.kind == ParticleKind::Random && !(phi > 0.0 && phi < 0.84) {
+                return Err(ls.error(
+                    &key("packing_fraction"),
+                    format!("= {phi} must be in (0, 0.84)"),
+                ));
+            }
+            let area = (region[1][0] - region[0][0]) * (region[1][1] - region[0][1]);
+            let count = area / (std::f64::consts::PI * r0 * r0);
+            if count > MAX_PARTICLES {
+                return Err(ls.error(
+                    &key("radius"),
+                    format!("gives up to {count:.3e} disks in the region, more than the {MAX_PARTICLES:.0e} a scene may have"),
+                ));
+            }
+        }
+        ParticleKind::List => {
+            let (Some(c), Some(r)) = (&p.centres, &p.radii) else {
+                return Err(ls.error(
+                    &key("centres"),
+                    "and radii are required for kind = \"list\"",
+                ));
+            };
+            if c.len() != r.len() {
+                return Err(ls.error(
+                    &key("radii"),
+                    format!("has {} values for {} centres", r.len(), c.len()),
+                ));
+            }
+            for (i, &ri) in r.iter().enumerate() {
+                if !(ri.is_finite() && ri > 0.0) {
+                    return Err(ls.error(
+                        &key("radii"),
+                        format!("[{i}] = {ri} must be a positive radius"),
+                    ));
+                }
+            }
+            for (i, ci) in c.iter().enumerate() {
+                if !(ci[0].is_finite() && ci[1].is_finite()) {
+                    return Err(ls.error(&key("centres"), format!("[{i}] is not finite")));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+fn check_walls(ls: &LoadedScene) -> Result<(), SceneError> {
+    for (i, w) in ls.scene.wall.iter().enumerate() {
+        let key = |f: &str| ki("wall", i, &[f]);
+        match (&w.from, &w.to, &w.polygon) {
+            (Some(a), Some(b), None) => {
+                if a == b || !a.iter().chain(b).all(|v| v.is_finite()) {
+                    return Err(ls.error(&key("to"), "must be a finite point other than from"));
+                }
+            }
+            (None, None, Some(p)) => {
+                let body = porofrac_nscd::RigidBody::polygon(p.clone());
+                if p.len() < 3 {
+                    return Err(ls.error(
+                        &key("polygon"),
+                        "needs at least three vertices (a segment: from, to)",
+                    ));
+                }
+                body.check(i).map_err(|_| {
+                    ls.error(
+                        &key("polygon"),
+                        "must be convex, counter-clockwise, with finite distinct vertices",
+                    )
+                })?;
+            }
+            _ => {
+                return Err(ls.error(
+                    &ki("wall", i, &[]),
+                    "needs either from and to (a segment) or polygon",
+                ));
+            }
+        }
+        let mut free = false;
+        if let Some(v) = &w.velocity {
+            for c in v {
+                match c {
+                    WallComponent::Velocity(x) => finite(ls, &key("velocity"), *x)?,
+                    WallComponent::Word(s) if s == "free" => free = true,
+                    WallComponent::Word(s) => {
+                        return Err(ls.error(
+                            &key("velocity"),
+                            format!("= \"{s}\": a component is a number (m/s) or \"free\""),
+                        ));
+                    }
+                }
+            }
+        }
+        if free {
+            positive(ls, &key("mass"), w.mass.unwrap_or(f64::NAN)).map_err(|_| {
+                ls.error(
+                    &key("mass"),
+                    "must be a positive number when a velocity component is \"free\"",
+                )
+            })?;
+        } else if w.mass.is_some() || w.force.is_some() {
+            return Err(ls.error(
+                &key(if w.mass.is_some() { "mass" } else { "force" }),
+                "applies only to a wall with a \"free\" velocity component",
+            ));
+        }
+        if let Some(f) = w.force {
+            for v in f {
+                finite(ls, &key("force"), v)?;
+            }
+        }
+    }
+    Ok(())
+}
+
+fn check_output(ls: &LoadedScene) -> Result<(), SceneError> {
+    let s = &ls.scene;
+    if s.output.every < 1 {
+        return Err(ls.error(
+            &k(&["output", "every"]),
+            format!("= {} must be ≥ 1", s.output.every),
+        ));
+    }
+    let mut names = std::collections::BTreeSet::new();
+    for (i, p) in s.output.probe.iter().enumerate() {
+        let key = |f: &str| ki("output.probe", i, &[f]);
+        if !names.insert(p.name.clone()) || p.name == "time" || p.name.contains(',') {
+            return Err(ls.error(
+                &key("name"),
+                format!("= \"{}\" is repeated, reserved or contains a comma", p.name),
+            ));
+        }
+        if !p.at.is_empty() {
+            return Err(ls.error(
+                &key("at"),
+                "is for grid models; model \"nscd\" probes a particle or a cell",
+            ));
+        }
+        let f = p.field.as_str();
+        if PARTICLE_FIELDS.contains(&f) {
+            match (p.particle, &p.cell) {
+                (Some(n), None) if n >= 0 => {}
+                (Some(n), None) => {
+                    return Err(ls.error(&key("particle"), format!("= {n} must be ≥ 0")));
+                }
+                _ => {
+                    return Err(ls.error(
+                        &key("particle"),
+                        format!("is required (and cell is not allowed) for field \"{f}\""),
+                    ));
+                }
+            }
+        } else if CELL_FIELDS.contains(&f) {
+            match (p.particle, &p.cell) {
+                (None, Some(c)) => {
+                    if c.center.len() != 2 || !c.center.iter().all(|v| v.is_finite()) {
+                        return Err(ls.error(&key("cell"), "center must be [x, y]"));
+                    }
+                    positive(ls, &key("cell"), c.radius)?;
+                }
+                _ => {
+                    return Err(ls.error(
+                        &key("cell"),
+                        format!("is required (and particle is not allowed) for field \"{f}\""),
+                    ));
+                }
+            }
+        } else {
+            return Err(ls.error(
+                &key("field"),
+                format!(
+                    "= \"{f}\" is not a field of model \"nscd\" (particle: {}; cell: {})",
+                    PARTICLE_FIELDS.join(" "),
+                    CELL_FIELDS.join(" ")
+                ),
+            ));
+        }
+    }
+    for (i, l) in s.output.line.iter().enumerate() {
+        let key = |f: &str| ki("output.line", i, &[f]);
+        if !PARTICLE_FIELDS.contains(&l.field.as_str()) {
+            return Err(ls.error(
+                &key("field"),
+                format!(
+                    "= \"{}\" must be a particle field: {}",
+                    l.field,
+                    PARTICLE_FIELDS.join(" ")
+                ),
+            ));
+        }
+        if l.from.len() != 2 || l.to.len() != 2 {
+            return Err(ls.error(&key("from"), "and to must be [x, y]"));
+        }
+        if l.points < 2 || l.points as u64 > crate::limits::MAX_LINE_POINTS {
+            return Err(ls.error(
+                &key("points"),
+                format!(
+                    "= {} must be in 2..={}",
+                    l.points,
+                    crate::limits::MAX_LINE_POINTS
+                ),
+            ));
+        }
+        if l.name.is_empty() || l.name.contains(['/', '\\']) {
+            return Err(ls.error(&key("name"), "must be a non-empty file name"));
+        }
+    }
+    Ok(())
+}

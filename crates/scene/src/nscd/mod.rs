@@ -1,0 +1,528 @@
+//! The NSCD model (seed 003, `[scene] model = "nscd"`): rigid disks and walls under
+//! non-smooth contact dynamics ([`porofrac_nscd`]).
+//!
+//! - *build*: the disks of `[particles]` (a seeded random packing, a hexagonal lattice
+//!   or a list), the walls of `[[wall]]`, the law of `[contact]` and the solver options
+//!   of `[nscd]` ([`build`]);
+//! - *step*: one θ-scheme step of [`porofrac_nscd::Nscd`] per schedule step;
+//! - *fields*: particle probes (`x y vx vy omega fx fy radius`, `fx fy` the sum of the
+//!   contact forces on the particle), tracked-cell probes (`p q anisotropy
+//!   anisotropy_volume dilation_x dilation_y contacts broken_bonds`, seed eqs. 7–11,
+//!   [`porofrac_particles::tracked`]), lines (the value of the particle nearest each
+//!   point), `vtk/particles_NNNN.vtp` + `vtk/contacts_NNNN.vtp` with `<name>.pvd` and
+//!   `<name>_contacts.pvd`, field extrema, and `summary.json` with `particles`,
+//!   `contacts`, `sweeps` (mean, max), `final_residual`, `not_converged_steps` and
+//!   `contact_updates_per_second` (local solves per second of NLGS wall time);
+//! - *plots* ([`plots`]): probe series and the disks coloured by initial layer.
+
+pub mod check;
+pub mod file;
+pub mod plots;
+
+use std::cell::RefCell;
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::time::Instant;
+
+use porofrac_grid::io::PvdWriter;
+use porofrac_nscd::{Axis, ContactLaw, Nscd, NscdError, Ordering, RigidBody, SolverParams};
+use porofrac_particles::packing::hexagonal;
+use porofrac_particles::vtk::{write_contacts, write_particles};
+use porofrac_particles::{Disks, RandomPacking, TrackedCell};
+
+use crate::check::{LoadedScene, SceneError, k, ki, step_count};
+use crate::driver::{Observer, drive};
+use crate::model::{Model, RunError, Sizes, StepStats};
+use crate::output::{SolverStats, Summary, WallSeconds, write_atomic};
+
+use file::{OrderingChoice, ParticleKind, WallComponent};
+
+/// Run a checked NSCD scene and write its `summary.json`.
+pub(crate) fn run(
+    ls: &LoadedScene,
+    out: &Path,
+    observer: &mut dyn Observer,
+) -> Result<Summary, RunError> {
+    let start = Instant::now();
+    let mut model = build(ls)?;
+    let build_seconds = start.elapsed().as_secs_f64();
+    let summary = drive(ls, &mut model, out, observer, start, build_seconds, 2)?;
+    let mut json = serde_json::to_value(&summary).expect("summary serializes");
+    if let Some(map) = json.as_object_mut() {
+        for (key, value) in model.summary_extras() {
+            map.insert(key.into(), value);
+        }
+    }
+    let text = serde_json::to_string_pretty(&json).expect("summary serializes");
+    write_atomic(&out.join("summary.json"), text.as_bytes())?;
+    Ok(summary)
+}
+
+/// What a probe reads.
+#[derive(Clone, Copy, Debug)]
+enum ProbeKind {
+    Particle(usize, usize),
+    Cell(usize, usize),
+}
+
+#[derive(Clone, Copy, Debug, Default)]
+struct RunStats {
+    steps: usize,
+    sweeps: usize,
+    max_sweeps: usize,
+    final_residual: f64,
+    max_residual: f64,
+    not_converged: usize,
+    updates: u64,
+    solve_seconds: f64,
+    max_contacts: usize,
+}
+
+/// An NSCD scene being run.
+pub struct NscdModel<'a> {
+    ls: &'a LoadedScene,
+    sys: Nscd,
+    times: Vec<f64>,
+    probes: Vec<ProbeKind>,
+    cells: Vec<TrackedCell>,
+    stats: RunStats,
+    step_seconds: f64,
+    contacts_pvd: RefCell<Option<PvdWriter>>,
+}
+
+fn scene_error(ls: &LoadedScene, e: &NscdError) -> RunError {
+    let key = match e {
+        NscdError::BadParameter { name, .. } => match *name {
+            "mu_static" | "mu_dynamic" => k(&["contact", "mu"]),
+            "cohesion" => k(&["contact", "cohesion"]),
+            "cohesion_distance" => k(&["contact", "d_w"]),
+            "dt" => k(&["schedule", "dt"]),
+            other => k(&["nscd", other]),
+        },
+        NscdError::BadBody { index, .. } => ki("wall", *index, &[]),
+        NscdError::Particles(_) | NscdError::InitialOverlap { .. } => k(&["particles"]),
+        NscdError::StepTooLarge { .. } => k(&[
+            "schedule",
+            if ls.scene.schedule.as_ref().is_some_and(|s| s.dt.is_some()) {
+                "dt"
+            } else {
+                "steps"
+            },
+        ]),
+    };
+    RunError::Scene(ls.error(&key, format!(": {e}")))
+}
+
+fn generate(ls: &LoadedScene) -> Result<Disks, SceneError> {
+    let p = ls
+        .scene
+        .particles
+        .as_ref()
+        .expect("checked: [particles] present");
+    let key = |f: &str| k(&["particles", f]);
+    let (centres, radii) = match p.kind {
+        ParticleKind::List => (
+            p.centres.clone().unwrap_or_default(),
+            p.radii.clone().unwrap_or_default(),
+        ),
+        ParticleKind::Hexagonal | ParticleKind::Random => {
+            let region = p.region.expect("checked");
+            let [r0, r1] = p.radius.expect("checked").range();
+            let packing = if p.kind == ParticleKind::Hexagonal {
+                hexagonal(region[0], region[1], r0)
+                    .map_err(|e| ls.error(&key("radius"), format!(": {e}")))?
+            } else {
+                RandomPacking::new(
+                    region[0],
+                    region[1],
+                    r0,
+                    r1,
+                    p.packing_fraction.unwrap_or(0.8),
+                    p.seed.unwrap_or(1),
+                )
+                .generate()
+                .map_err(|e| ls.error(&key("packing_fraction"), format!(": {e}")))?
+            };
+            (packing.centres, packing.radii)
+        }
+    };
+    if centres.is_empty() {
+        return Err(ls.error(&key("kind"), "generates no particle"));
+    }
+    Disks::new(&centres, &radii, p.density)
+        .map_err(|e| ls.error(&k(&["particles"]), format!(": {e}")))
+}
+
+fn walls(ls: &LoadedScene) -> Vec<RigidBody> {
+    ls.scene
+        .wall
+        .iter()
+        .map(|w| {
+            let vertices = match (&w.from, &w.to, &w.polygon) {
+                (Some(a), Some(b), _) => vec![*a, *b],
+                (_, _, Some(p)) => p.clone(),
+                _ => unreachable!("checked: from and to, or polygon"),
+            };
+            let force = w.force.unwrap_or([0.0; 2]);
+            let v = w
+                .velocity
+                .clone()
+                .unwrap_or([WallComponent::Velocity(0.0), WallComponent::Velocity(0.0)]);
+            let axis = |a: usize| match &v[a] {
+                WallComponent::Velocity(x) => Axis::Prescribed(*x),
+                WallComponent::Word(_) => Axis::Loaded(force[a]),
+            };
+            RigidBody::polygon(vertices)
+                .with_axes([axis(0), axis(1)], w.mass.unwrap_or(f64::INFINITY))
+        })
+        .collect()
+}
+
+/// Build the model of a checked NSCD scene.
+pub fn build(ls: &LoadedScene) -> Result<NscdModel<'_>, RunError> {
+    let s = &ls.scene;
+    let disks = generate(ls)?;
+    let c = s.contact.clone().unwrap_or_default();
+    let mu = c.mu.unwrap_or(0.0);
+    let law = ContactLaw {
+        mu_static: c.mu_static.unwrap_or(mu),
+        mu_dynamic: mu,
+        cohesion: c.cohesion.unwrap_or(0.0),
+        cohesion_distance: c.d_w.unwrap_or(0.0),
+    };
+    let n = s.nscd.clone().unwrap_or_default();
+    let defaults = SolverParams::default();
+    let params = SolverParams {
+        theta: n.theta.unwrap_or(defaults.theta),
+        tolerance: n.tolerance.unwrap_or(defaults.tolerance),
+        min_sweeps: n.min_sweeps.map_or(defaults.min_sweeps, |m| m as usize),
+        max_sweeps: n.max_sweeps.map_or(defaults.max_sweeps, |m| m as usize),
+        alert: n.alert,
+        ordering: match n.ordering.unwrap_or_default() {
+            OrderingChoice::Sorted => Ordering::Sorted,
+            OrderingChoice::Coloured => Ordering::Coloured,
+            OrderingChoice::Random => Ordering::Random {
+                seed: n.ordering_seed.unwrap_or(1),
+            },
+        },
+    };
+    let gravity = n.gravity.unwrap_or([0.0, -9.81]);
+    let sys = Nscd::new(disks, walls(ls), law, params, gravity).map_err(|e| scene_error(ls, &e))?;
+    let sch = s.schedule.as_ref().expect("checked: [schedule] present");
+    let steps = step_count(sch) as usize;
+    let dt = sch.dt.unwrap_or(sch.end_time / steps as f64);
+    let times: Vec<f64> = (0..=steps)
+        .map(|i| {
+            if i == steps {
+                sch.end_time
+            } else {
+                (i as f64 * dt).min(sch.end_time)
+            }
+        })
+        .collect();
+    let count = sys.disks.len();
+    let mut probes = Vec::new();
+    let mut cells = Vec::new();
+    for (i, p) in s.output.probe.iter().enumerate() {
+        if let Some(f) = check::PARTICLE_FIELDS.iter().position(|f| *f == p.field) {
+            let idx = p.particle.expect("checked") as usize;
+            if idx >= count {
+                return Err(ls
+                    .error(
+                        &ki("output.probe", i, &["particle"]),
+                        format!("= {idx} but the scene has {count} particles"),
+                    )
+                    .into());
+            }
+            probes.push(ProbeKind::Particle(idx, f));
+        } else {
+            let f = check::CELL_FIELDS
+                .iter()
+                .position(|f| *f == p.field)
+                .expect("checked");
+            let c = p.cell.as_ref().expect("checked");
+            let cell = TrackedCell::new(&sys.disks.x, [c.center[0], c.center[1]], c.radius);
+            if cell.count == 0 {
+                return Err(ls
+                    .error(&ki("output.probe", i, &["cell"]), "selects no particle")
+                    .into());
+            }
+            probes.push(ProbeKind::Cell(cells.len(), f));
+            cells.push(cell);
+        }
+    }
+    Ok(NscdModel {
+        ls,
+        sys,
+        times,
+        probes,
+        cells,
+        stats: RunStats::default(),
+        step_seconds: 0.0,
+        contacts_pvd: RefCell::new(None),
+    })
+}
+
+impl NscdModel<'_> {
+    /// Sum of the contact forces on each particle (N per metre).
+    fn particle_forces(&self) -> Vec<[f64; 2]> {
+        let mut f = vec![[0.0; 2]; self.sys.disks.len()];
+        for c in self.sys.contacts() {
+            let [rn, rt] = self.sys.contact_force(c);
+            let v = [rn * c.n[0] + rt * c.t[0], rn * c.n[1] + rt * c.t[1]];
+            let i = c.i as usize;
+            f[i][0] += v[0];
+            f[i][1] += v[1];
+            if let porofrac_nscd::detect::Antagonist::Disk(j) = c.other {
+                f[j as usize][0] -= v[0];
+                f[j as usize][1] -= v[1];
+            }
+        }
+        f
+    }
+
+    fn particle_value(&self, i: usize, field: usize, forces: &[[f64; 2]]) -> f64 {
+        let d = &self.sys.disks;
+        match check::PARTICLE_FIELDS[field] {
+            "x" => d.x[i][0],
+            "y" => d.x[i][1],
+            "vx" => d.v[i][0],
+            "vy" => d.v[i][1],
+            "omega" => d.omega[i],
+            "fx" => forces[i][0],
+            "fy" => forces[i][1],
+            _ => d.r[i],
+        }
+    }
+
+    /// Keys added to `summary.json`.
+    fn summary_extras(&self) -> Vec<(&'static str, serde_json::Value)> {
+        let st = &self.stats;
+        let mean = if st.steps > 0 {
+            st.sweeps as f64 / st.steps as f64
+        } else {
+            0.0
+        };
+        let rate = if st.solve_seconds > 0.0 {
+            st.updates as f64 / st.solve_seconds
+        } else {
+            0.0
+        };
+        vec![
+            ("particles", self.sys.disks.len().into()),
+            ("contacts", self.sys.contacts().len().into()),
+            ("max_contacts", st.max_contacts.into()),
+            (
+                "sweeps",
+                serde_json::json!({ "mean": mean, "max": st.max_sweeps, "total": st.sweeps }),
+            ),
+            ("final_residual", st.final_residual.into()),
+            ("not_converged_steps", st.not_converged.into()),
+            ("contact_updates", st.updates.into()),
+            ("contact_updates_per_second", rate.into()),
+            ("nlgs_seconds", st.solve_seconds.into()),
+        ]
+    }
+}
+
+impl Model for NscdModel<'_> {
+    fn times(&self) -> &[f64] {
+        &self.times
+    }
+
+    fn step(&mut self, step: usize) -> Result<StepStats, RunError> {
+        if step == 0 {
+            return Ok(StepStats::default());
+        }
+        let h = self.times[step] - self.times[step - 1];
+        let t0 = Instant::now();
+        let st = self.sys.step(h).map_err(|e| scene_error(self.ls, &e))?;
+        self.step_seconds += t0.elapsed().as_secs_f64();
+        let r = &mut self.stats;
+        r.steps += 1;
+        r.sweeps += st.sweeps;
+        r.max_sweeps = r.max_sweeps.max(st.sweeps);
+        r.final_residual = st.residual;
+        r.max_residual = r.max_residual.max(st.residual);
+        r.not_converged += usize::from(!st.converged);
+        r.updates += st.updates;
+        r.solve_seconds += st.solve_seconds;
+        r.max_contacts = r.max_contacts.max(st.contacts);
+        Ok(StepStats {
+            iterations: st.sweeps,
+            failed: 0,
+        })
+    }
+
+    fn probes(&self, values: &mut Vec<f64>) {
+        let forces = self.particle_forces();
+        let mut contacts = Vec::new();
+        self.sys.cell_contacts(&mut contacts);
+        let states: Vec<_> = self
+            .cells
+            .iter()
+            .map(|c| c.measure(&self.sys.disks.x, &contacts))
+            .collect();
+        for p in &self.probes {
+            values.push(match *p {
+                ProbeKind::Particle(i, f) => self.particle_value(i, f, &forces),
+                ProbeKind::Cell(c, f) => {
+                    let s = &states[c];
+                    match check::CELL_FIELDS[f] {
+                        "p" => s.p,
+                        "q" => s.q,
+                        "anisotropy" => s.anisotropy,
+                        "anisotropy_volume" => s.anisotropy_volume,
+                        "dilation_x" => s.dilation_x,
+                        "dilation_y" => s.dilation_y,
+                        "contacts" => s.contacts as f64,
+                        // Rigid disks have no bonds.
+                        _ => 0.0,
+                    }
+                }
+            });
+        }
+    }
+
+    fn line(&self, line: usize, rows: &mut Vec<Vec<f64>>) {
+        let l = &self.ls.scene.output.line[line];
+        let field = check::PARTICLE_FIELDS
+            .iter()
+            .position(|f| *f == l.field)
+            .expect("checked");
+        let forces = self.particle_forces();
+        let x = &self.sys.disks.x;
+        let n = l.points as usize;
+        let len = ((l.to[0] - l.from[0]).powi(2) + (l.to[1] - l.from[1]).powi(2)).sqrt();
+        for k in 0..n {
+            let s = k as f64 / (n - 1) as f64;
+            let p = [
+                l.from[0] + s * (l.to[0] - l.from[0]),
+                l.from[1] + s * (l.to[1] - l.from[1]),
+            ];
+            let nearest = (0..x.len())
+                .min_by(|&a, &b| {
+                    let da = (x[a][0] - p[0]).powi(2) + (x[a][1] - p[1]).powi(2);
+                    let db = (x[b][0] - p[0]).powi(2) + (x[b][1] - p[1]).powi(2);
+                    da.total_cmp(&db)
+                })
+                .unwrap_or(0);
+            rows.push(vec![
+                s * len,
+                p[0],
+                p[1],
+                self.particle_value(nearest, field, &forces),
+            ]);
+        }
+    }
+
+    fn after_step(&mut self, _out: &Path) -> Result<(), RunError> {
+        Ok(())
+    }
+
+    fn write_vtk(&self, dir: &Path, index: usize) -> Result<String, RunError> {
+        let io = |e: porofrac_particles::ParticleError| {
+            RunError::Output(crate::output::OutputError {
+                path: dir.to_path_buf(),
+                source: std::io::Error::other(e.to_string()),
+            })
+        };
+        let particles = format!("particles_{index:04}.vtp");
+        let contacts = format!("contacts_{index:04}.vtp");
+        write_particles(&dir.join(&particles), &self.sys.disks).map_err(io)?;
+        let mut lines = Vec::new();
+        self.sys.contact_lines(&mut lines);
+        write_contacts(&dir.join(&contacts), &lines).map_err(io)?;
+        let mut pvd = self.contacts_pvd.borrow_mut();
+        if pvd.is_none() {
+            let parent = dir.parent().unwrap_or(Path::new("."));
+            *pvd = Some(PvdWriter::create(
+                parent.join(format!("{}_contacts.pvd", self.ls.scene.scene.name)),
+            )?);
+        }
+        if let Some(pvd) = pvd.as_mut() {
+            pvd.add(self.sys.time, format!("vtk/{contacts}"))?;
+        }
+        Ok(particles)
+    }
+
+    fn field_extrema(&self) -> BTreeMap<String, [f64; 2]> {
+        let d = &self.sys.disks;
+        let mut out = BTreeMap::new();
+        let mut put = |name: &str, values: &mut dyn Iterator<Item = f64>| {
+            let mm = values.fold([f64::INFINITY, f64::NEG_INFINITY], |[a, b], v| {
+                [a.min(v), b.max(v)]
+            });
+            if mm[0] <= mm[1] {
+                out.insert(name.to_string(), mm);
+            }
+        };
+        put("radius", &mut d.r.iter().copied());
+        put("vx", &mut d.v.iter().map(|v| v[0]));
+        put("vy", &mut d.v.iter().map(|v| v[1]));
+        put(
+            "speed",
+            &mut d.v.iter().map(|v| (v[0] * v[0] + v[1] * v[1]).sqrt()),
+        );
+        put("omega", &mut d.omega.iter().copied());
+        put("ux", &mut (0..d.len()).map(|i| d.displacement(i)[0]));
+        put("uy", &mut (0..d.len()).map(|i| d.displacement(i)[1]));
+        let forces: Vec<[f64; 2]> = self
+            .sys
+            .contacts()
+            .iter()
+            .map(|c| self.sys.contact_force(c))
+            .collect();
+        put("normal_force", &mut forces.iter().map(|f| f[0]));
+        put("tangential_force", &mut forces.iter().map(|f| f[1]));
+        out
+    }
+
+    fn plots(&self, dir: &Path, written: &[f64], series: &[Vec<f64>]) -> Result<(), RunError> {
+        let probes: Vec<(String, String, Vec<f64>)> = self
+            .ls
+            .scene
+            .output
+            .probe
+            .iter()
+            .zip(series)
+            .map(|(p, v)| (p.name.clone(), p.field.clone(), v.clone()))
+            .collect();
+        plots::probe_plots(dir, &self.ls.scene.scene.name, written, &probes)?;
+        plots::layers(&dir.join("layers.png"), &self.sys.disks)?;
+        Ok(())
+    }
+
+    fn sizes(&self) -> Sizes {
+        Sizes {
+            cells: self.sys.disks.len(),
+            nodes: 0,
+            dofs: 3 * self.sys.disks.len(),
+        }
+    }
+
+    fn failed(&self) -> usize {
+        0
+    }
+
+    fn solver_stats(&self) -> SolverStats {
+        SolverStats {
+            linear: "nlgs".into(),
+            iterations: self.stats.sweeps,
+            max_relative_residual: self.stats.max_residual,
+            ..SolverStats::default()
+        }
+    }
+
+    fn errors(&self) -> Result<BTreeMap<String, f64>, RunError> {
+        Ok(BTreeMap::new())
+    }
+
+    fn wall_seconds(&self) -> WallSeconds {
+        WallSeconds {
+            assembly: self.step_seconds - self.stats.solve_seconds,
+            solve: self.stats.solve_seconds,
+            ..WallSeconds::default()
+        }
+    }
+}
