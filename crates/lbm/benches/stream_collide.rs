@@ -7,7 +7,10 @@ use porofrac_lbm::kernel::{Grid, Layout, Physics, aa_step, push_step_periodic};
 use porofrac_lbm::{Collision, Lattice, LatticeConfig};
 
 fn bench(c: &mut Criterion) {
-    let phys = Physics { rates: Collision::Bgk.rates(0.8).expect("tau"), accel: [0.0, 0.0] };
+    let phys = Physics {
+        rates: Collision::Bgk.rates(0.8).expect("tau"),
+        accel: [0.0, 0.0],
+    };
     let mut group = c.benchmark_group("d2q9_step");
     group.sample_size(10);
     for n in [128usize, 512, 1024, 2048] {

@@ -61,11 +61,18 @@ impl Shape {
                 [center[0] - radius, center[1] - radius],
                 [center[0] + radius, center[1] + radius],
             ],
-            Shape::Box { center, half, angle } => {
+            Shape::Box {
+                center,
+                half,
+                angle,
+            } => {
                 let (s, c) = angle.sin_cos();
                 let ex = (c * half[0]).abs() + (s * half[1]).abs();
                 let ey = (s * half[0]).abs() + (c * half[1]).abs();
-                [[center[0] - ex, center[1] - ey], [center[0] + ex, center[1] + ey]]
+                [
+                    [center[0] - ex, center[1] - ey],
+                    [center[0] + ex, center[1] + ey],
+                ]
             }
         }
     }
@@ -83,7 +90,11 @@ impl Shape {
                 let d = [p[0] - center[0], p[1] - center[1]];
                 d[0] * d[0] + d[1] * d[1] <= radius * radius
             }
-            Shape::Box { center, half, angle } => {
+            Shape::Box {
+                center,
+                half,
+                angle,
+            } => {
                 let l = Self::to_local(center, angle, p);
                 l[0].abs() <= half[0] && l[1].abs() <= half[1]
             }
@@ -102,7 +113,11 @@ impl Shape {
                 let disc = (b * b - a * c).max(0.0);
                 (-b - disc.sqrt()) / a
             }
-            Shape::Box { center, half, angle } => {
+            Shape::Box {
+                center,
+                half,
+                angle,
+            } => {
                 let o = Self::to_local(center, angle, p);
                 let (s, c) = angle.sin_cos();
                 let dl = [c * d[0] + s * d[1], -s * d[0] + c * d[1]];
@@ -127,13 +142,20 @@ mod tests {
 
     #[test]
     fn entry_points_lie_on_the_surface() {
-        let c = Shape::Circle { center: [5.3, 4.1], radius: 2.2 };
+        let c = Shape::Circle {
+            center: [5.3, 4.1],
+            radius: 2.2,
+        };
         let p = [2.5, 4.5];
         assert!(!c.contains(p) && c.contains([3.5, 4.5]));
         let t = c.entry(p, [1.0, 0.0]);
         let x = p[0] + t - 5.3;
         assert!((x * x + 0.4f64.powi(2) - 2.2f64.powi(2)).abs() < 1e-12);
-        let b = Shape::Box { center: [5.0, 5.0], half: [2.0, 1.0], angle: std::f64::consts::FRAC_PI_2 };
+        let b = Shape::Box {
+            center: [5.0, 5.0],
+            half: [2.0, 1.0],
+            angle: std::f64::consts::FRAC_PI_2,
+        };
         // rotated by 90°: extends ±1 in x and ±2 in y
         assert!(b.contains([5.9, 6.9]) && !b.contains([6.1, 5.0]));
         let t = b.entry([6.5, 5.5], [-1.0, 0.0]);

@@ -123,7 +123,13 @@ fn bands<'a>(
 /// One fused AA step over all interior nodes; `layout` is the layout before the step
 /// (Natural: even step, Swapped: odd step). `mask` (1 fluid, 0 solid, padded) may be
 /// omitted when every node is fluid. Returns the layout after the step.
-pub fn aa_step(pop: &mut [f64], g: Grid, layout: Layout, mask: Option<&[u8]>, phys: Physics) -> Layout {
+pub fn aa_step(
+    pop: &mut [f64],
+    g: Grid,
+    layout: Layout,
+    mask: Option<&[u8]>,
+    phys: Physics,
+) -> Layout {
     match (layout, mask) {
         (Layout::Natural, None) => aa::<false, false>(pop, g, &[], phys),
         (Layout::Natural, Some(m)) => aa::<false, true>(pop, g, m, phys),
@@ -161,7 +167,9 @@ fn aa<const ODD: bool, const MASK: bool>(pop: &mut [f64], g: Grid, mask: &[u8], 
             for x in 0..nx {
                 let on = if MASK { m[x] as f64 } else { 1.0 };
                 if ODD {
-                    let f = [r0[x], r3[x], r4[x], r1[x], r2[x], r7[x], r8[x], r5[x], r6[x]];
+                    let f = [
+                        r0[x], r3[x], r4[x], r1[x], r2[x], r7[x], r8[x], r5[x], r6[x],
+                    ];
                     let o = collide(f, phys.rates, phys.accel, on);
                     r0[x] = o[0];
                     r1[x] = o[1];
@@ -173,7 +181,9 @@ fn aa<const ODD: bool, const MASK: bool>(pop: &mut [f64], g: Grid, mask: &[u8], 
                     r7[x] = o[7];
                     r8[x] = o[8];
                 } else {
-                    let f = [r0[x], r1[x], r2[x], r3[x], r4[x], r5[x], r6[x], r7[x], r8[x]];
+                    let f = [
+                        r0[x], r1[x], r2[x], r3[x], r4[x], r5[x], r6[x], r7[x], r8[x],
+                    ];
                     let o = collide(f, phys.rates, phys.accel, on);
                     r0[x] = o[0];
                     r1[x] = o[3];

@@ -110,10 +110,16 @@ impl Lattice {
             if let SideKind::Pressure { density } = kind
                 && !(*density > 0.0 && density.is_finite())
             {
-                return Err(LbmError::Value(["xmin", "xmax", "ymin", "ymax"][s], *density));
+                return Err(LbmError::Value(
+                    ["xmin", "xmax", "ymin", "ymax"][s],
+                    *density,
+                ));
             }
         }
-        let grid = Grid { nx: cfg.nx, ny: cfg.ny };
+        let grid = Grid {
+            nx: cfg.nx,
+            ny: cfg.ny,
+        };
         let np = grid.np();
         let mut l = Lattice {
             grid,
@@ -170,9 +176,15 @@ impl Lattice {
                 let (rho, u) = if self.owner[node] == NONE {
                     f(p)
                 } else {
-                    (1.0, self.obstacles[self.owner[node] as usize].velocity_at(p))
+                    (
+                        1.0,
+                        self.obstacles[self.owner[node] as usize].velocity_at(p),
+                    )
                 };
-                let u = [u[0] - 0.5 * self.cfg.accel[0], u[1] - 0.5 * self.cfg.accel[1]];
+                let u = [
+                    u[0] - 0.5 * self.cfg.accel[0],
+                    u[1] - 0.5 * self.cfg.accel[1],
+                ];
                 for q in 0..Q {
                     self.pop[g.loc(self.layout, node, q)] = feq(q, rho, u);
                 }
@@ -237,7 +249,10 @@ impl Lattice {
         let node = g.node(i as isize, j as isize);
         if self.owner[node] != NONE {
             let p = [i as f64 + 0.5, j as f64 + 0.5];
-            return (1.0, self.obstacles[self.owner[node] as usize].velocity_at(p));
+            return (
+                1.0,
+                self.obstacles[self.owner[node] as usize].velocity_at(p),
+            );
         }
         let (mut rho, mut jx, mut jy) = (0.0, 0.0, 0.0);
         for q in 0..Q {
@@ -252,7 +267,9 @@ impl Lattice {
 
     /// Population `f_q` arriving at interior node `(i, j)`.
     pub fn population(&self, i: usize, j: usize, q: usize) -> f64 {
-        self.pop[self.grid.loc(self.layout, self.grid.node(i as isize, j as isize), q)]
+        self.pop[self
+            .grid
+            .loc(self.layout, self.grid.node(i as isize, j as isize), q)]
     }
 
     /// Largest speed over fluid nodes, or an error if a density is not positive and finite.
@@ -262,7 +279,11 @@ impl Lattice {
             for i in 0..self.grid.nx {
                 let (rho, u) = self.moments(i, j);
                 if !(rho > 0.0 && rho.is_finite()) {
-                    return Err(LbmError::Diverged { step: self.steps, i, j });
+                    return Err(LbmError::Diverged {
+                        step: self.steps,
+                        i,
+                        j,
+                    });
                 }
                 m = m.max((u[0] * u[0] + u[1] * u[1]).sqrt());
             }
@@ -289,21 +310,39 @@ impl Lattice {
         for (k, ob) in self.obstacles.iter().enumerate() {
             let [lo, hi] = ob.shape.bounds();
             let c = ob.shape.center();
-            let r = (lo[0] - c[0]).abs().max((hi[0] - c[0]).abs()).max((lo[1] - c[1]).abs()).max((hi[1] - c[1]).abs());
+            let r = (lo[0] - c[0])
+                .abs()
+                .max((hi[0] - c[0]).abs())
+                .max((lo[1] - c[1]).abs())
+                .max((hi[1] - c[1]).abs());
             let s = (ob.velocity[0].powi(2) + ob.velocity[1].powi(2)).sqrt()
                 + ob.angular_velocity.abs() * r * std::f64::consts::SQRT_2;
             if !(s < 1.0) {
-                return Err(LbmError::TooFast { obstacle: k, speed: s });
+                return Err(LbmError::TooFast {
+                    obstacle: k,
+                    speed: s,
+                });
             }
         }
-        let phys = Physics { rates: self.rates, accel: self.cfg.accel };
-        let mask = if self.obstacles.is_empty() { None } else { Some(&self.mask[..]) };
+        let phys = Physics {
+            rates: self.rates,
+            accel: self.cfg.accel,
+        };
+        let mask = if self.obstacles.is_empty() {
+            None
+        } else {
+            Some(&self.mask[..])
+        };
         self.layout = aa_step(&mut self.pop, self.grid, self.layout, mask, phys);
         self.apply_copies();
         self.apply_sides();
         self.apply_obstacles();
         self.steps += 1;
-        if self.obstacles.iter().any(|o| o.velocity != [0.0, 0.0] || o.angular_velocity != 0.0) {
+        if self
+            .obstacles
+            .iter()
+            .any(|o| o.velocity != [0.0, 0.0] || o.angular_velocity != 0.0)
+        {
             self.move_obstacles()?;
         }
         Ok(())
@@ -311,9 +350,14 @@ impl Lattice {
 
     fn check_inside(&self, k: usize, s: &Shape) -> Result<(), LbmError> {
         let [lo, hi] = s.bounds();
-        let (nx, ny) = (self.grid.nx as f64, self.grid.ny as f64);
-        if !(lo[0] >= 0.0 && lo[1] >= 0.0 && hi[0] <= nx && hi[1] <= ny) {
-            return Err(LbmError::Outside { obstacle: k });
+        let n = [self.grid.nx as f64, self.grid.ny as f64];
+        for a in 0..2 {
+            let inside = lo[a] >= 0.0 && hi[a] <= n[a];
+            // Along a periodic axis a body may also span the whole period (a wall).
+            let spans = self.cfg.periodic[a] && lo[a] <= 0.0 && hi[a] >= n[a];
+            if !(inside || spans) {
+                return Err(LbmError::Outside { obstacle: k });
+            }
         }
         Ok(())
     }
@@ -333,8 +377,20 @@ impl Lattice {
                 let node = g.node(i, j) as u32;
                 for q in 1..Q {
                     let (si, sj) = (i - C[q][0] as isize, j - C[q][1] as isize);
-                    let out_x = if si < 0 { Some(Side::XMin) } else if si >= nx { Some(Side::XMax) } else { None };
-                    let out_y = if sj < 0 { Some(Side::YMin) } else if sj >= ny { Some(Side::YMax) } else { None };
+                    let out_x = if si < 0 {
+                        Some(Side::XMin)
+                    } else if si >= nx {
+                        Some(Side::XMax)
+                    } else {
+                        None
+                    };
+                    let out_y = if sj < 0 {
+                        Some(Side::YMin)
+                    } else if sj >= ny {
+                        Some(Side::YMax)
+                    } else {
+                        None
+                    };
                     if out_x.is_none() && out_y.is_none() {
                         continue;
                     }
@@ -359,21 +415,31 @@ impl Lattice {
                         None => {
                             let wi = si.rem_euclid(nx) + C[q][0] as isize;
                             let wj = sj.rem_euclid(ny) + C[q][1] as isize;
-                            self.copies.push(CopyLink { dst: node, src: g.node(wi, wj) as u32, dir: q as u8 });
+                            self.copies.push(CopyLink {
+                                dst: node,
+                                src: g.node(wi, wj) as u32,
+                                dir: q as u8,
+                            });
                         }
                         Some(s) => {
                             let p = [i as f64 + 0.5, j as f64 + 0.5];
                             let at = [p[0] - 0.5 * C[q][0] as f64, p[1] - 0.5 * C[q][1] as f64];
                             match self.cfg.sides[s.index()] {
-                                SideKind::Wall | SideKind::Velocity => self.side_links.push(SideLink {
-                                    node,
-                                    dir: q as u8,
-                                    side: s.index() as u8,
-                                    at,
-                                    u: [0.0, 0.0],
-                                }),
+                                SideKind::Wall | SideKind::Velocity => {
+                                    self.side_links.push(SideLink {
+                                        node,
+                                        dir: q as u8,
+                                        side: s.index() as u8,
+                                        at,
+                                        u: [0.0, 0.0],
+                                    })
+                                }
                                 SideKind::Pressure { density } => {
-                                    self.pressure_links.push(PressureLink { node, dir: q as u8, density })
+                                    self.pressure_links.push(PressureLink {
+                                        node,
+                                        dir: q as u8,
+                                        density,
+                                    })
                                 }
                             }
                         }
@@ -398,7 +464,8 @@ impl Lattice {
             let a = OPP[i];
             let xb = g.shift(l.node as usize, a);
             let cu = C[i][0] as f64 * l.u[0] + C[i][1] as f64 * l.u[1];
-            self.pop[g.loc(lay, l.node as usize, i)] = self.pop[g.loc(lay, xb, a)] + 6.0 * W[i] * cu;
+            self.pop[g.loc(lay, l.node as usize, i)] =
+                self.pop[g.loc(lay, xb, a)] + 6.0 * W[i] * cu;
         }
         let acc = self.cfg.accel;
         for l in &self.pressure_links {
@@ -417,8 +484,8 @@ impl Lattice {
             let cu = c[0] * u[0] + c[1] * u[1];
             let usq = u[0] * u[0] + u[1] * u[1];
             let xb = g.shift(x, a);
-            self.pop[g.loc(lay, x, i)] =
-                -self.pop[g.loc(lay, xb, a)] + 2.0 * W[i] * l.density * (1.0 + 4.5 * cu * cu - 1.5 * usq);
+            self.pop[g.loc(lay, x, i)] = -self.pop[g.loc(lay, xb, a)]
+                + 2.0 * W[i] * l.density * (1.0 + 4.5 * cu * cu - 1.5 * usq);
         }
     }
 
@@ -441,7 +508,9 @@ impl Lattice {
                 into - wall
             } else {
                 let d = l.delta;
-                ((1.0 - d) * self.pop[g.loc(lay, xf, a)] + d * into + d * self.pop[g.loc(lay, l.f2 as usize, i)]
+                ((1.0 - d) * self.pop[g.loc(lay, xf, a)]
+                    + d * into
+                    + d * self.pop[g.loc(lay, l.f2 as usize, i)]
                     - wall)
                     / (1.0 + d)
             };
@@ -500,7 +569,13 @@ impl Lattice {
                 for q in 1..Q {
                     let m = g.shift(n, q);
                     let (mi, mj) = (m % g.stride(), m / g.stride());
-                    if mi >= 1 && mi <= g.nx && mj >= 1 && mj <= g.ny && self.owner[m] == NONE && !old.contains(&(m as u32)) {
+                    if mi >= 1
+                        && mi <= g.nx
+                        && mj >= 1
+                        && mj <= g.ny
+                        && self.owner[m] == NONE
+                        && !old.contains(&(m as u32))
+                    {
                         let rho: f64 = (0..Q).map(|p| self.pop[g.loc(self.layout, m, p)]).sum();
                         sum += rho;
                         cnt += 1;
@@ -524,6 +599,21 @@ impl Lattice {
             }
             let mut s = ob.shape;
             s.advance(ob.velocity, ob.angular_velocity);
+            // A body spanning a periodic axis keeps its centre in the first period.
+            let [lo, hi] = s.bounds();
+            let n = [self.grid.nx as f64, self.grid.ny as f64];
+            let c = s.center();
+            for a in 0..2 {
+                if self.cfg.periodic[a]
+                    && lo[a] <= 0.0
+                    && hi[a] >= n[a]
+                    && hi[a] - lo[a] >= 2.0 * n[a]
+                {
+                    let mut d = [0.0, 0.0];
+                    d[a] = c[a].rem_euclid(n[a]) - c[a];
+                    s.advance(d, 0.0);
+                }
+            }
             self.check_inside(k, &s)?;
             self.obstacles[k].shape = s;
             self.rasterize(k, true);
@@ -563,8 +653,13 @@ impl Lattice {
                     let p = [fi as f64 + 0.5, fj as f64 + 0.5];
                     let c = cf(a);
                     let delta = shape.entry(p, c);
-                    let f2 = match (wrap(fi - C[a][0] as isize, nx, per[0]), wrap(fj - C[a][1] as isize, ny, per[1])) {
-                        (Some(i2), Some(j2)) if self.owner[g.node(i2, j2)] == NONE => g.node(i2, j2) as u32,
+                    let f2 = match (
+                        wrap(fi - C[a][0] as isize, nx, per[0]),
+                        wrap(fj - C[a][1] as isize, ny, per[1]),
+                    ) {
+                        (Some(i2), Some(j2)) if self.owner[g.node(i2, j2)] == NONE => {
+                            g.node(i2, j2) as u32
+                        }
                         _ => NONE,
                     };
                     self.obstacle_links.push(ObstacleLink {

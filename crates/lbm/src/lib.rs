@@ -56,7 +56,9 @@ pub enum LbmError {
     #[error("{0} = {1} must be positive and finite")]
     Value(&'static str, f64),
     /// A velocity above the Mach limit.
-    #[error("{what}: Mach number {mach:.3} above {MAX_MACH} (lower the velocity, refine the spacing or lower tau)")]
+    #[error(
+        "{what}: Mach number {mach:.3} above {MAX_MACH} (lower the velocity, refine the spacing or lower tau)"
+    )]
     Mach {
         /// What moves.
         what: &'static str,

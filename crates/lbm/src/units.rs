@@ -24,8 +24,17 @@ pub struct Units {
 
 impl Units {
     /// Units from spacing, kinematic viscosity, density and relaxation time.
-    pub fn from_viscosity(dx: f64, viscosity: f64, density: f64, tau: f64) -> Result<Self, LbmError> {
-        for (name, v) in [("spacing", dx), ("viscosity", viscosity), ("density", density)] {
+    pub fn from_viscosity(
+        dx: f64,
+        viscosity: f64,
+        density: f64,
+        tau: f64,
+    ) -> Result<Self, LbmError> {
+        for (name, v) in [
+            ("spacing", dx),
+            ("viscosity", viscosity),
+            ("density", density),
+        ] {
             if !(v > 0.0 && v.is_finite()) {
                 return Err(LbmError::Value(name, v));
             }
@@ -34,7 +43,12 @@ impl Units {
             return Err(LbmError::Tau(tau));
         }
         let dt = CS2 * (tau - 0.5) * dx * dx / viscosity;
-        Ok(Units { dx, dt, density, tau })
+        Ok(Units {
+            dx,
+            dt,
+            density,
+            tau,
+        })
     }
     /// Lattice velocity of `v` (m/s).
     pub fn velocity(&self, v: f64) -> f64 {
