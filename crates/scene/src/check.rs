@@ -247,14 +247,34 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
     if s.scene.plane.is_some() && d == 3 {
         return Err(ls.error(&k(&["scene", "plane"]), "applies to 2D scenes only"));
     }
-    if ls.model() != "continuum" {
-        return Err(ls.error(
-            &k(&["scene", "model"]),
-            format!(
-                "= \"{}\" is not available in this version of porofrac (available: continuum)",
-                ls.model()
-            ),
-        ));
+    match ls.model() {
+        "continuum" => {
+            let lbm_key = if s.lbm.is_some() {
+                Some(k(&["lbm"]))
+            } else if !s.obstacle.is_empty() {
+                Some(ki("obstacle", 0, &[]))
+            } else if s.thermal.is_some() {
+                Some(k(&["thermal"]))
+            } else {
+                s.output
+                    .probe
+                    .iter()
+                    .position(|p| p.obstacle.is_some())
+                    .map(|i| ki("output.probe", i, &["obstacle"]))
+            };
+            if let Some(key) = lbm_key {
+                return Err(ls.error(&key, "belongs to model \"lbm\", not \"continuum\""));
+            }
+        }
+        "lbm" => return crate::lbm::check(ls),
+        other => {
+            return Err(ls.error(
+                &k(&["scene", "model"]),
+                format!(
+                    "= \"{other}\" is not available in this version of porofrac (available: continuum, lbm)"
+                ),
+            ));
+        }
     }
     check_grid(ls, d)?;
     // Materials.
@@ -524,7 +544,9 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
 }
 
 fn check_grid(ls: &LoadedScene, d: usize) -> Result<(), SceneError> {
-    let g = &ls.scene.grid;
+    let Some(g) = &ls.scene.grid else {
+        return Err(ls.error(&k(&["grid"]), "is required by the continuum model"));
+    };
     let key = |f: &str| k(&["grid", f]);
     if matches!(g.kind, GridKind::Triangles | GridKind::Voronoi) && d != 2 {
         return Err(ls.error(
@@ -741,7 +763,9 @@ fn check_sizes(ls: &LoadedScene, d: usize) -> Result<(), SceneError> {
         )
         .map_err(|e| ls.error(&key, e))?;
     }
-    let g = &s.grid;
+    let Some(g) = &s.grid else {
+        return Ok(());
+    };
     let per_axis: Vec<f64> = match &g.cells {
         Some(CellCount::PerAxis(v)) => v.iter().map(|&n| n as f64).collect(),
         Some(CellCount::One(n)) => vec![*n as f64],

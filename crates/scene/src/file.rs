@@ -198,8 +198,8 @@ pub enum LinearChoice {
 pub struct SceneFile {
     /// `[scene]`.
     pub scene: SceneSection,
-    /// `[grid]`.
-    pub grid: GridSection,
+    /// `[grid]` (continuum model).
+    pub grid: Option<GridSection>,
     /// `[[region]]`: later regions override earlier ones.
     #[serde(default)]
     pub region: Vec<Region>,
@@ -232,6 +232,13 @@ pub struct SceneFile {
     /// `[output]`.
     #[serde(default)]
     pub output: Output,
+    /// `[lbm]` (lattice Boltzmann model).
+    pub lbm: Option<crate::lbm::file::LbmSection>,
+    /// `[[obstacle]]` (lattice Boltzmann model).
+    #[serde(default)]
+    pub obstacle: Vec<crate::lbm::file::ObstacleSection>,
+    /// `[thermal]` (lattice Boltzmann model).
+    pub thermal: Option<crate::lbm::file::ThermalSection>,
 }
 
 /// `[scene]`.
@@ -555,7 +562,10 @@ pub struct Probe {
     /// Field name.
     pub field: String,
     /// Position.
+    #[serde(default)]
     pub at: Vec<f64>,
+    /// Lattice Boltzmann: the obstacle whose force or torque is probed (instead of `at`).
+    pub obstacle: Option<String>,
 }
 
 /// `[[output.line]]`.

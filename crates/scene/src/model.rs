@@ -133,6 +133,8 @@ fn run_model(
 ) -> Result<Summary, RunError> {
     let summary = match ls.model() {
         "continuum" => crate::continuum::run(ls, laws, out, observer)?,
+        // Writes its own summary.json (with the `lattice` block and `mlups`).
+        "lbm" => return crate::lbm::run(ls, out, observer),
         other => {
             return Err(ls
                 .error(

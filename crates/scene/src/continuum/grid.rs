@@ -26,7 +26,7 @@ pub(crate) fn point<const D: usize>(v: &[f64]) -> Point<D> {
 
 /// Build (or read) the grid of a checked scene.
 pub fn build_grid(ls: &LoadedScene) -> Result<AnyGrid, RunError> {
-    let g = &ls.scene.grid;
+    let g = ls.scene.grid.as_ref().expect("checked: [grid] is required");
     let d = ls.scene.scene.dim as usize;
     let seed = g.seed.unwrap_or(0);
     let per_axis = || match &g.cells {
