@@ -13,7 +13,7 @@ fn bench(c: &mut Criterion) {
     };
     let mut group = c.benchmark_group("d2q9_step");
     group.sample_size(10);
-    for n in [128usize, 512, 1024, 2048] {
+    for n in [64usize, 256, 1024, 2048, 4096] {
         let g = Grid { nx: n, ny: n };
         group.throughput(Throughput::Elements((n * n) as u64));
         let mut pop = vec![0.0; Q * g.np()];
@@ -34,6 +34,7 @@ fn bench(c: &mut Criterion) {
                 std::mem::swap(&mut src, &mut dst);
             })
         });
+        drop((src, dst));
         let mut lat = Lattice::new(LatticeConfig::periodic(n, n, 0.8)).expect("lattice");
         group.bench_with_input(BenchmarkId::new("lattice_step", n), &n, |b, _| {
             b.iter(|| lat.step().expect("step"))

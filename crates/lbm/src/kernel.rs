@@ -146,7 +146,46 @@ fn aa<const ODD: bool, const MASK: bool>(pop: &mut [f64], g: Grid, mask: &[u8], 
     let w = g.stride();
     let nx = g.nx;
     let bands = bands(pop, g, |j| if ODD { (1 + C[j][1]) as usize } else { 1 });
-    bands.into_par_iter().for_each(|(row0, n, mut s)| {
+    let arch = pulp::Arch::new();
+    bands.into_par_iter().for_each(|(row0, n, s)| {
+        arch.dispatch(AaBand::<ODD, MASK> {
+            s,
+            row0,
+            n,
+            w,
+            nx,
+            mask,
+            phys,
+        });
+    });
+}
+
+/// One band of an AA step, compiled for the widest vector instructions of the processor
+/// (`pulp` picks AVX2 or plain code at run time; the arithmetic is the same, so are the
+/// results).
+struct AaBand<'a, const ODD: bool, const MASK: bool> {
+    s: [&'a mut [f64]; 9],
+    row0: usize,
+    n: usize,
+    w: usize,
+    nx: usize,
+    mask: &'a [u8],
+    phys: Physics,
+}
+
+impl<const ODD: bool, const MASK: bool> pulp::WithSimd for AaBand<'_, ODD, MASK> {
+    type Output = ();
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) {
+        let AaBand {
+            mut s,
+            row0,
+            n,
+            w,
+            nx,
+            mask,
+            phys,
+        } = self;
         for r in 0..n {
             let m = if MASK {
                 &mask[(row0 + r + 1) * w + 1..][..nx]
@@ -155,91 +194,153 @@ fn aa<const ODD: bool, const MASK: bool>(pop: &mut [f64], g: Grid, mask: &[u8], 
             };
             let col = |j: usize| r * w + if ODD { (1 + C[j][0]) as usize } else { 1 };
             let [s0, s1, s2, s3, s4, s5, s6, s7, s8] = &mut s;
-            let r0 = &mut s0[col(0)..][..nx];
-            let r1 = &mut s1[col(1)..][..nx];
-            let r2 = &mut s2[col(2)..][..nx];
-            let r3 = &mut s3[col(3)..][..nx];
-            let r4 = &mut s4[col(4)..][..nx];
-            let r5 = &mut s5[col(5)..][..nx];
-            let r6 = &mut s6[col(6)..][..nx];
-            let r7 = &mut s7[col(7)..][..nx];
-            let r8 = &mut s8[col(8)..][..nx];
-            for x in 0..nx {
-                let on = if MASK { m[x] as f64 } else { 1.0 };
-                if ODD {
-                    let f = [
-                        r0[x], r3[x], r4[x], r1[x], r2[x], r7[x], r8[x], r5[x], r6[x],
-                    ];
-                    let o = collide(f, phys.rates, phys.accel, on);
-                    r0[x] = o[0];
-                    r1[x] = o[1];
-                    r2[x] = o[2];
-                    r3[x] = o[3];
-                    r4[x] = o[4];
-                    r5[x] = o[5];
-                    r6[x] = o[6];
-                    r7[x] = o[7];
-                    r8[x] = o[8];
-                } else {
-                    let f = [
-                        r0[x], r1[x], r2[x], r3[x], r4[x], r5[x], r6[x], r7[x], r8[x],
-                    ];
-                    let o = collide(f, phys.rates, phys.accel, on);
-                    r0[x] = o[0];
-                    r1[x] = o[3];
-                    r2[x] = o[4];
-                    r3[x] = o[1];
-                    r4[x] = o[2];
-                    r5[x] = o[7];
-                    r6[x] = o[8];
-                    r7[x] = o[5];
-                    r8[x] = o[6];
-                }
-            }
+            aa_row::<ODD, MASK>(
+                [
+                    &mut s0[col(0)..][..nx],
+                    &mut s1[col(1)..][..nx],
+                    &mut s2[col(2)..][..nx],
+                    &mut s3[col(3)..][..nx],
+                    &mut s4[col(4)..][..nx],
+                    &mut s5[col(5)..][..nx],
+                    &mut s6[col(6)..][..nx],
+                    &mut s7[col(7)..][..nx],
+                    &mut s8[col(8)..][..nx],
+                ],
+                m,
+                phys,
+            );
         }
-    });
+    }
+}
+
+/// Collide one row: slot `j` of node `x` is `r[j][x]` (see the module docs).
+#[inline(always)]
+fn aa_row<const ODD: bool, const MASK: bool>(r: [&mut [f64]; 9], m: &[u8], phys: Physics) {
+    let [r0, r1, r2, r3, r4, r5, r6, r7, r8] = r;
+    let nx = r0.len();
+    let (r1, r2, r3, r4) = (&mut r1[..nx], &mut r2[..nx], &mut r3[..nx], &mut r4[..nx]);
+    let (r5, r6, r7, r8) = (&mut r5[..nx], &mut r6[..nx], &mut r7[..nx], &mut r8[..nx]);
+    let m = if MASK { &m[..nx] } else { m };
+    for x in 0..nx {
+        let on = if MASK { m[x] as f64 } else { 1.0 };
+        if ODD {
+            let f = [
+                r0[x], r3[x], r4[x], r1[x], r2[x], r7[x], r8[x], r5[x], r6[x],
+            ];
+            let o = collide(f, phys.rates, phys.accel, on);
+            r0[x] = o[0];
+            r1[x] = o[1];
+            r2[x] = o[2];
+            r3[x] = o[3];
+            r4[x] = o[4];
+            r5[x] = o[5];
+            r6[x] = o[6];
+            r7[x] = o[7];
+            r8[x] = o[8];
+        } else {
+            let f = [
+                r0[x], r1[x], r2[x], r3[x], r4[x], r5[x], r6[x], r7[x], r8[x],
+            ];
+            let o = collide(f, phys.rates, phys.accel, on);
+            r0[x] = o[0];
+            r1[x] = o[3];
+            r2[x] = o[4];
+            r3[x] = o[1];
+            r4[x] = o[2];
+            r5[x] = o[7];
+            r6[x] = o[8];
+            r7[x] = o[5];
+            r8[x] = o[6];
+        }
+    }
 }
 
 /// One fused two-array push step for a fully periodic lattice without obstacles: collide
 /// `src` (Natural layout), push into `dst`, wrap the ghost layer of `dst` back into the
 /// interior. Used by the benchmarks and to check the AA kernel.
 pub fn push_step_periodic(src: &[f64], dst: &mut [f64], g: Grid, phys: Physics) {
-    let (w, np, nx) = (g.stride(), g.np(), g.nx);
     let bands = bands(dst, g, |j| (1 + C[j][1]) as usize);
-    bands.into_par_iter().for_each(|(row0, n, mut s)| {
+    let arch = pulp::Arch::new();
+    bands.into_par_iter().for_each(|(row0, n, s)| {
+        arch.dispatch(PushBand {
+            src,
+            s,
+            row0,
+            n,
+            g,
+            phys,
+        });
+    });
+    wrap_ghosts(dst, g);
+}
+
+/// One band of a push step, compiled like [`AaBand`].
+struct PushBand<'a> {
+    src: &'a [f64],
+    s: [&'a mut [f64]; 9],
+    row0: usize,
+    n: usize,
+    g: Grid,
+    phys: Physics,
+}
+
+impl pulp::WithSimd for PushBand<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) {
+        let PushBand {
+            src,
+            mut s,
+            row0,
+            n,
+            g,
+            phys,
+        } = self;
+        let (w, np, nx) = (g.stride(), g.np(), g.nx);
         for r in 0..n {
             let base = (row0 + r + 1) * w + 1;
             let f_in: [&[f64]; 9] = std::array::from_fn(|j| &src[j * np + base..][..nx]);
             let col = |j: usize| r * w + (1 + C[j][0]) as usize;
             let [s0, s1, s2, s3, s4, s5, s6, s7, s8] = &mut s;
-            let d = [
-                &mut s0[col(0)..][..nx],
-                &mut s1[col(1)..][..nx],
-                &mut s2[col(2)..][..nx],
-                &mut s3[col(3)..][..nx],
-                &mut s4[col(4)..][..nx],
-                &mut s5[col(5)..][..nx],
-                &mut s6[col(6)..][..nx],
-                &mut s7[col(7)..][..nx],
-                &mut s8[col(8)..][..nx],
-            ];
-            let [d0, d1, d2, d3, d4, d5, d6, d7, d8] = d;
-            for x in 0..nx {
-                let f = std::array::from_fn(|j| f_in[j][x]);
-                let o = collide(f, phys.rates, phys.accel, 1.0);
-                d0[x] = o[0];
-                d1[x] = o[1];
-                d2[x] = o[2];
-                d3[x] = o[3];
-                d4[x] = o[4];
-                d5[x] = o[5];
-                d6[x] = o[6];
-                d7[x] = o[7];
-                d8[x] = o[8];
-            }
+            push_row(
+                f_in,
+                [
+                    &mut s0[col(0)..][..nx],
+                    &mut s1[col(1)..][..nx],
+                    &mut s2[col(2)..][..nx],
+                    &mut s3[col(3)..][..nx],
+                    &mut s4[col(4)..][..nx],
+                    &mut s5[col(5)..][..nx],
+                    &mut s6[col(6)..][..nx],
+                    &mut s7[col(7)..][..nx],
+                    &mut s8[col(8)..][..nx],
+                ],
+                phys,
+            );
         }
-    });
-    wrap_ghosts(dst, g);
+    }
+}
+
+#[inline(always)]
+fn push_row(f_in: [&[f64]; 9], d: [&mut [f64]; 9], phys: Physics) {
+    let [d0, d1, d2, d3, d4, d5, d6, d7, d8] = d;
+    let nx = d0.len();
+    let (d1, d2, d3, d4) = (&mut d1[..nx], &mut d2[..nx], &mut d3[..nx], &mut d4[..nx]);
+    let (d5, d6, d7, d8) = (&mut d5[..nx], &mut d6[..nx], &mut d7[..nx], &mut d8[..nx]);
+    let f_in: [&[f64]; 9] = std::array::from_fn(|j| &f_in[j][..nx]);
+    for x in 0..nx {
+        let f = std::array::from_fn(|j| f_in[j][x]);
+        let o = collide(f, phys.rates, phys.accel, 1.0);
+        d0[x] = o[0];
+        d1[x] = o[1];
+        d2[x] = o[2];
+        d3[x] = o[3];
+        d4[x] = o[4];
+        d5[x] = o[5];
+        d6[x] = o[6];
+        d7[x] = o[7];
+        d8[x] = o[8];
+    }
 }
 
 /// Move what a push step wrote into the ghost layer to the interior node on the other side.
