@@ -28,12 +28,14 @@ pub mod d2q9;
 pub mod geometry;
 pub mod kernel;
 pub mod lattice;
+pub mod thermal;
 pub mod units;
 
 pub use boundary::{MomentumExchange, Side, SideKind};
 pub use collision::{Collision, Rates};
 pub use geometry::Shape;
 pub use lattice::{Lattice, LatticeConfig, MAX_MACH, Obstacle};
+pub use thermal::{Thermal, ThermalSide};
 pub use units::Units;
 
 /// Smallest relaxation time accepted: `τ` must exceed `½ + 0.005` (at `τ → ½` the viscosity
