@@ -6,8 +6,12 @@
 //!   and `.pvd` files are written.
 //! * A disk at rest in a closed box of fluid at rest: the obstacle probes `fx fy torque`
 //!   are zero to round-off.
+//! * Heat through the scene: conduction between a wall at 10 °C and one at 30 °C across
+//!   the Poiseuille channel reaches the linear profile (1e-9), and `temperature` is in
+//!   `field_extrema` and the `.vti`.
 //! * Bad scenes are refused with the key: keys of the continuum model, `tau = 0.5`, an
-//!   obstacle outside the extent, a wall faster than the Mach limit, `[thermal]`, a field
+//!   obstacle outside the extent, a wall faster than the Mach limit, a thermal diffusivity
+//!   too small for the lattice, a thermal side without a condition, a field
 //!   of another model, and `[lbm]` in a continuum scene.
 
 use std::path::{Path, PathBuf};
@@ -209,9 +213,21 @@ fn bad_lbm_scenes_name_the_key() {
         "Mach",
     );
     refused(
-        &format!("{POISEUILLE}\n[thermal]\ndiffusivity = 1e-7\n"),
-        "thermal",
-        "not available",
+        &format!("{POISEUILLE}\n[thermal]\ndiffusivity = 1e-9\n"),
+        "thermal.diffusivity",
+        "relaxation time",
+    );
+    refused(
+        &format!(
+            "{POISEUILLE}\n[thermal]\ndiffusivity = 1e-6\n[[thermal.boundary]]\nside = \"ymin\"\n"
+        ),
+        "thermal.boundary[0].side",
+        "exactly one of temperature and flux",
+    );
+    refused(
+        &POISEUILLE.replace("field = \"vx\"", "field = \"temperature\""),
+        "output.probe[0].field",
+        "needs [thermal]",
     );
     refused(
         &POISEUILLE.replace("field = \"vx\"", "field = \"ux\""),
@@ -235,4 +251,49 @@ fn bad_lbm_scenes_name_the_key() {
         "lbm",
         "belongs to model \"lbm\"",
     );
+}
+
+#[test]
+fn conduction_through_the_scene() {
+    let text = POISEUILLE.replace("body_force = [1.0e-5, 0.0]", "")
+        + r#"
+[thermal]
+diffusivity = 1.0e-6
+initial = "20 + 100 * x"
+
+[[thermal.boundary]]
+side = "ymin"
+temperature = 10.0
+
+[[thermal.boundary]]
+side = "ymax"
+temperature = 30.0
+
+[[output.probe]]
+name = "T"
+field = "temperature"
+at = [0.0015, 0.0035]
+"#;
+    let out = tmp("conduction");
+    parse(&text).unwrap().run(&out, &mut Silent).unwrap();
+    let csv = std::fs::read_to_string(out.join("probes.csv")).unwrap();
+    let last: Vec<f64> = csv
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    let exact = 10.0 + 20.0 * 0.0035 / 0.01;
+    assert!((last[3] - exact).abs() < 1e-9, "T = {} vs {exact}", last[3]);
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let t = summary["field_extrema"]["temperature"].as_array().unwrap();
+    assert!(
+        (t[0].as_f64().unwrap() - 11.0).abs() < 1e-9
+            && (t[1].as_f64().unwrap() - 29.0).abs() < 1e-9
+    );
+    let vti = String::from_utf8_lossy(&std::fs::read(out.join("vtk/step_0004.vti")).unwrap())
+        .into_owned();
+    assert!(vti.contains("Name=\"temperature\""));
 }

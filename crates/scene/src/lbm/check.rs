@@ -9,7 +9,7 @@ use crate::expr::Expr;
 use crate::file::{KeyPart, NumOrExpr};
 
 /// Probe and line fields of the model.
-pub const FIELDS: [&str; 4] = ["vx", "vy", "pressure", "density"];
+pub const FIELDS: [&str; 5] = ["vx", "vy", "pressure", "density", "temperature"];
 /// Obstacle probe fields.
 pub const OBSTACLE_FIELDS: [&str; 3] = ["fx", "fy", "torque"];
 /// Most lattice nodes a scene may ask for.
@@ -95,13 +95,6 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
     };
     if let Some(key) = foreign {
         return Err(ls.error(&key, "belongs to model \"continuum\", not \"lbm\""));
-    }
-    if let Some(t) = &s.thermal {
-        positive(ls, &k(&["thermal", "diffusivity"]), t.diffusivity)?;
-        return Err(ls.error(
-            &k(&["thermal"]),
-            "(heat transport) is not available in this version of porofrac",
-        ));
     }
     let Some(l) = &s.lbm else {
         return Err(ls.error(&k(&["lbm"]), "is required by model \"lbm\""));
@@ -271,6 +264,62 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
             expr(ls, &ok("angular_velocity"), w)?;
         }
     }
+    if let Some(t) = &s.thermal {
+        let tk = |f: &str| k(&["thermal", f]);
+        for (f, chi) in [
+            ("diffusivity", Some(t.diffusivity)),
+            ("solid_diffusivity", t.solid_diffusivity),
+        ] {
+            let Some(chi) = chi else { continue };
+            positive(ls, &tk(f), chi)?;
+            let tau = super::thermal_tau(chi, &units);
+            if !(tau > TAU_MIN && tau.is_finite()) {
+                return Err(ls.error(
+                    &tk(f),
+                    format!(
+                        "= {chi} m²/s gives a thermal relaxation time of {tau:.4} on this lattice (must exceed {TAU_MIN}): raise lbm.tau or refine lbm.spacing"
+                    ),
+                ));
+            }
+        }
+        if let Some(v) = &t.initial {
+            expr(ls, &tk("initial"), v)?;
+        }
+        let mut tsides = std::collections::BTreeSet::new();
+        for (i, b) in t.boundary.iter().enumerate() {
+            let bk = |f: &str| ki("thermal.boundary", i, &[f]);
+            let axis = match b.side {
+                super::file::SideChoice::Xmin | super::file::SideChoice::Xmax => 0,
+                _ => 1,
+            };
+            if seen[axis] {
+                return Err(ls.error(
+                    &bk("side"),
+                    format!("= \"{}\" is on a periodic axis", b.side.as_str()),
+                ));
+            }
+            if !tsides.insert(b.side.as_str()) {
+                return Err(ls.error(
+                    &bk("side"),
+                    format!("= \"{}\" is given twice", b.side.as_str()),
+                ));
+            }
+            match (b.temperature, b.flux) {
+                (Some(v), None) | (None, Some(v)) if v.is_finite() => {}
+                (Some(_), Some(_)) | (None, None) => {
+                    return Err(ls.error(&bk("side"), "needs exactly one of temperature and flux"));
+                }
+                (Some(v), None) => {
+                    return Err(
+                        ls.error(&bk("temperature"), format!("= {v} is not a finite number"))
+                    );
+                }
+                (None, Some(v)) => {
+                    return Err(ls.error(&bk("flux"), format!("= {v} is not a finite number")));
+                }
+            }
+        }
+    }
     check_schedule(ls, &units)?;
     check_output(ls, &names)
 }
@@ -428,11 +477,8 @@ fn check_output(
 }
 
 fn field(ls: &LoadedScene, key: &[KeyPart], f: &str) -> Result<(), SceneError> {
-    if f == "temperature" {
-        return Err(ls.error(
-            key,
-            "= \"temperature\" needs [thermal], which is not available in this version",
-        ));
+    if f == "temperature" && ls.scene.thermal.is_none() {
+        return Err(ls.error(key, "= \"temperature\" needs [thermal]"));
     }
     if !FIELDS.contains(&f) {
         return Err(ls.error(

@@ -24,7 +24,7 @@ use std::time::Instant;
 
 use porofrac_lbm::{
     Collision, Lattice, LatticeConfig, MAX_MACH, MomentumExchange, Obstacle, Shape, Side, SideKind,
-    Units,
+    Thermal, ThermalSide, Units,
 };
 
 pub use check::check;
@@ -39,6 +39,11 @@ use file::{
     AxisChoice, BoundaryKindChoice, CollisionChoice, ExchangeChoice, LbmSection, ShapeChoice,
     SideChoice,
 };
+
+/// Thermal relaxation time of diffusivity `chi` (m²/s): `τ_g = ½ + 3 χ Δt/Δx²`.
+pub(crate) fn thermal_tau(chi: f64, u: &Units) -> f64 {
+    0.5 + 3.0 * chi * u.dt / (u.dx * u.dx)
+}
 
 /// Nodes along x and y for the extent and spacing (as floats, for checks).
 pub(crate) fn nodes(l: &LbmSection) -> (f64, f64) {
@@ -97,6 +102,7 @@ enum FieldName {
     Vy,
     Pressure,
     Density,
+    Temperature,
 }
 
 impl FieldName {
@@ -105,6 +111,7 @@ impl FieldName {
             "vx" => FieldName::Vx,
             "vy" => FieldName::Vy,
             "pressure" => FieldName::Pressure,
+            "temperature" => FieldName::Temperature,
             _ => FieldName::Density,
         }
     }
@@ -114,6 +121,7 @@ impl FieldName {
 struct LbmModel<'a> {
     ls: &'a LoadedScene,
     lat: Lattice,
+    thermal: Option<Thermal>,
     units: Units,
     origin: [f64; 2],
     times: Vec<f64>,
@@ -258,9 +266,38 @@ fn build(ls: &LoadedScene) -> Result<LbmModel<'_>, RunError> {
         .map_err(|e| ls.error(&ki("obstacle", i, &["shape"]), e))?;
         motions.push((v, w));
     }
+    let thermal = match &s.thermal {
+        None => None,
+        Some(t) => {
+            let mut tsides = [ThermalSide::Adiabatic; 4];
+            for b in &t.boundary {
+                tsides[side_of(b.side).index()] = match (b.temperature, b.flux) {
+                    (Some(v), _) => ThermalSide::Temperature(v),
+                    (None, f) => ThermalSide::Flux(f.unwrap_or(0.0) * units.dt / units.dx),
+                };
+            }
+            let init = match &t.initial {
+                None => Expr::constant(0.0),
+                Some(NumOrExpr::Num(x)) => Expr::constant(*x),
+                Some(NumOrExpr::Expr(e)) => {
+                    Expr::parse(e).unwrap_or_else(|_| Expr::constant(f64::NAN))
+                }
+            };
+            let tau = thermal_tau(t.diffusivity, &units);
+            let tau_s = thermal_tau(t.solid_diffusivity.unwrap_or(t.diffusivity), &units);
+            let (dx, o) = (units.dx, origin);
+            Some(
+                Thermal::new(&lat, tau, tau_s, tsides, |p| {
+                    init.eval(&[o[0] + p[0] * dx, o[1] + p[1] * dx], 0.0)
+                })
+                .map_err(|e| ls.error(&k(&["thermal", "diffusivity"]), e))?,
+            )
+        }
+    };
     let mut model = LbmModel {
         ls,
         lat,
+        thermal,
         units,
         origin,
         times: output_times(ls),
@@ -418,8 +455,37 @@ impl LbmModel<'_> {
         }
     }
 
+    /// Temperature at an SI point, bilinear between nodes (solid nodes included: heat
+    /// crosses into obstacles).
+    fn sample_temperature(&self, x: [f64; 2]) -> f64 {
+        let Some(th) = &self.thermal else {
+            return f64::NAN;
+        };
+        let (nx, ny) = self.lat.size();
+        let gx = ((x[0] - self.origin[0]) / self.units.dx - 0.5).clamp(0.0, (nx - 1) as f64);
+        let gy = ((x[1] - self.origin[1]) / self.units.dx - 0.5).clamp(0.0, (ny - 1) as f64);
+        let (i0, j0) = (
+            (gx.floor() as usize).min(nx - 2),
+            (gy.floor() as usize).min(ny - 2),
+        );
+        let (fx, fy) = (gx - i0 as f64, gy - j0 as f64);
+        (1.0 - fx) * (1.0 - fy) * th.temperature(i0, j0)
+            + fx * (1.0 - fy) * th.temperature(i0 + 1, j0)
+            + (1.0 - fx) * fy * th.temperature(i0, j0 + 1)
+            + fx * fy * th.temperature(i0 + 1, j0 + 1)
+    }
+
+    fn value_at(&self, f: FieldName, x: [f64; 2]) -> f64 {
+        if f == FieldName::Temperature {
+            return self.sample_temperature(x);
+        }
+        let (rho, u) = self.sample(x);
+        self.field_value(f, rho, u)
+    }
+
     fn field_value(&self, f: FieldName, rho: f64, u: [f64; 2]) -> f64 {
         match f {
+            FieldName::Temperature => f64::NAN,
             FieldName::Vx => self.units.velocity_si(u[0]),
             FieldName::Vy => self.units.velocity_si(u[1]),
             FieldName::Pressure => self.units.pressure_si(rho),
@@ -445,6 +511,9 @@ impl Model for LbmModel<'_> {
             if varies {
                 self.apply_motion(self.lat.steps() as f64 * self.units.dt)?;
             }
+            if let Some(th) = &mut self.thermal {
+                th.step(&self.lat);
+            }
             self.lat
                 .step()
                 .map_err(|e| RunError::Flow(format!("lbm: {e}")))?;
@@ -463,10 +532,7 @@ impl Model for LbmModel<'_> {
     fn probes(&self, values: &mut Vec<f64>) {
         for p in &self.probes {
             values.push(match *p {
-                ProbeKind::Field(f, x) => {
-                    let (rho, u) = self.sample(x);
-                    self.field_value(f, rho, u)
-                }
+                ProbeKind::Field(f, x) => self.value_at(f, x),
                 ProbeKind::Obstacle(o, c) => {
                     let f = self.lat.force(o);
                     if c == 2 {
@@ -490,8 +556,7 @@ impl Model for LbmModel<'_> {
                 l.from[0] + s * (l.to[0] - l.from[0]),
                 l.from[1] + s * (l.to[1] - l.from[1]),
             ];
-            let (rho, u) = self.sample(x);
-            rows.push(vec![s * len, x[0], x[1], self.field_value(f, rho, u)]);
+            rows.push(vec![s * len, x[0], x[1], self.value_at(f, x)]);
         }
     }
 
@@ -520,17 +585,22 @@ impl Model for LbmModel<'_> {
             }
         }
         let origin = self.si([0.5, 0.5]);
-        let bytes = vti::image_data(
-            [nx, ny],
-            origin,
-            self.units.dx,
-            &[
-                ("velocity", 3, &velocity),
-                ("pressure", 1, &pressure),
-                ("density", 1, &density),
-                ("solid", 1, &solid),
-            ],
-        );
+        let temperature: Vec<f64> = match &self.thermal {
+            Some(th) => (0..ny)
+                .flat_map(|j| (0..nx).map(move |i| th.temperature(i, j)))
+                .collect(),
+            None => Vec::new(),
+        };
+        let mut arrays: Vec<(&str, usize, &[f64])> = vec![
+            ("velocity", 3, &velocity),
+            ("pressure", 1, &pressure),
+            ("density", 1, &density),
+            ("solid", 1, &solid),
+        ];
+        if self.thermal.is_some() {
+            arrays.push(("temperature", 1, &temperature));
+        }
+        let bytes = vti::image_data([nx, ny], origin, self.units.dx, &arrays);
         write_atomic(&dir.join(&name), &bytes)?;
         Ok(name)
     }
@@ -560,12 +630,23 @@ impl Model for LbmModel<'_> {
                 }
             }
         }
-        names
+        let mut out: BTreeMap<String, [f64; 2]> = names
             .iter()
             .zip(ext)
             .filter(|(_, e)| e[0] <= e[1])
             .map(|(n, e)| (n.to_string(), e))
-            .collect()
+            .collect();
+        if let Some(th) = &self.thermal {
+            let mut e = [f64::INFINITY, f64::NEG_INFINITY];
+            for j in 0..ny {
+                for i in 0..nx {
+                    let t = th.temperature(i, j);
+                    e = [e[0].min(t), e[1].max(t)];
+                }
+            }
+            out.insert("temperature".into(), e);
+        }
+        out
     }
 
     fn plots(&self, dir: &Path, written: &[f64], series: &[Vec<f64>]) -> Result<(), RunError> {
