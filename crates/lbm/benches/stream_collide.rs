@@ -1,5 +1,7 @@
 //! One fused stream–collide step on a periodic D2Q9 lattice: in-place AA streaming against
-//! the two-array push kernel, from cache-resident to memory-bound sizes.
+//! the two-array push kernel, from cache-resident to memory-bound sizes; `lattice_step` is
+//! the whole `Lattice::step` (kernel and periodic copies); `memory/copy_256MB` the copy
+//! bandwidth of the machine for comparison.
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use porofrac_lbm::d2q9::{Q, feq};
@@ -40,6 +42,15 @@ fn bench(c: &mut Criterion) {
             b.iter(|| lat.step().expect("step"))
         });
     }
+    group.finish();
+    // The memory bandwidth the kernels compete for: copy 2 × 256 MB (bytes read + written).
+    let mut group = c.benchmark_group("memory");
+    group.sample_size(10);
+    let n = 32 << 20;
+    let src = vec![1.0f64; n];
+    let mut dst = vec![0.0f64; n];
+    group.throughput(Throughput::Bytes((16 * n) as u64));
+    group.bench_function("copy_256MB", |b| b.iter(|| dst.copy_from_slice(&src)));
     group.finish();
 }
 

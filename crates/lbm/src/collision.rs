@@ -36,14 +36,14 @@ impl Collision {
 
     /// The two rates `(ω⁺, ω⁻)` for relaxation time `tau`.
     pub fn rates(self, tau: f64) -> Result<Rates, LbmError> {
-        if !(tau > crate::TAU_MIN) || !tau.is_finite() {
+        if !(tau.is_finite() && tau > crate::TAU_MIN) {
             return Err(LbmError::Tau(tau));
         }
         let plus = 1.0 / tau;
         let minus = match self {
             Collision::Bgk => plus,
             Collision::Trt { magic } => {
-                if !(magic > 0.0) || !magic.is_finite() {
+                if !(magic.is_finite() && magic > 0.0) {
                     return Err(LbmError::Magic(magic));
                 }
                 1.0 / (0.5 + magic / (tau - 0.5))

@@ -317,7 +317,7 @@ impl Lattice {
                 .max((hi[1] - c[1]).abs());
             let s = (ob.velocity[0].powi(2) + ob.velocity[1].powi(2)).sqrt()
                 + ob.angular_velocity.abs() * r * std::f64::consts::SQRT_2;
-            if !(s < 1.0) {
+            if s.is_nan() || s >= 1.0 {
                 return Err(LbmError::TooFast {
                     obstacle: k,
                     speed: s,

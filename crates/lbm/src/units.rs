@@ -90,7 +90,7 @@ impl Units {
     /// [`crate::MAX_MACH`].
     pub fn check_mach(&self, what: &'static str, speed: f64) -> Result<(), LbmError> {
         let ma = self.mach(speed.abs());
-        if !(ma <= crate::MAX_MACH) {
+        if ma.is_nan() || ma > crate::MAX_MACH {
             return Err(LbmError::Mach { what, mach: ma });
         }
         Ok(())

@@ -149,10 +149,10 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
         .map_err(|e| ls.error(&key("spacing"), e))?;
     let units = Units::from_viscosity(l.spacing, l.viscosity, l.density, l.tau)
         .map_err(|e| ls.error(&key("tau"), e))?;
-    if let Some(b) = &l.body_force {
-        if b.len() != 2 || !b.iter().all(|v| v.is_finite()) {
-            return Err(ls.error(&key("body_force"), "must be two finite numbers (m/s²)"));
-        }
+    if let Some(b) = &l.body_force
+        && (b.len() != 2 || !b.iter().all(|v| v.is_finite()))
+    {
+        return Err(ls.error(&key("body_force"), "must be two finite numbers (m/s²)"));
     }
     if let Some(v) = &l.initial_velocity {
         vector(ls, &key("initial_velocity"), v)?;
