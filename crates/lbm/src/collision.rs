@@ -75,11 +75,17 @@ const PAIRS: [(usize, usize, f64, f64, f64); 4] = [
 /// its populations). Returns the post-collision populations.
 #[inline(always)]
 pub fn collide(f: [f64; 9], rates: Rates, accel: [f64; 2], on: f64) -> [f64; 9] {
+    collide_with::<true>(f, rates, accel, on)
+}
+
+/// [`collide`], with the force terms compiled out when `FORCE` is false (then `accel` is
+/// ignored).
+#[inline(always)]
+pub fn collide_with<const FORCE: bool>(f: [f64; 9], rates: Rates, accel: [f64; 2], on: f64) -> [f64; 9] {
     let rho = f[0] + f[1] + f[2] + f[3] + f[4] + f[5] + f[6] + f[7] + f[8];
     let jx = f[1] - f[3] + f[5] - f[6] - f[7] + f[8];
     let jy = f[2] - f[4] + f[5] + f[6] - f[7] - f[8];
-    let fx = rho * accel[0] * on;
-    let fy = rho * accel[1] * on;
+    let (fx, fy) = if FORCE { (rho * accel[0] * on, rho * accel[1] * on) } else { (0.0, 0.0) };
     let inv = 1.0 / rho;
     let ux = (jx + 0.5 * fx) * inv;
     let uy = (jy + 0.5 * fy) * inv;
@@ -91,16 +97,23 @@ pub fn collide(f: [f64; 9], rates: Rates, accel: [f64; 2], on: f64) -> [f64; 9] 
     let uf = 3.0 * (ux * fx + uy * fy);
     let mut out = f;
     let feq0 = W[0] * rho * (1.0 - usq);
-    out[0] = f[0] - wp * (f[0] - feq0) - gp * W[0] * uf;
+    out[0] = f[0] - wp * (f[0] - feq0);
+    if FORCE {
+        out[0] -= gp * W[0] * uf;
+    }
     for (i, o, cx, cy, w) in PAIRS {
         let cu = cx * ux + cy * uy;
-        let cf = cx * fx + cy * fy;
         let eq_s = w * rho * (1.0 + 4.5 * cu * cu - usq);
         let eq_a = 3.0 * w * rho * cu;
         let fs = 0.5 * (f[i] + f[o]);
         let fa = 0.5 * (f[i] - f[o]);
-        let ds = -wp * (fs - eq_s) + gp * w * (9.0 * cu * cf - uf);
-        let da = -wm * (fa - eq_a) + gm * 3.0 * w * cf;
+        let mut ds = -wp * (fs - eq_s);
+        let mut da = -wm * (fa - eq_a);
+        if FORCE {
+            let cf = cx * fx + cy * fy;
+            ds += gp * w * (9.0 * cu * cf - uf);
+            da += gm * 3.0 * w * cf;
+        }
         out[i] = f[i] + ds + da;
         out[o] = f[o] + ds - da;
     }

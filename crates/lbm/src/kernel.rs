@@ -22,7 +22,7 @@
 
 use rayon::prelude::*;
 
-use crate::collision::{Rates, collide};
+use crate::collision::{Rates, collide_with};
 use crate::d2q9::{C, OPP};
 
 /// Where the populations of the interior nodes live after a step (see the module docs).
@@ -130,11 +130,16 @@ pub fn aa_step(
     mask: Option<&[u8]>,
     phys: Physics,
 ) -> Layout {
-    match (layout, mask) {
-        (Layout::Natural, None) => aa::<false, false>(pop, g, &[], phys),
-        (Layout::Natural, Some(m)) => aa::<false, true>(pop, g, m, phys),
-        (Layout::Swapped, None) => aa::<true, false>(pop, g, &[], phys),
-        (Layout::Swapped, Some(m)) => aa::<true, true>(pop, g, m, phys),
+    let force = phys.accel != [0.0, 0.0];
+    match (layout, mask, force) {
+        (Layout::Natural, None, false) => aa::<false, false, false>(pop, g, &[], phys),
+        (Layout::Natural, Some(m), false) => aa::<false, true, false>(pop, g, m, phys),
+        (Layout::Swapped, None, false) => aa::<true, false, false>(pop, g, &[], phys),
+        (Layout::Swapped, Some(m), false) => aa::<true, true, false>(pop, g, m, phys),
+        (Layout::Natural, None, true) => aa::<false, false, true>(pop, g, &[], phys),
+        (Layout::Natural, Some(m), true) => aa::<false, true, true>(pop, g, m, phys),
+        (Layout::Swapped, None, true) => aa::<true, false, true>(pop, g, &[], phys),
+        (Layout::Swapped, Some(m), true) => aa::<true, true, true>(pop, g, m, phys),
     }
     match layout {
         Layout::Natural => Layout::Swapped,
@@ -142,13 +147,13 @@ pub fn aa_step(
     }
 }
 
-fn aa<const ODD: bool, const MASK: bool>(pop: &mut [f64], g: Grid, mask: &[u8], phys: Physics) {
+fn aa<const ODD: bool, const MASK: bool, const FORCE: bool>(pop: &mut [f64], g: Grid, mask: &[u8], phys: Physics) {
     let w = g.stride();
     let nx = g.nx;
     let bands = bands(pop, g, |j| if ODD { (1 + C[j][1]) as usize } else { 1 });
     let arch = pulp::Arch::new();
     bands.into_par_iter().for_each(|(row0, n, s)| {
-        arch.dispatch(AaBand::<ODD, MASK> {
+        arch.dispatch(AaBand::<ODD, MASK, FORCE> {
             s,
             row0,
             n,
@@ -163,7 +168,7 @@ fn aa<const ODD: bool, const MASK: bool>(pop: &mut [f64], g: Grid, mask: &[u8], 
 /// One band of an AA step, compiled for the widest vector instructions of the processor
 /// (`pulp` picks AVX2 or plain code at run time; the arithmetic is the same, so are the
 /// results).
-struct AaBand<'a, const ODD: bool, const MASK: bool> {
+struct AaBand<'a, const ODD: bool, const MASK: bool, const FORCE: bool> {
     s: [&'a mut [f64]; 9],
     row0: usize,
     n: usize,
@@ -173,7 +178,9 @@ struct AaBand<'a, const ODD: bool, const MASK: bool> {
     phys: Physics,
 }
 
-impl<const ODD: bool, const MASK: bool> pulp::WithSimd for AaBand<'_, ODD, MASK> {
+impl<const ODD: bool, const MASK: bool, const FORCE: bool> pulp::WithSimd
+    for AaBand<'_, ODD, MASK, FORCE>
+{
     type Output = ();
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, _simd: S) {
@@ -194,7 +201,7 @@ impl<const ODD: bool, const MASK: bool> pulp::WithSimd for AaBand<'_, ODD, MASK>
             };
             let col = |j: usize| r * w + if ODD { (1 + C[j][0]) as usize } else { 1 };
             let [s0, s1, s2, s3, s4, s5, s6, s7, s8] = &mut s;
-            aa_row::<ODD, MASK>(
+            aa_row::<ODD, MASK, FORCE>(
                 [
                     &mut s0[col(0)..][..nx],
                     &mut s1[col(1)..][..nx],
@@ -215,7 +222,7 @@ impl<const ODD: bool, const MASK: bool> pulp::WithSimd for AaBand<'_, ODD, MASK>
 
 /// Collide one row: slot `j` of node `x` is `r[j][x]` (see the module docs).
 #[inline(always)]
-fn aa_row<const ODD: bool, const MASK: bool>(r: [&mut [f64]; 9], m: &[u8], phys: Physics) {
+fn aa_row<const ODD: bool, const MASK: bool, const FORCE: bool>(r: [&mut [f64]; 9], m: &[u8], phys: Physics) {
     let [r0, r1, r2, r3, r4, r5, r6, r7, r8] = r;
     let nx = r0.len();
     let (r1, r2, r3, r4) = (&mut r1[..nx], &mut r2[..nx], &mut r3[..nx], &mut r4[..nx]);
@@ -227,7 +234,7 @@ fn aa_row<const ODD: bool, const MASK: bool>(r: [&mut [f64]; 9], m: &[u8], phys:
             let f = [
                 r0[x], r3[x], r4[x], r1[x], r2[x], r7[x], r8[x], r5[x], r6[x],
             ];
-            let o = collide(f, phys.rates, phys.accel, on);
+            let o = collide_with::<FORCE>(f, phys.rates, phys.accel, on);
             r0[x] = o[0];
             r1[x] = o[1];
             r2[x] = o[2];
@@ -241,7 +248,7 @@ fn aa_row<const ODD: bool, const MASK: bool>(r: [&mut [f64]; 9], m: &[u8], phys:
             let f = [
                 r0[x], r1[x], r2[x], r3[x], r4[x], r5[x], r6[x], r7[x], r8[x],
             ];
-            let o = collide(f, phys.rates, phys.accel, on);
+            let o = collide_with::<FORCE>(f, phys.rates, phys.accel, on);
             r0[x] = o[0];
             r1[x] = o[3];
             r2[x] = o[4];
@@ -302,7 +309,9 @@ impl pulp::WithSimd for PushBand<'_> {
             let f_in: [&[f64]; 9] = std::array::from_fn(|j| &src[j * np + base..][..nx]);
             let col = |j: usize| r * w + (1 + C[j][0]) as usize;
             let [s0, s1, s2, s3, s4, s5, s6, s7, s8] = &mut s;
-            push_row(
+            let rows = push_row::<true>;
+            let rows = if phys.accel == [0.0, 0.0] { push_row::<false> } else { rows };
+            rows(
                 f_in,
                 [
                     &mut s0[col(0)..][..nx],
@@ -322,7 +331,7 @@ impl pulp::WithSimd for PushBand<'_> {
 }
 
 #[inline(always)]
-fn push_row(f_in: [&[f64]; 9], d: [&mut [f64]; 9], phys: Physics) {
+fn push_row<const FORCE: bool>(f_in: [&[f64]; 9], d: [&mut [f64]; 9], phys: Physics) {
     let [d0, d1, d2, d3, d4, d5, d6, d7, d8] = d;
     let nx = d0.len();
     let (d1, d2, d3, d4) = (&mut d1[..nx], &mut d2[..nx], &mut d3[..nx], &mut d4[..nx]);
@@ -330,7 +339,7 @@ fn push_row(f_in: [&[f64]; 9], d: [&mut [f64]; 9], phys: Physics) {
     let f_in: [&[f64]; 9] = std::array::from_fn(|j| &f_in[j][..nx]);
     for x in 0..nx {
         let f = std::array::from_fn(|j| f_in[j][x]);
-        let o = collide(f, phys.rates, phys.accel, 1.0);
+        let o = collide_with::<FORCE>(f, phys.rates, phys.accel, 1.0);
         d0[x] = o[0];
         d1[x] = o[1];
         d2[x] = o[2];
