@@ -81,11 +81,20 @@ pub fn collide(f: [f64; 9], rates: Rates, accel: [f64; 2], on: f64) -> [f64; 9] 
 /// [`collide`], with the force terms compiled out when `FORCE` is false (then `accel` is
 /// ignored).
 #[inline(always)]
-pub fn collide_with<const FORCE: bool>(f: [f64; 9], rates: Rates, accel: [f64; 2], on: f64) -> [f64; 9] {
+pub fn collide_with<const FORCE: bool>(
+    f: [f64; 9],
+    rates: Rates,
+    accel: [f64; 2],
+    on: f64,
+) -> [f64; 9] {
     let rho = f[0] + f[1] + f[2] + f[3] + f[4] + f[5] + f[6] + f[7] + f[8];
     let jx = f[1] - f[3] + f[5] - f[6] - f[7] + f[8];
     let jy = f[2] - f[4] + f[5] + f[6] - f[7] - f[8];
-    let (fx, fy) = if FORCE { (rho * accel[0] * on, rho * accel[1] * on) } else { (0.0, 0.0) };
+    let (fx, fy) = if FORCE {
+        (rho * accel[0] * on, rho * accel[1] * on)
+    } else {
+        (0.0, 0.0)
+    };
     let inv = 1.0 / rho;
     let ux = (jx + 0.5 * fx) * inv;
     let uy = (jy + 0.5 * fy) * inv;

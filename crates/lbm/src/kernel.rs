@@ -147,7 +147,12 @@ pub fn aa_step(
     }
 }
 
-fn aa<const ODD: bool, const MASK: bool, const FORCE: bool>(pop: &mut [f64], g: Grid, mask: &[u8], phys: Physics) {
+fn aa<const ODD: bool, const MASK: bool, const FORCE: bool>(
+    pop: &mut [f64],
+    g: Grid,
+    mask: &[u8],
+    phys: Physics,
+) {
     let w = g.stride();
     let nx = g.nx;
     let bands = bands(pop, g, |j| if ODD { (1 + C[j][1]) as usize } else { 1 });
@@ -222,7 +227,11 @@ impl<const ODD: bool, const MASK: bool, const FORCE: bool> pulp::WithSimd
 
 /// Collide one row: slot `j` of node `x` is `r[j][x]` (see the module docs).
 #[inline(always)]
-fn aa_row<const ODD: bool, const MASK: bool, const FORCE: bool>(r: [&mut [f64]; 9], m: &[u8], phys: Physics) {
+fn aa_row<const ODD: bool, const MASK: bool, const FORCE: bool>(
+    r: [&mut [f64]; 9],
+    m: &[u8],
+    phys: Physics,
+) {
     let [r0, r1, r2, r3, r4, r5, r6, r7, r8] = r;
     let nx = r0.len();
     let (r1, r2, r3, r4) = (&mut r1[..nx], &mut r2[..nx], &mut r3[..nx], &mut r4[..nx]);
@@ -310,7 +319,11 @@ impl pulp::WithSimd for PushBand<'_> {
             let col = |j: usize| r * w + (1 + C[j][0]) as usize;
             let [s0, s1, s2, s3, s4, s5, s6, s7, s8] = &mut s;
             let rows = push_row::<true>;
-            let rows = if phys.accel == [0.0, 0.0] { push_row::<false> } else { rows };
+            let rows = if phys.accel == [0.0, 0.0] {
+                push_row::<false>
+            } else {
+                rows
+            };
             rows(
                 f_in,
                 [
