@@ -3,7 +3,7 @@
 //! * Poiseuille flow between halfway walls driven by `body_force` with TRT: the probe on a
 //!   node row gives `a/(2ν) y (H − y)` to 1e-6 (TRT with Λ = 3/16 is exact for it), and
 //!   `summary.json` carries the `lattice` block, `mlups` and `field_extrema`; the `.vti`
-//!   and `.pvd` files are written.
+//!   and `.pvd` files and the speed, vorticity and probe plots are written.
 //! * A disk at rest in a closed box of fluid at rest: the obstacle probes `fx fy torque`
 //!   are zero to round-off.
 //! * Heat through the scene: conduction between a wall at 10 °C and one at 30 °C across
@@ -110,6 +110,15 @@ fn poiseuille_scene_is_exact_and_writes_its_outputs() {
             .unwrap()
             .contains("step_0004.vti")
     );
+    for png in ["speed.png", "vorticity.png", "probes.png"] {
+        assert!(
+            std::fs::metadata(out.join("plots").join(png))
+                .unwrap()
+                .len()
+                > 0,
+            "{png}"
+        );
+    }
 }
 
 #[test]

@@ -16,6 +16,7 @@
 
 pub mod check;
 pub mod file;
+mod images;
 mod vti;
 
 use std::collections::BTreeMap;
@@ -455,6 +456,48 @@ impl LbmModel<'_> {
         }
     }
 
+    /// `plots/speed.png`, `plots/vorticity.png` (`∂v_y/∂x − ∂v_x/∂y`, central differences
+    /// between fluid nodes) and, with heat, `plots/temperature.png`.
+    fn field_images(&self, dir: &Path) -> Result<(), RunError> {
+        let (nx, ny) = self.lat.size();
+        let mut speed = Vec::with_capacity(nx * ny);
+        let mut vel = Vec::with_capacity(nx * ny);
+        let mut solid = Vec::with_capacity(nx * ny);
+        for j in 0..ny {
+            for i in 0..nx {
+                let u = self.lat.moments(i, j).1;
+                let v = [self.units.velocity_si(u[0]), self.units.velocity_si(u[1])];
+                speed.push((v[0] * v[0] + v[1] * v[1]).sqrt());
+                vel.push(v);
+                solid.push(self.lat.is_solid(i, j));
+            }
+        }
+        let h = 2.0 * self.units.dx;
+        let mut vort = vec![0.0; nx * ny];
+        for j in 1..ny.saturating_sub(1) {
+            for i in 1..nx.saturating_sub(1) {
+                let k = j * nx + i;
+                vort[k] =
+                    (vel[k + 1][1] - vel[k - 1][1]) / h - (vel[k + nx][0] - vel[k - nx][0]) / h;
+            }
+        }
+        images::field_png(&dir.join("speed.png"), [nx, ny], &speed, &solid, false)?;
+        images::field_png(&dir.join("vorticity.png"), [nx, ny], &vort, &solid, true)?;
+        if let Some(th) = &self.thermal {
+            let t: Vec<f64> = (0..ny)
+                .flat_map(|j| (0..nx).map(move |i| th.temperature(i, j)))
+                .collect();
+            images::field_png(
+                &dir.join("temperature.png"),
+                [nx, ny],
+                &t,
+                &vec![false; nx * ny],
+                false,
+            )?;
+        }
+        Ok(())
+    }
+
     /// Temperature at an SI point, bilinear between nodes (solid nodes included: heat
     /// crosses into obstacles).
     fn sample_temperature(&self, x: [f64; 2]) -> f64 {
@@ -650,6 +693,7 @@ impl Model for LbmModel<'_> {
     }
 
     fn plots(&self, dir: &Path, written: &[f64], series: &[Vec<f64>]) -> Result<(), RunError> {
+        self.field_images(dir)?;
         let probes = &self.ls.scene.output.probe;
         if probes.is_empty() || written.is_empty() {
             return Ok(());
