@@ -54,11 +54,14 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Check { scene } => Scene::load(&scene)
             .map(|s| {
+                let what = match s.file().scene.model.as_deref().unwrap_or("continuum") {
+                    "continuum" => format!("grid {}", s.file().grid.kind.as_str()),
+                    model => format!("model {model}"),
+                };
                 println!(
-                    "{}: ok ({}D, grid {})",
+                    "{}: ok ({}D, {what})",
                     s.path().display(),
-                    s.file().scene.dim,
-                    s.file().grid.kind.as_str()
+                    s.file().scene.dim
                 );
                 ExitCode::SUCCESS
             })

@@ -247,24 +247,34 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
     if s.scene.plane.is_some() && d == 3 {
         return Err(ls.error(&k(&["scene", "plane"]), "applies to 2D scenes only"));
     }
-    if ls.model() == "nscd" {
-        return crate::nscd::check::check(ls);
-    }
-    crate::nscd::check::refuse_sections(ls, "continuum")?;
-    if ls.model() == "continuum" && !crate::nscd::check::has_section(ls, "grid") {
-        return Err(ls.error(
-            &k(&["grid"]),
-            "is missing: a continuum scene needs a [grid]",
-        ));
-    }
-    if ls.model() != "continuum" {
-        return Err(ls.error(
-            &k(&["scene", "model"]),
-            format!(
-                "= \"{}\" is not available in this version of porofrac (available: continuum, nscd)",
-                ls.model()
-            ),
-        ));
+    match ls.model() {
+        "nscd" => {
+            crate::lbm::check::refuse_sections(ls, "nscd")?;
+            return crate::nscd::check::check(ls);
+        }
+        "lbm" => {
+            crate::nscd::check::refuse_sections(ls, "lbm")?;
+            return crate::lbm::check(ls);
+        }
+        "continuum" => {
+            crate::nscd::check::refuse_sections(ls, "continuum")?;
+            crate::lbm::check::refuse_sections(ls, "continuum")?;
+            if !crate::nscd::check::has_section(ls, "grid") {
+                return Err(ls.error(
+                    &k(&["grid"]),
+                    "is missing: a continuum scene needs a [grid]",
+                ));
+            }
+        }
+        other => {
+            return Err(ls.error(
+                &k(&["scene", "model"]),
+                format!(
+                    "= \"{other}\" is not available in this version of porofrac (available: \
+                     continuum, nscd, lbm)"
+                ),
+            ));
+        }
     }
     check_grid(ls, d)?;
     // Materials.

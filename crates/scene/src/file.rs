@@ -240,6 +240,13 @@ pub struct SceneFile {
     pub contact: Option<crate::nscd::file::ContactSection>,
     /// `[nscd]`: the solver (model `nscd`).
     pub nscd: Option<crate::nscd::file::NscdSection>,
+    /// `[lbm]` (lattice Boltzmann model).
+    pub lbm: Option<crate::lbm::file::LbmSection>,
+    /// `[[obstacle]]` (lattice Boltzmann model).
+    #[serde(default)]
+    pub obstacle: Vec<crate::lbm::file::ObstacleSection>,
+    /// `[thermal]` (lattice Boltzmann model).
+    pub thermal: Option<crate::lbm::file::ThermalSection>,
 }
 
 /// `[scene]`.
@@ -591,6 +598,8 @@ pub struct Probe {
     pub particle: Option<i64>,
     /// Tracked cell (particle models).
     pub cell: Option<Ball>,
+    /// Lattice Boltzmann: the obstacle whose force or torque is probed (instead of `at`).
+    pub obstacle: Option<String>,
 }
 
 /// `[[output.line]]`.

@@ -35,6 +35,7 @@ pub mod driver;
 pub mod expr;
 pub mod file;
 pub mod laws;
+pub mod lbm;
 pub mod limits;
 pub mod model;
 pub mod nscd;

@@ -135,6 +135,8 @@ fn run_model(
         "continuum" => crate::continuum::run(ls, laws, out, observer)?,
         // Writes its own summary.json (the particle statistics on top of the shared keys).
         "nscd" => return crate::nscd::run(ls, out, observer),
+        // Writes its own summary.json (with the `lattice` block and `mlups`).
+        "lbm" => return crate::lbm::run(ls, out, observer),
         other => {
             return Err(ls
                 .error(

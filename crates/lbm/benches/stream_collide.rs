@@ -1,0 +1,58 @@
+//! One fused stream–collide step on a periodic D2Q9 lattice: in-place AA streaming against
+//! the two-array push kernel, from cache-resident to memory-bound sizes; `lattice_step` is
+//! the whole `Lattice::step` (kernel and periodic copies); `memory/copy_256MB` the copy
+//! bandwidth of the machine for comparison.
+
+use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use porofrac_lbm::d2q9::{Q, feq};
+use porofrac_lbm::kernel::{Grid, Layout, Physics, aa_step, push_step_periodic};
+use porofrac_lbm::{Collision, Lattice, LatticeConfig};
+
+fn bench(c: &mut Criterion) {
+    let phys = Physics {
+        rates: Collision::Bgk.rates(0.8).expect("tau"),
+        accel: [0.0, 0.0],
+    };
+    let mut group = c.benchmark_group("d2q9_step");
+    group.sample_size(10);
+    for n in [64usize, 256, 1024, 2048, 4096] {
+        let g = Grid { nx: n, ny: n };
+        group.throughput(Throughput::Elements((n * n) as u64));
+        let mut pop = vec![0.0; Q * g.np()];
+        for q in 0..Q {
+            for v in &mut pop[q * g.np()..(q + 1) * g.np()] {
+                *v = feq(q, 1.0, [0.01, 0.0]);
+            }
+        }
+        let mut layout = Layout::Natural;
+        group.bench_with_input(BenchmarkId::new("aa", n), &n, |b, _| {
+            b.iter(|| layout = aa_step(&mut pop, g, layout, None, phys))
+        });
+        let mut src = pop.clone();
+        let mut dst = pop.clone();
+        group.bench_with_input(BenchmarkId::new("two_array_push", n), &n, |b, _| {
+            b.iter(|| {
+                push_step_periodic(&src, &mut dst, g, phys);
+                std::mem::swap(&mut src, &mut dst);
+            })
+        });
+        drop((src, dst));
+        let mut lat = Lattice::new(LatticeConfig::periodic(n, n, 0.8)).expect("lattice");
+        group.bench_with_input(BenchmarkId::new("lattice_step", n), &n, |b, _| {
+            b.iter(|| lat.step().expect("step"))
+        });
+    }
+    group.finish();
+    // The memory bandwidth the kernels compete for: copy 2 × 256 MB (bytes read + written).
+    let mut group = c.benchmark_group("memory");
+    group.sample_size(10);
+    let n = 32 << 20;
+    let src = vec![1.0f64; n];
+    let mut dst = vec![0.0f64; n];
+    group.throughput(Throughput::Bytes((16 * n) as u64));
+    group.bench_function("copy_256MB", |b| b.iter(|| dst.copy_from_slice(&src)));
+    group.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

@@ -1,0 +1,201 @@
+//! The typed sections of a lattice Boltzmann scene: `[lbm]`, `[[lbm.boundary]]`,
+//! `[[obstacle]]` and `[thermal]` (see the README, "Lattice Boltzmann fluid").
+
+use serde::Deserialize;
+
+use crate::file::NumOrExpr;
+
+/// `[lbm]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LbmSection {
+    /// Min and max corner (m).
+    pub extent: [Vec<f64>; 2],
+    /// Lattice spacing Δx (m).
+    pub spacing: f64,
+    /// Fluid density (kg/m³).
+    pub density: f64,
+    /// Kinematic viscosity (m²/s).
+    pub viscosity: f64,
+    /// Relaxation time; with spacing and viscosity it fixes Δt.
+    pub tau: f64,
+    /// Collision operator.
+    #[serde(default)]
+    pub collision: CollisionChoice,
+    /// TRT magic parameter (default 3/16).
+    pub magic: Option<f64>,
+    /// Floating-point type of the populations.
+    #[serde(default)]
+    pub precision: PrecisionChoice,
+    /// Axes that wrap around.
+    #[serde(default)]
+    pub periodic: Vec<AxisChoice>,
+    /// Body acceleration on the fluid (m/s²).
+    pub body_force: Option<Vec<f64>>,
+    /// Initial velocity (m/s), numbers or expressions in x, y (default at rest).
+    pub initial_velocity: Option<Vec<NumOrExpr>>,
+    /// How the force on obstacles is summed from the cut links.
+    #[serde(default)]
+    pub momentum_exchange: ExchangeChoice,
+    /// `[[lbm.boundary]]`: the sides that are not periodic.
+    #[serde(default)]
+    pub boundary: Vec<LbmBoundary>,
+}
+
+/// `[lbm] collision`.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum CollisionChoice {
+    /// Single relaxation time.
+    #[default]
+    Bgk,
+    /// Two relaxation times.
+    Trt,
+}
+
+/// `[lbm] precision`.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum PrecisionChoice {
+    /// `f64` populations.
+    #[default]
+    Double,
+    /// `f32` populations (not available yet: refused by the check).
+    Single,
+}
+
+/// An axis.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum AxisChoice {
+    /// x.
+    X,
+    /// y.
+    Y,
+}
+
+/// `[lbm] momentum_exchange`.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum ExchangeChoice {
+    /// `c_α [f̃_α + f_ᾱ]` (seed eq. 8).
+    #[default]
+    Standard,
+    /// With relative velocities `c − u_w` (Wen et al. 2014).
+    GalileanInvariant,
+}
+
+/// A side of the box.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum SideChoice {
+    /// x = min.
+    Xmin,
+    /// x = max.
+    Xmax,
+    /// y = min.
+    Ymin,
+    /// y = max.
+    Ymax,
+}
+
+impl SideChoice {
+    /// The word of the scene file.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Xmin => "xmin",
+            Self::Xmax => "xmax",
+            Self::Ymin => "ymin",
+            Self::Ymax => "ymax",
+        }
+    }
+}
+
+/// `[[lbm.boundary]] kind`.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum BoundaryKindChoice {
+    /// No-slip wall halfway between nodes (moving with `velocity`).
+    #[default]
+    Wall,
+    /// Velocity inlet.
+    Velocity,
+    /// Pressure outlet.
+    Pressure,
+}
+
+/// `[[lbm.boundary]]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LbmBoundary {
+    /// Which side.
+    pub side: SideChoice,
+    /// What it is.
+    #[serde(default)]
+    pub kind: BoundaryKindChoice,
+    /// Wall or inlet velocity (m/s), numbers or expressions in x, y, t.
+    pub velocity: Option<Vec<NumOrExpr>>,
+    /// Outlet gauge pressure (Pa).
+    pub pressure: Option<f64>,
+}
+
+/// `[[obstacle]]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObstacleSection {
+    /// Name (for obstacle probes).
+    pub name: String,
+    /// Shape and position.
+    pub shape: ShapeChoice,
+    /// Prescribed velocity of the centre (m/s), numbers or expressions in t.
+    pub velocity: Option<Vec<NumOrExpr>>,
+    /// Prescribed angular velocity (rad/s), number or expression in t.
+    pub angular_velocity: Option<NumOrExpr>,
+}
+
+/// `shape = { circle = {...} }` or `{ box = [[x0, y0], [x1, y1]] }`.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(rename_all = "lowercase", deny_unknown_fields)]
+pub enum ShapeChoice {
+    /// A disk.
+    Circle(CircleShape),
+    /// An axis-aligned rectangle.
+    Box([Vec<f64>; 2]),
+}
+
+/// Centre and radius of a disk.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct CircleShape {
+    /// Centre (m).
+    pub center: Vec<f64>,
+    /// Radius (m).
+    pub radius: f64,
+}
+
+/// `[thermal]` (parsed so that its keys are known; not available in this version).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ThermalSection {
+    /// Diffusivity in the fluid (m²/s).
+    pub diffusivity: f64,
+    /// Diffusivity inside obstacles (m²/s).
+    pub solid_diffusivity: Option<f64>,
+    /// Initial temperature.
+    pub initial: Option<NumOrExpr>,
+    /// `[[thermal.boundary]]`.
+    #[serde(default)]
+    pub boundary: Vec<ThermalBoundary>,
+}
+
+/// `[[thermal.boundary]]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ThermalBoundary {
+    /// Which side.
+    pub side: SideChoice,
+    /// Fixed temperature.
+    pub temperature: Option<f64>,
+    /// Fixed flux.
+    pub flux: Option<f64>,
+}

@@ -1,0 +1,763 @@
+//! The lattice Boltzmann model (seed 002, `[scene] model = "lbm"`): a D2Q9 fluid with
+//! obstacles whose surfaces fall between nodes ([`porofrac_lbm`]).
+//!
+//! - *build*: the SI inputs of `[lbm]` are converted to lattice units ([`Units`]: `Δt`
+//!   from spacing, viscosity and tau), the sides of `[[lbm.boundary]]` and the
+//!   `[[obstacle]]`s are placed on the lattice. Nodes sit at the centres of the `Δx` cells
+//!   covering `extent`, so walls on the sides lie halfway between nodes;
+//! - *step*: from one output time to the next, `round(t/Δt)` lattice steps in total;
+//!   velocities given as expressions are evaluated at every lattice step;
+//! - *fields*: `vx vy pressure density` (bilinear between nodes), obstacle forces and
+//!   torques (momentum exchange, per metre of depth), `.vti` image data.
+//!
+//! `summary.json` gets a `lattice` block (spacing, time step, tau, collision, nodes, the
+//! Mach number of the largest velocity seen) and `mlups` (million fluid-node updates per
+//! second of stepping).
+
+pub mod check;
+pub mod file;
+mod images;
+mod vti;
+
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::time::Instant;
+
+use porofrac_lbm::{
+    Collision, Lattice, LatticeConfig, MAX_MACH, MomentumExchange, Obstacle, Shape, Side, SideKind,
+    Thermal, ThermalSide, Units,
+};
+
+pub use check::check;
+
+use crate::check::{LoadedScene, k, ki};
+use crate::driver::{Observer, drive};
+use crate::expr::Expr;
+use crate::file::NumOrExpr;
+use crate::model::{Model, RunError, Sizes, StepStats};
+use crate::output::{SolverStats, Summary, WallSeconds, write_atomic};
+use file::{
+    AxisChoice, BoundaryKindChoice, CollisionChoice, ExchangeChoice, LbmSection, ShapeChoice,
+    SideChoice,
+};
+
+/// Thermal relaxation time of diffusivity `chi` (m²/s): `τ_g = ½ + 3 χ Δt/Δx²`.
+pub(crate) fn thermal_tau(chi: f64, u: &Units) -> f64 {
+    0.5 + 3.0 * chi * u.dt / (u.dx * u.dx)
+}
+
+/// Nodes along x and y for the extent and spacing (as floats, for checks).
+pub(crate) fn nodes(l: &LbmSection) -> (f64, f64) {
+    let n = |a: usize| {
+        ((l.extent[1][a] - l.extent[0][a]) / l.spacing)
+            .round()
+            .max(0.0)
+    };
+    (n(0), n(1))
+}
+
+/// A velocity given as numbers or expressions.
+#[derive(Clone, Debug)]
+enum VelocityExpr {
+    Const([f64; 2]),
+    Vary([Expr; 2]),
+}
+
+impl VelocityExpr {
+    fn new(v: &[NumOrExpr]) -> Self {
+        let e: Vec<Expr> = v
+            .iter()
+            .map(|c| match c {
+                NumOrExpr::Num(x) => Expr::constant(*x),
+                NumOrExpr::Expr(s) => Expr::parse(s).unwrap_or_else(|_| Expr::constant(f64::NAN)),
+            })
+            .collect();
+        match (e[0].as_constant(), e[1].as_constant()) {
+            (Some(a), Some(b)) => VelocityExpr::Const([a, b]),
+            _ => VelocityExpr::Vary([e[0].clone(), e[1].clone()]),
+        }
+    }
+    fn at(&self, x: [f64; 2], t: f64) -> [f64; 2] {
+        match self {
+            VelocityExpr::Const(v) => *v,
+            VelocityExpr::Vary(e) => [e[0].eval(&x, t), e[1].eval(&x, t)],
+        }
+    }
+    fn varies_in_time(&self) -> bool {
+        match self {
+            VelocityExpr::Const(_) => false,
+            VelocityExpr::Vary(e) => e.iter().any(Expr::depends_on_time),
+        }
+    }
+}
+
+/// What a probe reads.
+enum ProbeKind {
+    Field(FieldName, [f64; 2]),
+    Obstacle(usize, usize),
+}
+
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum FieldName {
+    Vx,
+    Vy,
+    Pressure,
+    Density,
+    Temperature,
+}
+
+impl FieldName {
+    fn parse(s: &str) -> Self {
+        match s {
+            "vx" => FieldName::Vx,
+            "vy" => FieldName::Vy,
+            "pressure" => FieldName::Pressure,
+            "temperature" => FieldName::Temperature,
+            _ => FieldName::Density,
+        }
+    }
+}
+
+/// The lattice Boltzmann model stepping through its output times.
+struct LbmModel<'a> {
+    ls: &'a LoadedScene,
+    lat: Lattice,
+    thermal: Option<Thermal>,
+    units: Units,
+    origin: [f64; 2],
+    times: Vec<f64>,
+    sides: Vec<(Side, VelocityExpr)>,
+    motions: Vec<(Option<VelocityExpr>, Option<Expr>)>,
+    probes: Vec<ProbeKind>,
+    stepping_seconds: f64,
+    fluid_updates: f64,
+    max_mach: f64,
+    name: String,
+}
+
+/// Run a checked lattice Boltzmann scene and write its `summary.json`.
+pub(crate) fn run(
+    ls: &LoadedScene,
+    out: &Path,
+    observer: &mut dyn Observer,
+) -> Result<Summary, RunError> {
+    let start = Instant::now();
+    let mut model = build(ls)?;
+    let build_seconds = start.elapsed().as_secs_f64();
+    let summary = drive(ls, &mut model, out, observer, start, build_seconds, 2)?;
+    let mut json = serde_json::to_value(&summary).expect("summary serializes");
+    let l = ls.scene.lbm.as_ref().expect("checked");
+    let (nx, ny) = model.lat.size();
+    let rates = model.lat.rates();
+    json["lattice"] = serde_json::json!({
+        "spacing": model.units.dx,
+        "time_step": model.units.dt,
+        "tau": model.units.tau,
+        "collision": match l.collision { CollisionChoice::Bgk => "bgk", CollisionChoice::Trt => "trt" },
+        "omega_plus": rates.plus,
+        "omega_minus": rates.minus,
+        "lattice_viscosity": (model.units.tau - 0.5) / 3.0,
+        "nodes": [nx, ny],
+        "fluid_nodes": model.lat.fluid_nodes(),
+        "lattice_steps": model.lat.steps(),
+        "mach": model.max_mach,
+        "mach_limit": MAX_MACH,
+        "velocity_unit": model.units.dx / model.units.dt,
+        "streaming": "aa (in place, one population array)",
+        "population_bytes": model.lat.population_bytes(),
+    });
+    let mlups = if model.stepping_seconds > 0.0 {
+        model.fluid_updates / model.stepping_seconds / 1e6
+    } else {
+        0.0
+    };
+    json["mlups"] = serde_json::json!(mlups);
+    let text = serde_json::to_string_pretty(&json).expect("summary serializes");
+    write_atomic(&out.join("summary.json"), text.as_bytes())?;
+    Ok(summary)
+}
+
+fn build(ls: &LoadedScene) -> Result<LbmModel<'_>, RunError> {
+    let s = &ls.scene;
+    let l = s.lbm.as_ref().expect("checked");
+    let units = Units::from_viscosity(l.spacing, l.viscosity, l.density, l.tau)
+        .map_err(|e| ls.error(&k(&["lbm", "tau"]), e))?;
+    let (nx, ny) = nodes(l);
+    let (nx, ny) = (nx as usize, ny as usize);
+    let origin = [l.extent[0][0], l.extent[0][1]];
+    let mut periodic = [false; 2];
+    for a in &l.periodic {
+        periodic[match a {
+            AxisChoice::X => 0,
+            AxisChoice::Y => 1,
+        }] = true;
+    }
+    let side_of = |s: SideChoice| match s {
+        SideChoice::Xmin => Side::XMin,
+        SideChoice::Xmax => Side::XMax,
+        SideChoice::Ymin => Side::YMin,
+        SideChoice::Ymax => Side::YMax,
+    };
+    let mut kinds = [SideKind::Wall; 4];
+    let mut sides = Vec::new();
+    for b in &l.boundary {
+        let side = side_of(b.side);
+        kinds[side.index()] = match b.kind {
+            BoundaryKindChoice::Wall => SideKind::Wall,
+            BoundaryKindChoice::Velocity => SideKind::Velocity,
+            BoundaryKindChoice::Pressure => SideKind::Pressure {
+                density: units.pressure_density(b.pressure.unwrap_or(0.0)),
+            },
+        };
+        if let Some(v) = &b.velocity {
+            sides.push((side, VelocityExpr::new(v)));
+        }
+    }
+    let body = l.body_force.clone().unwrap_or(vec![0.0, 0.0]);
+    let cfg = LatticeConfig {
+        nx,
+        ny,
+        tau: l.tau,
+        collision: match l.collision {
+            CollisionChoice::Bgk => Collision::Bgk,
+            CollisionChoice::Trt => Collision::Trt {
+                magic: l.magic.unwrap_or(3.0 / 16.0),
+            },
+        },
+        periodic,
+        sides: kinds,
+        accel: [units.acceleration(body[0]), units.acceleration(body[1])],
+        momentum_exchange: match l.momentum_exchange {
+            ExchangeChoice::Standard => MomentumExchange::Standard,
+            ExchangeChoice::GalileanInvariant => MomentumExchange::GalileanInvariant,
+        },
+    };
+    let mut lat = Lattice::new(cfg).map_err(|e| ls.error(&k(&["lbm"]), e))?;
+    let mut motions = Vec::new();
+    for (i, o) in s.obstacle.iter().enumerate() {
+        let shape = match &o.shape {
+            ShapeChoice::Circle(c) => Shape::Circle {
+                center: [
+                    units.length(c.center[0] - origin[0]),
+                    units.length(c.center[1] - origin[1]),
+                ],
+                radius: units.length(c.radius),
+            },
+            ShapeChoice::Box(b) => Shape::aligned_box(
+                [
+                    units.length(b[0][0] - origin[0]),
+                    units.length(b[0][1] - origin[1]),
+                ],
+                [
+                    units.length(b[1][0] - origin[0]),
+                    units.length(b[1][1] - origin[1]),
+                ],
+            ),
+        };
+        let v = o.velocity.as_ref().map(|v| VelocityExpr::new(v));
+        let w = o.angular_velocity.as_ref().map(|w| match w {
+            NumOrExpr::Num(x) => Expr::constant(*x),
+            NumOrExpr::Expr(s) => Expr::parse(s).unwrap_or_else(|_| Expr::constant(f64::NAN)),
+        });
+        lat.add_obstacle(Obstacle {
+            shape,
+            velocity: [0.0, 0.0],
+            angular_velocity: 0.0,
+        })
+        .map_err(|e| ls.error(&ki("obstacle", i, &["shape"]), e))?;
+        motions.push((v, w));
+    }
+    let thermal = match &s.thermal {
+        None => None,
+        Some(t) => {
+            let mut tsides = [ThermalSide::Adiabatic; 4];
+            for b in &t.boundary {
+                tsides[side_of(b.side).index()] = match (b.temperature, b.flux) {
+                    (Some(v), _) => ThermalSide::Temperature(v),
+                    (None, f) => ThermalSide::Flux(f.unwrap_or(0.0) * units.dt / units.dx),
+                };
+            }
+            let init = match &t.initial {
+                None => Expr::constant(0.0),
+                Some(NumOrExpr::Num(x)) => Expr::constant(*x),
+                Some(NumOrExpr::Expr(e)) => {
+                    Expr::parse(e).unwrap_or_else(|_| Expr::constant(f64::NAN))
+                }
+            };
+            let tau = thermal_tau(t.diffusivity, &units);
+            let tau_s = thermal_tau(t.solid_diffusivity.unwrap_or(t.diffusivity), &units);
+            let (dx, o) = (units.dx, origin);
+            Some(
+                Thermal::new(&lat, tau, tau_s, tsides, |p| {
+                    init.eval(&[o[0] + p[0] * dx, o[1] + p[1] * dx], 0.0)
+                })
+                .map_err(|e| ls.error(&k(&["thermal", "diffusivity"]), e))?,
+            )
+        }
+    };
+    let mut model = LbmModel {
+        ls,
+        lat,
+        thermal,
+        units,
+        origin,
+        times: output_times(ls),
+        sides,
+        motions,
+        probes: Vec::new(),
+        stepping_seconds: 0.0,
+        fluid_updates: 0.0,
+        max_mach: 0.0,
+        name: s.scene.name.clone(),
+    };
+    for p in &s.output.probe {
+        model.probes.push(match &p.obstacle {
+            Some(o) => {
+                let idx = s
+                    .obstacle
+                    .iter()
+                    .position(|x| &x.name == o)
+                    .expect("checked");
+                let f = check::OBSTACLE_FIELDS
+                    .iter()
+                    .position(|f| *f == p.field)
+                    .expect("checked");
+                ProbeKind::Obstacle(idx, f)
+            }
+            None => ProbeKind::Field(FieldName::parse(&p.field), [p.at[0], p.at[1]]),
+        });
+    }
+    model.apply_motion(0.0)?;
+    if let Some(v) = &l.initial_velocity {
+        let v = VelocityExpr::new(v);
+        let (dx, o, u) = (units.dx, origin, units);
+        model.lat.init(|p| {
+            let x = [o[0] + p[0] * dx, o[1] + p[1] * dx];
+            let w = v.at(x, 0.0);
+            (1.0, [u.velocity(w[0]), u.velocity(w[1])])
+        });
+    }
+    model.check_state()?;
+    Ok(model)
+}
+
+fn output_times(ls: &LoadedScene) -> Vec<f64> {
+    let mut t = vec![0.0];
+    if let Some(sch) = &ls.scene.schedule {
+        let n = crate::check::step_count(sch).min(crate::limits::MAX_STEPS) as usize;
+        let dt = sch.dt.unwrap_or(sch.end_time / n as f64);
+        for k in 1..=n {
+            t.push((k as f64 * dt).min(sch.end_time));
+        }
+    }
+    t
+}
+
+impl LbmModel<'_> {
+    /// Lattice position → SI position.
+    fn si(&self, p: [f64; 2]) -> [f64; 2] {
+        [
+            self.origin[0] + p[0] * self.units.dx,
+            self.origin[1] + p[1] * self.units.dx,
+        ]
+    }
+
+    /// Set side and obstacle velocities at time `t` (s).
+    fn apply_motion(&mut self, t: f64) -> Result<(), RunError> {
+        let u = self.units;
+        for (side, v) in &self.sides {
+            let (o, dx) = (self.origin, u.dx);
+            self.lat.set_side_velocity(*side, |p| {
+                let w = v.at([o[0] + p[0] * dx, o[1] + p[1] * dx], t);
+                [u.velocity(w[0]), u.velocity(w[1])]
+            });
+        }
+        for (kk, (v, w)) in self.motions.iter().enumerate() {
+            let vel = v.as_ref().map_or([0.0, 0.0], |v| v.at([0.0, 0.0], t));
+            let omega = w.as_ref().map_or(0.0, |w| w.eval(&[0.0, 0.0], t));
+            if !(vel[0].is_finite() && vel[1].is_finite() && omega.is_finite()) {
+                return Err(self
+                    .ls
+                    .error(
+                        &ki("obstacle", kk, &["velocity"]),
+                        format!("is not finite at t = {t}"),
+                    )
+                    .into());
+            }
+            self.lat.set_obstacle_motion(
+                kk,
+                [u.velocity(vel[0]), u.velocity(vel[1])],
+                omega * u.dt,
+            );
+        }
+        Ok(())
+    }
+
+    fn time_dependent(&self) -> bool {
+        self.sides.iter().any(|(_, v)| v.varies_in_time())
+            || self.motions.iter().any(|(v, w)| {
+                v.as_ref().is_some_and(VelocityExpr::varies_in_time)
+                    || w.as_ref().is_some_and(Expr::depends_on_time)
+            })
+    }
+
+    /// The largest Mach number so far; an error when the flow diverged or exceeds the limit.
+    fn check_state(&mut self) -> Result<(), RunError> {
+        let speed = self
+            .lat
+            .max_speed()
+            .map_err(|e| RunError::Flow(format!("lbm: {e}")))?;
+        let ma = speed / (1.0f64 / 3.0).sqrt();
+        self.max_mach = self.max_mach.max(ma);
+        if ma > MAX_MACH {
+            return Err(RunError::Flow(format!(
+                "lbm: the flow reached Mach {ma:.3} (limit {MAX_MACH}) at t = {:.6e} s: refine lbm.spacing or lower lbm.tau",
+                self.lat.steps() as f64 * self.units.dt
+            )));
+        }
+        Ok(())
+    }
+
+    /// Density and velocity (lattice units) at an SI point, bilinear between nodes.
+    fn sample(&self, x: [f64; 2]) -> (f64, [f64; 2]) {
+        let (nx, ny) = self.lat.size();
+        let gx = ((x[0] - self.origin[0]) / self.units.dx - 0.5).clamp(0.0, (nx - 1) as f64);
+        let gy = ((x[1] - self.origin[1]) / self.units.dx - 0.5).clamp(0.0, (ny - 1) as f64);
+        let (i0, j0) = (
+            (gx.floor() as usize).min(nx - 2),
+            (gy.floor() as usize).min(ny - 2),
+        );
+        let (fx, fy) = (gx - i0 as f64, gy - j0 as f64);
+        let corners = [
+            (0, 0, (1.0 - fx) * (1.0 - fy)),
+            (1, 0, fx * (1.0 - fy)),
+            (0, 1, (1.0 - fx) * fy),
+            (1, 1, fx * fy),
+        ];
+        // Fluid nodes only where there are any (solid nodes carry no pressure).
+        let fluid = corners
+            .iter()
+            .any(|&(di, dj, w)| w > 0.0 && !self.lat.is_solid(i0 + di, j0 + dj));
+        let (mut rho, mut u, mut sum) = (0.0, [0.0, 0.0], 0.0);
+        for (di, dj, w) in corners {
+            if fluid && self.lat.is_solid(i0 + di, j0 + dj) {
+                continue;
+            }
+            let (r, v) = self.lat.moments(i0 + di, j0 + dj);
+            rho += w * r;
+            u[0] += w * v[0];
+            u[1] += w * v[1];
+            sum += w;
+        }
+        if sum > 0.0 {
+            (rho / sum, [u[0] / sum, u[1] / sum])
+        } else {
+            self.lat.moments(i0, j0)
+        }
+    }
+
+    /// `plots/speed.png`, `plots/vorticity.png` (`∂v_y/∂x − ∂v_x/∂y`, central differences
+    /// between fluid nodes) and, with heat, `plots/temperature.png`.
+    fn field_images(&self, dir: &Path) -> Result<(), RunError> {
+        let (nx, ny) = self.lat.size();
+        let mut speed = Vec::with_capacity(nx * ny);
+        let mut vel = Vec::with_capacity(nx * ny);
+        let mut solid = Vec::with_capacity(nx * ny);
+        for j in 0..ny {
+            for i in 0..nx {
+                let u = self.lat.moments(i, j).1;
+                let v = [self.units.velocity_si(u[0]), self.units.velocity_si(u[1])];
+                speed.push((v[0] * v[0] + v[1] * v[1]).sqrt());
+                vel.push(v);
+                solid.push(self.lat.is_solid(i, j));
+            }
+        }
+        let h = 2.0 * self.units.dx;
+        let mut vort = vec![0.0; nx * ny];
+        for j in 1..ny.saturating_sub(1) {
+            for i in 1..nx.saturating_sub(1) {
+                let k = j * nx + i;
+                vort[k] =
+                    (vel[k + 1][1] - vel[k - 1][1]) / h - (vel[k + nx][0] - vel[k - nx][0]) / h;
+            }
+        }
+        images::field_png(&dir.join("speed.png"), [nx, ny], &speed, &solid, false)?;
+        images::field_png(&dir.join("vorticity.png"), [nx, ny], &vort, &solid, true)?;
+        if let Some(th) = &self.thermal {
+            let t: Vec<f64> = (0..ny)
+                .flat_map(|j| (0..nx).map(move |i| th.temperature(i, j)))
+                .collect();
+            images::field_png(
+                &dir.join("temperature.png"),
+                [nx, ny],
+                &t,
+                &vec![false; nx * ny],
+                false,
+            )?;
+        }
+        Ok(())
+    }
+
+    /// Temperature at an SI point, bilinear between nodes (solid nodes included: heat
+    /// crosses into obstacles).
+    fn sample_temperature(&self, x: [f64; 2]) -> f64 {
+        let Some(th) = &self.thermal else {
+            return f64::NAN;
+        };
+        let (nx, ny) = self.lat.size();
+        let gx = ((x[0] - self.origin[0]) / self.units.dx - 0.5).clamp(0.0, (nx - 1) as f64);
+        let gy = ((x[1] - self.origin[1]) / self.units.dx - 0.5).clamp(0.0, (ny - 1) as f64);
+        let (i0, j0) = (
+            (gx.floor() as usize).min(nx - 2),
+            (gy.floor() as usize).min(ny - 2),
+        );
+        let (fx, fy) = (gx - i0 as f64, gy - j0 as f64);
+        (1.0 - fx) * (1.0 - fy) * th.temperature(i0, j0)
+            + fx * (1.0 - fy) * th.temperature(i0 + 1, j0)
+            + (1.0 - fx) * fy * th.temperature(i0, j0 + 1)
+            + fx * fy * th.temperature(i0 + 1, j0 + 1)
+    }
+
+    fn value_at(&self, f: FieldName, x: [f64; 2]) -> f64 {
+        if f == FieldName::Temperature {
+            return self.sample_temperature(x);
+        }
+        let (rho, u) = self.sample(x);
+        self.field_value(f, rho, u)
+    }
+
+    fn field_value(&self, f: FieldName, rho: f64, u: [f64; 2]) -> f64 {
+        match f {
+            FieldName::Temperature => f64::NAN,
+            FieldName::Vx => self.units.velocity_si(u[0]),
+            FieldName::Vy => self.units.velocity_si(u[1]),
+            FieldName::Pressure => self.units.pressure_si(rho),
+            FieldName::Density => rho * self.units.density,
+        }
+    }
+}
+
+impl Model for LbmModel<'_> {
+    fn times(&self) -> &[f64] {
+        &self.times
+    }
+
+    fn step(&mut self, step: usize) -> Result<StepStats, RunError> {
+        if step == 0 {
+            return Ok(StepStats::default());
+        }
+        let target = (self.times[step] / self.units.dt).round() as u64;
+        let varies = self.time_dependent();
+        let t0 = Instant::now();
+        let mut n = 0;
+        while self.lat.steps() < target {
+            if varies {
+                self.apply_motion(self.lat.steps() as f64 * self.units.dt)?;
+            }
+            if let Some(th) = &mut self.thermal {
+                th.step(&self.lat);
+            }
+            self.lat
+                .step()
+                .map_err(|e| RunError::Flow(format!("lbm: {e}")))?;
+            n += 1;
+        }
+        let dt = t0.elapsed().as_secs_f64();
+        self.stepping_seconds += dt;
+        self.fluid_updates += n as f64 * self.lat.fluid_nodes() as f64;
+        self.check_state()?;
+        Ok(StepStats {
+            iterations: n,
+            failed: 0,
+        })
+    }
+
+    fn probes(&self, values: &mut Vec<f64>) {
+        for p in &self.probes {
+            values.push(match *p {
+                ProbeKind::Field(f, x) => self.value_at(f, x),
+                ProbeKind::Obstacle(o, c) => {
+                    let f = self.lat.force(o);
+                    if c == 2 {
+                        self.units.torque_si(f[2])
+                    } else {
+                        self.units.force_si(f[c])
+                    }
+                }
+            });
+        }
+    }
+
+    fn line(&self, line: usize, rows: &mut Vec<Vec<f64>>) {
+        let l = &self.ls.scene.output.line[line];
+        let f = FieldName::parse(&l.field);
+        let n = l.points.max(2) as usize;
+        let len = ((l.to[0] - l.from[0]).powi(2) + (l.to[1] - l.from[1]).powi(2)).sqrt();
+        for i in 0..n {
+            let s = i as f64 / (n - 1) as f64;
+            let x = [
+                l.from[0] + s * (l.to[0] - l.from[0]),
+                l.from[1] + s * (l.to[1] - l.from[1]),
+            ];
+            rows.push(vec![s * len, x[0], x[1], self.value_at(f, x)]);
+        }
+    }
+
+    fn after_step(&mut self, _out: &Path) -> Result<(), RunError> {
+        Ok(())
+    }
+
+    fn write_vtk(&self, dir: &Path, index: usize) -> Result<String, RunError> {
+        let name = format!("step_{index:04}.vti");
+        let (nx, ny) = self.lat.size();
+        let mut velocity = Vec::with_capacity(3 * nx * ny);
+        let mut pressure = Vec::with_capacity(nx * ny);
+        let mut density = Vec::with_capacity(nx * ny);
+        let mut solid = Vec::with_capacity(nx * ny);
+        for j in 0..ny {
+            for i in 0..nx {
+                let (rho, u) = self.lat.moments(i, j);
+                velocity.extend([
+                    self.units.velocity_si(u[0]),
+                    self.units.velocity_si(u[1]),
+                    0.0,
+                ]);
+                pressure.push(self.units.pressure_si(rho));
+                density.push(rho * self.units.density);
+                solid.push(if self.lat.is_solid(i, j) { 1.0 } else { 0.0 });
+            }
+        }
+        let origin = self.si([0.5, 0.5]);
+        let temperature: Vec<f64> = match &self.thermal {
+            Some(th) => (0..ny)
+                .flat_map(|j| (0..nx).map(move |i| th.temperature(i, j)))
+                .collect(),
+            None => Vec::new(),
+        };
+        let mut arrays: Vec<(&str, usize, &[f64])> = vec![
+            ("velocity", 3, &velocity),
+            ("pressure", 1, &pressure),
+            ("density", 1, &density),
+            ("solid", 1, &solid),
+        ];
+        if self.thermal.is_some() {
+            arrays.push(("temperature", 1, &temperature));
+        }
+        let bytes = vti::image_data([nx, ny], origin, self.units.dx, &arrays);
+        write_atomic(&dir.join(&name), &bytes)?;
+        Ok(name)
+    }
+
+    fn field_extrema(&self) -> BTreeMap<String, [f64; 2]> {
+        let (nx, ny) = self.lat.size();
+        let names = ["vx", "vy", "pressure", "density", "speed"];
+        let mut ext = [[f64::INFINITY, f64::NEG_INFINITY]; 5];
+        for j in 0..ny {
+            for i in 0..nx {
+                if self.lat.is_solid(i, j) {
+                    continue;
+                }
+                let (rho, u) = self.lat.moments(i, j);
+                let vx = self.units.velocity_si(u[0]);
+                let vy = self.units.velocity_si(u[1]);
+                let v = [
+                    vx,
+                    vy,
+                    self.units.pressure_si(rho),
+                    rho * self.units.density,
+                    (vx * vx + vy * vy).sqrt(),
+                ];
+                for (e, x) in ext.iter_mut().zip(v) {
+                    e[0] = e[0].min(x);
+                    e[1] = e[1].max(x);
+                }
+            }
+        }
+        let mut out: BTreeMap<String, [f64; 2]> = names
+            .iter()
+            .zip(ext)
+            .filter(|(_, e)| e[0] <= e[1])
+            .map(|(n, e)| (n.to_string(), e))
+            .collect();
+        if let Some(th) = &self.thermal {
+            let mut e = [f64::INFINITY, f64::NEG_INFINITY];
+            for j in 0..ny {
+                for i in 0..nx {
+                    let t = th.temperature(i, j);
+                    e = [e[0].min(t), e[1].max(t)];
+                }
+            }
+            out.insert("temperature".into(), e);
+        }
+        out
+    }
+
+    fn plots(&self, dir: &Path, written: &[f64], series: &[Vec<f64>]) -> Result<(), RunError> {
+        self.field_images(dir)?;
+        let probes = &self.ls.scene.output.probe;
+        if probes.is_empty() || written.is_empty() {
+            return Ok(());
+        }
+        let forces: Vec<(String, Vec<f64>)> = probes
+            .iter()
+            .zip(series)
+            .filter(|(p, _)| p.obstacle.is_some())
+            .map(|(p, s)| (p.name.clone(), s.clone()))
+            .collect();
+        if !forces.is_empty() {
+            crate::plots::time_series(
+                &dir.join("obstacle_forces.png"),
+                written,
+                &forces,
+                &format!("{}: obstacle forces (N/m)", self.name),
+            )?;
+        }
+        let fields: Vec<(String, Vec<f64>)> = probes
+            .iter()
+            .zip(series)
+            .filter(|(p, _)| p.obstacle.is_none())
+            .map(|(p, s)| (p.name.clone(), s.clone()))
+            .collect();
+        if !fields.is_empty() {
+            crate::plots::time_series(
+                &dir.join("probes.png"),
+                written,
+                &fields,
+                &format!("{}: probes", self.name),
+            )?;
+        }
+        Ok(())
+    }
+
+    fn sizes(&self) -> Sizes {
+        let (nx, ny) = self.lat.size();
+        Sizes {
+            cells: nx * ny,
+            nodes: self.lat.fluid_nodes(),
+            dofs: 9 * nx * ny,
+        }
+    }
+
+    fn failed(&self) -> usize {
+        0
+    }
+
+    fn solver_stats(&self) -> SolverStats {
+        SolverStats {
+            linear: "lbm-d2q9".into(),
+            iterations: self.lat.steps() as usize,
+            ..SolverStats::default()
+        }
+    }
+
+    fn errors(&self) -> Result<BTreeMap<String, f64>, RunError> {
+        Ok(BTreeMap::new())
+    }
+
+    fn wall_seconds(&self) -> WallSeconds {
+        WallSeconds {
+            solve: self.stepping_seconds,
+            ..WallSeconds::default()
+        }
+    }
+}
