@@ -27,8 +27,14 @@ pub fn scf(level: usize, r: f64, n: f64, length: f64) -> (f64, usize, f64, f64) 
         .fix(2, constant(0.0));
     let top = Condition::new(grid.boundary("ymax").unwrap()).load(1, constant(1.0));
     let t0 = Instant::now();
-    let model = Cosserat::new(grid, m, Options::default(), &[left, bottom, top], BodyLoads::none())
-        .unwrap();
+    let model = Cosserat::new(
+        grid,
+        m,
+        Options::default(),
+        &[left, bottom, top],
+        BodyLoads::none(),
+    )
+    .unwrap();
     let t_asm = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
     let w = model.solve_static(0.0).unwrap();
@@ -40,7 +46,10 @@ pub fn scf(level: usize, r: f64, n: f64, length: f64) -> (f64, usize, f64, f64) 
 }
 
 fn main() {
-    let levels: usize = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(2);
+    let levels: usize = std::env::args()
+        .nth(1)
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(2);
     println!("r_mm  r/l     N     level cells   SCF_dem  SCF_ref  err%   asm_s  solve_s");
     for (r, rl) in [(0.216, 1.063), (0.216, 10.63), (0.864, 3.0)] {
         for n in [0.0, 0.25, 0.5, 0.75, 0.9] {

@@ -92,7 +92,11 @@ pub fn facet_rule<const D: usize>(grid: &Grid<D>, f: usize) -> ([Point<D>; 3], [
         p[1] = mid + half;
         (p, [0.5, 0.5, 0.0], 2)
     } else {
-        let v = [grid.node(nodes[0]), grid.node(nodes[1]), grid.node(nodes[2])];
+        let v = [
+            grid.node(nodes[0]),
+            grid.node(nodes[1]),
+            grid.node(nodes[2]),
+        ];
         for k in 0..3 {
             p[k] = (v[k] + v[(k + 1) % 3]) * 0.5;
         }
@@ -260,7 +264,9 @@ impl<const D: usize> Cosserat<D> {
         let m = cells.len() * n;
         let (gc, gg) = self.recon.gradient(c);
         for (&cc, g) in gc.iter().zip(gg) {
-            let l = cells.binary_search(&cc).expect("stencil cell in local list");
+            let l = cells
+                .binary_search(&cc)
+                .expect("stencil cell in local list");
             for a in 0..n {
                 for j in 0..D {
                     b[strain_index(D, a, j) * m + l * n + a] += scale * g[j];
@@ -268,7 +274,9 @@ impl<const D: usize> Cosserat<D> {
             }
         }
         let mut rot = |cc: usize, r: f64| {
-            let l = cells.binary_search(&cc).expect("stencil cell in local list");
+            let l = cells
+                .binary_search(&cc)
+                .expect("stencil cell in local list");
             for i in 0..D {
                 for j in 0..D {
                     for k in 0..rotations(D) {

@@ -97,7 +97,11 @@ impl Dynamics {
         }
         if u0.len() != neq || v0.len() != neq {
             return Err(CosseratError::Input {
-                what: format!("initial state of lengths {} / {}, want {neq}", u0.len(), v0.len()),
+                what: format!(
+                    "initial state of lengths {} / {}, want {neq}",
+                    u0.len(),
+                    v0.len()
+                ),
             });
         }
         let mass = lumped_mass(model);
@@ -153,7 +157,9 @@ impl Dynamics {
         let mass = lumped_mass(model);
         let system = model.system_values();
         let n = model.equations();
-        let mut x: Vec<f64> = (0..n).map(|i| 1.0 + ((i * 7919) % 13) as f64 / 13.0).collect();
+        let mut x: Vec<f64> = (0..n)
+            .map(|i| 1.0 + ((i * 7919) % 13) as f64 / 13.0)
+            .collect();
         let mut y = vec![0.0; n];
         let mut lambda = 0.0;
         for _ in 0..200 {

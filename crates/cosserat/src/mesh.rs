@@ -104,11 +104,7 @@ pub fn plate_with_hole(
     }
     for _ in 0..200 {
         let m = 0.5 * (a + b);
-        if total(m) < span {
-            a = m
-        } else {
-            b = m
-        }
+        if total(m) < span { a = m } else { b = m }
     }
     let q = 0.5 * (a + b);
     let mut rho = vec![0.0];
@@ -207,7 +203,12 @@ mod tests {
 
     #[test]
     fn crossed_mesh_counts_and_area() {
-        let g = crossed(Point::<2>::new(-0.12, -0.06), Point::<2>::new(0.12, 0.06), [5, 3]).unwrap();
+        let g = crossed(
+            Point::<2>::new(-0.12, -0.06),
+            Point::<2>::new(0.12, 0.06),
+            [5, 3],
+        )
+        .unwrap();
         assert_eq!(g.num_cells(), 60);
         let area: f64 = g.cell_volumes().iter().sum();
         assert!((area - 0.24 * 0.12).abs() < 1e-15);
@@ -223,7 +224,10 @@ mod tests {
         let area: f64 = g.cell_volumes().iter().sum();
         // The hole is polygonal: the area lies between the disc and the inscribed polygon.
         let disc = l * l - std::f64::consts::PI * r * r / 4.0;
-        assert!(area > disc && area < disc + r * r * 0.01, "{area} vs {disc}");
+        assert!(
+            area > disc && area < disc + r * r * 0.01,
+            "{area} vs {disc}"
+        );
         for side in ["xmin", "ymin", "xmax", "ymax"] {
             assert!(!g.boundary(side).unwrap().is_empty(), "{side}");
         }

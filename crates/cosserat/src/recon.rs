@@ -168,7 +168,10 @@ impl<const D: usize> Reconstruction<D> {
         stride: usize,
         a: usize,
     ) -> f64 {
-        w[c * stride + a] + self.cell_gradient(c, w, stride, a).dot(&(x - grid.cell_centroid(c)))
+        w[c * stride + a]
+            + self
+                .cell_gradient(c, w, stride, a)
+                .dot(&(x - grid.cell_centroid(c)))
     }
 
     /// Largest `|λ|` over all facet stencils (a conditioning indicator, Remark 5).

@@ -37,7 +37,11 @@ fn energy<const D: usize>(model: &Cosserat<D>, d: &Dynamics) -> f64 {
 fn newmark_conserves_energy_of_a_free_body() {
     let model = free_2d();
     let u0 = sample(model.grid(), |x| {
-        vec![1e-3 * (3.0 * x[0] * x[1]).sin(), 1e-3 * x[0] * x[0], 1e-3 * x[1]]
+        vec![
+            1e-3 * (3.0 * x[0] * x[1]).sin(),
+            1e-3 * x[0] * x[0],
+            1e-3 * x[1],
+        ]
     });
     let v0 = sample(model.grid(), |x| vec![0.01 * x[1], -0.02 * x[0], 0.05]);
     let mut d = Dynamics::new(&model, Integrator::Newmark, 2e-3, 0.0, u0, v0).unwrap();
@@ -52,7 +56,12 @@ fn newmark_conserves_energy_of_a_free_body() {
 
     // 3D: a perturbed box of tetrahedra.
     let g = perturb(
-        &simplices(Point::<3>::zeros(), Point::<3>::new(1.0, 0.6, 0.5), [3, 2, 2]).unwrap(),
+        &simplices(
+            Point::<3>::zeros(),
+            Point::<3>::new(1.0, 0.6, 0.5),
+            [3, 2, 2],
+        )
+        .unwrap(),
         0.2,
         6,
     )
@@ -65,7 +74,9 @@ fn newmark_conserves_energy_of_a_free_body() {
     let u0 = sample(model.grid(), |x| {
         vec![1e-3 * x[1] * x[2], 0.0, 1e-3 * x[0] * x[0], 0.0, 1e-3, 0.0]
     });
-    let v0 = sample(model.grid(), |x| vec![0.0, 0.01 * x[0], 0.0, 0.02, 0.0, 0.0]);
+    let v0 = sample(model.grid(), |x| {
+        vec![0.0, 0.01 * x[0], 0.0, 0.02, 0.0, 0.0]
+    });
     let mut d = Dynamics::new(&model, Integrator::Newmark, 2e-3, 0.0, u0, v0).unwrap();
     let e0 = energy(&model, &d);
     for _ in 0..200 {
@@ -82,8 +93,15 @@ fn explicit_stable_step_is_close_to_the_limit() {
     assert!(dt.is_finite() && dt > 0.0);
     let u0 = sample(model.grid(), |x| vec![1e-3 * x[0] * x[1], 0.0, 0.0]);
     let v0 = vec![0.0; u0.len()];
-    let mut d = Dynamics::new(&model, Integrator::Explicit, dt, 0.0, u0.clone(), v0.clone())
-        .unwrap();
+    let mut d = Dynamics::new(
+        &model,
+        Integrator::Explicit,
+        dt,
+        0.0,
+        u0.clone(),
+        v0.clone(),
+    )
+    .unwrap();
     let e0 = energy(&model, &d);
     let mut worst: f64 = 0.0;
     for _ in 0..400 {
@@ -113,7 +131,14 @@ fn zero_micro_inertia_is_refused() {
         .unwrap();
     let model = Cosserat::new(g, m, Options::default(), &[], BodyLoads::none()).unwrap();
     let n = model.equations();
-    let e = Dynamics::new(&model, Integrator::Newmark, 0.1, 0.0, vec![0.0; n], vec![0.0; n])
-        .unwrap_err();
+    let e = Dynamics::new(
+        &model,
+        Integrator::Newmark,
+        0.1,
+        0.0,
+        vec![0.0; n],
+        vec![0.0; n],
+    )
+    .unwrap_err();
     assert!(e.to_string().contains("micro_inertia"));
 }

@@ -12,8 +12,8 @@ use porofrac_cosserat::{
 
 fn scf(level: usize, r: f64, n: f64, length: f64) -> f64 {
     let (side, g, nu) = (16.2, 1e3, 0.3);
-    let grid = mesh::plate_with_hole(side, r, 16 * level, 10 * level, 0.1 * r / level as f64)
-        .unwrap();
+    let grid =
+        mesh::plate_with_hole(side, r, 16 * level, 10 * level, 0.1 * r / level as f64).unwrap();
     let a = n * n / (1.0 - n * n);
     let m = Material::with_length(g, nu, a * g, length).unwrap();
     let left = Condition::new(grid.boundary("xmin").unwrap())
@@ -53,6 +53,9 @@ fn scf_against_the_analytic_value() {
         let fine = (scf(5, r, n, r / rl) - want) / want;
         eprintln!("r = {r}, r/ℓ = {rl}, N = {n}: SCF {want:.4}, error {coarse:+.4} → {fine:+.4}");
         assert!(fine.abs() < 0.04, "r/ℓ = {rl}, N = {n}: error {fine}");
-        assert!(fine.abs() < coarse.abs(), "r/ℓ = {rl}, N = {n}: no improvement");
+        assert!(
+            fine.abs() < coarse.abs(),
+            "r/ℓ = {rl}, N = {n}: no improvement"
+        );
     }
 }

@@ -38,7 +38,12 @@ fn affine_exact_on_structured_and_crossed_triangles() {
 
 #[test]
 fn affine_exact_on_tetrahedra() {
-    let g3 = simplices(Point::<3>::zeros(), Point::<3>::new(1.0, 0.5, 0.5), [4, 3, 3]).unwrap();
+    let g3 = simplices(
+        Point::<3>::zeros(),
+        Point::<3>::new(1.0, 0.5, 0.5),
+        [4, 3, 3],
+    )
+    .unwrap();
     let p3 = perturb(&g3, 0.2, 3).unwrap();
     let g = Point::<3>::new(0.3, -0.8, 1.1);
     assert!(check_affine(&g3, -0.2, g) < 1e-12);

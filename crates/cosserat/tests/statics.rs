@@ -16,8 +16,7 @@ use std::sync::Arc;
 use common::{clamp_all, sample};
 use porofrac_cosserat::reference::ShearLayer;
 use porofrac_cosserat::{
-    BodyLoads, Condition, Cosserat, Material, Options, StrainVariant, constant, mesh,
-    strain_index,
+    BodyLoads, Condition, Cosserat, Material, Options, StrainVariant, constant, mesh, strain_index,
 };
 use porofrac_grid::generate::{perturb, simplices};
 use porofrac_grid::{Grid, Point};
@@ -54,11 +53,20 @@ fn patch_2d(grid: Grid<2>, variant: StrainVariant, phi: f64, couple: f64, want: 
             worst = worst.max((got[k] - want[k]).abs() / 4.0);
         }
         // Couple stress vanishes.
-        worst = worst.max(s[strain_index(2, 2, 0)].abs().max(s[strain_index(2, 2, 1)].abs()) / 4.0);
+        worst = worst.max(
+            s[strain_index(2, 2, 0)]
+                .abs()
+                .max(s[strain_index(2, 2, 1)].abs())
+                / 4.0,
+        );
     }
     // The solution is the exact field sampled at the barycentres.
     let exact_w = sample(model.grid(), exact);
-    let err = w.iter().zip(&exact_w).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+    let err = w
+        .iter()
+        .zip(&exact_w)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
     let size = exact_w.iter().fold(0.0f64, |a, b| a.max(b.abs()));
     worst.max(err / size)
 }
@@ -97,7 +105,12 @@ fn patch_test_2_exact_with_consistent_loads() {
 #[test]
 fn patch_test_3d_exact() {
     let g = perturb(
-        &simplices(Point::<3>::zeros(), Point::<3>::new(1.0, 0.8, 0.6), [3, 3, 2]).unwrap(),
+        &simplices(
+            Point::<3>::zeros(),
+            Point::<3>::new(1.0, 0.8, 0.6),
+            [3, 3, 2],
+        )
+        .unwrap(),
         0.2,
         5,
     )
@@ -206,7 +219,12 @@ fn rigid_modes_in_the_kernel() {
         assert!(d < 1e-12, "2D {v:?}: {d:e}");
     }
     let g3 = perturb(
-        &simplices(Point::<3>::zeros(), Point::<3>::new(1.0, 0.6, 0.5), [3, 2, 2]).unwrap(),
+        &simplices(
+            Point::<3>::zeros(),
+            Point::<3>::new(1.0, 0.6, 0.5),
+            [3, 2, 2],
+        )
+        .unwrap(),
         0.2,
         2,
     )
@@ -238,8 +256,12 @@ fn rigid_modes_in_the_kernel() {
 /// ν = 0, G = 10 GPa, Gc = 20 GPa, couple modulus 4Gℓ² = 100 N.
 pub fn shear_layer(variant: StrainVariant, ends: [f64; 4]) -> (f64, f64, f64) {
     let h = 1e-3;
-    let grid = mesh::crossed(Point::<2>::new(-h / 2.0, 0.0), Point::<2>::new(h / 2.0, h), [10, 50])
-        .unwrap();
+    let grid = mesh::crossed(
+        Point::<2>::new(-h / 2.0, 0.0),
+        Point::<2>::new(h / 2.0, h),
+        [10, 50],
+    )
+    .unwrap();
     let m = Material::with_length(1e10, 0.0, 2e10, 0.05e-3).unwrap();
     let [u0, p0, u1, p1] = ends;
     let bottom = Condition::new(grid.boundary("ymin").unwrap())
@@ -289,6 +311,9 @@ fn shear_layer_against_closed_form() {
     for v in [StrainVariant::Facet, StrainVariant::Cell] {
         let (ephi, eu, etau) = shear_layer(v, [0.0, 0.0, 1e-5, 0.0]);
         eprintln!("shear layer A, {v:?}: φ {ephi:.4e}, u1 {eu:.4e}, τ {etau:.4e}");
-        assert!(ephi < 0.02 && eu < 0.02 && etau < 0.01, "{v:?}: {ephi} {eu} {etau}");
+        assert!(
+            ephi < 0.02 && eu < 0.02 && etau < 0.01,
+            "{v:?}: {ephi} {eu} {etau}"
+        );
     }
 }

@@ -247,14 +247,18 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
     if s.scene.plane.is_some() && d == 3 {
         return Err(ls.error(&k(&["scene", "plane"]), "applies to 2D scenes only"));
     }
-    if ls.model() != "continuum" {
-        return Err(ls.error(
-            &k(&["scene", "model"]),
-            format!(
-                "= \"{}\" is not available in this version of porofrac (available: continuum)",
-                ls.model()
-            ),
-        ));
+    match ls.model() {
+        "continuum" => crate::cosserat::check::refuse_in_continuum(ls)?,
+        "cosserat" => return crate::cosserat::check::check(ls),
+        other => {
+            return Err(ls.error(
+                &k(&["scene", "model"]),
+                format!(
+                    "= \"{other}\" is not available in this version of porofrac (available: \
+                     continuum, cosserat)"
+                ),
+            ));
+        }
     }
     check_grid(ls, d)?;
     // Materials.

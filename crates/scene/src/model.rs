@@ -133,6 +133,7 @@ fn run_model(
 ) -> Result<Summary, RunError> {
     let summary = match ls.model() {
         "continuum" => crate::continuum::run(ls, laws, out, observer)?,
+        "cosserat" => crate::cosserat::run(ls, out, observer)?,
         other => {
             return Err(ls
                 .error(
