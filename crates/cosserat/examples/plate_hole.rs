@@ -2,7 +2,9 @@
 //! the Mindlin / Kaloni–Ariman value, for several (N, r/ℓ) and mesh levels, with the wall
 //! time of assembly (reconstruction included) and solve.
 //!
-//! `cargo run --release -p porofrac-cosserat --example plate_hole [levels]`
+//! `cargo run --release -p porofrac-cosserat --example plate_hole [levels]`, or
+//! `… --example plate_hole mesh <level> <r> <path.vtu>` to write the O-grid mesh of a level
+//! (the mesh of `scenes/cosserat_plate_hole.toml`).
 
 use std::time::Instant;
 
@@ -46,6 +48,16 @@ pub fn scf(level: usize, r: f64, n: f64, length: f64) -> (f64, usize, f64, f64) 
 }
 
 fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    if args.get(1).map(String::as_str) == Some("mesh") {
+        let level: usize = args[2].parse().expect("level");
+        let r: f64 = args[3].parse().expect("radius");
+        let grid =
+            mesh::plate_with_hole(16.2, r, 16 * level, 10 * level, 0.1 * r / level as f64).unwrap();
+        porofrac_grid::io::write_vtu(&args[4], &grid, &[], &[]).unwrap();
+        println!("{} triangles → {}", grid.num_cells(), args[4]);
+        return;
+    }
     let levels: usize = std::env::args()
         .nth(1)
         .and_then(|s| s.parse().ok())

@@ -11,12 +11,15 @@
 //! * *fields*: probes and lines (`ux`, `phi`, … P1-reconstructed at the point; stresses
 //!   and couple stresses of the containing cell; `energy`, `kinetic`, `work` totals), the
 //!   VTK cell data `displacement`, `rotation`, `stress`, `couple_stress` ([`vtk`]), and
-//!   plots of σ_yy and φ (2D) and of the probe series.
+//!   plots of σ_yy (whole grid and around its peak) and φ (2D) and of the probe series.
 
 pub mod check;
 pub mod fields;
 pub mod keys;
 pub mod vtk;
+
+#[cfg(test)]
+mod tests;
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -466,6 +469,16 @@ impl<const D: usize> Model for Run<'_, D> {
                     Values::Cell(&v),
                 )?;
             }
+            // σ_yy around its peak cell (a stress concentration is small on the whole
+            // grid): a window of 40 peak-cell diameters.
+            let f = Field::parse("syy", 2).expect("2D field");
+            let v: Vec<f64> = (0..nc).map(|c| self.cell_value(f, c)).collect();
+            let peak = (0..nc).max_by(|&a, &b| v[a].total_cmp(&v[b])).unwrap_or(0);
+            let h = 20.0 * self.model.reconstruction().diameter[peak];
+            let x = g2.cell_centroid(peak);
+            let mut plot = FieldPlot::new(&canvas, "σ_yy (Pa) near its peak", &[]);
+            plot.window = Some(([x[0] - h, x[1] - h], [x[0] + h, x[1] + h]));
+            crate::plots::field(&dir.join("syy_peak.png"), &plot, Values::Cell(&v))?;
         }
         if written.len() > 1 && !self.probes.is_empty() {
             let columns: Vec<(String, Vec<f64>)> = self
