@@ -317,7 +317,7 @@ pub fn barycentric<const D: usize>(
             }
         }
     }
-    if !(det.abs() > 1e-10 * scale) {
+    if det.is_nan() || det.abs() <= 1e-10 * scale {
         return None;
     }
     let mut l = [0.0f64; 3];

@@ -188,7 +188,8 @@ fn body_loads<const D: usize>(ls: &LoadedScene) -> BodyLoads<D> {
     b
 }
 
-/// How the run advances.
+/// How the run advances (one value per run: the size of the variants does not matter).
+#[allow(clippy::large_enum_variant)]
 enum Stepping {
     /// One static solve (an LU factored once).
     Static(SparseLu),
