@@ -1,4 +1,4 @@
-//! Plate with a hole (SEEDS 001.4 E2): the stress concentration factor of the DEM against
+//! Plate with a hole (the seed's verification plan §4 E2): the stress concentration factor of the DEM against
 //! the Mindlin / Kaloni–Ariman value, for several (N, r/ℓ) and mesh levels, with the wall
 //! time of assembly (reconstruction included) and solve.
 //!

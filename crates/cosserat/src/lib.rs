@@ -18,7 +18,7 @@
 //!    a sparse LU.
 //! 4. [`dynamics`]: diagonal mass (15) `ρ|K|`, `ρ j |K|`; Newmark average acceleration
 //!    (31) and explicit leapfrog with a computed stable step; energies.
-//! 5. [`reference`]: the closed forms used to verify it (the shear boundary layer and the
+//! 5. [`mod@reference`]: the closed forms used to verify it (the shear boundary layer and the
 //!    stress concentration factor of a hole).
 //!
 //! Sign conventions: `σ_ij` is the `i`-component of the traction on a face of normal `j`

@@ -1,7 +1,7 @@
 //! Simplex meshes the Cosserat experiments use that the grid crate does not generate.
 //!
 //! * [`crossed`]: each square of an `nx × ny` lattice cut into 4 triangles by its centre
-//!   (the "crossed" meshes of SEEDS 001.4 E1 and E3).
+//!   (the "crossed" meshes of the seed's verification plan §4 E1 and E3).
 //! * [`plate_with_hole`]: the quarter plate `[0, L]²` minus the disc of radius `r` at the
 //!   origin (E2), an O-grid graded towards the hole, each quad cut by its shorter diagonal.
 //! * [`locate`]: the simplex containing a point.

@@ -1,4 +1,4 @@
-//! Dynamics (SEEDS 001.3, 001.5 test 4):
+//! Dynamics (the seed's verification plan §3 and §5 test 4):
 //!
 //! * a free body (no Dirichlet condition, no load) under Newmark average acceleration
 //!   conserves `½VᵀMV + ½UᵀKU` to 1e-10 relative over 200 steps (2D and 3D);
