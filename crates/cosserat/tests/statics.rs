@@ -5,6 +5,9 @@
 //!   crossed E1 mesh and on a perturbed mesh, for both strain variants (test 2 with the
 //!   consistent load pairing); the 3D analogue on perturbed tetrahedra
 //!   (with the body couple `c_k = ε_kij σ_ij` that balances the skew stress);
+//! * patch test 3 (affine stress, body force and affine body couple): cell stresses within
+//!   2 % on the E1 mesh, the error falling at least at first order from 12 × 6 to 25 × 12
+//!   squares (this test is not exact for the method, like CR P1 elements);
 //! * rigid modes are in the kernel of the matrix without Dirichlet conditions (2D, 3D);
 //! * the shear boundary layer (E3) against its closed form: 2 % pointwise for φ and u1,
 //!   τ within 1 %.
@@ -314,6 +317,66 @@ fn shear_layer_against_closed_form() {
         assert!(
             ephi < 0.02 && eu < 0.02 && etau < 0.01,
             "{v:?}: {ephi} {eu} {etau}"
+        );
+    }
+}
+
+/// Patch test 3: largest cell-stress error relative to max |σ| = 4 on an `n × n/2` crossed
+/// mesh of the E1 domain.
+fn patch_3(n: usize, variant: StrainVariant) -> f64 {
+    let lo = Point::<2>::new(-0.12, -0.06);
+    let hi = Point::<2>::new(0.12, 0.06);
+    let grid = mesh::crossed(lo, hi, [n, n.div_ceil(2)]).unwrap();
+    let exact = |x: &Point<2>| {
+        vec![
+            1e-3 * (x[0] + x[1] / 2.0),
+            1e-3 * (x[0] + x[1]),
+            1e-3 * (0.25 - (x[0] - x[1])),
+        ]
+    };
+    let cond = clamp_all(&grid, exact);
+    let body = BodyLoads::none()
+        .with(0, constant(-1.0))
+        .with(1, constant(-1.0))
+        .with(2, Arc::new(|x: &Point<2>, _: f64| -2.0 * (x[0] - x[1])));
+    let opts = Options {
+        strain: variant,
+        ..Options::default()
+    };
+    let model = Cosserat::new(grid, e1_material(), opts, &[cond], body).unwrap();
+    let w = model.solve_static(0.0).unwrap();
+    let mut worst: f64 = 0.0;
+    for c in 0..model.grid().num_cells() {
+        let x = model.grid().cell_centroid(c);
+        let d = x[0] - x[1];
+        let s = model.cell_stress(c, &w);
+        let want = [4.0, 4.0, 1.5 - d, 1.5 + d, -0.04, 0.04];
+        let got = [
+            s[strain_index(2, 0, 0)],
+            s[strain_index(2, 1, 1)],
+            s[strain_index(2, 0, 1)],
+            s[strain_index(2, 1, 0)],
+            s[strain_index(2, 2, 0)],
+            s[strain_index(2, 2, 1)],
+        ];
+        for k in 0..6 {
+            worst = worst.max((got[k] - want[k]).abs() / 4.0);
+        }
+    }
+    worst
+}
+
+#[test]
+fn patch_test_3_converges() {
+    for v in [StrainVariant::Facet, StrainVariant::Cell] {
+        let coarse = patch_3(12, v);
+        let fine = patch_3(25, v);
+        eprintln!("patch test 3, {v:?}: 12 squares {coarse:.3e}, 25 squares {fine:.3e}");
+        assert!(fine < 0.02, "{v:?}: {fine}");
+        // At least first order: the spacing falls by 25/12.
+        assert!(
+            fine < coarse * 12.0 / 25.0 * 1.1,
+            "{v:?}: {coarse} → {fine}"
         );
     }
 }
