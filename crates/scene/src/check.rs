@@ -259,6 +259,7 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
         "continuum" => {
             crate::nscd::check::refuse_sections(ls, "continuum")?;
             crate::lbm::check::refuse_sections(ls, "continuum")?;
+            crate::cosserat::check::refuse_in_continuum(ls)?;
             if !crate::nscd::check::has_section(ls, "grid") {
                 return Err(ls.error(
                     &k(&["grid"]),
@@ -266,12 +267,17 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
                 ));
             }
         }
+        "cosserat" => {
+            crate::nscd::check::refuse_sections(ls, "cosserat")?;
+            crate::lbm::check::refuse_sections(ls, "cosserat")?;
+            return crate::cosserat::check::check(ls);
+        }
         other => {
             return Err(ls.error(
                 &k(&["scene", "model"]),
                 format!(
                     "= \"{other}\" is not available in this version of porofrac (available: \
-                     continuum, nscd, lbm)"
+                     continuum, nscd, lbm, cosserat)"
                 ),
             ));
         }

@@ -126,6 +126,8 @@ pub enum DiagonalsChoice {
     Structured,
     /// A checkerboard of diagonals.
     Alternating,
+    /// Each square cut into 4 triangles by its centre (`model = "cosserat"`).
+    Crossed,
 }
 
 /// `[initial] mechanics`.
@@ -382,7 +384,9 @@ pub enum Permeability {
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Material {
-    /// E (Pa).
+    /// E (Pa). Required by the continuum model; `model = "cosserat"` accepts
+    /// `shear_modulus` instead (absent: NaN, refused by the checks).
+    #[serde(default = "missing")]
     pub youngs_modulus: f64,
     /// ν.
     pub poisson_ratio: f64,
@@ -402,6 +406,20 @@ pub struct Material {
     pub cohesion: Option<f64>,
     /// Mohr–Coulomb friction angle (degrees).
     pub friction_angle: Option<f64>,
+    /// `model = "cosserat"`: G (Pa).
+    pub shear_modulus: Option<f64>,
+    /// `model = "cosserat"`: Gc (Pa).
+    pub cosserat_shear_modulus: Option<f64>,
+    /// `model = "cosserat"`: ℓ (m).
+    pub characteristic_length: Option<f64>,
+    /// `model = "cosserat"`, 3D: `[L, M, Mc]` (N).
+    pub couple_moduli: Option<Vec<f64>>,
+    /// `model = "cosserat"`: j (m²).
+    pub micro_inertia: Option<f64>,
+}
+
+fn missing() -> f64 {
+    f64::NAN
 }
 
 /// `[fluid]`.
@@ -430,6 +448,10 @@ pub struct Bc {
     pub flux: Option<NumOrExpr>,
     /// Rigid platen.
     pub platen: Option<Platen>,
+    /// `model = "cosserat"`: micro-rotation (2D one value, 3D three; or `"free"`).
+    pub rotation: Option<crate::cosserat::keys::PerRotation>,
+    /// `model = "cosserat"`: couple traction (N/m).
+    pub couple_traction: Option<crate::cosserat::keys::PerRotation>,
 }
 
 /// `platen = { force = [...] }`.
@@ -448,6 +470,8 @@ pub struct Loads {
     pub gravity: Option<Vec<f64>>,
     /// Body force (N/m³) per component.
     pub body_force: Option<Vec<NumOrExpr>>,
+    /// `model = "cosserat"`: body couple (N/m²).
+    pub body_couple: Option<crate::cosserat::keys::PerRotation>,
 }
 
 /// `[[source]]`.
@@ -537,6 +561,10 @@ pub struct Solver {
     pub tolerance: Option<f64>,
     /// Threads (0: default).
     pub threads: Option<i64>,
+    /// `model = "cosserat"`: η of the interior penalty.
+    pub penalty: Option<f64>,
+    /// `model = "cosserat"`: time integrator with a `[schedule]`.
+    pub time_integration: Option<crate::cosserat::keys::TimeIntegration>,
 }
 
 /// `[output]`.

@@ -31,6 +31,7 @@
 
 pub mod check;
 pub mod continuum;
+pub mod cosserat;
 pub mod driver;
 pub mod expr;
 pub mod file;

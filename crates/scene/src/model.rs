@@ -137,6 +137,7 @@ fn run_model(
         "nscd" => return crate::nscd::run(ls, out, observer),
         // Writes its own summary.json (with the `lattice` block and `mlups`).
         "lbm" => return crate::lbm::run(ls, out, observer),
+        "cosserat" => crate::cosserat::run(ls, out, observer)?,
         other => {
             return Err(ls
                 .error(

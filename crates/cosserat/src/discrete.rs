@@ -1,0 +1,690 @@
+//! The discrete problem (21)–(22): elastic form (13), interior penalty (17), Nitsche terms
+//! (18)–(20) and loads, assembled once into a [`BlockPattern`].
+//!
+//! **Elastic form.** At each quadrature point `q` of cell `K` the generalised strain is
+//! `s_q = B_q W` with the gradient part `∂_j w_a = Σ_c g_{K,c,j} w_{c,a}` (eq. 11) and the
+//! rotation coupling `e_ij += ε_ijk φ_{q,k}` (eq. 12). Two variants of `φ_q`
+//! ([`StrainVariant`]): the cell value `φ_K` at one point of weight `|K|` (the DEM reading
+//! of eq. 24), or the Crouzeix–Raviart value `φ_F` at each facet centroid with weight
+//! `|K|/(D+1)` (the author's code). The cell matrix is `Σ_q w_q B_qᵀ A B_q` (`Rᵀ A R`).
+//!
+//! **Interior penalty (17).** On an interior facet `F = K⁻ ∩ K⁺` (normal from `K⁻` to `K⁺`)
+//! `(η/h_F) ∫_F [w]ᵀ Q(n) [v]` with the jump of the P1 reconstructions (14),
+//! `h_F` the mean diameter of the two cells, and a facet rule exact for quadratics
+//! (2-point Gauss on segments, edge midpoints on triangles).
+//!
+//! **Nitsche (18)–(20)**, penalty-free and non-symmetric, on each fixed component `k` of a
+//! boundary facet `F ⊂ ∂K`: `−|F| (Σ̄_K(W) n)_k v_{F,k} + |F| (Σ̄_K(V) n)_k w_{F,k}` and the
+//! right-hand side `+|F| (Σ̄_K(V) n)_k ū_{D,k}` (`Σ̄_K` the cell's mean generalised stress,
+//! `ū_D` the facet mean of the data).
+//!
+//! **Loads.** Volume loads are tested with the rotation/displacement of the same
+//! quadrature as the strain (the consistent pairing, the seed's verification plan §2 (derived): `Σ_q w_q f(x_q)·v_q`);
+//! tractions with the facet values, `Σ_F |F| t̄·v_F`.
+//!
+//! The stiffness is kept in two value arrays on one pattern: the symmetric part (elastic +
+//! penalty) whose quadratic form is the stored energy, and the Nitsche part.
+
+use nalgebra::DMatrix;
+use porofrac_grid::{Grid, Point};
+
+use crate::conditions::{BodyLoads, Condition, Field, Slot};
+use crate::error::{CosseratError, Result};
+use crate::material::{Material, components, levi_civita, rotations, strain_index, strain_len};
+use crate::pattern::{BlockPattern, SparseLu};
+use crate::recon::Reconstruction;
+
+/// Where the rotation in the strain (12) is taken.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum StrainVariant {
+    /// Crouzeix–Raviart facet values at the facet centroids (the author's code, the
+    /// reference variant).
+    #[default]
+    Facet,
+    /// The cell value (the DEM reading of eq. 24).
+    Cell,
+}
+
+/// Discretisation options.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Options {
+    /// η of the interior penalty (17); 1 in every case of the paper.
+    pub penalty: f64,
+    /// Strain variant of eq. (12).
+    pub strain: StrainVariant,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Self {
+            penalty: 1.0,
+            strain: StrainVariant::default(),
+        }
+    }
+}
+
+/// A fixed component of a boundary facet: its Nitsche right-hand-side row.
+#[derive(Clone, Debug)]
+struct FixedTerm {
+    face: usize,
+    field: usize,
+    /// `(equation, |F| (Σ̄(e_eq) n)_k)`.
+    coef: Vec<(usize, f64)>,
+}
+
+/// A loaded component of a boundary facet.
+#[derive(Clone, Debug)]
+struct LoadTerm {
+    face: usize,
+    field: usize,
+    k: usize,
+}
+
+/// Quadrature on a facet: up to 3 points, weights summing to 1.
+pub fn facet_rule<const D: usize>(grid: &Grid<D>, f: usize) -> ([Point<D>; 3], [f64; 3], usize) {
+    let nodes = grid.face_nodes(f);
+    let mut p = [Point::<D>::zeros(); 3];
+    if D == 2 {
+        let (a, b) = (grid.node(nodes[0]), grid.node(nodes[1]));
+        let mid = (a + b) * 0.5;
+        let half = (b - a) * (0.5 / 3f64.sqrt());
+        p[0] = mid - half;
+        p[1] = mid + half;
+        (p, [0.5, 0.5, 0.0], 2)
+    } else {
+        let v = [
+            grid.node(nodes[0]),
+            grid.node(nodes[1]),
+            grid.node(nodes[2]),
+        ];
+        for k in 0..3 {
+            p[k] = (v[k] + v[(k + 1) % 3]) * 0.5;
+        }
+        (p, [1.0 / 3.0; 3], 3)
+    }
+}
+
+/// The assembled Cosserat DEM problem on a simplex grid.
+pub struct Cosserat<const D: usize> {
+    grid: Grid<D>,
+    material: Material,
+    options: Options,
+    recon: Reconstruction<D>,
+    law: DMatrix<f64>,
+    pattern: BlockPattern,
+    /// Elastic + penalty values (symmetric).
+    symmetric: Vec<f64>,
+    /// Nitsche values.
+    nitsche: Vec<f64>,
+    fields: Vec<Field<D>>,
+    fixed: Vec<FixedTerm>,
+    loads: Vec<LoadTerm>,
+    body: BodyLoads<D>,
+}
+
+impl<const D: usize> std::fmt::Debug for Cosserat<D> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Cosserat")
+            .field("cells", &self.grid.num_cells())
+            .field("equations", &self.pattern.equations())
+            .field("nnz", &self.pattern.nnz())
+            .finish()
+    }
+}
+
+/// Scratch buffers of the local assembly (reused across cells and facets).
+#[derive(Default)]
+struct Scratch {
+    cells: Vec<usize>,
+    b: Vec<f64>,
+    ab: Vec<f64>,
+    k: Vec<f64>,
+    bbar: Vec<f64>,
+    beta: Vec<f64>,
+}
+
+impl<const D: usize> Cosserat<D> {
+    /// Build the reconstruction, the pattern and the matrices.
+    ///
+    /// Errors: non-simplex cells, facets without stencil, `penalty ≤ 0` or non-finite,
+    /// conditions on interior faces, a component fixed and loaded on one face, or fixed or
+    /// loaded twice.
+    pub fn new(
+        grid: Grid<D>,
+        material: Material,
+        options: Options,
+        conditions: &[Condition<D>],
+        body: BodyLoads<D>,
+    ) -> Result<Self> {
+        if !(options.penalty.is_finite() && options.penalty > 0.0) {
+            return Err(CosseratError::Input {
+                what: format!("penalty η = {} must be positive", options.penalty),
+            });
+        }
+        let n = components(D);
+        if body.fields.len() != n {
+            return Err(CosseratError::Input {
+                what: format!("body loads: {} components, want {n}", body.fields.len()),
+            });
+        }
+        let recon = Reconstruction::new(&grid)?;
+        let law = material.law_matrix(D);
+        let pattern = BlockPattern::new(&neighbours(&grid, &recon), n);
+        let mut me = Self {
+            symmetric: vec![0.0; pattern.nnz()],
+            nitsche: vec![0.0; pattern.nnz()],
+            grid,
+            material,
+            options,
+            recon,
+            law,
+            pattern,
+            fields: Vec::new(),
+            fixed: Vec::new(),
+            loads: Vec::new(),
+            body,
+        };
+        me.assemble_cells();
+        me.assemble_penalty();
+        me.assemble_conditions(conditions)?;
+        Ok(me)
+    }
+
+    /// The grid.
+    pub fn grid(&self) -> &Grid<D> {
+        &self.grid
+    }
+    /// The material.
+    pub fn material(&self) -> &Material {
+        &self.material
+    }
+    /// The options.
+    pub fn options(&self) -> Options {
+        self.options
+    }
+    /// The reconstruction.
+    pub fn reconstruction(&self) -> &Reconstruction<D> {
+        &self.recon
+    }
+    /// The pattern.
+    pub fn pattern(&self) -> &BlockPattern {
+        &self.pattern
+    }
+    /// Values of the symmetric part (elastic + penalty).
+    pub fn symmetric_values(&self) -> &[f64] {
+        &self.symmetric
+    }
+    /// Values of the Nitsche part.
+    pub fn nitsche_values(&self) -> &[f64] {
+        &self.nitsche
+    }
+    /// Values of the full system matrix (symmetric + Nitsche).
+    pub fn system_values(&self) -> Vec<f64> {
+        self.symmetric
+            .iter()
+            .zip(&self.nitsche)
+            .map(|(a, b)| a + b)
+            .collect()
+    }
+    /// Number of unknowns.
+    pub fn equations(&self) -> usize {
+        self.pattern.equations()
+    }
+    /// The law matrix `A`.
+    pub fn law(&self) -> &DMatrix<f64> {
+        &self.law
+    }
+
+    /// Quadrature of cell `c`: `(weight, point, rotation source)`, the source a facet or
+    /// the cell itself (`None`).
+    fn quadrature(&self, c: usize, mut visit: impl FnMut(f64, &Point<D>, Option<usize>)) {
+        let vol = self.grid.cell_volume(c);
+        match self.options.strain {
+            StrainVariant::Cell => visit(vol, self.grid.cell_centroid(c), None),
+            StrainVariant::Facet => {
+                let w = vol / (D + 1) as f64;
+                for &f in self.grid.cell_faces(c) {
+                    visit(w, self.grid.face_centroid(f), Some(f));
+                }
+            }
+        }
+    }
+
+    /// Fill `b` (row-major `S × m`, `m = cells.len()·n`) with `B_q` of cell `c` for the
+    /// rotation source `src` (accumulated with factor `scale`).
+    fn add_strain_operator(
+        &self,
+        c: usize,
+        cells: &[usize],
+        src: Option<usize>,
+        scale: f64,
+        b: &mut [f64],
+    ) {
+        let n = components(D);
+        let m = cells.len() * n;
+        let (gc, gg) = self.recon.gradient(c);
+        for (&cc, g) in gc.iter().zip(gg) {
+            let l = cells
+                .binary_search(&cc)
+                .expect("stencil cell in local list");
+            for a in 0..n {
+                for j in 0..D {
+                    b[strain_index(D, a, j) * m + l * n + a] += scale * g[j];
+                }
+            }
+        }
+        let mut rot = |cc: usize, r: f64| {
+            let l = cells
+                .binary_search(&cc)
+                .expect("stencil cell in local list");
+            for i in 0..D {
+                for j in 0..D {
+                    for k in 0..rotations(D) {
+                        let e = levi_civita(D, i, j, k);
+                        if e != 0.0 {
+                            b[strain_index(D, i, j) * m + l * n + D + k] += scale * e * r;
+                        }
+                    }
+                }
+            }
+        };
+        match src {
+            None => rot(c, 1.0),
+            Some(f) => {
+                let st = &self.recon.facets[f];
+                for (&cc, &l) in st.cells.iter().zip(&st.weights) {
+                    rot(cc, l);
+                }
+            }
+        }
+    }
+
+    /// Mean strain operator `B̄_K = (1/|K|) Σ_q w_q B_q` over `recon.gradient(c)` cells.
+    fn mean_operator(&self, c: usize, s: &mut Scratch) {
+        let n = components(D);
+        s.cells.clear();
+        s.cells.extend_from_slice(self.recon.gradient(c).0);
+        let m = s.cells.len() * n;
+        s.bbar.clear();
+        s.bbar.resize(strain_len(D) * m, 0.0);
+        let vol = self.grid.cell_volume(c);
+        let cells = std::mem::take(&mut s.cells);
+        let mut bbar = std::mem::take(&mut s.bbar);
+        self.quadrature(c, |w, _, src| {
+            self.add_strain_operator(c, &cells, src, w / vol, &mut bbar)
+        });
+        s.cells = cells;
+        s.bbar = bbar;
+    }
+
+    fn assemble_cells(&mut self) {
+        let n = components(D);
+        let sl = strain_len(D);
+        let mut s = Scratch::default();
+        let mut values = std::mem::take(&mut self.symmetric);
+        for c in 0..self.grid.num_cells() {
+            s.cells.clear();
+            s.cells.extend_from_slice(self.recon.gradient(c).0);
+            let m = s.cells.len() * n;
+            s.k.clear();
+            s.k.resize(m * m, 0.0);
+            let cells = std::mem::take(&mut s.cells);
+            self.quadrature(c, |w, _, src| {
+                s.b.clear();
+                s.b.resize(sl * m, 0.0);
+                self.add_strain_operator(c, &cells, src, 1.0, &mut s.b);
+                add_btab(&self.law, &s.b, w, m, &mut s.ab, &mut s.k);
+            });
+            self.pattern.add_local(&mut values, &cells, &s.k);
+            s.cells = cells;
+        }
+        self.symmetric = values;
+    }
+
+    fn assemble_penalty(&mut self) {
+        let n = components(D);
+        let mut s = Scratch::default();
+        let mut values = std::mem::take(&mut self.symmetric);
+        let eta = self.options.penalty;
+        for f in 0..self.grid.num_faces() {
+            let (km, Some(kp)) = self.grid.face_cells(f) else {
+                continue;
+            };
+            s.cells.clear();
+            s.cells.extend_from_slice(self.recon.gradient(km).0);
+            s.cells.extend_from_slice(self.recon.gradient(kp).0);
+            s.cells.sort_unstable();
+            s.cells.dedup();
+            let nl = s.cells.len();
+            let m = nl * n;
+            s.k.clear();
+            s.k.resize(m * m, 0.0);
+            let normal = self.grid.face_normal(f);
+            let q = Material::acoustic(&self.law, D, normal.as_slice());
+            let h = 0.5 * (self.recon.diameter[km] + self.recon.diameter[kp]);
+            let area = self.grid.face_area(f);
+            let (pts, wts, np) = facet_rule(&self.grid, f);
+            for (x, &w) in pts.iter().zip(&wts).take(np) {
+                s.beta.clear();
+                s.beta.resize(nl, 0.0);
+                for (sign, k) in [(1.0, km), (-1.0, kp)] {
+                    let xk = self.grid.cell_centroid(k);
+                    let (gc, gg) = self.recon.gradient(k);
+                    for (&cc, g) in gc.iter().zip(gg) {
+                        let l = s.cells.binary_search(&cc).unwrap();
+                        s.beta[l] += sign * g.dot(&(x - xk));
+                    }
+                    let l = s.cells.binary_search(&k).unwrap();
+                    s.beta[l] += sign;
+                }
+                let scale = eta / h * w * area;
+                for lj in 0..nl {
+                    let bj = s.beta[lj];
+                    if bj == 0.0 {
+                        continue;
+                    }
+                    for li in 0..nl {
+                        let bi = s.beta[li];
+                        if bi == 0.0 {
+                            continue;
+                        }
+                        for bb in 0..n {
+                            for a in 0..n {
+                                s.k[(lj * n + bb) * m + li * n + a] += scale * bi * bj * q[(a, bb)];
+                            }
+                        }
+                    }
+                }
+            }
+            self.pattern.add_local(&mut values, &s.cells, &s.k);
+        }
+        self.symmetric = values;
+    }
+
+    fn assemble_conditions(&mut self, conditions: &[Condition<D>]) -> Result<()> {
+        let n = components(D);
+        // Per face: the slot of each component and the condition that set it.
+        let mut per_face: std::collections::BTreeMap<usize, Vec<(usize, usize, bool)>> =
+            Default::default();
+        for (ci, cond) in conditions.iter().enumerate() {
+            if cond.slots.len() != n {
+                return Err(CosseratError::Condition {
+                    index: ci,
+                    what: format!("{} components, want {n}", cond.slots.len()),
+                });
+            }
+            let mut ids = vec![usize::MAX; n];
+            for (k, slot) in cond.slots.iter().enumerate() {
+                match slot {
+                    Slot::Free => {}
+                    Slot::Fixed(fld) | Slot::Load(fld) => {
+                        ids[k] = self.fields.len();
+                        self.fields.push(fld.clone());
+                    }
+                }
+            }
+            for &f in &cond.faces {
+                if f >= self.grid.num_faces() || !self.grid.is_boundary_face(f) {
+                    return Err(CosseratError::Condition {
+                        index: ci,
+                        what: format!("face {f} is not a boundary face"),
+                    });
+                }
+                let entry = per_face.entry(f).or_default();
+                for (k, slot) in cond.slots.iter().enumerate() {
+                    let fixed = match slot {
+                        Slot::Free => continue,
+                        Slot::Fixed(_) => true,
+                        Slot::Load(_) => false,
+                    };
+                    if let Some(prev) = entry.iter().find(|e| e.0 == k) {
+                        let what = if prev.2 == fixed {
+                            "set twice"
+                        } else {
+                            "both fixed and loaded"
+                        };
+                        return Err(CosseratError::Condition {
+                            index: ci,
+                            what: format!("component {k} of face {f} is {what}"),
+                        });
+                    }
+                    entry.push((k, ids[k], fixed));
+                }
+            }
+        }
+        let mut s = Scratch::default();
+        let mut values = std::mem::take(&mut self.nitsche);
+        for (&f, slots) in &per_face {
+            let c = self.grid.face_cells(f).0;
+            let area = self.grid.face_area(f);
+            let normal = *self.grid.face_normal(f); // outward on the boundary
+            self.mean_operator(c, &mut s);
+            let m = s.cells.len() * n;
+            let st = self.recon.facets[f].clone();
+            let mut any_fixed = false;
+            s.k.clear();
+            s.k.resize(m * m, 0.0);
+            for &(k, field, fixed) in slots {
+                if !fixed {
+                    self.loads.push(LoadTerm { face: f, field, k });
+                    continue;
+                }
+                any_fixed = true;
+                // T_k[ρ] = Σ_j n_j (A B̄)[idx(k, j), ρ].
+                let mut t = vec![0.0; m];
+                for j in 0..D {
+                    let row = strain_index(D, k, j);
+                    for sidx in 0..strain_len(D) {
+                        let a = self.law[(row, sidx)] * normal[j];
+                        if a == 0.0 {
+                            continue;
+                        }
+                        for (tr, bv) in t.iter_mut().zip(&s.bbar[sidx * m..(sidx + 1) * m]) {
+                            *tr += a * bv;
+                        }
+                    }
+                }
+                for (&cc, &l) in st.cells.iter().zip(&st.weights) {
+                    let lc = s.cells.binary_search(&cc).unwrap() * n + k;
+                    for rho in 0..m {
+                        // −|F| λ_c T_k[ρ] at (row (cc,k), col ρ); +|F| T_k[ρ] λ_c at (ρ, (cc,k)).
+                        s.k[rho * m + lc] -= area * l * t[rho];
+                        s.k[lc * m + rho] += area * l * t[rho];
+                    }
+                }
+                let coef = s
+                    .cells
+                    .iter()
+                    .enumerate()
+                    .flat_map(|(li, &cc)| (0..n).map(move |a| (li, cc, a)))
+                    .filter_map(|(li, cc, a)| {
+                        let v = area * t[li * n + a];
+                        (v != 0.0).then_some((cc * n + a, v))
+                    })
+                    .collect();
+                self.fixed.push(FixedTerm {
+                    face: f,
+                    field,
+                    coef,
+                });
+            }
+            if any_fixed {
+                self.pattern.add_local(&mut values, &s.cells, &s.k);
+            }
+        }
+        self.nitsche = values;
+        Ok(())
+    }
+
+    /// Mean over facet `f` of field `i` at time `t`.
+    fn facet_mean(&self, f: usize, i: usize, t: f64) -> f64 {
+        let (p, w, np) = facet_rule(&self.grid, f);
+        (0..np).map(|q| w[q] * (self.fields[i])(&p[q], t)).sum()
+    }
+
+    /// The right-hand side at time `t`: volume loads, tractions and the Nitsche data.
+    pub fn rhs(&self, t: f64, out: &mut [f64]) {
+        let n = components(D);
+        out.fill(0.0);
+        if !self.body.is_empty() {
+            for c in 0..self.grid.num_cells() {
+                self.quadrature(c, |w, x, src| {
+                    for (k, fld) in self.body.fields.iter().enumerate() {
+                        let Some(fld) = fld else { continue };
+                        let v = w * fld(x, t);
+                        // Displacements are always tested with the same source as the
+                        // rotation (consistent pairing of the variant).
+                        match src {
+                            None => out[c * n + k] += v,
+                            Some(f) => {
+                                let st = &self.recon.facets[f];
+                                for (&cc, &l) in st.cells.iter().zip(&st.weights) {
+                                    out[cc * n + k] += v * l;
+                                }
+                            }
+                        }
+                    }
+                });
+            }
+        }
+        for lt in &self.loads {
+            let v = self.grid.face_area(lt.face) * self.facet_mean(lt.face, lt.field, t);
+            let st = &self.recon.facets[lt.face];
+            for (&cc, &l) in st.cells.iter().zip(&st.weights) {
+                out[cc * n + lt.k] += v * l;
+            }
+        }
+        for ft in &self.fixed {
+            let v = self.facet_mean(ft.face, ft.field, t);
+            for &(e, a) in &ft.coef {
+                out[e] += a * v;
+            }
+        }
+    }
+
+    /// Solve the static problem at time `t` with a fresh LU.
+    pub fn solve_static(&self, t: f64) -> Result<Vec<f64>> {
+        let mut lu = SparseLu::new(&self.pattern)?;
+        lu.factorize(&self.pattern, &self.system_values())?;
+        let mut x = vec![0.0; self.equations()];
+        self.rhs(t, &mut x);
+        lu.solve_in_place(&mut x)?;
+        Ok(x)
+    }
+
+    /// Mean generalised strain of cell `c` for the field `w` (length `strain_len(D)`).
+    pub fn cell_strain(&self, c: usize, w: &[f64]) -> [f64; 18] {
+        let n = components(D);
+        let mut s = [0.0; 18];
+        for a in 0..n {
+            let g = self.recon.cell_gradient(c, w, n, a);
+            for j in 0..D {
+                s[strain_index(D, a, j)] = g[j];
+            }
+        }
+        let vol = self.grid.cell_volume(c);
+        let mut phi = [0.0; 3];
+        self.quadrature(c, |wq, _, src| {
+            for k in 0..rotations(D) {
+                let v = match src {
+                    None => w[c * n + D + k],
+                    Some(f) => self.recon.facet_value(f, w, n, D + k),
+                };
+                phi[k] += wq / vol * v;
+            }
+        });
+        for i in 0..D {
+            for j in 0..D {
+                for k in 0..rotations(D) {
+                    s[strain_index(D, i, j)] += levi_civita(D, i, j, k) * phi[k];
+                }
+            }
+        }
+        s
+    }
+
+    /// Mean generalised stress `Σ̄ = A s̄` of cell `c`: `σ_ij` at `strain_index(i, j)`,
+    /// `m_kj` at `strain_index(D + k, j)`.
+    pub fn cell_stress(&self, c: usize, w: &[f64]) -> [f64; 18] {
+        let s = self.cell_strain(c, w);
+        let sl = strain_len(D);
+        let mut out = [0.0; 18];
+        for r in 0..sl {
+            out[r] = (0..sl).map(|q| self.law[(r, q)] * s[q]).sum();
+        }
+        out
+    }
+
+    /// Stored energy `½ Wᵀ K_sym W` (elastic + penalty).
+    pub fn energy(&self, w: &[f64]) -> f64 {
+        0.5 * self.pattern.form(&self.symmetric, w, w)
+    }
+}
+
+/// `K += w Bᵀ A B` with `B` row-major `S × m`, `K` column-major `m × m`.
+fn add_btab(a: &DMatrix<f64>, b: &[f64], w: f64, m: usize, ab: &mut Vec<f64>, k: &mut [f64]) {
+    let sl = a.nrows();
+    ab.clear();
+    ab.resize(sl * m, 0.0);
+    for r in 0..sl {
+        for q in 0..sl {
+            let arq = a[(r, q)];
+            if arq == 0.0 {
+                continue;
+            }
+            let src = &b[q * m..(q + 1) * m];
+            let dst = &mut ab[r * m..(r + 1) * m];
+            for (d, s) in dst.iter_mut().zip(src) {
+                *d += arq * s;
+            }
+        }
+    }
+    for r in 0..sl {
+        let brow = &b[r * m..(r + 1) * m];
+        let abrow = &ab[r * m..(r + 1) * m];
+        for (i, &bi) in brow.iter().enumerate() {
+            if bi == 0.0 {
+                continue;
+            }
+            let f = w * bi;
+            for (j, &abj) in abrow.iter().enumerate() {
+                k[j * m + i] += f * abj;
+            }
+        }
+    }
+}
+
+/// Cells coupled to each cell: the union of `grad(K')` over the elements containing it.
+fn neighbours<const D: usize>(grid: &Grid<D>, recon: &Reconstruction<D>) -> Vec<Vec<usize>> {
+    let nc = grid.num_cells();
+    // Element groups per cell K: grad(K) and grad(K) ∪ grad(K') for every face neighbour.
+    // c ∈ element(K) ⇒ nbr[c] ⊇ cells of element(K).
+    let mut in_grad: Vec<Vec<usize>> = vec![Vec::new(); nc];
+    for k in 0..nc {
+        for &c in recon.gradient(k).0 {
+            in_grad[c].push(k);
+        }
+    }
+    let face_nb = |k: usize| {
+        grid.cell_faces(k).iter().filter_map(move |&f| {
+            let (a, b) = grid.face_cells(f);
+            b.map(|b| if a == k { b } else { a })
+        })
+    };
+    let mut out = Vec::with_capacity(nc);
+    let mut buf = Vec::new();
+    for c in 0..nc {
+        buf.clear();
+        for &k in &in_grad[c] {
+            buf.extend_from_slice(recon.gradient(k).0);
+            for k2 in face_nb(k) {
+                buf.extend_from_slice(recon.gradient(k2).0);
+            }
+        }
+        buf.push(c);
+        buf.sort_unstable();
+        buf.dedup();
+        out.push(buf.clone());
+    }
+    out
+}

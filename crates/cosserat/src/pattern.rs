@@ -1,0 +1,249 @@
+//! The block sparsity pattern of the Cosserat system and the sparse LU on it.
+//!
+//! Unknown `(c, a)` (cell `c`, generalised component `a`) is equation `c·n + a`. Two cells
+//! couple when they share an element (a cell's gradient stencil, or the union of the two
+//! stencils of an interior facet), so the pattern is a block pattern with dense `n × n`
+//! blocks, built once from the cell neighbour lists and stored in compressed sparse column
+//! form with sorted rows. Every assembly writes into the same value array
+//! ([`BlockPattern::position`]); the LU's symbolic analysis (ordering, elimination
+//! structure) is done once per pattern and reused by every numeric factorisation.
+
+use faer::sparse::linalg::LuError;
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::{Conj, MatMut};
+
+use crate::error::{CosseratError, Result};
+
+/// Block compressed-column pattern (see the module docs).
+#[derive(Clone, Debug)]
+pub struct BlockPattern {
+    /// Components per cell (block size).
+    pub block: usize,
+    /// Offsets into `cells`, one per cell plus one.
+    pub nbr_pos: Vec<usize>,
+    /// Sorted coupled cells of each cell (its own included).
+    pub cells: Vec<usize>,
+    /// Column pointers of the scalar CSC pattern.
+    pub col_ptr: Vec<usize>,
+    /// Row indices of the scalar CSC pattern.
+    pub row_idx: Vec<usize>,
+}
+
+impl BlockPattern {
+    /// A pattern from sorted, duplicate-free, symmetric neighbour lists.
+    pub fn new(neighbours: &[Vec<usize>], block: usize) -> Self {
+        let mut nbr_pos = vec![0];
+        let mut cells = Vec::new();
+        for nb in neighbours {
+            cells.extend_from_slice(nb);
+            nbr_pos.push(cells.len());
+        }
+        let n = block;
+        let mut col_ptr = Vec::with_capacity(neighbours.len() * n + 1);
+        let mut row_idx = Vec::with_capacity(cells.len() * n * n);
+        col_ptr.push(0);
+        for nb in neighbours {
+            for _b in 0..n {
+                for &r in nb {
+                    for a in 0..n {
+                        row_idx.push(r * n + a);
+                    }
+                }
+                col_ptr.push(row_idx.len());
+            }
+        }
+        Self {
+            block,
+            nbr_pos,
+            cells,
+            col_ptr,
+            row_idx,
+        }
+    }
+
+    /// Number of equations.
+    pub fn equations(&self) -> usize {
+        self.col_ptr.len() - 1
+    }
+
+    /// Number of stored entries.
+    pub fn nnz(&self) -> usize {
+        self.row_idx.len()
+    }
+
+    /// Position in the value array of the block (row cell `r`, column cell `c`): the entry
+    /// `(r·n + a, c·n + b)` is at `position + b·len·n + a` with `len` = [`Self::column_len`].
+    /// `None` when the cells do not couple.
+    #[inline]
+    pub fn position(&self, r: usize, c: usize) -> Option<usize> {
+        let nb = &self.cells[self.nbr_pos[c]..self.nbr_pos[c + 1]];
+        let p = nb.binary_search(&r).ok()?;
+        Some(self.nbr_pos[c] * self.block * self.block + p * self.block)
+    }
+
+    /// Scalar rows per column of cell `c` (`len · n`).
+    #[inline]
+    pub fn column_len(&self, c: usize) -> usize {
+        (self.nbr_pos[c + 1] - self.nbr_pos[c]) * self.block
+    }
+
+    /// Add a dense local matrix (column-major, `m × m`, `m = cells.len()·n`) over the sorted
+    /// local cell list into `values`.
+    pub fn add_local(&self, values: &mut [f64], cells: &[usize], local: &[f64]) {
+        let n = self.block;
+        let m = cells.len() * n;
+        for (cj, &c) in cells.iter().enumerate() {
+            let stride = self.column_len(c);
+            for (ri, &r) in cells.iter().enumerate() {
+                let pos = self
+                    .position(r, c)
+                    .expect("local cells couple by construction");
+                for b in 0..n {
+                    let col = (cj * n + b) * m + ri * n;
+                    let dst = pos + b * stride;
+                    for a in 0..n {
+                        values[dst + a] += local[col + a];
+                    }
+                }
+            }
+        }
+    }
+
+    /// Positions of the diagonal entries, one per equation.
+    pub fn diagonal_positions(&self) -> Vec<usize> {
+        let n = self.block;
+        let cells = self.nbr_pos.len() - 1;
+        let mut d = Vec::with_capacity(cells * n);
+        for c in 0..cells {
+            let pos = self.position(c, c).expect("diagonal block present");
+            for a in 0..n {
+                d.push(pos + a * self.column_len(c) + a);
+            }
+        }
+        d
+    }
+
+    /// `y = A x` for the matrix with these `values`.
+    pub fn mul(&self, values: &[f64], x: &[f64], y: &mut [f64]) {
+        y.fill(0.0);
+        for j in 0..self.equations() {
+            let xj = x[j];
+            if xj == 0.0 {
+                continue;
+            }
+            for p in self.col_ptr[j]..self.col_ptr[j + 1] {
+                y[self.row_idx[p]] += values[p] * xj;
+            }
+        }
+    }
+
+    /// `xᵀ A y`.
+    pub fn form(&self, values: &[f64], x: &[f64], y: &[f64]) -> f64 {
+        let mut s = 0.0;
+        for j in 0..self.equations() {
+            let mut col = 0.0;
+            for p in self.col_ptr[j]..self.col_ptr[j + 1] {
+                col += values[p] * x[self.row_idx[p]];
+            }
+            s += col * y[j];
+        }
+        s
+    }
+
+    fn symbolic(&self) -> SymbolicSparseColMatRef<'_, usize> {
+        let n = self.equations();
+        SymbolicSparseColMatRef::new_checked(n, n, &self.col_ptr, None, &self.row_idx)
+    }
+}
+
+/// Sparse LU with partial pivoting (faer), the symbolic analysis shared by every
+/// factorisation of one pattern. Fits the non-symmetric Nitsche matrix.
+pub struct SparseLu {
+    symbolic: faer::sparse::linalg::solvers::SymbolicLu<usize>,
+    lu: Option<faer::sparse::linalg::solvers::Lu<usize, f64>>,
+    n: usize,
+    factorizations: usize,
+}
+
+impl std::fmt::Debug for SparseLu {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SparseLu")
+            .field("n", &self.n)
+            .field("factorizations", &self.factorizations)
+            .finish()
+    }
+}
+
+fn lu_error(e: LuError) -> CosseratError {
+    match e {
+        LuError::SymbolicSingular { index } => CosseratError::Solve(format!(
+            "the matrix is structurally singular at equation {index}"
+        )),
+        LuError::Generic(e) => CosseratError::Solve(format!("{e:?}")),
+    }
+}
+
+impl SparseLu {
+    /// Symbolic analysis of `pattern`.
+    pub fn new(pattern: &BlockPattern) -> Result<Self> {
+        let symbolic = faer::sparse::linalg::solvers::SymbolicLu::try_new(pattern.symbolic())
+            .map_err(|e| CosseratError::Solve(format!("{e:?}")))?;
+        Ok(Self {
+            symbolic,
+            lu: None,
+            n: pattern.equations(),
+            factorizations: 0,
+        })
+    }
+
+    /// Numeric factorisation of the matrix with `values` on `pattern`.
+    pub fn factorize(&mut self, pattern: &BlockPattern, values: &[f64]) -> Result<()> {
+        if values.len() != pattern.nnz() || pattern.equations() != self.n {
+            return Err(CosseratError::Input {
+                what: format!(
+                    "factorize: {} values for a pattern of {} entries ({} equations, LU built for {})",
+                    values.len(),
+                    pattern.nnz(),
+                    pattern.equations(),
+                    self.n
+                ),
+            });
+        }
+        self.lu = None;
+        let mat = SparseColMatRef::new(pattern.symbolic(), values);
+        let lu =
+            faer::sparse::linalg::solvers::Lu::try_new_with_symbolic(self.symbolic.clone(), mat)
+                .map_err(lu_error)?;
+        self.lu = Some(lu);
+        self.factorizations += 1;
+        Ok(())
+    }
+
+    /// Solve in place; a non-finite result (a numerically singular matrix) is an error.
+    pub fn solve_in_place(&self, rhs: &mut [f64]) -> Result<()> {
+        use faer::linalg::solvers::SolveCore;
+        let lu = self
+            .lu
+            .as_ref()
+            .ok_or_else(|| CosseratError::Solve("solve before factorisation".into()))?;
+        if rhs.len() != self.n {
+            return Err(CosseratError::Input {
+                what: format!("right-hand side of length {}, want {}", rhs.len(), self.n),
+            });
+        }
+        let n = self.n;
+        lu.solve_in_place_with_conj(Conj::No, MatMut::from_column_major_slice_mut(rhs, n, 1));
+        if let Some(i) = rhs.iter().position(|v| !v.is_finite()) {
+            return Err(CosseratError::Solve(format!(
+                "non-finite solution at equation {i}: the system is singular (missing \
+                 boundary conditions or zero moduli?)"
+            )));
+        }
+        Ok(())
+    }
+
+    /// Numeric factorisations done so far.
+    pub fn factorizations(&self) -> usize {
+        self.factorizations
+    }
+}

@@ -1,0 +1,38 @@
+//! Types of the scene keys of `model = "cosserat"` that live in the shared sections
+//! (`[[bc]] rotation`, `couple_traction`, `[loads] body_couple`, `[solver]
+//! time_integration`).
+
+use serde::Deserialize;
+
+use crate::file::NumOrExpr;
+
+/// One value per rotation component: a single value in 2D, three in 3D.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(untagged)]
+pub enum PerRotation {
+    /// One value (2D).
+    One(NumOrExpr),
+    /// Three values (3D).
+    Many(Vec<NumOrExpr>),
+}
+
+impl PerRotation {
+    /// The values in order.
+    pub fn values(&self) -> Vec<&NumOrExpr> {
+        match self {
+            Self::One(v) => vec![v],
+            Self::Many(v) => v.iter().collect(),
+        }
+    }
+}
+
+/// `[solver] time_integration` with a `[schedule]`.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum TimeIntegration {
+    /// Newmark average acceleration (implicit).
+    #[default]
+    Newmark,
+    /// Explicit leapfrog with sub-steps below the computed stable step.
+    Explicit,
+}

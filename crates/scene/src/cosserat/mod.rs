@@ -1,0 +1,522 @@
+//! `model = "cosserat"`: the variational DEM for Cosserat media (crate
+//! `porofrac-cosserat`) driven by a scene (SCENE-MODELS.md, "Cosserat media").
+//!
+//! * *build*: the simplex grid (`triangles` with `diagonals = "structured" | "crossed"`,
+//!   `tetrahedra`, or a file), the material of the one region, the `[[bc]]` conditions
+//!   (displacement and rotation components fixed weakly by the Nitsche terms, traction and
+//!   couple traction loaded), `[loads]` body force and couple, `[solver] penalty`;
+//! * *step*: without `[schedule]` one static solve (sparse LU); with one, Newmark average
+//!   acceleration (one factorisation for the run) or explicit leapfrog with sub-steps
+//!   below the computed stable step, from rest;
+//! * *fields*: probes and lines (`ux`, `phi`, … P1-reconstructed at the point; stresses
+//!   and couple stresses of the containing cell; `energy`, `kinetic`, `work` totals), the
+//!   VTK cell data `displacement`, `rotation`, `stress`, `couple_stress` ([`vtk`]), and
+//!   plots of σ_yy (whole grid and around its peak) and φ (2D) and of the probe series.
+
+pub mod check;
+pub mod fields;
+pub mod keys;
+pub mod vtk;
+
+#[cfg(test)]
+mod tests;
+
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::sync::Arc;
+use std::time::Instant;
+
+use porofrac_cosserat::dynamics::Dynamics;
+use porofrac_cosserat::{
+    BodyLoads, Condition, Cosserat, CosseratError, Integrator, Material, Options, SparseLu,
+    components,
+};
+use porofrac_grid::generate::perturb;
+use porofrac_grid::{Grid, Point};
+
+use crate::check::{LoadedScene, k, ki};
+use crate::continuum::grid::{AnyGrid, build_grid, point};
+use crate::driver::{Observer, drive};
+use crate::file::{DiagonalsChoice, GridKind, NumOrExpr};
+use crate::model::{Model, RunError, Sizes, StepStats};
+use crate::output::{SolverStats, Summary, WallSeconds};
+use crate::plots::{Canvas, FieldPlot, Values};
+
+use fields::Field;
+use keys::TimeIntegration;
+
+/// Run a checked cosserat scene.
+pub(crate) fn run(
+    ls: &LoadedScene,
+    out: &Path,
+    observer: &mut dyn Observer,
+) -> Result<Summary, RunError> {
+    let start = Instant::now();
+    let g = &ls.scene.grid;
+    let grid = if g.kind == GridKind::Triangles && g.diagonals == Some(DiagonalsChoice::Crossed) {
+        let ext = g.extent.clone().expect("checked");
+        let n = match &g.cells {
+            Some(crate::file::CellCount::PerAxis(v)) => [v[0] as usize, v[1] as usize],
+            _ => unreachable!("checked"),
+        };
+        let grid = porofrac_cosserat::mesh::crossed(point(&ext[0]), point(&ext[1]), n)
+            .map_err(|e| ls.error(&k(&["grid", "cells"]), e))?;
+        let amp = g.perturb.unwrap_or(0.0);
+        AnyGrid::Two(if amp > 0.0 {
+            perturb(&grid, amp, g.seed.unwrap_or(0))
+                .map_err(|e| ls.error(&k(&["grid", "perturb"]), e))?
+        } else {
+            grid
+        })
+    } else {
+        build_grid(ls)?.0
+    };
+    let grid_seconds = start.elapsed().as_secs_f64();
+    match grid {
+        AnyGrid::Two(g) => run_dim(ls, g, out, observer, start, grid_seconds),
+        AnyGrid::Three(g) => run_dim(ls, g, out, observer, start, grid_seconds),
+    }
+}
+
+/// A library error as a scene error at the key it comes from.
+fn scene_error(ls: &LoadedScene, e: CosseratError) -> RunError {
+    let material = ls.scene.region[0].material.clone().unwrap_or_default();
+    let key = match &e {
+        CosseratError::Material { name, .. } => {
+            let field = name.split(['[', ' ']).next().unwrap_or(name);
+            k(&["material", &material, field])
+        }
+        CosseratError::NotSimplex { .. } | CosseratError::NoStencil { .. } => k(&["grid", "kind"]),
+        CosseratError::Condition { index, .. } => ki("bc", *index, &[]),
+        CosseratError::Grid(_) => k(&["grid"]),
+        CosseratError::Input { .. } | CosseratError::Solve(_) => k(&["scene", "model"]),
+    };
+    RunError::Scene(ls.error(&key, format!(": {e}")))
+}
+
+fn to_field<const D: usize>(v: &NumOrExpr) -> porofrac_cosserat::Field<D> {
+    let f = v.to_field();
+    Arc::new(move |x: &Point<D>, t: f64| f.eval(x.as_slice(), t))
+}
+
+fn is_free(v: &NumOrExpr) -> bool {
+    matches!(v, NumOrExpr::Expr(s) if s == "free")
+}
+
+/// The material of the scene's one region.
+fn material(ls: &LoadedScene, d: usize) -> Result<Material, RunError> {
+    let name = ls.scene.region[0].material.clone().expect("checked");
+    let m = &ls.scene.material[&name];
+    let nu = m.poisson_ratio;
+    let g = m
+        .shear_modulus
+        .unwrap_or_else(|| m.youngs_modulus / (2.0 * (1.0 + nu)));
+    let gc = m.cosserat_shear_modulus.unwrap_or(0.0);
+    let mat = match (&m.couple_moduli, m.characteristic_length) {
+        (Some(c), _) if d == 3 => Material::with_couple_moduli(g, nu, gc, [c[0], c[1], c[2]]),
+        (_, Some(l)) => Material::with_length(g, nu, gc, l),
+        _ => unreachable!("checked: a length scale is present"),
+    }
+    .map_err(|e| scene_error(ls, e))?;
+    match (m.density, m.micro_inertia) {
+        (Some(rho), Some(j)) => mat.with_inertia(rho, j).map_err(|e| scene_error(ls, e)),
+        (Some(rho), None) => {
+            let j = mat.micro_inertia;
+            mat.with_inertia(rho, j).map_err(|e| scene_error(ls, e))
+        }
+        _ => Ok(mat),
+    }
+}
+
+fn conditions<const D: usize>(
+    ls: &LoadedScene,
+    grid: &Grid<D>,
+) -> Result<Vec<Condition<D>>, RunError> {
+    let mut out = Vec::new();
+    for (i, bc) in ls.scene.bc.iter().enumerate() {
+        let faces = grid.boundary(&bc.boundary).map_err(|e| {
+            ls.error(
+                &ki("bc", i, &["boundary"]),
+                format!("= \"{}\": {e}", bc.boundary),
+            )
+        })?;
+        let mut c = Condition::new(faces);
+        if let Some(u) = &bc.displacement {
+            for (a, v) in u.iter().enumerate().filter(|(_, v)| !is_free(v)) {
+                c = c.fix(a, to_field(v));
+            }
+        }
+        if let Some(t) = &bc.traction {
+            for (a, v) in t.iter().enumerate() {
+                c = c.load(a, to_field(v));
+            }
+        }
+        if let Some(r) = &bc.rotation {
+            for (kk, v) in r
+                .values()
+                .into_iter()
+                .enumerate()
+                .filter(|(_, v)| !is_free(v))
+            {
+                c = c.fix(D + kk, to_field(v));
+            }
+        }
+        if let Some(m) = &bc.couple_traction {
+            for (kk, v) in m.values().into_iter().enumerate() {
+                c = c.load(D + kk, to_field(v));
+            }
+        }
+        out.push(c);
+    }
+    Ok(out)
+}
+
+fn body_loads<const D: usize>(ls: &LoadedScene) -> BodyLoads<D> {
+    let mut b = BodyLoads::none();
+    if let Some(l) = &ls.scene.loads {
+        if let Some(f) = &l.body_force {
+            for (a, v) in f.iter().enumerate() {
+                b = b.with(a, to_field(v));
+            }
+        }
+        if let Some(c) = &l.body_couple {
+            for (kk, v) in c.values().into_iter().enumerate() {
+                b = b.with(D + kk, to_field(v));
+            }
+        }
+    }
+    b
+}
+
+/// How the run advances (one value per run: the size of the variants does not matter).
+#[allow(clippy::large_enum_variant)]
+enum Stepping {
+    /// One static solve (an LU factored once).
+    Static(SparseLu),
+    /// Dynamics with `substeps` integrator steps per output step.
+    Dynamic { state: Dynamics, substeps: usize },
+}
+
+/// Sample points of a line: arc length, position, cell.
+type LinePoints<const D: usize> = Vec<(f64, Point<D>, usize)>;
+
+struct Run<'a, const D: usize> {
+    ls: &'a LoadedScene,
+    model: Cosserat<D>,
+    times: Vec<f64>,
+    stepping: Stepping,
+    /// Generalised displacements of the current state.
+    w: Vec<f64>,
+    /// Cell generalised stresses of the current state.
+    stress: Vec<[f64; 18]>,
+    probes: Vec<(Field, Point<D>, usize)>,
+    lines: Vec<(Field, LinePoints<D>)>,
+    wall: WallSeconds,
+    stats: SolverStats,
+}
+
+fn run_dim<const D: usize>(
+    ls: &LoadedScene,
+    grid: Grid<D>,
+    out: &Path,
+    observer: &mut dyn Observer,
+    start: Instant,
+    grid_seconds: f64,
+) -> Result<Summary, RunError> {
+    let t_asm = Instant::now();
+    let mat = material(ls, D)?;
+    let cond = conditions(ls, &grid)?;
+    let body = body_loads::<D>(ls);
+    let options = Options {
+        penalty: ls.scene.solver.penalty.unwrap_or(1.0),
+        ..Options::default()
+    };
+    let model = Cosserat::new(grid, mat, options, &cond, body).map_err(|e| scene_error(ls, e))?;
+    let n_eq = model.equations();
+    let mut times = vec![0.0];
+    let stepping = match &ls.scene.schedule {
+        None => {
+            let mut lu = SparseLu::new(model.pattern()).map_err(|e| scene_error(ls, e))?;
+            lu.factorize(model.pattern(), &model.system_values())
+                .map_err(|e| scene_error(ls, e))?;
+            Stepping::Static(lu)
+        }
+        Some(sch) => {
+            // Uniform output steps (a dt that does not divide end_time is shortened).
+            let n = crate::check::step_count(sch) as usize;
+            let dt_out = sch.end_time / n as f64;
+            times.extend((1..=n).map(|i| i as f64 * dt_out));
+            let integ = ls.scene.solver.time_integration.unwrap_or_default();
+            let (integrator, substeps) = match integ {
+                TimeIntegration::Newmark => (Integrator::Newmark, 1),
+                TimeIntegration::Explicit => {
+                    let stable = Dynamics::stable_step(&model);
+                    (
+                        Integrator::Explicit,
+                        (dt_out / stable).ceil().max(1.0) as usize,
+                    )
+                }
+            };
+            let state = Dynamics::new(
+                &model,
+                integrator,
+                dt_out / substeps as f64,
+                0.0,
+                vec![0.0; n_eq],
+                vec![0.0; n_eq],
+            )
+            .map_err(|e| scene_error(ls, e))?;
+            Stepping::Dynamic { state, substeps }
+        }
+    };
+    let grid = model.grid();
+    let locate = |x: &Point<D>| crate::sample::locate(grid, x).map(|l| l.cell);
+    let mut probes = Vec::new();
+    for (i, p) in ls.scene.output.probe.iter().enumerate() {
+        let x = point::<D>(&p.at);
+        let cell = locate(&x)
+            .ok_or_else(|| ls.error(&ki("output.probe", i, &["at"]), "lies outside the grid"))?;
+        probes.push((Field::parse(&p.field, D).expect("checked"), x, cell));
+    }
+    let mut lines = Vec::new();
+    for (i, l) in ls.scene.output.line.iter().enumerate() {
+        let (a, b) = (point::<D>(&l.from), point::<D>(&l.to));
+        let mut pts = Vec::new();
+        for j in 0..l.points as usize {
+            let s = j as f64 / (l.points as f64 - 1.0);
+            let x = a + (b - a) * s;
+            let cell = locate(&x).ok_or_else(|| {
+                ls.error(
+                    &ki("output.line", i, &[]),
+                    format!("point {x:?} lies outside the grid"),
+                )
+            })?;
+            pts.push(((b - a).norm() * s, x, cell));
+        }
+        lines.push((Field::parse(&l.field, D).expect("checked"), pts));
+    }
+    let (linear, factorizations) = match &stepping {
+        Stepping::Static(lu) => ("sparse-lu", lu.factorizations()),
+        Stepping::Dynamic { substeps, .. } => {
+            if ls.scene.solver.time_integration == Some(TimeIntegration::Explicit) {
+                ("explicit", 0)
+            } else {
+                let _ = substeps;
+                ("sparse-lu", 1)
+            }
+        }
+    };
+    let mut run = Run {
+        ls,
+        times,
+        stepping,
+        w: vec![0.0; n_eq],
+        stress: vec![[0.0; 18]; model.grid().num_cells()],
+        probes,
+        lines,
+        wall: WallSeconds {
+            assembly: t_asm.elapsed().as_secs_f64(),
+            ..WallSeconds::default()
+        },
+        stats: SolverStats {
+            linear: linear.into(),
+            factorizations,
+            symbolic_factorizations: usize::from(factorizations > 0),
+            ..SolverStats::default()
+        },
+        model,
+    };
+    drive(ls, &mut run, out, observer, start, grid_seconds, D)
+}
+
+impl<const D: usize> Run<'_, D> {
+    fn refresh_stress(&mut self) {
+        for c in 0..self.model.grid().num_cells() {
+            self.stress[c] = self.model.cell_stress(c, &self.w);
+        }
+    }
+
+    fn value(&self, f: Field, x: &Point<D>, cell: usize) -> f64 {
+        match f {
+            Field::Dof(a) => self.model.reconstruction().p1_value(
+                self.model.grid(),
+                cell,
+                x,
+                &self.w,
+                components(D),
+                a,
+            ),
+            Field::Stress(i) => self.stress[cell][i],
+            Field::Energy => self.model.energy(&self.w),
+            Field::Kinetic => match &self.stepping {
+                Stepping::Dynamic { state, .. } => state.kinetic(),
+                Stepping::Static(_) => 0.0,
+            },
+            Field::Work => match &self.stepping {
+                Stepping::Dynamic { state, .. } => state.external_work,
+                Stepping::Static(_) => {
+                    let mut f = vec![0.0; self.w.len()];
+                    self.model.rhs(0.0, &mut f);
+                    f.iter().zip(&self.w).map(|(a, b)| a * b).sum()
+                }
+            },
+        }
+    }
+
+    fn cell_value(&self, f: Field, c: usize) -> f64 {
+        match f {
+            Field::Dof(a) => self.w[c * components(D) + a],
+            Field::Stress(i) => self.stress[c][i],
+            _ => 0.0,
+        }
+    }
+}
+
+impl<const D: usize> Model for Run<'_, D> {
+    fn times(&self) -> &[f64] {
+        &self.times
+    }
+
+    fn step(&mut self, step: usize) -> Result<StepStats, RunError> {
+        let t_solve = Instant::now();
+        let ls = self.ls;
+        match &mut self.stepping {
+            Stepping::Static(lu) => {
+                let mut x = vec![0.0; self.w.len()];
+                self.model.rhs(self.times[step], &mut x);
+                lu.solve_in_place(&mut x).map_err(|e| scene_error(ls, e))?;
+                self.w = x;
+            }
+            Stepping::Dynamic { state, substeps } => {
+                if step > 0 {
+                    for _ in 0..*substeps {
+                        state.step(&self.model).map_err(|e| scene_error(ls, e))?;
+                    }
+                }
+                self.w.clone_from(&state.u);
+            }
+        }
+        self.wall.solve += t_solve.elapsed().as_secs_f64();
+        self.refresh_stress();
+        Ok(StepStats {
+            iterations: 0,
+            failed: 0,
+        })
+    }
+
+    fn probes(&self, values: &mut Vec<f64>) {
+        values.extend(self.probes.iter().map(|(f, x, c)| self.value(*f, x, *c)));
+    }
+
+    fn line(&self, line: usize, rows: &mut Vec<Vec<f64>>) {
+        let (field, points) = &self.lines[line];
+        for (s, x, c) in points {
+            let mut r = Vec::with_capacity(D + 2);
+            r.push(*s);
+            r.extend(x.iter().copied());
+            r.push(self.value(*field, x, *c));
+            rows.push(r);
+        }
+    }
+
+    fn after_step(&mut self, _out: &Path) -> Result<(), RunError> {
+        Ok(())
+    }
+
+    fn write_vtk(&self, dir: &Path, index: usize) -> Result<String, RunError> {
+        let name = format!("step_{index:04}.vtu");
+        vtk::write(&dir.join(&name), self.model.grid(), &self.w, &self.stress)?;
+        Ok(name)
+    }
+
+    fn field_extrema(&self) -> BTreeMap<String, [f64; 2]> {
+        let mut out = BTreeMap::new();
+        let nc = self.model.grid().num_cells();
+        for name in Field::names(D) {
+            let f = Field::parse(&name, D).expect("listed");
+            let r = match f {
+                Field::Dof(_) | Field::Stress(_) => {
+                    (0..nc).fold([f64::INFINITY, f64::NEG_INFINITY], |r, c| {
+                        let v = self.cell_value(f, c);
+                        [r[0].min(v), r[1].max(v)]
+                    })
+                }
+                _ => {
+                    let v = self.value(f, self.model.grid().cell_centroid(0), 0);
+                    [v, v]
+                }
+            };
+            out.insert(name, r);
+        }
+        out
+    }
+
+    fn plots(&self, dir: &Path, written: &[f64], series: &[Vec<f64>]) -> Result<(), RunError> {
+        if !self.ls.scene.output.plots {
+            return Ok(());
+        }
+        if let Some(g2) = (self.model.grid() as &dyn std::any::Any).downcast_ref::<Grid<2>>() {
+            let canvas = Canvas::of_grid(g2);
+            let nc = g2.num_cells();
+            for (name, title) in [
+                ("syy", "σ_yy (Pa), cell values"),
+                ("phi", "φ (rad), cell values"),
+            ] {
+                let f = Field::parse(name, 2).expect("2D field");
+                let v: Vec<f64> = (0..nc).map(|c| self.cell_value(f, c)).collect();
+                crate::plots::field(
+                    &dir.join(format!("{name}.png")),
+                    &FieldPlot::new(&canvas, title, &[]),
+                    Values::Cell(&v),
+                )?;
+            }
+            // σ_yy around its peak cell (a stress concentration is small on the whole
+            // grid): a window of 40 peak-cell diameters.
+            let f = Field::parse("syy", 2).expect("2D field");
+            let v: Vec<f64> = (0..nc).map(|c| self.cell_value(f, c)).collect();
+            let peak = (0..nc).max_by(|&a, &b| v[a].total_cmp(&v[b])).unwrap_or(0);
+            let h = 20.0 * self.model.reconstruction().diameter[peak];
+            let x = g2.cell_centroid(peak);
+            let mut plot = FieldPlot::new(&canvas, "σ_yy (Pa) near its peak", &[]);
+            plot.window = Some(([x[0] - h, x[1] - h], [x[0] + h, x[1] + h]));
+            crate::plots::field(&dir.join("syy_peak.png"), &plot, Values::Cell(&v))?;
+        }
+        if written.len() > 1 && !self.probes.is_empty() {
+            let columns: Vec<(String, Vec<f64>)> = self
+                .ls
+                .scene
+                .output
+                .probe
+                .iter()
+                .enumerate()
+                .map(|(i, p)| (p.name.clone(), series[i].clone()))
+                .collect();
+            crate::plots::time_series(&dir.join("probes.png"), written, &columns, "probes")?;
+        }
+        Ok(())
+    }
+
+    fn sizes(&self) -> Sizes {
+        Sizes {
+            cells: self.model.grid().num_cells(),
+            nodes: self.model.grid().num_nodes(),
+            dofs: self.model.equations(),
+        }
+    }
+
+    fn failed(&self) -> usize {
+        0
+    }
+
+    fn solver_stats(&self) -> SolverStats {
+        self.stats.clone()
+    }
+
+    fn errors(&self) -> Result<BTreeMap<String, f64>, RunError> {
+        Ok(BTreeMap::new())
+    }
+
+    fn wall_seconds(&self) -> WallSeconds {
+        self.wall
+    }
+}
