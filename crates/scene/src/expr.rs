@@ -455,7 +455,7 @@ impl Expr {
 }
 
 /// Points evaluated together by [`Program::eval_points`].
-pub const LANES: usize = 8;
+pub const LANES: usize = 32;
 
 /// Several expressions compiled into one program that evaluates every common
 /// subexpression once (the components of a body force share `sin(pi*x)`, ...).
