@@ -197,7 +197,8 @@ fn len_is(ls: &LoadedScene, path: &[KeyPart], got: usize, want: usize) -> Result
     Ok(())
 }
 
-fn expr_ok(
+/// A number (finite) or an expression that parses (or `"free"` where allowed).
+pub(crate) fn expr_ok(
     ls: &LoadedScene,
     path: &[KeyPart],
     v: &NumOrExpr,

@@ -186,5 +186,6 @@ pub(crate) fn drive(
         field_extrema: extrema,
         errors,
         version: env!("CARGO_PKG_VERSION").into(),
+        extra: model.summary_extras(),
     })
 }

@@ -101,6 +101,11 @@ pub trait Model {
     fn errors(&self) -> Result<BTreeMap<String, f64>, RunError>;
     /// Wall time of the model's phases so far (assembly, solve, flow, its own output).
     fn wall_seconds(&self) -> WallSeconds;
+    /// Keys of the model's own in `summary.json`, besides the shared ones (none by
+    /// default).
+    fn summary_extras(&self) -> serde_json::Map<String, serde_json::Value> {
+        serde_json::Map::new()
+    }
 }
 
 /// Run a validated scene: dispatch on `[scene] model`, in the thread pool the scene asks
@@ -133,10 +138,8 @@ fn run_model(
 ) -> Result<Summary, RunError> {
     let summary = match ls.model() {
         "continuum" => crate::continuum::run(ls, laws, out, observer)?,
-        // Writes its own summary.json (the particle statistics on top of the shared keys).
-        "nscd" => return crate::nscd::run(ls, out, observer),
-        // Writes its own summary.json (with the `lattice` block and `mlups`).
-        "lbm" => return crate::lbm::run(ls, out, observer),
+        "nscd" => crate::nscd::run(ls, out, observer)?,
+        "lbm" => crate::lbm::run(ls, out, observer)?,
         "cosserat" => crate::cosserat::run(ls, out, observer)?,
         other => {
             return Err(ls

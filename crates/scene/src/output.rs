@@ -182,6 +182,11 @@ pub struct Summary {
     pub errors: std::collections::BTreeMap<String, f64>,
     /// porofrac version.
     pub version: String,
+    /// Keys a model adds ([`crate::model::Model::summary_extras`]: the `lattice` block
+    /// and `mlups` of the lattice Boltzmann model, the particle statistics of contact
+    /// dynamics).
+    #[serde(flatten)]
+    pub extra: serde_json::Map<String, serde_json::Value>,
 }
 
 impl Summary {
@@ -238,6 +243,7 @@ pub(crate) fn write_failed_summary(
         field_extrema: Default::default(),
         errors: Default::default(),
         version: env!("CARGO_PKG_VERSION").into(),
+        extra: serde_json::Map::new(),
     };
     let _ = summary.write(out);
 }

@@ -1,8 +1,7 @@
 //! Checks of a `model = "cosserat"` scene (SCENE-MODELS.md, "Cosserat media"), and the
 //! refusal of the Cosserat keys in continuum scenes. Every problem names its key.
 
-use crate::check::{LoadedScene, SceneError, k, ki};
-use crate::expr::Expr;
+use crate::check::{LoadedScene, SceneError, expr_ok, k, ki};
 use crate::file::{DiagonalsChoice, GridKind, KeyPart, NumOrExpr, Select};
 
 use super::fields::Field;
@@ -96,24 +95,6 @@ fn len_is(ls: &LoadedScene, path: &[KeyPart], got: usize, want: usize) -> Result
         ));
     }
     Ok(())
-}
-
-fn expr_ok(
-    ls: &LoadedScene,
-    path: &[KeyPart],
-    v: &NumOrExpr,
-    allow_free: bool,
-) -> Result<(), SceneError> {
-    match v {
-        NumOrExpr::Num(x) if !x.is_finite() => {
-            Err(ls.error(path, format!("= {x} is not a finite number")))
-        }
-        NumOrExpr::Num(_) => Ok(()),
-        NumOrExpr::Expr(s) if allow_free && s == "free" => Ok(()),
-        NumOrExpr::Expr(s) => Expr::parse(s)
-            .map(|_| ())
-            .map_err(|e| ls.error(path, format!("= \"{s}\": bad expression at {e}"))),
-    }
 }
 
 fn per_rotation(

@@ -144,37 +144,7 @@ pub(crate) fn run(
     let start = Instant::now();
     let mut model = build(ls)?;
     let build_seconds = start.elapsed().as_secs_f64();
-    let summary = drive(ls, &mut model, out, observer, start, build_seconds, 2)?;
-    let mut json = serde_json::to_value(&summary).expect("summary serializes");
-    let l = ls.scene.lbm.as_ref().expect("checked");
-    let (nx, ny) = model.lat.size();
-    let rates = model.lat.rates();
-    json["lattice"] = serde_json::json!({
-        "spacing": model.units.dx,
-        "time_step": model.units.dt,
-        "tau": model.units.tau,
-        "collision": match l.collision { CollisionChoice::Bgk => "bgk", CollisionChoice::Trt => "trt" },
-        "omega_plus": rates.plus,
-        "omega_minus": rates.minus,
-        "lattice_viscosity": (model.units.tau - 0.5) / 3.0,
-        "nodes": [nx, ny],
-        "fluid_nodes": model.lat.fluid_nodes(),
-        "lattice_steps": model.lat.steps(),
-        "mach": model.max_mach,
-        "mach_limit": MAX_MACH,
-        "velocity_unit": model.units.dx / model.units.dt,
-        "streaming": "aa (in place, one population array)",
-        "population_bytes": model.lat.population_bytes(),
-    });
-    let mlups = if model.stepping_seconds > 0.0 {
-        model.fluid_updates / model.stepping_seconds / 1e6
-    } else {
-        0.0
-    };
-    json["mlups"] = serde_json::json!(mlups);
-    let text = serde_json::to_string_pretty(&json).expect("summary serializes");
-    write_atomic(&out.join("summary.json"), text.as_bytes())?;
-    Ok(summary)
+    drive(ls, &mut model, out, observer, start, build_seconds, 2)
 }
 
 fn build(ls: &LoadedScene) -> Result<LbmModel<'_>, RunError> {
@@ -538,6 +508,37 @@ impl LbmModel<'_> {
 }
 
 impl Model for LbmModel<'_> {
+    fn summary_extras(&self) -> serde_json::Map<String, serde_json::Value> {
+        let mut json = serde_json::Map::new();
+        let l = self.ls.scene.lbm.as_ref().expect("checked");
+        let (nx, ny) = self.lat.size();
+        let rates = self.lat.rates();
+        json.insert("lattice".into(), serde_json::json!({
+        "spacing": self.units.dx,
+        "time_step": self.units.dt,
+        "tau": self.units.tau,
+        "collision": match l.collision { CollisionChoice::Bgk => "bgk", CollisionChoice::Trt => "trt" },
+        "omega_plus": rates.plus,
+        "omega_minus": rates.minus,
+        "lattice_viscosity": (self.units.tau - 0.5) / 3.0,
+        "nodes": [nx, ny],
+        "fluid_nodes": self.lat.fluid_nodes(),
+        "lattice_steps": self.lat.steps(),
+        "mach": self.max_mach,
+        "mach_limit": MAX_MACH,
+        "velocity_unit": self.units.dx / self.units.dt,
+        "streaming": "aa (in place, one population array)",
+        "population_bytes": self.lat.population_bytes(),
+    }));
+        let mlups = if self.stepping_seconds > 0.0 {
+            self.fluid_updates / self.stepping_seconds / 1e6
+        } else {
+            0.0
+        };
+        json.insert("mlups".into(), serde_json::json!(mlups));
+        json
+    }
+
     fn times(&self) -> &[f64] {
         &self.times
     }

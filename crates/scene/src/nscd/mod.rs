@@ -33,7 +33,7 @@ use porofrac_particles::{Disks, RandomPacking, TrackedCell};
 use crate::check::{LoadedScene, SceneError, k, ki, step_count};
 use crate::driver::{Observer, drive};
 use crate::model::{Model, RunError, Sizes, StepStats};
-use crate::output::{SolverStats, Summary, WallSeconds, write_atomic};
+use crate::output::{SolverStats, Summary, WallSeconds};
 
 use file::{OrderingChoice, ParticleKind, WallComponent};
 
@@ -46,16 +46,7 @@ pub(crate) fn run(
     let start = Instant::now();
     let mut model = build(ls)?;
     let build_seconds = start.elapsed().as_secs_f64();
-    let summary = drive(ls, &mut model, out, observer, start, build_seconds, 2)?;
-    let mut json = serde_json::to_value(&summary).expect("summary serializes");
-    if let Some(map) = json.as_object_mut() {
-        for (key, value) in model.summary_extras() {
-            map.insert(key.into(), value);
-        }
-    }
-    let text = serde_json::to_string_pretty(&json).expect("summary serializes");
-    write_atomic(&out.join("summary.json"), text.as_bytes())?;
-    Ok(summary)
+    drive(ls, &mut model, out, observer, start, build_seconds, 2)
 }
 
 /// What a probe reads.
@@ -296,7 +287,7 @@ impl NscdModel<'_> {
     }
 
     /// Keys added to `summary.json`.
-    fn summary_extras(&self) -> Vec<(&'static str, serde_json::Value)> {
+    fn particle_statistics(&self) -> Vec<(&'static str, serde_json::Value)> {
         let st = &self.stats;
         let mean = if st.steps > 0 {
             st.sweeps as f64 / st.steps as f64
@@ -326,6 +317,13 @@ impl NscdModel<'_> {
 }
 
 impl Model for NscdModel<'_> {
+    fn summary_extras(&self) -> serde_json::Map<String, serde_json::Value> {
+        self.particle_statistics()
+            .into_iter()
+            .map(|(k, v)| (k.to_string(), v))
+            .collect()
+    }
+
     fn times(&self) -> &[f64] {
         &self.times
     }
