@@ -11,20 +11,10 @@
 
 mod common;
 
-use common::{porofrac, read_csv, tmp_dir};
+use common::read_csv;
 
 fn run(name: &str, text: &str) -> (i32, String, std::path::PathBuf) {
-    let dir = tmp_dir(name);
-    let path = dir.join(format!("{name}.toml"));
-    std::fs::write(&path, text).unwrap();
-    let out = dir.join("out");
-    let (code, _, err) = porofrac(&[
-        "run",
-        path.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    (code, err, out)
+    common::run_text(name, text)
 }
 
 fn well_scene(well: &str) -> String {

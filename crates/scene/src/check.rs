@@ -197,6 +197,32 @@ fn len_is(ls: &LoadedScene, path: &[KeyPart], got: usize, want: usize) -> Result
     Ok(())
 }
 
+/// The part of `[[output.line]]` number `i` every model checks alike: `points` in
+/// `2..=MAX_LINE_POINTS` and a name that is a file name.
+pub(crate) fn line_points_and_name(
+    ls: &LoadedScene,
+    i: usize,
+    l: &crate::file::Line,
+) -> Result<(), SceneError> {
+    if !(2..=crate::limits::MAX_LINE_POINTS as i64).contains(&l.points) {
+        return Err(ls.error(
+            &ki("output.line", i, &["points"]),
+            format!(
+                "= {} must be in 2..={}",
+                l.points,
+                crate::limits::MAX_LINE_POINTS
+            ),
+        ));
+    }
+    if l.name.is_empty() || l.name.contains(['/', '\\']) {
+        return Err(ls.error(
+            &ki("output.line", i, &["name"]),
+            "must be a non-empty file name",
+        ));
+    }
+    Ok(())
+}
+
 /// A number (finite) or an expression that parses (or `"free"` where allowed).
 pub(crate) fn expr_ok(
     ls: &LoadedScene,
@@ -543,28 +569,7 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
         field_ok(&l.field, ki("output.line", i, &["field"]))?;
         len_is(ls, &ki("output.line", i, &["from"]), l.from.len(), d)?;
         len_is(ls, &ki("output.line", i, &["to"]), l.to.len(), d)?;
-        if l.points < 2 {
-            return Err(ls.error(
-                &ki("output.line", i, &["points"]),
-                format!("= {} must be ≥ 2", l.points),
-            ));
-        }
-        if l.points as u64 > crate::limits::MAX_LINE_POINTS {
-            return Err(ls.error(
-                &ki("output.line", i, &["points"]),
-                format!(
-                    "= {} is more than the {} points a line may have",
-                    l.points,
-                    crate::limits::MAX_LINE_POINTS
-                ),
-            ));
-        }
-        if l.name.is_empty() || l.name.contains(['/', '\\']) {
-            return Err(ls.error(
-                &ki("output.line", i, &["name"]),
-                "must be a non-empty file name",
-            ));
-        }
+        line_points_and_name(ls, i, l)?;
     }
     check_wells(ls, d)?;
     check_sizes(ls, d)?;

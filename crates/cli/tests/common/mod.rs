@@ -42,6 +42,22 @@ pub fn run_ok(scene: &Path, out: &Path) {
     assert_eq!(code, 0, "{}: {err}", scene.display());
 }
 
+/// Write `text` as the scene `<name>.toml` in a fresh directory and run it into `out/`
+/// there: exit status, stderr and the output directory.
+pub fn run_text(name: &str, text: &str) -> (i32, String, PathBuf) {
+    let dir = tmp_dir(name);
+    let path = dir.join(format!("{name}.toml"));
+    std::fs::write(&path, text).unwrap();
+    let out = dir.join("out");
+    let (code, _, err) = porofrac(&[
+        "run",
+        path.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    (code, err, out)
+}
+
 /// Header and numeric rows of a CSV file.
 pub fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
     let text = std::fs::read_to_string(path).unwrap();

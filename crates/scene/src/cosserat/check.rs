@@ -356,22 +356,7 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
         Field::parse(&l.field, d).map_err(|e| ls.error(&ki("output.line", i, &["field"]), e))?;
         len_is(ls, &ki("output.line", i, &["from"]), l.from.len(), d)?;
         len_is(ls, &ki("output.line", i, &["to"]), l.to.len(), d)?;
-        if l.points < 2 || l.points as u64 > crate::limits::MAX_LINE_POINTS {
-            return Err(ls.error(
-                &ki("output.line", i, &["points"]),
-                format!(
-                    "= {} must be in 2..={}",
-                    l.points,
-                    crate::limits::MAX_LINE_POINTS
-                ),
-            ));
-        }
-        if l.name.is_empty() || l.name.contains(['/', '\\']) {
-            return Err(ls.error(
-                &ki("output.line", i, &["name"]),
-                "must be a non-empty file name",
-            ));
-        }
+        crate::check::line_points_and_name(ls, i, l)?;
     }
     Ok(())
 }

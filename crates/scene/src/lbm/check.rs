@@ -481,19 +481,7 @@ fn check_output(
                 return Err(ls.error(&lk(f), "must be two finite numbers (m)"));
             }
         }
-        if !(2..=crate::limits::MAX_LINE_POINTS as i64).contains(&l.points) {
-            return Err(ls.error(
-                &lk("points"),
-                format!(
-                    "= {} must be in 2..={}",
-                    l.points,
-                    crate::limits::MAX_LINE_POINTS
-                ),
-            ));
-        }
-        if l.name.is_empty() || l.name.contains(['/', '\\']) {
-            return Err(ls.error(&lk("name"), "must be a non-empty file name"));
-        }
+        crate::check::line_points_and_name(ls, i, l)?;
     }
     Ok(())
 }

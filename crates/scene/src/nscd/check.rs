@@ -464,19 +464,7 @@ fn check_output(ls: &LoadedScene) -> Result<(), SceneError> {
         if l.from.len() != 2 || l.to.len() != 2 {
             return Err(ls.error(&key("from"), "and to must be [x, y]"));
         }
-        if l.points < 2 || l.points as u64 > crate::limits::MAX_LINE_POINTS {
-            return Err(ls.error(
-                &key("points"),
-                format!(
-                    "= {} must be in 2..={}",
-                    l.points,
-                    crate::limits::MAX_LINE_POINTS
-                ),
-            ));
-        }
-        if l.name.is_empty() || l.name.contains(['/', '\\']) {
-            return Err(ls.error(&key("name"), "must be a non-empty file name"));
-        }
+        crate::check::line_points_and_name(ls, i, l)?;
     }
     Ok(())
 }
