@@ -61,7 +61,10 @@ fn small_borehole_scene_runs_and_logs_broken_bonds() {
     let particles = s["particles"].as_u64().unwrap();
     let bonds = s["bonds"].as_u64().unwrap();
     let broken = s["broken_bonds"].as_u64().unwrap();
-    assert!(particles > 50 && bonds > 2 * particles, "{particles} particles, {bonds} bonds");
+    assert!(
+        particles > 50 && bonds > 2 * particles,
+        "{particles} particles, {bonds} bonds"
+    );
     assert!(broken > 0, "the pressure ramp breaks bonds");
     assert_eq!(
         broken,
@@ -81,7 +84,12 @@ fn small_borehole_scene_runs_and_logs_broken_bonds() {
     assert_eq!(header, ["time", "pressure", "broken", "x0"]);
     assert_eq!(rows[0][1], 0.0);
     assert!((rows.last().unwrap()[1] - 2.5e7 * 0.15).abs() < 1.0);
-    for f in ["vtk/particles_0000.vtp", "vtk/contacts_0000.vtp", "plots/particles.png", "plots/breakage.png"] {
+    for f in [
+        "vtk/particles_0000.vtp",
+        "vtk/contacts_0000.vtp",
+        "plots/particles.png",
+        "plots/breakage.png",
+    ] {
         assert!(out.join(f).exists(), "{f}");
     }
     let vtp = std::fs::read_to_string(out.join("vtk/particles_0003.vtp")).unwrap();
@@ -91,12 +99,32 @@ fn small_borehole_scene_runs_and_logs_broken_bonds() {
 #[test]
 fn bad_lsm_input_names_the_key() {
     let cases = [
-        ("[lsm]\ndamping = \"local\"\ndamping_coefficient = 0.7", "[lsm]\ndt = 1.0\n", "lsm.dt"),
-        ("poisson_ratio = 0.2\n", "poisson_ratio = 0.2\nkn = -1.0\n", "bonds.kn"),
-        ("youngs_modulus = 1.0e9\npoisson_ratio = 0.2\n", "kn = -1.0e9\n", "bonds.kn"),
-        ("friction_angle = 30.0\n", "friction_angle = 30.0\nstiffness = 1\n", "stiffness"),
+        (
+            "[lsm]\ndamping = \"local\"\ndamping_coefficient = 0.7",
+            "[lsm]\ndt = 1.0\n",
+            "lsm.dt",
+        ),
+        (
+            "poisson_ratio = 0.2\n",
+            "poisson_ratio = 0.2\nkn = -1.0\n",
+            "bonds.kn",
+        ),
+        (
+            "youngs_modulus = 1.0e9\npoisson_ratio = 0.2\n",
+            "kn = -1.0e9\n",
+            "bonds.kn",
+        ),
+        (
+            "friction_angle = 30.0\n",
+            "friction_angle = 30.0\nstiffness = 1\n",
+            "stiffness",
+        ),
         ("[schedule]", "[contact]\nmu = 0.3\n\n[schedule]", "contact"),
-        ("poisson_ratio = 0.2\n", "poisson_ratio = 0.4\n", "bonds.poisson_ratio"),
+        (
+            "poisson_ratio = 0.2\n",
+            "poisson_ratio = 0.4\n",
+            "bonds.poisson_ratio",
+        ),
     ];
     for (from, to, key) in cases {
         assert!(SCENE.contains(from), "{from}");
@@ -113,7 +141,10 @@ fn bad_lsm_input_names_the_key() {
     let listed = listed.replace("[loading]\npressure_rate = 2.5e7\n", "");
     let (code, err, _) = run_text("lsm_overlap", &listed);
     assert_ne!(code, 0);
-    assert!(err.contains("particles") && err.contains("overlap"), "{err}");
+    assert!(
+        err.contains("particles") && err.contains("overlap"),
+        "{err}"
+    );
     // An lsm section in another model's scene.
     let (code, err, _) = run_text(
         "lsm_in_nscd",
