@@ -71,7 +71,7 @@ impl BondLaw {
                 ));
             }
         }
-        if !(self.friction_angle >= 0.0 && self.friction_angle < std::f64::consts::FRAC_PI_2) {
+        if !(0.0..std::f64::consts::FRAC_PI_2).contains(&self.friction_angle) {
             return Err(LsmError::bad(
                 "bonds.friction_angle",
                 self.friction_angle,

@@ -501,7 +501,7 @@ impl Region {
                 if v.len() < 3 {
                     return bad("polygon", v.len() as f64, "needs at least 3 vertices");
                 }
-                if !(self.area() > 0.0) {
+                if self.area().is_nan() || self.area() <= 0.0 {
                     return bad("polygon", 0.0, "has zero area");
                 }
             }
