@@ -336,7 +336,11 @@ def hole_scf(nu, n, r, length):
 
 
 def main():
+    if len(sys.argv) != 5:
+        sys.exit("usage: python dem.py MESH.vtu R R_OVER_L N")
     path, r, rl, n_cos = sys.argv[1], float(sys.argv[2]), float(sys.argv[3]), float(sys.argv[4])
+    if not (r > 0 and rl > 0 and 0 <= n_cos < 1):
+        sys.exit(f"need R > 0, R_OVER_L > 0 and 0 <= N < 1, got {r}, {rl}, {n_cos}")
     t = time.perf_counter()
     pts, tri = read_triangles(path)
     t_read = time.perf_counter() - t

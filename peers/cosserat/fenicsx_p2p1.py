@@ -39,7 +39,11 @@ SIDE, G, NU = 16.2, 1e3, 0.3
 
 
 def main():
+    if len(sys.argv) != 5:
+        sys.exit("usage: python fenicsx_p2p1.py MESH.vtu R R_OVER_L N")
     path, r, rl, n_cos = sys.argv[1], float(sys.argv[2]), float(sys.argv[3]), float(sys.argv[4])
+    if not (r > 0 and rl > 0 and 0 <= n_cos < 1):
+        sys.exit(f"need R > 0, R_OVER_L > 0 and 0 <= N < 1, got {r}, {rl}, {n_cos}")
     comm = MPI.COMM_WORLD
     pts, tri = read_triangles(path)
     coord = basix.ufl.element("Lagrange", "triangle", 1, shape=(2,))
