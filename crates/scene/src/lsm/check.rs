@@ -2,7 +2,7 @@
 //! and the model named, every value checked (the bond law is built here, so that a bad
 //! stiffness or strength names its key).
 
-use crate::check::{LoadedScene, SceneError, k, step_count_f64};
+use crate::check::{LoadedScene, SceneError, k};
 use crate::file::KeyPart;
 use porofrac_lsm::{BondLaw, LsmError};
 
@@ -320,32 +320,6 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
             positive(ls, &key("pressure_max"), m)?;
         }
     }
-    let Some(sch) = &s.schedule else {
-        return Err(ls.error(
-            &k(&["schedule"]),
-            "is missing: model \"lsm\" needs end_time and dt or steps",
-        ));
-    };
-    positive(ls, &k(&["schedule", "end_time"]), sch.end_time)?;
-    match (sch.dt, sch.steps) {
-        (Some(dt), _) => positive(ls, &k(&["schedule", "dt"]), dt)?,
-        (None, Some(n)) if n >= 1 => {}
-        (None, Some(n)) => {
-            return Err(ls.error(&k(&["schedule", "steps"]), format!("= {n} must be ≥ 1")));
-        }
-        (None, None) => {
-            return Err(ls.error(&k(&["schedule", "dt"]), "is missing: give dt or steps"));
-        }
-    }
-    let n = step_count_f64(sch);
-    if n > crate::limits::MAX_STEPS as f64 {
-        return Err(ls.error(
-            &k(&["schedule", if sch.dt.is_some() { "dt" } else { "steps" }]),
-            format!(
-                "gives {n:.3e} output steps, more than the {} a run may take",
-                crate::limits::MAX_STEPS
-            ),
-        ));
-    }
+    crate::nscd::check::check_particle_schedule(ls, "lsm")?;
     crate::nscd::check::check_output_of(ls, "lsm", &CELL_FIELDS, &GLOBAL_FIELDS)
 }

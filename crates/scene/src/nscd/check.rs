@@ -191,11 +191,17 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
             }
         }
     }
-    // Schedule.
-    let Some(sch) = &s.schedule else {
+    check_particle_schedule(ls, "nscd")?;
+    check_output_of(ls, "nscd", &CELL_FIELDS, &[])
+}
+
+/// The `[schedule]` of a particle model: present, `end_time > 0`, `dt > 0` or `steps ≥ 1`,
+/// and no more output steps than a run may take.
+pub(crate) fn check_particle_schedule(ls: &LoadedScene, model: &str) -> Result<(), SceneError> {
+    let Some(sch) = &ls.scene.schedule else {
         return Err(ls.error(
             &k(&["schedule"]),
-            "is missing: model \"nscd\" needs end_time and dt or steps",
+            format!("is missing: model \"{model}\" needs end_time and dt or steps"),
         ));
     };
     positive(ls, &k(&["schedule", "end_time"]), sch.end_time)?;
@@ -219,7 +225,7 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
             ),
         ));
     }
-    check_output_of(ls, "nscd", &CELL_FIELDS, &[])
+    Ok(())
 }
 
 fn check_walls(ls: &LoadedScene) -> Result<(), SceneError> {
