@@ -518,6 +518,17 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
             format!("= {a} must be an angle in (0, 90] degrees"),
         ));
     }
+    if let Some(r) = s.physics.crack_exclusion {
+        if !(r.is_finite() && r >= 0.0) {
+            return Err(ls.error(
+                &k(&["physics", "crack_exclusion"]),
+                format!("= {r} must be a distance ≥ 0 (m)"),
+            ));
+        }
+        if s.physics.crack_tracking.is_none() {
+            return Err(ls.error(&k(&["physics", "crack_exclusion"]), "needs crack_tracking"));
+        }
+    }
     if let Some(r) = s.physics.open_edge_stiffness
         && !(r.is_finite() && (0.0..1.0).contains(&r))
     {

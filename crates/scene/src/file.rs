@@ -552,6 +552,8 @@ pub struct Physics {
     pub open_edge_stiffness: Option<f64>,
     /// Crack tracking angle in degrees (absent: no tracking).
     pub crack_tracking: Option<f64>,
+    /// Crack tracking: no new crack within this distance (m) of a failed cell (default 0).
+    pub crack_exclusion: Option<f64>,
 }
 
 /// `[solver]`.

@@ -22,8 +22,9 @@
 //! area below the equilateral triangle of side `s`: the triangles grade from `s_w` on the
 //! wall to `s` at the interface. The disc inside the polygon is triangulated the same way.
 //!
-//! Cells are numbered coarse first (x fastest, zone cells skipped), then the triangles in
-//! the triangulation's order (deterministic: the insertion order is fixed). Tags: the
+//! Cells are numbered coarse first (x fastest, zone cells skipped), then the triangles by
+//! their centroids row by row (y, then x); the Steiner points likewise (a banded
+//! numbering, as on a lattice). Tags: the
 //! triangles get [`REFINED_TAG`]; the triangles inside the well polygon get `well_tag`.
 
 use spade::{ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation};
@@ -301,14 +302,24 @@ pub fn round_well(spec: &RoundWellSpec) -> Result<Grid<2>> {
             "round well grid: the refinement did not complete".into(),
         ));
     }
+    // The Steiner points and then the triangles are numbered row by row (y, then x), as
+    // on a lattice: a banded numbering keeps the fill of the factorizations low.
     node_of.resize(cdt.num_vertices(), usize::MAX);
-    for v in cdt.vertices() {
-        let i = v.fix().index();
-        if node_of[i] == usize::MAX {
-            let p = v.position();
-            node_of[i] = nodes.len();
-            nodes.push(Point::<2>::new(p.x, p.y));
-        }
+    let mut steiner: Vec<(usize, Point<2>)> = cdt
+        .vertices()
+        .filter(|v| node_of[v.fix().index()] == usize::MAX)
+        .map(|v| {
+            (
+                v.fix().index(),
+                Point::<2>::new(v.position().x, v.position().y),
+            )
+        })
+        .collect();
+    let row_order = |a: &Point<2>, b: &Point<2>| a[1].total_cmp(&b[1]).then(a[0].total_cmp(&b[0]));
+    steiner.sort_by(|a, b| row_order(&a.1, &b.1));
+    for (i, p) in steiner {
+        node_of[i] = nodes.len();
+        nodes.push(p);
     }
     // Inside the regular polygon: the centroid's projection on its sector's mid-direction
     // is below the apothem.
@@ -320,10 +331,16 @@ pub fn round_well(spec: &RoundWellSpec) -> Result<Grid<2>> {
         let mid = ((phi / sector).floor() + 0.5) * sector;
         d[0] * mid.cos() + d[1] * mid.sin() < apothem
     };
+    let mut triangles: Vec<([usize; 3], Point<2>)> = cdt
+        .inner_faces()
+        .map(|f| {
+            let t = f.vertices().map(|v| node_of[v.fix().index()]);
+            (t, (nodes[t[0]] + nodes[t[1]] + nodes[t[2]]) / 3.0)
+        })
+        .collect();
+    triangles.sort_by(|a, b| row_order(&a.1, &b.1));
     let mut well = Vec::new();
-    for f in cdt.inner_faces() {
-        let [a, b, cc] = f.vertices().map(|v| node_of[v.fix().index()]);
-        let centroid = (nodes[a] + nodes[b] + nodes[cc]) / 3.0;
+    for ([a, b, cc], centroid) in triangles {
         if in_well(centroid) {
             well.push(pos.len() - 1);
         }
