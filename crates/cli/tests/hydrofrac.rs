@@ -23,8 +23,11 @@
 //!   is `3σh − σH − Δp` (compression positive), so the wall fails at
 //!   `Δp_b = 3σh − σH + T = 3 · 4.29e6 − 1e7 + 2e5 = 3.06e6 Pa` above p₀ (in total
 //!   stresses the classical `p_b = 3S_h − S_H + T − p₀`, the same 1.306e7 Pa). With steps
-//!   of 10 s, the well pressure of the step at which the first cell fails is within 15 %
-//!   of `p_b` and the first failures lie within 20° of the top or bottom of the well.
+//!   of 10 s, the well pressure of the step at which the first cell fails approaches `p_b`
+//!   as the wall cells shrink (`well_size` 0.02 then 0.01 m) and is within 15 % of it on
+//!   the finer wall; the first failures lie within 20° of the top or bottom of the well.
+//!   (The failing cell's recovered stress averages the hoop stress over a cell: on the
+//!   scene's 1/24 m wall the first failure comes 26 % above `p_b`.)
 //! * **3D** (`scenes/hydrofrac_3d.toml`, a vertical well section, shortened to 15 minutes
 //!   of injection for the test): the fracture is a vertical plane normal to x, the least
 //!   compressive stress, so in the x–y plane its axis is within 15° of y and it reaches at
@@ -239,9 +242,11 @@ fn load_on_the_side_gives_one_crack() {
     check_one_crack(&out, 0.0, 1.0 / 12.0);
 }
 
-#[test]
-fn breakdown_pressure_is_hubbert_willis_at_the_top_of_the_well() {
-    let dir = tmp_dir("hydrofrac-breakdown");
+/// The well pressure at the first failure and the first failed cells, for the seed's
+/// scene with `well_size` on the wall, steps of 10 s over 240 s.
+fn breakdown(well_size: f64) -> (f64, Vec<[f64; 3]>) {
+    let dir = tmp_dir(&format!("hydrofrac-breakdown-{well_size}"));
+    let size = format!("well_radius = 0.25\nwell_size = {well_size}");
     let scene = variant(
         &dir,
         &seed_scene(),
@@ -249,13 +254,11 @@ fn breakdown_pressure_is_hubbert_willis_at_the_top_of_the_well() {
             ("end_time = 2400.0", "end_time = 240.0"),
             ("dt = 60.0", "dt = 10.0"),
             ("every = 10", "every = 1"),
+            ("well_radius = 0.25", &size),
         ],
     );
     let out = dir.join("out");
     run_ok(&scene, &out);
-    let (s_v, nu, t, p0) = (1.0e7, 0.3, 2.0e5, 1.0e7);
-    let s_h = nu / (1.0 - nu) * s_v;
-    let p_b = p0 + 3.0 * s_h - s_v + t;
     let f = fractures(&out);
     assert!(!f.is_empty(), "nothing failed within 240 s");
     let first = f.iter().map(|p| p[2]).fold(f64::INFINITY, f64::min);
@@ -264,20 +267,37 @@ fn breakdown_pressure_is_hubbert_willis_at_the_top_of_the_well() {
         .iter()
         .find(|r| r[0] == first)
         .expect("probe at the first failure")[1];
-    assert!(
-        (p - p_b).abs() <= 0.15 * p_b,
-        "well pressure {p} Pa at the first failure (t = {first} s), Hubbert–Willis {p_b} Pa"
-    );
-    for q in f.iter().filter(|q| q[2] == first) {
-        let from_y = (q[0] - CENTER[0])
-            .atan2((q[1] - CENTER[1]).abs())
-            .to_degrees()
-            .abs();
-        assert!(
-            from_y <= 20.0,
-            "first failure at {q:?}, {from_y}° from the top or bottom"
-        );
+    (p, f.into_iter().filter(|q| q[2] == first).collect())
+}
+
+#[test]
+fn breakdown_pressure_is_hubbert_willis_at_the_top_of_the_well() {
+    let (s_v, nu, t, p0) = (1.0e7, 0.3, 2.0e5, 1.0e7);
+    let s_h = nu / (1.0 - nu) * s_v;
+    let p_b = p0 + 3.0 * s_h - s_v + t;
+    let mut errors = Vec::new();
+    for well_size in [0.02, 0.01] {
+        let (p, first) = breakdown(well_size);
+        for q in &first {
+            let from_y = (q[0] - CENTER[0])
+                .atan2((q[1] - CENTER[1]).abs())
+                .to_degrees()
+                .abs();
+            assert!(
+                from_y <= 20.0,
+                "first failure at {q:?}, {from_y}° from the top or bottom"
+            );
+        }
+        errors.push(((p - p_b) / p_b, p));
     }
+    eprintln!("breakdown: Hubbert–Willis {p_b} Pa, (relative error, pressure) {errors:?}");
+    // Converging as the wall cells shrink, within 15 % on the finer wall.
+    assert!(errors[1].0.abs() < errors[0].0.abs(), "{errors:?}");
+    assert!(
+        errors[1].0.abs() <= 0.15,
+        "well pressure {} Pa at the first failure, Hubbert–Willis {p_b} Pa",
+        errors[1].1
+    );
 }
 
 #[test]
