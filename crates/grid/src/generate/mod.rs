@@ -27,7 +27,7 @@ mod voronoi;
 pub use composite::{CompositeSpec, Diagonals, REFINED_TAG, composite};
 pub use extrude::extrude;
 pub use perturb::{MAX_PERTURB, perturb};
-pub use round_well::{MIN_ANGLE_DEG, MIN_WELL_NODES, RoundWellSpec, round_well};
+pub use round_well::{MIN_ANGLE_DEG, MIN_WELL_NODES, RoundWellSpec, ZoneCells, round_well};
 pub use structured::{cartesian, simplices};
 pub use tetrahedralize::{Tetrahedralized, tetrahedralize};
 pub use voronoi::{DEFAULT_LLOYD, voronoi};

@@ -41,6 +41,9 @@ pub const MIN_ANGLE_DEG: f64 = 28.0;
 /// Fewest nodes on the well circumference.
 pub const MIN_WELL_NODES: usize = 32;
 
+/// The zone as inclusive coarse cell ranges `([i0, i1], [j0, j1])`.
+pub type ZoneCells = ([usize; 2], [usize; 2]);
+
 /// Parameters of [`round_well`] (scene-file keys in brackets).
 #[derive(Clone, Debug, PartialEq)]
 pub struct RoundWellSpec {
@@ -91,7 +94,7 @@ impl RoundWellSpec {
 
     /// The zone as inclusive coarse cell ranges and the number of well nodes, after
     /// checking the spec.
-    pub fn layout(&self) -> Result<(([usize; 2], [usize; 2]), usize)> {
+    pub fn layout(&self) -> Result<(ZoneCells, usize)> {
         let bad = |what: String| Err(GridError::Input(format!("round well grid: {what}")));
         let square = CompositeSpec::new(
             self.lo,
@@ -105,7 +108,7 @@ impl RoundWellSpec {
         let zone = square.zone_cells().map_err(|e| {
             GridError::Input(e.to_string().replace("composite grid", "round well grid"))
         })?;
-        let s = self.interface_spacing(zone);
+        let s = self.interface_spacing();
         let sw = self.well_size.unwrap_or(0.5 * s);
         if !(sw.is_finite() && sw > 0.0) {
             return bad(format!("well_size must be > 0, got {sw}"));
@@ -137,7 +140,7 @@ impl RoundWellSpec {
         ]
     }
 
-    fn zone_box(&self, ([i0, i1], [j0, j1]): ([usize; 2], [usize; 2])) -> (Point<2>, Point<2>) {
+    fn zone_box(&self, ([i0, i1], [j0, j1]): ZoneCells) -> (Point<2>, Point<2>) {
         let h = self.spacing();
         let at = |i: usize, a: usize| {
             if i == self.cells[a] {
@@ -152,7 +155,7 @@ impl RoundWellSpec {
         )
     }
 
-    fn interface_spacing(&self, _zone: ([usize; 2], [usize; 2])) -> f64 {
+    fn interface_spacing(&self) -> f64 {
         let h = self.spacing();
         h[0].max(h[1]) / self.refine as f64
     }
@@ -289,7 +292,7 @@ pub fn round_well(spec: &RoundWellSpec) -> Result<Grid<2>> {
             cdt.add_constraint(lp[k], lp[(k + 1) % lp.len()]);
         }
     }
-    let s = spec.interface_spacing(zone);
+    let s = spec.interface_spacing();
     let result = cdt.refine(
         RefinementParameters::<f64>::new()
             .with_angle_limit(spade::AngleLimit::from_deg(MIN_ANGLE_DEG))
