@@ -209,7 +209,7 @@ fn seed_scene_fracture_starts_at_the_well_and_grows_along_the_largest_compressio
 
 fn side_load_scene(dir: &Path) -> PathBuf {
     variant(
-        &dir,
+        dir,
         &seed_scene(),
         &[
             (
