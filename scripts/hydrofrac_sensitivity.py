@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Grid sensitivity of the seed's hydraulic fracture (scenes/hydrofrac_seed.toml).
+"""Grid sensitivity of the seed's hydraulic fracture on the composite (staircase) well
+(scenes/hydrofrac_composite.toml, the former scenes/hydrofrac_seed.toml).
 
 Runs variants of the scene through the release binary and prints, for each, the number of
 fractured cells, the angle of the principal axis of their centroids (degrees from x; the
@@ -19,7 +20,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 BIN = ROOT / "target" / "release" / "porofrac"
-BASE = (ROOT / "scenes" / "hydrofrac_seed.toml").read_text()
+BASE = (ROOT / "scenes" / "hydrofrac_composite.toml").read_text()
 OUT = Path(sys.argv[1] if len(sys.argv) > 1 else "/tmp/hydrofrac_sensitivity")
 
 

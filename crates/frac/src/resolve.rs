@@ -101,12 +101,16 @@ pub fn resolve<const D: usize, S, E>(
                         .fold(f64::NEG_INFINITY, f64::max)
             }
         };
-        for &(c, u, mode) in &violating {
-            if u >= threshold && state.fail(c, time, mode) {
+        violating.retain(|v| v.1 >= threshold);
+        // Every crack point is taken on the lines of the cells failed before this round.
+        if let Some(t) = tracking.as_deref_mut() {
+            for &(c, _, _) in &violating {
+                t.record(c, &stress[c], state.flags());
+            }
+        }
+        for &(c, _, mode) in &violating {
+            if state.fail(c, time, mode) {
                 new_failures += 1;
-                if let Some(t) = tracking.as_deref_mut() {
-                    t.record(c, &stress[c]);
-                }
             }
         }
     }

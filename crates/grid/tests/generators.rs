@@ -1,8 +1,8 @@
 //! Generators: reproducibility, counts, hanging nodes, tags, and errors on bad input.
 
 use porofrac_grid::generate::{
-    CompositeSpec, Diagonals, MAX_PERTURB, REFINED_TAG, cartesian, composite, perturb, simplices,
-    voronoi,
+    CompositeSpec, Diagonals, MAX_PERTURB, MIN_ANGLE_DEG, MIN_WELL_NODES, REFINED_TAG,
+    RoundWellSpec, cartesian, composite, extrude, perturb, round_well, simplices, voronoi,
 };
 use porofrac_grid::{Grid, GridError, Point};
 
@@ -334,4 +334,179 @@ fn composite_rejects_bad_specs() {
         );
     }
     assert!(composite(&ok).is_ok());
+}
+
+fn round_seed_scene(refine: usize) -> RoundWellSpec {
+    RoundWellSpec::new(
+        P2::new(0.0, 0.0),
+        P2::new(30.0, 30.0),
+        [30, 30],
+        P2::new(15.0, 15.0),
+        3.0,
+        refine,
+        0.25,
+    )
+}
+
+/// Nodes of `g` on the circle |x − c| = r (to 1e-12 relative).
+fn on_circle(g: &Grid<2>, c: P2, r: f64) -> usize {
+    g.nodes()
+        .iter()
+        .filter(|p| ((*p - c).norm() - r).abs() < 1e-12 * r)
+        .count()
+}
+
+#[test]
+fn round_well_resolves_the_circle_and_refines_with_the_zone() {
+    let mut last = 0;
+    for refine in [12, 17, 24] {
+        let spec = round_seed_scene(refine);
+        let g = round_well(&spec).unwrap();
+        let n = on_circle(&g, spec.center, 0.25);
+        // Default wall size: half the interface spacing 1/refine, n a multiple of 4.
+        let want = (4 * (std::f64::consts::TAU * 0.25 * refine as f64 * 2.0 / 4.0).ceil() as usize)
+            .max(MIN_WELL_NODES);
+        assert_eq!(n, want, "refine {refine}");
+        assert!(
+            n >= MIN_WELL_NODES && n > last,
+            "refine {refine}: {n} nodes"
+        );
+        last = n;
+        // Nodes on both axes through the centre (where the hoop stress is extreme).
+        for d in [
+            P2::new(0.25, 0.0),
+            P2::new(0.0, 0.25),
+            P2::new(-0.25, 0.0),
+            P2::new(0.0, -0.25),
+        ] {
+            let q = spec.center + d;
+            assert!(
+                g.nodes().iter().any(|p| (p - q).norm() < 1e-12),
+                "node at {q:?}"
+            );
+        }
+    }
+    // An explicit wall size: 2πR / s rounded up to a multiple of 4.
+    let mut spec = round_seed_scene(12);
+    spec.well_size = Some(0.01);
+    let g = round_well(&spec).unwrap();
+    assert_eq!(on_circle(&g, spec.center, 0.25), 160);
+}
+
+#[test]
+fn round_well_areas_tags_hanging_nodes_and_grading() {
+    let refine = 12;
+    let spec = round_seed_scene(refine);
+    let g = round_well(&spec).unwrap();
+    // The box, the zone and the well polygon keep their areas.
+    assert!((total_volume(&g) - 900.0).abs() < 1e-10 * 900.0);
+    let zone = &g.cell_tags()[REFINED_TAG];
+    let coarse = 900 - 36;
+    assert_eq!(zone, &(coarse..g.num_cells()).collect::<Vec<_>>());
+    let zone_area: f64 = zone.iter().map(|&c| g.cell_volume(c)).sum();
+    assert!(
+        (zone_area - 36.0).abs() < 1e-10 * 36.0,
+        "zone area {zone_area}"
+    );
+    let n = on_circle(&g, spec.center, 0.25) as f64;
+    let polygon = 0.5 * n * 0.25f64.powi(2) * (std::f64::consts::TAU / n).sin();
+    let well = &g.cell_tags()["well"];
+    let well_area: f64 = well.iter().map(|&c| g.cell_volume(c)).sum();
+    assert!(
+        (well_area - polygon).abs() < 1e-10 * polygon,
+        "{well_area} vs {polygon}"
+    );
+    for &c in well {
+        assert!((g.cell_centroid(c) - spec.center).norm() < 0.25);
+    }
+    // Coarse cells: 4 corners + (refine − 1) hanging nodes per edge shared with the zone.
+    let mut hanging = 0;
+    for c in 0..coarse {
+        assert!((g.cell_volume(c) - 1.0).abs() < 1e-12);
+        hanging += g.cell_nodes(c).len() - 4;
+    }
+    assert_eq!(hanging, 24 * (refine - 1));
+    // Quality and grading: the smallest angle stays near the refinement's limit (the
+    // constraint loops may keep a few smaller ones), triangles are finer at the wall than at
+    // the interface, and none is larger than the interface triangle.
+    let s = 1.0 / refine as f64;
+    let mut min_angle = f64::INFINITY;
+    let mut max_area = 0.0f64;
+    let (mut near, mut far) = (Vec::new(), Vec::new());
+    for &c in zone {
+        let v = g.cell_nodes(c);
+        assert_eq!(v.len(), 3);
+        let p = [g.node(v[0]), g.node(v[1]), g.node(v[2])];
+        for k in 0..3 {
+            let (a, b) = (p[(k + 1) % 3] - p[k], p[(k + 2) % 3] - p[k]);
+            min_angle = min_angle.min(a.angle(&b).to_degrees());
+        }
+        let area = g.cell_volume(c);
+        // Refinement never splits the kept interface edges: the bound holds away from them.
+        let on_interface = p
+            .iter()
+            .any(|q| (0..2).any(|a| (q[a] - 12.0).abs() < 1e-12 || (q[a] - 18.0).abs() < 1e-12));
+        if !on_interface {
+            max_area = max_area.max(area / (0.25 * 3f64.sqrt() * s * s));
+        }
+        let d = (g.cell_centroid(c) - spec.center).norm();
+        if (0.25..0.3).contains(&d) {
+            near.push(area);
+        } else if d > 2.0 {
+            far.push(area);
+        }
+    }
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    eprintln!("smallest angle {min_angle}°, largest area / equilateral {max_area}");
+    assert!(
+        min_angle > 0.7 * MIN_ANGLE_DEG,
+        "smallest angle {min_angle}°"
+    );
+    assert!(
+        max_area <= 1.0 + 1e-9,
+        "largest triangle {max_area} × the equilateral of side s"
+    );
+    assert!(
+        mean(&near) < 0.75 * mean(&far),
+        "{} vs {}",
+        mean(&near),
+        mean(&far)
+    );
+    // Deterministic.
+    let again = round_well(&spec).unwrap();
+    assert_eq!(g.nodes(), again.nodes());
+    // Extruded: a vertical cylinder of tetrahedra in the polygon prisms' far field.
+    let g3 = extrude(&g, &[0.0, 1.0, 2.0]).unwrap();
+    assert!((g3.cell_volumes().iter().sum::<f64>() - 1800.0).abs() < 1e-9 * 1800.0);
+    let well3: f64 = g3.cell_tags()["well"]
+        .iter()
+        .map(|&c| g3.cell_volume(c))
+        .sum();
+    assert!((well3 - 2.0 * polygon).abs() < 1e-9 * polygon);
+}
+
+#[test]
+fn round_well_bad_specs_are_errors() {
+    let err = |spec: RoundWellSpec| match round_well(&spec) {
+        Err(GridError::Input(m)) => m,
+        other => panic!("expected an input error, got {other:?}"),
+    };
+    let mut s = round_seed_scene(12);
+    s.well_radius = 4.0;
+    assert!(err(s).contains("bigger than the refined zone"));
+    let mut s = round_seed_scene(12);
+    s.well_radius = 2.95;
+    assert!(err(s).contains("no room for the well"));
+    let mut s = round_seed_scene(12);
+    s.well_size = Some(0.0);
+    assert!(err(s).contains("well_size"));
+    let mut s = round_seed_scene(12);
+    s.well_radius = -1.0;
+    assert!(err(s).contains("well_radius"));
+    let mut s = round_seed_scene(0);
+    s.refine = 0;
+    assert!(err(s).contains("refine"));
+    let mut s = round_seed_scene(12);
+    s.zone_half_width = 0.0;
+    assert!(err(s).contains("zone_half_width"));
 }

@@ -10,6 +10,8 @@ use crate::file::{
     key_text, line_of_offset, locate,
 };
 use crate::laws::LawRegistry;
+use porofrac_grid::Point;
+use porofrac_grid::generate::RoundWellSpec;
 
 /// A problem in a scene file.
 #[derive(Clone, Debug, PartialEq)]
@@ -524,6 +526,17 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
             format!("= {a} must be an angle in (0, 90] degrees"),
         ));
     }
+    if let Some(r) = s.physics.crack_exclusion {
+        if !(r.is_finite() && r >= 0.0) {
+            return Err(ls.error(
+                &k(&["physics", "crack_exclusion"]),
+                format!("= {r} must be a distance ≥ 0 (m)"),
+            ));
+        }
+        if s.physics.crack_tracking.is_none() {
+            return Err(ls.error(&k(&["physics", "crack_exclusion"]), "needs crack_tracking"));
+        }
+    }
     if let Some(r) = s.physics.open_edge_stiffness
         && !(r.is_finite() && (0.0..1.0).contains(&r))
     {
@@ -674,7 +687,10 @@ fn check_grid(ls: &LoadedScene, d: usize) -> Result<(), SceneError> {
     {
         return Err(ls.error(&key("well_path"), "needs points of 3 coordinates"));
     }
-    if g.kind == GridKind::Composite {
+    if g.well_size.is_some() && g.kind != GridKind::RoundWell {
+        return Err(ls.error(&key("well_size"), "applies to round-well grids only"));
+    }
+    if matches!(g.kind, GridKind::Composite | GridKind::RoundWell) {
         for f in ["center", "zone_half_width", "refine", "well_radius"] {
             let present = match f {
                 "center" => g.center.is_some(),
@@ -683,7 +699,10 @@ fn check_grid(ls: &LoadedScene, d: usize) -> Result<(), SceneError> {
                 _ => g.well_radius.is_some(),
             };
             if !present {
-                return Err(ls.error(&key(f), "is required for kind = \"composite\""));
+                return Err(ls.error(
+                    &key(f),
+                    format!("is required for kind = \"{}\"", g.kind.as_str()),
+                ));
             }
         }
         if let Some(c) = &g.center
@@ -697,6 +716,56 @@ fn check_grid(ls: &LoadedScene, d: usize) -> Result<(), SceneError> {
                 ),
             ));
         }
+    }
+    if g.kind == GridKind::RoundWell {
+        check_round_well(ls, ext)?;
+    }
+    Ok(())
+}
+
+/// The round well's sizes, each error naming its key: positive sizes, a well inside the
+/// zone with room for one interface spacing of triangles around it.
+fn check_round_well(ls: &LoadedScene, ext: &[Vec<f64>; 2]) -> Result<(), SceneError> {
+    let g = &ls.scene.grid;
+    let key = |f: &str| k(&["grid", f]);
+    let positive = |f: &str, v: Option<f64>| match v {
+        Some(x) if !(x.is_finite() && x > 0.0) => {
+            Err(ls.error(&key(f), format!("= {x} must be a size > 0")))
+        }
+        _ => Ok(()),
+    };
+    positive("zone_half_width", g.zone_half_width)?;
+    positive("well_radius", g.well_radius)?;
+    positive("well_size", g.well_size)?;
+    let refine = g.refine.unwrap_or(0);
+    if refine < 1 {
+        return Err(ls.error(&key("refine"), format!("= {refine} must be ≥ 1")));
+    }
+    let Some(CellCount::PerAxis(n)) = &g.cells else {
+        return Ok(());
+    };
+    let c = g.center.clone().unwrap_or_default();
+    let p = |v: &[f64]| Point::<2>::new(v[0], v[1]);
+    let mut spec = RoundWellSpec::new(
+        p(&ext[0]),
+        p(&ext[1]),
+        [n[0].max(1) as usize, n[1].max(1) as usize],
+        p(&c),
+        g.zone_half_width.unwrap_or(0.0),
+        refine as usize,
+        g.well_radius.unwrap_or(0.0),
+    );
+    spec.well_size = g.well_size;
+    if let Err(e) = spec.layout() {
+        let m = e.to_string();
+        let f = if m.contains("bigger than the refined zone") {
+            "well_radius"
+        } else if m.contains("well_size") {
+            "well_size"
+        } else {
+            "zone_half_width"
+        };
+        return Err(ls.error(&key(f), m));
     }
     Ok(())
 }
@@ -850,7 +919,7 @@ fn check_sizes(ls: &LoadedScene, d: usize) -> Result<(), SceneError> {
         GridKind::Triangles => (2.0 * boxes, corners),
         GridKind::Tetrahedra => (6.0 * boxes, corners),
         GridKind::Voronoi => (boxes, 2.0 * boxes),
-        GridKind::Composite => {
+        GridKind::Composite | GridKind::RoundWell => {
             // The far field plus the refined zone (about (2 w / h · refine)² squares of
             // two triangles), extruded over cells[2] layers in 3D.
             let (nx, ny) = (per_axis[0], per_axis.get(1).copied().unwrap_or(1.0));

@@ -101,6 +101,8 @@ pub enum GridKind {
     File,
     /// A far field with a refined simplex zone around a well.
     Composite,
+    /// A far field with a zone of graded triangles around a round well.
+    RoundWell,
 }
 
 impl GridKind {
@@ -113,6 +115,7 @@ impl GridKind {
             Self::Voronoi => "voronoi",
             Self::File => "file",
             Self::Composite => "composite",
+            Self::RoundWell => "round-well",
         }
     }
 }
@@ -300,6 +303,8 @@ pub struct GridSection {
     pub well_radius: Option<f64>,
     /// Composite: name of the well tag (default `well`).
     pub well_tag: Option<String>,
+    /// Round well: edge length on the well wall (m; default half the zone's spacing).
+    pub well_size: Option<f64>,
     /// Composite: split of the fine squares.
     pub diagonals: Option<DiagonalsChoice>,
     /// Voronoi: Lloyd iterations.
@@ -555,6 +560,8 @@ pub struct Physics {
     pub open_edge_stiffness: Option<f64>,
     /// Crack tracking angle in degrees (absent: no tracking).
     pub crack_tracking: Option<f64>,
+    /// Crack tracking: no new crack within this distance (m) of a failed cell (default 0).
+    pub crack_exclusion: Option<f64>,
 }
 
 /// `[solver]`.

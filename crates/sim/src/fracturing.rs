@@ -152,6 +152,10 @@ pub struct FractureSettings {
     /// Crack tracking: the largest angle (degrees) between a crack's growth and the plane
     /// normal to `σ₁` ([`porofrac_frac::tracking`]); `None`: no tracking.
     pub tracking_angle: Option<f64>,
+    /// Crack tracking: no new crack nucleates within this distance (m) of a failed cell
+    /// ([`CrackTracking::with_exclusion_radius`]); 0: only the cells next to a crack are
+    /// excluded.
+    pub exclusion_radius: f64,
     /// Failure rounds (coupled solves with a new failure state) allowed per step.
     pub max_rounds: usize,
     /// Active-set iterations allowed per coupled solve.
@@ -170,6 +174,7 @@ impl FractureSettings {
             policy: FailurePolicy::default(),
             stress: StressMeasure::Cell,
             tracking_angle: None,
+            exclusion_radius: 0.0,
             max_rounds: 500,
             max_active_set: 30,
             active_set_tolerance: 1e-6,
@@ -208,7 +213,11 @@ impl<const D: usize> FailureResolution<D> {
         let adjacency =
             (can_fail && settings.stress == StressMeasure::Recovered).then(|| NodeCells::new(grid));
         let tracking = match (can_fail, settings.tracking_angle) {
-            (true, Some(a)) => Some(CrackTracking::new(grid, a).map_err(|e| e.to_string())?),
+            (true, Some(a)) => Some(
+                CrackTracking::new(grid, a)
+                    .and_then(|t| t.with_exclusion_radius(settings.exclusion_radius))
+                    .map_err(|e| e.to_string())?,
+            ),
             _ => None,
         };
         Ok(Self {

@@ -10,6 +10,8 @@
 //!   iterations.
 //! * [`composite`]: a 2D Cartesian far field with a refined triangle zone around a point,
 //!   joined by hanging nodes, with `refined` and well cell tags.
+//! * [`round_well`]: a 2D Cartesian far field with a zone of graded triangles (constrained
+//!   Delaunay with refinement) around a circular well, joined by hanging nodes.
 //! * [`tetrahedralize`]: some cells of any 3D grid replaced by tetrahedra (refined by
 //!   edge splits) that conform with the cells around them: an MDEM zone in a VEM far
 //!   field, e.g. around a well in a corner-point grid.
@@ -17,6 +19,7 @@
 mod composite;
 mod extrude;
 mod perturb;
+mod round_well;
 mod structured;
 mod tetrahedralize;
 mod voronoi;
@@ -24,6 +27,7 @@ mod voronoi;
 pub use composite::{CompositeSpec, Diagonals, REFINED_TAG, composite};
 pub use extrude::extrude;
 pub use perturb::{MAX_PERTURB, perturb};
+pub use round_well::{MIN_ANGLE_DEG, MIN_WELL_NODES, RoundWellSpec, ZoneCells, round_well};
 pub use structured::{cartesian, simplices};
 pub use tetrahedralize::{Tetrahedralized, tetrahedralize};
 pub use voronoi::{DEFAULT_LLOYD, voronoi};

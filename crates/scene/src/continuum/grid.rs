@@ -3,7 +3,8 @@
 
 use porofrac_grid::generate::tetrahedralize;
 use porofrac_grid::generate::{
-    CompositeSpec, Diagonals, cartesian, composite, extrude, perturb, simplices, voronoi,
+    CompositeSpec, Diagonals, RoundWellSpec, cartesian, composite, extrude, perturb, round_well,
+    simplices, voronoi,
 };
 use porofrac_grid::io::grdecl::{CornerPointGrid, DeckLimit, fault_faces};
 use porofrac_grid::io::{read_grdecl_with, read_msh, read_vtu};
@@ -261,17 +262,36 @@ fn build_plain_grid(ls: &LoadedScene) -> Result<AnyGrid, RunError> {
             if d == 2 {
                 return Ok(AnyGrid::Two(g2));
             }
-            let (z0, z1, nz) = (ext[0][2], ext[1][2], n[2]);
-            let levels: Vec<f64> = (0..=nz)
-                .map(|i| {
-                    if i == nz {
-                        z1
-                    } else {
-                        z0 + (z1 - z0) * i as f64 / nz as f64
-                    }
-                })
-                .collect();
-            return Ok(AnyGrid::Three(extrude(&g2, &levels).map_err(at_grid)?));
+            return Ok(AnyGrid::Three(
+                extrude(&g2, &z_levels(ext[0][2], ext[1][2], n[2])).map_err(at_grid)?,
+            ));
+        }
+        (_, GridKind::RoundWell) => {
+            // 2D: the round-well grid; 3D: the same in x, y, extruded over cells[2] layers
+            // (a vertical cylinder of tetrahedra in polygonal prisms).
+            let n = per_axis();
+            let c = g.center.clone().unwrap_or_default();
+            let mut spec = RoundWellSpec::new(
+                point(&ext[0][..2]),
+                point(&ext[1][..2]),
+                [n[0], n[1]],
+                point(&c),
+                g.zone_half_width.unwrap_or(0.0),
+                g.refine.unwrap_or(0).max(0) as usize,
+                g.well_radius.unwrap_or(0.0),
+            );
+            spec.well_size = g.well_size;
+            if let Some(t) = &g.well_tag {
+                spec.well_tag = t.clone();
+            }
+            let g2 = round_well(&spec).map_err(at_grid)?;
+            return Ok(if d == 2 {
+                AnyGrid::Two(g2)
+            } else {
+                AnyGrid::Three(
+                    extrude(&g2, &z_levels(ext[0][2], ext[1][2], n[2])).map_err(at_grid)?,
+                )
+            });
         }
         (_, GridKind::File) => {
             let path = ls.resolve(g.path.as_deref().unwrap_or(""));
@@ -391,4 +411,17 @@ pub(crate) fn select_cells<const D: usize>(
             .into());
     }
     Ok(cells)
+}
+
+/// `nz + 1` equally spaced z levels from `z0` to exactly `z1`.
+fn z_levels(z0: f64, z1: f64, nz: usize) -> Vec<f64> {
+    (0..=nz)
+        .map(|i| {
+            if i == nz {
+                z1
+            } else {
+                z0 + (z1 - z0) * i as f64 / nz as f64
+            }
+        })
+        .collect()
 }

@@ -734,6 +734,7 @@ fn fracture_settings<const D: usize>(ls: &LoadedScene, comp: &Composition<D>) ->
             settings.stress = StressMeasure::Recovered;
         }
         settings.tracking_angle = s.physics.crack_tracking;
+        settings.exclusion_radius = s.physics.crack_exclusion.unwrap_or(0.0);
     }
     settings
 }

@@ -151,6 +151,7 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
         ("fracture_permeability", p.fracture_permeability.is_some()),
         ("open_edge_stiffness", p.open_edge_stiffness.is_some()),
         ("crack_tracking", p.crack_tracking.is_some()),
+        ("crack_exclusion", p.crack_exclusion.is_some()),
     ] {
         if set {
             return Err(other_model(ls, &k(&["physics", key]), model));
