@@ -113,7 +113,6 @@ pub(crate) struct ObstacleLink {
     pub delta: f64,
     /// `x_f2`, or `u32::MAX` where it is not fluid.
     pub f2: u32,
-    pub obstacle: u32,
     /// Wall point `x_w` (unwrapped lattice coordinates).
     pub xw: [f64; 2],
 }

@@ -34,7 +34,7 @@ pub mod units;
 pub use boundary::{MomentumExchange, Side, SideKind};
 pub use collision::{Collision, Rates};
 pub use geometry::Shape;
-pub use lattice::{Lattice, LatticeConfig, MAX_MACH, Obstacle};
+pub use lattice::{Lattice, LatticeConfig, MAX_MACH, Obstacle, ObstacleMotion};
 pub use thermal::{Thermal, ThermalSide};
 pub use units::Units;
 
