@@ -497,7 +497,10 @@ impl Lattice {
         }
         v.sort_unstable();
         v.dedup();
-        self.sources.push(Source { nodes: v, rate: 0.0 });
+        self.sources.push(Source {
+            nodes: v,
+            rate: 0.0,
+        });
         Ok(self.sources.len() - 1)
     }
 
@@ -734,7 +737,6 @@ impl Lattice {
                 + 2.0 * W[i] * l.density * (1.0 + 4.5 * cu * cu - 1.5 * usq);
         }
     }
-
 
     fn apply_obstacles(&mut self) {
         let (g, lay) = (self.grid, self.layout);

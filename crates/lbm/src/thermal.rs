@@ -223,8 +223,16 @@ impl Thermal {
                 let n = ((j + 1) as usize) * w + (i + 1) as usize;
                 for q in 1..5 {
                     let (mi, mj) = (i + C5[q][0], j + C5[q][1]);
-                    let wi = if self.periodic[0] { mi.rem_euclid(nx) } else { mi };
-                    let wj = if self.periodic[1] { mj.rem_euclid(ny) } else { mj };
+                    let wi = if self.periodic[0] {
+                        mi.rem_euclid(nx)
+                    } else {
+                        mi
+                    };
+                    let wj = if self.periodic[1] {
+                        mj.rem_euclid(ny)
+                    } else {
+                        mj
+                    };
                     if (0..nx).contains(&wi)
                         && (0..ny).contains(&wj)
                         && lat.owner(wi as usize, wj as usize) == Some(k)

@@ -128,7 +128,8 @@ fn a_source_adds_its_mass_and_no_momentum() {
         .unwrap();
     let m0 = l.mass();
     for n in 0..100 {
-        l.set_source_rate(s, 1e-4 * (n as f64 / 50.0).min(1.0)).unwrap();
+        l.set_source_rate(s, 1e-4 * (n as f64 / 50.0).min(1.0))
+            .unwrap();
         l.step().unwrap();
     }
     let added = l.mass() - m0;

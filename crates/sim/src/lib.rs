@@ -50,6 +50,7 @@ pub mod laws;
 mod ldlt;
 pub mod linear;
 pub mod ordering;
+pub mod particle_fluid;
 pub mod pattern;
 mod quadrature;
 pub mod solve;
