@@ -115,6 +115,8 @@ pub(crate) struct ObstacleLink {
     pub f2: u32,
     /// Wall point `x_w` (unwrapped lattice coordinates).
     pub xw: [f64; 2],
+    /// Position of `x_f` (the image nearest the obstacle's centre when last computed).
+    pub p: [f64; 2],
 }
 
 /// How the force on an obstacle is summed from its cut links (seed eq. 8).

@@ -130,6 +130,21 @@ struct Scratch {
     moved: Vec<bool>,
     /// Per obstacle: cut links to rebuild.
     dirty: Vec<bool>,
+    /// Per obstacle: centre at its last rasterisation.
+    raster_at: Vec<[f64; 2]>,
+    /// Per obstacle: how far it may move from `raster_at` without a node centre crossing
+    /// its surface (circles; 0 for boxes).
+    margin: Vec<f64>,
+    /// Per obstacle: shape when `δ` of its links was last computed.
+    linked_at: Vec<Shape>,
+}
+
+/// What an obstacle update does to one obstacle's cut links.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum LinkWork {
+    Keep,
+    Deltas,
+    Rebuild,
 }
 
 /// A set of nodes that receive mass.
@@ -156,12 +171,15 @@ pub struct Lattice {
     solid_nodes: Vec<Vec<u32>>,
     /// Cut links of each obstacle.
     links: Vec<Vec<ObstacleLink>>,
+    /// Unknowns of each obstacle's cut links in the current step (scratch).
+    backs: Vec<Vec<f64>>,
     forces: Vec<[f64; 3]>,
     exchange: Vec<[f64; 3]>,
     motion: ObstacleMotion,
     scratch: Scratch,
     sources: Vec<Source>,
     injected: f64,
+    geometry_tolerance: f64,
     copies: Vec<CopyLink>,
     side_links: Vec<SideLink>,
     pressure_links: Vec<PressureLink>,
@@ -204,6 +222,7 @@ impl Lattice {
             obstacles: Vec::new(),
             solid_nodes: Vec::new(),
             links: Vec::new(),
+            backs: Vec::new(),
             forces: Vec::new(),
             exchange: Vec::new(),
             motion: ObstacleMotion::Integrated,
@@ -213,6 +232,7 @@ impl Lattice {
             },
             sources: Vec::new(),
             injected: 0.0,
+            geometry_tolerance: 0.0,
             copies: Vec::new(),
             side_links: Vec::new(),
             pressure_links: Vec::new(),
@@ -293,6 +313,9 @@ impl Lattice {
         self.exchange.push([0.0; 3]);
         self.scratch.moved.push(true);
         self.scratch.dirty.push(true);
+        self.scratch.raster_at.push([f64::NAN; 2]);
+        self.scratch.margin.push(0.0);
+        self.scratch.linked_at.push(self.obstacles[k].shape);
         // A new body takes its nodes without refill or momentum bookkeeping.
         self.rasterize(k, false);
         self.exchange[k] = [0.0; 3];
@@ -303,6 +326,18 @@ impl Lattice {
     /// The obstacles.
     pub fn obstacles(&self) -> &[Obstacle] {
         &self.obstacles
+    }
+
+    /// Keep `δ` and the wall points of an obstacle's cut links until it has moved by more
+    /// than `tolerance` spacings since they were computed (default 0: recompute whenever it
+    /// moves). The solid nodes and the wall velocities are always current; only the wall
+    /// position seen by the interpolation lags, by less than `tolerance`.
+    pub fn set_geometry_tolerance(&mut self, tolerance: f64) -> Result<(), LbmError> {
+        if !(tolerance.is_finite() && (0.0..0.5).contains(&tolerance)) {
+            return Err(LbmError::Value("geometry tolerance (below 0.5)", tolerance));
+        }
+        self.geometry_tolerance = tolerance;
+        Ok(())
     }
 
     /// Who moves the obstacles (default [`ObstacleMotion::Integrated`]).
@@ -361,7 +396,14 @@ impl Lattice {
             let mut s = self.obstacles[k].shape;
             self.check_inside(k, &mut s)?;
             self.obstacles[k].shape = s;
-            self.rasterize(k, true);
+            // A circle that moved less than the distance from its surface to the nearest
+            // node centre covers the same nodes.
+            let (c, at) = (s.center(), self.scratch.raster_at[k]);
+            let d = ((c[0] - at[0]).powi(2) + (c[1] - at[1]).powi(2)).sqrt();
+            let same_nodes = d < self.scratch.margin[k];
+            if !same_nodes {
+                self.rasterize(k, true);
+            }
         }
         self.refill();
         self.finish_update();
@@ -604,7 +646,8 @@ impl Lattice {
         }
         let [lo, hi] = s.bounds();
         for a in 0..2 {
-            if !self.cfg.periodic[a] && !(lo[a] >= 0.0 && hi[a] <= n[a]) {
+            let inside = lo[a] >= 0.0 && hi[a] <= n[a];
+            if !self.cfg.periodic[a] && !inside {
                 return Err(LbmError::Outside { obstacle: k });
             }
         }
@@ -738,47 +781,67 @@ impl Lattice {
         }
     }
 
+    /// The obstacle rules, in two passes: every obstacle's unknowns and force in parallel
+    /// (a rule reads no unknown of another rule, see [`crate::boundary`]), then the
+    /// unknowns written back.
     fn apply_obstacles(&mut self) {
+        use rayon::prelude::*;
         let (g, lay) = (self.grid, self.layout);
         let gi = self.cfg.momentum_exchange == MomentumExchange::GalileanInvariant;
-        for (k, links) in self.links.iter().enumerate() {
-            let ob = &self.obstacles[k];
-            let c = ob.shape.center();
-            let mut f = [0.0; 3];
-            for l in links {
-                let a = l.alpha as usize;
-                let i = OPP[a];
-                let xf = l.node as usize;
-                let uw = ob.velocity_at(l.xw);
-                let ca = cf(a);
-                let wall = 6.0 * W[a] * (ca[0] * uw[0] + ca[1] * uw[1]);
-                let into = self.pop[g.loc(lay, g.shift(xf, a), a)];
-                let back = if l.f2 == NONE {
-                    into - wall
-                } else {
-                    let d = l.delta;
-                    ((1.0 - d) * self.pop[g.loc(lay, xf, a)]
-                        + d * into
-                        + d * self.pop[g.loc(lay, l.f2 as usize, i)]
-                        - wall)
-                        / (1.0 + d)
-                };
-                self.pop[g.loc(lay, xf, i)] = back;
-                let df = if gi {
-                    [
-                        (ca[0] - uw[0]) * into - (-ca[0] - uw[0]) * back,
-                        (ca[1] - uw[1]) * into - (-ca[1] - uw[1]) * back,
-                    ]
-                } else {
-                    [ca[0] * (into + back), ca[1] * (into + back)]
-                };
-                let r = [l.xw[0] - c[0], l.xw[1] - c[1]];
-                f[0] += df[0];
-                f[1] += df[1];
-                f[2] += r[0] * df[1] - r[1] * df[0];
+        let mut backs = std::mem::take(&mut self.backs);
+        backs.resize_with(self.links.len(), Vec::new);
+        let pop = &self.pop;
+        let obstacles = &self.obstacles;
+        self.forces
+            .par_iter_mut()
+            .zip(backs.par_iter_mut())
+            .zip(self.links.par_iter())
+            .enumerate()
+            .for_each(|(k, ((force, back_k), links))| {
+                let ob = &obstacles[k];
+                let c = ob.shape.center();
+                let mut f = [0.0; 3];
+                back_k.clear();
+                for l in links {
+                    let a = l.alpha as usize;
+                    let i = OPP[a];
+                    let xf = l.node as usize;
+                    let uw = ob.velocity_at(l.xw);
+                    let ca = cf(a);
+                    let wall = 6.0 * W[a] * (ca[0] * uw[0] + ca[1] * uw[1]);
+                    let into = pop[g.loc(lay, g.shift(xf, a), a)];
+                    let back = if l.f2 == NONE {
+                        into - wall
+                    } else {
+                        let d = l.delta;
+                        ((1.0 - d) * pop[g.loc(lay, xf, a)]
+                            + d * into
+                            + d * pop[g.loc(lay, l.f2 as usize, i)]
+                            - wall)
+                            / (1.0 + d)
+                    };
+                    back_k.push(back);
+                    let df = if gi {
+                        [
+                            (ca[0] - uw[0]) * into - (-ca[0] - uw[0]) * back,
+                            (ca[1] - uw[1]) * into - (-ca[1] - uw[1]) * back,
+                        ]
+                    } else {
+                        [ca[0] * (into + back), ca[1] * (into + back)]
+                    };
+                    let r = [l.xw[0] - c[0], l.xw[1] - c[1]];
+                    f[0] += df[0];
+                    f[1] += df[1];
+                    f[2] += r[0] * df[1] - r[1] * df[0];
+                }
+                *force = f;
+            });
+        for (links, back_k) in self.links.iter().zip(&backs) {
+            for (l, &b) in links.iter().zip(back_k) {
+                self.pop[g.loc(lay, l.node as usize, OPP[l.alpha as usize])] = b;
             }
-            self.forces[k] = f;
         }
+        self.backs = backs;
     }
 
     fn apply_sources(&mut self) {
@@ -809,8 +872,16 @@ impl Lattice {
     /// The image of coordinate `x` along axis `a` nearest to `c` (periodic axes).
     fn near(&self, a: usize, x: f64, c: f64) -> f64 {
         if self.cfg.periodic[a] {
+            // both in the first period (or close to it): one image shift at most
             let n = if a == 0 { self.grid.nx } else { self.grid.ny } as f64;
-            x - ((x - c) / n).round() * n
+            let d = x - c;
+            if d > 0.5 * n {
+                x - n
+            } else if d < -0.5 * n {
+                x + n
+            } else {
+                x
+            }
         } else {
             x
         }
@@ -859,18 +930,40 @@ impl Lattice {
         let j1 = (hi[1] - 0.5).ceil() as isize;
         let mut out = std::mem::take(&mut self.scratch.nodes);
         out.clear();
-        for j in j0..=j1 {
-            for i in i0..=i1 {
-                if shape.contains([i as f64 + 0.5, j as f64 + 0.5])
-                    && let Some(n) = self.wrap(i, j)
-                {
-                    out.push(n as u32);
+        let mut margin = 0.0;
+        if let Shape::Circle { center, radius } = shape {
+            // nodes beyond one spacing outside the scanned box are at least that far from
+            // the surface
+            margin = 1.0f64;
+            for j in j0 - 1..=j1 + 1 {
+                let dy = j as f64 + 0.5 - center[1];
+                for i in i0 - 1..=i1 + 1 {
+                    let dx = i as f64 + 0.5 - center[0];
+                    let r = (dx * dx + dy * dy).sqrt();
+                    margin = margin.min((r - radius).abs());
+                    if r <= radius
+                        && let Some(n) = self.wrap(i, j)
+                    {
+                        out.push(n as u32);
+                    }
+                }
+            }
+        } else {
+            for j in j0..=j1 {
+                for i in i0..=i1 {
+                    if shape.contains([i as f64 + 0.5, j as f64 + 0.5])
+                        && let Some(n) = self.wrap(i, j)
+                    {
+                        out.push(n as u32);
+                    }
                 }
             }
         }
         out.sort_unstable();
         out.dedup();
         self.scratch.nodes = out;
+        self.scratch.raster_at[k] = shape.center();
+        self.scratch.margin[k] = margin;
     }
 
     /// Rasterise obstacle `k` again. Nodes it leaves become fluid (fresh, refilled later by
@@ -978,15 +1071,28 @@ impl Lattice {
         self.scratch.released = released;
     }
 
+    /// Padded node `(i + di, j + dj)` of padded node `n` at `(i, j)`, wrapped along
+    /// periodic axes, or `None` outside the box.
+    #[inline]
+    fn offset(&self, n: usize, (i, j): (isize, isize), di: isize, dj: isize) -> Option<usize> {
+        let (nx, ny) = (self.grid.nx as isize, self.grid.ny as isize);
+        if i >= 2 && j >= 2 && i < nx - 2 && j < ny - 2 {
+            Some((n as isize + dj * self.grid.stride() as isize + di) as usize)
+        } else {
+            self.wrap(i + di, j + dj)
+        }
+    }
+
     /// Mark the obstacles whose cut links see a changed node, rebuild their links, update
-    /// `δ` of the other moved obstacles, clear the flags.
+    /// `δ` of the other moved obstacles (in parallel over obstacles), clear the flags.
     fn finish_update(&mut self) {
         let changed = std::mem::take(&mut self.scratch.changed);
         for &n in &changed {
-            let (i, j) = self.ij(n as usize);
+            let n = n as usize;
+            let ij = self.ij(n);
             for dj in -2..=2 {
                 for di in -2..=2 {
-                    if let Some(m) = self.wrap(i + di, j + dj) {
+                    if let Some(m) = self.offset(n, ij, di, dj) {
                         let o = self.owner[m];
                         if o != NONE {
                             self.scratch.dirty[o as usize] = true;
@@ -998,61 +1104,91 @@ impl Lattice {
         let mut changed = changed;
         changed.clear();
         self.scratch.changed = changed;
-        for k in 0..self.obstacles.len() {
-            if self.scratch.dirty[k] {
-                self.build_links(k);
-            } else if self.scratch.moved[k] {
-                self.update_deltas(k);
+        let tol = self.geometry_tolerance;
+        let work: Vec<LinkWork> = (0..self.obstacles.len())
+            .map(|k| {
+                if self.scratch.dirty[k] {
+                    LinkWork::Rebuild
+                } else if self.scratch.moved[k]
+                    && moved_by(&self.scratch.linked_at[k], &self.obstacles[k].shape) > tol
+                {
+                    LinkWork::Deltas
+                } else {
+                    LinkWork::Keep
+                }
+            })
+            .collect();
+        let mut links = std::mem::take(&mut self.links);
+        {
+            use rayon::prelude::*;
+            let this = &*self;
+            links
+                .par_iter_mut()
+                .zip(work.par_iter())
+                .enumerate()
+                .for_each(|(k, (l, w))| match w {
+                    LinkWork::Rebuild => this.build_links(k, l),
+                    LinkWork::Deltas => this.update_deltas(k, l),
+                    LinkWork::Keep => {}
+                });
+        }
+        self.links = links;
+        for (k, w) in work.iter().enumerate() {
+            if *w != LinkWork::Keep {
+                self.scratch.linked_at[k] = self.obstacles[k].shape;
             }
             self.scratch.dirty[k] = false;
             self.scratch.moved[k] = false;
         }
     }
 
-    /// `δ` and the wall point of a link from fluid node `xf` along `a` into obstacle `k`.
-    fn link_geometry(&self, k: usize, xf: usize, a: usize) -> (f64, [f64; 2]) {
-        let p = self.position_near(k, xf);
+    /// `δ` and the wall point of a link from fluid node at `p` along `a` into obstacle
+    /// `k`.
+    #[inline]
+    fn link_geometry(&self, k: usize, p: [f64; 2], a: usize) -> (f64, [f64; 2]) {
         let c = cf(a);
         let delta = self.obstacles[k].shape.entry(p, c);
         (delta, [p[0] + delta * c[0], p[1] + delta * c[1]])
     }
 
-    fn update_deltas(&mut self, k: usize) {
-        let mut links = std::mem::take(&mut self.links[k]);
-        for l in &mut links {
-            (l.delta, l.xw) = self.link_geometry(k, l.node as usize, l.alpha as usize);
+    fn update_deltas(&self, k: usize, links: &mut [ObstacleLink]) {
+        let c = self.obstacles[k].shape.center();
+        for l in links {
+            // the centre may have been brought back into the first period
+            l.p = [self.near(0, l.p[0], c[0]), self.near(1, l.p[1], c[1])];
+            (l.delta, l.xw) = self.link_geometry(k, l.p, l.alpha as usize);
         }
-        self.links[k] = links;
     }
 
-    fn build_links(&mut self, k: usize) {
-        let mut links = std::mem::take(&mut self.links[k]);
+    fn build_links(&self, k: usize, links: &mut Vec<ObstacleLink>) {
         links.clear();
         for &b in &self.solid_nodes[k] {
-            let (bi, bj) = self.ij(b as usize);
+            let b = b as usize;
+            let ij = self.ij(b);
             for a in 1..Q {
-                let (fi, fj) = (bi - C[a][0] as isize, bj - C[a][1] as isize);
-                let Some(xf) = self.wrap(fi, fj) else {
+                let (cx, cy) = (C[a][0] as isize, C[a][1] as isize);
+                let Some(xf) = self.offset(b, ij, -cx, -cy) else {
                     continue;
                 };
                 if self.owner[xf] != NONE {
                     continue;
                 }
-                let f2 = match self.wrap(fi - C[a][0] as isize, fj - C[a][1] as isize) {
+                let f2 = match self.offset(b, ij, -2 * cx, -2 * cy) {
                     Some(m) if self.owner[m] == NONE => m as u32,
                     _ => NONE,
                 };
-                let (delta, xw) = self.link_geometry(k, xf, a);
+                let p = self.position_near(k, xf);
+                let (delta, xw) = self.link_geometry(k, p, a);
                 links.push(ObstacleLink {
                     node: xf as u32,
                     alpha: a as u8,
                     delta,
                     f2,
                     xw,
+                    p,
                 });
             }
         }
-        self.links[k] = links;
     }
 
     /// The cut links of obstacle `k`: fluid node `(i, j)`, direction `α` into the body and
@@ -1067,5 +1203,18 @@ impl Lattice {
     /// Cut links of all obstacles.
     pub fn cut_links(&self) -> usize {
         self.links.iter().map(Vec::len).sum()
+    }
+}
+
+/// Largest displacement of a point of shape `b` from where it was in shape `a` (lattice
+/// units; a rotation counts at the corners of a box).
+fn moved_by(a: &Shape, b: &Shape) -> f64 {
+    let (ca, cb) = (a.center(), b.center());
+    let d = ((ca[0] - cb[0]).powi(2) + (ca[1] - cb[1]).powi(2)).sqrt();
+    match (a, b) {
+        (Shape::Box { angle: x, half, .. }, Shape::Box { angle: y, .. }) => {
+            d + (x - y).abs() * (half[0] * half[0] + half[1] * half[1]).sqrt()
+        }
+        _ => d,
     }
 }

@@ -230,7 +230,8 @@ impl<P: ParticleSolver> ParticleFluid<P> {
         }
         let d = particles.disks();
         for i in 0..d.len() {
-            if !(d.r[i] >= options.min_radius_nodes * units.dx) {
+            let resolved = d.r[i] >= options.min_radius_nodes * units.dx;
+            if !resolved {
                 return Err(CouplingError::TooSmall {
                     particle: i,
                     radius: d.r[i],
@@ -444,12 +445,12 @@ impl<P: ParticleSolver> ParticleFluid<P> {
                 self.units.torque_si(f[2] + e[2]),
             ];
         }
-        if self.thermal.is_some() {
+        if let Some(th) = &self.thermal {
+            let sides: f64 = th.side_heat().iter().sum();
             let (p, f) = self.heat_content();
             self.heat.particles = p;
             self.heat.fluid = f;
-            let th = self.thermal.as_ref().expect("checked above");
-            self.heat.sides_in = th.side_heat().iter().sum::<f64>() * self.heat_scale();
+            self.heat.sides_in = sides * self.heat_scale();
         }
         let t1 = Instant::now();
         let n = self.substeps();
@@ -507,7 +508,8 @@ impl<P: ParticleSolver> ParticleFluid<P> {
             let w = d.omega[i] * self.units.dt;
             let r = d.r[i] / self.units.dx;
             let mach = ((v[0] * v[0] + v[1] * v[1]).sqrt() + w.abs() * r) / cs;
-            if !(mach <= MAX_MACH) {
+            let slow = mach <= MAX_MACH;
+            if !slow {
                 return Err(CouplingError::TooFast { particle: i, mach });
             }
             self.lattice
