@@ -54,8 +54,9 @@ fn bench(c: &mut Criterion) {
     });
     for n in [100usize, 1000] {
         let d = disks(n, &u);
+        let mut solver = RigidDisks::new(d.clone());
         let mut sim = ParticleFluid::new(
-            RigidDisks::new(d.clone()),
+            &solver,
             Lattice::new(cfg.clone()).expect("lattice"),
             u,
             [0.0, 0.0],
@@ -63,7 +64,7 @@ fn bench(c: &mut Criterion) {
         )
         .expect("coupling");
         group.bench_with_input(BenchmarkId::new("coupled_step", n), &n, |b, _| {
-            b.iter(|| sim.step().expect("step"))
+            b.iter(|| sim.step(&mut solver).expect("step"))
         });
         let s = sim.stats();
         eprintln!(

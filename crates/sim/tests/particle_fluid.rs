@@ -54,14 +54,14 @@ fn sedimenting_disk_reaches_the_fixed_disk_terminal_speed() {
     cfg.accel = [0.0, u.acceleration(accel)];
     let lat = Lattice::new(cfg.clone()).unwrap();
     let mut sim =
-        ParticleFluid::new(solver, lat, u, [0.0, 0.0], CouplingOptions::default()).unwrap();
+        ParticleFluid::new(&solver, lat, u, [0.0, 0.0], CouplingOptions::default()).unwrap();
     let (steps, window) = (7000, 2500);
     let mut rel = 0.0;
     let mut samples = 0;
     for s in 0..steps {
-        sim.step().unwrap();
+        sim.step(&mut solver).unwrap();
         if s >= steps - window && s % 10 == 0 {
-            let v = u.velocity(sim.particles().disks.v[0][1]);
+            let v = u.velocity(solver.disks.v[0][1]);
             let uf = mean_fluid_velocity(sim.lattice())[1];
             rel += v - uf;
             samples += 1;
@@ -116,32 +116,27 @@ fn fluid_and_disk_momentum_is_conserved_in_a_closed_periodic_box() {
         disks.omega[0] = 0.005 / u.dt;
         let m = disks.mass[0];
         let p0 = [m * disks.v[0][0], m * disks.v[0][1]];
-        let mut sim = ParticleFluid::new(
-            RigidDisks::new(disks),
-            lat,
-            u,
-            [0.0, 0.0],
-            CouplingOptions::default(),
-        )
-        .unwrap();
+        let mut solver = RigidDisks::new(disks);
+        let mut sim =
+            ParticleFluid::new(&solver, lat, u, [0.0, 0.0], CouplingOptions::default()).unwrap();
         let scale = (p0[0] * p0[0] + p0[1] * p0[1]).sqrt();
         let mut worst: f64 = 0.0;
         for _ in 0..600 {
-            sim.step().unwrap();
+            sim.step(&mut solver).unwrap();
             let pf = sim.fluid_momentum();
-            let v = sim.particles().disks.v[0];
+            let v = solver.disks.v[0];
             for a in 0..2 {
                 worst = worst.max((pf[a] + m * v[a] - p0[a]).abs() / scale);
             }
         }
-        let v = sim.particles().disks.v[0];
+        let v = solver.disks.v[0];
         eprintln!(
             "{collision:?}: momentum defect {worst:.2e}; disk speed now {v:?}, x {:?}",
-            sim.particles().disks.x[0]
+            solver.disks.x[0]
         );
         // the disk gave most of its momentum to the fluid, and crossed a side
         assert!(v[0].abs() < 0.5 * p0[0] / m);
-        assert!(sim.particles().disks.x[0][0] > n as f64 * DX);
+        assert!(solver.disks.x[0][0] > n as f64 * DX);
         assert!(
             worst < 1e-12,
             "{collision:?}: relative momentum defect {worst:e}"
@@ -167,22 +162,17 @@ fn a_hot_moving_disk_cools_and_every_joule_is_booked() {
         solid_diffusivity: 4.0 * chi,
         sides: [ThermalSide::Temperature(0.0); 4],
     };
-    let mut sim = ParticleFluid::new(
-        RigidDisks::new(disks),
-        lat,
-        u,
-        [0.0, 0.0],
-        CouplingOptions::default(),
-    )
-    .unwrap()
-    .with_thermal(setup, |_| 0.0, &[100.0])
-    .unwrap();
+    let mut solver = RigidDisks::new(disks);
+    let mut sim = ParticleFluid::new(&solver, lat, u, [0.0, 0.0], CouplingOptions::default())
+        .unwrap()
+        .with_thermal(setup, |_| 0.0, &[100.0])
+        .unwrap();
     let h0 = *sim.heat();
     assert!(h0.particles > 0.0 && h0.fluid == 0.0);
     let mut worst: f64 = 0.0;
     let mut worst_particle: f64 = 0.0;
     for _ in 0..1500 {
-        sim.step().unwrap();
+        sim.step(&mut solver).unwrap();
         let h = sim.heat();
         worst = worst.max(h.defect().abs() / h0.initial);
         worst_particle = worst_particle.max(h.particle_defect().abs() / h0.initial);
@@ -217,7 +207,7 @@ fn a_disk_below_two_spacings_is_an_error_naming_it() {
     )
     .unwrap();
     let err = ParticleFluid::new(
-        RigidDisks::new(disks.clone()),
+        &RigidDisks::new(disks.clone()),
         lat(),
         u,
         [0.0, 0.0],
@@ -234,7 +224,7 @@ fn a_disk_below_two_spacings_is_an_error_naming_it() {
     ok.r[1] = 2.0 * DX;
     assert!(
         ParticleFluid::new(
-            RigidDisks::new(ok),
+            &RigidDisks::new(ok),
             lat(),
             u,
             [0.0, 0.0],
@@ -256,8 +246,9 @@ fn injection_adds_the_ramped_mass_and_reaches_the_ramped_pressure() {
     // rate control: Q(t) = Q_max min(t/T, 1); no disk, so no interpolated bounce-back
     // (which does not conserve mass exactly) and all mass stays in the fluid
     let (q_max, ramp) = (1e-6, 100.0 * u.dt);
+    let mut none = RigidDisks::new(Disks::new(&[], &[], 2.0 * RHO).unwrap());
     let mut sim = ParticleFluid::new(
-        RigidDisks::new(Disks::new(&[], &[], 2.0 * RHO).unwrap()),
+        &none,
         Lattice::new(cfg.clone()).unwrap(),
         u,
         [0.0, 0.0],
@@ -276,7 +267,7 @@ fn injection_adds_the_ramped_mass_and_reaches_the_ramped_pressure() {
     let m0 = sim.lattice().mass();
     let steps = 300;
     for _ in 0..steps {
-        sim.step().unwrap();
+        sim.step(&mut none).unwrap();
     }
     // ∫Q dt of the steps' rates, Q taken at the start of each step
     let want: f64 = (0..steps)
@@ -300,8 +291,9 @@ fn injection_adds_the_ramped_mass_and_reaches_the_ramped_pressure() {
 
     // pressure control in the closed box: the source nodes follow the ramp
     let peak = 0.05; // Pa: lattice density 1 + 0.015 at this spacing and time step
+    let mut solver = RigidDisks::new(disks);
     let mut sim = ParticleFluid::new(
-        RigidDisks::new(disks),
+        &solver,
         Lattice::new(cfg).unwrap(),
         u,
         [0.0, 0.0],
@@ -321,7 +313,7 @@ fn injection_adds_the_ramped_mass_and_reaches_the_ramped_pressure() {
     // with gain 1 the 12 source nodes fill the 1600-node box with a lag of about
     // 1600/12 ≈ 130 steps
     for _ in 0..2000 {
-        sim.step().unwrap();
+        sim.step(&mut solver).unwrap();
     }
     let inj = sim.injection().unwrap();
     let p = inj.pressure(sim.lattice(), sim.units());

@@ -116,6 +116,9 @@ impl CouplingError {
 pub struct CouplingOptions {
     /// Smallest disk radius in lattice spacings (default 2).
     pub min_radius_nodes: f64,
+    /// Particle sub-steps are at most this fraction of the particles' stable step (default
+    /// 1).
+    pub particle_dt_fraction: f64,
     /// Heat capacity per volume `ρ c_p` of fluid and solid (J/(m³·K); default 4.18e6,
     /// water).
     pub heat_capacity: f64,
@@ -125,6 +128,7 @@ impl Default for CouplingOptions {
     fn default() -> Self {
         CouplingOptions {
             min_radius_nodes: 2.0,
+            particle_dt_fraction: 1.0,
             heat_capacity: 4.18e6,
         }
     }
@@ -186,10 +190,12 @@ pub struct CouplingStats {
     pub particle_seconds: f64,
 }
 
-/// Disks in a lattice Boltzmann fluid, optionally with heat (see the module docs).
+/// The fluid side of disks in a lattice Boltzmann fluid, optionally with heat (see the
+/// module docs). The particle model stays with the caller and is passed to every step, so
+/// a model that owns more than its disks (walls, loading, outputs) keeps them.
 #[derive(Debug)]
-pub struct ParticleFluid<P: ParticleSolver> {
-    particles: P,
+pub struct ParticleFluid {
+    count: usize,
     lattice: Lattice,
     thermal: Option<Thermal>,
     units: Units,
@@ -203,12 +209,12 @@ pub struct ParticleFluid<P: ParticleSolver> {
     time: f64,
 }
 
-impl<P: ParticleSolver> ParticleFluid<P> {
+impl ParticleFluid {
     /// Couple `particles` with `lattice` (lattice units from `units`; `origin` is the SI
     /// position of the lattice corner, node `(i, j)` sits at `o + (i + ½, j + ½) Δx`). The
     /// lattice may hold fixed obstacles already; one obstacle per disk is added after them.
-    pub fn new(
-        particles: P,
+    pub fn new<P: ParticleSolver>(
+        particles: &P,
         mut lattice: Lattice,
         units: Units,
         origin: [f64; 2],
@@ -219,6 +225,13 @@ impl<P: ParticleSolver> ParticleFluid<P> {
                 "min_radius_nodes",
                 options.min_radius_nodes,
                 "must be finite and not negative",
+            ));
+        }
+        if !(options.particle_dt_fraction > 0.0 && options.particle_dt_fraction <= 1.0) {
+            return Err(CouplingError::argument(
+                "particle_dt_fraction",
+                options.particle_dt_fraction,
+                "must be in (0, 1]",
             ));
         }
         if !(options.heat_capacity.is_finite() && options.heat_capacity > 0.0) {
@@ -258,7 +271,7 @@ impl<P: ParticleSolver> ParticleFluid<P> {
         lattice.set_obstacle_motion_mode(ObstacleMotion::External);
         let n = d.len();
         let mut s = ParticleFluid {
-            particles,
+            count: n,
             lattice,
             thermal: None,
             units,
@@ -271,7 +284,7 @@ impl<P: ParticleSolver> ParticleFluid<P> {
             stats: CouplingStats::default(),
             time: 0.0,
         };
-        s.place()?;
+        s.place(particles)?;
         Ok(s)
     }
 
@@ -283,7 +296,7 @@ impl<P: ParticleSolver> ParticleFluid<P> {
         fluid: impl Fn([f64; 2]) -> f64,
         particle: &[f64],
     ) -> Result<Self, CouplingError> {
-        if particle.len() != self.particles.disks().len() {
+        if particle.len() != self.count {
             return Err(CouplingError::argument(
                 "particle temperatures (count)",
                 particle.len() as f64,
@@ -340,14 +353,6 @@ impl<P: ParticleSolver> ParticleFluid<P> {
         Ok(self)
     }
 
-    /// The particle model.
-    pub fn particles(&self) -> &P {
-        &self.particles
-    }
-    /// The particle model, mutable (e.g. to change its loads between steps).
-    pub fn particles_mut(&mut self) -> &mut P {
-        &mut self.particles
-    }
     /// The fluid lattice.
     pub fn lattice(&self) -> &Lattice {
         &self.lattice
@@ -380,9 +385,10 @@ impl<P: ParticleSolver> ParticleFluid<P> {
     pub fn dt(&self) -> f64 {
         self.units.dt
     }
-    /// Particle sub-steps per fluid step for the particles' current stable step.
-    pub fn substeps(&self) -> usize {
-        let dtp = self.particles.stable_dt();
+    /// Particle sub-steps per fluid step for the particles' current stable step (times
+    /// `particle_dt_fraction`).
+    pub fn substeps<P: ParticleSolver>(&self, particles: &P) -> usize {
+        let dtp = self.options.particle_dt_fraction * particles.stable_dt();
         if dtp.is_finite() && dtp > 0.0 {
             (self.units.dt / dtp).ceil().max(1.0) as usize
         } else {
@@ -416,11 +422,19 @@ impl<P: ParticleSolver> ParticleFluid<P> {
         [p[0] * s, p[1] * s]
     }
 
-    /// One coupled step (see the module docs).
-    pub fn step(&mut self) -> Result<(), CouplingError> {
+    /// One coupled step of `particles`, the model given at construction (see the module
+    /// docs).
+    pub fn step<P: ParticleSolver>(&mut self, particles: &mut P) -> Result<(), CouplingError> {
+        if particles.disks().len() != self.count {
+            return Err(CouplingError::argument(
+                "particles (count)",
+                particles.disks().len() as f64,
+                "differs from the disks the coupling was built with",
+            ));
+        }
         let t0 = Instant::now();
         let before = self.particle_heat_raw();
-        self.place()?;
+        self.place(particles)?;
         if self.thermal.is_some() {
             self.heat.carried += (self.particle_heat_raw() - before) * self.heat_scale();
         }
@@ -453,10 +467,10 @@ impl<P: ParticleSolver> ParticleFluid<P> {
             self.heat.sides_in = sides * self.heat_scale();
         }
         let t1 = Instant::now();
-        let n = self.substeps();
+        let n = self.substeps(particles);
         let h = self.units.dt / n as f64;
         for _ in 0..n {
-            self.particles
+            particles
                 .advance(h, &self.loads)
                 .map_err(|e| CouplingError::Particles(Box::new(e)))?;
         }
@@ -496,8 +510,8 @@ impl<P: ParticleSolver> ParticleFluid<P> {
     }
 
     /// Step 1: place every disk on the lattice and rasterise.
-    fn place(&mut self) -> Result<(), CouplingError> {
-        let d = self.particles.disks();
+    fn place<P: ParticleSolver>(&mut self, particles: &P) -> Result<(), CouplingError> {
+        let d = particles.disks();
         let cs = CS2.sqrt();
         for i in 0..d.len() {
             let c = lattice_point(&self.units, self.origin, d.x[i]);
