@@ -198,4 +198,7 @@ pub struct ThermalBoundary {
     pub temperature: Option<f64>,
     /// Fixed flux.
     pub flux: Option<f64>,
+    /// Zero-gradient outflow (advected heat leaves, nothing is reflected).
+    #[serde(default)]
+    pub outflow: bool,
 }
