@@ -234,6 +234,11 @@ fn bad_lbm_scenes_name_the_key() {
         "exactly one of temperature, flux and outflow = true",
     );
     refused(
+        &format!("{POISEUILLE}\n[thermal]\ndiffusivity = 1e-6\nparticle_temperature = 80.0\n"),
+        "thermal.particle_temperature",
+        "belongs to model \"lsm\"",
+    );
+    refused(
         &POISEUILLE.replace("field = \"vx\"", "field = \"temperature\""),
         "output.probe[0].field",
         "needs [thermal]",

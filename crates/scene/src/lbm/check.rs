@@ -118,6 +118,19 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
     if let Some(key) = foreign {
         return Err(ls.error(&key, "belongs to model \"continuum\", not \"lbm\""));
     }
+    if let Some(t) = &s.thermal {
+        for (name, set) in [
+            ("particle_temperature", t.particle_temperature.is_some()),
+            ("heat_capacity", t.heat_capacity.is_some()),
+        ] {
+            if set {
+                return Err(ls.error(
+                    &k(&["thermal", name]),
+                    "belongs to model \"lsm\", not \"lbm\"",
+                ));
+            }
+        }
+    }
     let (units, seen) = check_section(ls)?;
     let l = s.lbm.as_ref().expect("checked by check_section");
     let mut names = std::collections::BTreeSet::new();

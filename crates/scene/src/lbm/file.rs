@@ -186,6 +186,12 @@ pub struct ThermalSection {
     /// `[[thermal.boundary]]`.
     #[serde(default)]
     pub boundary: Vec<ThermalBoundary>,
+    /// Initial temperature of the particles (model `lsm`; default `initial` at their
+    /// centres).
+    pub particle_temperature: Option<f64>,
+    /// Heat capacity per volume ρ c_p of fluid and particles, J/(m³·K), for the heat books
+    /// (model `lsm`; default 4.18e6).
+    pub heat_capacity: Option<f64>,
 }
 
 /// `[[thermal.boundary]]`.

@@ -16,7 +16,7 @@
 
 pub mod check;
 pub mod file;
-mod images;
+pub(crate) mod images;
 mod vti;
 
 use std::collections::BTreeMap;

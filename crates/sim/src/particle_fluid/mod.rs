@@ -357,6 +357,11 @@ impl ParticleFluid {
     pub fn lattice(&self) -> &Lattice {
         &self.lattice
     }
+    /// The fluid lattice, mutable: for side velocities and conditions between steps (the
+    /// obstacles are the coupling's: placing them here is undone at the next step).
+    pub fn lattice_mut(&mut self) -> &mut Lattice {
+        &mut self.lattice
+    }
     /// The temperature lattice.
     pub fn thermal(&self) -> Option<&Thermal> {
         self.thermal.as_ref()
