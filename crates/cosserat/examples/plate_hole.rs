@@ -4,7 +4,10 @@
 //!
 //! `cargo run --release -p porofrac-cosserat --example plate_hole [levels]`, or
 //! `… --example plate_hole mesh <level> <r> <path.vtu>` to write the O-grid mesh of a level
-//! (the mesh of `scenes/cosserat_plate_hole.toml`).
+//! (the mesh of `scenes/cosserat_plate_hole.toml`), or
+//! `… --example plate_hole run <path.vtu> <r> <r/ℓ> <N>` to solve on a mesh file and print
+//! one `RESULT {json}` line (SCF, cells, dofs, nnz, assembly and solve wall time) in the
+//! form of the peers `peers/cosserat/dem.py` and `peers/cosserat/fenicsx_p2p1.py`.
 
 use std::time::Instant;
 
@@ -15,9 +18,15 @@ use porofrac_cosserat::{
 
 /// SCF of the DEM: the largest cell σ22 over the applied traction T = 1.
 pub fn scf(level: usize, r: f64, n: f64, length: f64) -> (f64, usize, f64, f64) {
-    let (side, g, nu) = (16.2, 1e3, 0.3);
-    let n_theta = 16 * level;
-    let grid = mesh::plate_with_hole(side, r, n_theta, 10 * level, 0.1 * r / level as f64).unwrap();
+    let grid =
+        mesh::plate_with_hole(16.2, r, 16 * level, 10 * level, 0.1 * r / level as f64).unwrap();
+    let (s22, cells, t_asm, t_solve, _) = scf_on(grid, n, length);
+    (s22, cells, t_asm, t_solve)
+}
+
+/// SCF on a given quarter-plate grid: `(SCF, cells, assembly s, solve s, nnz)`.
+fn scf_on(grid: porofrac_grid::Grid<2>, n: f64, length: f64) -> (f64, usize, f64, f64, usize) {
+    let (g, nu) = (1e3, 0.3);
     let a = n * n / (1.0 - n * n);
     let m = Material::with_length(g, nu, a * g, length).unwrap();
     let cells = grid.num_cells();
@@ -44,7 +53,7 @@ pub fn scf(level: usize, r: f64, n: f64, length: f64) -> (f64, usize, f64, f64) 
     let s22 = (0..cells)
         .map(|c| model.cell_stress(c, &w)[strain_index(2, 1, 1)])
         .fold(f64::MIN, f64::max);
-    (s22, cells, t_asm, t_solve)
+    (s22, cells, t_asm, t_solve, model.pattern().nnz())
 }
 
 fn main() {
@@ -56,6 +65,22 @@ fn main() {
             mesh::plate_with_hole(16.2, r, 16 * level, 10 * level, 0.1 * r / level as f64).unwrap();
         porofrac_grid::io::write_vtu(&args[4], &grid, &[], &[]).unwrap();
         println!("{} triangles → {}", grid.num_cells(), args[4]);
+        return;
+    }
+    if args.get(1).map(String::as_str) == Some("run") {
+        let usage = "plate_hole run <path.vtu> <r> <r/l> <N>";
+        let grid = porofrac_grid::io::read_vtu::<2>(&args[2]).expect("readable 2D .vtu mesh");
+        let num = |i: usize| -> f64 { args.get(i).and_then(|s| s.parse().ok()).expect(usage) };
+        let (r, rl, n) = (num(3), num(4), num(5));
+        let (s22, cells, ta, ts, nnz) = scf_on(grid, n, r / rl);
+        println!(
+            "RESULT {{\"code\": \"porofrac\", \"mesh\": \"{}\", \"cells\": {cells}, \"dofs\": {}, \
+             \"nnz\": {nnz}, \"scf\": {s22:.15e}, \"scf_ref\": {:.15e}, \"t_assemble\": {ta:.6}, \
+             \"t_solve\": {ts:.6}}}",
+            args[2],
+            3 * cells,
+            hole_scf(0.3, n, r, r / rl)
+        );
         return;
     }
     let levels: usize = std::env::args()

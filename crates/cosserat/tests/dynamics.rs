@@ -5,13 +5,19 @@
 //! * explicit leapfrog at the computed stable step stays bounded (energy within 2 % of its
 //!   initial value over 400 steps), and 1.1 × the estimated limit `2/ω_max` blows up,
 //!   which shows the estimate is close to the true limit;
-//! * a zero micro-inertia is refused for dynamics.
+//! * a zero micro-inertia is refused for dynamics;
+//! * the seed's 3D beam in dynamic flexion (E4): the first period of the tip deflection
+//!   after a one-step tip impulse lies between the Euler–Bernoulli periods of the Cosserat
+//!   bound (`D = EI + (M + Mc)a²`, 31.0 µs) and of the Cauchy beam (`D = EI`, 48.9 µs), and
+//!   a coarser mesh is stiffer (shorter period).
 
 mod common;
 
 use common::sample;
 use porofrac_cosserat::dynamics::EXPLICIT_SAFETY;
-use porofrac_cosserat::{BodyLoads, Cosserat, Dynamics, Integrator, Material, Options};
+use porofrac_cosserat::{
+    BodyLoads, Condition, Cosserat, Dynamics, Field, Integrator, Material, Options, constant,
+};
 use porofrac_grid::Point;
 use porofrac_grid::generate::{perturb, simplices};
 
@@ -141,4 +147,81 @@ fn zero_micro_inertia_is_refused() {
     )
     .unwrap_err();
     assert!(e.to_string().contains("micro_inertia"));
+}
+
+/// The tip deflection history of the seed's beam (1 mm × 40 µm × 40 µm, `nx × 2 × 2`
+/// cubes of 6 tetrahedra, clamped at x = 0, a y-traction `p0 = E·1e-6` on the tip face
+/// during the first step, Newmark over `T = 200 L √(ρ/E)`), and the times at which it
+/// changes sign (linear interpolation between steps).
+fn beam_sign_changes(nx: usize, steps: usize) -> Vec<f64> {
+    let (lx, a) = (1e-3, 4e-5);
+    let g = simplices(Point::<3>::zeros(), Point::<3>::new(lx, a, a), [nx, 2, 2]).unwrap();
+    let (k, shear) = (16.67e9, 10e9);
+    let nu = (3.0 * k - 2.0 * shear) / (2.0 * (3.0 * k + shear));
+    let young = 9.0 * k * shear / (3.0 * k + shear);
+    // Rattez et al.: Gc = 5 GPa, L = 1 N, M = Mc = 2.5 N, ρ = 2500, j = (2/5)ℓ², ℓ = 10 µm.
+    let m = Material::with_couple_moduli(shear, nu, 5e9, [1.0, 2.5, 2.5])
+        .unwrap()
+        .with_inertia(2500.0, 0.4 * 1e-10)
+        .unwrap();
+    let dt = 200.0 * lx * (2500.0 / young).sqrt() / steps as f64;
+    let p0 = young * 1e-6;
+    let clamp =
+        Condition::new(g.boundary("xmin").unwrap()).clamp((0..6).map(|_| constant(0.0)).collect());
+    let impulse: Field<3> = std::sync::Arc::new(move |_, t| if t <= 1.5 * dt { p0 } else { 0.0 });
+    let tip = Condition::new(g.boundary("xmax").unwrap()).load(1, impulse);
+    let model = Cosserat::new(g, m, Options::default(), &[clamp, tip], BodyLoads::none()).unwrap();
+    let n = model.equations();
+    let grid = model.grid();
+    let tip_cells: Vec<usize> = (0..grid.num_cells())
+        .filter(|&c| grid.cell_centroid(c)[0] > lx * (1.0 - 1.0 / nx as f64))
+        .collect();
+    let mut d = Dynamics::new(
+        &model,
+        Integrator::Newmark,
+        dt,
+        0.0,
+        vec![0.0; n],
+        vec![0.0; n],
+    )
+    .unwrap();
+    let (mut t0, mut y0) = (0.0, 0.0);
+    let mut changes = Vec::new();
+    for _ in 0..steps {
+        d.step(&model).unwrap();
+        let y = tip_cells.iter().map(|&c| d.u[6 * c + 1]).sum::<f64>() / tip_cells.len() as f64;
+        if y0 != 0.0 && (y > 0.0) != (y0 > 0.0) {
+            changes.push(t0 + (d.t - t0) * y0 / (y0 - y));
+        }
+        (t0, y0) = (d.t, y);
+    }
+    changes
+}
+
+#[test]
+fn beam_in_flexion_oscillates_between_the_euler_bernoulli_bounds() {
+    // Clamped square beam, side a, length L: f1 = 1.8751²/(2π) √(D/(ρ a² L⁴)).
+    let (lx, a, rho): (f64, f64, f64) = (1e-3, 4e-5, 2500.0);
+    let young = 9.0 * 16.67e9 * 10e9 / (3.0 * 16.67e9 + 10e9);
+    let ei = young * a.powi(4) / 12.0;
+    let period = |d: f64| {
+        2.0 * std::f64::consts::PI / 1.8751f64.powi(2) * (rho * a * a * lx.powi(4) / d).sqrt()
+    };
+    let (cosserat, cauchy) = (period(ei + (2.5 + 2.5) * a * a), period(ei));
+    assert!((cosserat - 31.0e-6).abs() < 0.1e-6 && (cauchy - 48.9e-6).abs() < 0.1e-6);
+    // The first period ends at the second sign change of the tip deflection.
+    let fine = beam_sign_changes(160, 500);
+    let coarse = beam_sign_changes(40, 500);
+    assert!(fine.len() >= 2 && coarse.len() >= 2, "{fine:?} {coarse:?}");
+    assert!(
+        fine[1] > cosserat && fine[1] < cauchy,
+        "period {:.3e} s outside [{cosserat:.3e}, {cauchy:.3e}]",
+        fine[1]
+    );
+    assert!(
+        coarse[1] < fine[1],
+        "coarse {:.3e} ≥ fine {:.3e}",
+        coarse[1],
+        fine[1]
+    );
 }

@@ -189,6 +189,9 @@ impl<const D: usize> Grid<D> {
         }
         drop(chunks);
 
+        let boundary = (0..face_cells.len())
+            .filter(|&f| face_cells[f][1] == NO_CELL)
+            .collect();
         let mut grid = Grid {
             nodes,
             face_node_pos,
@@ -206,6 +209,7 @@ impl<const D: usize> Grid<D> {
             cell_centroid: Vec::new(),
             cell_tags: BTreeMap::new(),
             face_tags: BTreeMap::new(),
+            boundary,
         };
         check_nodes_used_and_distinct(&grid)?;
         grid.compute_geometry()?;

@@ -33,6 +33,8 @@ pub struct Grid<const D: usize> {
     // tags
     pub(crate) cell_tags: BTreeMap<String, Vec<usize>>,
     pub(crate) face_tags: BTreeMap<String, Vec<usize>>,
+    /// The faces with one cell, ascending (the topology never changes after building).
+    pub(crate) boundary: Vec<usize>,
 }
 
 /// Names of the bounding-box sides, in the order `[x, y, z] × [min, max]`.
@@ -282,9 +284,7 @@ impl<const D: usize> Grid<D> {
 
     /// All boundary faces.
     pub fn boundary_faces(&self) -> Vec<usize> {
-        (0..self.num_faces())
-            .filter(|&f| self.is_boundary_face(f))
-            .collect()
+        self.boundary.clone()
     }
 
     /// Boundary faces on a named side of the bounding box (`xmin` … `zmax`) or carrying a
@@ -294,17 +294,26 @@ impl<const D: usize> Grid<D> {
     /// of that side's plane; this works for generated and imported grids alike.
     pub fn boundary(&self, name: &str) -> Result<Vec<usize>> {
         if let Some(k) = SIDE_NAMES[..2 * D].iter().position(|&s| s == name) {
-            let (lo, hi) = self.bounding_box();
+            // The bounding box of the grid is that of its boundary nodes.
+            let mut lo = Point::<D>::repeat(f64::INFINITY);
+            let mut hi = Point::<D>::repeat(f64::NEG_INFINITY);
+            for &f in &self.boundary {
+                for &n in self.face_nodes(f) {
+                    lo = lo.inf(&self.nodes[n]);
+                    hi = hi.sup(&self.nodes[n]);
+                }
+            }
             let axis = k / 2;
             let plane = if k % 2 == 0 { lo[axis] } else { hi[axis] };
             let tol = 1e-9 * (hi - lo).amax().max(f64::MIN_POSITIVE);
-            return Ok((0..self.num_faces())
+            return Ok(self
+                .boundary
+                .iter()
+                .copied()
                 .filter(|&f| {
-                    self.is_boundary_face(f)
-                        && self
-                            .face_nodes(f)
-                            .iter()
-                            .all(|&n| (self.nodes[n][axis] - plane).abs() <= tol)
+                    self.face_nodes(f)
+                        .iter()
+                        .all(|&n| (self.nodes[n][axis] - plane).abs() <= tol)
                 })
                 .collect());
         }

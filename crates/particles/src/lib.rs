@@ -26,7 +26,7 @@ pub mod vtk;
 
 pub use cells::CellList;
 pub use disks::Disks;
-pub use packing::{Packing, RandomPacking};
+pub use packing::{Hole, Packing, RadiusDistribution, RandomPacking, Region};
 pub use tracked::{CellContact, CellState, TrackedCell};
 
 /// A bad particle set or packing request. Every variant names the offending index or

@@ -12,6 +12,11 @@
 //!   are then numbered row by row of cells (neighbours get nearby indices). The same seed gives the same packing bit for bit (SplitMix64,
 //!   sequential sweeps). The method reaches φ ≈ 0.82 for radius ratios near 2; above
 //!   the random close packing it does not relax and says so.
+//! * [`Region`] (box, disk, polygon) and [`Hole`] (a borehole): [`carve`] keeps the
+//!   disks of a packing that lie wholly inside the region and outside the holes;
+//!   [`hexagonal_in`] and [`RandomPacking::generate_in`] generate over the bounding box
+//!   and carve. Radii are uniform in `[r_min, r_max]` or drawn from a list
+//!   ([`RadiusDistribution`]).
 //! * [`Packing::max_overlap`], [`Packing::packing_fraction`],
 //!   [`Packing::coordination`]: the checks.
 
@@ -181,6 +186,8 @@ pub struct RandomPacking {
     pub seed: u64,
     /// Largest overlap left, as a fraction of `r_min` (default 1e-3).
     pub tolerance: f64,
+    /// How radii are drawn (default uniform in `[r_min, r_max]`).
+    pub distribution: RadiusDistribution,
     /// Most relaxation sweeps (default 20 000).
     pub max_sweeps: usize,
     /// Over-relaxation ω of the push-apart (default 1.7): each overlapping pair is moved
@@ -207,13 +214,64 @@ impl RandomPacking {
             packing_fraction,
             seed,
             tolerance: 1e-3,
+            distribution: RadiusDistribution::Uniform,
             max_sweeps: 20_000,
             relaxation: 1.7,
         }
     }
 
+    /// Radii drawn with equal probability from `radii` (sieve classes); `r_min` and
+    /// `r_max` become the smallest and largest entry.
+    pub fn with_radii(mut self, radii: &[f64]) -> Self {
+        self.r_min = radii.iter().copied().fold(f64::INFINITY, f64::min);
+        self.r_max = radii.iter().copied().fold(0.0, f64::max);
+        self.distribution = RadiusDistribution::List(radii.to_vec());
+        self
+    }
+
+    fn draw_radius(&self, rng: &mut SplitMix64) -> f64 {
+        match &self.distribution {
+            RadiusDistribution::Uniform => rng.range(self.r_min, self.r_max),
+            RadiusDistribution::List(list) => list[rng.below(list.len())],
+        }
+    }
+
+    /// Generate the packing in the box, then keep the disks lying wholly inside `region`
+    /// and outside every hole ([`carve`]). The packing fraction is that of the box.
+    pub fn generate_in(&self, region: &Region, holes: &[Hole]) -> Result<Packing, ParticleError> {
+        region.check()?;
+        for h in holes {
+            h.check()?;
+        }
+        Ok(carve(&self.generate()?, region, holes))
+    }
+
     /// Generate the packing.
     pub fn generate(&self) -> Result<Packing, ParticleError> {
+        if let RadiusDistribution::List(list) = &self.distribution {
+            if list.is_empty() {
+                return Err(ParticleError::BadArgument {
+                    argument: "radii",
+                    value: 0.0,
+                    message: "the list of radii is empty",
+                });
+            }
+            for (i, &r) in list.iter().enumerate() {
+                if !(r.is_finite() && r > 0.0) {
+                    return Err(ParticleError::BadRadius {
+                        index: i,
+                        radius: r,
+                    });
+                }
+                if r < self.r_min || r > self.r_max {
+                    return Err(ParticleError::BadArgument {
+                        argument: "radii",
+                        value: r,
+                        message: "a listed radius lies outside [r_min, r_max]",
+                    });
+                }
+            }
+        }
         let (lo, hi) = (self.lo, self.hi);
         if !(self.r_min.is_finite() && self.r_min > 0.0) {
             return Err(ParticleError::BadRadius {
@@ -255,7 +313,7 @@ impl RandomPacking {
         let mut p = Packing::default();
         let mut solid = 0.0;
         loop {
-            let r = rng.range(self.r_min, self.r_max);
+            let r = self.draw_radius(&mut rng);
             let a = std::f64::consts::PI * r * r;
             if solid + a > target {
                 break;
@@ -324,5 +382,216 @@ impl RandomPacking {
             overlap: worst,
             sweeps: self.max_sweeps,
         })
+    }
+}
+
+/// How the radii of a random packing are drawn.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub enum RadiusDistribution {
+    /// Uniform in `[r_min, r_max]`.
+    #[default]
+    Uniform,
+    /// Each disk takes one of the listed radii with equal probability.
+    List(Vec<f64>),
+}
+
+/// The region a packing fills.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Region {
+    /// The box `[lo, hi]`.
+    Box {
+        /// Lower-left corner (m).
+        lo: [f64; 2],
+        /// Upper-right corner (m).
+        hi: [f64; 2],
+    },
+    /// A disk.
+    Disk {
+        /// Centre (m).
+        centre: [f64; 2],
+        /// Radius (m).
+        radius: f64,
+    },
+    /// A simple polygon, vertices in order (either orientation).
+    Polygon(Vec<[f64; 2]>),
+}
+
+/// A circular hole (a borehole) left empty in a packing.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hole {
+    /// Centre (m).
+    pub centre: [f64; 2],
+    /// Radius (m).
+    pub radius: f64,
+}
+
+impl Hole {
+    fn check(&self) -> Result<(), ParticleError> {
+        if !(self.radius.is_finite() && self.radius > 0.0) {
+            return Err(ParticleError::BadArgument {
+                argument: "hole radius",
+                value: self.radius,
+                message: "must be a positive finite number",
+            });
+        }
+        Ok(())
+    }
+}
+
+impl Region {
+    /// The bounding box `(lo, hi)`.
+    pub fn bounds(&self) -> ([f64; 2], [f64; 2]) {
+        match self {
+            Region::Box { lo, hi } => (*lo, *hi),
+            Region::Disk { centre, radius } => (
+                [centre[0] - radius, centre[1] - radius],
+                [centre[0] + radius, centre[1] + radius],
+            ),
+            Region::Polygon(v) => v.iter().fold(
+                ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]),
+                |(lo, hi), p| {
+                    (
+                        [lo[0].min(p[0]), lo[1].min(p[1])],
+                        [hi[0].max(p[0]), hi[1].max(p[1])],
+                    )
+                },
+            ),
+        }
+    }
+
+    /// Area of the region (m²).
+    pub fn area(&self) -> f64 {
+        match self {
+            Region::Box { lo, hi } => (hi[0] - lo[0]) * (hi[1] - lo[1]),
+            Region::Disk { radius, .. } => std::f64::consts::PI * radius * radius,
+            Region::Polygon(v) => {
+                let n = v.len();
+                0.5 * (0..n)
+                    .map(|k| {
+                        let (a, b) = (v[k], v[(k + 1) % n]);
+                        a[0] * b[1] - b[0] * a[1]
+                    })
+                    .sum::<f64>()
+                    .abs()
+            }
+        }
+    }
+
+    /// An error naming the region's argument if it is degenerate.
+    pub fn check(&self) -> Result<(), ParticleError> {
+        let bad = |argument, value, message| {
+            Err(ParticleError::BadArgument {
+                argument,
+                value,
+                message,
+            })
+        };
+        match self {
+            Region::Box { lo, hi } => {
+                if !(hi[0] > lo[0] && hi[1] > lo[1]) {
+                    return bad("box", hi[0] - lo[0], "hi must exceed lo on both axes");
+                }
+            }
+            Region::Disk { radius, .. } => {
+                if !(radius.is_finite() && *radius > 0.0) {
+                    return bad("disk radius", *radius, "must be a positive finite number");
+                }
+            }
+            Region::Polygon(v) => {
+                if v.len() < 3 {
+                    return bad("polygon", v.len() as f64, "needs at least 3 vertices");
+                }
+                if self.area().is_nan() || self.area() <= 0.0 {
+                    return bad("polygon", 0.0, "has zero area");
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Whether the disk of centre `c` and radius `r` lies wholly inside the region.
+    pub fn contains_disk(&self, c: [f64; 2], r: f64) -> bool {
+        match self {
+            Region::Box { lo, hi } => {
+                c[0] - r >= lo[0] - 1e-12 * r
+                    && c[0] + r <= hi[0] + 1e-12 * r
+                    && c[1] - r >= lo[1] - 1e-12 * r
+                    && c[1] + r <= hi[1] + 1e-12 * r
+            }
+            Region::Disk { centre, radius } => dist(c, *centre) + r <= radius * (1.0 + 1e-12),
+            Region::Polygon(v) => {
+                // Inside by the even–odd rule, and at least r from every edge.
+                let n = v.len();
+                let mut inside = false;
+                for k in 0..n {
+                    let (a, b) = (v[k], v[(k + 1) % n]);
+                    if (a[1] > c[1]) != (b[1] > c[1]) {
+                        let x = a[0] + (c[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]);
+                        if c[0] < x {
+                            inside = !inside;
+                        }
+                    }
+                    if segment_distance(c, a, b) < r * (1.0 - 1e-12) {
+                        return false;
+                    }
+                }
+                inside
+            }
+        }
+    }
+}
+
+fn segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    let ab = [b[0] - a[0], b[1] - a[1]];
+    let l2 = ab[0] * ab[0] + ab[1] * ab[1];
+    let t = if l2 > 0.0 {
+        (((p[0] - a[0]) * ab[0] + (p[1] - a[1]) * ab[1]) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    dist(p, [a[0] + t * ab[0], a[1] + t * ab[1]])
+}
+
+/// The disks of `p` lying wholly inside `region` and outside every hole, in their
+/// original order.
+pub fn carve(p: &Packing, region: &Region, holes: &[Hole]) -> Packing {
+    let mut out = Packing::default();
+    for (c, &r) in p.centres.iter().zip(&p.radii) {
+        let in_hole = holes
+            .iter()
+            .any(|h| dist(*c, h.centre) < h.radius + r * (1.0 - 1e-12));
+        if region.contains_disk(*c, r) && !in_hole {
+            out.centres.push(*c);
+            out.radii.push(r);
+        }
+    }
+    out
+}
+
+/// Equal disks of radius `r` on a triangular lattice over the bounding box of `region`,
+/// carved to the region and the holes ([`carve`]).
+pub fn hexagonal_in(region: &Region, holes: &[Hole], r: f64) -> Result<Packing, ParticleError> {
+    region.check()?;
+    for h in holes {
+        h.check()?;
+    }
+    let (lo, hi) = region.bounds();
+    Ok(carve(&hexagonal(lo, hi, r)?, region, holes))
+}
+
+impl Packing {
+    /// Disk area over the area of `region` less the holes (holes assumed inside the
+    /// region and disjoint).
+    pub fn packing_fraction_in(&self, region: &Region, holes: &[Hole]) -> f64 {
+        let solid: f64 = self
+            .radii
+            .iter()
+            .map(|r| std::f64::consts::PI * r * r)
+            .sum();
+        let holes: f64 = holes
+            .iter()
+            .map(|h| std::f64::consts::PI * h.radius * h.radius)
+            .sum();
+        solid / (region.area() - holes)
     }
 }

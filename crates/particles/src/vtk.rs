@@ -54,6 +54,16 @@ fn array(s: &mut String, kind: &str, name: &str, comps: usize, values: impl Iter
 
 /// Write the disks as vertices with their point data.
 pub fn write_particles(path: &Path, d: &Disks) -> Result<(), ParticleError> {
+    write_particles_with(path, d, &[])
+}
+
+/// Write the disks as vertices with their point data and the extra scalar point data
+/// `extra` (name, one value per disk).
+pub fn write_particles_with(
+    path: &Path,
+    d: &Disks,
+    extra: &[(&str, &[f64])],
+) -> Result<(), ParticleError> {
     let n = d.len();
     let mut s = String::with_capacity(200 * n + 1000);
     let _ = write!(
@@ -91,6 +101,9 @@ pub fn write_particles(path: &Path, d: &Disks) -> Result<(), ParticleError> {
         }),
     );
     array(&mut s, "Int64", "id", 1, (0..n).map(|i| i as f64));
+    for (name, values) in extra {
+        array(&mut s, "Float64", name, 1, values.iter().copied());
+    }
     s.push_str("</PointData>\n</Piece>\n</PolyData>\n</VTKFile>\n");
     write_atomic(path, &s)
 }

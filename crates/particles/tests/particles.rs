@@ -190,3 +190,53 @@ fn trishear_field_is_incompressible_and_continuous() {
     assert_eq!(t.l2_mismatch(&pts, &v), 0.0);
     assert!((t.l2_mismatch(&pts, &[[0.0; 2]; 2]) - 1.0).abs() < 1e-15);
 }
+
+#[test]
+fn packings_in_a_disk_with_a_hole_and_in_a_polygon() {
+    use porofrac_particles::packing::{Hole, Region, hexagonal_in};
+    let disk = Region::Disk {
+        centre: [0.0, 0.0],
+        radius: 10.0,
+    };
+    let hole = Hole {
+        centre: [0.0, 0.0],
+        radius: 2.0,
+    };
+    let spec = RandomPacking::new([-10.0, -10.0], [10.0, 10.0], 0.2, 0.5, 0.8, 3);
+    let a = spec.generate_in(&disk, &[hole]).unwrap();
+    assert_eq!(a, spec.generate_in(&disk, &[hole]).unwrap(), "reproducible");
+    a.check_overlap(spec.tolerance * spec.r_min).unwrap();
+    for (c, r) in a.centres.iter().zip(&a.radii) {
+        let d = (c[0] * c[0] + c[1] * c[1]).sqrt();
+        assert!(
+            d + r <= 10.0 + 1e-9 && d - r >= 2.0 - 1e-9,
+            "disk at {c:?} r {r}"
+        );
+    }
+    // Carving loses the disks cut by the two circles only: the fraction stays near 0.8.
+    let phi = a.packing_fraction_in(&disk, &[hole]);
+    assert!(phi > 0.7 && phi < 0.8, "packing fraction {phi}");
+    assert!(a.coordination(0.01 * spec.r_min) > 3.0);
+    // A triangle: every hexagonal disk inside it, the area fraction near π/(2√3) inside.
+    let tri = Region::Polygon(vec![[0.0, 0.0], [20.0, 0.0], [0.0, 20.0]]);
+    let h = hexagonal_in(&tri, &[], 0.25).unwrap();
+    for (c, r) in h.centres.iter().zip(&h.radii) {
+        assert!(
+            c[0] >= *r - 1e-9 && c[1] >= *r - 1e-9 && c[0] + c[1] + r * 2f64.sqrt() <= 20.0 + 1e-9
+        );
+    }
+    let phi = h.packing_fraction_in(&tri, &[]);
+    assert!(
+        phi > 0.8 && phi < std::f64::consts::PI / 12f64.sqrt(),
+        "hexagonal fraction {phi}"
+    );
+    // Radii from a list: only listed values appear.
+    let listed = RandomPacking::new([0.0, 0.0], [10.0, 10.0], 0.0, 0.0, 0.7, 9)
+        .with_radii(&[0.2, 0.3, 0.45])
+        .generate()
+        .unwrap();
+    assert!(listed.radii.iter().all(|r| [0.2, 0.3, 0.45].contains(r)));
+    for r in [0.2, 0.3, 0.45] {
+        assert!(listed.radii.contains(&r));
+    }
+}

@@ -277,15 +277,18 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
     match ls.model() {
         "nscd" => {
             crate::lbm::check::refuse_sections(ls, "nscd")?;
+            crate::lsm::check::refuse_sections(ls, "nscd")?;
             return crate::nscd::check::check(ls);
         }
         "lbm" => {
             crate::nscd::check::refuse_sections(ls, "lbm")?;
+            crate::lsm::check::refuse_sections(ls, "lbm")?;
             return crate::lbm::check(ls);
         }
         "continuum" => {
             crate::nscd::check::refuse_sections(ls, "continuum")?;
             crate::lbm::check::refuse_sections(ls, "continuum")?;
+            crate::lsm::check::refuse_sections(ls, "continuum")?;
             crate::cosserat::check::refuse_in_continuum(ls)?;
             if !crate::nscd::check::has_section(ls, "grid") {
                 return Err(ls.error(
@@ -294,9 +297,14 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
                 ));
             }
         }
+        "lsm" => {
+            crate::lbm::check::refuse_sections(ls, "lsm")?;
+            return crate::lsm::check::check(ls);
+        }
         "cosserat" => {
             crate::nscd::check::refuse_sections(ls, "cosserat")?;
             crate::lbm::check::refuse_sections(ls, "cosserat")?;
+            crate::lsm::check::refuse_sections(ls, "cosserat")?;
             return crate::cosserat::check::check(ls);
         }
         other => {
@@ -304,7 +312,7 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
                 &k(&["scene", "model"]),
                 format!(
                     "= \"{other}\" is not available in this version of porofrac (available: \
-                     continuum, nscd, lbm, cosserat)"
+                     continuum, nscd, lbm, cosserat, lsm)"
                 ),
             ));
         }

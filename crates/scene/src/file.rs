@@ -233,8 +233,8 @@ pub struct SceneFile {
     /// `[output]`.
     #[serde(default)]
     pub output: Output,
-    /// `[particles]` (model `nscd`).
-    pub particles: Option<crate::nscd::file::ParticlesSection>,
+    /// `[particles]` (models `nscd` and `lsm`).
+    pub particles: Option<crate::particles::ParticlesSection>,
     /// `[[wall]]`: rigid bodies (model `nscd`).
     #[serde(default)]
     pub wall: Vec<crate::nscd::file::WallSection>,
@@ -242,6 +242,14 @@ pub struct SceneFile {
     pub contact: Option<crate::nscd::file::ContactSection>,
     /// `[nscd]`: the solver (model `nscd`).
     pub nscd: Option<crate::nscd::file::NscdSection>,
+    /// `[bonds]` (model `lsm`).
+    pub bonds: Option<crate::lsm::file::BondsSection>,
+    /// `[contacts]` (model `lsm`).
+    pub contacts: Option<crate::lsm::file::ContactsSection>,
+    /// `[lsm]` (model `lsm`).
+    pub lsm: Option<crate::lsm::file::LsmSection>,
+    /// `[loading]` (model `lsm`).
+    pub loading: Option<crate::lsm::file::LoadingSection>,
     /// `[lbm]` (lattice Boltzmann model).
     pub lbm: Option<crate::lbm::file::LbmSection>,
     /// `[[obstacle]]` (lattice Boltzmann model).

@@ -38,9 +38,12 @@ pub mod file;
 pub mod laws;
 pub mod lbm;
 pub mod limits;
+pub mod lsm;
 pub mod model;
 pub mod nscd;
 pub mod output;
+pub mod particle_output;
+pub mod particles;
 pub mod plots;
 pub mod sample;
 

@@ -141,6 +141,7 @@ fn run_model(
         "nscd" => crate::nscd::run(ls, out, observer)?,
         "lbm" => crate::lbm::run(ls, out, observer)?,
         "cosserat" => crate::cosserat::run(ls, out, observer)?,
+        "lsm" => crate::lsm::run(ls, out, observer)?,
         other => {
             return Err(ls
                 .error(

@@ -4,7 +4,7 @@
 use crate::check::{LoadedScene, SceneError, k, ki, step_count_f64};
 use crate::file::KeyPart;
 
-use super::file::{ParticleKind, RadiusSpec, WallComponent};
+use super::file::WallComponent;
 
 /// Top-level sections of the NSCD model.
 pub const SECTIONS: [&str; 4] = ["particles", "wall", "contact", "nscd"];
@@ -15,8 +15,7 @@ const CONTINUUM: [&str; 10] = [
     "grid", "region", "material", "fluid", "bc", "loads", "source", "well", "initial", "physics",
 ];
 
-/// Fields of one particle (`particle = N` probes, lines).
-pub const PARTICLE_FIELDS: [&str; 8] = ["x", "y", "vx", "vy", "omega", "fx", "fy", "radius"];
+pub use crate::particle_output::PARTICLE_FIELDS;
 /// Fields of a tracked cell (`cell = { center, radius }` probes).
 pub const CELL_FIELDS: [&str; 8] = [
     "p",
@@ -77,8 +76,7 @@ fn non_negative(ls: &LoadedScene, key: &[KeyPart], v: f64) -> Result<(), SceneEr
     }
 }
 
-/// Most disks a scene may generate.
-pub const MAX_PARTICLES: f64 = 2.0e7;
+pub use crate::particles::MAX_PARTICLES;
 
 /// Check an NSCD scene.
 pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
@@ -138,7 +136,7 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
             "belongs to model \"continuum\", not \"nscd\"",
         ));
     }
-    check_particles(ls)?;
+    crate::particles::check(ls, "nscd")?;
     check_walls(ls)?;
     if let Some(c) = &s.contact {
         let key = |f: &str| k(&["contact", f]);
@@ -221,101 +219,7 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
             ),
         ));
     }
-    check_output(ls)
-}
-
-fn check_particles(ls: &LoadedScene) -> Result<(), SceneError> {
-    let Some(p) = &ls.scene.particles else {
-        return Err(ls.error(
-            &k(&["particles"]),
-            "is missing: model \"nscd\" needs [particles]",
-        ));
-    };
-    let key = |f: &str| k(&["particles", f]);
-    positive(ls, &key("density"), p.density)?;
-    match p.kind {
-        ParticleKind::Random | ParticleKind::Hexagonal => {
-            let Some(region) = p.region else {
-                return Err(ls.error(&key("region"), "is required for this kind"));
-            };
-            for a in 0..2 {
-                if !(region[0][a].is_finite()
-                    && region[1][a].is_finite()
-                    && region[1][a] > region[0][a])
-                {
-                    return Err(ls.error(
-                        &key("region"),
-                        "must be [[x0, y0], [x1, y1]] with x1 > x0, y1 > y0",
-                    ));
-                }
-            }
-            let Some(radius) = p.radius else {
-                return Err(ls.error(&key("radius"), "is required for this kind"));
-            };
-            let [r0, r1] = radius.range();
-            positive(ls, &key("radius"), r0)?;
-            if !(r1.is_finite() && r1 >= r0) {
-                return Err(ls.error(&key("radius"), "must be [min, max] with max ≥ min"));
-            }
-            if p.kind == ParticleKind::Hexagonal
-                && matches!(radius, RadiusSpec::Range(_))
-                && r1 != r0
-            {
-                return Err(ls.error(
-                    &key("radius"),
-                    "must be one number for kind = \"hexagonal\"",
-                ));
-            }
-            for a in 0..2 {
-                if region[1][a] - region[0][a] < 2.0 * r1 {
-                    return Err(ls.error(&key("region"), "is narrower than one largest diameter"));
-                }
-            }
-            let phi = p.packing_fraction.unwrap_or(0.8);
-            if p.kind == ParticleKind::Random && !(phi > 0.0 && phi < 0.84) {
-                return Err(ls.error(
-                    &key("packing_fraction"),
-                    format!("= {phi} must be in (0, 0.84)"),
-                ));
-            }
-            let area = (region[1][0] - region[0][0]) * (region[1][1] - region[0][1]);
-            let count = area / (std::f64::consts::PI * r0 * r0);
-            if count > MAX_PARTICLES {
-                return Err(ls.error(
-                    &key("radius"),
-                    format!("gives up to {count:.3e} disks in the region, more than the {MAX_PARTICLES:.0e} a scene may have"),
-                ));
-            }
-        }
-        ParticleKind::List => {
-            let (Some(c), Some(r)) = (&p.centres, &p.radii) else {
-                return Err(ls.error(
-                    &key("centres"),
-                    "and radii are required for kind = \"list\"",
-                ));
-            };
-            if c.len() != r.len() {
-                return Err(ls.error(
-                    &key("radii"),
-                    format!("has {} values for {} centres", r.len(), c.len()),
-                ));
-            }
-            for (i, &ri) in r.iter().enumerate() {
-                if !(ri.is_finite() && ri > 0.0) {
-                    return Err(ls.error(
-                        &key("radii"),
-                        format!("[{i}] = {ri} must be a positive radius"),
-                    ));
-                }
-            }
-            for (i, ci) in c.iter().enumerate() {
-                if !(ci[0].is_finite() && ci[1].is_finite()) {
-                    return Err(ls.error(&key("centres"), format!("[{i}] is not finite")));
-                }
-            }
-        }
-    }
-    Ok(())
+    check_output_of(ls, "nscd", &CELL_FIELDS, &[])
 }
 
 fn check_walls(ls: &LoadedScene) -> Result<(), SceneError> {
@@ -386,7 +290,15 @@ fn check_walls(ls: &LoadedScene) -> Result<(), SceneError> {
     Ok(())
 }
 
-fn check_output(ls: &LoadedScene) -> Result<(), SceneError> {
+/// Check the probes and lines of a particle scene of `model`: particle fields with
+/// `particle = N`, `cell_fields` with `cell = { center, radius }`, `global_fields` with
+/// neither.
+pub fn check_output_of(
+    ls: &LoadedScene,
+    model: &str,
+    cell_fields: &[&str],
+    global_fields: &[&str],
+) -> Result<(), SceneError> {
     let s = &ls.scene;
     if s.output.every < 1 {
         return Err(ls.error(
@@ -406,7 +318,7 @@ fn check_output(ls: &LoadedScene) -> Result<(), SceneError> {
         if !p.at.is_empty() {
             return Err(ls.error(
                 &key("at"),
-                "is for grid models; model \"nscd\" probes a particle or a cell",
+                format!("is for grid models; model \"{model}\" probes a particle or a cell"),
             ));
         }
         let f = p.field.as_str();
@@ -423,7 +335,18 @@ fn check_output(ls: &LoadedScene) -> Result<(), SceneError> {
                     ));
                 }
             }
-        } else if CELL_FIELDS.contains(&f) {
+        } else if global_fields.contains(&f) {
+            if p.particle.is_some() || p.cell.is_some() {
+                return Err(ls.error(
+                    &key(if p.particle.is_some() {
+                        "particle"
+                    } else {
+                        "cell"
+                    }),
+                    format!("is not allowed for field \"{f}\" (a value of the whole scene)"),
+                ));
+            }
+        } else if cell_fields.contains(&f) {
             match (p.particle, &p.cell) {
                 (None, Some(c)) => {
                     if c.center.len() != 2 || !c.center.iter().all(|v| v.is_finite()) {
@@ -442,9 +365,10 @@ fn check_output(ls: &LoadedScene) -> Result<(), SceneError> {
             return Err(ls.error(
                 &key("field"),
                 format!(
-                    "= \"{f}\" is not a field of model \"nscd\" (particle: {}; cell: {})",
+                    "= \"{f}\" is not a field of model \"{model}\" (particle: {}; cell: {}; scene: {})",
                     PARTICLE_FIELDS.join(" "),
-                    CELL_FIELDS.join(" ")
+                    cell_fields.join(" "),
+                    global_fields.join(" ")
                 ),
             ));
         }

@@ -3,62 +3,7 @@
 
 use serde::Deserialize;
 
-/// `[particles] kind`: how the disks are generated.
-#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
-#[serde(rename_all = "kebab-case")]
-pub enum ParticleKind {
-    /// A dense random polydisperse packing in `region` (random placement with overlap
-    /// relaxation, [`porofrac_particles::RandomPacking`]).
-    #[default]
-    Random,
-    /// Equal disks on a triangular lattice filling `region`.
-    Hexagonal,
-    /// The disks listed in `centres` and `radii`.
-    List,
-}
-
-/// A radius, or a `[min, max]` range drawn uniformly.
-#[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
-#[serde(untagged)]
-pub enum RadiusSpec {
-    /// One radius (m).
-    One(f64),
-    /// `[min, max]` (m).
-    Range([f64; 2]),
-}
-
-impl RadiusSpec {
-    /// `[min, max]`.
-    pub fn range(&self) -> [f64; 2] {
-        match *self {
-            Self::One(r) => [r, r],
-            Self::Range(r) => r,
-        }
-    }
-}
-
-/// `[particles]`.
-#[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ParticlesSection {
-    /// Generator (default `"random"`).
-    #[serde(default)]
-    pub kind: ParticleKind,
-    /// The box filled: `[[x0, y0], [x1, y1]]` (m).
-    pub region: Option<[[f64; 2]; 2]>,
-    /// Radius (hexagonal) or `[min, max]` (random), m.
-    pub radius: Option<RadiusSpec>,
-    /// Random: disk area over box area (default 0.8).
-    pub packing_fraction: Option<f64>,
-    /// Random: seed (default 1).
-    pub seed: Option<u64>,
-    /// List: centres (m).
-    pub centres: Option<Vec<[f64; 2]>>,
-    /// List: radii (m).
-    pub radii: Option<Vec<f64>>,
-    /// Density (kg/m³; masses per metre of thickness).
-    pub density: f64,
-}
+pub use crate::particles::{ParticleKind, ParticlesSection, RadiusSpec};
 
 /// A velocity component of a wall: a number (m/s) or `"free"`.
 #[derive(Clone, Debug, Deserialize, PartialEq)]

@@ -25,17 +25,17 @@ use std::path::Path;
 use std::time::Instant;
 
 use porofrac_grid::io::PvdWriter;
-use porofrac_nscd::{Axis, ContactLaw, Nscd, NscdError, Ordering, RigidBody, SolverParams};
-use porofrac_particles::packing::hexagonal;
-use porofrac_particles::vtk::{write_contacts, write_particles};
-use porofrac_particles::{Disks, RandomPacking, TrackedCell};
 
-use crate::check::{LoadedScene, SceneError, k, ki, step_count};
+use crate::particle_output;
+use porofrac_nscd::{Axis, ContactLaw, Nscd, NscdError, Ordering, RigidBody, SolverParams};
+use porofrac_particles::TrackedCell;
+
+use crate::check::{LoadedScene, k, ki, step_count};
 use crate::driver::{Observer, drive};
 use crate::model::{Model, RunError, Sizes, StepStats};
 use crate::output::{SolverStats, Summary, WallSeconds};
 
-use file::{OrderingChoice, ParticleKind, WallComponent};
+use file::{OrderingChoice, WallComponent};
 
 /// Run a checked NSCD scene and write its `summary.json`.
 pub(crate) fn run(
@@ -104,46 +104,6 @@ fn scene_error(ls: &LoadedScene, e: &NscdError) -> RunError {
     RunError::Scene(ls.error(&key, format!(": {e}")))
 }
 
-fn generate(ls: &LoadedScene) -> Result<Disks, SceneError> {
-    let p = ls
-        .scene
-        .particles
-        .as_ref()
-        .expect("checked: [particles] present");
-    let key = |f: &str| k(&["particles", f]);
-    let (centres, radii) = match p.kind {
-        ParticleKind::List => (
-            p.centres.clone().unwrap_or_default(),
-            p.radii.clone().unwrap_or_default(),
-        ),
-        ParticleKind::Hexagonal | ParticleKind::Random => {
-            let region = p.region.expect("checked");
-            let [r0, r1] = p.radius.expect("checked").range();
-            let packing = if p.kind == ParticleKind::Hexagonal {
-                hexagonal(region[0], region[1], r0)
-                    .map_err(|e| ls.error(&key("radius"), format!(": {e}")))?
-            } else {
-                RandomPacking::new(
-                    region[0],
-                    region[1],
-                    r0,
-                    r1,
-                    p.packing_fraction.unwrap_or(0.8),
-                    p.seed.unwrap_or(1),
-                )
-                .generate()
-                .map_err(|e| ls.error(&key("packing_fraction"), format!(": {e}")))?
-            };
-            (packing.centres, packing.radii)
-        }
-    };
-    if centres.is_empty() {
-        return Err(ls.error(&key("kind"), "generates no particle"));
-    }
-    Disks::new(&centres, &radii, p.density)
-        .map_err(|e| ls.error(&k(&["particles"]), format!(": {e}")))
-}
-
 fn walls(ls: &LoadedScene) -> Vec<RigidBody> {
     ls.scene
         .wall
@@ -172,7 +132,7 @@ fn walls(ls: &LoadedScene) -> Vec<RigidBody> {
 /// Build the model of a checked NSCD scene.
 pub fn build(ls: &LoadedScene) -> Result<NscdModel<'_>, RunError> {
     let s = &ls.scene;
-    let disks = generate(ls)?;
+    let disks = crate::particles::generate(ls)?;
     let c = s.contact.clone().unwrap_or_default();
     let mu = c.mu.unwrap_or(0.0);
     let law = ContactLaw {
@@ -273,17 +233,7 @@ impl NscdModel<'_> {
     }
 
     fn particle_value(&self, i: usize, field: usize, forces: &[[f64; 2]]) -> f64 {
-        let d = &self.sys.disks;
-        match check::PARTICLE_FIELDS[field] {
-            "x" => d.x[i][0],
-            "y" => d.x[i][1],
-            "vx" => d.v[i][0],
-            "vy" => d.v[i][1],
-            "omega" => d.omega[i],
-            "fx" => forces[i][0],
-            "fy" => forces[i][1],
-            _ => d.r[i],
-        }
+        particle_output::particle_value(&self.sys.disks, i, field, forces)
     }
 
     /// Keys added to `summary.json`.
@@ -383,35 +333,8 @@ impl Model for NscdModel<'_> {
     }
 
     fn line(&self, line: usize, rows: &mut Vec<Vec<f64>>) {
-        let l = &self.ls.scene.output.line[line];
-        let field = check::PARTICLE_FIELDS
-            .iter()
-            .position(|f| *f == l.field)
-            .expect("checked");
         let forces = self.particle_forces();
-        let x = &self.sys.disks.x;
-        let n = l.points as usize;
-        let len = ((l.to[0] - l.from[0]).powi(2) + (l.to[1] - l.from[1]).powi(2)).sqrt();
-        for k in 0..n {
-            let s = k as f64 / (n - 1) as f64;
-            let p = [
-                l.from[0] + s * (l.to[0] - l.from[0]),
-                l.from[1] + s * (l.to[1] - l.from[1]),
-            ];
-            let nearest = (0..x.len())
-                .min_by(|&a, &b| {
-                    let da = (x[a][0] - p[0]).powi(2) + (x[a][1] - p[1]).powi(2);
-                    let db = (x[b][0] - p[0]).powi(2) + (x[b][1] - p[1]).powi(2);
-                    da.total_cmp(&db)
-                })
-                .unwrap_or(0);
-            rows.push(vec![
-                s * len,
-                p[0],
-                p[1],
-                self.particle_value(nearest, field, &forces),
-            ]);
-        }
+        particle_output::line_rows(self.ls, line, &self.sys.disks, &forces, rows);
     }
 
     fn after_step(&mut self, _out: &Path) -> Result<(), RunError> {
@@ -419,60 +342,30 @@ impl Model for NscdModel<'_> {
     }
 
     fn write_vtk(&self, dir: &Path, index: usize) -> Result<String, RunError> {
-        let io = |e: porofrac_particles::ParticleError| {
-            RunError::Output(crate::output::OutputError {
-                path: dir.to_path_buf(),
-                source: std::io::Error::other(e.to_string()),
-            })
-        };
-        let particles = format!("particles_{index:04}.vtp");
-        let contacts = format!("contacts_{index:04}.vtp");
-        write_particles(&dir.join(&particles), &self.sys.disks).map_err(io)?;
         let mut lines = Vec::new();
         self.sys.contact_lines(&mut lines);
-        write_contacts(&dir.join(&contacts), &lines).map_err(io)?;
-        let mut pvd = self.contacts_pvd.borrow_mut();
-        if pvd.is_none() {
-            let parent = dir.parent().unwrap_or(Path::new("."));
-            *pvd = Some(PvdWriter::create(
-                parent.join(format!("{}_contacts.pvd", self.ls.scene.scene.name)),
-            )?);
-        }
-        if let Some(pvd) = pvd.as_mut() {
-            pvd.add(self.sys.time, format!("vtk/{contacts}"))?;
-        }
-        Ok(particles)
+        particle_output::write_vtk(
+            self.ls,
+            dir,
+            index,
+            self.sys.time,
+            &self.sys.disks,
+            &[],
+            &lines,
+            &self.contacts_pvd,
+        )
     }
 
     fn field_extrema(&self) -> BTreeMap<String, [f64; 2]> {
-        let d = &self.sys.disks;
-        let mut out = BTreeMap::new();
-        let mut put = |name: &str, values: &mut dyn Iterator<Item = f64>| {
-            let mm = values.fold([f64::INFINITY, f64::NEG_INFINITY], |[a, b], v| {
-                [a.min(v), b.max(v)]
-            });
-            if mm[0] <= mm[1] {
-                out.insert(name.to_string(), mm);
-            }
-        };
-        put("radius", &mut d.r.iter().copied());
-        put("vx", &mut d.v.iter().map(|v| v[0]));
-        put("vy", &mut d.v.iter().map(|v| v[1]));
-        put(
-            "speed",
-            &mut d.v.iter().map(|v| (v[0] * v[0] + v[1] * v[1]).sqrt()),
-        );
-        put("omega", &mut d.omega.iter().copied());
-        put("ux", &mut (0..d.len()).map(|i| d.displacement(i)[0]));
-        put("uy", &mut (0..d.len()).map(|i| d.displacement(i)[1]));
+        let mut out = particle_output::disk_extrema(&self.sys.disks);
         let forces: Vec<[f64; 2]> = self
             .sys
             .contacts()
             .iter()
             .map(|c| self.sys.contact_force(c))
             .collect();
-        put("normal_force", &mut forces.iter().map(|f| f[0]));
-        put("tangential_force", &mut forces.iter().map(|f| f[1]));
+        particle_output::put_extrema(&mut out, "normal_force", forces.iter().map(|f| f[0]));
+        particle_output::put_extrema(&mut out, "tangential_force", forces.iter().map(|f| f[1]));
         out
     }
 

@@ -1,0 +1,351 @@
+//! Validation of a lattice solid scene: the keys of other models refused with the key
+//! and the model named, every value checked (the bond law is built here, so that a bad
+//! stiffness or strength names its key).
+
+use crate::check::{LoadedScene, SceneError, k, step_count_f64};
+use crate::file::KeyPart;
+use porofrac_lsm::{BondLaw, LsmError};
+
+use super::file::{DampingChoice, NormalChoice};
+
+/// Top-level sections of the model (besides `[particles]`, shared with `nscd`).
+pub const SECTIONS: [&str; 4] = ["bonds", "contacts", "lsm", "loading"];
+const SHARED: [&str; 5] = ["scene", "schedule", "output", "solver", "particles"];
+const OTHERS: [(&str, &str); 16] = [
+    ("wall", "nscd"),
+    ("contact", "nscd"),
+    ("nscd", "nscd"),
+    ("lbm", "lbm"),
+    ("obstacle", "lbm"),
+    ("thermal", "lbm"),
+    ("grid", "continuum"),
+    ("region", "continuum"),
+    ("material", "continuum"),
+    ("fluid", "continuum"),
+    ("bc", "continuum"),
+    ("loads", "continuum"),
+    ("source", "continuum"),
+    ("well", "continuum"),
+    ("initial", "continuum"),
+    ("physics", "continuum"),
+];
+
+/// Fields of a tracked cell.
+pub const CELL_FIELDS: [&str; 8] = [
+    "p",
+    "q",
+    "anisotropy",
+    "anisotropy_volume",
+    "dilation_x",
+    "dilation_y",
+    "contacts",
+    "broken_bonds",
+];
+/// Fields of the whole scene: wall pressure (Pa), platen load (N/m), broken bonds (all,
+/// tensile, shear).
+pub const GLOBAL_FIELDS: [&str; 5] = [
+    "pressure",
+    "platen_force",
+    "broken",
+    "broken_tensile",
+    "broken_shear",
+];
+
+fn top_level(ls: &LoadedScene) -> Vec<String> {
+    toml::from_str::<toml::Table>(&ls.text)
+        .map(|t| t.keys().cloned().collect())
+        .unwrap_or_default()
+}
+
+/// Refuse the lattice solid sections in a scene of another `model`.
+pub fn refuse_sections(ls: &LoadedScene, model: &str) -> Result<(), SceneError> {
+    for key in top_level(ls) {
+        if SECTIONS.contains(&key.as_str()) {
+            return Err(ls.error(
+                &k(&[&key]),
+                format!("belongs to model \"lsm\", not \"{model}\""),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The key path of a library parameter name such as `bonds.kn`.
+pub fn key_of(name: &str) -> Vec<KeyPart> {
+    let parts: Vec<&str> = name.split('.').collect();
+    match parts.as_slice() {
+        ["bonds", "tensile"] => k(&["bonds", "tensile_strength"]),
+        ["contacts", "modulus"] | ["contacts", "poisson"] => k(&["contacts", "modulus"]),
+        ["damping", _] => k(&["lsm", "damping_coefficient"]),
+        ["E"] => k(&["bonds", "youngs_modulus"]),
+        ["nu"] => k(&["bonds", "poisson_ratio"]),
+        ["hole radius"] => k(&["particles", "hole"]),
+        [s, f] => k(&[s, f]),
+        _ => k(&["lsm"]),
+    }
+}
+
+/// The error of a library error at its key.
+pub fn lsm_error(ls: &LoadedScene, e: &LsmError) -> SceneError {
+    let key = match e {
+        LsmError::BadParameter { name, .. } => key_of(name),
+        LsmError::TimeStep { .. } => k(&["lsm", "dt"]),
+        LsmError::Overlap { .. } | LsmError::NotFinite { .. } => k(&["particles"]),
+        LsmError::External { .. } => k(&["loading"]),
+        LsmError::Calibration(_) => k(&["bonds", "calibrate"]),
+    };
+    ls.error(&key, format!(": {e}"))
+}
+
+fn positive(ls: &LoadedScene, key: &[KeyPart], v: f64) -> Result<(), SceneError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(ls.error(key, format!("= {v} must be a positive number")))
+    }
+}
+
+/// The bond law of `[bonds]`.
+pub fn bond_law(ls: &LoadedScene) -> Result<BondLaw, SceneError> {
+    let Some(b) = &ls.scene.bonds else {
+        return Err(ls.error(&k(&["bonds"]), "is missing: model \"lsm\" needs [bonds]"));
+    };
+    let key = |f: &str| k(&["bonds", f]);
+    let (kn, ks) = match (b.youngs_modulus, b.poisson_ratio, b.kn) {
+        (Some(_), _, Some(_)) | (_, Some(_), Some(_)) => {
+            return Err(ls.error(
+                &key("kn"),
+                "give youngs_modulus and poisson_ratio, or kn and ks, not both",
+            ));
+        }
+        (Some(e), Some(nu), None) => {
+            if b.ks.is_some() {
+                return Err(ls.error(&key("ks"), "is set by youngs_modulus and poisson_ratio"));
+            }
+            porofrac_lsm::calibrate::hexagonal_springs(e, nu).map_err(|e| lsm_error(ls, &e))?
+        }
+        (Some(_), None, None) => {
+            return Err(ls.error(&key("poisson_ratio"), "is required with youngs_modulus"));
+        }
+        (None, Some(_), None) => {
+            return Err(ls.error(&key("youngs_modulus"), "is required with poisson_ratio"));
+        }
+        (None, None, Some(kn)) => (kn, b.ks.unwrap_or(0.0)),
+        (None, None, None) => {
+            return Err(ls.error(
+                &key("youngs_modulus"),
+                "is missing: give youngs_modulus and poisson_ratio, or kn",
+            ));
+        }
+    };
+    let phi = b.friction_angle.unwrap_or(30.0);
+    if !(0.0..90.0).contains(&phi) {
+        return Err(ls.error(
+            &key("friction_angle"),
+            format!("= {phi} must be in [0, 90) degrees"),
+        ));
+    }
+    let tensile = b.tensile_strength.unwrap_or(f64::INFINITY);
+    let law = BondLaw {
+        kn,
+        ks,
+        kb: b.kb.unwrap_or(0.0),
+        tensile,
+        cohesion: b
+            .cohesion
+            .unwrap_or(tensile * phi.to_radians().tan().max(1e-300)),
+        friction_angle: phi.to_radians(),
+    };
+    law.check().map_err(|e| lsm_error(ls, &e))?;
+    if let Some(t) = b.tolerance
+        && !(t.is_finite() && (0.0..=0.5).contains(&t))
+    {
+        return Err(ls.error(&key("tolerance"), format!("= {t} must be in [0, 0.5]")));
+    }
+    Ok(law)
+}
+
+/// Check a lattice solid scene.
+pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
+    let s = &ls.scene;
+    for key in top_level(ls) {
+        if SECTIONS.contains(&key.as_str()) || SHARED.contains(&key.as_str()) {
+            continue;
+        }
+        let owner = OTHERS
+            .iter()
+            .find(|o| o.0 == key)
+            .map_or("another model", |o| o.1);
+        return Err(ls.error(
+            &k(&[&key]),
+            format!("belongs to model \"{owner}\", not \"lsm\""),
+        ));
+    }
+    if s.scene.dim != 2 {
+        return Err(ls.error(
+            &k(&["scene", "dim"]),
+            format!("= {} must be 2: model \"lsm\" has disks", s.scene.dim),
+        ));
+    }
+    if s.scene.plane.is_some() {
+        return Err(ls.error(
+            &k(&["scene", "plane"]),
+            "belongs to model \"continuum\", not \"lsm\"",
+        ));
+    }
+    for (name, set) in [
+        ("mechanics", s.solver.mechanics.is_some()),
+        ("linear", s.solver.linear.is_some()),
+        ("tolerance", s.solver.tolerance.is_some()),
+    ] {
+        if set {
+            return Err(ls.error(
+                &k(&["solver", name]),
+                "belongs to model \"continuum\", not \"lsm\"",
+            ));
+        }
+    }
+    if s.output.exact_displacement.is_some() {
+        return Err(ls.error(
+            &k(&["output", "exact_displacement"]),
+            "belongs to model \"continuum\", not \"lsm\"",
+        ));
+    }
+    crate::particles::check(ls, "lsm")?;
+    bond_law(ls)?;
+    if let Some(c) = &s.contacts {
+        let key = |f: &str| k(&["contacts", f]);
+        for (f, v) in [("friction", c.friction), ("kn", c.kn), ("ks", c.ks)] {
+            if let Some(v) = v
+                && !(v.is_finite() && v >= 0.0)
+            {
+                return Err(ls.error(&key(f), format!("= {v} must be a number ≥ 0")));
+            }
+        }
+        match c.normal {
+            NormalChoice::Hertz => {
+                positive(ls, &key("modulus"), c.modulus.unwrap_or(f64::NAN))
+                    .map_err(|_| ls.error(&key("modulus"), "(a positive Young's modulus of the grains) is required with normal = \"hertz\""))?;
+                let nu = c.poisson_ratio.unwrap_or(0.25);
+                if !(nu > -1.0 && nu < 0.5) {
+                    return Err(ls.error(
+                        &key("poisson_ratio"),
+                        format!("= {nu} must be in (-1, 0.5)"),
+                    ));
+                }
+            }
+            NormalChoice::Linear => {
+                for (f, set) in [
+                    ("modulus", c.modulus.is_some()),
+                    ("poisson_ratio", c.poisson_ratio.is_some()),
+                ] {
+                    if set {
+                        return Err(ls.error(&key(f), "applies to normal = \"hertz\""));
+                    }
+                }
+            }
+        }
+    }
+    if let Some(l) = &s.lsm {
+        let key = |f: &str| k(&["lsm", f]);
+        if let Some(dt) = l.dt {
+            positive(ls, &key("dt"), dt)?;
+        }
+        if let Some(f) = l.dt_fraction
+            && !(f > 0.0 && f <= 1.0)
+        {
+            return Err(ls.error(&key("dt_fraction"), format!("= {f} must be in (0, 1]")));
+        }
+        match (l.damping, l.damping_coefficient) {
+            (DampingChoice::None, Some(_)) => {
+                return Err(ls.error(
+                    &key("damping_coefficient"),
+                    "needs damping = \"local\" or \"viscous\"",
+                ));
+            }
+            (DampingChoice::Local, Some(a)) if !(0.0..1.0).contains(&a) => {
+                return Err(ls.error(
+                    &key("damping_coefficient"),
+                    format!("= {a} must be in [0, 1) for local damping"),
+                ));
+            }
+            (DampingChoice::Viscous, None) => {
+                return Err(ls.error(
+                    &key("damping_coefficient"),
+                    "(the rate, 1/s) is required with damping = \"viscous\"",
+                ));
+            }
+            (DampingChoice::Viscous, Some(c)) if !(c.is_finite() && c >= 0.0) => {
+                return Err(ls.error(&key("damping_coefficient"), format!("= {c} must be ≥ 0")));
+            }
+            _ => {}
+        }
+        if let Some(g) = l.gravity
+            && !g.iter().all(|v| v.is_finite())
+        {
+            return Err(ls.error(&key("gravity"), "must be finite"));
+        }
+    }
+    if let Some(l) = &s.loading {
+        let key = |f: &str| k(&["loading", f]);
+        if let Some(p) = l.platens {
+            positive(ls, &key("platens"), p.velocity).map_err(|_| {
+                ls.error(
+                    &key("platens"),
+                    format!("velocity = {} must be positive", p.velocity),
+                )
+            })?;
+            positive(ls, &key("platens"), p.thickness).map_err(|_| {
+                ls.error(
+                    &key("platens"),
+                    format!("thickness = {} must be positive", p.thickness),
+                )
+            })?;
+        }
+        if let Some(r) = l.pressure_rate {
+            if !(r.is_finite() && r >= 0.0) {
+                return Err(ls.error(&key("pressure_rate"), format!("= {r} must be ≥ 0")));
+            }
+            if s.particles.as_ref().is_none_or(|p| p.hole.is_none()) {
+                return Err(ls.error(
+                    &key("pressure_rate"),
+                    "needs a hole: [particles] hole = { center, radius }",
+                ));
+            }
+        }
+        if let Some(m) = l.pressure_max {
+            if l.pressure_rate.is_none() {
+                return Err(ls.error(&key("pressure_max"), "needs pressure_rate"));
+            }
+            positive(ls, &key("pressure_max"), m)?;
+        }
+    }
+    let Some(sch) = &s.schedule else {
+        return Err(ls.error(
+            &k(&["schedule"]),
+            "is missing: model \"lsm\" needs end_time and dt or steps",
+        ));
+    };
+    positive(ls, &k(&["schedule", "end_time"]), sch.end_time)?;
+    match (sch.dt, sch.steps) {
+        (Some(dt), _) => positive(ls, &k(&["schedule", "dt"]), dt)?,
+        (None, Some(n)) if n >= 1 => {}
+        (None, Some(n)) => {
+            return Err(ls.error(&k(&["schedule", "steps"]), format!("= {n} must be ≥ 1")));
+        }
+        (None, None) => {
+            return Err(ls.error(&k(&["schedule", "dt"]), "is missing: give dt or steps"));
+        }
+    }
+    let n = step_count_f64(sch);
+    if n > crate::limits::MAX_STEPS as f64 {
+        return Err(ls.error(
+            &k(&["schedule", if sch.dt.is_some() { "dt" } else { "steps" }]),
+            format!(
+                "gives {n:.3e} output steps, more than the {} a run may take",
+                crate::limits::MAX_STEPS
+            ),
+        ));
+    }
+    crate::nscd::check::check_output_of(ls, "lsm", &CELL_FIELDS, &GLOBAL_FIELDS)
+}

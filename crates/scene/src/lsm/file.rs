@@ -1,0 +1,118 @@
+//! The sections of a lattice solid scene (`[scene] model = "lsm"`), parsed strictly
+//! like the rest of the file ([`crate::file`]). `[particles]` is shared with the other
+//! particle model ([`crate::particles`]).
+
+use serde::Deserialize;
+
+/// `[bonds]`: springs from `youngs_modulus` and `poisson_ratio` (hexagonal lattice
+/// closed form, [`porofrac_lsm`]) or `kn`, `ks` directly; strengths; calibration.
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BondsSection {
+    /// 2D Young's modulus E (Pa), with `poisson_ratio`.
+    pub youngs_modulus: Option<f64>,
+    /// Poisson's ratio ν ≤ 1/3.
+    pub poisson_ratio: Option<f64>,
+    /// Normal stiffness k_n (N/m²), instead of E and ν.
+    pub kn: Option<f64>,
+    /// Shear stiffness k_s (N/m², default 0 with `kn`).
+    pub ks: Option<f64>,
+    /// Bending stiffness k_b (N·m/m per rad, default 0).
+    pub kb: Option<f64>,
+    /// Tensile strength σ_t (Pa): tension cut-off (default unbreakable).
+    pub tensile_strength: Option<f64>,
+    /// Cohesion c (Pa, default σ_t tan φ).
+    pub cohesion: Option<f64>,
+    /// Friction angle φ of the bond strength (degrees, default 30).
+    pub friction_angle: Option<f64>,
+    /// Disks closer than (R_i + R_j)(1 + tolerance) are bonded (default 0.05).
+    pub tolerance: Option<f64>,
+    /// Measure E, ν (uniaxial compression) and σ_t (Brazilian test) of the packing
+    /// before the run, into `summary.json` `calibration` (default false).
+    #[serde(default)]
+    pub calibrate: bool,
+}
+
+/// `[contacts] normal`.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum NormalChoice {
+    /// `F = k_n δ`.
+    #[default]
+    Linear,
+    /// Hertz, from `modulus` and `poisson_ratio`.
+    Hertz,
+}
+
+/// `[contacts]`: unbonded and broken-bond contacts.
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactsSection {
+    /// Coulomb friction μ (default 0.6).
+    pub friction: Option<f64>,
+    /// Normal law (default linear).
+    #[serde(default)]
+    pub normal: NormalChoice,
+    /// Linear normal stiffness (N/m², default the bonds' k_n).
+    pub kn: Option<f64>,
+    /// Tangential stiffness (N/m², default the bonds' k_s).
+    pub ks: Option<f64>,
+    /// Hertz: grain Young's modulus (Pa).
+    pub modulus: Option<f64>,
+    /// Hertz: grain Poisson's ratio.
+    pub poisson_ratio: Option<f64>,
+}
+
+/// `[lsm] damping`.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum DampingChoice {
+    /// None.
+    #[default]
+    None,
+    /// Local (Cundall), α = `damping_coefficient` (default 0.7).
+    Local,
+    /// Viscous, rate = `damping_coefficient` (1/s, required).
+    Viscous,
+}
+
+/// `[lsm]`: time stepping.
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LsmSection {
+    /// Time step (s); default `dt_fraction` × the stable one. Above the stable one is an
+    /// error.
+    pub dt: Option<f64>,
+    /// Time step as a fraction of the stable one (default 0.5).
+    pub dt_fraction: Option<f64>,
+    /// Damping (default none).
+    #[serde(default)]
+    pub damping: DampingChoice,
+    /// α (local) or rate (viscous).
+    pub damping_coefficient: Option<f64>,
+    /// Gravity (m/s², default `[0, 0]`).
+    pub gravity: Option<[f64; 2]>,
+}
+
+/// `[loading] platens`: the particles within `thickness` of the top and of the bottom
+/// of the sample move towards each other at `velocity`.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlatensSpec {
+    /// Speed of each platen (m/s).
+    pub velocity: f64,
+    /// Thickness of the platen layers (m).
+    pub thickness: f64,
+}
+
+/// `[loading]`.
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LoadingSection {
+    /// Platens (a Brazilian or compression test).
+    pub platens: Option<PlatensSpec>,
+    /// Pressure on the wall of `[particles] hole` rising at this rate (Pa/s).
+    pub pressure_rate: Option<f64>,
+    /// Largest pressure, then held (Pa, default no limit).
+    pub pressure_max: Option<f64>,
+}

@@ -1,0 +1,732 @@
+//! The lattice solid model (seed 002.5, `[scene] model = "lsm"`): bonded disks
+//! ([`porofrac_lsm`]).
+//!
+//! - *build*: the disks of `[particles]` ([`crate::particles`]), the bond law of
+//!   `[bonds]` (E and ν through the hexagonal closed form, or k_n, k_s), `[contacts]`,
+//!   `[lsm]` (time step, damping, gravity) and `[loading]` (platens, a pressure ramp on
+//!   the hole); with `[bonds] calibrate = true` a uniaxial compression and a Brazilian
+//!   test of the same packing recipe first ([`porofrac_lsm::calibrate`]);
+//! - *step*: as many LSM steps as fit between two output times;
+//! - *fields*: particle probes (`x y vx vy omega fx fy radius`), tracked cells (`p q
+//!   anisotropy anisotropy_volume dilation_x dilation_y contacts broken_bonds`), scene
+//!   probes (`pressure platen_force broken broken_tensile broken_shear`), lines,
+//!   `vtk/particles_NNNN.vtp` (with `broken_bonds` per particle) and
+//!   `vtk/contacts_NNNN.vtp` (intact bonds `bonded = 1`, touching contacts `0`),
+//!   `broken.csv` (`time,i,j,x,y,mode`), field extrema and `summary.json` keys
+//!   (`particles`, `bonds`, `broken_bonds`, `broken_tensile`, `broken_shear`,
+//!   `contacts`, `lsm_steps`, `dt`, `stable_dt`, `bond_updates_per_second`,
+//!   `contact_updates_per_second`, `breakdown_pressure`, `calibration`);
+//! - *plots*: probe series, `particles.png` (disks coloured by displacement, broken
+//!   bonds drawn) and `breakage.png` (broken bonds against time, by mode).
+
+pub mod check;
+pub mod file;
+
+use std::cell::RefCell;
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::time::Instant;
+
+use plotters::style::RGBColor;
+use porofrac_grid::io::PvdWriter;
+use porofrac_lsm::calibrate::{QuasiStatic, brazilian, hexagonal_moduli, uniaxial};
+use porofrac_lsm::{BreakMode, ContactLaw, Damping, LatticeSolid, LsmSpec, Motion, NormalLaw};
+use porofrac_particles::packing::Region;
+use porofrac_particles::tracked::CellContact;
+use porofrac_particles::vtk::ContactLine;
+use porofrac_particles::{Disks, RandomPacking, TrackedCell};
+
+use crate::check::{LoadedScene, SceneError, k, ki, step_count};
+use crate::driver::{Observer, drive};
+use crate::model::{Model, RunError, Sizes, StepStats};
+use crate::output::{SolverStats, Summary, WallSeconds};
+use crate::particle_output::{self, PARTICLE_FIELDS};
+
+use file::{DampingChoice, NormalChoice};
+
+/// Run a checked lattice solid scene and write its `summary.json`.
+pub(crate) fn run(
+    ls: &LoadedScene,
+    out: &Path,
+    observer: &mut dyn Observer,
+) -> Result<Summary, RunError> {
+    let start = Instant::now();
+    let mut model = build(ls)?;
+    let build_seconds = start.elapsed().as_secs_f64();
+    drive(ls, &mut model, out, observer, start, build_seconds, 2)
+}
+
+#[derive(Clone, Copy, Debug)]
+enum ProbeKind {
+    Particle(usize, usize),
+    Cell(usize, usize),
+    Global(usize),
+}
+
+/// Results of `[bonds] calibrate = true`.
+#[derive(Clone, Copy, Debug)]
+struct Calibration {
+    e: f64,
+    nu: f64,
+    tensile: f64,
+}
+
+/// A lattice solid scene being run.
+pub struct LsmModel<'a> {
+    ls: &'a LoadedScene,
+    solid: LatticeSolid,
+    times: Vec<f64>,
+    dt: f64,
+    probes: Vec<ProbeKind>,
+    cells: Vec<TrackedCell>,
+    top: Vec<usize>,
+    bottom: Vec<usize>,
+    wall: Option<usize>,
+    pressure_rate: f64,
+    pressure_max: f64,
+    pressure: f64,
+    breakdown: Option<f64>,
+    calibration: Option<Calibration>,
+    lsm_steps: u64,
+    step_seconds: f64,
+    broken_written: usize,
+    history: Vec<[f64; 3]>,
+    contacts_pvd: RefCell<Option<PvdWriter>>,
+}
+
+fn spec_of(ls: &LoadedScene) -> Result<LsmSpec, SceneError> {
+    let s = &ls.scene;
+    let law = check::bond_law(ls)?;
+    let mut spec = LsmSpec::new(law);
+    spec.bond_tolerance = s.bonds.as_ref().and_then(|b| b.tolerance).unwrap_or(0.05);
+    let c = s.contacts.clone().unwrap_or_default();
+    spec.contacts = ContactLaw {
+        normal: match c.normal {
+            NormalChoice::Linear => NormalLaw::Linear,
+            NormalChoice::Hertz => NormalLaw::Hertz {
+                modulus: c.modulus.unwrap_or(f64::NAN),
+                poisson: c.poisson_ratio.unwrap_or(0.25),
+            },
+        },
+        kn: c.kn.unwrap_or(law.kn),
+        ks: c.ks.unwrap_or(law.ks),
+        friction: c.friction.unwrap_or(0.6),
+    };
+    let l = s.lsm.clone().unwrap_or_default();
+    spec.damping = match l.damping {
+        DampingChoice::None => Damping::None,
+        DampingChoice::Local => Damping::Local {
+            alpha: l.damping_coefficient.unwrap_or(0.7),
+        },
+        DampingChoice::Viscous => Damping::Viscous {
+            rate: l.damping_coefficient.unwrap_or(0.0),
+        },
+    };
+    spec.gravity = l.gravity.unwrap_or([0.0; 2]);
+    Ok(spec)
+}
+
+/// Calibration samples with the packing recipe of `[particles]` (random kind): a box of
+/// 20 × 20 largest radii for E and ν, a disk of radius 10 largest radii for σ_t.
+fn calibrate(ls: &LoadedScene, spec: &LsmSpec) -> Result<Calibration, SceneError> {
+    let p = ls.scene.particles.as_ref().expect("checked");
+    let key = k(&["bonds", "calibrate"]);
+    let (r0, r1) = match (&p.radius_list, p.radius) {
+        (Some(l), _) => (
+            l.iter().copied().fold(f64::INFINITY, f64::min),
+            l.iter().copied().fold(0.0, f64::max),
+        ),
+        (None, Some(r)) => (r.range()[0], r.range()[1]),
+        _ => return Err(ls.error(&key, "needs a random or hexagonal [particles] kind")),
+    };
+    let packing = |lo: [f64; 2], hi: [f64; 2], region: &Region| -> Result<Disks, SceneError> {
+        let mut rp = RandomPacking::new(
+            lo,
+            hi,
+            r0,
+            r1,
+            p.packing_fraction.unwrap_or(0.8),
+            p.seed.unwrap_or(1),
+        );
+        if let Some(l) = &p.radius_list {
+            rp = rp.with_radii(l);
+        }
+        let pk = rp
+            .generate_in(region, &[])
+            .map_err(|e| ls.error(&key, format!(": {e}")))?;
+        Disks::new(&pk.centres, &pk.radii, p.density).map_err(|e| ls.error(&key, format!(": {e}")))
+    };
+    let (e_lattice, _) = hexagonal_moduli(spec.bonds.kn, spec.bonds.ks);
+    let c = (e_lattice / p.density).sqrt();
+    let side = 20.0 * r1;
+    let boxed = packing(
+        [0.0; 2],
+        [side; 2],
+        &Region::Box {
+            lo: [0.0; 2],
+            hi: [side; 2],
+        },
+    )?;
+    let q = QuasiStatic {
+        speed: 2e-4 * c,
+        ..QuasiStatic::new(1.0)
+    };
+    let u = uniaxial(boxed, *spec, 1e-3, &q).map_err(|e| check::lsm_error(ls, &e))?;
+    let rad = 10.0 * r1;
+    let disk = packing(
+        [-rad; 2],
+        [rad; 2],
+        &Region::Disk {
+            centre: [0.0; 2],
+            radius: rad,
+        },
+    )?;
+    let q = QuasiStatic {
+        speed: 2e-5 * c,
+        ..QuasiStatic::new(1.0)
+    };
+    let b = brazilian(disk, *spec, 2.0 * r1, &q).map_err(|e| check::lsm_error(ls, &e))?;
+    Ok(Calibration {
+        e: u.e,
+        nu: u.nu,
+        tensile: b.tensile_strength,
+    })
+}
+
+/// Build the model of a checked lattice solid scene.
+pub fn build(ls: &LoadedScene) -> Result<LsmModel<'_>, RunError> {
+    let s = &ls.scene;
+    let disks = crate::particles::generate(ls)?;
+    let spec = spec_of(ls)?;
+    let calibration = if s.bonds.as_ref().is_some_and(|b| b.calibrate) {
+        Some(calibrate(ls, &spec)?)
+    } else {
+        None
+    };
+    let mut solid = LatticeSolid::new(disks, spec).map_err(|e| check::lsm_error(ls, &e))?;
+    let l = s.lsm.clone().unwrap_or_default();
+    let stable = solid.stable_dt();
+    let dt = match l.dt {
+        Some(dt) if dt > stable => {
+            return Err(ls
+                .error(
+                    &k(&["lsm", "dt"]),
+                    format!("= {dt:.4e} s is above the stable time step {stable:.4e} s"),
+                )
+                .into());
+        }
+        Some(dt) => dt,
+        None => l.dt_fraction.unwrap_or(0.5) * stable,
+    };
+    let load = s.loading.clone().unwrap_or_default();
+    let (mut top, mut bottom) = (Vec::new(), Vec::new());
+    if let Some(pl) = load.platens {
+        let d = solid.disks();
+        let (lo, hi) =
+            d.x.iter()
+                .zip(&d.r)
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), (x, r)| {
+                    (a.min(x[1] - r), b.max(x[1] + r))
+                });
+        for i in 0..d.len() {
+            if d.x[i][1] + d.r[i] > hi - pl.thickness {
+                top.push(i);
+            } else if d.x[i][1] - d.r[i] < lo + pl.thickness {
+                bottom.push(i);
+            }
+        }
+        if top.is_empty() || bottom.is_empty() {
+            return Err(ls
+                .error(&k(&["loading", "platens"]), "selects no particle")
+                .into());
+        }
+        for &i in &top {
+            solid.set_motion(i, Motion::Velocity([0.0, -pl.velocity]));
+        }
+        for &i in &bottom {
+            solid.set_motion(i, Motion::Velocity([0.0, pl.velocity]));
+        }
+    }
+    let wall = match (
+        load.pressure_rate,
+        s.particles.as_ref().and_then(|p| p.hole),
+    ) {
+        (Some(_), Some(h)) => Some(
+            solid
+                .add_pressure_wall(h.center, h.radius)
+                .map_err(|e| check::lsm_error(ls, &e))?,
+        ),
+        _ => None,
+    };
+    let sch = s.schedule.as_ref().expect("checked: [schedule] present");
+    let steps = step_count(sch) as usize;
+    let h = sch.dt.unwrap_or(sch.end_time / steps as f64);
+    let times: Vec<f64> = (0..=steps)
+        .map(|i| {
+            if i == steps {
+                sch.end_time
+            } else {
+                (i as f64 * h).min(sch.end_time)
+            }
+        })
+        .collect();
+    let count = solid.disks().len();
+    let mut probes = Vec::new();
+    let mut cells = Vec::new();
+    for (i, p) in s.output.probe.iter().enumerate() {
+        if let Some(f) = PARTICLE_FIELDS.iter().position(|f| *f == p.field) {
+            let idx = p.particle.expect("checked") as usize;
+            if idx >= count {
+                return Err(ls
+                    .error(
+                        &ki("output.probe", i, &["particle"]),
+                        format!("= {idx} but the scene has {count} particles"),
+                    )
+                    .into());
+            }
+            probes.push(ProbeKind::Particle(idx, f));
+        } else if let Some(f) = check::GLOBAL_FIELDS.iter().position(|f| *f == p.field) {
+            probes.push(ProbeKind::Global(f));
+        } else {
+            let f = check::CELL_FIELDS
+                .iter()
+                .position(|f| *f == p.field)
+                .expect("checked");
+            let c = p.cell.as_ref().expect("checked");
+            let cell = TrackedCell::new(&solid.disks().x, [c.center[0], c.center[1]], c.radius);
+            if cell.count == 0 {
+                return Err(ls
+                    .error(&ki("output.probe", i, &["cell"]), "selects no particle")
+                    .into());
+            }
+            probes.push(ProbeKind::Cell(cells.len(), f));
+            cells.push(cell);
+        }
+    }
+    Ok(LsmModel {
+        ls,
+        solid,
+        times,
+        dt,
+        probes,
+        cells,
+        top,
+        bottom,
+        wall,
+        pressure_rate: load.pressure_rate.unwrap_or(0.0),
+        pressure_max: load.pressure_max.unwrap_or(f64::INFINITY),
+        pressure: 0.0,
+        breakdown: None,
+        calibration,
+        lsm_steps: 0,
+        step_seconds: 0.0,
+        broken_written: 0,
+        history: vec![[0.0; 3]],
+        contacts_pvd: RefCell::new(None),
+    })
+}
+
+impl LsmModel<'_> {
+    fn forces2(&self) -> Vec<[f64; 2]> {
+        self.solid.forces().iter().map(|f| [f[0], f[1]]).collect()
+    }
+
+    fn platen_force(&self) -> f64 {
+        let f = self.solid.forces();
+        0.5 * (self.top.iter().map(|&i| f[i][1]).sum::<f64>()
+            - self.bottom.iter().map(|&i| f[i][1]).sum::<f64>())
+    }
+
+    fn broken_by_mode(&self) -> (usize, usize) {
+        let t = self
+            .solid
+            .broken()
+            .iter()
+            .filter(|b| b.mode == BreakMode::Tensile)
+            .count();
+        (t, self.solid.broken().len() - t)
+    }
+
+    /// Intact bonds and touching contacts as the tracked cells and the VTK lines see
+    /// them.
+    fn links(&self, cell: &mut Vec<CellContact>, lines: &mut Vec<ContactLine>) {
+        let d = self.solid.disks();
+        for (b, f) in self.solid.bonds().iter().zip(self.solid.bond_forces()) {
+            if b.intact {
+                push_link(
+                    d,
+                    b.i as usize,
+                    b.j as usize,
+                    f.f,
+                    -f.fn_,
+                    f.fs,
+                    true,
+                    cell,
+                    lines,
+                );
+            }
+        }
+        let (pairs, forces) = self.solid.contacts();
+        for (p, f) in pairs.iter().zip(forces) {
+            if f.fn_ > 0.0 {
+                push_link(
+                    d,
+                    p.i as usize,
+                    p.j as usize,
+                    f.f,
+                    f.fn_,
+                    f.ft,
+                    false,
+                    cell,
+                    lines,
+                );
+            }
+        }
+    }
+}
+
+fn push_link(
+    d: &Disks,
+    i: usize,
+    j: usize,
+    force_i: [f64; 2],
+    normal_force: f64,
+    tangential_force: f64,
+    bonded: bool,
+    cell: &mut Vec<CellContact>,
+    lines: &mut Vec<ContactLine>,
+) {
+    let branch = [d.x[i][0] - d.x[j][0], d.x[i][1] - d.x[j][1]];
+    let l = (branch[0] * branch[0] + branch[1] * branch[1])
+        .sqrt()
+        .max(1e-300);
+    cell.push(CellContact {
+        i,
+        j: Some(j),
+        normal: [branch[0] / l, branch[1] / l],
+        branch,
+        force: force_i,
+    });
+    lines.push(ContactLine {
+        a: d.x[i],
+        b: d.x[j],
+        normal_force,
+        tangential_force,
+        bonded,
+    });
+}
+
+/// A blue–green–yellow–red ramp for t in [0, 1].
+fn ramp(t: f64) -> RGBColor {
+    let stops = [
+        (49.0, 54.0, 149.0),
+        (69.0, 117.0, 180.0),
+        (116.0, 196.0, 118.0),
+        (254.0, 224.0, 71.0),
+        (215.0, 48.0, 39.0),
+    ];
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        0.0
+    } * (stops.len() - 1) as f64;
+    let k = (t as usize).min(stops.len() - 2);
+    let f = t - k as f64;
+    let (a, b) = (stops[k], stops[k + 1]);
+    let mix = |x: f64, y: f64| (x + f * (y - x)).round() as u8;
+    RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
+}
+
+impl Model for LsmModel<'_> {
+    fn summary_extras(&self) -> serde_json::Map<String, serde_json::Value> {
+        let (t, sh) = self.broken_by_mode();
+        let (bu, cu) = self.solid.updates();
+        let rate = |n: u64| {
+            if self.step_seconds > 0.0 {
+                n as f64 / self.step_seconds
+            } else {
+                0.0
+            }
+        };
+        let mut m = serde_json::Map::new();
+        m.insert("particles".into(), self.solid.disks().len().into());
+        m.insert("bonds".into(), self.solid.bonds().len().into());
+        m.insert("broken_bonds".into(), self.solid.broken().len().into());
+        m.insert("broken_tensile".into(), t.into());
+        m.insert("broken_shear".into(), sh.into());
+        m.insert("contacts".into(), self.solid.touching().into());
+        m.insert("lsm_steps".into(), self.lsm_steps.into());
+        m.insert("dt".into(), self.dt.into());
+        m.insert("stable_dt".into(), self.solid.stable_dt().into());
+        m.insert("bond_updates".into(), bu.into());
+        m.insert("bond_updates_per_second".into(), rate(bu).into());
+        m.insert("contact_updates_per_second".into(), rate(cu).into());
+        m.insert("step_seconds".into(), self.step_seconds.into());
+        if self.wall.is_some() {
+            m.insert("final_pressure".into(), self.pressure.into());
+            m.insert(
+                "breakdown_pressure".into(),
+                self.breakdown.map_or(serde_json::Value::Null, |p| p.into()),
+            );
+        }
+        if let Some(c) = self.calibration {
+            let mut cal = serde_json::json!({
+                "youngs_modulus": c.e,
+                "poisson_ratio": c.nu,
+                "tensile_strength": c.tensile,
+            });
+            let p = self.ls.scene.particles.as_ref().expect("checked");
+            if let (Some(h), Some(dk)) = (p.hole, p.disk) {
+                let (a2, b2) = (h.radius * h.radius, dk.radius * dk.radius);
+                cal["breakdown_estimate"] = (c.tensile * (b2 - a2) / (b2 + a2)).into();
+            }
+            m.insert("calibration".into(), cal);
+        }
+        m
+    }
+
+    fn times(&self) -> &[f64] {
+        &self.times
+    }
+
+    fn step(&mut self, step: usize) -> Result<StepStats, RunError> {
+        if step == 0 {
+            return Ok(StepStats::default());
+        }
+        let h = self.times[step] - self.times[step - 1];
+        let n = (h / self.dt).ceil().max(1.0) as usize;
+        let dt = h / n as f64;
+        let t0 = Instant::now();
+        for _ in 0..n {
+            if let Some(w) = self.wall {
+                self.pressure =
+                    (self.pressure_rate * (self.solid.time() + dt)).min(self.pressure_max);
+                self.solid
+                    .set_wall_pressure(w, self.pressure)
+                    .map_err(|e| check::lsm_error(self.ls, &e))?;
+            }
+            let r = self
+                .solid
+                .step(dt, &[])
+                .map_err(|e| check::lsm_error(self.ls, &e))?;
+            if r.broken > 0 && self.breakdown.is_none() && self.wall.is_some() {
+                self.breakdown = Some(self.pressure);
+            }
+        }
+        self.step_seconds += t0.elapsed().as_secs_f64();
+        self.lsm_steps += n as u64;
+        let (t, sh) = self.broken_by_mode();
+        self.history.push([self.solid.time(), t as f64, sh as f64]);
+        Ok(StepStats {
+            iterations: n,
+            failed: self.solid.broken().len(),
+        })
+    }
+
+    fn probes(&self, values: &mut Vec<f64>) {
+        let forces = self.forces2();
+        let (mut cc, mut lines) = (Vec::new(), Vec::new());
+        if !self.cells.is_empty() {
+            self.links(&mut cc, &mut lines);
+        }
+        let x = &self.solid.disks().x;
+        let states: Vec<_> = self.cells.iter().map(|c| c.measure(x, &cc)).collect();
+        let (t, sh) = self.broken_by_mode();
+        for p in &self.probes {
+            values.push(match *p {
+                ProbeKind::Particle(i, f) => {
+                    particle_output::particle_value(self.solid.disks(), i, f, &forces)
+                }
+                ProbeKind::Global(f) => match check::GLOBAL_FIELDS[f] {
+                    "pressure" => self.pressure,
+                    "platen_force" => self.platen_force(),
+                    "broken" => (t + sh) as f64,
+                    "broken_tensile" => t as f64,
+                    _ => sh as f64,
+                },
+                ProbeKind::Cell(c, f) => {
+                    let s = &states[c];
+                    match check::CELL_FIELDS[f] {
+                        "p" => s.p,
+                        "q" => s.q,
+                        "anisotropy" => s.anisotropy,
+                        "anisotropy_volume" => s.anisotropy_volume,
+                        "dilation_x" => s.dilation_x,
+                        "dilation_y" => s.dilation_y,
+                        "contacts" => s.contacts as f64,
+                        _ => {
+                            let cell = &self.cells[c];
+                            self.solid
+                                .broken()
+                                .iter()
+                                .filter(|b| {
+                                    (b.x - cell.center[0]).powi(2) + (b.y - cell.center[1]).powi(2)
+                                        <= cell.radius * cell.radius
+                                })
+                                .count() as f64
+                        }
+                    }
+                }
+            });
+        }
+    }
+
+    fn line(&self, line: usize, rows: &mut Vec<Vec<f64>>) {
+        particle_output::line_rows(self.ls, line, self.solid.disks(), &self.forces2(), rows);
+    }
+
+    fn after_step(&mut self, out: &Path) -> Result<(), RunError> {
+        let broken = self.solid.broken();
+        if broken.len() == self.broken_written && self.broken_written > 0 {
+            return Ok(());
+        }
+        let mut text = String::from("time,i,j,x,y,mode\n");
+        for b in broken {
+            text.push_str(&format!(
+                "{:e},{},{},{:e},{:e},{}\n",
+                b.time,
+                b.i,
+                b.j,
+                b.x,
+                b.y,
+                b.mode.as_str()
+            ));
+        }
+        let path = out.join("broken.csv");
+        let tmp = out.join("broken.csv.tmp");
+        let io = |e: std::io::Error| {
+            RunError::Output(crate::output::OutputError {
+                path: path.clone(),
+                source: e,
+            })
+        };
+        std::fs::write(&tmp, text).map_err(io)?;
+        std::fs::rename(&tmp, &path).map_err(io)?;
+        self.broken_written = broken.len();
+        Ok(())
+    }
+
+    fn write_vtk(&self, dir: &Path, index: usize) -> Result<String, RunError> {
+        let d = self.solid.disks();
+        let mut per = vec![0.0; d.len()];
+        for b in self.solid.broken() {
+            per[b.i] += 1.0;
+            per[b.j] += 1.0;
+        }
+        let (mut cc, mut lines) = (Vec::new(), Vec::new());
+        self.links(&mut cc, &mut lines);
+        particle_output::write_vtk(
+            self.ls,
+            dir,
+            index,
+            self.solid.time(),
+            d,
+            &[("broken_bonds", &per)],
+            &lines,
+            &self.contacts_pvd,
+        )
+    }
+
+    fn field_extrema(&self) -> BTreeMap<String, [f64; 2]> {
+        let mut out = particle_output::disk_extrema(self.solid.disks());
+        let live = self
+            .solid
+            .bonds()
+            .iter()
+            .zip(self.solid.bond_forces())
+            .filter(|(b, _)| b.intact);
+        particle_output::put_extrema(
+            &mut out,
+            "bond_normal_force",
+            live.clone().map(|(_, f)| f.fn_),
+        );
+        particle_output::put_extrema(&mut out, "bond_shear_force", live.map(|(_, f)| f.fs));
+        out
+    }
+
+    fn plots(&self, dir: &Path, written: &[f64], series: &[Vec<f64>]) -> Result<(), RunError> {
+        let probes: Vec<(String, String, Vec<f64>)> = self
+            .ls
+            .scene
+            .output
+            .probe
+            .iter()
+            .zip(series)
+            .map(|(p, v)| (p.name.clone(), p.field.clone(), v.clone()))
+            .collect();
+        crate::nscd::plots::probe_plots(dir, &self.ls.scene.scene.name, written, &probes)?;
+        let d = self.solid.disks();
+        let u: Vec<f64> = (0..d.len())
+            .map(|i| {
+                let u = d.displacement(i);
+                (u[0] * u[0] + u[1] * u[1]).sqrt()
+            })
+            .collect();
+        let umax = u.iter().copied().fold(0.0, f64::max).max(1e-300);
+        let segments: Vec<([f64; 2], [f64; 2])> = self
+            .solid
+            .broken()
+            .iter()
+            .map(|b| (d.x[b.i], d.x[b.j]))
+            .collect();
+        particle_output::draw_disks(
+            &dir.join("particles.png"),
+            d,
+            |i| ramp(u[i] / umax),
+            &segments,
+        )?;
+        let times: Vec<f64> = self.history.iter().map(|h| h[0]).collect();
+        let columns = vec![
+            (
+                "tensile".to_string(),
+                self.history.iter().map(|h| h[1]).collect(),
+            ),
+            (
+                "shear".to_string(),
+                self.history.iter().map(|h| h[2]).collect(),
+            ),
+            (
+                "total".to_string(),
+                self.history.iter().map(|h| h[1] + h[2]).collect(),
+            ),
+        ];
+        crate::plots::time_series(
+            &dir.join("breakage.png"),
+            &times,
+            &columns,
+            &format!("{}: broken bonds", self.ls.scene.scene.name),
+        )?;
+        Ok(())
+    }
+
+    fn sizes(&self) -> Sizes {
+        Sizes {
+            cells: self.solid.disks().len(),
+            nodes: 0,
+            dofs: 3 * self.solid.disks().len(),
+        }
+    }
+
+    fn failed(&self) -> usize {
+        self.solid.broken().len()
+    }
+
+    fn solver_stats(&self) -> SolverStats {
+        SolverStats {
+            linear: "explicit".into(),
+            iterations: self.lsm_steps as usize,
+            ..SolverStats::default()
+        }
+    }
+
+    fn errors(&self) -> Result<BTreeMap<String, f64>, RunError> {
+        Ok(BTreeMap::new())
+    }
+
+    fn wall_seconds(&self) -> WallSeconds {
+        WallSeconds {
+            assembly: self.step_seconds,
+            ..WallSeconds::default()
+        }
+    }
+}

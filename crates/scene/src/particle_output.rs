@@ -1,0 +1,206 @@
+//! Outputs shared by the particle models (`nscd`, `lsm`): particle probe values, line
+//! samples (the particle nearest each point), field extrema of the disks, the VTK
+//! PolyData files (`vtk/particles_NNNN.vtp`, `vtk/contacts_NNNN.vtp` and
+//! `<name>_contacts.pvd`) and a picture of the disks.
+
+use std::cell::RefCell;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use plotters::prelude::*;
+use porofrac_grid::io::PvdWriter;
+use porofrac_particles::Disks;
+use porofrac_particles::vtk::{ContactLine, write_contacts, write_particles_with};
+
+use crate::check::LoadedScene;
+use crate::model::RunError;
+use crate::plots::PlotError;
+
+/// Fields of one particle (`particle = N` probes, lines).
+pub const PARTICLE_FIELDS: [&str; 8] = ["x", "y", "vx", "vy", "omega", "fx", "fy", "radius"];
+
+/// Value of `PARTICLE_FIELDS[field]` for particle i (`forces`: `[f_x, f_y]` per particle).
+pub fn particle_value(d: &Disks, i: usize, field: usize, forces: &[[f64; 2]]) -> f64 {
+    match PARTICLE_FIELDS[field] {
+        "x" => d.x[i][0],
+        "y" => d.x[i][1],
+        "vx" => d.v[i][0],
+        "vy" => d.v[i][1],
+        "omega" => d.omega[i],
+        "fx" => forces[i][0],
+        "fy" => forces[i][1],
+        _ => d.r[i],
+    }
+}
+
+/// Rows `s, x, y, value` of `[[output.line]]` number `line`: the value of the particle
+/// nearest each point.
+pub fn line_rows(
+    ls: &LoadedScene,
+    line: usize,
+    d: &Disks,
+    forces: &[[f64; 2]],
+    rows: &mut Vec<Vec<f64>>,
+) {
+    let l = &ls.scene.output.line[line];
+    let field = PARTICLE_FIELDS
+        .iter()
+        .position(|f| *f == l.field)
+        .expect("checked");
+    let x = &d.x;
+    let n = l.points as usize;
+    let len = ((l.to[0] - l.from[0]).powi(2) + (l.to[1] - l.from[1]).powi(2)).sqrt();
+    for k in 0..n {
+        let s = k as f64 / (n - 1) as f64;
+        let p = [
+            l.from[0] + s * (l.to[0] - l.from[0]),
+            l.from[1] + s * (l.to[1] - l.from[1]),
+        ];
+        let nearest = (0..x.len())
+            .min_by(|&a, &b| {
+                let da = (x[a][0] - p[0]).powi(2) + (x[a][1] - p[1]).powi(2);
+                let db = (x[b][0] - p[0]).powi(2) + (x[b][1] - p[1]).powi(2);
+                da.total_cmp(&db)
+            })
+            .unwrap_or(0);
+        rows.push(vec![
+            s * len,
+            p[0],
+            p[1],
+            particle_value(d, nearest, field, forces),
+        ]);
+    }
+}
+
+/// Insert `[min, max]` of `values` under `name` (nothing if empty).
+pub fn put_extrema(
+    out: &mut BTreeMap<String, [f64; 2]>,
+    name: &str,
+    values: impl Iterator<Item = f64>,
+) {
+    let mm = values.fold([f64::INFINITY, f64::NEG_INFINITY], |[a, b], v| {
+        [a.min(v), b.max(v)]
+    });
+    if mm[0] <= mm[1] {
+        out.insert(name.to_string(), mm);
+    }
+}
+
+/// Extrema of the disk fields: `radius vx vy speed omega ux uy`.
+pub fn disk_extrema(d: &Disks) -> BTreeMap<String, [f64; 2]> {
+    let mut out = BTreeMap::new();
+    put_extrema(&mut out, "radius", d.r.iter().copied());
+    put_extrema(&mut out, "vx", d.v.iter().map(|v| v[0]));
+    put_extrema(&mut out, "vy", d.v.iter().map(|v| v[1]));
+    put_extrema(
+        &mut out,
+        "speed",
+        d.v.iter().map(|v| (v[0] * v[0] + v[1] * v[1]).sqrt()),
+    );
+    put_extrema(&mut out, "omega", d.omega.iter().copied());
+    put_extrema(&mut out, "ux", (0..d.len()).map(|i| d.displacement(i)[0]));
+    put_extrema(&mut out, "uy", (0..d.len()).map(|i| d.displacement(i)[1]));
+    out
+}
+
+/// Write `particles_NNNN.vtp` (with the `extra` point data) and `contacts_NNNN.vtp`
+/// into `dir`, and add the contacts file to `<name>_contacts.pvd` next to `dir`;
+/// returns the particles file name.
+pub fn write_vtk(
+    ls: &LoadedScene,
+    dir: &Path,
+    index: usize,
+    time: f64,
+    d: &Disks,
+    extra: &[(&str, &[f64])],
+    lines: &[ContactLine],
+    contacts_pvd: &RefCell<Option<PvdWriter>>,
+) -> Result<String, RunError> {
+    let io = |e: porofrac_particles::ParticleError| {
+        RunError::Output(crate::output::OutputError {
+            path: dir.to_path_buf(),
+            source: std::io::Error::other(e.to_string()),
+        })
+    };
+    let particles = format!("particles_{index:04}.vtp");
+    let contacts = format!("contacts_{index:04}.vtp");
+    write_particles_with(&dir.join(&particles), d, extra).map_err(io)?;
+    write_contacts(&dir.join(&contacts), lines).map_err(io)?;
+    let mut pvd = contacts_pvd.borrow_mut();
+    if pvd.is_none() {
+        let parent = dir.parent().unwrap_or(Path::new("."));
+        *pvd = Some(PvdWriter::create(
+            parent.join(format!("{}_contacts.pvd", ls.scene.scene.name)),
+        )?);
+    }
+    if let Some(pvd) = pvd.as_mut() {
+        pvd.add(time, format!("vtk/{contacts}"))?;
+    }
+    Ok(particles)
+}
+
+fn perr<E: std::fmt::Display>(path: &Path) -> impl Fn(E) -> PlotError + '_ {
+    move |e| PlotError {
+        path: path.to_path_buf(),
+        what: e.to_string(),
+    }
+}
+
+/// A picture of the disks at their current position, disk i filled with `colour(i)`,
+/// and the `segments` drawn over them in black (written atomically).
+pub fn draw_disks(
+    path: &Path,
+    d: &Disks,
+    colour: impl Fn(usize) -> RGBColor,
+    segments: &[([f64; 2], [f64; 2])],
+) -> Result<(), PlotError> {
+    if d.is_empty() {
+        return Ok(());
+    }
+    std::fs::create_dir_all(path.parent().unwrap_or(Path::new("."))).map_err(perr(path))?;
+    let b = d.x.iter().zip(&d.r).fold(
+        [
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ],
+        |b, (p, r)| {
+            [
+                b[0].min(p[0] - r),
+                b[1].max(p[0] + r),
+                b[2].min(p[1] - r),
+                b[3].max(p[1] + r),
+            ]
+        },
+    );
+    let (w, h) = ((b[1] - b[0]).max(1e-9), (b[3] - b[2]).max(1e-9));
+    let width = 1600u32;
+    let height = ((width as f64 * h / w).ceil() as u32).clamp(50, 4000);
+    let scale = (width as f64 / w).min(height as f64 / h);
+    let px = |p: [f64; 2]| {
+        (
+            ((p[0] - b[0]) * scale) as i32,
+            height as i32 - ((p[1] - b[2]) * scale) as i32,
+        )
+    };
+    let tmp = path.with_extension("tmp.png");
+    {
+        let root = BitMapBackend::new(&tmp, (width, height)).into_drawing_area();
+        root.fill(&WHITE).map_err(perr(path))?;
+        for i in 0..d.len() {
+            let r = ((d.r[i] * scale).round() as i32).max(1);
+            root.draw(&Circle::new(px(d.x[i]), r, colour(i).filled()))
+                .map_err(perr(path))?;
+        }
+        for (a, c) in segments {
+            root.draw(&PathElement::new(
+                vec![px(*a), px(*c)],
+                BLACK.stroke_width(3),
+            ))
+            .map_err(perr(path))?;
+        }
+        root.present().map_err(perr(path))?;
+    }
+    std::fs::rename(&tmp, path).map_err(perr(path))
+}

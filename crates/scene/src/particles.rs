@@ -1,0 +1,352 @@
+//! `[particles]`, shared by the particle models (`nscd`, `lsm`): the section, its
+//! checks and the generation of the disks (a seeded random packing, a hexagonal lattice
+//! or a list; in a box, a disk or a polygon, with an optional hole;
+//! [`porofrac_particles::packing`]).
+
+use serde::Deserialize;
+
+use porofrac_particles::packing::{Hole, RadiusDistribution, Region, hexagonal_in};
+use porofrac_particles::{Disks, RandomPacking};
+
+use crate::check::{LoadedScene, SceneError, k};
+
+/// `[particles] kind`: how the disks are generated.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum ParticleKind {
+    /// A dense random polydisperse packing in `region` (random placement with overlap
+    /// relaxation, [`porofrac_particles::RandomPacking`]).
+    #[default]
+    Random,
+    /// Equal disks on a triangular lattice filling `region`.
+    Hexagonal,
+    /// The disks listed in `centres` and `radii`.
+    List,
+}
+
+/// A radius, or a `[min, max]` range drawn uniformly.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
+#[serde(untagged)]
+pub enum RadiusSpec {
+    /// One radius (m).
+    One(f64),
+    /// `[min, max]` (m).
+    Range([f64; 2]),
+}
+
+impl RadiusSpec {
+    /// `[min, max]`.
+    pub fn range(&self) -> [f64; 2] {
+        match *self {
+            Self::One(r) => [r, r],
+            Self::Range(r) => r,
+        }
+    }
+}
+
+/// `[particles]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ParticlesSection {
+    /// Generator (default `"random"`).
+    #[serde(default)]
+    pub kind: ParticleKind,
+    /// The box filled: `[[x0, y0], [x1, y1]]` (m); or `disk`, or `polygon`.
+    pub region: Option<[[f64; 2]; 2]>,
+    /// Radius (hexagonal) or `[min, max]` (random), m.
+    pub radius: Option<RadiusSpec>,
+    /// Random: disk area over box area (default 0.8).
+    pub packing_fraction: Option<f64>,
+    /// Random: seed (default 1).
+    pub seed: Option<u64>,
+    /// List: centres (m).
+    pub centres: Option<Vec<[f64; 2]>>,
+    /// List: radii (m).
+    pub radii: Option<Vec<f64>>,
+    /// Density (kg/m³; masses per metre of thickness).
+    pub density: f64,
+    /// Instead of `region`: a disk region `{ center = [x, y], radius = R }`.
+    pub disk: Option<CircleSpec>,
+    /// Instead of `region`: a polygon region, vertices in order (m).
+    pub polygon: Option<Vec<[f64; 2]>>,
+    /// A circular hole left empty (a borehole): `{ center = [x, y], radius = a }`.
+    pub hole: Option<CircleSpec>,
+    /// Random: how radii are drawn (default uniform in `radius`).
+    #[serde(default)]
+    pub distribution: Distribution,
+    /// Random with `distribution = "list"`: the radii drawn from, with equal
+    /// probability (m).
+    pub radius_list: Option<Vec<f64>>,
+}
+
+/// A circle `{ center = [x, y], radius = r }`.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct CircleSpec {
+    /// Centre (m).
+    pub center: [f64; 2],
+    /// Radius (m).
+    pub radius: f64,
+}
+
+/// `[particles] distribution`.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum Distribution {
+    /// Uniform in `radius = [min, max]`.
+    #[default]
+    Uniform,
+    /// One of `radius_list`, with equal probability.
+    List,
+}
+
+/// Most disks a scene may generate.
+pub const MAX_PARTICLES: f64 = 2.0e7;
+
+fn positive(ls: &LoadedScene, f: &str, v: f64) -> Result<(), SceneError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(ls.error(
+            &k(&["particles", f]),
+            format!("= {v} must be a positive number"),
+        ))
+    }
+}
+
+/// The region of a checked `[particles]` section.
+pub fn region(p: &ParticlesSection) -> Option<Region> {
+    if let Some(b) = p.region {
+        return Some(Region::Box { lo: b[0], hi: b[1] });
+    }
+    if let Some(c) = p.disk {
+        return Some(Region::Disk {
+            centre: c.center,
+            radius: c.radius,
+        });
+    }
+    p.polygon.clone().map(Region::Polygon)
+}
+
+/// The hole of a checked `[particles]` section.
+pub fn hole(p: &ParticlesSection) -> Vec<Hole> {
+    p.hole
+        .map(|h| Hole {
+            centre: h.center,
+            radius: h.radius,
+        })
+        .into_iter()
+        .collect()
+}
+
+/// Check `[particles]` of a scene of `model`.
+pub fn check(ls: &LoadedScene, model: &str) -> Result<(), SceneError> {
+    let Some(p) = &ls.scene.particles else {
+        return Err(ls.error(
+            &k(&["particles"]),
+            format!("is missing: model \"{model}\" needs [particles]"),
+        ));
+    };
+    let key = |f: &str| k(&["particles", f]);
+    positive(ls, "density", p.density)?;
+    match p.kind {
+        ParticleKind::Random | ParticleKind::Hexagonal => {
+            let given = [p.region.is_some(), p.disk.is_some(), p.polygon.is_some()];
+            if given.iter().filter(|g| **g).count() != 1 {
+                return Err(ls.error(
+                    &key("region"),
+                    "(or disk, or polygon): exactly one region is required for this kind",
+                ));
+            }
+            if let Some(region) = p.region {
+                for a in 0..2 {
+                    if !(region[0][a].is_finite()
+                        && region[1][a].is_finite()
+                        && region[1][a] > region[0][a])
+                    {
+                        return Err(ls.error(
+                            &key("region"),
+                            "must be [[x0, y0], [x1, y1]] with x1 > x0, y1 > y0",
+                        ));
+                    }
+                }
+            }
+            if let Some(c) = p.disk {
+                positive(ls, "disk", c.radius)?;
+                if !(c.center[0].is_finite() && c.center[1].is_finite()) {
+                    return Err(ls.error(&key("disk"), "center is not finite"));
+                }
+            }
+            if let Some(poly) = &p.polygon {
+                let r = Region::Polygon(poly.clone());
+                if poly.iter().any(|v| !(v[0].is_finite() && v[1].is_finite()))
+                    || r.check().is_err()
+                {
+                    return Err(ls.error(
+                        &key("polygon"),
+                        "must list at least 3 finite vertices enclosing an area",
+                    ));
+                }
+            }
+            if let Some(h) = p.hole {
+                positive(ls, "hole", h.radius)?;
+                if !(h.center[0].is_finite() && h.center[1].is_finite()) {
+                    return Err(ls.error(&key("hole"), "center is not finite"));
+                }
+            }
+            let radius = match (p.distribution, p.radius, &p.radius_list) {
+                (Distribution::List, _, Some(list)) => {
+                    if p.kind == ParticleKind::Hexagonal {
+                        return Err(ls.error(
+                            &key("distribution"),
+                            "= \"list\" applies to kind = \"random\"",
+                        ));
+                    }
+                    if list.is_empty() || list.iter().any(|r| !(r.is_finite() && *r > 0.0)) {
+                        return Err(
+                            ls.error(&key("radius_list"), "must list positive finite radii")
+                        );
+                    }
+                    let lo = list.iter().copied().fold(f64::INFINITY, f64::min);
+                    let hi = list.iter().copied().fold(0.0, f64::max);
+                    RadiusSpec::Range([lo, hi])
+                }
+                (Distribution::List, _, None) => {
+                    return Err(ls.error(
+                        &key("radius_list"),
+                        "is required with distribution = \"list\"",
+                    ));
+                }
+                (Distribution::Uniform, _, Some(_)) => {
+                    return Err(ls.error(&key("radius_list"), "needs distribution = \"list\""));
+                }
+                (Distribution::Uniform, Some(r), None) => r,
+                (Distribution::Uniform, None, None) => {
+                    return Err(ls.error(&key("radius"), "is required for this kind"));
+                }
+            };
+            let [r0, r1] = radius.range();
+            positive(ls, "radius", r0)?;
+            if !(r1.is_finite() && r1 >= r0) {
+                return Err(ls.error(&key("radius"), "must be [min, max] with max ≥ min"));
+            }
+            if p.kind == ParticleKind::Hexagonal
+                && matches!(radius, RadiusSpec::Range(_))
+                && r1 != r0
+            {
+                return Err(ls.error(
+                    &key("radius"),
+                    "must be one number for kind = \"hexagonal\"",
+                ));
+            }
+            let (lo, hi) = region(p).expect("one region").bounds();
+            for a in 0..2 {
+                if hi[a] - lo[a] < 2.0 * r1 {
+                    return Err(ls.error(&key("region"), "is narrower than one largest diameter"));
+                }
+            }
+            let phi = p.packing_fraction.unwrap_or(0.8);
+            if p.kind == ParticleKind::Random && !(phi > 0.0 && phi < 0.84) {
+                return Err(ls.error(
+                    &key("packing_fraction"),
+                    format!("= {phi} must be in (0, 0.84)"),
+                ));
+            }
+            let area = (hi[0] - lo[0]) * (hi[1] - lo[1]);
+            let count = area / (std::f64::consts::PI * r0 * r0);
+            if count > MAX_PARTICLES {
+                return Err(ls.error(
+                    &key("radius"),
+                    format!("gives up to {count:.3e} disks in the region, more than the {MAX_PARTICLES:.0e} a scene may have"),
+                ));
+            }
+        }
+        ParticleKind::List => {
+            for (f, set) in [
+                ("disk", p.disk.is_some()),
+                ("polygon", p.polygon.is_some()),
+                ("hole", p.hole.is_some()),
+                ("radius_list", p.radius_list.is_some()),
+            ] {
+                if set {
+                    return Err(ls.error(&key(f), "does not apply to kind = \"list\""));
+                }
+            }
+            let (Some(c), Some(r)) = (&p.centres, &p.radii) else {
+                return Err(ls.error(
+                    &key("centres"),
+                    "and radii are required for kind = \"list\"",
+                ));
+            };
+            if c.len() != r.len() {
+                return Err(ls.error(
+                    &key("radii"),
+                    format!("has {} values for {} centres", r.len(), c.len()),
+                ));
+            }
+            for (i, &ri) in r.iter().enumerate() {
+                if !(ri.is_finite() && ri > 0.0) {
+                    return Err(ls.error(
+                        &key("radii"),
+                        format!("[{i}] = {ri} must be a positive radius"),
+                    ));
+                }
+            }
+            for (i, ci) in c.iter().enumerate() {
+                if !(ci[0].is_finite() && ci[1].is_finite()) {
+                    return Err(ls.error(&key("centres"), format!("[{i}] is not finite")));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The disks of a checked `[particles]` section.
+pub fn generate(ls: &LoadedScene) -> Result<Disks, SceneError> {
+    let p = ls
+        .scene
+        .particles
+        .as_ref()
+        .expect("checked: [particles] present");
+    let key = |f: &str| k(&["particles", f]);
+    let (centres, radii) = match p.kind {
+        ParticleKind::List => (
+            p.centres.clone().unwrap_or_default(),
+            p.radii.clone().unwrap_or_default(),
+        ),
+        ParticleKind::Hexagonal | ParticleKind::Random => {
+            let region = region(p).expect("checked");
+            let holes = hole(p);
+            let packing = if p.kind == ParticleKind::Hexagonal {
+                let [r0, _] = p.radius.expect("checked").range();
+                hexagonal_in(&region, &holes, r0)
+                    .map_err(|e| ls.error(&key("radius"), format!(": {e}")))?
+            } else {
+                let (lo, hi) = region.bounds();
+                let mut spec = match (&p.radius_list, p.radius) {
+                    (Some(list), _) => {
+                        RandomPacking::new(lo, hi, 0.0, 0.0, 0.8, 1).with_radii(list)
+                    }
+                    (None, r) => {
+                        let [r0, r1] = r.expect("checked").range();
+                        RandomPacking::new(lo, hi, r0, r1, 0.8, 1)
+                    }
+                };
+                spec.packing_fraction = p.packing_fraction.unwrap_or(0.8);
+                spec.seed = p.seed.unwrap_or(1);
+                if !matches!(spec.distribution, RadiusDistribution::List(_)) {
+                    spec.distribution = RadiusDistribution::Uniform;
+                }
+                spec.generate_in(&region, &holes)
+                    .map_err(|e| ls.error(&key("packing_fraction"), format!(": {e}")))?
+            };
+            (packing.centres, packing.radii)
+        }
+    };
+    if centres.is_empty() {
+        return Err(ls.error(&key("kind"), "generates no particle"));
+    }
+    Disks::new(&centres, &radii, p.density)
+        .map_err(|e| ls.error(&k(&["particles"]), format!(": {e}")))
+}
