@@ -38,6 +38,7 @@
 //! not enter cracks narrower than the spacing.
 
 mod injection;
+mod lsm;
 mod solver;
 
 pub use injection::{Injection, InjectionControl};
