@@ -22,7 +22,8 @@
 //!   with `x_f2 = x_f − c_α`; where `x_f2` is not fluid, the plain moving bounce-back
 //!   `L(x_f, ᾱ) = L(x_b, α) − 6 w_α ρ₀ c_α·u_w`.
 //! * **Force** (seed eq. 8, momentum exchange per cut link):
-//!   `ΔF = c_α [L(x_b, α) + L(x_f, ᾱ)]`, or with the Galilean-invariant correction of
+//!   `ΔF = c_α [L(x_b, α) + L(x_f, ᾱ) − 2 w_α ρ₀]` (gauge: the reference density's share
+//!   cancels over a body wetted all round, see [`crate::lattice`]), or with the Galilean-invariant correction of
 //!   Wen et al. (2014) `ΔF = (c_α − u_w) L(x_b, α) − (c_ᾱ − u_w) L(x_f, ᾱ)`; torque
 //!   `(x_w − X) × ΔF`.
 //!

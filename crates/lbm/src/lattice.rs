@@ -21,6 +21,13 @@
 //! momentum of fluid plus bodies is conserved to round-off with the standard momentum
 //! exchange (the Galilean-invariant variant is not conservative).
 //!
+//! **Gauge forces.** The momentum exchange of each cut link is taken relative to the fluid
+//! at rest at the reference density, `ΔF = c_α [L(x_b, α) + L(x_f, ᾱ) − 2 w_α ρ₀]`: the
+//! reference terms of the entry and exit links of every lattice line through a body cancel,
+//! so a body wetted all round feels exactly the same force and torque; a body partly
+//! covered by others (touching particles of a rock) is not pushed by the ambient pressure
+//! `c_s² ρ₀` on its wetted part only, which the solid contacts would carry.
+//!
 //! **Mass sources** (seed §002.6, injection): `f_α += w_α S` on the fluid nodes of a
 //! source after every step, `S` the mass per node and step ([`Lattice::set_source_rate`]);
 //! it adds mass and no momentum. [`Lattice::injected_mass`] counts what went in.
@@ -821,13 +828,19 @@ impl Lattice {
                             / (1.0 + d)
                     };
                     back_k.push(back);
+                    // the reference density's share, 2 w_α ρ₀ c_α: only gauge pressure
+                    // loads the body (zero for a body wetted all round)
+                    let amb = 2.0 * W[a];
                     let df = if gi {
                         [
-                            (ca[0] - uw[0]) * into - (-ca[0] - uw[0]) * back,
-                            (ca[1] - uw[1]) * into - (-ca[1] - uw[1]) * back,
+                            (ca[0] - uw[0]) * into - (-ca[0] - uw[0]) * back - amb * ca[0],
+                            (ca[1] - uw[1]) * into - (-ca[1] - uw[1]) * back - amb * ca[1],
                         ]
                     } else {
-                        [ca[0] * (into + back), ca[1] * (into + back)]
+                        [
+                            ca[0] * (into + back - amb),
+                            ca[1] * (into + back - amb),
+                        ]
                     };
                     let r = [l.xw[0] - c[0], l.xw[1] - c[1]];
                     f[0] += df[0];

@@ -142,3 +142,24 @@ fn a_source_adds_its_mass_and_no_momentum() {
     assert!(l.add_source(&[(24, 0)]).is_err());
     assert!(l.set_source_rate(s, f64::NAN).is_err());
 }
+
+#[test]
+fn a_body_partly_covered_by_another_feels_no_ambient_pressure() {
+    // A disk half buried in a box (a particle touching others in a rock): in fluid at
+    // rest only gauge pressure loads it, so nothing; with absolute pressure c_s² ρ₀ on its
+    // wetted half it would be pushed by about c_s² · 2R = 2.7 (lattice units).
+    let mut l = Lattice::new(LatticeConfig::periodic(40, 40, 0.8)).unwrap();
+    l.add_obstacle(Obstacle {
+        shape: Shape::aligned_box([5.0, 5.0], [20.3, 35.0]),
+        velocity: [0.0, 0.0],
+        angular_velocity: 0.0,
+    })
+    .unwrap();
+    let d = l.add_obstacle(disk([20.1, 19.7], 4.1, [0.0, 0.0], 0.0)).unwrap();
+    for _ in 0..20 {
+        l.step().unwrap();
+    }
+    let f = l.force(d);
+    assert!(l.cut_links_of(d).count() > 10);
+    assert!(f.iter().all(|v| v.abs() < 1e-12), "{f:?}");
+}
