@@ -81,7 +81,10 @@ fn hot_grains_cool_in_flowing_fluid_and_the_heat_books_balance() {
     assert!(defect.abs() < 1e-10 * initial, "{h}");
     assert!(h["particle_defect"].as_f64().unwrap().abs() < 1e-10 * initial);
     let extracted = h["extracted_from_particles"].as_f64().unwrap();
-    assert!(extracted > 0.01 * h["particles_initial"].as_f64().unwrap(), "{h}");
+    assert!(
+        extracted > 0.01 * h["particles_initial"].as_f64().unwrap(),
+        "{h}"
+    );
     assert_eq!(s["fluid"]["fluid_steps"].as_u64(), Some(400));
     let (header, rows) = read_csv(&out.join("heat.csv"));
     assert_eq!(header[0], "time");
@@ -104,5 +107,8 @@ fn a_grain_below_two_lattice_spacings_names_the_spacing() {
     let text = SCENE.replace("spacing = 0.0005", "spacing = 0.0011");
     let (code, err, _) = run_text("lsm_fluid_coarse", &text);
     assert_eq!(code, 1);
-    assert!(err.contains("lbm.spacing") && err.contains("below 2 lattice spacings"), "{err}");
+    assert!(
+        err.contains("lbm.spacing") && err.contains("below 2 lattice spacings"),
+        "{err}"
+    );
 }

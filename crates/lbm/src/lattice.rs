@@ -837,10 +837,7 @@ impl Lattice {
                             (ca[1] - uw[1]) * into - (-ca[1] - uw[1]) * back - amb * ca[1],
                         ]
                     } else {
-                        [
-                            ca[0] * (into + back - amb),
-                            ca[1] * (into + back - amb),
-                        ]
+                        [ca[0] * (into + back - amb), ca[1] * (into + back - amb)]
                     };
                     let r = [l.xw[0] - c[0], l.xw[1] - c[1]];
                     f[0] += df[0];

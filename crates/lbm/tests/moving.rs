@@ -155,7 +155,9 @@ fn a_body_partly_covered_by_another_feels_no_ambient_pressure() {
         angular_velocity: 0.0,
     })
     .unwrap();
-    let d = l.add_obstacle(disk([20.1, 19.7], 4.1, [0.0, 0.0], 0.0)).unwrap();
+    let d = l
+        .add_obstacle(disk([20.1, 19.7], 4.1, [0.0, 0.0], 0.0))
+        .unwrap();
     for _ in 0..20 {
         l.step().unwrap();
     }

@@ -149,7 +149,10 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
         {
             return Err(ls.error(&key("gain"), format!("= {g} must be in (0, 1]")));
         }
-        if s.loading.as_ref().is_some_and(|l| l.pressure_rate.is_some()) {
+        if s.loading
+            .as_ref()
+            .is_some_and(|l| l.pressure_rate.is_some())
+        {
             return Err(ls.error(
                 &k(&["loading", "pressure_rate"]),
                 "and [injection] both load the borehole: keep one",
@@ -174,7 +177,9 @@ pub struct Fluid {
 
 fn coupling_error(ls: &LoadedScene, e: CouplingError) -> RunError {
     match e {
-        CouplingError::TooSmall { .. } => ls.error(&k(&["lbm", "spacing"]), format!(": {e}")).into(),
+        CouplingError::TooSmall { .. } => {
+            ls.error(&k(&["lbm", "spacing"]), format!(": {e}")).into()
+        }
         CouplingError::Outside { .. } => ls.error(&k(&["lbm", "extent"]), format!(": {e}")).into(),
         CouplingError::Particles(p) => RunError::Flow(format!("lsm: {p}")),
         e => RunError::Flow(format!("lsm–lbm: {e}")),
@@ -183,7 +188,11 @@ fn coupling_error(ls: &LoadedScene, e: CouplingError) -> RunError {
 
 impl Fluid {
     /// The fluid of a checked scene, if it has `[lbm]`; `dt` is the lattice solid's step.
-    pub fn build(ls: &LoadedScene, solid: &LatticeSolid, dt: f64) -> Result<Option<Self>, RunError> {
+    pub fn build(
+        ls: &LoadedScene,
+        solid: &LatticeSolid,
+        dt: f64,
+    ) -> Result<Option<Self>, RunError> {
         let s = &ls.scene;
         if s.lbm.is_none() {
             return Ok(None);
@@ -215,7 +224,10 @@ impl Fluid {
             };
             let d = solid.disks();
             let temps: Vec<f64> = (0..d.len())
-                .map(|i| t.particle_temperature.unwrap_or_else(|| init.eval(&d.x[i], 0.0)))
+                .map(|i| {
+                    t.particle_temperature
+                        .unwrap_or_else(|| init.eval(&d.x[i], 0.0))
+                })
                 .collect();
             pf = pf
                 .with_thermal(setup, |x| init.eval(&x, 0.0), &temps)
@@ -224,7 +236,10 @@ impl Fluid {
         if let Some(inj) = &s.injection {
             let hole = s.particles.as_ref().and_then(|p| p.hole);
             let center = inj.center.or(hole.map(|h| h.center)).expect("checked");
-            let radius = inj.radius.or(hole.map(|h| 0.5 * h.radius)).expect("checked");
+            let radius = inj
+                .radius
+                .or(hole.map(|h| 0.5 * h.radius))
+                .expect("checked");
             let control = match (inj.pressure, inj.rate) {
                 (Some(p), _) => InjectionControl::Pressure {
                     peak: p,
@@ -420,7 +435,13 @@ impl Fluid {
                 solid_mask.push(lat.is_solid(i, j));
             }
         }
-        crate::lbm::images::field_png(&dir.join("fluid_speed.png"), [nx, ny], &speed, &solid_mask, false)?;
+        crate::lbm::images::field_png(
+            &dir.join("fluid_speed.png"),
+            [nx, ny],
+            &speed,
+            &solid_mask,
+            false,
+        )?;
         crate::lbm::images::field_png(
             &dir.join("fluid_pressure.png"),
             [nx, ny],
@@ -434,7 +455,13 @@ impl Fluid {
                 .map(|(i, j)| th.temperature(i, j))
                 .collect();
             let none = vec![false; nx * ny];
-            crate::lbm::images::field_png(&dir.join("temperature.png"), [nx, ny], &t, &none, false)?;
+            crate::lbm::images::field_png(
+                &dir.join("temperature.png"),
+                [nx, ny],
+                &t,
+                &none,
+                false,
+            )?;
             let d = solid.disks();
             let temps: Vec<f64> = (0..d.len())
                 .map(|i| self.pf.particle_temperature(i).unwrap_or(f64::NAN))
@@ -442,7 +469,9 @@ impl Fluid {
             let (lo, hi) = temps
                 .iter()
                 .filter(|v| v.is_finite())
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                    (a.min(v), b.max(v))
+                });
             let span = (hi - lo).max(1e-300);
             crate::particle_output::draw_disks(
                 &dir.join("particles_temperature.png"),
