@@ -3,7 +3,7 @@
 //! adds temperature (conjugate: the disks' nodes carry `solid_diffusivity`), `[injection]`
 //! a ramped mass source at the borehole.
 //!
-//! - *build*: the lattice of `[lbm]` ([`crate::lbm::lattice_of`]), one moving obstacle per
+//! - *build*: the lattice of `[lbm]` (as the `lbm` model builds it), one moving obstacle per
 //!   disk; a disk of radius below two spacings is an error naming `lbm.spacing`;
 //! - *step*: one fluid step of `Δt` (from spacing, viscosity and tau) per coupled step, the
 //!   lattice solid sub-cycled within it at its own step (`[lsm] dt` or `dt_fraction`);
