@@ -22,7 +22,8 @@
 //!   with `x_f2 = x_f − c_α`; where `x_f2` is not fluid, the plain moving bounce-back
 //!   `L(x_f, ᾱ) = L(x_b, α) − 6 w_α ρ₀ c_α·u_w`.
 //! * **Force** (seed eq. 8, momentum exchange per cut link):
-//!   `ΔF = c_α [L(x_b, α) + L(x_f, ᾱ)]`, or with the Galilean-invariant correction of
+//!   `ΔF = c_α [L(x_b, α) + L(x_f, ᾱ) − 2 w_α ρ₀]` (gauge: the reference density's share
+//!   cancels over a body wetted all round, see [`crate::lattice`]), or with the Galilean-invariant correction of
 //!   Wen et al. (2014) `ΔF = (c_α − u_w) L(x_b, α) − (c_ᾱ − u_w) L(x_f, ᾱ)`; torque
 //!   `(x_w − X) × ΔF`.
 //!
@@ -113,9 +114,10 @@ pub(crate) struct ObstacleLink {
     pub delta: f64,
     /// `x_f2`, or `u32::MAX` where it is not fluid.
     pub f2: u32,
-    pub obstacle: u32,
     /// Wall point `x_w` (unwrapped lattice coordinates).
     pub xw: [f64; 2],
+    /// Position of `x_f` (the image nearest the obstacle's centre when last computed).
+    pub p: [f64; 2],
 }
 
 /// How the force on an obstacle is summed from its cut links (seed eq. 8).

@@ -84,6 +84,7 @@ impl Shape {
     }
 
     /// Whether `p` is inside (boundary included).
+    #[inline]
     pub fn contains(&self, p: [f64; 2]) -> bool {
         match *self {
             Shape::Circle { center, radius } => {
@@ -103,6 +104,7 @@ impl Shape {
 
     /// The fraction `δ ∈ [0, 1]` of the segment `p → p + d` (from a point outside to one
     /// inside) at which it enters the shape.
+    #[inline]
     pub fn entry(&self, p: [f64; 2], d: [f64; 2]) -> f64 {
         let t = match *self {
             Shape::Circle { center, radius } => {

@@ -1,4 +1,40 @@
 //! The lattice: populations, geometry and boundary lists, and the step that ties them.
+//!
+//! Obstacles move in one of two ways ([`ObstacleMotion`]): the lattice advances them by
+//! their own velocity after every step, or a caller places them
+//! ([`Lattice::place_obstacle`]) and re-rasterises them ([`Lattice::update_obstacles`]),
+//! which is how coupled particles are carried. Either way only what changed is rebuilt:
+//!
+//! * an obstacle that did not move keeps its solid nodes and cut links;
+//! * an obstacle that moved is rasterised again (its bounding box); if it covers the same
+//!   nodes, only `δ` and the wall point of its cut links are recomputed (the usual case for
+//!   slowly moving particles);
+//! * if nodes changed owner, the cut links of every obstacle with a solid node within two
+//!   nodes of a changed node are rebuilt (a link reads its fluid node `x_f` and `x_f2`).
+//!
+//! **Covered and uncovered nodes** (seed §002.3). A fluid node that an obstacle covers
+//! leaves the fluid with its momentum `ρu`; the body gains it. A node it uncovers is
+//! refilled with `f^eq(ρ̄, u_w)`, `ρ̄` the mean density of its fluid neighbours and `u_w`
+//! the body's velocity there; the body loses `ρ̄ u_w`. These transfers are reported by
+//! [`Lattice::node_exchange`] apart from the momentum exchange on cut links
+//! ([`Lattice::force`]); the sum of both is the momentum the fluid gave the body, so the
+//! momentum of fluid plus bodies is conserved to round-off with the standard momentum
+//! exchange (the Galilean-invariant variant is not conservative).
+//!
+//! **Gauge forces.** The momentum exchange of each cut link is taken relative to the fluid
+//! at rest at the reference density, `ΔF = c_α [L(x_b, α) + L(x_f, ᾱ) − 2 w_α ρ₀]`: the
+//! reference terms of the entry and exit links of every lattice line through a body cancel,
+//! so a body wetted all round feels exactly the same force and torque; a body partly
+//! covered by others (touching particles of a rock) is not pushed by the ambient pressure
+//! `c_s² ρ₀` on its wetted part only, which the solid contacts would carry.
+//!
+//! **Mass sources** (seed §002.6, injection): `f_α += w_α S` on the fluid nodes of a
+//! source after every step, `S` the mass per node and step ([`Lattice::set_source_rate`]);
+//! it adds mass and no momentum. [`Lattice::injected_mass`] counts what went in.
+//!
+//! **Periodic sides**: an obstacle may cross a periodic side; its nodes are taken modulo the
+//! period and its geometry is computed with the image nearest its centre, which is kept in
+//! the first period.
 
 use crate::LbmError;
 use crate::boundary::{
@@ -73,6 +109,58 @@ impl Obstacle {
     }
 }
 
+/// Who moves the obstacles.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ObstacleMotion {
+    /// After every step the lattice advances each obstacle by its velocity and angular
+    /// velocity (one step's worth) and re-rasterises it.
+    #[default]
+    Integrated,
+    /// The caller places the obstacles ([`Lattice::place_obstacle`]) and calls
+    /// [`Lattice::update_obstacles`] before a step; the velocities only enter the wall
+    /// rule and the refill.
+    External,
+}
+
+/// Scratch state of the incremental obstacle update (kept to avoid allocating per step).
+#[derive(Clone, Debug, Default)]
+struct Scratch {
+    /// Nodes a raster finds.
+    nodes: Vec<u32>,
+    /// Nodes that changed owner in this update.
+    changed: Vec<u32>,
+    /// Nodes released in this update and the obstacle that released them.
+    released: Vec<(u32, u32)>,
+    /// Per node: released in this update and not yet covered again.
+    fresh: Vec<bool>,
+    /// Per obstacle: placed or advanced since the last update.
+    moved: Vec<bool>,
+    /// Per obstacle: cut links to rebuild.
+    dirty: Vec<bool>,
+    /// Per obstacle: centre at its last rasterisation.
+    raster_at: Vec<[f64; 2]>,
+    /// Per obstacle: how far it may move from `raster_at` without a node centre crossing
+    /// its surface (circles; 0 for boxes).
+    margin: Vec<f64>,
+    /// Per obstacle: shape when `δ` of its links was last computed.
+    linked_at: Vec<Shape>,
+}
+
+/// What an obstacle update does to one obstacle's cut links.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum LinkWork {
+    Keep,
+    Deltas,
+    Rebuild,
+}
+
+/// A set of nodes that receive mass.
+#[derive(Clone, Debug)]
+struct Source {
+    nodes: Vec<u32>,
+    rate: f64,
+}
+
 /// A D2Q9 lattice with its boundaries and obstacles.
 #[derive(Clone, Debug)]
 pub struct Lattice {
@@ -86,12 +174,22 @@ pub struct Lattice {
     /// Obstacle owning a solid node, or NONE.
     owner: Vec<u32>,
     obstacles: Vec<Obstacle>,
+    /// Solid nodes of each obstacle (sorted).
     solid_nodes: Vec<Vec<u32>>,
+    /// Cut links of each obstacle.
+    links: Vec<Vec<ObstacleLink>>,
+    /// Unknowns of each obstacle's cut links in the current step (scratch).
+    backs: Vec<Vec<f64>>,
     forces: Vec<[f64; 3]>,
+    exchange: Vec<[f64; 3]>,
+    motion: ObstacleMotion,
+    scratch: Scratch,
+    sources: Vec<Source>,
+    injected: f64,
+    geometry_tolerance: f64,
     copies: Vec<CopyLink>,
     side_links: Vec<SideLink>,
     pressure_links: Vec<PressureLink>,
-    obstacle_links: Vec<ObstacleLink>,
     steps: u64,
 }
 
@@ -130,11 +228,21 @@ impl Lattice {
             owner: vec![NONE; np],
             obstacles: Vec::new(),
             solid_nodes: Vec::new(),
+            links: Vec::new(),
+            backs: Vec::new(),
             forces: Vec::new(),
+            exchange: Vec::new(),
+            motion: ObstacleMotion::Integrated,
+            scratch: Scratch {
+                fresh: vec![false; np],
+                ..Scratch::default()
+            },
+            sources: Vec::new(),
+            injected: 0.0,
+            geometry_tolerance: 0.0,
             copies: Vec::new(),
             side_links: Vec::new(),
             pressure_links: Vec::new(),
-            obstacle_links: Vec::new(),
             steps: 0,
             cfg,
         };
@@ -176,10 +284,7 @@ impl Lattice {
                 let (rho, u) = if self.owner[node] == NONE {
                     f(p)
                 } else {
-                    (
-                        1.0,
-                        self.obstacles[self.owner[node] as usize].velocity_at(p),
-                    )
+                    (1.0, self.body_velocity(self.owner[node] as usize, node))
                 };
                 let u = [
                     u[0] - 0.5 * self.cfg.accel[0],
@@ -202,21 +307,49 @@ impl Lattice {
         }
     }
 
-    /// Add an obstacle; it must lie inside the box. Returns its index.
+    /// Add an obstacle; it must lie inside the box along axes that are not periodic.
+    /// Returns its index.
     pub fn add_obstacle(&mut self, ob: Obstacle) -> Result<usize, LbmError> {
         let k = self.obstacles.len();
-        self.check_inside(k, &ob.shape)?;
+        let mut ob = ob;
+        self.check_inside(k, &mut ob.shape)?;
         self.obstacles.push(ob);
         self.solid_nodes.push(Vec::new());
+        self.links.push(Vec::new());
         self.forces.push([0.0; 3]);
+        self.exchange.push([0.0; 3]);
+        self.scratch.moved.push(true);
+        self.scratch.dirty.push(true);
+        self.scratch.raster_at.push([f64::NAN; 2]);
+        self.scratch.margin.push(0.0);
+        self.scratch.linked_at.push(self.obstacles[k].shape);
+        // A new body takes its nodes without refill or momentum bookkeeping.
         self.rasterize(k, false);
-        self.build_obstacle_links();
+        self.exchange[k] = [0.0; 3];
+        self.finish_update();
         Ok(k)
     }
 
     /// The obstacles.
     pub fn obstacles(&self) -> &[Obstacle] {
         &self.obstacles
+    }
+
+    /// Keep `δ` and the wall points of an obstacle's cut links until it has moved by more
+    /// than `tolerance` spacings since they were computed (default 0: recompute whenever it
+    /// moves). The solid nodes and the wall velocities are always current; only the wall
+    /// position seen by the interpolation lags, by less than `tolerance`.
+    pub fn set_geometry_tolerance(&mut self, tolerance: f64) -> Result<(), LbmError> {
+        if !(tolerance.is_finite() && (0.0..0.5).contains(&tolerance)) {
+            return Err(LbmError::Value("geometry tolerance (below 0.5)", tolerance));
+        }
+        self.geometry_tolerance = tolerance;
+        Ok(())
+    }
+
+    /// Who moves the obstacles (default [`ObstacleMotion::Integrated`]).
+    pub fn set_obstacle_motion_mode(&mut self, motion: ObstacleMotion) {
+        self.motion = motion;
     }
 
     /// Prescribe the motion of obstacle `k` for the next steps (the hook for coupled
@@ -226,15 +359,93 @@ impl Lattice {
         self.obstacles[k].angular_velocity = angular_velocity;
     }
 
+    /// Place obstacle `k`: its centre, its rotation angle (boxes; ignored for circles), its
+    /// velocity and angular velocity. Takes effect at [`Lattice::update_obstacles`].
+    pub fn place_obstacle(
+        &mut self,
+        k: usize,
+        center: [f64; 2],
+        angle: f64,
+        velocity: [f64; 2],
+        angular_velocity: f64,
+    ) {
+        let ob = &mut self.obstacles[k];
+        let old = ob.shape;
+        match &mut ob.shape {
+            Shape::Circle { center: c, .. } => *c = center,
+            Shape::Box {
+                center: c,
+                angle: a,
+                ..
+            } => {
+                *c = center;
+                *a = angle;
+            }
+        }
+        ob.velocity = velocity;
+        ob.angular_velocity = angular_velocity;
+        if ob.shape != old {
+            self.scratch.moved[k] = true;
+        }
+    }
+
+    /// Re-rasterise the obstacles placed since the last update: cover and uncover nodes
+    /// (refill, momentum bookkeeping in [`Lattice::node_exchange`]) and rebuild what
+    /// changed. Errors if an obstacle left the box along an axis that is not periodic.
+    pub fn update_obstacles(&mut self) -> Result<(), LbmError> {
+        for e in &mut self.exchange {
+            *e = [0.0; 3];
+        }
+        for k in 0..self.obstacles.len() {
+            if !self.scratch.moved[k] {
+                continue;
+            }
+            let mut s = self.obstacles[k].shape;
+            self.check_inside(k, &mut s)?;
+            self.obstacles[k].shape = s;
+            // A circle that moved less than the distance from its surface to the nearest
+            // node centre covers the same nodes.
+            let (c, at) = (s.center(), self.scratch.raster_at[k]);
+            let d = ((c[0] - at[0]).powi(2) + (c[1] - at[1]).powi(2)).sqrt();
+            let same_nodes = d < self.scratch.margin[k];
+            if !same_nodes {
+                self.rasterize(k, true);
+            }
+        }
+        self.refill();
+        self.finish_update();
+        Ok(())
+    }
+
     /// Force `(fx, fy)` and torque on obstacle `k` from the last step (lattice units,
     /// momentum exchange over the cut links).
     pub fn force(&self, k: usize) -> [f64; 3] {
         self.forces[k]
     }
 
+    /// Momentum `(px, py)` and angular momentum the body `k` took from the fluid by covering
+    /// and uncovering nodes at its last update (lattice units; zero if it did not move).
+    pub fn node_exchange(&self, k: usize) -> [f64; 3] {
+        self.exchange[k]
+    }
+
     /// Whether an interior node is solid.
     pub fn is_solid(&self, i: usize, j: usize) -> bool {
         self.owner[self.grid.node(i as isize, j as isize)] != NONE
+    }
+
+    /// The obstacle covering interior node `(i, j)`, if any.
+    pub fn owner(&self, i: usize, j: usize) -> Option<usize> {
+        let o = self.owner[self.grid.node(i as isize, j as isize)];
+        (o != NONE).then_some(o as usize)
+    }
+
+    /// Interior nodes `(i, j)` covered by obstacle `k`.
+    pub fn obstacle_nodes(&self, k: usize) -> impl Iterator<Item = (usize, usize)> + '_ {
+        let w = self.grid.stride();
+        self.solid_nodes[k]
+            .iter()
+            .map(move |&n| (n as usize % w - 1, n as usize / w - 1))
     }
 
     /// Interior fluid nodes.
@@ -245,15 +456,15 @@ impl Lattice {
     /// Density and velocity of interior node `(i, j)` (solid nodes: 1 and the body's
     /// velocity).
     pub fn moments(&self, i: usize, j: usize) -> (f64, [f64; 2]) {
-        let g = self.grid;
-        let node = g.node(i as isize, j as isize);
+        let node = self.grid.node(i as isize, j as isize);
         if self.owner[node] != NONE {
-            let p = [i as f64 + 0.5, j as f64 + 0.5];
-            return (
-                1.0,
-                self.obstacles[self.owner[node] as usize].velocity_at(p),
-            );
+            return (1.0, self.body_velocity(self.owner[node] as usize, node));
         }
+        self.fluid_moments(node)
+    }
+
+    fn fluid_moments(&self, node: usize) -> (f64, [f64; 2]) {
+        let g = self.grid;
         let (mut rho, mut jx, mut jy) = (0.0, 0.0, 0.0);
         for q in 0..Q {
             let f = self.pop[g.loc(self.layout, node, q)];
@@ -263,6 +474,22 @@ impl Lattice {
         }
         let a = self.cfg.accel;
         (rho, [jx / rho + 0.5 * a[0], jy / rho + 0.5 * a[1]])
+    }
+
+    /// Total momentum `Σ ρu` of the fluid nodes (lattice units).
+    pub fn momentum(&self) -> [f64; 2] {
+        let mut p = [0.0; 2];
+        for j in 0..self.grid.ny {
+            for i in 0..self.grid.nx {
+                let node = self.grid.node(i as isize, j as isize);
+                if self.owner[node] == NONE {
+                    let (rho, u) = self.fluid_moments(node);
+                    p[0] += rho * u[0];
+                    p[1] += rho * u[1];
+                }
+            }
+        }
+        p
     }
 
     /// Population `f_q` arriving at interior node `(i, j)`.
@@ -304,8 +531,58 @@ impl Lattice {
         s
     }
 
+    /// Add a mass source on interior nodes `(i, j)` (rate 0 until
+    /// [`Lattice::set_source_rate`]). Returns its index.
+    pub fn add_source(&mut self, nodes: &[(usize, usize)]) -> Result<usize, LbmError> {
+        if nodes.is_empty() {
+            return Err(LbmError::Value("source nodes (count)", 0.0));
+        }
+        let mut v = Vec::with_capacity(nodes.len());
+        for &(i, j) in nodes {
+            if i >= self.grid.nx || j >= self.grid.ny {
+                return Err(LbmError::Value("source node index", i.max(j) as f64));
+            }
+            v.push(self.grid.node(i as isize, j as isize) as u32);
+        }
+        v.sort_unstable();
+        v.dedup();
+        self.sources.push(Source {
+            nodes: v,
+            rate: 0.0,
+        });
+        Ok(self.sources.len() - 1)
+    }
+
+    /// Mass added to every fluid node of source `s` per step (lattice units; negative is a
+    /// sink).
+    pub fn set_source_rate(&mut self, s: usize, rate: f64) -> Result<(), LbmError> {
+        if !rate.is_finite() {
+            return Err(LbmError::Value("source rate", rate));
+        }
+        self.sources[s].rate = rate;
+        Ok(())
+    }
+
+    /// Mean density of the fluid nodes of source `s` (1 if all are solid).
+    pub fn source_density(&self, s: usize) -> f64 {
+        let (mut sum, mut n) = (0.0, 0usize);
+        for &node in &self.sources[s].nodes {
+            if self.owner[node as usize] == NONE {
+                sum += self.fluid_moments(node as usize).0;
+                n += 1;
+            }
+        }
+        if n == 0 { 1.0 } else { sum / n as f64 }
+    }
+
+    /// Mass the sources added since the start (lattice units).
+    pub fn injected_mass(&self) -> f64 {
+        self.injected
+    }
+
     /// One time step: collide and stream every node, apply the boundary lists, sum the
-    /// obstacle forces, then move the obstacles (refilling uncovered nodes).
+    /// obstacle forces, add the sources, then (with [`ObstacleMotion::Integrated`]) move
+    /// the obstacles.
     pub fn step(&mut self) -> Result<(), LbmError> {
         for (k, ob) in self.obstacles.iter().enumerate() {
             let [lo, hi] = ob.shape.bounds();
@@ -337,25 +614,47 @@ impl Lattice {
         self.apply_copies();
         self.apply_sides();
         self.apply_obstacles();
+        self.apply_sources();
         self.steps += 1;
-        if self
-            .obstacles
-            .iter()
-            .any(|o| o.velocity != [0.0, 0.0] || o.angular_velocity != 0.0)
-        {
-            self.move_obstacles()?;
+        if self.motion == ObstacleMotion::Integrated {
+            let mut any = false;
+            for k in 0..self.obstacles.len() {
+                let ob = &mut self.obstacles[k];
+                if ob.velocity != [0.0, 0.0] || ob.angular_velocity != 0.0 {
+                    let (v, w) = (ob.velocity, ob.angular_velocity);
+                    ob.shape.advance(v, w);
+                    self.scratch.moved[k] = true;
+                    any = true;
+                }
+            }
+            if any {
+                self.update_obstacles()?;
+            }
         }
         Ok(())
     }
 
-    fn check_inside(&self, k: usize, s: &Shape) -> Result<(), LbmError> {
-        let [lo, hi] = s.bounds();
+    /// Along a non-periodic axis the shape must lie inside the box; along a periodic one its
+    /// centre is brought into the first period.
+    fn check_inside(&self, k: usize, s: &mut Shape) -> Result<(), LbmError> {
         let n = [self.grid.nx as f64, self.grid.ny as f64];
+        let c = s.center();
+        let mut d = [0.0; 2];
+        for a in 0..2 {
+            if self.cfg.periodic[a] {
+                if !c[a].is_finite() {
+                    return Err(LbmError::Outside { obstacle: k });
+                }
+                d[a] = c[a].rem_euclid(n[a]) - c[a];
+            }
+        }
+        if d != [0.0, 0.0] {
+            s.advance(d, 0.0);
+        }
+        let [lo, hi] = s.bounds();
         for a in 0..2 {
             let inside = lo[a] >= 0.0 && hi[a] <= n[a];
-            // Along a periodic axis a body may also span the whole period (a wall).
-            let spans = self.cfg.periodic[a] && lo[a] <= 0.0 && hi[a] >= n[a];
-            if !(inside || spans) {
+            if !self.cfg.periodic[a] && !inside {
                 return Err(LbmError::Outside { obstacle: k });
             }
         }
@@ -489,194 +788,443 @@ impl Lattice {
         }
     }
 
+    /// The obstacle rules, in two passes: every obstacle's unknowns and force in parallel
+    /// (a rule reads no unknown of another rule, see [`crate::boundary`]), then the
+    /// unknowns written back.
     fn apply_obstacles(&mut self) {
+        use rayon::prelude::*;
         let (g, lay) = (self.grid, self.layout);
-        for f in &mut self.forces {
-            *f = [0.0; 3];
-        }
         let gi = self.cfg.momentum_exchange == MomentumExchange::GalileanInvariant;
-        for l in &self.obstacle_links {
-            let a = l.alpha as usize;
-            let i = OPP[a];
-            let xf = l.node as usize;
-            let ob = &self.obstacles[l.obstacle as usize];
-            let uw = ob.velocity_at(l.xw);
-            let ca = cf(a);
-            let wall = 6.0 * W[a] * (ca[0] * uw[0] + ca[1] * uw[1]);
-            let into = self.pop[g.loc(lay, g.shift(xf, a), a)];
-            let back = if l.f2 == NONE {
-                into - wall
-            } else {
-                let d = l.delta;
-                ((1.0 - d) * self.pop[g.loc(lay, xf, a)]
-                    + d * into
-                    + d * self.pop[g.loc(lay, l.f2 as usize, i)]
-                    - wall)
-                    / (1.0 + d)
-            };
-            self.pop[g.loc(lay, xf, i)] = back;
-            let df = if gi {
-                [
-                    (ca[0] - uw[0]) * into - (-ca[0] - uw[0]) * back,
-                    (ca[1] - uw[1]) * into - (-ca[1] - uw[1]) * back,
-                ]
-            } else {
-                [ca[0] * (into + back), ca[1] * (into + back)]
-            };
-            let c = ob.shape.center();
-            let r = [l.xw[0] - c[0], l.xw[1] - c[1]];
-            let f = &mut self.forces[l.obstacle as usize];
-            f[0] += df[0];
-            f[1] += df[1];
-            f[2] += r[0] * df[1] - r[1] * df[0];
-        }
-    }
-
-    /// Mark the nodes inside obstacle `k`; with `refill`, give the nodes it uncovered the
-    /// equilibrium at the mean density of their fluid neighbours and the body's velocity.
-    fn rasterize(&mut self, k: usize, refill: bool) {
-        let g = self.grid;
-        let old = std::mem::take(&mut self.solid_nodes[k]);
-        for &n in &old {
-            self.owner[n as usize] = NONE;
-            self.mask[n as usize] = 1;
-        }
-        let shape = self.obstacles[k].shape;
-        let [lo, hi] = shape.bounds();
-        let i0 = (lo[0] - 0.5).floor().max(0.0) as isize;
-        let j0 = (lo[1] - 0.5).floor().max(0.0) as isize;
-        let i1 = ((hi[0] - 0.5).ceil() as isize).min(g.nx as isize - 1);
-        let j1 = ((hi[1] - 0.5).ceil() as isize).min(g.ny as isize - 1);
-        let mut now = Vec::new();
-        for j in j0..=j1 {
-            for i in i0..=i1 {
-                let n = g.node(i, j);
-                if self.owner[n] == NONE && shape.contains([i as f64 + 0.5, j as f64 + 0.5]) {
-                    self.owner[n] = k as u32;
-                    self.mask[n] = 0;
-                    now.push(n as u32);
+        let mut backs = std::mem::take(&mut self.backs);
+        backs.resize_with(self.links.len(), Vec::new);
+        let pop = &self.pop;
+        let obstacles = &self.obstacles;
+        self.forces
+            .par_iter_mut()
+            .zip(backs.par_iter_mut())
+            .zip(self.links.par_iter())
+            .enumerate()
+            .for_each(|(k, ((force, back_k), links))| {
+                let ob = &obstacles[k];
+                let c = ob.shape.center();
+                let mut f = [0.0; 3];
+                back_k.clear();
+                for l in links {
+                    let a = l.alpha as usize;
+                    let i = OPP[a];
+                    let xf = l.node as usize;
+                    let uw = ob.velocity_at(l.xw);
+                    let ca = cf(a);
+                    let wall = 6.0 * W[a] * (ca[0] * uw[0] + ca[1] * uw[1]);
+                    let into = pop[g.loc(lay, g.shift(xf, a), a)];
+                    let back = if l.f2 == NONE {
+                        into - wall
+                    } else {
+                        let d = l.delta;
+                        ((1.0 - d) * pop[g.loc(lay, xf, a)]
+                            + d * into
+                            + d * pop[g.loc(lay, l.f2 as usize, i)]
+                            - wall)
+                            / (1.0 + d)
+                    };
+                    back_k.push(back);
+                    // the reference density's share, 2 w_α ρ₀ c_α: only gauge pressure
+                    // loads the body (zero for a body wetted all round)
+                    let amb = 2.0 * W[a];
+                    let df = if gi {
+                        [
+                            (ca[0] - uw[0]) * into - (-ca[0] - uw[0]) * back - amb * ca[0],
+                            (ca[1] - uw[1]) * into - (-ca[1] - uw[1]) * back - amb * ca[1],
+                        ]
+                    } else {
+                        [ca[0] * (into + back - amb), ca[1] * (into + back - amb)]
+                    };
+                    let r = [l.xw[0] - c[0], l.xw[1] - c[1]];
+                    f[0] += df[0];
+                    f[1] += df[1];
+                    f[2] += r[0] * df[1] - r[1] * df[0];
                 }
+                *force = f;
+            });
+        for (links, back_k) in self.links.iter().zip(&backs) {
+            for (l, &b) in links.iter().zip(back_k) {
+                self.pop[g.loc(lay, l.node as usize, OPP[l.alpha as usize])] = b;
             }
         }
-        self.solid_nodes[k] = now;
-        if refill {
-            for &n in &old {
+        self.backs = backs;
+    }
+
+    fn apply_sources(&mut self) {
+        let (g, lay) = (self.grid, self.layout);
+        for s in &self.sources {
+            if s.rate == 0.0 {
+                continue;
+            }
+            for &n in &s.nodes {
                 let n = n as usize;
                 if self.owner[n] != NONE {
                     continue;
                 }
-                let (mut sum, mut cnt) = (0.0, 0usize);
-                for q in 1..Q {
-                    let m = g.shift(n, q);
-                    let (mi, mj) = (m % g.stride(), m / g.stride());
-                    if mi >= 1
-                        && mi <= g.nx
-                        && mj >= 1
-                        && mj <= g.ny
-                        && self.owner[m] == NONE
-                        && !old.contains(&(m as u32))
-                    {
-                        let rho: f64 = (0..Q).map(|p| self.pop[g.loc(self.layout, m, p)]).sum();
-                        sum += rho;
-                        cnt += 1;
-                    }
-                }
-                let rho = if cnt > 0 { sum / cnt as f64 } else { 1.0 };
-                let p = [(n % g.stride()) as f64 - 0.5, (n / g.stride()) as f64 - 0.5];
-                let u = self.obstacles[k].velocity_at(p);
                 for q in 0..Q {
-                    self.pop[g.loc(self.layout, n, q)] = feq(q, rho, u);
+                    self.pop[g.loc(lay, n, q)] += W[q] * s.rate;
                 }
+                self.injected += s.rate;
             }
         }
     }
 
-    fn move_obstacles(&mut self) -> Result<(), LbmError> {
-        for k in 0..self.obstacles.len() {
-            let ob = &self.obstacles[k];
-            if ob.velocity == [0.0, 0.0] && ob.angular_velocity == 0.0 {
-                continue;
-            }
-            let mut s = ob.shape;
-            s.advance(ob.velocity, ob.angular_velocity);
-            // A body spanning a periodic axis keeps its centre in the first period.
-            let [lo, hi] = s.bounds();
-            let n = [self.grid.nx as f64, self.grid.ny as f64];
-            let c = s.center();
-            for a in 0..2 {
-                if self.cfg.periodic[a]
-                    && lo[a] <= 0.0
-                    && hi[a] >= n[a]
-                    && hi[a] - lo[a] >= 2.0 * n[a]
-                {
-                    let mut d = [0.0, 0.0];
-                    d[a] = c[a].rem_euclid(n[a]) - c[a];
-                    s.advance(d, 0.0);
-                }
-            }
-            self.check_inside(k, &s)?;
-            self.obstacles[k].shape = s;
-            self.rasterize(k, true);
-        }
-        self.build_obstacle_links();
-        Ok(())
+    /// Interior coordinates of padded node `n`.
+    fn ij(&self, n: usize) -> (isize, isize) {
+        let w = self.grid.stride();
+        ((n % w) as isize - 1, (n / w) as isize - 1)
     }
 
-    fn build_obstacle_links(&mut self) {
-        let g = self.grid;
-        let (nx, ny) = (g.nx as isize, g.ny as isize);
+    /// The image of coordinate `x` along axis `a` nearest to `c` (periodic axes).
+    fn near(&self, a: usize, x: f64, c: f64) -> f64 {
+        if self.cfg.periodic[a] {
+            // both in the first period (or close to it): one image shift at most
+            let n = if a == 0 { self.grid.nx } else { self.grid.ny } as f64;
+            let d = x - c;
+            if d > 0.5 * n {
+                x - n
+            } else if d < -0.5 * n {
+                x + n
+            } else {
+                x
+            }
+        } else {
+            x
+        }
+    }
+
+    /// Position of padded node `n`, as the image nearest to obstacle `k`'s centre.
+    fn position_near(&self, k: usize, n: usize) -> [f64; 2] {
+        let (i, j) = self.ij(n);
+        let c = self.obstacles[k].shape.center();
+        [
+            self.near(0, i as f64 + 0.5, c[0]),
+            self.near(1, j as f64 + 0.5, c[1]),
+        ]
+    }
+
+    /// Rigid-body velocity of obstacle `k` at padded node `n`.
+    fn body_velocity(&self, k: usize, n: usize) -> [f64; 2] {
+        self.obstacles[k].velocity_at(self.position_near(k, n))
+    }
+
+    /// Padded node of interior coordinates `(i, j)` wrapped along periodic axes, or `None`
+    /// outside the box.
+    fn wrap(&self, i: isize, j: isize) -> Option<usize> {
+        let (nx, ny) = (self.grid.nx as isize, self.grid.ny as isize);
         let per = self.cfg.periodic;
-        self.obstacle_links.clear();
-        let wrap = |i: isize, n: isize, p: bool| -> Option<isize> {
-            if (0..n).contains(&i) {
-                Some(i)
+        let w = |x: isize, n: isize, p: bool| {
+            if (0..n).contains(&x) {
+                Some(x)
             } else if p {
-                Some(i.rem_euclid(n))
+                Some(x.rem_euclid(n))
             } else {
                 None
             }
         };
-        for (k, nodes) in self.solid_nodes.iter().enumerate() {
-            let shape = self.obstacles[k].shape;
-            for &b in nodes {
-                let b = b as usize;
-                let (bi, bj) = ((b % g.stride()) as isize - 1, (b / g.stride()) as isize - 1);
-                for a in 1..Q {
-                    let (fi, fj) = (bi - C[a][0] as isize, bj - C[a][1] as isize);
-                    let (Some(wi), Some(wj)) = (wrap(fi, nx, per[0]), wrap(fj, ny, per[1])) else {
-                        continue;
-                    };
-                    let xf = g.node(wi, wj);
-                    if self.owner[xf] != NONE {
-                        continue;
+        Some(self.grid.node(w(i, nx, per[0])?, w(j, ny, per[1])?))
+    }
+
+    /// Nodes whose centre lies in obstacle `k` (wrapped, sorted, deduplicated) into
+    /// `scratch.nodes`.
+    fn raster(&mut self, k: usize) {
+        let shape = self.obstacles[k].shape;
+        let [lo, hi] = shape.bounds();
+        let i0 = (lo[0] - 0.5).floor() as isize;
+        let j0 = (lo[1] - 0.5).floor() as isize;
+        let i1 = (hi[0] - 0.5).ceil() as isize;
+        let j1 = (hi[1] - 0.5).ceil() as isize;
+        let mut out = std::mem::take(&mut self.scratch.nodes);
+        out.clear();
+        let mut margin = 0.0;
+        if let Shape::Circle { center, radius } = shape {
+            // nodes beyond one spacing outside the scanned box are at least that far from
+            // the surface
+            margin = 1.0f64;
+            for j in j0 - 1..=j1 + 1 {
+                let dy = j as f64 + 0.5 - center[1];
+                for i in i0 - 1..=i1 + 1 {
+                    let dx = i as f64 + 0.5 - center[0];
+                    let r = (dx * dx + dy * dy).sqrt();
+                    margin = margin.min((r - radius).abs());
+                    if r <= radius
+                        && let Some(n) = self.wrap(i, j)
+                    {
+                        out.push(n as u32);
                     }
-                    let p = [fi as f64 + 0.5, fj as f64 + 0.5];
-                    let c = cf(a);
-                    let delta = shape.entry(p, c);
-                    let f2 = match (
-                        wrap(fi - C[a][0] as isize, nx, per[0]),
-                        wrap(fj - C[a][1] as isize, ny, per[1]),
-                    ) {
-                        (Some(i2), Some(j2)) if self.owner[g.node(i2, j2)] == NONE => {
-                            g.node(i2, j2) as u32
-                        }
-                        _ => NONE,
-                    };
-                    self.obstacle_links.push(ObstacleLink {
-                        node: xf as u32,
-                        alpha: a as u8,
-                        delta,
-                        f2,
-                        obstacle: k as u32,
-                        xw: [p[0] + delta * c[0], p[1] + delta * c[1]],
-                    });
                 }
+            }
+        } else {
+            for j in j0..=j1 {
+                for i in i0..=i1 {
+                    if shape.contains([i as f64 + 0.5, j as f64 + 0.5])
+                        && let Some(n) = self.wrap(i, j)
+                    {
+                        out.push(n as u32);
+                    }
+                }
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+        self.scratch.nodes = out;
+        self.scratch.raster_at[k] = shape.center();
+        self.scratch.margin[k] = margin;
+    }
+
+    /// Rasterise obstacle `k` again. Nodes it leaves become fluid (fresh, refilled later by
+    /// [`Lattice::refill`]); fluid nodes it takes give it their momentum (with
+    /// `bookkeeping`). A node another obstacle owns is left to it.
+    fn rasterize(&mut self, k: usize, bookkeeping: bool) {
+        self.raster(k);
+        let kk = k as u32;
+        let mut new = std::mem::take(&mut self.scratch.nodes);
+        new.retain(|&n| {
+            let o = self.owner[n as usize];
+            o == NONE || o == kk
+        });
+        let old = std::mem::take(&mut self.solid_nodes[k]);
+        if new != old {
+            let (mut a, mut b) = (0, 0);
+            while a < old.len() || b < new.len() {
+                let (o, n) = (old.get(a).copied(), new.get(b).copied());
+                match (o, n) {
+                    (Some(x), Some(y)) if x == y => {
+                        a += 1;
+                        b += 1;
+                    }
+                    (Some(x), y) if y.is_none_or(|y| x < y) => {
+                        // released
+                        let x = x as usize;
+                        self.owner[x] = NONE;
+                        self.mask[x] = 1;
+                        self.scratch.fresh[x] = true;
+                        self.scratch.released.push((x as u32, kk));
+                        self.scratch.changed.push(x as u32);
+                        a += 1;
+                    }
+                    (_, Some(y)) => {
+                        // covered
+                        let y = y as usize;
+                        if self.scratch.fresh[y] {
+                            self.scratch.fresh[y] = false;
+                        } else if bookkeeping {
+                            let (rho, u) = self.fluid_moments(y);
+                            let p = self.position_near(k, y);
+                            let c = self.obstacles[k].shape.center();
+                            let m = [rho * u[0], rho * u[1]];
+                            let e = &mut self.exchange[k];
+                            e[0] += m[0];
+                            e[1] += m[1];
+                            e[2] += (p[0] - c[0]) * m[1] - (p[1] - c[1]) * m[0];
+                        }
+                        self.owner[y] = kk;
+                        self.mask[y] = 0;
+                        self.scratch.changed.push(y as u32);
+                        b += 1;
+                    }
+                    _ => unreachable!("merge of two sorted lists"),
+                }
+            }
+            self.scratch.dirty[k] = true;
+        }
+        self.scratch.nodes = old;
+        self.solid_nodes[k] = new;
+    }
+
+    /// Refill the nodes released in this update and still fluid: `f^eq(ρ̄, u_w)`, `ρ̄` the
+    /// mean density of the neighbours that were fluid before; the body that released a node
+    /// loses the momentum it now carries.
+    fn refill(&mut self) {
+        let g = self.grid;
+        let released = std::mem::take(&mut self.scratch.released);
+        for &(n, k) in &released {
+            let (n, k) = (n as usize, k as usize);
+            if self.owner[n] != NONE {
+                continue;
+            }
+            let (i, j) = self.ij(n);
+            let (mut sum, mut cnt) = (0.0, 0usize);
+            for q in 1..Q {
+                if let Some(m) = self.wrap(i + C[q][0] as isize, j + C[q][1] as isize)
+                    && self.owner[m] == NONE
+                    && !self.scratch.fresh[m]
+                {
+                    sum += self.fluid_moments(m).0;
+                    cnt += 1;
+                }
+            }
+            let rho = if cnt > 0 { sum / cnt as f64 } else { 1.0 };
+            let p = self.position_near(k, n);
+            let u = self.obstacles[k].velocity_at(p);
+            let a = self.cfg.accel;
+            let ue = [u[0] - 0.5 * a[0], u[1] - 0.5 * a[1]];
+            for q in 0..Q {
+                self.pop[g.loc(self.layout, n, q)] = feq(q, rho, ue);
+            }
+            let c = self.obstacles[k].shape.center();
+            let m = [rho * u[0], rho * u[1]];
+            let e = &mut self.exchange[k];
+            e[0] -= m[0];
+            e[1] -= m[1];
+            e[2] -= (p[0] - c[0]) * m[1] - (p[1] - c[1]) * m[0];
+        }
+        for &(n, _) in &released {
+            self.scratch.fresh[n as usize] = false;
+        }
+        let mut released = released;
+        released.clear();
+        self.scratch.released = released;
+    }
+
+    /// Padded node `(i + di, j + dj)` of padded node `n` at `(i, j)`, wrapped along
+    /// periodic axes, or `None` outside the box.
+    #[inline]
+    fn offset(&self, n: usize, (i, j): (isize, isize), di: isize, dj: isize) -> Option<usize> {
+        let (nx, ny) = (self.grid.nx as isize, self.grid.ny as isize);
+        if i >= 2 && j >= 2 && i < nx - 2 && j < ny - 2 {
+            Some((n as isize + dj * self.grid.stride() as isize + di) as usize)
+        } else {
+            self.wrap(i + di, j + dj)
+        }
+    }
+
+    /// Mark the obstacles whose cut links see a changed node, rebuild their links, update
+    /// `δ` of the other moved obstacles (in parallel over obstacles), clear the flags.
+    fn finish_update(&mut self) {
+        let changed = std::mem::take(&mut self.scratch.changed);
+        for &n in &changed {
+            let n = n as usize;
+            let ij = self.ij(n);
+            for dj in -2..=2 {
+                for di in -2..=2 {
+                    if let Some(m) = self.offset(n, ij, di, dj) {
+                        let o = self.owner[m];
+                        if o != NONE {
+                            self.scratch.dirty[o as usize] = true;
+                        }
+                    }
+                }
+            }
+        }
+        let mut changed = changed;
+        changed.clear();
+        self.scratch.changed = changed;
+        let tol = self.geometry_tolerance;
+        let work: Vec<LinkWork> = (0..self.obstacles.len())
+            .map(|k| {
+                if self.scratch.dirty[k] {
+                    LinkWork::Rebuild
+                } else if self.scratch.moved[k]
+                    && moved_by(&self.scratch.linked_at[k], &self.obstacles[k].shape) > tol
+                {
+                    LinkWork::Deltas
+                } else {
+                    LinkWork::Keep
+                }
+            })
+            .collect();
+        let mut links = std::mem::take(&mut self.links);
+        {
+            use rayon::prelude::*;
+            let this = &*self;
+            links
+                .par_iter_mut()
+                .zip(work.par_iter())
+                .enumerate()
+                .for_each(|(k, (l, w))| match w {
+                    LinkWork::Rebuild => this.build_links(k, l),
+                    LinkWork::Deltas => this.update_deltas(k, l),
+                    LinkWork::Keep => {}
+                });
+        }
+        self.links = links;
+        for (k, w) in work.iter().enumerate() {
+            if *w != LinkWork::Keep {
+                self.scratch.linked_at[k] = self.obstacles[k].shape;
+            }
+            self.scratch.dirty[k] = false;
+            self.scratch.moved[k] = false;
+        }
+    }
+
+    /// `δ` and the wall point of a link from fluid node at `p` along `a` into obstacle
+    /// `k`.
+    #[inline]
+    fn link_geometry(&self, k: usize, p: [f64; 2], a: usize) -> (f64, [f64; 2]) {
+        let c = cf(a);
+        let delta = self.obstacles[k].shape.entry(p, c);
+        (delta, [p[0] + delta * c[0], p[1] + delta * c[1]])
+    }
+
+    fn update_deltas(&self, k: usize, links: &mut [ObstacleLink]) {
+        let c = self.obstacles[k].shape.center();
+        for l in links {
+            // the centre may have been brought back into the first period
+            l.p = [self.near(0, l.p[0], c[0]), self.near(1, l.p[1], c[1])];
+            (l.delta, l.xw) = self.link_geometry(k, l.p, l.alpha as usize);
+        }
+    }
+
+    fn build_links(&self, k: usize, links: &mut Vec<ObstacleLink>) {
+        links.clear();
+        for &b in &self.solid_nodes[k] {
+            let b = b as usize;
+            let ij = self.ij(b);
+            for a in 1..Q {
+                let (cx, cy) = (C[a][0] as isize, C[a][1] as isize);
+                let Some(xf) = self.offset(b, ij, -cx, -cy) else {
+                    continue;
+                };
+                if self.owner[xf] != NONE {
+                    continue;
+                }
+                let f2 = match self.offset(b, ij, -2 * cx, -2 * cy) {
+                    Some(m) if self.owner[m] == NONE => m as u32,
+                    _ => NONE,
+                };
+                let p = self.position_near(k, xf);
+                let (delta, xw) = self.link_geometry(k, p, a);
+                links.push(ObstacleLink {
+                    node: xf as u32,
+                    alpha: a as u8,
+                    delta,
+                    f2,
+                    xw,
+                    p,
+                });
             }
         }
     }
 
+    /// The cut links of obstacle `k`: fluid node `(i, j)`, direction `α` into the body and
+    /// `δ` (seed eq. 6).
+    pub fn cut_links_of(&self, k: usize) -> impl Iterator<Item = (usize, usize, usize, f64)> + '_ {
+        self.links[k].iter().map(|l| {
+            let (i, j) = self.ij(l.node as usize);
+            (i as usize, j as usize, l.alpha as usize, l.delta)
+        })
+    }
+
     /// Cut links of all obstacles.
     pub fn cut_links(&self) -> usize {
-        self.obstacle_links.len()
+        self.links.iter().map(Vec::len).sum()
+    }
+}
+
+/// Largest displacement of a point of shape `b` from where it was in shape `a` (lattice
+/// units; a rotation counts at the corners of a box).
+fn moved_by(a: &Shape, b: &Shape) -> f64 {
+    let (ca, cb) = (a.center(), b.center());
+    let d = ((ca[0] - cb[0]).powi(2) + (ca[1] - cb[1]).powi(2)).sqrt();
+    match (a, b) {
+        (Shape::Box { angle: x, half, .. }, Shape::Box { angle: y, .. }) => {
+            d + (x - y).abs() * (half[0] * half[0] + half[1] * half[1]).sqrt()
+        }
+        _ => d,
     }
 }

@@ -7,7 +7,12 @@
 //! Mora, Wang & Alonso-Marroquin (2015), eqs. 1–3 and 6–8. Everything here is in lattice
 //! units (`Δx = Δt = 1`, reference density 1); [`Units`] converts from SI. The crate knows
 //! no particles: an obstacle is a [`Shape`] with a velocity and an angular velocity, which a
-//! caller may change before every step ([`Lattice::set_obstacle_motion`]).
+//! caller may change before every step ([`Lattice::set_obstacle_motion`]), or place itself
+//! ([`ObstacleMotion::External`], [`Lattice::place_obstacle`],
+//! [`Lattice::update_obstacles`]: how coupled particles are carried; only what moved is
+//! re-rasterised, and the momentum of covered and uncovered nodes is reported). Mass
+//! sources ([`Lattice::add_source`]) inject fluid (seed §002.6); the temperature lattice
+//! ([`Thermal`]) keeps the books of the heat through the sides and out of each obstacle.
 //!
 //! ```
 //! use porofrac_lbm::{Lattice, LatticeConfig, Obstacle, Shape};
@@ -34,7 +39,7 @@ pub mod units;
 pub use boundary::{MomentumExchange, Side, SideKind};
 pub use collision::{Collision, Rates};
 pub use geometry::Shape;
-pub use lattice::{Lattice, LatticeConfig, MAX_MACH, Obstacle};
+pub use lattice::{Lattice, LatticeConfig, MAX_MACH, Obstacle, ObstacleMotion};
 pub use thermal::{Thermal, ThermalSide};
 pub use units::Units;
 

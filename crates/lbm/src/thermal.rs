@@ -14,9 +14,20 @@
 //! * fixed flux `q` (into the box, lattice units `q Δt/Δx`, temperature times velocity):
 //!   `g_ī(x_f) = g*_i(x_f) + q`, so exactly `q` per link and step enters (0: adiabatic).
 //!
+//! * outflow: zero gradient, `g_ī(x_f) = g*_ī(x_f)` (what the last node sends inwards is
+//!   what comes in: advected heat leaves, nothing is reflected).
+//!
 //! Collision conserves `T` at every node and streaming moves it, so with periodic and
 //! adiabatic sides `Σ T` is constant to round-off, and a flux side adds exactly `q` per link
 //! and step.
+//!
+//! **Bookkeeping.** With `ρ c_p` the same in solid and fluid, the heat of a node is
+//! `ρ c_p Δx² T` per unit depth, and the step balance is exact:
+//! `Σ T(t+1) − Σ T(t) = Σ_sides` [`Thermal::side_heat`] increments. Per obstacle,
+//! [`Thermal::obstacle_heat`] is what left its nodes in the last step towards any node it
+//! does not cover (fluid, another obstacle or a side): for an obstacle that does not move,
+//! `Σ_{its nodes} T` drops by exactly that. A moving obstacle also takes or leaves the
+//! heat of the nodes it covers or uncovers (the heat stays on the lattice).
 
 use rayon::prelude::*;
 
@@ -38,6 +49,8 @@ pub enum ThermalSide {
     Temperature(f64),
     /// Fixed flux into the box (lattice units).
     Flux(f64),
+    /// Zero-gradient outflow.
+    Outflow,
 }
 
 /// The temperature lattice.
@@ -52,6 +65,10 @@ pub struct Thermal {
     /// Populations (padded, node-major).
     g: Vec<[f64; 5]>,
     post: Vec<[f64; 5]>,
+    /// Heat that entered through each side since the start (Σ T units).
+    side_heat: [f64; 4],
+    /// Heat that left each obstacle's nodes in the last step.
+    obstacle_heat: Vec<f64>,
 }
 
 impl Thermal {
@@ -80,6 +97,8 @@ impl Thermal {
             omega_solid: 1.0 / tau_solid,
             g: vec![[0.0; 5]; np],
             post: vec![[0.0; 5]; np],
+            side_heat: [0.0; 4],
+            obstacle_heat: vec![0.0; lat.obstacles().len()],
         };
         for j in 0..ny {
             for i in 0..nx {
@@ -101,6 +120,50 @@ impl Thermal {
         (0..self.ny)
             .map(|j| (0..self.nx).map(|i| self.temperature(i, j)).sum::<f64>())
             .sum()
+    }
+
+    /// Heat that entered through each side `xmin, xmax, ymin, ymax` since the start
+    /// (lattice units: temperature × nodes).
+    pub fn side_heat(&self) -> [f64; 4] {
+        self.side_heat
+    }
+
+    /// Heat that left obstacle `k`'s nodes in the last step (lattice units).
+    pub fn obstacle_heat(&self, k: usize) -> f64 {
+        self.obstacle_heat.get(k).copied().unwrap_or(0.0)
+    }
+
+    /// `Σ T` over the nodes obstacle `k` of `lat` covers.
+    pub fn obstacle_total(&self, lat: &Lattice, k: usize) -> f64 {
+        lat.obstacle_nodes(k)
+            .map(|(i, j)| self.temperature(i, j))
+            .sum()
+    }
+
+    /// Mean temperature of the nodes obstacle `k` of `lat` covers (`None` if it covers none).
+    pub fn obstacle_temperature(&self, lat: &Lattice, k: usize) -> Option<f64> {
+        let n = lat.obstacle_nodes(k).count();
+        (n > 0).then(|| self.obstacle_total(lat, k) / n as f64)
+    }
+
+    /// Mean temperature of every interior node whose centre lies within `radius` of `center`
+    /// (lattice units), or `None` if there is none.
+    pub fn mean_in_disk(&self, center: [f64; 2], radius: f64) -> Option<f64> {
+        let (mut s, mut n) = (0.0, 0usize);
+        let j0 = (center[1] - radius - 0.5).floor().max(0.0) as usize;
+        let j1 = ((center[1] + radius - 0.5).ceil().max(0.0) as usize).min(self.ny - 1);
+        let i0 = (center[0] - radius - 0.5).floor().max(0.0) as usize;
+        let i1 = ((center[0] + radius - 0.5).ceil().max(0.0) as usize).min(self.nx - 1);
+        for j in j0..=j1 {
+            for i in i0..=i1 {
+                let d = [i as f64 + 0.5 - center[0], j as f64 + 0.5 - center[1]];
+                if d[0] * d[0] + d[1] * d[1] <= radius * radius {
+                    s += self.temperature(i, j);
+                    n += 1;
+                }
+            }
+        }
+        (n > 0).then(|| s / n as f64)
     }
 
     /// One step with the velocities of `lat` (call before `lat.step()`, so both use the
@@ -130,6 +193,7 @@ impl Thermal {
                 }
             });
         self.fill_ghosts();
+        self.sum_obstacle_heat(lat);
         let post = &self.post;
         self.g.par_chunks_mut(w).enumerate().for_each(|(jp, row)| {
             if jp == 0 || jp > ny {
@@ -143,6 +207,46 @@ impl Thermal {
                 }
             }
         });
+    }
+
+    /// What leaves each obstacle's nodes in this step towards nodes it does not cover
+    /// (after the ghosts are filled, so a side's incoming population is known).
+    fn sum_obstacle_heat(&mut self, lat: &Lattice) {
+        let n_ob = lat.obstacles().len();
+        self.obstacle_heat.resize(n_ob, 0.0);
+        let (nx, ny) = (self.nx as isize, self.ny as isize);
+        let w = self.nx + 2;
+        for k in 0..n_ob {
+            let mut out = 0.0;
+            for (i, j) in lat.obstacle_nodes(k) {
+                let (i, j) = (i as isize, j as isize);
+                let n = ((j + 1) as usize) * w + (i + 1) as usize;
+                for q in 1..5 {
+                    let (mi, mj) = (i + C5[q][0], j + C5[q][1]);
+                    let wi = if self.periodic[0] {
+                        mi.rem_euclid(nx)
+                    } else {
+                        mi
+                    };
+                    let wj = if self.periodic[1] {
+                        mj.rem_euclid(ny)
+                    } else {
+                        mj
+                    };
+                    if (0..nx).contains(&wi)
+                        && (0..ny).contains(&wj)
+                        && lat.owner(wi as usize, wj as usize) == Some(k)
+                    {
+                        continue;
+                    }
+                    // the neighbour's population towards this node (a ghost on a side holds
+                    // what enters there, periodic or not)
+                    let m = ((mj + 1) as usize) * w + (mi + 1) as usize;
+                    out += self.post[n][q] - self.post[m][OPP5[q]];
+                }
+            }
+            self.obstacle_heat[k] = out;
+        }
     }
 
     /// Ghost populations that stream into the box: periodic copies or the side rules.
@@ -171,11 +275,14 @@ impl Thermal {
                     self.post[idx(across.0, across.1)][q_in]
                 } else {
                     let out = self.post[idx(node.0, node.1)][OPP5[q_in]];
-                    match self.sides[side.index()] {
+                    let v = match self.sides[side.index()] {
                         ThermalSide::Adiabatic => out,
                         ThermalSide::Flux(q) => out + q,
                         ThermalSide::Temperature(t) => -out + 2.0 * W5[q_in] * t,
-                    }
+                        ThermalSide::Outflow => self.post[idx(node.0, node.1)][q_in],
+                    };
+                    self.side_heat[side.index()] += v - out;
+                    v
                 };
                 self.post[g][q_in] = value;
             }

@@ -395,7 +395,6 @@ fn drag_is_galilean_invariant() {
 #[test]
 fn bad_input_is_an_error() {
     assert!(Lattice::new(LatticeConfig::periodic(8, 8, 0.5)).is_err());
-    let mut l = Lattice::new(LatticeConfig::periodic(16, 16, 0.8)).unwrap();
     let outside = Obstacle {
         shape: Shape::Circle {
             center: [1.0, 8.0],
@@ -404,7 +403,20 @@ fn bad_input_is_an_error() {
         velocity: [0.0, 0.0],
         angular_velocity: 0.0,
     };
-    assert!(l.add_obstacle(outside).is_err());
+    // Across a wall it is outside; across a periodic side it wraps.
+    let mut walls = LatticeConfig::periodic(16, 16, 0.8);
+    walls.periodic = [false, true];
+    let mut w = Lattice::new(walls).unwrap();
+    assert_eq!(
+        w.add_obstacle(outside.clone()),
+        Err(porofrac_lbm::LbmError::Outside { obstacle: 0 })
+    );
+    let mut l = Lattice::new(LatticeConfig::periodic(16, 16, 0.8)).unwrap();
+    let wrapped = l.add_obstacle(outside).unwrap();
+    assert!(l.is_solid(15, 8) && l.is_solid(0, 8) && !l.is_solid(3, 8));
+    l.step().unwrap();
+    // at rest in fluid at rest: no force, also across the periodic side
+    assert!(l.force(wrapped)[0].abs() < 1e-12 && l.force(wrapped)[1].abs() < 1e-12);
     let k = l
         .add_obstacle(Obstacle {
             shape: Shape::Circle {

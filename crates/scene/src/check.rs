@@ -300,7 +300,7 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
             }
         }
         "lsm" => {
-            crate::lbm::check::refuse_sections(ls, "lsm")?;
+            // [lbm] and [thermal] are the fluid of a lattice solid scene
             return crate::lsm::check::check(ls);
         }
         "cosserat" => {

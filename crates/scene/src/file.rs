@@ -253,6 +253,8 @@ pub struct SceneFile {
     pub lsm: Option<crate::lsm::file::LsmSection>,
     /// `[loading]` (model `lsm`).
     pub loading: Option<crate::lsm::file::LoadingSection>,
+    /// `[injection]` (model `lsm` with `[lbm]`).
+    pub injection: Option<crate::lsm::fluid::InjectionSection>,
     /// `[lbm]` (lattice Boltzmann model).
     pub lbm: Option<crate::lbm::file::LbmSection>,
     /// `[[obstacle]]` (lattice Boltzmann model).

@@ -231,7 +231,12 @@ fn bad_lbm_scenes_name_the_key() {
             "{POISEUILLE}\n[thermal]\ndiffusivity = 1e-6\n[[thermal.boundary]]\nside = \"ymin\"\n"
         ),
         "thermal.boundary[0].side",
-        "exactly one of temperature and flux",
+        "exactly one of temperature, flux and outflow = true",
+    );
+    refused(
+        &format!("{POISEUILLE}\n[thermal]\ndiffusivity = 1e-6\nparticle_temperature = 80.0\n"),
+        "thermal.particle_temperature",
+        "belongs to model \"lsm\"",
     );
     refused(
         &POISEUILLE.replace("field = \"vx\"", "field = \"temperature\""),

@@ -18,6 +18,12 @@
 //! State that changes (displacements, time) is passed explicitly; the types above are
 //! built once per grid and set of conditions.
 //!
+//! [`particle_fluid`] couples a particle model (any [`particle_fluid::ParticleSolver`]:
+//! the lattice solid model, or free rigid disks) with the lattice Boltzmann fluid and heat
+//! of `porofrac-lbm` (seed 002, §002.6): disks rasterised as moving obstacles every fluid
+//! step, momentum-exchange loads in SI, particles sub-cycled, injection by a mass source,
+//! heat books.
+//!
 //! ```no_run
 //! # use porofrac_sim::*;
 //! # fn run(grid: &porofrac_grid::Grid<2>, law: &dyn porofrac_law::CellLaw<2>) -> Result<()> {
@@ -50,6 +56,7 @@ pub mod laws;
 mod ldlt;
 pub mod linear;
 pub mod ordering;
+pub mod particle_fluid;
 pub mod pattern;
 mod quadrature;
 pub mod solve;

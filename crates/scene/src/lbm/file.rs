@@ -186,6 +186,12 @@ pub struct ThermalSection {
     /// `[[thermal.boundary]]`.
     #[serde(default)]
     pub boundary: Vec<ThermalBoundary>,
+    /// Initial temperature of the particles (model `lsm`; default `initial` at their
+    /// centres).
+    pub particle_temperature: Option<f64>,
+    /// Heat capacity per volume ρ c_p of fluid and particles, J/(m³·K), for the heat books
+    /// (model `lsm`; default 4.18e6).
+    pub heat_capacity: Option<f64>,
 }
 
 /// `[[thermal.boundary]]`.
@@ -198,4 +204,7 @@ pub struct ThermalBoundary {
     pub temperature: Option<f64>,
     /// Fixed flux.
     pub flux: Option<f64>,
+    /// Zero-gradient outflow (advected heat leaves, nothing is reflected).
+    #[serde(default)]
+    pub outflow: bool,
 }

@@ -16,7 +16,7 @@
 
 pub mod check;
 pub mod file;
-mod images;
+pub(crate) mod images;
 mod vti;
 
 use std::collections::BTreeMap;
@@ -58,13 +58,13 @@ pub(crate) fn nodes(l: &LbmSection) -> (f64, f64) {
 
 /// A velocity given as numbers or expressions.
 #[derive(Clone, Debug)]
-enum VelocityExpr {
+pub(crate) enum VelocityExpr {
     Const([f64; 2]),
     Vary([Expr; 2]),
 }
 
 impl VelocityExpr {
-    fn new(v: &[NumOrExpr]) -> Self {
+    pub(crate) fn new(v: &[NumOrExpr]) -> Self {
         let e: Vec<Expr> = v
             .iter()
             .map(|c| match c {
@@ -77,13 +77,13 @@ impl VelocityExpr {
             _ => VelocityExpr::Vary([e[0].clone(), e[1].clone()]),
         }
     }
-    fn at(&self, x: [f64; 2], t: f64) -> [f64; 2] {
+    pub(crate) fn at(&self, x: [f64; 2], t: f64) -> [f64; 2] {
         match self {
             VelocityExpr::Const(v) => *v,
             VelocityExpr::Vary(e) => [e[0].eval(&x, t), e[1].eval(&x, t)],
         }
     }
-    fn varies_in_time(&self) -> bool {
+    pub(crate) fn varies_in_time(&self) -> bool {
         match self {
             VelocityExpr::Const(_) => false,
             VelocityExpr::Vary(e) => e.iter().any(Expr::depends_on_time),
@@ -147,7 +147,47 @@ pub(crate) fn run(
     drive(ls, &mut model, out, observer, start, build_seconds, 2)
 }
 
-fn build(ls: &LoadedScene) -> Result<LbmModel<'_>, RunError> {
+/// The lattice of `[lbm]` without obstacles: units, the SI corner, the lattice and the
+/// velocities of its sides (every model that has a fluid).
+pub(crate) struct LatticeParts {
+    /// The lattice.
+    pub lat: Lattice,
+    /// SI ↔ lattice units.
+    pub units: Units,
+    /// SI position of the lattice corner.
+    pub origin: [f64; 2],
+    /// Sides with a prescribed velocity.
+    pub sides: Vec<(Side, VelocityExpr)>,
+}
+
+/// Set the velocities of `sides` at time `t` (lattice corner at `origin`).
+pub(crate) fn set_side_velocities(
+    lat: &mut Lattice,
+    sides: &[(Side, VelocityExpr)],
+    units: &Units,
+    origin: [f64; 2],
+    t: f64,
+) {
+    let (u, o, dx) = (*units, origin, units.dx);
+    for (side, v) in sides {
+        lat.set_side_velocity(*side, |p| {
+            let w = v.at([o[0] + p[0] * dx, o[1] + p[1] * dx], t);
+            [u.velocity(w[0]), u.velocity(w[1])]
+        });
+    }
+}
+
+fn side_of(s: SideChoice) -> Side {
+    match s {
+        SideChoice::Xmin => Side::XMin,
+        SideChoice::Xmax => Side::XMax,
+        SideChoice::Ymin => Side::YMin,
+        SideChoice::Ymax => Side::YMax,
+    }
+}
+
+/// Build the lattice of a checked `[lbm]`.
+pub(crate) fn lattice_of(ls: &LoadedScene) -> Result<LatticeParts, RunError> {
     let s = &ls.scene;
     let l = s.lbm.as_ref().expect("checked");
     let units = Units::from_viscosity(l.spacing, l.viscosity, l.density, l.tau)
@@ -162,12 +202,6 @@ fn build(ls: &LoadedScene) -> Result<LbmModel<'_>, RunError> {
             AxisChoice::Y => 1,
         }] = true;
     }
-    let side_of = |s: SideChoice| match s {
-        SideChoice::Xmin => Side::XMin,
-        SideChoice::Xmax => Side::XMax,
-        SideChoice::Ymin => Side::YMin,
-        SideChoice::Ymax => Side::YMax,
-    };
     let mut kinds = [SideKind::Wall; 4];
     let mut sides = Vec::new();
     for b in &l.boundary {
@@ -202,7 +236,46 @@ fn build(ls: &LoadedScene) -> Result<LbmModel<'_>, RunError> {
             ExchangeChoice::GalileanInvariant => MomentumExchange::GalileanInvariant,
         },
     };
-    let mut lat = Lattice::new(cfg).map_err(|e| ls.error(&k(&["lbm"]), e))?;
+    let lat = Lattice::new(cfg).map_err(|e| ls.error(&k(&["lbm"]), e))?;
+    Ok(LatticeParts {
+        lat,
+        units,
+        origin,
+        sides,
+    })
+}
+
+/// The thermal side conditions of a checked `[thermal]`.
+pub(crate) fn thermal_sides(t: &file::ThermalSection, units: &Units) -> [ThermalSide; 4] {
+    let mut tsides = [ThermalSide::Adiabatic; 4];
+    for b in &t.boundary {
+        tsides[side_of(b.side).index()] = match (b.temperature, b.flux, b.outflow) {
+            (_, _, true) => ThermalSide::Outflow,
+            (Some(v), _, _) => ThermalSide::Temperature(v),
+            (None, f, _) => ThermalSide::Flux(f.unwrap_or(0.0) * units.dt / units.dx),
+        };
+    }
+    tsides
+}
+
+/// The initial temperature of a checked `[thermal]` (0 if not given).
+pub(crate) fn thermal_initial(t: &file::ThermalSection) -> Expr {
+    match &t.initial {
+        None => Expr::constant(0.0),
+        Some(NumOrExpr::Num(x)) => Expr::constant(*x),
+        Some(NumOrExpr::Expr(e)) => Expr::parse(e).unwrap_or_else(|_| Expr::constant(f64::NAN)),
+    }
+}
+
+fn build(ls: &LoadedScene) -> Result<LbmModel<'_>, RunError> {
+    let s = &ls.scene;
+    let l = s.lbm.as_ref().expect("checked");
+    let LatticeParts {
+        mut lat,
+        units,
+        origin,
+        sides,
+    } = lattice_of(ls)?;
     let mut motions = Vec::new();
     for (i, o) in s.obstacle.iter().enumerate() {
         let shape = match &o.shape {
@@ -240,20 +313,8 @@ fn build(ls: &LoadedScene) -> Result<LbmModel<'_>, RunError> {
     let thermal = match &s.thermal {
         None => None,
         Some(t) => {
-            let mut tsides = [ThermalSide::Adiabatic; 4];
-            for b in &t.boundary {
-                tsides[side_of(b.side).index()] = match (b.temperature, b.flux) {
-                    (Some(v), _) => ThermalSide::Temperature(v),
-                    (None, f) => ThermalSide::Flux(f.unwrap_or(0.0) * units.dt / units.dx),
-                };
-            }
-            let init = match &t.initial {
-                None => Expr::constant(0.0),
-                Some(NumOrExpr::Num(x)) => Expr::constant(*x),
-                Some(NumOrExpr::Expr(e)) => {
-                    Expr::parse(e).unwrap_or_else(|_| Expr::constant(f64::NAN))
-                }
-            };
+            let tsides = thermal_sides(t, &units);
+            let init = thermal_initial(t);
             let tau = thermal_tau(t.diffusivity, &units);
             let tau_s = thermal_tau(t.solid_diffusivity.unwrap_or(t.diffusivity), &units);
             let (dx, o) = (units.dx, origin);
@@ -335,13 +396,7 @@ impl LbmModel<'_> {
     /// Set side and obstacle velocities at time `t` (s).
     fn apply_motion(&mut self, t: f64) -> Result<(), RunError> {
         let u = self.units;
-        for (side, v) in &self.sides {
-            let (o, dx) = (self.origin, u.dx);
-            self.lat.set_side_velocity(*side, |p| {
-                let w = v.at([o[0] + p[0] * dx, o[1] + p[1] * dx], t);
-                [u.velocity(w[0]), u.velocity(w[1])]
-            });
-        }
+        set_side_velocities(&mut self.lat, &self.sides, &u, self.origin, t);
         for (kk, (v, w)) in self.motions.iter().enumerate() {
             let vel = v.as_ref().map_or([0.0, 0.0], |v| v.at([0.0, 0.0], t));
             let omega = w.as_ref().map_or(0.0, |w| w.eval(&[0.0, 0.0], t));

@@ -8,8 +8,9 @@ use porofrac_lsm::{BondLaw, LsmError};
 
 use super::file::{DampingChoice, NormalChoice};
 
-/// Top-level sections of the model (besides `[particles]`, shared with `nscd`).
-pub const SECTIONS: [&str; 4] = ["bonds", "contacts", "lsm", "loading"];
+/// Top-level sections of the model (besides `[particles]`, shared with `nscd`, and
+/// `[lbm]`, `[thermal]`, shared with `lbm`).
+pub const SECTIONS: [&str; 5] = ["bonds", "contacts", "lsm", "loading", "injection"];
 const SHARED: [&str; 5] = ["scene", "schedule", "output", "solver", "particles"];
 const OTHERS: [(&str, &str); 16] = [
     ("wall", "nscd"),
@@ -169,7 +170,10 @@ pub fn bond_law(ls: &LoadedScene) -> Result<BondLaw, SceneError> {
 pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
     let s = &ls.scene;
     for key in top_level(ls) {
-        if SECTIONS.contains(&key.as_str()) || SHARED.contains(&key.as_str()) {
+        if SECTIONS.contains(&key.as_str())
+            || SHARED.contains(&key.as_str())
+            || super::fluid::SECTIONS.contains(&key.as_str())
+        {
             continue;
         }
         let owner = OTHERS
@@ -321,5 +325,6 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
         }
     }
     crate::nscd::check::check_particle_schedule(ls, "lsm")?;
+    super::fluid::check(ls)?;
     crate::nscd::check::check_output_of(ls, "lsm", &CELL_FIELDS, &GLOBAL_FIELDS)
 }

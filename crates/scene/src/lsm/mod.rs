@@ -21,6 +21,7 @@
 
 pub mod check;
 pub mod file;
+pub mod fluid;
 
 use std::cell::RefCell;
 use std::collections::BTreeMap;
@@ -92,6 +93,7 @@ pub struct LsmModel<'a> {
     broken_written: usize,
     history: Vec<[f64; 3]>,
     contacts_pvd: RefCell<Option<PvdWriter>>,
+    fluid: Option<fluid::Fluid>,
 }
 
 fn spec_of(ls: &LoadedScene) -> Result<LsmSpec, SceneError> {
@@ -303,6 +305,7 @@ pub fn build(ls: &LoadedScene) -> Result<LsmModel<'_>, RunError> {
             cells.push(cell);
         }
     }
+    let fluid = fluid::Fluid::build(ls, &solid, dt)?;
     Ok(LsmModel {
         ls,
         solid,
@@ -323,6 +326,7 @@ pub fn build(ls: &LoadedScene) -> Result<LsmModel<'_>, RunError> {
         broken_written: 0,
         history: vec![[0.0; 3]],
         contacts_pvd: RefCell::new(None),
+        fluid,
     })
 }
 
@@ -462,6 +466,9 @@ impl Model for LsmModel<'_> {
         m.insert("bond_updates_per_second".into(), rate(bu).into());
         m.insert("contact_updates_per_second".into(), rate(cu).into());
         m.insert("step_seconds".into(), self.step_seconds.into());
+        if let Some(f) = &self.fluid {
+            f.summary(&mut m);
+        }
         if self.wall.is_some() {
             m.insert("final_pressure".into(), self.pressure.into());
             m.insert(
@@ -492,6 +499,19 @@ impl Model for LsmModel<'_> {
     fn step(&mut self, step: usize) -> Result<StepStats, RunError> {
         if step == 0 {
             return Ok(StepStats::default());
+        }
+        if let Some(f) = &mut self.fluid {
+            let t0 = Instant::now();
+            let n = f.advance(self.ls, &mut self.solid, self.times[step])?;
+            self.step_seconds += t0.elapsed().as_secs_f64();
+            self.lsm_steps += n as u64;
+            self.pressure = f.pressure();
+            let (t, sh) = self.broken_by_mode();
+            self.history.push([self.solid.time(), t as f64, sh as f64]);
+            return Ok(StepStats {
+                iterations: n,
+                failed: self.solid.broken().len(),
+            });
         }
         let h = self.times[step] - self.times[step - 1];
         let n = (h / self.dt).ceil().max(1.0) as usize;
@@ -576,6 +596,9 @@ impl Model for LsmModel<'_> {
     }
 
     fn after_step(&mut self, out: &Path) -> Result<(), RunError> {
+        if let Some(f) = &self.fluid {
+            f.write_csv(out)?;
+        }
         let broken = self.solid.broken();
         if broken.len() == self.broken_written && self.broken_written > 0 {
             return Ok(());
@@ -655,6 +678,9 @@ impl Model for LsmModel<'_> {
             .map(|(p, v)| (p.name.clone(), p.field.clone(), v.clone()))
             .collect();
         crate::nscd::plots::probe_plots(dir, &self.ls.scene.scene.name, written, &probes)?;
+        if let Some(f) = &self.fluid {
+            f.plots(dir, &self.solid)?;
+        }
         let d = self.solid.disks();
         let u: Vec<f64> = (0..d.len())
             .map(|i| {
