@@ -11,6 +11,14 @@ pub enum Shape {
         /// Radius.
         radius: f64,
     },
+    /// The outside of a circle: the wall of an enclosing cylinder, solid everywhere in
+    /// the lattice beyond `radius` from `center` (circular Couette flow, a rotating drum).
+    Hollow {
+        /// Centre.
+        center: [f64; 2],
+        /// Radius of the fluid region.
+        radius: f64,
+    },
     /// A rectangle, possibly rotated.
     Box {
         /// Centre.
@@ -35,14 +43,16 @@ impl Shape {
     /// The reference point (centre) about which the shape rotates.
     pub fn center(&self) -> [f64; 2] {
         match *self {
-            Shape::Circle { center, .. } | Shape::Box { center, .. } => center,
+            Shape::Circle { center, .. }
+            | Shape::Hollow { center, .. }
+            | Shape::Box { center, .. } => center,
         }
     }
 
     /// Translate by `d` and rotate by `dangle` about the centre.
     pub fn advance(&mut self, d: [f64; 2], dangle: f64) {
         match self {
-            Shape::Circle { center, .. } => {
+            Shape::Circle { center, .. } | Shape::Hollow { center, .. } => {
                 center[0] += d[0];
                 center[1] += d[1];
             }
@@ -54,10 +64,10 @@ impl Shape {
         }
     }
 
-    /// Axis-aligned bounding box `[lo, hi]`.
+    /// Axis-aligned bounding box `[lo, hi]` (of the circle for [`Shape::Hollow`]).
     pub fn bounds(&self) -> [[f64; 2]; 2] {
         match *self {
-            Shape::Circle { center, radius } => [
+            Shape::Circle { center, radius } | Shape::Hollow { center, radius } => [
                 [center[0] - radius, center[1] - radius],
                 [center[0] + radius, center[1] + radius],
             ],
@@ -91,6 +101,10 @@ impl Shape {
                 let d = [p[0] - center[0], p[1] - center[1]];
                 d[0] * d[0] + d[1] * d[1] <= radius * radius
             }
+            Shape::Hollow { center, radius } => {
+                let d = [p[0] - center[0], p[1] - center[1]];
+                d[0] * d[0] + d[1] * d[1] >= radius * radius
+            }
             Shape::Box {
                 center,
                 half,
@@ -114,6 +128,15 @@ impl Shape {
                 let c = o[0] * o[0] + o[1] * o[1] - radius * radius;
                 let disc = (b * b - a * c).max(0.0);
                 (-b - disc.sqrt()) / a
+            }
+            Shape::Hollow { center, radius } => {
+                // from inside the circle outwards: the larger root
+                let o = [p[0] - center[0], p[1] - center[1]];
+                let a = d[0] * d[0] + d[1] * d[1];
+                let b = o[0] * d[0] + o[1] * d[1];
+                let c = o[0] * o[0] + o[1] * o[1] - radius * radius;
+                let disc = (b * b - a * c).max(0.0);
+                (-b + disc.sqrt()) / a
             }
             Shape::Box {
                 center,
@@ -162,5 +185,16 @@ mod tests {
         assert!(b.contains([5.9, 6.9]) && !b.contains([6.1, 5.0]));
         let t = b.entry([6.5, 5.5], [-1.0, 0.0]);
         assert!((t - 0.5).abs() < 1e-12);
+        // the outside of a circle: a link from the fluid inside leaves at the surface
+        let h = Shape::Hollow {
+            center: [5.3, 4.1],
+            radius: 2.2,
+        };
+        assert!(!h.contains([5.3, 4.1]) && h.contains([8.0, 4.1]));
+        let p = [7.0, 4.5];
+        let t = h.entry(p, [1.0, 0.0]);
+        let x = p[0] + t - 5.3;
+        assert!(t > 0.0 && t < 1.0);
+        assert!((x * x + 0.4f64.powi(2) - 2.2f64.powi(2)).abs() < 1e-12);
     }
 }

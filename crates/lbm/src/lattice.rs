@@ -372,7 +372,7 @@ impl Lattice {
         let ob = &mut self.obstacles[k];
         let old = ob.shape;
         match &mut ob.shape {
-            Shape::Circle { center: c, .. } => *c = center,
+            Shape::Circle { center: c, .. } | Shape::Hollow { center: c, .. } => *c = center,
             Shape::Box {
                 center: c,
                 angle: a,
@@ -934,10 +934,17 @@ impl Lattice {
     fn raster(&mut self, k: usize) {
         let shape = self.obstacles[k].shape;
         let [lo, hi] = shape.bounds();
-        let i0 = (lo[0] - 0.5).floor() as isize;
-        let j0 = (lo[1] - 0.5).floor() as isize;
-        let i1 = (hi[0] - 0.5).ceil() as isize;
-        let j1 = (hi[1] - 0.5).ceil() as isize;
+        let (i0, j0, i1, j1) = if let Shape::Hollow { .. } = shape {
+            // solid beyond its circle: the whole lattice
+            (0, 0, self.grid.nx as isize - 1, self.grid.ny as isize - 1)
+        } else {
+            (
+                (lo[0] - 0.5).floor() as isize,
+                (lo[1] - 0.5).floor() as isize,
+                (hi[0] - 0.5).ceil() as isize,
+                (hi[1] - 0.5).ceil() as isize,
+            )
+        };
         let mut out = std::mem::take(&mut self.scratch.nodes);
         out.clear();
         let mut margin = 0.0;
