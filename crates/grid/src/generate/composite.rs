@@ -236,39 +236,14 @@ pub fn composite(spec: &CompositeSpec) -> Result<Grid<2>> {
         }
     }
     let fine = |ii: usize, jj: usize| fine_id[jj * (fx + 1) + ii];
-    // Fine lattice index of a coarse lattice point on the zone boundary.
-    let to_fine = |i: usize, j: usize| ((i - i0) * r, (j - j0) * r);
-
-    let mut pos = vec![0usize];
-    let mut cell_nodes: Vec<usize> = Vec::new();
-    for j in 0..ny {
-        for i in 0..nx {
-            if in_zone(i, j) {
-                continue;
-            }
-            let corners = [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)];
-            // Cell across each edge (bottom, right, top, left).
-            let across = [
-                (j > 0).then(|| (i, j - 1)),
-                Some((i + 1, j)),
-                Some((i, j + 1)),
-                (i > 0).then(|| (i - 1, j)),
-            ];
-            for e in 0..4 {
-                let (a, b) = (corners[e], corners[(e + 1) % 4]);
-                cell_nodes.push(coarse_id[a.1 * (nx + 1) + a.0]);
-                if across[e].is_some_and(|(x, y)| x < nx && y < ny && in_zone(x, y)) {
-                    let (fa, fb) = (to_fine(a.0, a.1), to_fine(b.0, b.1));
-                    for k in 1..r {
-                        let ii = (fa.0 * (r - k) + fb.0 * k) / r;
-                        let jj = (fa.1 * (r - k) + fb.1 * k) / r;
-                        cell_nodes.push(fine(ii, jj));
-                    }
-                }
-            }
-            pos.push(cell_nodes.len());
-        }
-    }
+    let (mut pos, mut cell_nodes) = far_field_cells(
+        [nx, ny],
+        [i0, j0],
+        r,
+        in_zone,
+        |i, j| coarse_id[j * (nx + 1) + i],
+        fine,
+    );
     let num_coarse = pos.len() - 1;
     for jj in 0..fy {
         for ii in 0..fx {
@@ -306,6 +281,55 @@ pub fn composite(spec: &CompositeSpec) -> Result<Grid<2>> {
     }
     grid.set_cell_tag(spec.well_tag.clone(), well)?;
     Ok(grid)
+}
+
+/// The coarse far-field quadrilaterals of a composite-style grid: every cell of the
+/// `nx × ny` lattice outside the zone (`in_zone`), counter-clockwise from its lower-left
+/// corner, with the `r − 1` hanging nodes of each edge shared with the zone inserted.
+/// `coarse(i, j)` is the node of coarse lattice point `(i, j)`, `fine(ii, jj)` the node of
+/// zone lattice point `(ii, jj)` counted from the zone corner `(i0, j0)`. Returns the
+/// offsets and the node list of the cells.
+pub(crate) fn far_field_cells(
+    [nx, ny]: [usize; 2],
+    [i0, j0]: [usize; 2],
+    r: usize,
+    in_zone: impl Fn(usize, usize) -> bool,
+    coarse: impl Fn(usize, usize) -> usize,
+    fine: impl Fn(usize, usize) -> usize,
+) -> (Vec<usize>, Vec<usize>) {
+    // Zone lattice index of a coarse lattice point on the zone boundary.
+    let to_fine = |i: usize, j: usize| ((i - i0) * r, (j - j0) * r);
+    let mut pos = vec![0usize];
+    let mut cell_nodes: Vec<usize> = Vec::new();
+    for j in 0..ny {
+        for i in 0..nx {
+            if in_zone(i, j) {
+                continue;
+            }
+            let corners = [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)];
+            // Cell across each edge (bottom, right, top, left).
+            let across = [
+                (j > 0).then(|| (i, j - 1)),
+                Some((i + 1, j)),
+                Some((i, j + 1)),
+                (i > 0).then(|| (i - 1, j)),
+            ];
+            for e in 0..4 {
+                let (a, b) = (corners[e], corners[(e + 1) % 4]);
+                cell_nodes.push(coarse(a.0, a.1));
+                if across[e].is_some_and(|(x, y)| x < nx && y < ny && in_zone(x, y)) {
+                    let (fa, fb) = (to_fine(a.0, a.1), to_fine(b.0, b.1));
+                    for k in 1..r {
+                        let ii = (fa.0 * (r - k) + fb.0 * k) / r;
+                        let jj = (fa.1 * (r - k) + fb.1 * k) / r;
+                        cell_nodes.push(fine(ii, jj));
+                    }
+                }
+            }
+            pos.push(cell_nodes.len());
+        }
+    }
+    (pos, cell_nodes)
 }
 
 #[cfg(test)]

@@ -30,7 +30,7 @@
 use spade::{ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation};
 
 use crate::error::{GridError, Result};
-use crate::generate::composite::{CompositeSpec, REFINED_TAG};
+use crate::generate::composite::{CompositeSpec, REFINED_TAG, far_field_cells};
 use crate::grid::Grid;
 use crate::point::Point;
 
@@ -224,37 +224,14 @@ pub fn round_well(spec: &RoundWellSpec) -> Result<Grid<2>> {
         ring_id[jj * (fx + 1) + ii] = id;
         ring.push(id);
     }
-    let to_fine = |i: usize, j: usize| ((i - i0) * r, (j - j0) * r);
-
-    let mut pos = vec![0usize];
-    let mut cell_nodes: Vec<usize> = Vec::new();
-    for j in 0..ny {
-        for i in 0..nx {
-            if in_zone(i, j) {
-                continue;
-            }
-            let corners = [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)];
-            let across = [
-                (j > 0).then(|| (i, j - 1)),
-                Some((i + 1, j)),
-                Some((i, j + 1)),
-                (i > 0).then(|| (i - 1, j)),
-            ];
-            for e in 0..4 {
-                let (a, b) = (corners[e], corners[(e + 1) % 4]);
-                cell_nodes.push(coarse_id[a.1 * (nx + 1) + a.0]);
-                if across[e].is_some_and(|(x, y)| x < nx && y < ny && in_zone(x, y)) {
-                    let (fa, fb) = (to_fine(a.0, a.1), to_fine(b.0, b.1));
-                    for k in 1..r {
-                        let ii = (fa.0 * (r - k) + fb.0 * k) / r;
-                        let jj = (fa.1 * (r - k) + fb.1 * k) / r;
-                        cell_nodes.push(ring_id[jj * (fx + 1) + ii]);
-                    }
-                }
-            }
-            pos.push(cell_nodes.len());
-        }
-    }
+    let (mut pos, mut cell_nodes) = far_field_cells(
+        [nx, ny],
+        [i0, j0],
+        r,
+        in_zone,
+        |i, j| coarse_id[j * (nx + 1) + i],
+        |ii, jj| ring_id[jj * (fx + 1) + ii],
+    );
     let num_coarse = pos.len() - 1;
 
     // The zone: constrained Delaunay triangulation of the ring and the well polygon.
