@@ -69,6 +69,29 @@ pub struct LatticeConfig {
     pub accel: [f64; 2],
     /// Force summation on obstacles.
     pub momentum_exchange: MomentumExchange,
+    /// Whether the obstacle rules are corrected to create no mass.
+    pub obstacle_mass: ObstacleMass,
+}
+
+/// The mass balance of the obstacle rules.
+///
+/// The interpolated bounce-back (seed eq. 7) does not conserve mass: what it returns
+/// along the cut links of a body differs from what arrived, by an amount that depends on
+/// the flow next to the wall. Against a body at rest in a symmetric flow it cancels; at a
+/// turning wall it does not (a disk of radius 6 turning at 0.02 spacings per step in a
+/// closed 28² box gains 0.3 % of the fluid's mass in 5 000 steps), so the pressure drifts
+/// and the flow never settles. A rigid surface lets no net mass through, so with
+/// [`ObstacleMass::Conserved`] each body's imbalance of the step, `Σ_links (back − into)`,
+/// is taken back from its returned populations in proportion to the link weights `w_α`
+/// (the correction of the mass-conserving curved-boundary schemes, e.g. Bao, Yuan & Schaefer
+/// 2008). Covering and refilling nodes as a body moves are booked separately.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ObstacleMass {
+    /// Each body's cut links create no mass (default).
+    #[default]
+    Conserved,
+    /// The rules as they are.
+    Uncorrected,
 }
 
 impl LatticeConfig {
@@ -83,6 +106,7 @@ impl LatticeConfig {
             sides: [SideKind::Wall; 4],
             accel: [0.0, 0.0],
             momentum_exchange: MomentumExchange::Standard,
+            obstacle_mass: ObstacleMass::Conserved,
         }
     }
 }
@@ -795,6 +819,7 @@ impl Lattice {
         use rayon::prelude::*;
         let (g, lay) = (self.grid, self.layout);
         let gi = self.cfg.momentum_exchange == MomentumExchange::GalileanInvariant;
+        let conserve = self.cfg.obstacle_mass == ObstacleMass::Conserved;
         let mut backs = std::mem::take(&mut self.backs);
         backs.resize_with(self.links.len(), Vec::new);
         let pop = &self.pop;
@@ -809,6 +834,8 @@ impl Lattice {
                 let c = ob.shape.center();
                 let mut f = [0.0; 3];
                 back_k.clear();
+                // what the rules return, and the mass they create: Σ (back − into)
+                let (mut gained, mut weights) = (0.0, 0.0);
                 for l in links {
                     let a = l.alpha as usize;
                     let i = OPP[a];
@@ -827,7 +854,24 @@ impl Lattice {
                             - wall)
                             / (1.0 + d)
                     };
+                    gained += back - into;
+                    weights += W[a];
                     back_k.push(back);
+                }
+                if conserve && weights > 0.0 {
+                    // no net flux through a rigid surface: the mass the rules created
+                    // goes back, shared by the links in proportion to their weights
+                    let per_weight = gained / weights;
+                    for (l, back) in links.iter().zip(back_k.iter_mut()) {
+                        *back -= per_weight * W[l.alpha as usize];
+                    }
+                }
+                for (l, &back) in links.iter().zip(back_k.iter()) {
+                    let a = l.alpha as usize;
+                    let xf = l.node as usize;
+                    let uw = ob.velocity_at(l.xw);
+                    let ca = cf(a);
+                    let into = pop[g.loc(lay, g.shift(xf, a), a)];
                     // the reference density's share, 2 w_α ρ₀ c_α: only gauge pressure
                     // loads the body (zero for a body wetted all round)
                     let amb = 2.0 * W[a];

@@ -39,7 +39,7 @@ pub mod units;
 pub use boundary::{MomentumExchange, Side, SideKind};
 pub use collision::{Collision, Rates};
 pub use geometry::Shape;
-pub use lattice::{Lattice, LatticeConfig, MAX_MACH, Obstacle, ObstacleMotion};
+pub use lattice::{Lattice, LatticeConfig, MAX_MACH, Obstacle, ObstacleMass, ObstacleMotion};
 pub use thermal::{Thermal, ThermalSide};
 pub use units::Units;
 

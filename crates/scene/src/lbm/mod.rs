@@ -235,6 +235,7 @@ pub(crate) fn lattice_of(ls: &LoadedScene) -> Result<LatticeParts, RunError> {
             ExchangeChoice::Standard => MomentumExchange::Standard,
             ExchangeChoice::GalileanInvariant => MomentumExchange::GalileanInvariant,
         },
+        obstacle_mass: porofrac_lbm::ObstacleMass::Conserved,
     };
     let lat = Lattice::new(cfg).map_err(|e| ls.error(&k(&["lbm"]), e))?;
     Ok(LatticeParts {
