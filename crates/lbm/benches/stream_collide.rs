@@ -1,7 +1,9 @@
 //! One fused stream–collide step on a periodic D2Q9 lattice: in-place AA streaming against
 //! the two-array push kernel, from cache-resident to memory-bound sizes; `lattice_step` is
 //! the whole `Lattice::step` (kernel and periodic copies); `memory/copy_256MB` the copy
-//! bandwidth of the machine for comparison.
+//! bandwidth of the machine for comparison, and `memory/update_256MB` the bandwidth of the
+//! AA kernel's own traffic pattern (each 8-byte value read and written back in place, no
+//! write-allocate), on the rayon pool's threads (`RAYON_NUM_THREADS`).
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use porofrac_lbm::d2q9::{Q, feq};
@@ -51,6 +53,14 @@ fn bench(c: &mut Criterion) {
     let mut dst = vec![0.0f64; n];
     group.throughput(Throughput::Bytes((16 * n) as u64));
     group.bench_function("copy_256MB", |b| b.iter(|| dst.copy_from_slice(&src)));
+    // In place, like AA streaming: 16 bytes per value (read + write of the same line).
+    group.bench_function("update_256MB", |b| {
+        use rayon::prelude::*;
+        b.iter(|| {
+            dst.par_chunks_mut(1 << 16)
+                .for_each(|c| c.iter_mut().for_each(|v| *v = 0.5 * *v + 1.0))
+        })
+    });
     group.finish();
 }
 

@@ -21,6 +21,10 @@
 //!   `L(x_f, ᾱ) = [(1−δ) L(x_f, α) + δ L(x_b, α) + δ L(x_f2, ᾱ) − 6 w_α ρ₀ c_α·u_w]/(1+δ)`
 //!   with `x_f2 = x_f − c_α`; where `x_f2` is not fluid, the plain moving bounce-back
 //!   `L(x_f, ᾱ) = L(x_b, α) − 6 w_α ρ₀ c_α·u_w`.
+//!   The interpolation does not conserve mass; with
+//!   [`ObstacleMass::Conserved`](crate::ObstacleMass) (default) each body's imbalance
+//!   `m = Σ [L(x_f, ᾱ) − L(x_b, α)]` over its cut links is removed again,
+//!   `L(x_f, ᾱ) −= m w_α / Σ w_α`, before the force is summed.
 //! * **Force** (seed eq. 8, momentum exchange per cut link):
 //!   `ΔF = c_α [L(x_b, α) + L(x_f, ᾱ) − 2 w_α ρ₀]` (gauge: the reference density's share
 //!   cancels over a body wetted all round, see [`crate::lattice`]), or with the Galilean-invariant correction of
