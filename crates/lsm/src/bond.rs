@@ -140,6 +140,12 @@ impl Bond {
     /// The breakage test of [`crate::law`]: `Some(mode)` if the bond breaks under `f`.
     #[inline]
     pub fn breaks(&self, f: &BondForce, law: &BondLaw) -> Option<BreakMode> {
+        self.breaks_with(f, law.friction_angle.tan())
+    }
+
+    /// [`Self::breaks`] with `tan φ` given (computed once per step, not once per bond).
+    #[inline]
+    pub(crate) fn breaks_with(&self, f: &BondForce, tan_phi: f64) -> Option<BreakMode> {
         let bend = if self.m_max.is_finite() {
             f.mb.abs() / self.m_max
         } else {
@@ -148,7 +154,7 @@ impl Bond {
         if f.fn_ / self.f_tensile + bend > 1.0 {
             return Some(BreakMode::Tensile);
         }
-        if f.fs.abs() > self.f_cohesion - f.fn_ * law.friction_angle.tan() {
+        if f.fs.abs() > self.f_cohesion - f.fn_ * tan_phi {
             return Some(BreakMode::Shear);
         }
         None

@@ -539,10 +539,11 @@ impl LatticeSolid {
         let disks = &self.disks;
         let dx = &self.dx;
         let law = self.spec.bonds;
+        let tan_phi = law.friction_angle.tan();
         let kernel = |(b, (f, brk)): (&mut Bond, (&mut BondForce, &mut Option<BreakMode>))| {
             if b.intact {
                 *f = b.update(disks, dx, &law);
-                *brk = b.breaks(f, &law);
+                *brk = b.breaks_with(f, tan_phi);
             } else {
                 *f = BondForce::default();
                 *brk = None;

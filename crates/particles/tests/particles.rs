@@ -120,21 +120,62 @@ fn tracked_cell_stress_and_fabric() {
     assert_eq!(s.dilation_x, 1.0);
 }
 
+/// The values of the binary `DataArray` `name` of a `.vtp` text: the `UInt64` byte count
+/// checked against the payload, then the little-endian values.
+fn vtp_array(text: &str, name: &str) -> Vec<[u8; 8]> {
+    use base64::Engine as _;
+    let tag = format!("Name=\"{name}\"");
+    let at = text.find(&tag).unwrap_or_else(|| panic!("{name} missing"));
+    let body = &text[at..];
+    let body = &body[body.find('>').unwrap() + 1..body.find("</DataArray>").unwrap()];
+    let bytes = base64::engine::general_purpose::STANDARD
+        .decode(body.trim())
+        .unwrap();
+    let count = u64::from_le_bytes(bytes[..8].try_into().unwrap()) as usize;
+    assert_eq!(count, bytes.len() - 8, "{name}: byte count header");
+    bytes[8..]
+        .chunks_exact(8)
+        .map(|c| c.try_into().unwrap())
+        .collect()
+}
+
 #[test]
 fn vtk_files_are_written() {
     let dir = std::env::temp_dir().join(format!("porofrac-particles-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let d = Disks::new(&[[0.0, 0.0], [1.0, 0.0]], &[0.5, 0.5], 1000.0).unwrap();
+    let mut d = Disks::new(&[[0.0, 0.0], [1.0, 0.0]], &[0.5, 0.25], 1000.0).unwrap();
+    d.v[1] = [0.125, -3.5];
     vtk::write_particles(&dir.join("p.vtp"), &d).unwrap();
     let text = std::fs::read_to_string(dir.join("p.vtp")).unwrap();
     for name in ["radius", "velocity", "omega", "displacement", "id"] {
         assert!(text.contains(&format!("Name=\"{name}\"")), "{name}");
     }
-    vtk::write_contacts(&dir.join("c.vtp"), &[vtk::ContactLine::default()]).unwrap();
+    let f = |v: Vec<[u8; 8]>| v.into_iter().map(f64::from_le_bytes).collect::<Vec<_>>();
+    let i = |v: Vec<[u8; 8]>| v.into_iter().map(i64::from_le_bytes).collect::<Vec<_>>();
+    assert_eq!(f(vtp_array(&text, "radius")), [0.5, 0.25]);
+    assert_eq!(
+        f(vtp_array(&text, "velocity")),
+        [0.0, 0.0, 0.0, 0.125, -3.5, 0.0]
+    );
+    assert_eq!(
+        f(vtp_array(&text, "Points")),
+        [0.0, 0.0, 0.0, 1.0, 0.0, 0.0]
+    );
+    assert_eq!(i(vtp_array(&text, "offsets")), [1, 2]);
+    let line = vtk::ContactLine {
+        a: [0.0, 1.0],
+        b: [2.0, 3.0],
+        normal_force: 7.5,
+        tangential_force: -1.0,
+        bonded: true,
+    };
+    vtk::write_contacts(&dir.join("c.vtp"), &[line, vtk::ContactLine::default()]).unwrap();
     let text = std::fs::read_to_string(dir.join("c.vtp")).unwrap();
-    for name in ["normal_force", "tangential_force", "bonded"] {
-        assert!(text.contains(&format!("Name=\"{name}\"")), "{name}");
-    }
+    assert_eq!(f(vtp_array(&text, "normal_force")), [7.5, 0.0]);
+    assert_eq!(f(vtp_array(&text, "tangential_force")), [-1.0, 0.0]);
+    assert_eq!(i(vtp_array(&text, "bonded")), [1, 0]);
+    assert_eq!(i(vtp_array(&text, "connectivity")), [0, 1, 2, 3]);
+    assert_eq!(i(vtp_array(&text, "offsets")), [2, 4]);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
