@@ -74,9 +74,9 @@ fn array(
         Kind::Float64 => "Float64",
         Kind::Int64 => "Int64",
     };
-    write!(
+    writeln!(
         w,
-        "<DataArray type=\"{ty}\" Name=\"{name}\" NumberOfComponents=\"{comps}\" format=\"binary\">\n"
+        "<DataArray type=\"{ty}\" Name=\"{name}\" NumberOfComponents=\"{comps}\" format=\"binary\">"
     )?;
     {
         // values gathered in blocks: the encoder is fast on long writes only
@@ -105,9 +105,9 @@ fn array(
 
 /// The file's opening up to the `Piece` element.
 fn header(w: &mut impl Write, piece: &str) -> std::io::Result<()> {
-    write!(
+    writeln!(
         w,
-        "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<PolyData>\n{piece}\n"
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<PolyData>\n{piece}"
     )
 }
 
