@@ -45,7 +45,7 @@ pub fn limit_angle(
     band: f64,
 ) -> Option<LimitAngle> {
     let top = x.iter().map(|p| p[1]).fold(f64::NEG_INFINITY, f64::max);
-    if !(band > 0.0) || !(top > y0) {
+    if !(band > 0.0 && top > y0) {
         return None;
     }
     let bands = ((top - y0) / band).ceil() as usize;

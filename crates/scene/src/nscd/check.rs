@@ -209,7 +209,7 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
             for v in f.tip {
                 finite(ls, &key("tip"), v)?;
             }
-            if !(f.dip > 0.0 && f.dip < 90.0) {
+            if !(f64::MIN_POSITIVE..90.0).contains(&f.dip) {
                 return Err(ls.error(
                     &key("dip"),
                     format!("= {} must be in (0, 90) degrees", f.dip),
@@ -227,7 +227,7 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
                 positive(ls, &key("velocity_window"), w)?;
             }
             if let Some(h) = f.half_apex
-                && !(h > 0.0 && h < 90.0)
+                && !(f64::MIN_POSITIVE..90.0).contains(&h)
             {
                 return Err(ls.error(
                     &key("half_apex"),

@@ -72,7 +72,7 @@ impl FaultProbe {
         let inside: Vec<usize> = (0..d.len())
             .filter(|&i| {
                 let p = d.x[i];
-                p[0] >= a[0] && p[0] <= b[0] && p[1] >= a[1] && p[1] <= b[1]
+                (a[0]..=b[0]).contains(&p[0]) && (a[1]..=b[1]).contains(&p[1])
             })
             .collect();
         let x: Vec<[f64; 2]> = inside.iter().map(|&i| d.x[i]).collect();
