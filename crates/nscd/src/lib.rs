@@ -13,7 +13,8 @@
 //! * [`solver`]: the θ-scheme on velocities (eq. 3) and the non-linear Gauss–Seidel
 //!   sweeps over the contacts (eq. 5, Table 1) with body-velocity accumulation, warm
 //!   start and the convergence test;
-//! * [`colour`]: the coloured parallel sweep (deterministic for any thread count).
+//! * [`colour`]: the coloured parallel sweep (deterministic for any thread count);
+//! * [`settle`]: gravity settling of a sample before its loading.
 //!
 //! Disks are [`porofrac_particles::Disks`]; a disk of infinite mass (or inertia) does
 //! not move (or rotate).
@@ -22,10 +23,12 @@ pub mod body;
 pub mod colour;
 pub mod detect;
 pub mod law;
+pub mod settle;
 pub mod solver;
 
 pub use body::{Axis, RigidBody};
 pub use law::ContactLaw;
+pub use settle::{SettleParams, SettleStats};
 pub use solver::{Nscd, Ordering, SolverParams, StepStats};
 
 /// Anything that stops an NSCD computation. Each variant names the parameter,
@@ -80,5 +83,17 @@ pub enum NscdError {
         distance: f64,
         /// Its radius (m).
         radius: f64,
+    },
+    /// Gravity settling did not reach its kinetic-energy criterion.
+    #[error(
+        "settling not finished after {steps} steps: kinetic energy {kinetic:.3e} J/m against {released:.3e} J/m of potential energy released"
+    )]
+    NotSettled {
+        /// Steps taken.
+        steps: usize,
+        /// Kinetic energy at the end (J per metre).
+        kinetic: f64,
+        /// Potential energy released (J per metre).
+        released: f64,
     },
 }

@@ -18,6 +18,7 @@
 
 pub mod cells;
 pub mod disks;
+pub mod fault;
 pub mod packing;
 pub mod rng;
 pub mod tracked;

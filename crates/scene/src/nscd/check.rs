@@ -190,6 +190,54 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
                 finite(ls, &key("gravity"), v)?;
             }
         }
+        if let Some(r) = n.settle_ratio {
+            positive(ls, &key("settle_ratio"), r)?;
+        }
+        if let Some(d) = n.settle_dt {
+            positive(ls, &key("settle_dt"), d)?;
+        }
+        if let Some(m) = n.settle_max_steps
+            && !(1..=100_000_000).contains(&m)
+        {
+            return Err(ls.error(
+                &key("settle_max_steps"),
+                format!("= {m} must be in 1..=1e8"),
+            ));
+        }
+        if let Some(f) = &n.fault {
+            let key = |f: &str| k(&["nscd", "fault", f]);
+            for v in f.tip {
+                finite(ls, &key("tip"), v)?;
+            }
+            if !(f64::MIN_POSITIVE..90.0).contains(&f.dip) {
+                return Err(ls.error(
+                    &key("dip"),
+                    format!("= {} must be in (0, 90) degrees", f.dip),
+                ));
+            }
+            positive(ls, &key("slip_rate"), f.slip_rate)?;
+            let [a, b] = f.window;
+            if !(a.iter().chain(&b).all(|v| v.is_finite()) && b[0] > a[0] && b[1] > a[1]) {
+                return Err(ls.error(
+                    &key("window"),
+                    "must be [[x0, y0], [x1, y1]] with x1 > x0 and y1 > y0",
+                ));
+            }
+            if let Some(w) = f.velocity_window {
+                positive(ls, &key("velocity_window"), w)?;
+            }
+            if let Some(h) = f.half_apex
+                && !(f64::MIN_POSITIVE..90.0).contains(&h)
+            {
+                return Err(ls.error(
+                    &key("half_apex"),
+                    format!("= {h} must be in (0, 90) degrees"),
+                ));
+            }
+            if let Some(b) = f.band {
+                positive(ls, &key("band"), b)?;
+            }
+        }
     }
     check_particle_schedule(ls, "nscd")?;
     check_output_of(ls, "nscd", &CELL_FIELDS, &[])

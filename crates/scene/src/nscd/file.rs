@@ -85,4 +85,37 @@ pub struct NscdSection {
     pub ordering_seed: Option<u64>,
     /// Gravity (m/s², default `[0, -9.81]`).
     pub gravity: Option<[f64; 2]>,
+    /// Gravity settling before the loading: stop when the kinetic energy is below this
+    /// fraction of the potential energy released (SEEDS 003.6: 1e-6). No settling when
+    /// absent.
+    pub settle_ratio: Option<f64>,
+    /// Most settling steps (default 20 000); reaching it is an error.
+    pub settle_max_steps: Option<i64>,
+    /// Settling step (s, default the schedule's `dt`).
+    pub settle_dt: Option<f64>,
+    /// `[nscd.fault]`: measures of a fault-propagation experiment in `summary.json`.
+    pub fault: Option<FaultSection>,
+}
+
+/// `[nscd.fault]`: the basement fault of a fault-propagation experiment (seed 003, F2),
+/// for the measures written to `summary.json` at the end of the run
+/// ([`porofrac_particles::fault`]): the limit angle θ_l, the run-out, and the trishear
+/// L2 mismatch of the particle velocities.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FaultSection {
+    /// The fault tip at t = 0 (the moving block's upper corner, m).
+    pub tip: [f64; 2],
+    /// Dip of the fault (degrees, in (0, 90)); the hanging wall moves up along it.
+    pub dip: f64,
+    /// Slip rate of the hanging wall along the fault (m/s).
+    pub slip_rate: f64,
+    /// The particles measured: current centres in `[[x0, y0], [x1, y1]]` (m).
+    pub window: [[f64; 2]; 2],
+    /// Particle velocities are averaged over this last part of the run (s, default 1).
+    pub velocity_window: Option<f64>,
+    /// Half apical angle of the analytic trishear zone (degrees); default: fitted.
+    pub half_apex: Option<f64>,
+    /// Band height of the limit-angle measure (m, default 4 × the largest radius).
+    pub band: Option<f64>,
 }

@@ -16,6 +16,7 @@
 //! - *plots* ([`plots`]): probe series and the disks coloured by initial layer.
 
 pub mod check;
+pub mod fault;
 pub mod file;
 pub mod plots;
 
@@ -79,6 +80,8 @@ pub struct NscdModel<'a> {
     stats: RunStats,
     step_seconds: f64,
     contacts_pvd: RefCell<Option<PvdWriter>>,
+    settling: Option<(porofrac_nscd::SettleStats, f64)>,
+    fault: Option<fault::FaultProbe>,
 }
 
 fn scene_error(ls: &LoadedScene, e: &NscdError) -> RunError {
@@ -92,6 +95,7 @@ fn scene_error(ls: &LoadedScene, e: &NscdError) -> RunError {
         },
         NscdError::BadBody { index, .. } => ki("wall", *index, &[]),
         NscdError::Particles(_) | NscdError::InitialOverlap { .. } => k(&["particles"]),
+        NscdError::NotSettled { .. } => k(&["nscd", "settle_max_steps"]),
         NscdError::StepTooLarge { .. } => k(&[
             "schedule",
             if ls.scene.schedule.as_ref().is_some_and(|s| s.dt.is_some()) {
@@ -158,10 +162,29 @@ pub fn build(ls: &LoadedScene) -> Result<NscdModel<'_>, RunError> {
         },
     };
     let gravity = n.gravity.unwrap_or([0.0, -9.81]);
-    let sys = Nscd::new(disks, walls(ls), law, params, gravity).map_err(|e| scene_error(ls, &e))?;
+    let mut sys =
+        Nscd::new(disks, walls(ls), law, params, gravity).map_err(|e| scene_error(ls, &e))?;
     let sch = s.schedule.as_ref().expect("checked: [schedule] present");
     let steps = step_count(sch) as usize;
     let dt = sch.dt.unwrap_or(sch.end_time / steps as f64);
+    let settling = match n.settle_ratio {
+        Some(ratio) => {
+            let t0 = Instant::now();
+            let st = sys
+                .settle(porofrac_nscd::SettleParams {
+                    dt: n.settle_dt.unwrap_or(dt),
+                    ratio,
+                    max_steps: n.settle_max_steps.map_or(20_000, |m| m as usize),
+                })
+                .map_err(|e| scene_error(ls, &e))?;
+            Some((st, t0.elapsed().as_secs_f64()))
+        }
+        None => None,
+    };
+    let fault = n
+        .fault
+        .as_ref()
+        .map(|f| fault::FaultProbe::new(f, &sys, sch.end_time));
     let times: Vec<f64> = (0..=steps)
         .map(|i| {
             if i == steps {
@@ -211,6 +234,8 @@ pub fn build(ls: &LoadedScene) -> Result<NscdModel<'_>, RunError> {
         stats: RunStats::default(),
         step_seconds: 0.0,
         contacts_pvd: RefCell::new(None),
+        settling,
+        fault,
     })
 }
 
@@ -262,6 +287,25 @@ impl NscdModel<'_> {
             ("contact_updates", st.updates.into()),
             ("contact_updates_per_second", rate.into()),
             ("nlgs_seconds", st.solve_seconds.into()),
+            (
+                "settling",
+                match &self.settling {
+                    Some((s, secs)) => serde_json::json!({
+                        "steps": s.steps,
+                        "kinetic_energy": s.kinetic,
+                        "potential_energy_released": s.released,
+                        "sweeps": s.sweeps,
+                        "seconds": secs,
+                    }),
+                    None => serde_json::Value::Null,
+                },
+            ),
+            (
+                "fault",
+                self.fault
+                    .as_ref()
+                    .map_or(serde_json::Value::Null, |f| f.measure(&self.sys)),
+            ),
         ]
     }
 }
@@ -296,6 +340,9 @@ impl Model for NscdModel<'_> {
         r.updates += st.updates;
         r.solve_seconds += st.solve_seconds;
         r.max_contacts = r.max_contacts.max(st.contacts);
+        if let Some(f) = &mut self.fault {
+            f.after_step(&self.sys);
+        }
         Ok(StepStats {
             iterations: st.sweeps,
             failed: 0,
