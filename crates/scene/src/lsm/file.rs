@@ -92,6 +92,9 @@ pub struct LsmSection {
     pub damping_coefficient: Option<f64>,
     /// Gravity (m/s², default `[0, 0]`).
     pub gravity: Option<[f64; 2]>,
+    /// With `[lbm]`: the fluid sees every disk enlarged by the bond tolerance, so the
+    /// gap of a bonded pair holds no fluid (default false).
+    pub seal_bonds: Option<bool>,
 }
 
 /// `[loading] platens`: the particles within `thickness` of the top and of the bottom

@@ -19,7 +19,7 @@ use serde::Deserialize;
 use porofrac_lbm::Lattice;
 use porofrac_lsm::LatticeSolid;
 use porofrac_sim::particle_fluid::{
-    CouplingError, CouplingOptions, InjectionControl, ParticleFluid, ThermalSetup,
+    CouplingError, CouplingOptions, InjectionControl, LoadAveraging, ParticleFluid, ThermalSetup,
 };
 
 use crate::check::{LoadedScene, SceneError, k};
@@ -68,6 +68,12 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
             if set {
                 return Err(ls.error(&k(&[name]), "needs [lbm]: the fluid that carries it"));
             }
+        }
+        if s.lsm.as_ref().is_some_and(|l| l.seal_bonds.is_some()) {
+            return Err(ls.error(
+                &k(&["lsm", "seal_bonds"]),
+                "needs [lbm]: it sets what the fluid sees",
+            ));
         }
         return Ok(());
     };
@@ -211,6 +217,12 @@ impl Fluid {
                 .as_ref()
                 .and_then(|t| t.heat_capacity)
                 .unwrap_or(CouplingOptions::default().heat_capacity),
+            loads: LoadAveraging::TwoSteps,
+            fluid_radius_factor: if s.lsm.as_ref().and_then(|l| l.seal_bonds) == Some(true) {
+                1.0 + s.bonds.as_ref().and_then(|b| b.tolerance).unwrap_or(0.05)
+            } else {
+                1.0
+            },
             ..CouplingOptions::default()
         };
         let mut pf = ParticleFluid::new(solid, lat, units, origin, options)
@@ -367,6 +379,8 @@ impl Fluid {
                 "pressure_unit": u.pressure_si(2.0),
                 "fluid_seconds": st.fluid_seconds,
                 "particle_seconds": st.particle_seconds,
+                "particle_share": st.particle_seconds
+                    / (st.fluid_seconds + st.particle_seconds).max(1e-300),
             }),
         );
         if let Some(inj) = self.pf.injection() {

@@ -17,7 +17,22 @@
 //! 6. **Particles**: `n_sub = ⌈Δt / Δt_p⌉` sub-steps of `Δt/n_sub`, `Δt_p` the
 //!    particles' stable step ([`ParticleSolver::stable_dt`]), with the loads of step 5
 //!    held constant (their time average over the lattice step is the step's momentum
-//!    transfer divided by `Δt`).
+//!    transfer divided by `Δt`), or with [`LoadAveraging::TwoSteps`] the mean of the
+//!    loads of this step and the previous one.
+//!
+//! **Stability of the explicit exchange.** The loads of step 5 answer the wall velocity
+//! of step 1 one lattice step late. For the small, light disks of a bonded rock
+//! (radius 3 Δx, `ρ_s/ρ_f = 2.6`) this feedback has a mode that flips sign every lattice
+//! step and grows by about 1.4 % per step from round-off, in fluid at rest: a rock of
+//! 30 disks in still fluid reaches Mach 0.3 after about 2 700 steps, with or without
+//! local damping, without any bond oscillation involved (it vanishes at 4× the solid
+//! density). Taking the wall velocity as the mean of the previous sub-steps slows it
+//! (growth ≈ 0.4 % per step) but does not remove it. Averaging the loads of two
+//! consecutive steps ([`LoadAveraging::TwoSteps`]) cancels the flipping part of the
+//! feedback exactly and keeps the slow part (a delay of half a step): the same rock stays
+//! at round-off. The half of the last step's load not yet given to the particles is
+//! [`ParticleFluid::pending_impulse`]; with it fluid plus particles still conserve
+//! momentum to round-off.
 //!
 //! **Momentum.** With the standard momentum exchange the fluid loses exactly what the
 //! particles gain in steps 1 and 5, so fluid plus particles conserve momentum to
@@ -123,6 +138,23 @@ pub struct CouplingOptions {
     /// Heat capacity per volume `ρ c_p` of fluid and solid (J/(m³·K); default 4.18e6,
     /// water).
     pub heat_capacity: f64,
+    /// Loads given to the particles (default: those of the step).
+    pub loads: LoadAveraging,
+    /// The fluid sees disk `i` with radius `fluid_radius_factor · R_i` (default 1; the
+    /// resolution rule applies to `R_i`). Above 1 the gaps of bonded disks closer than
+    /// that hold no fluid (a cemented, impermeable contact).
+    pub fluid_radius_factor: f64,
+}
+
+/// The fluid loads given to the particles during a lattice step.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LoadAveraging {
+    /// The loads of this step.
+    #[default]
+    Step,
+    /// The mean of the loads of this step and of the previous one (see the module docs:
+    /// cancels the sign-flipping mode of the explicit exchange).
+    TwoSteps,
 }
 
 impl Default for CouplingOptions {
@@ -131,6 +163,8 @@ impl Default for CouplingOptions {
             min_radius_nodes: 2.0,
             particle_dt_fraction: 1.0,
             heat_capacity: 4.18e6,
+            loads: LoadAveraging::Step,
+            fluid_radius_factor: 1.0,
         }
     }
 }
@@ -204,6 +238,8 @@ pub struct ParticleFluid {
     first: usize,
     options: CouplingOptions,
     loads: Vec<[f64; 3]>,
+    /// Loads of the previous step (two-step averaging).
+    previous: Vec<[f64; 3]>,
     injection: Option<Injection>,
     heat: HeatBudget,
     stats: CouplingStats,
@@ -242,6 +278,14 @@ impl ParticleFluid {
                 "must be positive",
             ));
         }
+        let factor = options.fluid_radius_factor;
+        if !(factor.is_finite() && (1.0..=2.0).contains(&factor)) {
+            return Err(CouplingError::argument(
+                "fluid_radius_factor",
+                factor,
+                "must be in [1, 2]",
+            ));
+        }
         let d = particles.disks();
         for i in 0..d.len() {
             let resolved = d.r[i] >= options.min_radius_nodes * units.dx;
@@ -259,7 +303,7 @@ impl ParticleFluid {
             let ob = Obstacle {
                 shape: Shape::Circle {
                     center: lattice_point(&units, origin, d.x[i]),
-                    radius: d.r[i] / units.dx,
+                    radius: factor * d.r[i] / units.dx,
                 },
                 velocity: [0.0, 0.0],
                 angular_velocity: 0.0,
@@ -280,6 +324,7 @@ impl ParticleFluid {
             first,
             options,
             loads: vec![[0.0; 3]; n],
+            previous: vec![[0.0; 3]; n],
             injection: None,
             heat: HeatBudget::default(),
             stats: CouplingStats::default(),
@@ -405,6 +450,20 @@ impl ParticleFluid {
     pub fn fluid_loads(&self) -> &[[f64; 3]] {
         &self.loads
     }
+    /// Momentum the fluid has given up but the particles have not received yet
+    /// (N·s/m): with [`LoadAveraging::TwoSteps`] half of the last step's load times `Δt`;
+    /// zero otherwise. Fluid + particles + this is conserved.
+    pub fn pending_impulse(&self) -> [f64; 2] {
+        match self.options.loads {
+            LoadAveraging::Step => [0.0; 2],
+            LoadAveraging::TwoSteps => {
+                let h = 0.5 * self.units.dt;
+                self.previous
+                    .iter()
+                    .fold([0.0; 2], |a, f| [a[0] + h * f[0], a[1] + h * f[1]])
+            }
+        }
+    }
     /// Heat books (zero without a temperature lattice).
     pub fn heat(&self) -> &HeatBudget {
         &self.heat
@@ -456,14 +515,21 @@ impl ParticleFluid {
             self.heat.from_particles += out * self.heat_scale();
         }
         self.lattice.step()?;
-        for (i, l) in self.loads.iter_mut().enumerate() {
+        let two = self.options.loads == LoadAveraging::TwoSteps;
+        for (i, (l, p)) in self.loads.iter_mut().zip(&mut self.previous).enumerate() {
             let f = self.lattice.force(self.first + i);
             let e = self.lattice.node_exchange(self.first + i);
-            *l = [
+            let now = [
                 self.units.force_si(f[0] + e[0]),
                 self.units.force_si(f[1] + e[1]),
                 self.units.torque_si(f[2] + e[2]),
             ];
+            if two {
+                *l = std::array::from_fn(|a| 0.5 * (now[a] + p[a]));
+                *p = now;
+            } else {
+                *l = now;
+            }
         }
         if let Some(th) = &self.thermal {
             let sides: f64 = th.side_heat().iter().sum();
@@ -526,7 +592,7 @@ impl ParticleFluid {
                 self.units.velocity(d.v[i][1]),
             ];
             let w = d.omega[i] * self.units.dt;
-            let r = d.r[i] / self.units.dx;
+            let r = self.options.fluid_radius_factor * d.r[i] / self.units.dx;
             let mach = ((v[0] * v[0] + v[1] * v[1]).sqrt() + w.abs() * r) / cs;
             let slow = mach <= MAX_MACH;
             if !slow {
