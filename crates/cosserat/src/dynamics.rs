@@ -87,7 +87,8 @@ impl Dynamics {
     }
 
     /// [`Self::new`] with the linear solver of the Newmark matrix `K + M/(β dt²)` chosen
-    /// by `linear` (its preconditioner is built on `P + M/(β dt²)`, see [`crate::linear`]).
+    /// by `linear` (its preconditioner is built on `P + M/(β dt²)`, see [`crate::linear`];
+    /// "auto" by [`crate::LinearSolver::resolve_newmark`]).
     pub fn with_solver<const D: usize>(
         model: &Cosserat<D>,
         integrator: Integrator,
@@ -136,7 +137,11 @@ impl Dynamics {
                     eff[p] += mass[i] / (beta * dt * dt);
                     pre[p] += mass[i] / (beta * dt * dt);
                 }
-                Some(model.linear(&eff, &pre, linear)?)
+                let linear = LinearOptions {
+                    solver: linear.solver.resolve_newmark(neq),
+                    ..*linear
+                };
+                Some(model.linear(&eff, &pre, &linear)?)
             }
         };
         Ok(Self {

@@ -14,7 +14,8 @@
 //! and `(θ × x, θ)`).
 //!
 //! **Choice.** [`LinearSolver::Auto`] takes the LU below [`AUTO_GMRES_EQUATIONS`]
-//! equations and GMRES above (measured in docs/BENCHMARKS.md: the LU's fill grows as
+//! equations and GMRES above (the Newmark matrix, solved at every step: below
+//! [`AUTO_GMRES_EQUATIONS_NEWMARK`]) (measured in docs/BENCHMARKS.md: the LU's fill grows as
 //! cells^1.4 on the plate meshes, GMRES with the V-cycle stays linear in memory).
 
 use porofrac_amg::{Amg, AmgOptions, NearNullSpace, Precision, SymCsr};
@@ -24,8 +25,15 @@ use crate::error::{CosseratError, Result};
 use crate::krylov::{GmresOptions, GmresStats, gmres};
 use crate::pattern::{BlockPattern, SparseLu};
 
-/// Equations from which [`LinearSolver::Auto`] takes GMRES with the V-cycle.
+/// Equations from which [`LinearSolver::Auto`] takes GMRES with the V-cycle for a static
+/// solve.
 pub const AUTO_GMRES_EQUATIONS: usize = 20_000;
+
+/// Equations from which [`LinearSolver::Auto`] takes GMRES for the Newmark matrix, solved
+/// at every step: the LU's one factorisation is then amortised over the steps (each a
+/// pair of triangular solves against tens of V-cycles for GMRES), so it is kept up to the
+/// size where its memory grows past a few GB (2.5 GB at 61,440 unknowns on the plate).
+pub const AUTO_GMRES_EQUATIONS_NEWMARK: usize = 100_000;
 
 /// Which linear solver.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -40,10 +48,19 @@ pub enum LinearSolver {
 }
 
 impl LinearSolver {
-    /// The solver used for `equations` unknowns (never [`Self::Auto`]).
+    /// The solver used for a static solve of `equations` unknowns (never [`Self::Auto`]).
     pub fn resolve(self, equations: usize) -> Self {
+        self.resolve_from(equations, AUTO_GMRES_EQUATIONS)
+    }
+
+    /// The solver used for the Newmark matrix of `equations` unknowns.
+    pub fn resolve_newmark(self, equations: usize) -> Self {
+        self.resolve_from(equations, AUTO_GMRES_EQUATIONS_NEWMARK)
+    }
+
+    fn resolve_from(self, equations: usize, threshold: usize) -> Self {
         match self {
-            Self::Auto if equations >= AUTO_GMRES_EQUATIONS => Self::GmresAmg,
+            Self::Auto if equations >= threshold => Self::GmresAmg,
             Self::Auto => Self::Lu,
             s => s,
         }
