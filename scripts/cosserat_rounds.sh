@@ -6,7 +6,7 @@
 #
 # For each O-grid level L (320 L^2 triangles, written by `plate_hole mesh L 0.216 FILE`):
 #   porofrac   crates/cosserat/examples/plate_hole.rs `run FILE ... auto` (library: assembly
-#              with the reconstruction; the solver "auto" picks the LU below 20,000 unknowns
+#              with the reconstruction; the solver "auto" picks the LU below 12,000 unknowns
 #              and GMRES with the multigrid preconditioner above), REPEAT times (default 3);
 #              up to LU_MAX_LEVEL (default 8) also `... lu` (faer sparse LU) once
 #   command    `porofrac run` on a copy of scenes/cosserat_plate_hole.toml pointing at FILE
