@@ -125,7 +125,7 @@ struct GmresAmg {
 }
 
 enum Kind {
-    Lu(SparseLu),
+    Lu(Box<SparseLu>),
     Gmres(Box<GmresAmg>),
 }
 
@@ -169,7 +169,7 @@ impl Linear {
             LinearSolver::Lu | LinearSolver::Auto => {
                 let mut lu = SparseLu::new(sys.pattern)?;
                 lu.factorize(sys.pattern, sys.values)?;
-                Kind::Lu(lu)
+                Kind::Lu(Box::new(lu))
             }
             LinearSolver::GmresAmg => Kind::Gmres(Box::new(GmresAmg::new(sys, options.gmres)?)),
         };
