@@ -5,15 +5,16 @@
 # usage: scripts/cosserat_rounds.sh [LEVEL ...]        (default: 3 5 8 12 18)
 #
 # For each O-grid level L (320 L^2 triangles, written by `plate_hole mesh L 0.216 FILE`):
-#   porofrac   crates/cosserat/examples/plate_hole.rs `run FILE ...` (library: assembly with
-#              the reconstruction, faer sparse LU)
+#   porofrac   crates/cosserat/examples/plate_hole.rs `run FILE ... auto` (library: assembly
+#              with the reconstruction; the solver "auto" picks the LU below 12,000 unknowns
+#              and GMRES with the multigrid preconditioner above), REPEAT times (default 3);
+#              up to LU_MAX_LEVEL (default 8) also `... lu` (faer sparse LU) once
 #   command    `porofrac run` on a copy of scenes/cosserat_plate_hole.toml pointing at FILE
 #              (the user's path; times from summary.json, whole process from `date`)
 #   python-dem peers/cosserat/dem.py (the same method in numpy/scipy, spsolve)
 #   fenicsx    peers/cosserat/fenicsx_p2p1.py (mixed P2-P1 FEM, MUMPS)
-# Above DEM_MAX_LEVEL (default 12: 46,080 triangles) only FEniCSx runs: the DEM's sparse LU
-# (faer) needs 8.1 GB at level 12 and went past the machine's 23 GB at level 18 (103,680
-# triangles), so both DEM codes are capped there.
+# Above DEM_MAX_LEVEL (default 18: 103,680 triangles) only FEniCSx runs. The Python DEM runs
+# under a 16 GB address-space limit (PY_MEM_KB); a MemoryError there is logged as such.
 # FEM_EXTRA_LEVELS (default "1 2") adds FEniCSx-only coarse levels (to reach the DEM's
 # error range). Every run prints one `RESULT {json}` line; everything goes to stdout and to
 # $OUT/rounds.txt (OUT default target/cosserat_rounds). FEM_PYTHON / FEM_LIB select the
@@ -24,7 +25,10 @@ cd "$root"
 if [ $# -eq 0 ]; then set -- 3 5 8 12 18; fi
 levels=("$@")
 out=${OUT:-$root/target/cosserat_rounds}
-dem_max=${DEM_MAX_LEVEL:-12}
+dem_max=${DEM_MAX_LEVEL:-18}
+lu_max=${LU_MAX_LEVEL:-8}
+repeat=${REPEAT:-3}
+py_mem_kb=${PY_MEM_KB:-16000000}
 fem_extra=${FEM_EXTRA_LEVELS:-1 2}
 fem_python=${FEM_PYTHON:-/work/venv-fem/bin/python}
 fem_lib=${FEM_LIB:-/work/venv-fem/lib}
@@ -56,7 +60,13 @@ for L in "${levels[@]}"; do
         (cd peers/cosserat && py fenicsx_p2p1.py "$mesh" "$r" "$rl" "$n") | grep '^RESULT' | sed "s/^RESULT {/RESULT {\"level\": $L, /" | tee -a "$log"
         continue
     fi
-    "$ex" run "$mesh" "$r" "$rl" "$n" | sed "s/^RESULT {/RESULT {\"level\": $L, /" | tee -a "$log"
+    for _ in $(seq "$repeat"); do
+        say "# load $(cut -d' ' -f1-3 /proc/loadavg)"
+        "$ex" run "$mesh" "$r" "$rl" "$n" auto 2>&1 | sed "s/^RESULT {/RESULT {\"level\": $L, /" | tee -a "$log"
+    done
+    if [ "$L" -le "$lu_max" ]; then
+        "$ex" run "$mesh" "$r" "$rl" "$n" lu | sed "s/^RESULT {\"code\": \"porofrac\"/RESULT {\"level\": $L, \"code\": \"porofrac-lu\"/" | tee -a "$log"
+    fi
     # The command: the bundled scene with the mesh path replaced.
     scene="$out/scene_L$L.toml"
     sed "s|^path = .*|path = \"$mesh\"|" scenes/cosserat_plate_hole.toml >"$scene"
@@ -71,9 +81,12 @@ print("RESULT " + json.dumps({"level": int(sys.argv[2]), "code": "porofrac-comma
       "dofs": s["dofs"], "scf": s["field_extrema"]["syy"][1], "t_grid": w["grid"],
       "t_assembly_and_factor": w["assembly"], "t_solve": w["solve"], "t_output": w["output"],
       "t_total": w["total"], "t_process": float(sys.argv[4]) - float(sys.argv[3]),
-      "peak_memory_bytes": s.get("peak_memory_bytes")}))
+      "peak_memory_bytes": s.get("peak_memory_bytes"), "linear": s["solver"]["linear"],
+      "iterations": s["solver"]["iterations"]}))
 EOF
-    (cd peers/cosserat && py dem.py "$mesh" "$r" "$rl" "$n") | sed "s/^RESULT {/RESULT {\"level\": $L, /" | tee -a "$log"
+    say "# python-dem $(date -u +%T) load $(cut -d' ' -f1-3 /proc/loadavg)"
+    (cd peers/cosserat && ulimit -v "$py_mem_kb" && py dem.py "$mesh" "$r" "$rl" "$n" 2>&1 | tail -3) | sed "s/^RESULT {/RESULT {\"level\": $L, /" | tee -a "$log" || say "# level $L: python-dem failed"
+    say "# load $(cut -d' ' -f1-3 /proc/loadavg)"
     (cd peers/cosserat && py fenicsx_p2p1.py "$mesh" "$r" "$rl" "$n") | grep '^RESULT' | sed "s/^RESULT {/RESULT {\"level\": $L, /" | tee -a "$log"
 done
 say "# end $(date -u +%FT%TZ) load $(cat /proc/loadavg)"

@@ -31,6 +31,7 @@ The method, as in crates/cosserat/src/{recon.rs, discrete.rs, material.rs}:
 * traction tested with the facet values; SCF = max over cells of the mean sigma_22.
 """
 import json
+import resource
 import sys
 import time
 from itertools import combinations
@@ -348,6 +349,7 @@ def main():
     res.update(solve(pts, tri, r, rl, n_cos))
     res["t_read"] = t_read
     res["scf_ref"] = hole_scf(NU, n_cos, r, r / rl)
+    res["peak_memory_bytes"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
     print("RESULT " + json.dumps(res), flush=True)
 
 

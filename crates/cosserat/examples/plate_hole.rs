@@ -13,19 +13,25 @@ use std::time::Instant;
 
 use porofrac_cosserat::reference::hole_scf;
 use porofrac_cosserat::{
-    BodyLoads, Condition, Cosserat, Material, Options, constant, mesh, strain_index,
+    BodyLoads, Condition, Cosserat, LinearOptions, LinearSolver, Material, Options, constant, mesh,
+    strain_index,
 };
 
 /// SCF of the DEM: the largest cell σ22 over the applied traction T = 1.
 pub fn scf(level: usize, r: f64, n: f64, length: f64) -> (f64, usize, f64, f64) {
     let grid =
         mesh::plate_with_hole(16.2, r, 16 * level, 10 * level, 0.1 * r / level as f64).unwrap();
-    let (s22, cells, t_asm, t_solve, _) = scf_on(grid, n, length);
+    let (s22, cells, t_asm, t_solve, _) = scf_on(grid, n, length, LinearSolver::Lu);
     (s22, cells, t_asm, t_solve)
 }
 
 /// SCF on a given quarter-plate grid: `(SCF, cells, assembly s, solve s, nnz)`.
-fn scf_on(grid: porofrac_grid::Grid<2>, n: f64, length: f64) -> (f64, usize, f64, f64, usize) {
+fn scf_on(
+    grid: porofrac_grid::Grid<2>,
+    n: f64,
+    length: f64,
+    solver: LinearSolver,
+) -> (f64, usize, f64, f64, usize) {
     let (g, nu) = (1e3, 0.3);
     let a = n * n / (1.0 - n * n);
     let m = Material::with_length(g, nu, a * g, length).unwrap();
@@ -48,12 +54,37 @@ fn scf_on(grid: porofrac_grid::Grid<2>, n: f64, length: f64) -> (f64, usize, f64
     .unwrap();
     let t_asm = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
-    let w = model.solve_static(0.0).unwrap();
+    let options = LinearOptions {
+        solver,
+        ..Default::default()
+    };
+    let (w, stats, used) = model.solve_static_with(0.0, &options).unwrap();
     let t_solve = t1.elapsed().as_secs_f64();
+    if solver != LinearSolver::Lu {
+        eprintln!(
+            "solver {} iterations {} residual {:.2e}",
+            used.name(),
+            stats.iterations,
+            stats.max_residual
+        );
+    }
     let s22 = (0..cells)
         .map(|c| model.cell_stress(c, &w)[strain_index(2, 1, 1)])
         .fold(f64::MIN, f64::max);
     (s22, cells, t_asm, t_solve, model.pattern().nnz())
+}
+
+/// Peak resident memory of this process (bytes, `VmHWM` of /proc/self/status; 0 when
+/// unavailable).
+fn peak_memory() -> u64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .and_then(|l| l.split_whitespace().nth(1)?.parse::<u64>().ok())
+        })
+        .map_or(0, |kb| kb * 1024)
 }
 
 fn main() {
@@ -68,18 +99,26 @@ fn main() {
         return;
     }
     if args.get(1).map(String::as_str) == Some("run") {
-        let usage = "plate_hole run <path.vtu> <r> <r/l> <N>";
+        let usage = "plate_hole run <path.vtu> <r> <r/l> <N> [auto|lu|gmres-amg]";
         let grid = porofrac_grid::io::read_vtu::<2>(&args[2]).expect("readable 2D .vtu mesh");
         let num = |i: usize| -> f64 { args.get(i).and_then(|s| s.parse().ok()).expect(usage) };
         let (r, rl, n) = (num(3), num(4), num(5));
-        let (s22, cells, ta, ts, nnz) = scf_on(grid, n, r / rl);
+        let solver = match args.get(6).map(String::as_str) {
+            None | Some("auto") => LinearSolver::Auto,
+            Some("lu") => LinearSolver::Lu,
+            Some("gmres-amg") => LinearSolver::GmresAmg,
+            Some(_) => panic!("{usage}"),
+        };
+        let (s22, cells, ta, ts, nnz) = scf_on(grid, n, r / rl, solver);
         println!(
             "RESULT {{\"code\": \"porofrac\", \"mesh\": \"{}\", \"cells\": {cells}, \"dofs\": {}, \
              \"nnz\": {nnz}, \"scf\": {s22:.15e}, \"scf_ref\": {:.15e}, \"t_assemble\": {ta:.6}, \
-             \"t_solve\": {ts:.6}}}",
+             \"t_solve\": {ts:.6}, \"solver\": \"{}\", \"peak_memory_bytes\": {}}}",
             args[2],
             3 * cells,
-            hole_scf(0.3, n, r, r / rl)
+            hole_scf(0.3, n, r, r / rl),
+            solver.resolve(3 * cells).name(),
+            peak_memory()
         );
         return;
     }

@@ -30,9 +30,15 @@ use porofrac_grid::{Grid, Point};
 
 use crate::conditions::{BodyLoads, Condition, Field, Slot};
 use crate::error::{CosseratError, Result};
+use crate::linear::{Linear, LinearOptions, LinearSolver, LinearStats, SystemRef};
 use crate::material::{Material, components, levi_civita, rotations, strain_index, strain_len};
 use crate::pattern::{BlockPattern, SparseLu};
 use crate::recon::Reconstruction;
+
+/// `γ` of the boundary penalty in [`Cosserat::preconditioner_values`]: of 1, 10, 30, 100
+/// and 1000, 30 gave the fewest GMRES iterations on the plate with a hole (8,000 and 20,480
+/// triangles, docs/BENCHMARKS.md).
+pub const PRECONDITIONER_PENALTY: f64 = 30.0;
 
 /// Where the rotation in the strain (12) is taken.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -116,6 +122,8 @@ pub struct Cosserat<const D: usize> {
     symmetric: Vec<f64>,
     /// Nitsche values.
     nitsche: Vec<f64>,
+    /// Boundary penalty of the preconditioner: `(value position, value)`.
+    boundary: Vec<(usize, f64)>,
     fields: Vec<Field<D>>,
     fixed: Vec<FixedTerm>,
     loads: Vec<LoadTerm>,
@@ -173,6 +181,7 @@ impl<const D: usize> Cosserat<D> {
         let mut me = Self {
             symmetric: vec![0.0; pattern.nnz()],
             nitsche: vec![0.0; pattern.nnz()],
+            boundary: Vec::new(),
             grid,
             material,
             options,
@@ -217,6 +226,18 @@ impl<const D: usize> Cosserat<D> {
     /// Values of the Nitsche part.
     pub fn nitsche_values(&self) -> &[f64] {
         &self.nitsche
+    }
+    /// Values of the symmetric positive definite matrix that preconditions the system:
+    /// the symmetric part plus a boundary penalty `γ (|F|/h_K) Q_kk(n) w_{F,k} v_{F,k}`
+    /// (`γ` = [`PRECONDITIONER_PENALTY`]) on
+    /// every fixed component (it removes the rigid motions from the kernel of the
+    /// symmetric part; the system itself has no penalty).
+    pub fn preconditioner_values(&self) -> Vec<f64> {
+        let mut p = self.symmetric.clone();
+        for &(pos, v) in &self.boundary {
+            p[pos] += PRECONDITIONER_PENALTY * v;
+        }
+        p
     }
     /// Values of the full system matrix (symmetric + Nitsche).
     pub fn system_values(&self) -> Vec<f64> {
@@ -492,6 +513,16 @@ impl<const D: usize> Cosserat<D> {
                         s.k[lc * m + rho] += area * l * t[rho];
                     }
                 }
+                // Preconditioner only: (|F|/h) Q_kk(n) w_{F,k} v_{F,k}, symmetric positive.
+                let q = Material::acoustic(&self.law, D, normal.as_slice())[(k, k)];
+                let pen = area / self.recon.diameter[c] * q;
+                for (&cj, &lj) in st.cells.iter().zip(&st.weights) {
+                    let col = self.pattern.column_len(cj);
+                    for (&ci, &li) in st.cells.iter().zip(&st.weights) {
+                        let pos = self.pattern.position(ci, cj).expect("stencil cells couple");
+                        self.boundary.push((pos + k * col + k, pen * li * lj));
+                    }
+                }
                 let coef = s
                     .cells
                     .iter()
@@ -570,6 +601,58 @@ impl<const D: usize> Cosserat<D> {
         self.rhs(t, &mut x);
         lu.solve_in_place(&mut x)?;
         Ok(x)
+    }
+
+    /// Cell barycentres, `D` per cell (the multigrid's rigid motions).
+    pub fn centres(&self) -> Vec<f64> {
+        (0..self.grid.num_cells())
+            .flat_map(|c| {
+                self.grid
+                    .cell_centroid(c)
+                    .iter()
+                    .copied()
+                    .collect::<Vec<_>>()
+            })
+            .collect()
+    }
+
+    /// Set up the solver `options` for the system matrix with `values` (the system or
+    /// the Newmark matrix) and the preconditioning matrix with `preconditioner`.
+    pub fn linear(
+        &self,
+        values: &[f64],
+        preconditioner: &[f64],
+        options: &LinearOptions,
+    ) -> Result<Linear> {
+        let centres = self.centres();
+        Linear::new(
+            SystemRef {
+                pattern: &self.pattern,
+                values,
+                preconditioner,
+                centres: &centres,
+                dim: D,
+            },
+            options,
+        )
+    }
+
+    /// Solve the static problem at time `t` with the solver `options`; also returns the
+    /// solver's statistics.
+    pub fn solve_static_with(
+        &self,
+        t: f64,
+        options: &LinearOptions,
+    ) -> Result<(Vec<f64>, LinearStats, LinearSolver)> {
+        let mut solver = self.linear(
+            &self.system_values(),
+            &self.preconditioner_values(),
+            options,
+        )?;
+        let mut x = vec![0.0; self.equations()];
+        self.rhs(t, &mut x);
+        solver.solve(&mut x, None)?;
+        Ok((x, solver.stats(), solver.solver()))
     }
 
     /// Mean generalised strain of cell `c` for the field `w` (length `strain_len(D)`).

@@ -16,8 +16,8 @@
 
 use crate::discrete::Cosserat;
 use crate::error::{CosseratError, Result};
+use crate::linear::{Linear, LinearOptions, LinearStats};
 use crate::material::components;
-use crate::pattern::SparseLu;
 
 /// Time integrator.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -47,7 +47,7 @@ pub struct Dynamics {
     pub a: Vec<f64>,
     mass: Vec<f64>,
     system: Vec<f64>,
-    lu: Option<SparseLu>,
+    solver: Option<Linear>,
     /// Work done by the external loads so far (trapezoidal in time).
     pub external_work: f64,
     f_prev: Vec<f64>,
@@ -74,7 +74,7 @@ impl Dynamics {
     /// Start at `t0` from `u0`, `v0` (the initial acceleration solves `M A = F − K U`).
     ///
     /// Errors: `dt ≤ 0`, a zero micro-inertia (the rotation mass vanishes), wrong lengths,
-    /// or an LU failure.
+    /// or a failure of the linear solver (factorisation or multigrid setup).
     pub fn new<const D: usize>(
         model: &Cosserat<D>,
         integrator: Integrator,
@@ -82,6 +82,21 @@ impl Dynamics {
         t0: f64,
         u0: Vec<f64>,
         v0: Vec<f64>,
+    ) -> Result<Self> {
+        Self::with_solver(model, integrator, dt, t0, u0, v0, &LinearOptions::default())
+    }
+
+    /// [`Self::new`] with the linear solver of the Newmark matrix `K + M/(β dt²)` chosen
+    /// by `linear` (its preconditioner is built on `P + M/(β dt²)`, see [`crate::linear`];
+    /// "auto" by [`crate::LinearSolver::resolve_newmark`]).
+    pub fn with_solver<const D: usize>(
+        model: &Cosserat<D>,
+        integrator: Integrator,
+        dt: f64,
+        t0: f64,
+        u0: Vec<f64>,
+        v0: Vec<f64>,
+        linear: &LinearOptions,
     ) -> Result<Self> {
         let neq = model.equations();
         if !(dt.is_finite() && dt > 0.0) {
@@ -112,17 +127,21 @@ impl Dynamics {
         let mut ku = vec![0.0; neq];
         model.pattern().mul(&system, &u0, &mut ku);
         let a: Vec<f64> = (0..neq).map(|i| (f[i] - ku[i]) / mass[i]).collect();
-        let lu = match integrator {
+        let solver = match integrator {
             Integrator::Explicit => None,
             Integrator::Newmark => {
                 let beta = 0.25;
                 let mut eff = system.clone();
+                let mut pre = model.preconditioner_values();
                 for (i, p) in model.pattern().diagonal_positions().into_iter().enumerate() {
                     eff[p] += mass[i] / (beta * dt * dt);
+                    pre[p] += mass[i] / (beta * dt * dt);
                 }
-                let mut lu = SparseLu::new(model.pattern())?;
-                lu.factorize(model.pattern(), &eff)?;
-                Some(lu)
+                let linear = LinearOptions {
+                    solver: linear.solver.resolve_newmark(neq),
+                    ..*linear
+                };
+                Some(model.linear(&eff, &pre, &linear)?)
             }
         };
         Ok(Self {
@@ -134,12 +153,22 @@ impl Dynamics {
             a,
             mass,
             system,
-            lu,
+            solver,
             external_work: 0.0,
             f_prev: f,
             scratch: vec![0.0; neq],
             scratch2: ku,
         })
+    }
+
+    /// The Newmark solver and its statistics (`None` for the explicit integrator).
+    pub fn solver(&self) -> Option<&Linear> {
+        self.solver.as_ref()
+    }
+
+    /// Statistics of the Newmark solves (default for the explicit integrator).
+    pub fn solver_stats(&self) -> LinearStats {
+        self.solver.as_ref().map(Linear::stats).unwrap_or_default()
     }
 
     /// The time step.
@@ -197,10 +226,14 @@ impl Dynamics {
                             + self.v[i] / (beta * dt)
                             + (0.5 / beta - 1.0) * self.a[i]);
                 }
-                self.lu
-                    .as_ref()
-                    .expect("Newmark has an LU")
-                    .solve_in_place(&mut rhs)?;
+                // Initial guess: the predictor u + dt v + (½ − β) dt² a.
+                let guess: Vec<f64> = (0..n)
+                    .map(|i| self.u[i] + dt * self.v[i] + (0.5 - beta) * dt * dt * self.a[i])
+                    .collect();
+                self.solver
+                    .as_mut()
+                    .expect("Newmark has a linear solver")
+                    .solve(&mut rhs, Some(&guess))?;
                 for i in 0..n {
                     let a1 = (rhs[i] - self.u[i] - dt * self.v[i]) / (beta * dt * dt)
                         - (1.0 - 2.0 * beta) / (2.0 * beta) * self.a[i];

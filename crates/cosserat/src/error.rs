@@ -57,6 +57,20 @@ pub enum CosseratError {
         /// Argument and problem.
         what: String,
     },
+    /// GMRES did not reach its tolerance.
+    #[error(
+        "GMRES reached a relative residual of {residual:.3e} in {iterations} iterations, \
+         not the tolerance {tolerance:.1e} (a harder system than the multigrid \
+         preconditioner handles: use the LU)"
+    )]
+    NotConverged {
+        /// Iterations done.
+        iterations: usize,
+        /// True relative residual reached.
+        residual: f64,
+        /// The tolerance asked for.
+        tolerance: f64,
+    },
     /// The sparse LU failed or produced a non-finite solution.
     #[error("linear solve: {0}")]
     Solve(String),

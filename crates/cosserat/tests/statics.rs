@@ -42,7 +42,7 @@ fn patch_2d(grid: Grid<2>, variant: StrainVariant, phi: f64, couple: f64, want: 
         ..Options::default()
     };
     let model = Cosserat::new(grid, e1_material(), opts, &[cond], body).unwrap();
-    let w = model.solve_static(0.0).unwrap();
+    let w = common::solve_checked(&model);
     let mut worst: f64 = 0.0;
     for c in 0..model.grid().num_cells() {
         let s = model.cell_stress(c, &w);
@@ -162,7 +162,7 @@ fn patch_test_3d_exact() {
         };
         let cond = clamp_all(&g, exact);
         let model = Cosserat::new(g.clone(), m.clone(), opts, &[cond], body.clone()).unwrap();
-        let w = model.solve_static(0.0).unwrap();
+        let w = common::solve_checked(&model);
         for c in 0..g.num_cells() {
             let s = model.cell_stress(c, &w);
             for r in 0..18 {
@@ -283,7 +283,7 @@ pub fn shear_layer(variant: StrainVariant, ends: [f64; 4]) -> (f64, f64, f64) {
         ..Options::default()
     };
     let model = Cosserat::new(grid, m, opts, &[bottom, top, mirror], BodyLoads::none()).unwrap();
-    let w = model.solve_static(0.0).unwrap();
+    let w = common::solve_checked(&model);
     let exact = ShearLayer::new(h, 1e10, 2e10, 100.0, ends);
     let (mut ephi, mut eu): (f64, f64) = (0.0, 0.0);
     for k in 1..20 {
@@ -344,7 +344,7 @@ fn patch_3(n: usize, variant: StrainVariant) -> f64 {
         ..Options::default()
     };
     let model = Cosserat::new(grid, e1_material(), opts, &[cond], body).unwrap();
-    let w = model.solve_static(0.0).unwrap();
+    let w = common::solve_checked(&model);
     let mut worst: f64 = 0.0;
     for c in 0..model.grid().num_cells() {
         let x = model.grid().cell_centroid(c);

@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 
 use crate::expr::Expr;
 use crate::file::{
-    Bc, CellCount, Component, GridKind, KeyPart, NumOrExpr, Permeability, SceneFile, Select,
-    key_text, line_of_offset, locate,
+    Bc, CellCount, Component, GridKind, KeyPart, LinearChoice, NumOrExpr, Permeability, SceneFile,
+    Select, key_text, line_of_offset, locate,
 };
 use crate::laws::LawRegistry;
 use porofrac_grid::Point;
@@ -547,6 +547,20 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
     }
     if let Some(t) = s.solver.tolerance {
         positive(ls, &k(&["solver", "tolerance"]), t)?;
+    }
+    if let Some(l @ (LinearChoice::Lu | LinearChoice::GmresAmg)) = s.solver.linear {
+        return Err(ls.error(
+            &k(&["solver", "linear"]),
+            format!(
+                "= \"{}\" is a solver of model \"cosserat\"; this model takes \"auto\", \
+                 \"cholesky\" or \"cg-amg\"",
+                if l == LinearChoice::Lu {
+                    "lu"
+                } else {
+                    "gmres-amg"
+                }
+            ),
+        ));
     }
     if let Some(t) = s.solver.threads
         && !(0..=1024).contains(&t)

@@ -192,6 +192,10 @@ pub enum LinearChoice {
     Cholesky,
     /// CG preconditioned by smoothed-aggregation AMG.
     CgAmg,
+    /// Sparse LU with partial pivoting (model `cosserat`).
+    Lu,
+    /// Restarted GMRES preconditioned by smoothed-aggregation AMG (model `cosserat`).
+    GmresAmg,
 }
 
 /// A whole scene file.

@@ -277,6 +277,9 @@ impl<'a, const D: usize> Stepper<'a, D> {
                 let linear = match s.solver.linear.unwrap_or_default() {
                     LinearChoice::Cholesky => LinearSolver::Cholesky,
                     LinearChoice::CgAmg => cg,
+                    LinearChoice::Lu | LinearChoice::GmresAmg => {
+                        unreachable!("refused by check: cosserat solvers")
+                    }
                     LinearChoice::Auto => {
                         match LinearSolver::Auto.resolve(D, body.dofs.num_equations()) {
                             LinearSolver::CgAmg { .. } => cg,

@@ -2,7 +2,7 @@
 //! refusal of the Cosserat keys in continuum scenes. Every problem names its key.
 
 use crate::check::{LoadedScene, SceneError, expr_ok, k, ki};
-use crate::file::{DiagonalsChoice, GridKind, KeyPart, NumOrExpr, Select};
+use crate::file::{DiagonalsChoice, GridKind, KeyPart, LinearChoice, NumOrExpr, Select};
 
 use super::fields::Field;
 use super::keys::PerRotation;
@@ -157,14 +157,30 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
             return Err(other_model(ls, &k(&["physics", key]), model));
         }
     }
-    for (key, set) in [
-        ("mechanics", s.solver.mechanics.is_some()),
-        ("linear", s.solver.linear.is_some()),
-        ("tolerance", s.solver.tolerance.is_some()),
-    ] {
-        if set {
-            return Err(other_model(ls, &k(&["solver", key]), model));
-        }
+    if s.solver.mechanics.is_some() {
+        return Err(other_model(ls, &k(&["solver", "mechanics"]), model));
+    }
+    if let Some(l @ (LinearChoice::Cholesky | LinearChoice::CgAmg)) = s.solver.linear {
+        return Err(ls.error(
+            &k(&["solver", "linear"]),
+            format!(
+                "= \"{}\" is a solver of model \"continuum\" (symmetric matrices); model \
+                 \"cosserat\" takes \"auto\", \"lu\" or \"gmres-amg\"",
+                if l == LinearChoice::Cholesky {
+                    "cholesky"
+                } else {
+                    "cg-amg"
+                }
+            ),
+        ));
+    }
+    if let Some(t) = s.solver.tolerance
+        && !(t.is_finite() && t > 0.0 && t < 1.0)
+    {
+        return Err(ls.error(
+            &k(&["solver", "tolerance"]),
+            format!("= {t} must be in (0, 1) (GMRES's relative residual)"),
+        ));
     }
     if s.output.exact_displacement.is_some() {
         return Err(other_model(

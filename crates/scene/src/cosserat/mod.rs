@@ -28,8 +28,8 @@ use std::time::Instant;
 
 use porofrac_cosserat::dynamics::Dynamics;
 use porofrac_cosserat::{
-    BodyLoads, Condition, Cosserat, CosseratError, Integrator, Material, Options, SparseLu,
-    components,
+    BodyLoads, Condition, Cosserat, CosseratError, GmresOptions, Integrator, Linear, LinearOptions,
+    LinearSolver, Material, Options, components,
 };
 use porofrac_grid::generate::perturb;
 use porofrac_grid::{Grid, Point};
@@ -37,7 +37,7 @@ use porofrac_grid::{Grid, Point};
 use crate::check::{LoadedScene, k, ki};
 use crate::continuum::grid::{AnyGrid, build_grid, point};
 use crate::driver::{Observer, drive};
-use crate::file::{DiagonalsChoice, GridKind, NumOrExpr};
+use crate::file::{DiagonalsChoice, GridKind, LinearChoice, NumOrExpr};
 use crate::model::{Model, RunError, Sizes, StepStats};
 use crate::output::{SolverStats, Summary, WallSeconds};
 use crate::plots::{Canvas, FieldPlot, Values};
@@ -89,6 +89,7 @@ fn scene_error(ls: &LoadedScene, e: CosseratError) -> RunError {
         CosseratError::NotSimplex { .. } | CosseratError::NoStencil { .. } => k(&["grid", "kind"]),
         CosseratError::Condition { index, .. } => ki("bc", *index, &[]),
         CosseratError::Grid(_) => k(&["grid"]),
+        CosseratError::NotConverged { .. } => k(&["solver", "linear"]),
         CosseratError::Input { .. } | CosseratError::Solve(_) => k(&["scene", "model"]),
     };
     RunError::Scene(ls.error(&key, format!(": {e}")))
@@ -188,11 +189,27 @@ fn body_loads<const D: usize>(ls: &LoadedScene) -> BodyLoads<D> {
     b
 }
 
+/// `[solver] linear` and `tolerance` as the library's options.
+fn linear_options(ls: &LoadedScene) -> LinearOptions {
+    let s = &ls.scene.solver;
+    let solver = match s.linear.unwrap_or_default() {
+        LinearChoice::Lu => LinearSolver::Lu,
+        LinearChoice::GmresAmg => LinearSolver::GmresAmg,
+        // cholesky and cg-amg are refused by the check.
+        _ => LinearSolver::Auto,
+    };
+    let mut gmres = GmresOptions::default();
+    if let Some(t) = s.tolerance {
+        gmres.tolerance = t;
+    }
+    LinearOptions { solver, gmres }
+}
+
 /// How the run advances (one value per run: the size of the variants does not matter).
 #[allow(clippy::large_enum_variant)]
 enum Stepping {
-    /// One static solve (an LU factored once).
-    Static(SparseLu),
+    /// One static solve (an LU factored once, or GMRES with its preconditioner).
+    Static(Linear),
     /// Dynamics with `substeps` integrator steps per output step.
     Dynamic { state: Dynamics, substeps: usize },
 }
@@ -233,13 +250,18 @@ fn run_dim<const D: usize>(
     };
     let model = Cosserat::new(grid, mat, options, &cond, body).map_err(|e| scene_error(ls, e))?;
     let n_eq = model.equations();
+    let linear_options = linear_options(ls);
     let mut times = vec![0.0];
     let stepping = match &ls.scene.schedule {
         None => {
-            let mut lu = SparseLu::new(model.pattern()).map_err(|e| scene_error(ls, e))?;
-            lu.factorize(model.pattern(), &model.system_values())
+            let solver = model
+                .linear(
+                    &model.system_values(),
+                    &model.preconditioner_values(),
+                    &linear_options,
+                )
                 .map_err(|e| scene_error(ls, e))?;
-            Stepping::Static(lu)
+            Stepping::Static(solver)
         }
         Some(sch) => {
             // Uniform output steps (a dt that does not divide end_time is shortened).
@@ -257,13 +279,14 @@ fn run_dim<const D: usize>(
                     )
                 }
             };
-            let state = Dynamics::new(
+            let state = Dynamics::with_solver(
                 &model,
                 integrator,
                 dt_out / substeps as f64,
                 0.0,
                 vec![0.0; n_eq],
                 vec![0.0; n_eq],
+                &linear_options,
             )
             .map_err(|e| scene_error(ls, e))?;
             Stepping::Dynamic { state, substeps }
@@ -295,16 +318,14 @@ fn run_dim<const D: usize>(
         }
         lines.push((Field::parse(&l.field, D).expect("checked"), pts));
     }
-    let (linear, factorizations) = match &stepping {
-        Stepping::Static(lu) => ("sparse-lu", lu.factorizations()),
-        Stepping::Dynamic { substeps, .. } => {
-            if ls.scene.solver.time_integration == Some(TimeIntegration::Explicit) {
-                ("explicit", 0)
-            } else {
-                let _ = substeps;
-                ("sparse-lu", 1)
-            }
-        }
+    let solver = match &stepping {
+        Stepping::Static(l) => Some(l),
+        Stepping::Dynamic { state, .. } => state.solver(),
+    };
+    let (linear, factorizations) = match solver.map(Linear::solver) {
+        None => ("explicit", 0),
+        Some(LinearSolver::GmresAmg) => ("gmres-amg", 0),
+        Some(_) => ("sparse-lu", 1),
     };
     let mut run = Run {
         ls,
@@ -381,10 +402,12 @@ impl<const D: usize> Model for Run<'_, D> {
         let t_solve = Instant::now();
         let ls = self.ls;
         match &mut self.stepping {
-            Stepping::Static(lu) => {
+            Stepping::Static(solver) => {
                 let mut x = vec![0.0; self.w.len()];
                 self.model.rhs(self.times[step], &mut x);
-                lu.solve_in_place(&mut x).map_err(|e| scene_error(ls, e))?;
+                solver
+                    .solve(&mut x, Some(&self.w))
+                    .map_err(|e| scene_error(ls, e))?;
                 self.w = x;
             }
             Stepping::Dynamic { state, substeps } => {
@@ -509,7 +532,16 @@ impl<const D: usize> Model for Run<'_, D> {
     }
 
     fn solver_stats(&self) -> SolverStats {
-        self.stats.clone()
+        let linear = match &self.stepping {
+            Stepping::Static(l) => Some(l.stats()),
+            Stepping::Dynamic { state, .. } => state.solver().map(Linear::stats),
+        };
+        let mut stats = self.stats.clone();
+        if let Some(l) = linear {
+            stats.iterations = l.iterations;
+            stats.max_relative_residual = l.max_residual;
+        }
+        stats
     }
 
     fn errors(&self) -> Result<BTreeMap<String, f64>, RunError> {

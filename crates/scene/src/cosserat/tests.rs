@@ -179,3 +179,28 @@ fn bad_scenes_name_their_key() {
     let e = error_of(&format!("{BASE}\n[schedule]\nend_time = 1.0\nsteps = 2\n"));
     assert!(e.contains("density") || e.contains("micro_inertia"), "{e}");
 }
+
+/// `[solver] linear` and `tolerance`: the continuum model's solvers are refused naming the
+/// key, a tolerance outside (0, 1) names its key, and GMRES with the multigrid runs,
+/// reaching the tolerance asked for.
+#[test]
+fn linear_solver_keys() {
+    let with = |extra: &str| format!("{BASE}\n[solver]\n{extra}\n");
+    let e = error_of(&with("linear = \"cholesky\""));
+    assert!(e.contains("solver.linear") && e.contains("cosserat"), "{e}");
+    let e = error_of(&with("linear = \"gmres-amg\"\ntolerance = 2.0"));
+    assert!(e.contains("solver.tolerance"), "{e}");
+    let scene = Scene::parse(
+        &with("linear = \"gmres-amg\"\ntolerance = 1e-11"),
+        Path::new("t.toml"),
+        LawRegistry::default(),
+    )
+    .unwrap();
+    let s = scene.run(&out_dir("gmres"), &mut Silent).unwrap();
+    assert_eq!(s.solver.linear, "gmres-amg");
+    assert!(
+        s.solver.iterations > 0 && s.solver.max_relative_residual <= 1e-11,
+        "{:?}",
+        s.solver
+    );
+}

@@ -1,0 +1,188 @@
+//! GMRES with the multigrid preconditioner against the sparse LU:
+//!
+//! * the plate with a hole (level 2, 1,280 triangles, N = 0.5, r/ℓ = 1.063): the GMRES
+//!   solution at tolerance 1e-12 equals the LU's to 1e-9 of its largest entry, the stress
+//!   concentration factor to 1e-9 relative, in fewer than 150 iterations;
+//! * the Newmark matrix of the same plate (a step load held for 10 steps) and of a 3D
+//!   clamped box of tetrahedra under a body force: every step converges and the states
+//!   equal the LU's to 1e-8 of their largest entry;
+//! * the error path: too few iterations is [`CosseratError::NotConverged`] with the
+//!   residual reached, never a NaN.
+
+mod common;
+
+use porofrac_cosserat::{
+    BodyLoads, Condition, Cosserat, CosseratError, Dynamics, GmresOptions, Integrator,
+    LinearOptions, LinearSolver, Material, Options, constant, mesh, strain_index,
+};
+use porofrac_grid::Point;
+use porofrac_grid::generate::{perturb, simplices};
+
+fn plate(level: usize) -> Cosserat<2> {
+    let (r, n) = (0.216, 0.5f64);
+    let grid =
+        mesh::plate_with_hole(16.2, r, 16 * level, 10 * level, 0.1 * r / level as f64).unwrap();
+    let a = n * n / (1.0 - n * n);
+    let m = Material::with_length(1e3, 0.3, a * 1e3, r / 1.063)
+        .unwrap()
+        .with_inertia(1e-3, 1e-4)
+        .unwrap();
+    let left = Condition::new(grid.boundary("xmin").unwrap())
+        .fix(0, constant(0.0))
+        .fix(2, constant(0.0));
+    let bottom = Condition::new(grid.boundary("ymin").unwrap())
+        .fix(1, constant(0.0))
+        .fix(2, constant(0.0));
+    let top = Condition::new(grid.boundary("ymax").unwrap()).load(1, constant(1.0));
+    Cosserat::new(
+        grid,
+        m,
+        Options::default(),
+        &[left, bottom, top],
+        BodyLoads::none(),
+    )
+    .unwrap()
+}
+
+fn options(solver: LinearSolver, tolerance: f64) -> LinearOptions {
+    LinearOptions {
+        solver,
+        gmres: GmresOptions {
+            tolerance,
+            ..GmresOptions::default()
+        },
+    }
+}
+
+fn max_abs(v: &[f64]) -> f64 {
+    v.iter().fold(0.0, |m, x| m.max(x.abs()))
+}
+
+fn max_diff(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).fold(0.0, |m, (x, y)| m.max((x - y).abs()))
+}
+
+fn scf(model: &Cosserat<2>, w: &[f64]) -> f64 {
+    (0..model.grid().num_cells())
+        .map(|c| model.cell_stress(c, w)[strain_index(2, 1, 1)])
+        .fold(f64::MIN, f64::max)
+}
+
+#[test]
+fn plate_with_hole_gmres_equals_lu() {
+    let model = plate(2);
+    let (lu, _, used) = model
+        .solve_static_with(0.0, &options(LinearSolver::Lu, 1e-12))
+        .unwrap();
+    assert_eq!(used, LinearSolver::Lu);
+    let (gm, stats, used) = model
+        .solve_static_with(0.0, &options(LinearSolver::GmresAmg, 1e-12))
+        .unwrap();
+    assert_eq!(used, LinearSolver::GmresAmg);
+    assert!(stats.max_residual <= 1e-12, "{stats:?}");
+    assert!(stats.iterations < 150, "{stats:?}");
+    let d = max_diff(&lu, &gm) / max_abs(&lu);
+    assert!(d < 1e-9, "relative difference {d:.2e} ({stats:?})");
+    let (s_lu, s_gm) = (scf(&model, &lu), scf(&model, &gm));
+    assert!(
+        ((s_gm - s_lu) / s_lu).abs() < 1e-9,
+        "SCF {s_gm} against {s_lu}"
+    );
+}
+
+/// Newmark states with the LU and with GMRES after `steps` steps.
+fn newmark_pair<const D: usize>(
+    model: &Cosserat<D>,
+    dt: f64,
+    steps: usize,
+) -> (Vec<f64>, Vec<f64>, usize) {
+    let n = model.equations();
+    let mut states = Vec::new();
+    let mut iterations = 0;
+    for solver in [LinearSolver::Lu, LinearSolver::GmresAmg] {
+        let mut d = Dynamics::with_solver(
+            model,
+            Integrator::Newmark,
+            dt,
+            0.0,
+            vec![0.0; n],
+            vec![0.0; n],
+            &options(solver, 1e-12),
+        )
+        .unwrap();
+        assert_eq!(d.solver().unwrap().solver(), solver);
+        for _ in 0..steps {
+            d.step(model).unwrap();
+        }
+        let st = d.solver_stats();
+        assert_eq!(st.solves, steps);
+        if solver == LinearSolver::GmresAmg {
+            assert!(st.max_residual <= 1e-12, "{st:?}");
+            iterations = st.max_iterations;
+        }
+        states.push(d.u);
+    }
+    let g = states.pop().unwrap();
+    (states.pop().unwrap(), g, iterations)
+}
+
+#[test]
+fn newmark_gmres_equals_lu_in_2d_and_3d() {
+    // The plate: a step load; dt about a tenth of the time a shear wave takes to cross it.
+    let model = plate(1);
+    let (lu, gm, its) = newmark_pair(&model, 0.05, 10);
+    let d = max_diff(&lu, &gm) / max_abs(&lu);
+    assert!(max_abs(&lu) > 0.0);
+    assert!(
+        d < 1e-8,
+        "2D: relative difference {d:.2e} (max iterations {its})"
+    );
+    assert!(its < 100, "2D: {its} iterations");
+
+    // 3D: a clamped perturbed box of tetrahedra under gravity.
+    let g = perturb(
+        &simplices(
+            Point::<3>::zeros(),
+            Point::<3>::new(1.0, 0.6, 0.5),
+            [4, 3, 2],
+        )
+        .unwrap(),
+        0.2,
+        6,
+    )
+    .unwrap();
+    let m = Material::with_couple_moduli(1000.0, 0.25, 300.0, [1.0, 2.0, 0.5])
+        .unwrap()
+        .with_inertia(2.0, 0.02)
+        .unwrap();
+    let clamp = Condition::new(g.boundary("xmin").unwrap()).clamp(vec![constant(0.0); 6]);
+    let body = BodyLoads::none().with(2, constant(-9.81));
+    let model = Cosserat::new(g, m, Options::default(), &[clamp], body).unwrap();
+    let (lu, gm, its) = newmark_pair(&model, 5e-3, 10);
+    let d = max_diff(&lu, &gm) / max_abs(&lu);
+    assert!(max_abs(&lu) > 0.0);
+    assert!(
+        d < 1e-8,
+        "3D: relative difference {d:.2e} (max iterations {its})"
+    );
+    assert!(its < 100, "3D: {its} iterations");
+}
+
+#[test]
+fn too_few_iterations_is_an_error_with_the_residual() {
+    let model = plate(1);
+    let mut o = options(LinearSolver::GmresAmg, 1e-12);
+    o.gmres.max_iterations = 3;
+    let e = model.solve_static_with(0.0, &o).unwrap_err();
+    match e {
+        CosseratError::NotConverged {
+            iterations,
+            residual,
+            tolerance,
+        } => {
+            assert_eq!(iterations, 3);
+            assert!(residual.is_finite() && residual > tolerance, "{residual}");
+        }
+        e => panic!("unexpected error {e}"),
+    }
+}
