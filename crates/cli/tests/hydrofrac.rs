@@ -374,7 +374,9 @@ fn three_d_fracture_is_the_vertical_plane_normal_to_the_least_compressive_stress
     // centroid's offset: 30°), nowhere else.
     for p in f.iter().filter(|p| p[3] == 0.0) {
         let q = [p[0], p[1], 0.0];
-        let from_y = (p[0] - CENTER[0]).atan2((p[1] - CENTER[1]).abs()).to_degrees();
+        let from_y = (p[0] - CENTER[0])
+            .atan2((p[1] - CENTER[1]).abs())
+            .to_degrees();
         assert!(
             distance_to_well(&q) <= WELL_RADIUS + 2.0 * cell && from_y.abs() <= 30.0,
             "cell at {p:?} failed at t = 0 outside the wall's tension band"
@@ -383,21 +385,30 @@ fn three_d_fracture_is_the_vertical_plane_normal_to_the_least_compressive_stress
     let first = f.iter().map(|p| p[3]).fold(f64::INFINITY, f64::min);
     for p in f.iter().filter(|p| p[3] == first) {
         let r = distance_to_well(&[p[0], p[1], 0.0]);
-        assert!(r <= WELL_RADIUS + 2.0 * cell, "first failure at {p:?}, {r} m from the axis");
+        assert!(
+            r <= WELL_RADIUS + 2.0 * cell,
+            "first failure at {p:?}, {r} m from the axis"
+        );
     }
     // One plane: every fractured cell within one cell size of the plane x = 15 through
     // the well's axis normal to x (the least compressive stress), over the height: cells
     // in both layers, and the crack reaching 0.5 m from the axis.
     for p in &f {
         let off = (p[0] - CENTER[0]).abs();
-        assert!(off <= cell, "fractured cell at {p:?} is {off} m off the plane (cell {cell})");
+        assert!(
+            off <= cell,
+            "fractured cell at {p:?} is {off} m off the plane (cell {cell})"
+        );
     }
     assert!(f.iter().any(|p| p[2] < 0.5) && f.iter().any(|p| p[2] > 0.5));
     let reach = f
         .iter()
         .map(|p| distance_to_well(&[p[0], p[1], 0.0]))
         .fold(0.0, f64::max);
-    assert!(reach >= 0.5, "the crack reaches only {reach} m from the axis");
+    assert!(
+        reach >= 0.5,
+        "the crack reaches only {reach} m from the axis"
+    );
     // Fields on the mid-height cross-section.
     for plot in ["pressure", "uz", "szz", "smax"] {
         assert!(

@@ -109,8 +109,7 @@ impl LowRank {
     ) -> Result<bool, LdltError> {
         self.clear_change();
         let n = self.slot.len();
-        if col_ptr.len() != n + 1 || base.len() != values.len() || values.len() != row_idx.len()
-        {
+        if col_ptr.len() != n + 1 || base.len() != values.len() || values.len() != row_idx.len() {
             return Err(LdltError("low-rank update of another pattern".into()));
         }
         for j in 0..n {
@@ -283,11 +282,18 @@ mod tests {
                     changed[q] *= 2.5;
                 }
             }
-            assert!(lr.prepare(&mut ldlt, &cp, &ri, &base, &changed, 64).unwrap());
+            assert!(
+                lr.prepare(&mut ldlt, &cp, &ri, &base, &changed, 64)
+                    .unwrap()
+            );
             let mut x = b.clone();
             lr.solve(&mut ldlt, &mut x).unwrap();
             let ax = mul(n, &cp, &ri, &changed, &x);
-            let err = ax.iter().zip(&b).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+            let err = ax
+                .iter()
+                .zip(&b)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
             assert!(err < 1e-12, "round {round}: residual {err:e}");
         }
         assert!(lr.cached_len() > 4);
@@ -297,7 +303,11 @@ mod tests {
         let mut x = b.clone();
         lr.solve(&mut ldlt, &mut x).unwrap();
         let ax = mul(n, &cp, &ri, &base, &x);
-        let err = ax.iter().zip(&b).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+        let err = ax
+            .iter()
+            .zip(&b)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
         assert!(err < 1e-12, "plain residual {err:e}");
     }
 }
