@@ -87,6 +87,14 @@
 //! bits. [`Monolithic::stats`], [`FixedStress::stats`] and [`ExplicitPressure::stats`]
 //! report the factorizations and solves done ([`CouplingStats`]).
 //!
+//! A matrix that differs from the factorized one in a few unknowns (a fracturing cell
+//! switching law or permeability changes the rows of its nodes and of its and its
+//! neighbours' pressures) is not factorized again: [`Monolithic`] solves it by a
+//! low-rank update of the factors (Sherman–Morrison–Woodbury, `crate::lowrank`), every
+//! such solve refined with the residual of the matrix itself to the relative residual
+//! `1e-12` of a fresh factorization (else it factorizes), and keeps the pressure scale
+//! of the factors meanwhile. Beyond `DEFAULT_MAX_RANK` changed unknowns it factorizes.
+//!
 //! # Fixed-stress split
 //!
 //! [`FixedStress`] iterates flow then mechanics (Kim, Tchelepi & Juanes 2011; Mikelić &
@@ -1031,7 +1039,8 @@ impl Monolithic {
         }
     }
 
-    /// Iterative refinement of a low-rank solve `work.z` of `work.rhs`: the updated
+    /// Iterative refinement of a low-rank solve `work.z` of `work.rhs` (every one, the
+    /// accuracy depends on the right-hand side): the updated
     /// solve loses digits as the change grows (the capacitance matrix pairs `G` with the
     /// large stiffness drop of a failed cell), so correct with the residual of the
     /// current matrix, `z += solve(b − A z)`, until it is at the level of a fresh
@@ -1258,7 +1267,7 @@ impl<const D: usize> BiotCoupling<D> for Monolithic {
         }
         w.z.clone_from(&w.rhs);
         let mut solved = self.low_rank.solve(&mut self.ldlt, &mut w.z);
-        if fresh && self.low_rank.is_active() && solved.is_ok() {
+        if self.low_rank.is_active() && solved.is_ok() {
             solved = self.refine_update(&mut w);
         }
         let result = solved
