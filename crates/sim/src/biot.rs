@@ -795,7 +795,7 @@ pub struct Monolithic {
     /// The matrix of the current factors (`values` differs from it by a low-rank change).
     factor_values: Vec<f64>,
     /// The update of the factors to `values`.
-    low_rank: LowRank,
+    low_rank: Box<LowRank>,
     /// At most this many changed unknowns go through `low_rank`; beyond, a factorization.
     max_rank: usize,
     /// Matrices solved by a low-rank update.
@@ -919,7 +919,7 @@ impl Monolithic {
             ldlt,
             values: vec![0.0; nnz],
             factor_values: Vec::new(),
-            low_rank: LowRank::new(n),
+            low_rank: Box::new(LowRank::new(n)),
             max_rank: DEFAULT_MAX_RANK,
             updates: 0,
             factored: None,
