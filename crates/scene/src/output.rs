@@ -138,6 +138,8 @@ pub struct SolverStats {
     pub symbolic_factorizations: usize,
     /// Nonzeros of the factor.
     pub factor_nnz: usize,
+    /// Matrices solved by a low-rank update of the factors instead of a factorization.
+    pub low_rank_updates: usize,
     /// Iterations of iterative solvers (total).
     pub iterations: usize,
     /// Largest relative residual ‖K u − f‖ / ‖f‖ over the solves.

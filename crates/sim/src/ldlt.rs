@@ -231,6 +231,39 @@ impl Ldlt {
         Ok(())
     }
 
+    /// Solve `A X = B` in place for the `k` columns of `B` stored column-major in `rhs`
+    /// (`n · k` values): faer's supernodal solve, blocked over the columns.
+    pub(crate) fn solve_columns_in_place(
+        &mut self,
+        rhs: &mut [f64],
+        k: usize,
+    ) -> Result<(), LdltError> {
+        if !self.factored {
+            return Err(LdltError("solve before a successful factorization".into()));
+        }
+        if rhs.len() != self.n * k {
+            return Err(LdltError(format!(
+                "right-hand sides of length {}, want {} × {k}",
+                rhs.len(),
+                self.n
+            )));
+        }
+        if k == 0 {
+            return Ok(());
+        }
+        self.solves += k;
+        let mut mem = MemBuffer::try_new(self.symbolic.solve_in_place_scratch::<f64>(k, Par::Seq))
+            .map_err(|_| LdltError("out of memory".into()))?;
+        let ldlt = LdltRef::<'_, usize, f64>::new(&self.symbolic, &self.values);
+        ldlt.solve_in_place_with_conj(
+            Conj::No,
+            MatMut::from_column_major_slice_mut(rhs, self.n, k),
+            Par::Seq,
+            MemStack::new(&mut mem),
+        );
+        Ok(())
+    }
+
     /// Solve `A x = b` in place (`rhs` holds `b` on entry, `x` on return).
     pub(crate) fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LdltError> {
         if !self.factored {

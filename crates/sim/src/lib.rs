@@ -55,6 +55,7 @@ pub mod heap;
 pub mod laws;
 mod ldlt;
 pub mod linear;
+mod lowrank;
 pub mod ordering;
 pub mod particle_fluid;
 pub mod pattern;

@@ -474,6 +474,7 @@ impl<'a, const D: usize> Stepper<'a, D> {
         self.stats.factorizations = coupling.numeric_factorizations;
         self.stats.symbolic_factorizations = coupling.symbolic_factorizations;
         self.stats.factor_nnz = coupling.factor_nnz;
+        self.stats.low_rank_updates = coupling.low_rank_updates;
         self.failures = frac.failures().clone();
         self.pressure = Some(next.state.pressure.clone());
         self.u.clone_from(&next.state.displacement);

@@ -1,0 +1,313 @@
+//! Solves with a matrix that differs from a factorized one in a few rows and columns
+//! (Sherman–Morrison–Woodbury in capacitance form).
+//!
+//! A fracturing step changes the coupled matrix only where a cell switched law or
+//! permeability: `A = A₀ + P Δ Pᵀ`, with `P` the columns of the identity of the set `T` of
+//! unknowns in a changed entry (`m = |T|`) and `Δ` the symmetric `m × m` change. With the
+//! factors of `A₀` and `G = Pᵀ A₀⁻¹ P`, `A x = b` is
+//!
+//! ```text
+//!   (I + G Δ) y = Pᵀ A₀⁻¹ b ,      x = A₀⁻¹ (b − P Δ y)
+//! ```
+//!
+//! (`y = Pᵀ x`; Hager 1989, *Updating the inverse of a matrix*). The columns of `G` are
+//! solves of `A₀` with unit vectors; they are kept for every unknown met since the last
+//! factorization (one blocked multi-column solve per batch of new unknowns), so a later
+//! change pays only for the unknowns new to it. A solve is then two solves with `A₀` and
+//! one with the `m × m` capacitance matrix `I + G Δ` (dense LU with partial pivoting,
+//! factorized once per change). The caller bounds `m` and factorizes `A` afresh beyond it,
+//! and checks the residual of the result against `A` itself.
+
+use faer::Mat;
+use faer::linalg::solvers::{PartialPivLu, Solve};
+
+use crate::ldlt::{Ldlt, LdltError};
+
+/// Unknowns whose columns of `A₀⁻¹` are computed in one blocked solve.
+const BATCH: usize = 32;
+
+/// Marks an unknown without a slot.
+const NONE: usize = usize::MAX;
+
+/// The update of a factorized matrix `A₀` to a matrix of the same pattern differing in
+/// few unknowns (see the module docs).
+pub(crate) struct LowRank {
+    /// Per unknown: its slot among the cached columns, or [`NONE`].
+    slot: Vec<usize>,
+    /// The unknown of every slot.
+    cached: Vec<usize>,
+    /// `g[a][b] = (A₀⁻¹)[cached[b], cached[a]]`.
+    g: Vec<Vec<f64>>,
+    /// The unknowns `T` of the current change.
+    support: Vec<usize>,
+    /// Per unknown: its index in `support`, or [`NONE`].
+    local: Vec<usize>,
+    /// The entries `(i, j, Δ_ij)` of the change, indices into `support`, both triangles.
+    delta: Vec<(usize, usize, f64)>,
+    /// LU of `I + G Δ`; `None`: no change set up (solve with `A₀`).
+    lu: Option<PartialPivLu<f64>>,
+    /// Work vector of the first solve.
+    z: Vec<f64>,
+}
+
+impl LowRank {
+    /// No cached columns, no change, for `n` unknowns.
+    pub(crate) fn new(n: usize) -> Self {
+        Self {
+            slot: vec![NONE; n],
+            cached: Vec::new(),
+            g: Vec::new(),
+            support: Vec::new(),
+            local: vec![NONE; n],
+            delta: Vec::new(),
+            lu: None,
+            z: Vec::new(),
+        }
+    }
+
+    /// Forget the cached columns and the change (after a new factorization of `A₀`).
+    pub(crate) fn clear(&mut self) {
+        for &u in &self.cached {
+            self.slot[u] = NONE;
+        }
+        self.cached.clear();
+        self.g.clear();
+        self.clear_change();
+    }
+
+    fn clear_change(&mut self) {
+        for &u in &self.support {
+            self.local[u] = NONE;
+        }
+        self.support.clear();
+        self.delta.clear();
+        self.lu = None;
+    }
+
+    /// Whether a change is set up (solves go through the capacitance matrix).
+    pub(crate) fn is_active(&self) -> bool {
+        self.lu.is_some()
+    }
+
+    /// Unknowns whose columns of `A₀⁻¹` are cached.
+    #[cfg(test)]
+    pub(crate) fn cached_len(&self) -> usize {
+        self.cached.len()
+    }
+
+    /// Set up the change from the factorized upper triangle `base` to `values` (the same
+    /// CSC pattern `col_ptr`, `row_idx`). Returns `false`, with nothing set up, when more
+    /// than `max_rank` unknowns changed.
+    pub(crate) fn prepare(
+        &mut self,
+        ldlt: &mut Ldlt,
+        col_ptr: &[usize],
+        row_idx: &[usize],
+        base: &[f64],
+        values: &[f64],
+        max_rank: usize,
+    ) -> Result<bool, LdltError> {
+        self.clear_change();
+        let n = self.slot.len();
+        if col_ptr.len() != n + 1 || base.len() != values.len() || values.len() != row_idx.len() {
+            return Err(LdltError("low-rank update of another pattern".into()));
+        }
+        for j in 0..n {
+            for q in col_ptr[j]..col_ptr[j + 1] {
+                let d = values[q] - base[q];
+                if d == 0.0 {
+                    continue;
+                }
+                let i = row_idx[q];
+                for u in [i, j] {
+                    if self.local[u] == NONE {
+                        self.local[u] = self.support.len();
+                        self.support.push(u);
+                    }
+                }
+                if self.support.len() > max_rank {
+                    self.clear_change();
+                    return Ok(false);
+                }
+                let (a, b) = (self.local[i], self.local[j]);
+                self.delta.push((a, b, d));
+                if a != b {
+                    self.delta.push((b, a, d));
+                }
+            }
+        }
+        self.extend_cache(ldlt)?;
+        let m = self.support.len();
+        let slots: Vec<usize> = self.support.iter().map(|&u| self.slot[u]).collect();
+        let mut cap = Mat::<f64>::identity(m, m);
+        for &(k, j, v) in &self.delta {
+            let col = &self.g[slots[k]];
+            for (i, &si) in slots.iter().enumerate() {
+                cap[(i, j)] += v * col[si];
+            }
+        }
+        self.lu = Some(cap.partial_piv_lu());
+        Ok(true)
+    }
+
+    /// Cache the columns of `A₀⁻¹` of the support's unknowns not cached yet.
+    fn extend_cache(&mut self, ldlt: &mut Ldlt) -> Result<(), LdltError> {
+        let n = self.slot.len();
+        let new: Vec<usize> = self
+            .support
+            .iter()
+            .copied()
+            .filter(|&u| self.slot[u] == NONE)
+            .collect();
+        let mut cols = Vec::new();
+        for chunk in new.chunks(BATCH) {
+            let k = chunk.len();
+            cols.clear();
+            cols.resize(n * k, 0.0);
+            for (c, &u) in chunk.iter().enumerate() {
+                cols[c * n + u] = 1.0;
+            }
+            ldlt.solve_columns_in_place(&mut cols, k)?;
+            let old = self.cached.len();
+            for &u in chunk {
+                self.slot[u] = self.cached.len();
+                self.cached.push(u);
+            }
+            // Old columns gain the rows of the new unknowns (A₀⁻¹ is symmetric).
+            for a in 0..old {
+                let v = self.cached[a];
+                let col = &mut self.g[a];
+                col.extend((0..k).map(|c| cols[c * n + v]));
+            }
+            for c in 0..k {
+                let col = &cols[c * n..(c + 1) * n];
+                self.g.push(self.cached.iter().map(|&v| col[v]).collect());
+            }
+        }
+        Ok(())
+    }
+
+    /// Solve `A x = b` in place with the factors of `A₀` and the change set up by
+    /// [`LowRank::prepare`] (plainly with `A₀` when none is).
+    pub(crate) fn solve(&mut self, ldlt: &mut Ldlt, rhs: &mut [f64]) -> Result<(), LdltError> {
+        let Some(lu) = &self.lu else {
+            return ldlt.solve_in_place(rhs);
+        };
+        self.z.clear();
+        self.z.extend_from_slice(rhs);
+        ldlt.solve_in_place(&mut self.z)?;
+        let m = self.support.len();
+        let mut y = Mat::<f64>::from_fn(m, 1, |i, _| self.z[self.support[i]]);
+        lu.solve_in_place(y.as_mut());
+        for &(i, j, v) in &self.delta {
+            rhs[self.support[i]] -= v * y[(j, 0)];
+        }
+        ldlt.solve_in_place(rhs)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Upper-triangle CSC of a quasi-definite matrix: a 2D 5-point Laplacian block
+    /// (`nx × nx`, positive) and a negative diagonal block coupled to it.
+    fn matrix(nx: usize) -> (usize, Vec<usize>, Vec<usize>, Vec<f64>) {
+        let nu = nx * nx;
+        let n = nu + nx;
+        let mut col_ptr = vec![0];
+        let mut rows = Vec::new();
+        let mut vals = Vec::new();
+        for j in 0..n {
+            if j < nu {
+                let (x, y) = (j % nx, j / nx);
+                if y > 0 {
+                    rows.push(j - nx);
+                    vals.push(-1.0);
+                }
+                if x > 0 {
+                    rows.push(j - 1);
+                    vals.push(-1.0);
+                }
+                rows.push(j);
+                vals.push(4.2);
+            } else {
+                let c = j - nu;
+                rows.push(c * nx + c);
+                vals.push(0.5);
+                rows.push(j);
+                vals.push(-2.0);
+            }
+            col_ptr.push(rows.len());
+        }
+        (n, col_ptr, rows, vals)
+    }
+
+    fn mul(n: usize, cp: &[usize], ri: &[usize], v: &[f64], x: &[f64]) -> Vec<f64> {
+        let mut y = vec![0.0; n];
+        for j in 0..n {
+            for q in cp[j]..cp[j + 1] {
+                let i = ri[q];
+                y[i] += v[q] * x[j];
+                if i != j {
+                    y[j] += v[q] * x[i];
+                }
+            }
+        }
+        y
+    }
+
+    /// The updated solve satisfies the changed system to rounding, also after a second
+    /// change that reuses cached columns and adds new ones, and when the change softens
+    /// a block to almost nothing (a cell that fails).
+    #[test]
+    fn update_solves_the_changed_matrix() {
+        let (n, cp, ri, base) = matrix(12);
+        let mut ldlt = Ldlt::analyse(n, &cp, &ri, None).unwrap();
+        ldlt.factorize(&cp, &ri, &base).unwrap();
+        let mut lr = LowRank::new(n);
+        let b: Vec<f64> = (0..n).map(|i| ((i * 7 + 3) % 11) as f64 - 5.0).collect();
+        let mut changed = base.clone();
+        // Soften the couplings of unknowns 40..44 (both triangles are one stored entry).
+        for j in 40..44 {
+            for q in cp[j]..cp[j + 1] {
+                changed[q] *= if ri[q] == j { 0.3 } else { 1e-6 };
+            }
+        }
+        for round in 0..2 {
+            if round == 1 {
+                // A second change: more unknowns, some cached already.
+                let j = n - 3;
+                for q in cp[j]..cp[j + 1] {
+                    changed[q] *= 2.5;
+                }
+            }
+            assert!(
+                lr.prepare(&mut ldlt, &cp, &ri, &base, &changed, 64)
+                    .unwrap()
+            );
+            let mut x = b.clone();
+            lr.solve(&mut ldlt, &mut x).unwrap();
+            let ax = mul(n, &cp, &ri, &changed, &x);
+            let err = ax
+                .iter()
+                .zip(&b)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            assert!(err < 1e-12, "round {round}: residual {err:e}");
+        }
+        assert!(lr.cached_len() > 4);
+        // Too many unknowns: nothing set up, a plain solve with A₀.
+        assert!(!lr.prepare(&mut ldlt, &cp, &ri, &base, &changed, 3).unwrap());
+        assert!(!lr.is_active());
+        let mut x = b.clone();
+        lr.solve(&mut ldlt, &mut x).unwrap();
+        let ax = mul(n, &cp, &ri, &base, &x);
+        let err = ax
+            .iter()
+            .zip(&b)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(err < 1e-12, "plain residual {err:e}");
+    }
+}
