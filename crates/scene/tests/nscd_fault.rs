@@ -1,7 +1,7 @@
 //! The fault-propagation experiment (seed 003, F2) through the library: the trends of
 //! the seed on the bundled reduced runs (`scenes/nscd/fault_gamma*.toml`, the
-//! 150 m × 15 m geometry scaled by 1/5) — the one that holds runs, the others are kept
-//! ignored with the measured values — and the scene keys of the settling and of the
+//! 150 m × 15 m geometry scaled by 1/5, and `fault_thick.toml`, scaled by 2/5) — those
+//! that hold run, the others are kept ignored with the measured values — and the scene keys of the settling and of the
 //! fault measures on a smaller sample ([`scene_text`]: geometry × `SCALE` of the
 //! paper's, radii, density, μ and γ unchanged, the basement block at the paper's
 //! 0.325 m/s for the run that gives the paper's slip over thickness, 13 m / 15 m,
