@@ -4,8 +4,8 @@
 //! 100 m wide box with a floor and two side walls, settled under gravity for 20 steps.
 //! Each measured iteration is one time step of h = 1e-3 s with exactly 100 sweeps
 //! (min = max = 100); criterion reports elements per second = contacts × 100 / time.
-//! Two variants: the sequential sweep in sorted order, and the coloured parallel sweep
-//! in rayon's default pool (one thread per core).
+//! Three variants: the sequential sweep in sorted order, and the coloured and the
+//! slab-partitioned parallel sweeps in rayon's default pool (one thread per core).
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use porofrac_nscd::{ContactLaw, Nscd, Ordering, RigidBody, SolverParams};
@@ -42,6 +42,7 @@ fn bench(c: &mut Criterion) {
     for (name, ordering) in [
         ("sorted, 1 thread", Ordering::Sorted),
         ("coloured, rayon pool", Ordering::Coloured),
+        ("slabs, rayon pool", Ordering::Slabs),
     ] {
         let mut s = pile(ordering);
         let contacts = s.step(1e-3).unwrap().contacts;

@@ -173,7 +173,7 @@ pub fn sweep(
     (num, den)
 }
 
-fn solve_chunk(
+pub(crate) fn solve_chunk(
     chunk: &mut [Contact],
     vel: &SharedVelocities,
     inv_m: &[f64],

@@ -24,6 +24,7 @@ pub mod colour;
 pub mod detect;
 pub mod law;
 pub mod settle;
+pub mod slabs;
 pub mod solver;
 
 pub use body::{Axis, RigidBody};

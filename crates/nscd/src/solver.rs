@@ -31,7 +31,10 @@
 //! (candidate, then antagonist), the same every sweep; [`Ordering::Random`] draws a new
 //! permutation for every sweep from a seed and the step number, reproducible too;
 //! [`Ordering::Coloured`] sweeps colour groups of independent contacts in parallel
-//! ([`crate::colour`]), with a result that does not depend on the thread count.
+//! ([`crate::colour`]), with a result that does not depend on the thread count;
+//! [`Ordering::Slabs`] sweeps one slab of disks per thread in parallel, each in sorted
+//! order, then the contacts between slabs ([`crate::slabs`]), with a result that depends
+//! on the thread count only.
 
 use porofrac_particles::Disks;
 use porofrac_particles::rng::SplitMix64;
@@ -57,6 +60,10 @@ pub enum Ordering {
     /// Colour groups swept in parallel ([`crate::colour`]): the same result for any
     /// number of threads.
     Coloured,
+    /// One slab of disks per thread swept in parallel, each in sorted order, then the
+    /// contacts between slabs ([`crate::slabs`]): the same result for a given number of
+    /// threads.
+    Slabs,
 }
 
 /// Options of the time stepping and of NLGS.
@@ -184,6 +191,7 @@ pub struct Nscd {
     shared: crate::colour::SharedVelocities,
     masks: Vec<u64>,
     starts: Vec<usize>,
+    slabs: crate::slabs::Slabs,
 }
 
 impl Nscd {
@@ -238,6 +246,7 @@ impl Nscd {
             shared: Default::default(),
             masks: Vec::new(),
             starts: Vec::new(),
+            slabs: crate::slabs::Slabs::default(),
         };
         let offsets: Vec<[f64; 2]> = s.bodies.iter().map(|b| b.offset).collect();
         let mut found = Vec::new();
@@ -468,19 +477,30 @@ impl Nscd {
             _ => None,
         };
         let coloured = self.params.ordering == Ordering::Coloured && !self.contacts.is_empty();
+        let slabs = self.params.ordering == Ordering::Slabs && !self.contacts.is_empty();
         let mut serial_last = false;
-        if coloured {
+        if coloured || slabs {
             let moving: Vec<bool> = (0..n)
                 .map(|i| self.inv_m[i] > 0.0 || self.inv_i[i] > 0.0)
                 .collect();
             let body_moving: Vec<bool> = self.body_inv.iter().map(|b| *b != [0.0, 0.0]).collect();
-            serial_last = crate::colour::colour(
-                &mut self.contacts,
-                &moving,
-                &body_moving,
-                &mut self.masks,
-                &mut self.starts,
-            );
+            if coloured {
+                serial_last = crate::colour::colour(
+                    &mut self.contacts,
+                    &moving,
+                    &body_moving,
+                    &mut self.masks,
+                    &mut self.starts,
+                );
+            } else {
+                self.slabs.partition(
+                    &mut self.contacts,
+                    &d.x,
+                    &moving,
+                    &body_moving,
+                    rayon::current_num_threads(),
+                );
+            }
             self.shared.load(&d.v, &d.omega, &self.body_v);
         }
         if !self.contacts.is_empty() {
@@ -490,6 +510,14 @@ impl Nscd {
                         &mut self.contacts,
                         &self.starts,
                         serial_last,
+                        &self.shared,
+                        &self.inv_m,
+                        &self.inv_i,
+                        &self.body_inv,
+                    )
+                } else if slabs {
+                    self.slabs.sweep(
+                        &mut self.contacts,
                         &self.shared,
                         &self.inv_m,
                         &self.inv_i,
@@ -544,7 +572,7 @@ impl Nscd {
         } else {
             stats.converged = true;
         }
-        if coloured {
+        if coloured || slabs {
             self.shared.store(&mut d.v, &mut d.omega, &mut self.body_v);
         }
         stats.updates = stats.sweeps as u64 * self.contacts.len() as u64;

@@ -63,6 +63,9 @@ pub enum OrderingChoice {
     /// Colour groups of independent contacts swept in parallel (the same result for
     /// any number of threads).
     Coloured,
+    /// One slab of disks per thread swept in parallel, then the contacts between slabs
+    /// (the same result for a given number of threads).
+    Slabs,
 }
 
 /// `[nscd]`: time stepping and NLGS.

@@ -156,6 +156,7 @@ pub fn build(ls: &LoadedScene) -> Result<NscdModel<'_>, RunError> {
         ordering: match n.ordering.unwrap_or_default() {
             OrderingChoice::Sorted => Ordering::Sorted,
             OrderingChoice::Coloured => Ordering::Coloured,
+            OrderingChoice::Slabs => Ordering::Slabs,
             OrderingChoice::Random => Ordering::Random {
                 seed: n.ordering_seed.unwrap_or(1),
             },
