@@ -31,7 +31,9 @@ use std::time::Instant;
 use plotters::style::RGBColor;
 use porofrac_grid::io::PvdWriter;
 use porofrac_lsm::calibrate::{QuasiStatic, brazilian, hexagonal_moduli, uniaxial};
-use porofrac_lsm::{BreakMode, ContactLaw, Damping, LatticeSolid, LsmSpec, Motion, NormalLaw};
+use porofrac_lsm::{
+    BreakMode, ContactLaw, Damping, LatticeSolid, LsmSpec, Motion, NormalLaw, WallFaces,
+};
 use porofrac_particles::packing::Region;
 use porofrac_particles::tracked::CellContact;
 use porofrac_particles::vtk::ContactLine;
@@ -43,7 +45,7 @@ use crate::model::{Model, RunError, Sizes, StepStats};
 use crate::output::{SolverStats, Summary, WallSeconds};
 use crate::particle_output::{self, PARTICLE_FIELDS};
 
-use file::{DampingChoice, NormalChoice};
+use file::{DampingChoice, NormalChoice, WallChoice};
 
 /// Run a checked lattice solid scene and write its `summary.json`.
 pub(crate) fn run(
@@ -62,6 +64,8 @@ enum ProbeKind {
     Particle(usize, usize),
     Cell(usize, usize),
     Global(usize),
+    /// A fluid field ([`check::FLUID_FIELDS`]) at a point (m).
+    Fluid([f64; 2], usize),
 }
 
 /// Results of `[bonds] calibrate = true`.
@@ -253,11 +257,22 @@ pub fn build(ls: &LoadedScene) -> Result<LsmModel<'_>, RunError> {
         load.pressure_rate,
         s.particles.as_ref().and_then(|p| p.hole),
     ) {
-        (Some(_), Some(h)) => Some(
-            solid
-                .add_pressure_wall(h.center, h.radius)
-                .map_err(|e| check::lsm_error(ls, &e))?,
-        ),
+        (Some(_), Some(h)) => {
+            let faces = match load.wall {
+                WallChoice::Rays => WallFaces::Rays,
+                WallChoice::Wetted => WallFaces::Wetted {
+                    spacing: load
+                        .wall_spacing
+                        .unwrap_or(0.5 * solid.disks().radius_range()[0]),
+                    seal: spec.bond_tolerance + 1.0,
+                },
+            };
+            Some(
+                solid
+                    .add_pressure_wall_on(h.center, h.radius, faces)
+                    .map_err(|e| check::lsm_error(ls, &e))?,
+            )
+        }
         _ => None,
     };
     let sch = s.schedule.as_ref().expect("checked: [schedule] present");
@@ -276,7 +291,9 @@ pub fn build(ls: &LoadedScene) -> Result<LsmModel<'_>, RunError> {
     let mut probes = Vec::new();
     let mut cells = Vec::new();
     for (i, p) in s.output.probe.iter().enumerate() {
-        if let Some(f) = PARTICLE_FIELDS.iter().position(|f| *f == p.field) {
+        if let Some(f) = check::FLUID_FIELDS.iter().position(|f| *f == p.field) {
+            probes.push(ProbeKind::Fluid([p.at[0], p.at[1]], f));
+        } else if let Some(f) = PARTICLE_FIELDS.iter().position(|f| *f == p.field) {
             let idx = p.particle.expect("checked") as usize;
             if idx >= count {
                 return Err(ls
@@ -564,6 +581,10 @@ impl Model for LsmModel<'_> {
                     "broken_tensile" => t as f64,
                     _ => sh as f64,
                 },
+                ProbeKind::Fluid(x, f) => self
+                    .fluid
+                    .as_ref()
+                    .map_or(f64::NAN, |fl| fl.point_values(x)[f]),
                 ProbeKind::Cell(c, f) => {
                     let s = &states[c];
                     match check::CELL_FIELDS[f] {
