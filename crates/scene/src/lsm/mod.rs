@@ -4,12 +4,15 @@
 //! - *build*: the disks of `[particles]` ([`crate::particles`]), the bond law of
 //!   `[bonds]` (E and ν through the hexagonal closed form, or k_n, k_s), `[contacts]`,
 //!   `[lsm]` (time step, damping, gravity) and `[loading]` (platens, a pressure ramp on
-//!   the hole); with `[bonds] calibrate = true` a uniaxial compression and a Brazilian
+//!   the hole, on the faces seen from its centre or on the faces a fluid would wet,
+//!   [`porofrac_lsm::WallFaces`]); with `[bonds] calibrate = true` a uniaxial compression and a Brazilian
 //!   test of the same packing recipe first ([`porofrac_lsm::calibrate`]);
 //! - *step*: as many LSM steps as fit between two output times;
 //! - *fields*: particle probes (`x y vx vy omega fx fy radius`), tracked cells (`p q
 //!   anisotropy anisotropy_volume dilation_x dilation_y contacts broken_bonds`), scene
-//!   probes (`pressure platen_force broken broken_tensile broken_shear`), lines,
+//!   probes (`pressure platen_force broken broken_tensile broken_shear`), with `[lbm]`
+//!   fluid probes at a point (`fluid_pressure fluid_speed`, [`fluid::Fluid::point_values`]),
+//!   lines,
 //!   `vtk/particles_NNNN.vtp` (with `broken_bonds` per particle) and
 //!   `vtk/contacts_NNNN.vtp` (intact bonds `bonded = 1`, touching contacts `0`),
 //!   `broken.csv` (`time,i,j,x,y,mode`), field extrema and `summary.json` keys
