@@ -50,7 +50,7 @@ pub mod wall;
 pub use bond::{Bond, BondForce, BreakMode, BrokenBond};
 pub use law::{BondLaw, ContactLaw, Damping, Motion, NormalLaw};
 pub use solid::{LatticeSolid, LsmSpec, StepReport};
-pub use wall::PressureWall;
+pub use wall::{PressureWall, WallFaces};
 
 /// A bad parameter or a failed step. Every variant names the argument or the particle.
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]

@@ -28,7 +28,7 @@
 use crate::bond::{Bond, BondForce, BreakMode, BrokenBond};
 use crate::contact::{ContactForce, Pair};
 use crate::law::{BondLaw, ContactLaw, Damping, Motion};
-use crate::{LsmError, PressureWall};
+use crate::{LsmError, PressureWall, WallFaces};
 use porofrac_particles::Disks;
 use porofrac_particles::cells::{CellList, max_radius};
 use rayon::prelude::*;
@@ -336,7 +336,18 @@ impl LatticeSolid {
     /// A pressure wall on the circular hole of `centre` and `radius` (see
     /// [`PressureWall`]); returns its index for [`Self::set_wall_pressure`].
     pub fn add_pressure_wall(&mut self, centre: [f64; 2], radius: f64) -> Result<usize, LsmError> {
-        let w = PressureWall::new(&self.disks, centre, radius)?;
+        self.add_pressure_wall_on(centre, radius, WallFaces::Rays)
+    }
+
+    /// A pressure wall on the circular hole of `centre` and `radius` loading `faces`
+    /// ([`PressureWall::with_faces`]); returns its index for [`Self::set_wall_pressure`].
+    pub fn add_pressure_wall_on(
+        &mut self,
+        centre: [f64; 2],
+        radius: f64,
+        faces: WallFaces,
+    ) -> Result<usize, LsmError> {
+        let w = PressureWall::with_faces(&self.disks, centre, radius, faces)?;
         self.walls.push(w);
         Ok(self.walls.len() - 1)
     }

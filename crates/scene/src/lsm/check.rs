@@ -2,7 +2,7 @@
 //! and the model named, every value checked (the bond law is built here, so that a bad
 //! stiffness or strength names its key).
 
-use crate::check::{LoadedScene, SceneError, k};
+use crate::check::{LoadedScene, SceneError, k, ki};
 use crate::file::KeyPart;
 use porofrac_lsm::{BondLaw, LsmError};
 
@@ -52,6 +52,62 @@ pub const GLOBAL_FIELDS: [&str; 5] = [
     "broken_shear",
 ];
 
+/// Fields of the fluid at a point `at = [x, y]` (scenes with `[lbm]`): gauge pressure
+/// (Pa) and speed (m/s), bilinear between the fluid nodes around the point.
+pub const FLUID_FIELDS: [&str; 2] = ["fluid_pressure", "fluid_speed"];
+
+/// Check the fluid point probes; returns the scene with each of them replaced by a
+/// scene-wide probe of the same name, for the checks shared with the other particle
+/// model (which refuse `at`).
+fn check_fluid_probes(ls: &LoadedScene) -> Result<Option<LoadedScene>, SceneError> {
+    let s = &ls.scene;
+    let mut out: Option<LoadedScene> = None;
+    for (i, p) in s.output.probe.iter().enumerate() {
+        if !FLUID_FIELDS.contains(&p.field.as_str()) {
+            continue;
+        }
+        let key = |f: &str| ki("output.probe", i, &[f]);
+        let Some(l) = &s.lbm else {
+            return Err(ls.error(
+                &key("field"),
+                format!("= \"{}\" needs [lbm]: the fluid it probes", p.field),
+            ));
+        };
+        if p.particle.is_some() || p.cell.is_some() {
+            return Err(ls.error(
+                &key(if p.particle.is_some() {
+                    "particle"
+                } else {
+                    "cell"
+                }),
+                format!(
+                    "is not allowed for field \"{}\" (it takes at = [x, y])",
+                    p.field
+                ),
+            ));
+        }
+        let finite = p.at.len() == 2 && p.at.iter().all(|v| v.is_finite());
+        if !finite {
+            return Err(ls.error(&key("at"), "must be [x, y] (m)"));
+        }
+        let inside = (0..2).all(|a| {
+            let (lo, hi) = (l.extent[0].get(a), l.extent[1].get(a));
+            matches!((lo, hi), (Some(lo), Some(hi)) if p.at[a] >= *lo && p.at[a] <= *hi)
+        });
+        if !inside {
+            return Err(ls.error(
+                &key("at"),
+                format!("= [{}, {}] lies outside lbm.extent", p.at[0], p.at[1]),
+            ));
+        }
+        let o = out.get_or_insert_with(|| ls.clone());
+        let q = &mut o.scene.output.probe[i];
+        q.field = GLOBAL_FIELDS[0].to_string();
+        q.at.clear();
+    }
+    Ok(out)
+}
+
 fn top_level(ls: &LoadedScene) -> Vec<String> {
     toml::from_str::<toml::Table>(&ls.text)
         .map(|t| t.keys().cloned().collect())
@@ -80,7 +136,8 @@ pub fn key_of(name: &str) -> Vec<KeyPart> {
         ["damping", _] => k(&["lsm", "damping_coefficient"]),
         ["E"] => k(&["bonds", "youngs_modulus"]),
         ["nu"] => k(&["bonds", "poisson_ratio"]),
-        ["hole radius"] => k(&["particles", "hole"]),
+        ["hole radius"] | ["hole centre x"] => k(&["particles", "hole"]),
+        ["wall spacing"] | ["wall seal"] => k(&["loading", "wall"]),
         [s, f] => k(&[s, f]),
         _ => k(&["lsm"]),
     }
@@ -323,8 +380,23 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
             }
             positive(ls, &key("pressure_max"), m)?;
         }
+        if l.wall != super::file::WallChoice::Rays && l.pressure_rate.is_none() {
+            return Err(ls.error(&key("wall"), "needs pressure_rate"));
+        }
+        if let Some(h) = l.wall_spacing {
+            if l.wall != super::file::WallChoice::Wetted {
+                return Err(ls.error(&key("wall_spacing"), "needs wall = \"wetted\""));
+            }
+            positive(ls, &key("wall_spacing"), h)?;
+        }
     }
     crate::nscd::check::check_particle_schedule(ls, "lsm")?;
     super::fluid::check(ls)?;
-    crate::nscd::check::check_output_of(ls, "lsm", &CELL_FIELDS, &GLOBAL_FIELDS)
+    let shared = check_fluid_probes(ls)?;
+    crate::nscd::check::check_output_of(
+        shared.as_ref().unwrap_or(ls),
+        "lsm",
+        &CELL_FIELDS,
+        &GLOBAL_FIELDS,
+    )
 }

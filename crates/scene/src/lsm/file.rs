@@ -108,6 +108,18 @@ pub struct PlatensSpec {
     pub thickness: f64,
 }
 
+/// `[loading] wall`: which faces of the lining particles the hole pressure loads.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum WallChoice {
+    /// The faces seen from the hole centre.
+    #[default]
+    Rays,
+    /// The faces a fluid filling the hole wets (notches and connected pockets), bonded
+    /// gaps sealed ([`porofrac_lsm::WallFaces::Wetted`]).
+    Wetted,
+}
+
 /// `[loading]`.
 #[derive(Clone, Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -118,4 +130,10 @@ pub struct LoadingSection {
     pub pressure_rate: Option<f64>,
     /// Largest pressure, then held (Pa, default no limit).
     pub pressure_max: Option<f64>,
+    /// Faces the pressure loads (default `"rays"`).
+    #[serde(default)]
+    pub wall: WallChoice,
+    /// `wall = "wetted"`: raster spacing (m, default half the smallest radius, the
+    /// lattice spacing a fluid would need).
+    pub wall_spacing: Option<f64>,
 }

@@ -358,6 +358,44 @@ impl Fluid {
             .map_or(0.0, |i| i.pressure(self.pf.lattice(), self.pf.units()))
     }
 
+    /// The fields of [`super::check::FLUID_FIELDS`] at SI point `x`: gauge pressure (Pa)
+    /// and speed (m/s), bilinear between the four nodes around `x`, over the fluid ones
+    /// only (weights renormalised); NaN when all four are covered by particles.
+    pub fn point_values(&self, x: [f64; 2]) -> [f64; 2] {
+        let (lat, u, o) = (self.pf.lattice(), self.pf.units(), self.pf.origin());
+        let (nx, ny) = lat.size();
+        let g = |a: usize, n: usize| ((x[a] - o[a]) / u.dx - 0.5).clamp(0.0, (n - 1) as f64);
+        let (gx, gy) = (g(0, nx), g(1, ny));
+        let (i0, j0) = (
+            (gx.floor() as usize).min(nx - 2),
+            (gy.floor() as usize).min(ny - 2),
+        );
+        let (fx, fy) = (gx - i0 as f64, gy - j0 as f64);
+        let (mut rho, mut v, mut sum) = (0.0, [0.0; 2], 0.0);
+        for (di, dj, w) in [
+            (0, 0, (1.0 - fx) * (1.0 - fy)),
+            (1, 0, fx * (1.0 - fy)),
+            (0, 1, (1.0 - fx) * fy),
+            (1, 1, fx * fy),
+        ] {
+            if lat.is_solid(i0 + di, j0 + dj) {
+                continue;
+            }
+            let (r, m) = lat.moments(i0 + di, j0 + dj);
+            rho += w * r;
+            v[0] += w * m[0];
+            v[1] += w * m[1];
+            sum += w;
+        }
+        if sum <= 0.0 {
+            return [f64::NAN; 2];
+        }
+        [
+            u.pressure_si(rho / sum),
+            u.velocity_si(v[0].hypot(v[1]) / sum),
+        ]
+    }
+
     /// `summary.json` keys.
     pub fn summary(&self, m: &mut serde_json::Map<String, serde_json::Value>) {
         let u = self.pf.units();

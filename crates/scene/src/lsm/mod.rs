@@ -4,12 +4,15 @@
 //! - *build*: the disks of `[particles]` ([`crate::particles`]), the bond law of
 //!   `[bonds]` (E and ν through the hexagonal closed form, or k_n, k_s), `[contacts]`,
 //!   `[lsm]` (time step, damping, gravity) and `[loading]` (platens, a pressure ramp on
-//!   the hole); with `[bonds] calibrate = true` a uniaxial compression and a Brazilian
+//!   the hole, on the faces seen from its centre or on the faces a fluid would wet,
+//!   [`porofrac_lsm::WallFaces`]); with `[bonds] calibrate = true` a uniaxial compression and a Brazilian
 //!   test of the same packing recipe first ([`porofrac_lsm::calibrate`]);
 //! - *step*: as many LSM steps as fit between two output times;
 //! - *fields*: particle probes (`x y vx vy omega fx fy radius`), tracked cells (`p q
 //!   anisotropy anisotropy_volume dilation_x dilation_y contacts broken_bonds`), scene
-//!   probes (`pressure platen_force broken broken_tensile broken_shear`), lines,
+//!   probes (`pressure platen_force broken broken_tensile broken_shear`), with `[lbm]`
+//!   fluid probes at a point (`fluid_pressure fluid_speed`, [`fluid::Fluid::point_values`]),
+//!   lines,
 //!   `vtk/particles_NNNN.vtp` (with `broken_bonds` per particle) and
 //!   `vtk/contacts_NNNN.vtp` (intact bonds `bonded = 1`, touching contacts `0`),
 //!   `broken.csv` (`time,i,j,x,y,mode`), field extrema and `summary.json` keys
@@ -31,7 +34,9 @@ use std::time::Instant;
 use plotters::style::RGBColor;
 use porofrac_grid::io::PvdWriter;
 use porofrac_lsm::calibrate::{QuasiStatic, brazilian, hexagonal_moduli, uniaxial};
-use porofrac_lsm::{BreakMode, ContactLaw, Damping, LatticeSolid, LsmSpec, Motion, NormalLaw};
+use porofrac_lsm::{
+    BreakMode, ContactLaw, Damping, LatticeSolid, LsmSpec, Motion, NormalLaw, WallFaces,
+};
 use porofrac_particles::packing::Region;
 use porofrac_particles::tracked::CellContact;
 use porofrac_particles::vtk::ContactLine;
@@ -43,7 +48,7 @@ use crate::model::{Model, RunError, Sizes, StepStats};
 use crate::output::{SolverStats, Summary, WallSeconds};
 use crate::particle_output::{self, PARTICLE_FIELDS};
 
-use file::{DampingChoice, NormalChoice};
+use file::{DampingChoice, NormalChoice, WallChoice};
 
 /// Run a checked lattice solid scene and write its `summary.json`.
 pub(crate) fn run(
@@ -62,6 +67,8 @@ enum ProbeKind {
     Particle(usize, usize),
     Cell(usize, usize),
     Global(usize),
+    /// A fluid field ([`check::FLUID_FIELDS`]) at a point (m).
+    Fluid([f64; 2], usize),
 }
 
 /// Results of `[bonds] calibrate = true`.
@@ -253,11 +260,22 @@ pub fn build(ls: &LoadedScene) -> Result<LsmModel<'_>, RunError> {
         load.pressure_rate,
         s.particles.as_ref().and_then(|p| p.hole),
     ) {
-        (Some(_), Some(h)) => Some(
-            solid
-                .add_pressure_wall(h.center, h.radius)
-                .map_err(|e| check::lsm_error(ls, &e))?,
-        ),
+        (Some(_), Some(h)) => {
+            let faces = match load.wall {
+                WallChoice::Rays => WallFaces::Rays,
+                WallChoice::Wetted => WallFaces::Wetted {
+                    spacing: load
+                        .wall_spacing
+                        .unwrap_or(0.5 * solid.disks().radius_range()[0]),
+                    seal: spec.bond_tolerance + 1.0,
+                },
+            };
+            Some(
+                solid
+                    .add_pressure_wall_on(h.center, h.radius, faces)
+                    .map_err(|e| check::lsm_error(ls, &e))?,
+            )
+        }
         _ => None,
     };
     let sch = s.schedule.as_ref().expect("checked: [schedule] present");
@@ -276,7 +294,9 @@ pub fn build(ls: &LoadedScene) -> Result<LsmModel<'_>, RunError> {
     let mut probes = Vec::new();
     let mut cells = Vec::new();
     for (i, p) in s.output.probe.iter().enumerate() {
-        if let Some(f) = PARTICLE_FIELDS.iter().position(|f| *f == p.field) {
+        if let Some(f) = check::FLUID_FIELDS.iter().position(|f| *f == p.field) {
+            probes.push(ProbeKind::Fluid([p.at[0], p.at[1]], f));
+        } else if let Some(f) = PARTICLE_FIELDS.iter().position(|f| *f == p.field) {
             let idx = p.particle.expect("checked") as usize;
             if idx >= count {
                 return Err(ls
@@ -564,6 +584,10 @@ impl Model for LsmModel<'_> {
                     "broken_tensile" => t as f64,
                     _ => sh as f64,
                 },
+                ProbeKind::Fluid(x, f) => self
+                    .fluid
+                    .as_ref()
+                    .map_or(f64::NAN, |fl| fl.point_values(x)[f]),
                 ProbeKind::Cell(c, f) => {
                     let s = &states[c];
                     match check::CELL_FIELDS[f] {
