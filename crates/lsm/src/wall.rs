@@ -176,7 +176,7 @@ fn wetted_loads(
             hi[a] = hi[a].max(disks.x[i][a] + r);
         }
     }
-    let cells = |a: usize| ((hi[a] - lo[a]) / h).ceil() as usize + 4;
+    let cells = |a: usize| (((hi[a] - lo[a]) / h).ceil() as usize).saturating_add(4);
     let (nx, ny) = (cells(0), cells(1));
     if nx.saturating_mul(ny) > 1 << 28 {
         return Err(LsmError::bad(
