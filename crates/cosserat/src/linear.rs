@@ -153,17 +153,18 @@ pub struct LinearStats {
     pub max_iterations: usize,
     /// Largest true relative residual of a GMRES solve.
     pub max_residual: f64,
-    /// Stored entries of the `LDLᵀ` factor `L` ([`LinearSolver::GmresLdlt`]; 0 for the
-    /// others: faer does not report the LU's).
+    /// Stored entries of the `LDLᵀ` factor `L` ([`LinearSolver::GmresLdlt`]), plus the
+    /// `|T|²` of the dense Schur complement ([`LinearSolver::LdltSchur`]); 0 for the
+    /// others (faer does not report the LU's).
     pub factor_entries: usize,
 }
 
 /// The preconditioner of GMRES.
 enum Precond {
     /// One V-cycle on the preconditioning matrix.
-    Amg(Amg),
+    Amg(Box<Amg>),
     /// The `LDLᵀ` factors of the preconditioning matrix.
-    Ldlt(Ldlt),
+    Ldlt(Box<Ldlt>),
     /// The exact inverse by the `LDLᵀ` and the dense Schur complement.
     Schur(Box<Schur>),
 }
@@ -583,7 +584,9 @@ impl Gmres {
                 drop((ucol, urow, uval));
                 let null = rigid_motions(sys.centres, sys.dim)?;
                 let nodes: Vec<usize> = (0..n).map(|e| e / p.block).collect();
-                Precond::Amg(Amg::new(sym, &nodes, &null, &amg_options()).map_err(amg_err)?)
+                Precond::Amg(Box::new(
+                    Amg::new(sym, &nodes, &null, &amg_options()).map_err(amg_err)?,
+                ))
             }
             PrecondKind::Ldlt => {
                 let ldlt_err =
@@ -591,7 +594,7 @@ impl Gmres {
                 let perm = cell_amd(p)?;
                 let mut f = Ldlt::analyse(n, &ucol, &urow, Some(&perm)).map_err(ldlt_err)?;
                 f.factorize(&ucol, &urow, &uval).map_err(ldlt_err)?;
-                Precond::Ldlt(f)
+                Precond::Ldlt(Box::new(f))
             }
             PrecondKind::Schur => {
                 Precond::Schur(Box::new(Schur::new(sys, n, (&ucol, &urow, &uval))?))
