@@ -37,11 +37,13 @@
 //! `LDLᵀ` of `P` (plain AMD) as an inexact preconditioner instead (40–43 iterations on the
 //! plate from 8,640 to 61,440 unknowns).
 //!
-//! **Choice.** [`LinearSolver::Auto`] takes [`LinearSolver::LdltSchur`] below
-//! [`AUTO_GMRES_EQUATIONS`] equations and GMRES with the V-cycle above (measured in
-//! docs/BENCHMARKS.md: the factor's memory grows as `n log n` and its time faster than
-//! `n`; GMRES with the V-cycle stays linear in memory). The Newmark matrix, solved at
-//! every step, keeps the LU below [`AUTO_GMRES_EQUATIONS_NEWMARK`].
+//! **Choice.** [`LinearSolver::Auto`] takes, in 2D, [`LinearSolver::LdltSchur`] below
+//! [`AUTO_GMRES_EQUATIONS`] equations (with at most [`AUTO_SCHUR_UNKNOWNS`] unknowns in
+//! `T`) and GMRES with the V-cycle above (measured in docs/BENCHMARKS.md: the factor's
+//! memory grows as `n^1.2` and its time as `n^1.4` on the plate; GMRES with the V-cycle
+//! stays linear in memory); in 3D, where only the LU and GMRES were measured and `T` grows
+//! as `n^(2/3)`, the LU below [`AUTO_GMRES_EQUATIONS_3D`] and GMRES above. The Newmark
+//! matrix, solved at every step, keeps the LU below [`AUTO_GMRES_EQUATIONS_NEWMARK`].
 
 use porofrac_amg::{Amg, AmgOptions, NearNullSpace, Precision, SymCsr};
 use porofrac_sim::ldlt::Ldlt;
@@ -59,6 +61,16 @@ use crate::pattern::{BlockPattern, SparseLu};
 /// 61,440 unknowns).
 pub const AUTO_GMRES_EQUATIONS: usize = 100_000;
 
+/// Equations from which [`LinearSolver::Auto`] takes GMRES with the V-cycle for a static
+/// solve in 3D (below: the LU; the Schur complement solve is measured in 2D only).
+pub const AUTO_GMRES_EQUATIONS_3D: usize = 12_000;
+
+/// Largest number of boundary unknowns `T` for which [`LinearSolver::Auto`] takes
+/// [`LinearSolver::LdltSchur`] (2D): its dense `|T| × |T|` block then takes at most 34 MB
+/// per copy and `O(|T|³)` work of about 1.5 s (on the plate, 1,440 unknowns at 61,440: 0.5 s,
+/// about 13 % of the setup).
+pub const AUTO_SCHUR_UNKNOWNS: usize = 2_048;
+
 /// Equations from which [`LinearSolver::Auto`] takes GMRES for the Newmark matrix, solved
 /// at every step: the LU's one factorisation is then amortised over the steps (each a
 /// pair of triangular solves against tens of V-cycles for GMRES), so it is kept up to the
@@ -68,9 +80,10 @@ pub const AUTO_GMRES_EQUATIONS_NEWMARK: usize = 100_000;
 /// Which linear solver.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum LinearSolver {
-    /// [`Self::LdltSchur`] below [`AUTO_GMRES_EQUATIONS`] equations, [`Self::GmresAmg`]
-    /// from there (the Newmark matrix: [`Self::Lu`] below
-    /// [`AUTO_GMRES_EQUATIONS_NEWMARK`]).
+    /// In 2D [`Self::LdltSchur`] below [`AUTO_GMRES_EQUATIONS`] equations (and at most
+    /// [`AUTO_SCHUR_UNKNOWNS`] boundary unknowns), [`Self::GmresAmg`] otherwise; in 3D
+    /// [`Self::Lu`] below [`AUTO_GMRES_EQUATIONS_3D`], [`Self::GmresAmg`] from there (the
+    /// Newmark matrix: [`Self::Lu`] below [`AUTO_GMRES_EQUATIONS_NEWMARK`]).
     #[default]
     Auto,
     /// Sparse LU with partial pivoting (faer).
@@ -87,7 +100,9 @@ pub enum LinearSolver {
 }
 
 impl LinearSolver {
-    /// The solver used for a static solve of `equations` unknowns (never [`Self::Auto`]).
+    /// The solver used for a static 2D solve of `equations` unknowns by size alone (never
+    /// [`Self::Auto`]; [`Linear::new`] also applies the 3D rule and the bound on the
+    /// boundary unknowns of [`Self::Auto`]).
     pub fn resolve(self, equations: usize) -> Self {
         self.resolve_from(equations, AUTO_GMRES_EQUATIONS, Self::LdltSchur)
     }
@@ -187,21 +202,29 @@ struct Schur {
     xt: Vec<f64>,
 }
 
+/// The unknowns `T` of the rows and columns where the system differs from the
+/// preconditioning matrix (marked `true`).
+fn schur_unknowns(sys: SystemRef<'_>) -> Vec<bool> {
+    let p = sys.pattern;
+    let n = p.equations();
+    let mut in_t = vec![false; n];
+    for j in 0..n {
+        for q in p.col_ptr[j]..p.col_ptr[j + 1] {
+            if sys.values[q] != sys.preconditioner[q] {
+                in_t[j] = true;
+                in_t[p.row_idx[q]] = true;
+            }
+        }
+    }
+    in_t
+}
+
 impl Schur {
     /// Set up from the system and the upper triangle of the preconditioning matrix.
     fn new(sys: SystemRef<'_>, n: usize, upper: (&[usize], &[usize], &[f64])) -> Result<Self> {
         let p = sys.pattern;
         let ldlt_err = |e| CosseratError::Solve(format!("LDLᵀ of the preconditioning matrix: {e}"));
-        // T: the unknowns of the rows and columns where the system differs.
-        let mut in_t = vec![false; n];
-        for j in 0..n {
-            for q in p.col_ptr[j]..p.col_ptr[j + 1] {
-                if sys.values[q] != sys.preconditioner[q] {
-                    in_t[j] = true;
-                    in_t[p.row_idx[q]] = true;
-                }
-            }
-        }
+        let in_t = schur_unknowns(sys);
         // AMD of the cells without a component in T, then T.
         let b = p.block;
         let t_cell: Vec<bool> = (0..n / b)
@@ -344,7 +367,26 @@ impl Linear {
             }
         }
         let mut stats = LinearStats::default();
-        let kind = match options.solver.resolve(n) {
+        let solver = match options.solver {
+            // Measured on 2D plates only; in 3D the boundary unknowns grow as n^(2/3) and the
+            // dense block with them, so 3D keeps the LU and GMRES, and a 2D system whose
+            // dense block would be large takes GMRES.
+            LinearSolver::Auto if sys.dim == 3 => {
+                if n < AUTO_GMRES_EQUATIONS_3D {
+                    LinearSolver::Lu
+                } else {
+                    LinearSolver::GmresAmg
+                }
+            }
+            LinearSolver::Auto
+                if n < AUTO_GMRES_EQUATIONS
+                    && schur_unknowns(sys).iter().filter(|&&t| t).count() > AUTO_SCHUR_UNKNOWNS =>
+            {
+                LinearSolver::GmresAmg
+            }
+            s => s.resolve(n),
+        };
+        let kind = match solver {
             LinearSolver::Lu | LinearSolver::Auto => {
                 let mut lu = SparseLu::new(sys.pattern)?;
                 lu.factorize(sys.pattern, sys.values)?;

@@ -107,11 +107,42 @@ fn plate_with_hole_gmres_equals_lu() {
     }
 }
 
+/// `auto`: the Schur complement solve for a static 2D plate, the LU for a small 3D box.
 #[test]
 fn auto_takes_the_schur_solve_for_a_static_plate() {
     assert_eq!(LinearSolver::Auto.resolve(8_640), LinearSolver::LdltSchur);
     assert_eq!(LinearSolver::Auto.resolve(311_040), LinearSolver::GmresAmg);
     assert_eq!(LinearSolver::Auto.resolve_newmark(8_640), LinearSolver::Lu);
+    let (_, _, used) = plate(1)
+        .solve_static_with(0.0, &options(LinearSolver::Auto, 1e-10))
+        .unwrap();
+    assert_eq!(used, LinearSolver::LdltSchur);
+    let (_, _, used) = clamped_box()
+        .solve_static_with(0.0, &options(LinearSolver::Auto, 1e-10))
+        .unwrap();
+    assert_eq!(used, LinearSolver::Lu);
+}
+
+/// A clamped perturbed box of tetrahedra under gravity.
+fn clamped_box() -> Cosserat<3> {
+    let g = perturb(
+        &simplices(
+            Point::<3>::zeros(),
+            Point::<3>::new(1.0, 0.6, 0.5),
+            [4, 3, 2],
+        )
+        .unwrap(),
+        0.2,
+        6,
+    )
+    .unwrap();
+    let m = Material::with_couple_moduli(1000.0, 0.25, 300.0, [1.0, 2.0, 0.5])
+        .unwrap()
+        .with_inertia(2.0, 0.02)
+        .unwrap();
+    let clamp = Condition::new(g.boundary("xmin").unwrap()).clamp(vec![constant(0.0); 6]);
+    let body = BodyLoads::none().with(2, constant(-9.81));
+    Cosserat::new(g, m, Options::default(), &[clamp], body).unwrap()
 }
 
 /// Newmark states with the LU and with `solver` after `steps` steps.
@@ -168,24 +199,7 @@ fn newmark_gmres_equals_lu_in_2d_and_3d() {
     }
 
     // 3D: a clamped perturbed box of tetrahedra under gravity.
-    let g = perturb(
-        &simplices(
-            Point::<3>::zeros(),
-            Point::<3>::new(1.0, 0.6, 0.5),
-            [4, 3, 2],
-        )
-        .unwrap(),
-        0.2,
-        6,
-    )
-    .unwrap();
-    let m = Material::with_couple_moduli(1000.0, 0.25, 300.0, [1.0, 2.0, 0.5])
-        .unwrap()
-        .with_inertia(2.0, 0.02)
-        .unwrap();
-    let clamp = Condition::new(g.boundary("xmin").unwrap()).clamp(vec![constant(0.0); 6]);
-    let body = BodyLoads::none().with(2, constant(-9.81));
-    let model = Cosserat::new(g, m, Options::default(), &[clamp], body).unwrap();
+    let model = clamped_box();
     for (solver, max_its) in [(LinearSolver::GmresAmg, 100), (LinearSolver::LdltSchur, 3)] {
         let (lu, gm, its) = newmark_pair(&model, 5e-3, 10, solver);
         let d = max_diff(&lu, &gm) / max_abs(&lu);
