@@ -6,15 +6,17 @@
 #
 # For each O-grid level L (320 L^2 triangles, written by `plate_hole mesh L 0.216 FILE`):
 #   porofrac   crates/cosserat/examples/plate_hole.rs `run FILE ... auto` (library: assembly
-#              with the reconstruction; the solver "auto" picks the LU below 12,000 unknowns
-#              and GMRES with the multigrid preconditioner above), REPEAT times (default 3);
-#              up to LU_MAX_LEVEL (default 8) also `... lu` (faer sparse LU) once
+#              with the reconstruction; the solver "auto" picks the LDLT + Schur complement
+#              solve below 100,000 unknowns and GMRES with the multigrid preconditioner
+#              above), REPEAT times (default 3); once `... gmres-amg` where auto is the
+#              factorisation, and up to LU_MAX_LEVEL (default 8) `... lu` (faer sparse LU)
 #   command    `porofrac run` on a copy of scenes/cosserat_plate_hole.toml pointing at FILE
 #              (the user's path; times from summary.json, whole process from `date`)
 #   python-dem peers/cosserat/dem.py (the same method in numpy/scipy, spsolve)
 #   fenicsx    peers/cosserat/fenicsx_p2p1.py (mixed P2-P1 FEM, MUMPS)
-# Above DEM_MAX_LEVEL (default 18: 103,680 triangles) only FEniCSx runs. The Python DEM runs
-# under a 16 GB address-space limit (PY_MEM_KB); a MemoryError there is logged as such.
+# Above DEM_MAX_LEVEL (default 18: 103,680 triangles) only FEniCSx runs; the Python DEM runs
+# up to PY_MAX_LEVEL (default 12: at level 18 SciPy's SuperLU needed more than 17 minutes
+# and 8 GB), under a 16 GB address-space limit (PY_MEM_KB); a MemoryError there is logged.
 # FEM_EXTRA_LEVELS (default "1 2") adds FEniCSx-only coarse levels (to reach the DEM's
 # error range). Every run prints one `RESULT {json}` line; everything goes to stdout and to
 # $OUT/rounds.txt (OUT default target/cosserat_rounds). FEM_PYTHON / FEM_LIB select the
@@ -27,6 +29,7 @@ levels=("$@")
 out=${OUT:-$root/target/cosserat_rounds}
 dem_max=${DEM_MAX_LEVEL:-18}
 lu_max=${LU_MAX_LEVEL:-8}
+py_max=${PY_MAX_LEVEL:-12}
 repeat=${REPEAT:-3}
 py_mem_kb=${PY_MEM_KB:-16000000}
 fem_extra=${FEM_EXTRA_LEVELS:-1 2}
@@ -64,6 +67,9 @@ for L in "${levels[@]}"; do
         say "# load $(cut -d' ' -f1-3 /proc/loadavg)"
         "$ex" run "$mesh" "$r" "$rl" "$n" auto 2>&1 | sed "s/^RESULT {/RESULT {\"level\": $L, /" | tee -a "$log"
     done
+    if [ "$(( 960 * L * L ))" -lt 100000 ]; then
+        "$ex" run "$mesh" "$r" "$rl" "$n" gmres-amg | sed "s/^RESULT {\"code\": \"porofrac\"/RESULT {\"level\": $L, \"code\": \"porofrac-gmres-amg\"/" | tee -a "$log"
+    fi
     if [ "$L" -le "$lu_max" ]; then
         "$ex" run "$mesh" "$r" "$rl" "$n" lu | sed "s/^RESULT {\"code\": \"porofrac\"/RESULT {\"level\": $L, \"code\": \"porofrac-lu\"/" | tee -a "$log"
     fi
@@ -84,8 +90,12 @@ print("RESULT " + json.dumps({"level": int(sys.argv[2]), "code": "porofrac-comma
       "peak_memory_bytes": s.get("peak_memory_bytes"), "linear": s["solver"]["linear"],
       "iterations": s["solver"]["iterations"]}))
 EOF
-    say "# python-dem $(date -u +%T) load $(cut -d' ' -f1-3 /proc/loadavg)"
-    (cd peers/cosserat && ulimit -v "$py_mem_kb" && py dem.py "$mesh" "$r" "$rl" "$n" 2>&1 | tail -3) | sed "s/^RESULT {/RESULT {\"level\": $L, /" | tee -a "$log" || say "# level $L: python-dem failed"
+    if [ "$L" -le "$py_max" ]; then
+        say "# python-dem $(date -u +%T) load $(cut -d' ' -f1-3 /proc/loadavg)"
+        (cd peers/cosserat && ulimit -v "$py_mem_kb" && py dem.py "$mesh" "$r" "$rl" "$n" 2>&1 | tail -3) | sed "s/^RESULT {/RESULT {\"level\": $L, /" | tee -a "$log" || say "# level $L: python-dem failed"
+    else
+        say "# level $L: python-dem skipped (above PY_MAX_LEVEL=$py_max)"
+    fi
     say "# load $(cut -d' ' -f1-3 /proc/loadavg)"
     (cd peers/cosserat && py fenicsx_p2p1.py "$mesh" "$r" "$rl" "$n") | grep '^RESULT' | sed "s/^RESULT {/RESULT {\"level\": $L, /" | tee -a "$log"
 done

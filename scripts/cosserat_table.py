@@ -60,14 +60,16 @@ def main():
                         f"{o['t_solve']:.6f},{o['t_total']:.6f},{o['scf']:.15e},{o['err_rel']:.6e}\n")
     levels = sorted({o["level"] for o in out if o["code"] == "porofrac"})
     print("| level | triangles | DEM dofs | porofrac solver (GMRES its) | porofrac asm / solve (s) "
-          "| porofrac peak (GB) | LU solve (s) / peak (GB) | Python asm / solve (s) | Python peak (GB) "
+          "| porofrac peak (GB) | GMRES-AMG solve (s) (its) / peak (GB) | LU solve (s) / peak (GB) "
+          "| Python asm / solve (s) | Python peak (GB) "
           "| Python / porofrac | command total (s) / peak (GB) | DEM SCF (err) | SCF rel. diff Python "
           "| FEM dofs | FEM asm / solve (s) | FEM SCF (err) |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for L in levels:
         p = by[("porofrac", L)]
         n = len(groups[("porofrac", L)])
         lu = by.get(("porofrac-lu", L))
+        am = by.get(("porofrac-gmres-amg", L))
         q = by.get(("python-dem", L))
         c = by.get(("porofrac-command", L))
         f = by.get(("fenicsx-p2p1", L))
@@ -76,6 +78,7 @@ def main():
                 p["raw"].get("solver", "lu") + (f" ({its})" if its else ""),
                 f"{p['t_assemble']:.2f} / {p['t_solve']:.2f}" + (f" (median of {n})" if n > 1 else ""),
                 gb(p["raw"])]
+        cell.append(f"{am['t_solve']:.2f} ({am['raw'].get('iterations')}) / {gb(am['raw'])}" if am else "—")
         cell.append(f"{lu['t_solve']:.2f} / {gb(lu['raw'])}" if lu else "—")
         if q:
             cell += [f"{q['t_assemble']:.2f} / {q['t_solve']:.2f}", gb(q["raw"]),

@@ -1,6 +1,7 @@
 //! Assembly (reconstruction included) and linear solves of the Cosserat DEM on the plate
-//! with a hole, O-grid level 5 (8,000 triangles, 24,000 unknowns; r = 0.216 mm,
-//! r/ℓ = 1.063, N = 0.5): `cargo bench -p porofrac-cosserat`.
+//! with a hole, O-grid levels 3 and 5 (2,880 and 8,000 triangles, 8,640 and 24,000
+//! unknowns; r = 0.216 mm, r/ℓ = 1.063, N = 0.5), every solver: `cargo bench -p
+//! porofrac-cosserat`.
 
 #![allow(missing_docs)]
 
@@ -10,8 +11,8 @@ use porofrac_cosserat::{
 };
 use porofrac_grid::Grid;
 
-fn grid() -> Grid<2> {
-    let (level, r) = (5, 0.216);
+fn grid(level: usize) -> Grid<2> {
+    let r = 0.216;
     mesh::plate_with_hole(16.2, r, 16 * level, 10 * level, 0.1 * r / level as f64).unwrap()
 }
 
@@ -37,21 +38,28 @@ fn model(grid: Grid<2>) -> Cosserat<2> {
 }
 
 fn bench(c: &mut Criterion) {
-    let g = grid();
-    let mut group = c.benchmark_group("cosserat_plate_hole_level5");
-    group.sample_size(10);
-    group.bench_function("assembly", |b| b.iter(|| model(g.clone())));
-    let m = model(g);
-    for solver in [LinearSolver::Lu, LinearSolver::GmresAmg] {
-        let options = LinearOptions {
-            solver,
-            ..LinearOptions::default()
-        };
-        group.bench_function(format!("solve_{}", solver.name()), |b| {
-            b.iter(|| m.solve_static_with(0.0, &options).unwrap())
-        });
+    for level in [3, 5] {
+        let g = grid(level);
+        let mut group = c.benchmark_group(format!("cosserat_plate_hole_level{level}"));
+        group.sample_size(10);
+        group.bench_function("assembly", |b| b.iter(|| model(g.clone())));
+        let m = model(g);
+        for solver in [
+            LinearSolver::Lu,
+            LinearSolver::GmresAmg,
+            LinearSolver::GmresLdlt,
+            LinearSolver::LdltSchur,
+        ] {
+            let options = LinearOptions {
+                solver,
+                ..LinearOptions::default()
+            };
+            group.bench_function(format!("solve_{}", solver.name()), |b| {
+                b.iter(|| m.solve_static_with(0.0, &options).unwrap())
+            });
+        }
+        group.finish();
     }
-    group.finish();
 }
 
 criterion_group!(benches, bench);

@@ -5,33 +5,47 @@
 //! `cargo run --release -p porofrac-cosserat --example plate_hole [levels]`, or
 //! `… --example plate_hole mesh <level> <r> <path.vtu>` to write the O-grid mesh of a level
 //! (the mesh of `scenes/cosserat_plate_hole.toml`), or
-//! `… --example plate_hole run <path.vtu> <r> <r/ℓ> <N>` to solve on a mesh file and print
-//! one `RESULT {json}` line (SCF, cells, dofs, nnz, assembly and solve wall time) in the
-//! form of the peers `peers/cosserat/dem.py` and `peers/cosserat/fenicsx_p2p1.py`.
+//! `… --example plate_hole run <path.vtu> <r> <r/ℓ> <N> [auto|lu|gmres-amg|gmres-ldlt|ldlt-schur]`
+//! to solve on a mesh file and print one `RESULT {json}` line (SCF, cells, dofs, nnz,
+//! assembly and solve wall time, and the split: reconstruction alone, solver setup,
+//! solve, iterations, entries of the factors) in the form of the peers
+//! `peers/cosserat/dem.py` and `peers/cosserat/fenicsx_p2p1.py`.
 
 use std::time::Instant;
 
 use porofrac_cosserat::reference::hole_scf;
 use porofrac_cosserat::{
-    BodyLoads, Condition, Cosserat, LinearOptions, LinearSolver, Material, Options, constant, mesh,
-    strain_index,
+    BodyLoads, Condition, Cosserat, LinearOptions, LinearSolver, LinearStats, Material, Options,
+    Reconstruction, constant, mesh, strain_index,
 };
 
 /// SCF of the DEM: the largest cell σ22 over the applied traction T = 1.
 pub fn scf(level: usize, r: f64, n: f64, length: f64) -> (f64, usize, f64, f64) {
     let grid =
         mesh::plate_with_hole(16.2, r, 16 * level, 10 * level, 0.1 * r / level as f64).unwrap();
-    let (s22, cells, t_asm, t_solve, _) = scf_on(grid, n, length, LinearSolver::Lu);
-    (s22, cells, t_asm, t_solve)
+    let m = scf_on(grid, n, length, LinearSolver::Lu);
+    (m.scf, m.cells, m.t_asm, m.t_setup + m.t_iter)
 }
 
-/// SCF on a given quarter-plate grid: `(SCF, cells, assembly s, solve s, nnz)`.
-fn scf_on(
-    grid: porofrac_grid::Grid<2>,
-    n: f64,
-    length: f64,
-    solver: LinearSolver,
-) -> (f64, usize, f64, f64, usize) {
+/// What one solve on a plate grid measured.
+struct Measured {
+    scf: f64,
+    cells: usize,
+    nnz: usize,
+    /// Reconstruction alone (s), timed on its own before the assembly.
+    t_recon: f64,
+    /// Assembly including the reconstruction (s).
+    t_asm: f64,
+    /// Solver setup: factorisation or multigrid hierarchy (s).
+    t_setup: f64,
+    /// Solve (triangular solves or GMRES iterations) (s).
+    t_iter: f64,
+    stats: LinearStats,
+    used: LinearSolver,
+}
+
+/// SCF on a given quarter-plate grid.
+fn scf_on(grid: porofrac_grid::Grid<2>, n: f64, length: f64, solver: LinearSolver) -> Measured {
     let (g, nu) = (1e3, 0.3);
     let a = n * n / (1.0 - n * n);
     let m = Material::with_length(g, nu, a * g, length).unwrap();
@@ -43,6 +57,9 @@ fn scf_on(
         .fix(1, constant(0.0))
         .fix(2, constant(0.0));
     let top = Condition::new(grid.boundary("ymax").unwrap()).load(1, constant(1.0));
+    let tr = Instant::now();
+    drop(Reconstruction::new(&grid).unwrap());
+    let t_recon = tr.elapsed().as_secs_f64();
     let t0 = Instant::now();
     let model = Cosserat::new(
         grid,
@@ -53,25 +70,38 @@ fn scf_on(
     )
     .unwrap();
     let t_asm = t0.elapsed().as_secs_f64();
-    let t1 = Instant::now();
     let options = LinearOptions {
         solver,
         ..Default::default()
     };
-    let (w, stats, used) = model.solve_static_with(0.0, &options).unwrap();
-    let t_solve = t1.elapsed().as_secs_f64();
-    if solver != LinearSolver::Lu {
-        eprintln!(
-            "solver {} iterations {} residual {:.2e}",
-            used.name(),
-            stats.iterations,
-            stats.max_residual
-        );
-    }
+    let t1 = Instant::now();
+    let mut lin = model
+        .linear(
+            &model.system_values(),
+            &model.preconditioner_values(),
+            &options,
+        )
+        .unwrap();
+    let t_setup = t1.elapsed().as_secs_f64();
+    let t2 = Instant::now();
+    let mut w = vec![0.0; model.equations()];
+    model.rhs(0.0, &mut w);
+    lin.solve(&mut w, None).unwrap();
+    let t_iter = t2.elapsed().as_secs_f64();
     let s22 = (0..cells)
         .map(|c| model.cell_stress(c, &w)[strain_index(2, 1, 1)])
         .fold(f64::MIN, f64::max);
-    (s22, cells, t_asm, t_solve, model.pattern().nnz())
+    Measured {
+        scf: s22,
+        cells,
+        nnz: model.pattern().nnz(),
+        t_recon,
+        t_asm,
+        t_setup,
+        t_iter,
+        stats: lin.stats(),
+        used: lin.solver(),
+    }
 }
 
 /// Peak resident memory of this process (bytes, `VmHWM` of /proc/self/status; 0 when
@@ -99,7 +129,7 @@ fn main() {
         return;
     }
     if args.get(1).map(String::as_str) == Some("run") {
-        let usage = "plate_hole run <path.vtu> <r> <r/l> <N> [auto|lu|gmres-amg]";
+        let usage = "plate_hole run <path.vtu> <r> <r/l> <N> [auto|lu|gmres-amg|gmres-ldlt]";
         let grid = porofrac_grid::io::read_vtu::<2>(&args[2]).expect("readable 2D .vtu mesh");
         let num = |i: usize| -> f64 { args.get(i).and_then(|s| s.parse().ok()).expect(usage) };
         let (r, rl, n) = (num(3), num(4), num(5));
@@ -107,17 +137,32 @@ fn main() {
             None | Some("auto") => LinearSolver::Auto,
             Some("lu") => LinearSolver::Lu,
             Some("gmres-amg") => LinearSolver::GmresAmg,
+            Some("gmres-ldlt") => LinearSolver::GmresLdlt,
+            Some("ldlt-schur") => LinearSolver::LdltSchur,
             Some(_) => panic!("{usage}"),
         };
-        let (s22, cells, ta, ts, nnz) = scf_on(grid, n, r / rl, solver);
+        let m = scf_on(grid, n, r / rl, solver);
         println!(
-            "RESULT {{\"code\": \"porofrac\", \"mesh\": \"{}\", \"cells\": {cells}, \"dofs\": {}, \
-             \"nnz\": {nnz}, \"scf\": {s22:.15e}, \"scf_ref\": {:.15e}, \"t_assemble\": {ta:.6}, \
-             \"t_solve\": {ts:.6}, \"solver\": \"{}\", \"peak_memory_bytes\": {}}}",
+            "RESULT {{\"code\": \"porofrac\", \"mesh\": \"{}\", \"cells\": {}, \"dofs\": {}, \
+             \"nnz\": {}, \"scf\": {:.15e}, \"scf_ref\": {:.15e}, \"t_assemble\": {:.6}, \
+             \"t_solve\": {:.6}, \"t_reconstruction\": {:.6}, \"t_setup\": {:.6}, \
+             \"t_iterations\": {:.6}, \"iterations\": {}, \"residual\": {:.3e}, \
+             \"factor_nnz\": {}, \"solver\": \"{}\", \"peak_memory_bytes\": {}}}",
             args[2],
-            3 * cells,
+            m.cells,
+            3 * m.cells,
+            m.nnz,
+            m.scf,
             hole_scf(0.3, n, r, r / rl),
-            solver.resolve(3 * cells).name(),
+            m.t_asm,
+            m.t_setup + m.t_iter,
+            m.t_recon,
+            m.t_setup,
+            m.t_iter,
+            m.stats.iterations,
+            m.stats.max_residual,
+            m.stats.factor_entries,
+            m.used.name(),
             peak_memory()
         );
         return;

@@ -15,7 +15,7 @@ type BoxError = Box<dyn std::error::Error>;
 const SERIES: &[(&str, &str, RGBColor, bool)] = &[
     (
         "porofrac",
-        "porofrac DEM (library, LU / GMRES-AMG)",
+        "porofrac DEM (library, LDLᵀ + Schur / GMRES-AMG)",
         RGBColor(31, 119, 180),
         false,
     ),

@@ -13,12 +13,40 @@
 //! space is the rigid motions of the Cosserat medium at the cell barycentres (translations
 //! and `(θ × x, θ)`).
 //!
-//! **Choice.** [`LinearSolver::Auto`] takes the LU below [`AUTO_GMRES_EQUATIONS`]
-//! equations and GMRES above (the Newmark matrix, solved at every step: below
-//! [`AUTO_GMRES_EQUATIONS_NEWMARK`]) (measured in docs/BENCHMARKS.md: the LU's fill grows as
-//! cells^1.4 on the plate meshes, GMRES with the V-cycle stays linear in memory).
+//! **Exact solve from the symmetric factor** ([`LinearSolver::LdltSchur`]). `K` and `P`
+//! differ only in the rows and columns of the unknowns `T` that the Nitsche terms and the
+//! boundary penalty touch (the components of the cells in the stencils of the fixed
+//! boundary facets: `|T|` = 540 of 8,640 unknowns on the 2,880-triangle plate, growing as
+//! the boundary, i.e. as `√n` in 2D): `K = P + E` with `E` zero outside `T × T`. `P` is
+//! factorised `P = L D Lᵀ` by the sparse `LDLᵀ` of `porofrac-sim` with `T` eliminated last
+//! (the other cells in approximate minimum degree order, faer's AMD on the cell graph), so
+//! the last `|T|` columns of the factors hold the Schur complement
+//! `S_P = P_TT − P_TI P_II⁻¹ P_IT = L_TT D_T L_TTᵀ`, and `(P⁻¹)_TT = S_P⁻¹`. Writing
+//! `K x = b` as `P x = b − E x_T` and restricting `x = P⁻¹ b − P⁻¹ E x_T` to `T`:
+//!
+//! ```text
+//!   (S_P + E_TT) x_T = S_P (P⁻¹ b)_T ,      x = P⁻¹ (b − E x_T) ,
+//! ```
+//!
+//! (computed as `x_T = u_T − (S_P + E_TT)⁻¹ E_TT u_T`, `u = P⁻¹ b`, without the product
+//! with `S_P` whose rounding the condition number of `S_P` would amplify): a dense LU with partial pivoting of the `|T| × |T|` Schur complement `S_P + E_TT` of `K`
+//! and two sparse solves with `P`. This is `K⁻¹` up to rounding; it is applied as the
+//! preconditioner of GMRES, which checks the true residual (one iteration, relative
+//! residual 1e-13 on the plate meshes). The dense part costs `O(|T|³)`, small against the
+//! sparse factorisation up to 10⁵ unknowns in 2D. [`LinearSolver::GmresLdlt`] uses the
+//! `LDLᵀ` of `P` (plain AMD) as an inexact preconditioner instead (40–43 iterations on the
+//! plate from 8,640 to 61,440 unknowns).
+//!
+//! **Choice.** [`LinearSolver::Auto`] takes, in 2D, [`LinearSolver::LdltSchur`] below
+//! [`AUTO_GMRES_EQUATIONS`] equations (with at most [`AUTO_SCHUR_UNKNOWNS`] unknowns in
+//! `T`) and GMRES with the V-cycle above (measured in docs/BENCHMARKS.md: the factor's
+//! memory grows as `n^1.2` and its time as `n^1.4` on the plate; GMRES with the V-cycle
+//! stays linear in memory); in 3D, where only the LU and GMRES were measured and `T` grows
+//! as `n^(2/3)`, the LU below [`AUTO_GMRES_EQUATIONS_3D`] and GMRES above. The Newmark
+//! matrix, solved at every step, keeps the LU below [`AUTO_GMRES_EQUATIONS_NEWMARK`].
 
 use porofrac_amg::{Amg, AmgOptions, NearNullSpace, Precision, SymCsr};
+use porofrac_sim::ldlt::Ldlt;
 use rayon::prelude::*;
 
 use crate::error::{CosseratError, Result};
@@ -26,9 +54,22 @@ use crate::krylov::{GmresOptions, GmresStats, gmres};
 use crate::pattern::{BlockPattern, SparseLu};
 
 /// Equations from which [`LinearSolver::Auto`] takes GMRES with the V-cycle for a static
-/// solve: `porofrac run scenes/cosserat_plate_hole.toml` (15,360 unknowns) took 4.6 s with
-/// the LU and 2.8 s with GMRES, the shear layer (6,000) 1.0 s and 2.5 s.
-pub const AUTO_GMRES_EQUATIONS: usize = 12_000;
+/// solve (below: [`LinearSolver::LdltSchur`]). On the plate with a hole
+/// (`plate_hole run` of crates/cosserat/examples, docs/BENCHMARKS.md) the two take the
+/// same time at 138,240 unknowns (12.6 s and 12.3 s), the factorisation with 2.5 times
+/// the memory (1.8 GB); below, the factorisation is faster (3 to 6 times at 8,640 to
+/// 61,440 unknowns).
+pub const AUTO_GMRES_EQUATIONS: usize = 100_000;
+
+/// Equations from which [`LinearSolver::Auto`] takes GMRES with the V-cycle for a static
+/// solve in 3D (below: the LU; the Schur complement solve is measured in 2D only).
+pub const AUTO_GMRES_EQUATIONS_3D: usize = 12_000;
+
+/// Largest number of boundary unknowns `T` for which [`LinearSolver::Auto`] takes
+/// [`LinearSolver::LdltSchur`] (2D): its dense `|T| × |T|` block then takes at most 34 MB
+/// per copy and `O(|T|³)` work of about 1.5 s (on the plate, 1,440 unknowns at 61,440: 0.5 s,
+/// about 13 % of the setup).
+pub const AUTO_SCHUR_UNKNOWNS: usize = 2_048;
 
 /// Equations from which [`LinearSolver::Auto`] takes GMRES for the Newmark matrix, solved
 /// at every step: the LU's one factorisation is then amortised over the steps (each a
@@ -39,40 +80,54 @@ pub const AUTO_GMRES_EQUATIONS_NEWMARK: usize = 100_000;
 /// Which linear solver.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum LinearSolver {
-    /// [`Self::Lu`] below [`AUTO_GMRES_EQUATIONS`] equations, [`Self::GmresAmg`] from there.
+    /// In 2D [`Self::LdltSchur`] below [`AUTO_GMRES_EQUATIONS`] equations (and at most
+    /// [`AUTO_SCHUR_UNKNOWNS`] boundary unknowns), [`Self::GmresAmg`] otherwise; in 3D
+    /// [`Self::Lu`] below [`AUTO_GMRES_EQUATIONS_3D`], [`Self::GmresAmg`] from there (the
+    /// Newmark matrix: [`Self::Lu`] below [`AUTO_GMRES_EQUATIONS_NEWMARK`]).
     #[default]
     Auto,
     /// Sparse LU with partial pivoting (faer).
     Lu,
     /// Restarted GMRES preconditioned by a smoothed-aggregation V-cycle.
     GmresAmg,
+    /// Restarted GMRES preconditioned by the sparse `LDLᵀ` factorisation of the
+    /// preconditioning matrix.
+    GmresLdlt,
+    /// Direct: the sparse `LDLᵀ` of the preconditioning matrix with the unknowns where it
+    /// differs from the system ordered last, corrected exactly by a dense LU of the Schur
+    /// complement on those unknowns; GMRES checks the residual (one or two iterations).
+    LdltSchur,
 }
 
 impl LinearSolver {
-    /// The solver used for a static solve of `equations` unknowns (never [`Self::Auto`]).
+    /// The solver used for a static 2D solve of `equations` unknowns by size alone (never
+    /// [`Self::Auto`]; [`Linear::new`] also applies the 3D rule and the bound on the
+    /// boundary unknowns of [`Self::Auto`]).
     pub fn resolve(self, equations: usize) -> Self {
-        self.resolve_from(equations, AUTO_GMRES_EQUATIONS)
+        self.resolve_from(equations, AUTO_GMRES_EQUATIONS, Self::LdltSchur)
     }
 
     /// The solver used for the Newmark matrix of `equations` unknowns.
     pub fn resolve_newmark(self, equations: usize) -> Self {
-        self.resolve_from(equations, AUTO_GMRES_EQUATIONS_NEWMARK)
+        self.resolve_from(equations, AUTO_GMRES_EQUATIONS_NEWMARK, Self::Lu)
     }
 
-    fn resolve_from(self, equations: usize, threshold: usize) -> Self {
+    fn resolve_from(self, equations: usize, threshold: usize, direct: Self) -> Self {
         match self {
             Self::Auto if equations >= threshold => Self::GmresAmg,
-            Self::Auto => Self::Lu,
+            Self::Auto => direct,
             s => s,
         }
     }
 
-    /// Short name: `"auto"`, `"lu"` or `"gmres-amg"`.
+    /// Short name: `"auto"`, `"lu"`, `"gmres-amg"`, `"gmres-ldlt"` or `"ldlt-schur"`.
     pub fn name(self) -> &'static str {
         match self {
             Self::Auto => "auto",
             Self::Lu => "lu",
             Self::GmresAmg => "gmres-amg",
+            Self::GmresLdlt => "gmres-ldlt",
+            Self::LdltSchur => "ldlt-schur",
         }
     }
 }
@@ -82,7 +137,7 @@ impl LinearSolver {
 pub struct LinearOptions {
     /// The solver.
     pub solver: LinearSolver,
-    /// GMRES parameters (used by [`LinearSolver::GmresAmg`]).
+    /// GMRES parameters (used by every solver but [`LinearSolver::Lu`]).
     pub gmres: GmresOptions,
 }
 
@@ -113,20 +168,166 @@ pub struct LinearStats {
     pub max_iterations: usize,
     /// Largest true relative residual of a GMRES solve.
     pub max_residual: f64,
+    /// Stored entries of the `LDLᵀ` factor `L` ([`LinearSolver::GmresLdlt`]), plus the
+    /// `|T|²` of the dense Schur complement ([`LinearSolver::LdltSchur`]); 0 for the
+    /// others (faer does not report the LU's).
+    pub factor_entries: usize,
 }
 
-/// GMRES with the V-cycle: the system in row form (parallel products) and the hierarchy.
-struct GmresAmg {
+/// The preconditioner of GMRES.
+enum Precond {
+    /// One V-cycle on the preconditioning matrix.
+    Amg(Box<Amg>),
+    /// The `LDLᵀ` factors of the preconditioning matrix.
+    Ldlt(Box<Ldlt>),
+    /// The exact inverse by the `LDLᵀ` and the dense Schur complement.
+    Schur(Box<Schur>),
+}
+
+/// `A = P + E` with `P` symmetric positive definite and `E` non-zero only on the `k`
+/// unknowns `T` (ordered last in `P`'s factorisation). With `S_P` the Schur complement of
+/// the others in `P` (the trailing block of its factors), `(P⁻¹)_TT = S_P⁻¹`, so
+/// `A x = b` is `x_T = u_T − (S_P + E_TT)⁻¹ E_TT u_T` with `u = P⁻¹ b` (a dense LU) and
+/// `x = P⁻¹ (b − E x_T)`: two sparse solves with `P` and one dense solve.
+struct Schur {
+    ldlt: Ldlt,
+    /// The unknowns of `T` in the order of the dense block.
+    tail: Vec<usize>,
+    /// `E_TT` as `(row, column, value)` in the dense block's indices.
+    e: Vec<(u32, u32, f64)>,
+    /// LU of `S_P + E_TT`.
+    lu: faer::linalg::solvers::PartialPivLu<f64>,
+    /// Work vectors of length `k`.
+    ut: Vec<f64>,
+    xt: Vec<f64>,
+}
+
+/// The unknowns `T` of the rows and columns where the system differs from the
+/// preconditioning matrix (marked `true`).
+fn schur_unknowns(sys: SystemRef<'_>) -> Vec<bool> {
+    let p = sys.pattern;
+    let n = p.equations();
+    let mut in_t = vec![false; n];
+    for j in 0..n {
+        for q in p.col_ptr[j]..p.col_ptr[j + 1] {
+            if sys.values[q] != sys.preconditioner[q] {
+                in_t[j] = true;
+                in_t[p.row_idx[q]] = true;
+            }
+        }
+    }
+    in_t
+}
+
+impl Schur {
+    /// Set up from the system and the upper triangle of the preconditioning matrix.
+    fn new(sys: SystemRef<'_>, n: usize, upper: (&[usize], &[usize], &[f64])) -> Result<Self> {
+        let p = sys.pattern;
+        let ldlt_err = |e| CosseratError::Solve(format!("LDLᵀ of the preconditioning matrix: {e}"));
+        let in_t = schur_unknowns(sys);
+        // AMD of the cells without a component in T, then T.
+        let b = p.block;
+        let t_cell: Vec<bool> = (0..n / b)
+            .map(|c| (0..b).any(|a| in_t[c * b + a]))
+            .collect();
+        let order = cell_amd_masked(p, &t_cell)?;
+        let mut perm: Vec<usize> = order.iter().copied().filter(|&i| !in_t[i]).collect();
+        let first = perm.len();
+        perm.extend(order.iter().copied().filter(|&i| in_t[i]));
+        let tail = perm[first..].to_vec();
+        let k = tail.len();
+        let mut local = vec![u32::MAX; n];
+        for (j, &i) in tail.iter().enumerate() {
+            local[i] = j as u32;
+        }
+        let mut e = Vec::new();
+        for j in 0..n {
+            for q in p.col_ptr[j]..p.col_ptr[j + 1] {
+                let d = sys.values[q] - sys.preconditioner[q];
+                if d != 0.0 {
+                    e.push((local[p.row_idx[q]], local[j], d));
+                }
+            }
+        }
+        let (ucol, urow, uval) = upper;
+        let mut ldlt = Ldlt::analyse(n, ucol, urow, Some(&perm)).map_err(ldlt_err)?;
+        ldlt.factorize(ucol, urow, uval).map_err(ldlt_err)?;
+        if ldlt.permutation().is_some_and(|a| a[first..] != tail[..]) {
+            return Err(CosseratError::Solve(
+                "LDLᵀ: the boundary unknowns are not eliminated last".into(),
+            ));
+        }
+        let sp = ldlt.trailing_schur_complement(k).map_err(ldlt_err)?;
+        let mut sa = faer::Mat::from_fn(k, k, |i, j| sp[j * k + i]);
+        drop(sp);
+        for &(i, j, v) in &e {
+            sa[(i as usize, j as usize)] += v;
+        }
+        let lu = sa.partial_piv_lu();
+        if let Some(i) = (0..k).find(|&i| {
+            let u = lu.U()[(i, i)];
+            !(u.is_finite() && u != 0.0)
+        }) {
+            return Err(CosseratError::Solve(format!(
+                "the Schur complement on the boundary unknowns is singular (pivot {i} of {k}): \
+                 missing boundary conditions or zero moduli?"
+            )));
+        }
+        Ok(Self {
+            ldlt,
+            tail,
+            e,
+            lu,
+            ut: vec![0.0; k],
+            xt: vec![0.0; k],
+        })
+    }
+
+    /// `z = A⁻¹ r`.
+    fn apply(&mut self, r: &[f64], z: &mut [f64]) -> Result<()> {
+        use faer::linalg::solvers::Solve;
+        let err = |e| CosseratError::Solve(format!("LDLᵀ solve: {e}"));
+        let k = self.tail.len();
+        z.copy_from_slice(r);
+        self.ldlt.solve_in_place(z).map_err(err)?;
+        for (u, &i) in self.ut.iter_mut().zip(&self.tail) {
+            *u = z[i];
+        }
+        // x_T = u_T − (S_P + E)⁻¹ E u_T (no product with S_P: its rounding would be
+        // amplified by the condition number of S_P).
+        self.xt.fill(0.0);
+        for &(i, j, v) in &self.e {
+            self.xt[i as usize] += v * self.ut[j as usize];
+        }
+        self.lu
+            .solve_in_place(faer::MatMut::from_column_major_slice_mut(
+                &mut self.xt,
+                k,
+                1,
+            ));
+        for (x, &u) in self.xt.iter_mut().zip(&self.ut) {
+            *x = u - *x;
+        }
+        z.copy_from_slice(r);
+        for &(i, j, v) in &self.e {
+            z[self.tail[i as usize]] -= v * self.xt[j as usize];
+        }
+        self.ldlt.solve_in_place(z).map_err(err)
+    }
+}
+
+/// GMRES: the system in row form (parallel products) and the preconditioner.
+struct Gmres {
     row_ptr: Vec<usize>,
     col_idx: Vec<u32>,
     row_values: Vec<f64>,
-    amg: Amg,
+    pre: Precond,
     options: GmresOptions,
 }
 
 enum Kind {
     Lu(Box<SparseLu>),
-    Gmres(Box<GmresAmg>),
+    Gmres(Box<Gmres>),
 }
 
 /// A factorised (LU) or preconditioned (GMRES) system, solved for any number of
@@ -165,26 +366,64 @@ impl Linear {
                 });
             }
         }
-        let kind = match options.solver.resolve(n) {
+        let mut stats = LinearStats::default();
+        let solver = match options.solver {
+            // Measured on 2D plates only; in 3D the boundary unknowns grow as n^(2/3) and the
+            // dense block with them, so 3D keeps the LU and GMRES, and a 2D system whose
+            // dense block would be large takes GMRES.
+            LinearSolver::Auto if sys.dim == 3 => {
+                if n < AUTO_GMRES_EQUATIONS_3D {
+                    LinearSolver::Lu
+                } else {
+                    LinearSolver::GmresAmg
+                }
+            }
+            LinearSolver::Auto
+                if n < AUTO_GMRES_EQUATIONS
+                    && schur_unknowns(sys).iter().filter(|&&t| t).count() > AUTO_SCHUR_UNKNOWNS =>
+            {
+                LinearSolver::GmresAmg
+            }
+            s => s.resolve(n),
+        };
+        let kind = match solver {
             LinearSolver::Lu | LinearSolver::Auto => {
                 let mut lu = SparseLu::new(sys.pattern)?;
                 lu.factorize(sys.pattern, sys.values)?;
                 Kind::Lu(Box::new(lu))
             }
-            LinearSolver::GmresAmg => Kind::Gmres(Box::new(GmresAmg::new(sys, options.gmres)?)),
+            LinearSolver::GmresAmg => {
+                Kind::Gmres(Box::new(Gmres::new(sys, options.gmres, PrecondKind::Amg)?))
+            }
+            s @ (LinearSolver::GmresLdlt | LinearSolver::LdltSchur) => {
+                let kind = if s == LinearSolver::GmresLdlt {
+                    PrecondKind::Ldlt
+                } else {
+                    PrecondKind::Schur
+                };
+                let g = Gmres::new(sys, options.gmres, kind)?;
+                match &g.pre {
+                    Precond::Ldlt(f) => stats.factor_entries = f.factor_nnz(),
+                    Precond::Schur(f) => {
+                        stats.factor_entries = f.ldlt.factor_nnz() + f.tail.len().pow(2)
+                    }
+                    Precond::Amg(_) => {}
+                }
+                Kind::Gmres(Box::new(g))
+            }
         };
-        Ok(Self {
-            kind,
-            n,
-            stats: LinearStats::default(),
-        })
+        Ok(Self { kind, n, stats })
     }
 
     /// The solver in use.
     pub fn solver(&self) -> LinearSolver {
-        match self.kind {
+        match &self.kind {
             Kind::Lu(_) => LinearSolver::Lu,
-            Kind::Gmres(_) => LinearSolver::GmresAmg,
+            Kind::Gmres(g) => match g.pre {
+                Precond::Amg(_) => LinearSolver::GmresAmg,
+                Precond::Ldlt(_) => LinearSolver::GmresLdlt,
+                Precond::Schur(_) => LinearSolver::LdltSchur,
+            },
         }
     }
 
@@ -266,8 +505,67 @@ fn rigid_motions(centres: &[f64], dim: usize) -> Result<NearNullSpace> {
     NearNullSpace::from_vectors(n, data).map_err(|e| CosseratError::Solve(format!("AMG: {e}")))
 }
 
-impl GmresAmg {
-    fn new(sys: SystemRef<'_>, options: GmresOptions) -> Result<Self> {
+/// Which preconditioner [`Gmres::new`] builds.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum PrecondKind {
+    Amg,
+    Ldlt,
+    Schur,
+}
+
+/// Approximate minimum degree order of the cell graph of `pattern` (faer's AMD), each
+/// cell's components kept together: `perm[k]` is the equation eliminated `k`-th.
+fn cell_amd(pattern: &BlockPattern) -> Result<Vec<usize>> {
+    cell_amd_masked(pattern, &[])
+}
+
+/// [`cell_amd`] of the graph without the cells marked in `skip` (their edges dropped; the
+/// marked cells are numbered after the others, in their order).
+fn cell_amd_masked(pattern: &BlockPattern, skip: &[bool]) -> Result<Vec<usize>> {
+    use faer::dyn_stack::{MemBuffer, MemStack};
+    use faer::sparse::linalg::amd;
+    let nc = pattern.nbr_pos.len() - 1;
+    let skipped = |c: usize| skip.get(c).copied().unwrap_or(false);
+    let mut col_ptr = Vec::with_capacity(nc + 1);
+    let mut row_idx = Vec::with_capacity(pattern.cells.len() / 2 + nc);
+    col_ptr.push(0);
+    for c in 0..nc {
+        let nb = &pattern.cells[pattern.nbr_pos[c]..pattern.nbr_pos[c + 1]];
+        if !skipped(c) {
+            row_idx.extend(
+                nb.iter()
+                    .copied()
+                    .take_while(|&r| r <= c)
+                    .filter(|&r| !skipped(r)),
+            );
+        } else {
+            row_idx.push(c);
+        }
+        col_ptr.push(row_idx.len());
+    }
+    let sym = faer::sparse::SymbolicSparseColMatRef::new_checked(nc, nc, &col_ptr, None, &row_idx);
+    let (mut fwd, mut inv) = (vec![0usize; nc], vec![0usize; nc]);
+    let mut mem = MemBuffer::try_new(amd::order_scratch::<usize>(nc, row_idx.len()))
+        .map_err(|_| CosseratError::Solve("AMD ordering: out of memory".into()))?;
+    amd::order(
+        &mut fwd,
+        &mut inv,
+        sym,
+        amd::Control::default(),
+        MemStack::new(&mut mem),
+    )
+    .map_err(|e| CosseratError::Solve(format!("AMD ordering: {e:?}")))?;
+    let b = pattern.block;
+    Ok(fwd
+        .iter()
+        .filter(|&&c| !skipped(c))
+        .chain((0..nc).filter(|&c| skipped(c)).collect::<Vec<_>>().iter())
+        .flat_map(|&c| (0..b).map(move |a| c * b + a))
+        .collect())
+}
+
+impl Gmres {
+    fn new(sys: SystemRef<'_>, options: GmresOptions, kind: PrecondKind) -> Result<Self> {
         let p = sys.pattern;
         let n = p.equations();
         if p.nnz() > u32::MAX as usize || n > u32::MAX as usize {
@@ -315,22 +613,40 @@ impl GmresAmg {
             }
             ucol.push(urow.len());
         }
-        let amg_err = |e: porofrac_amg::AmgError| {
-            CosseratError::Solve(format!("multigrid preconditioner setup: {e}"))
+        let pre = match kind {
+            PrecondKind::Amg => {
+                let amg_err = |e: porofrac_amg::AmgError| {
+                    CosseratError::Solve(format!("multigrid preconditioner setup: {e}"))
+                };
+                // The hierarchy only preconditions: its finest matrix in single precision
+                // halves the memory traffic of the smoother (same iteration counts
+                // measured).
+                let sym = SymCsr::from_upper_csc_in(Precision::Single, n, &ucol, &urow, &uval)
+                    .map_err(amg_err)?;
+                drop((ucol, urow, uval));
+                let null = rigid_motions(sys.centres, sys.dim)?;
+                let nodes: Vec<usize> = (0..n).map(|e| e / p.block).collect();
+                Precond::Amg(Box::new(
+                    Amg::new(sym, &nodes, &null, &amg_options()).map_err(amg_err)?,
+                ))
+            }
+            PrecondKind::Ldlt => {
+                let ldlt_err =
+                    |e| CosseratError::Solve(format!("LDLᵀ of the preconditioning matrix: {e}"));
+                let perm = cell_amd(p)?;
+                let mut f = Ldlt::analyse(n, &ucol, &urow, Some(&perm)).map_err(ldlt_err)?;
+                f.factorize(&ucol, &urow, &uval).map_err(ldlt_err)?;
+                Precond::Ldlt(Box::new(f))
+            }
+            PrecondKind::Schur => {
+                Precond::Schur(Box::new(Schur::new(sys, n, (&ucol, &urow, &uval))?))
+            }
         };
-        // The hierarchy only preconditions: its finest matrix in single precision halves
-        // the memory traffic of the smoother (same iteration counts measured).
-        let sym = SymCsr::from_upper_csc_in(Precision::Single, n, &ucol, &urow, &uval)
-            .map_err(amg_err)?;
-        drop((ucol, urow, uval));
-        let null = rigid_motions(sys.centres, sys.dim)?;
-        let nodes: Vec<usize> = (0..n).map(|e| e / p.block).collect();
-        let amg = Amg::new(sym, &nodes, &null, &amg_options()).map_err(amg_err)?;
         Ok(Self {
             row_ptr,
             col_idx,
             row_values,
-            amg,
+            pre,
             options,
         })
     }
@@ -345,7 +661,7 @@ impl GmresAmg {
             row_ptr,
             col_idx,
             row_values,
-            amg,
+            pre,
             options,
         } = self;
         let me = RowMatrix {
@@ -355,9 +671,16 @@ impl GmresAmg {
         };
         gmres(
             |x, y| me.apply(x, y),
-            |r, z| {
-                amg.apply(r, z)
-                    .map_err(|e| CosseratError::Solve(format!("multigrid V-cycle: {e}")))
+            |r, z| match pre {
+                Precond::Amg(amg) => amg
+                    .apply(r, z)
+                    .map_err(|e| CosseratError::Solve(format!("multigrid V-cycle: {e}"))),
+                Precond::Ldlt(f) => {
+                    z.copy_from_slice(r);
+                    f.solve_in_place(z)
+                        .map_err(|e| CosseratError::Solve(format!("LDLᵀ solve: {e}")))
+                }
+                Precond::Schur(f) => f.apply(r, z),
             },
             &b,
             rhs,

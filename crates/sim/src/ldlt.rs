@@ -1,6 +1,11 @@
 //! Sparse `LDLᵀ` factorization of a symmetric matrix given by its upper triangle, with a
 //! triangular solve for one right-hand side at a time.
 //!
+//! Public for the other solvers of the workspace: [`Ldlt::analyse`] (pattern and an
+//! optional elimination order, e.g. from [`crate::ordering::pattern_dissection`]),
+//! [`Ldlt::factorize`] (values), [`Ldlt::solve_in_place`]; [`Ldlt::factor_nnz`] for the
+//! fill.
+//!
 //! # Factorization
 //!
 //! With a fill-reducing permutation `P` (AMD, or one given by the caller),
@@ -62,11 +67,22 @@ use pulp::Simd;
 const RELAX: Option<&[(usize, f64)]> = Some(&[(4, 1.0), (16, 0.8), (48, 0.1), (usize::MAX, 0.05)]);
 
 /// A failure of the factorization (a message naming the cause).
-#[derive(Debug)]
-pub(crate) struct LdltError(pub(crate) String);
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct LdltError(
+    /// The message.
+    pub String,
+);
+
+impl std::fmt::Display for LdltError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for LdltError {}
 
 /// The symbolic analysis and numeric factors of one sparsity pattern.
-pub(crate) struct Ldlt {
+pub struct Ldlt {
     n: usize,
     symbolic: SymbolicCholesky<usize>,
     values: Vec<f64>,
@@ -88,7 +104,7 @@ impl Ldlt {
     /// Symbolic analysis of the `n × n` matrix whose upper triangle has the CSC pattern
     /// (`col_ptr`, `row_idx`); `perm` is the elimination order (`perm[k]` eliminated
     /// `k`-th), `None` for AMD.
-    pub(crate) fn analyse(
+    pub fn analyse(
         n: usize,
         col_ptr: &[usize],
         row_idx: &[usize],
@@ -141,34 +157,39 @@ impl Ldlt {
     }
 
     /// Use `par` for the numeric factorization.
-    pub(crate) fn set_parallelism(&mut self, par: Par) {
+    pub fn set_parallelism(&mut self, par: Par) {
         self.par = par;
         self.mem = None;
     }
+    /// The elimination order of the factors: `perm[k]` is the unknown eliminated `k`-th
+    /// (`None`: the identity).
+    pub fn permutation(&self) -> Option<&[usize]> {
+        self.symbolic.perm().map(|p| p.arrays().0)
+    }
     /// Stored entries of `L` (with `D` on its diagonal).
-    pub(crate) fn factor_nnz(&self) -> usize {
+    pub fn factor_nnz(&self) -> usize {
         self.symbolic.len_val()
     }
     /// Numeric factorizations done.
-    pub(crate) fn numeric_factorizations(&self) -> usize {
+    pub fn numeric_factorizations(&self) -> usize {
         self.numeric
     }
     /// Solves done.
-    pub(crate) fn solves(&self) -> usize {
+    pub fn solves(&self) -> usize {
         self.solves
     }
     /// Whether every pivot of `D` is positive (the matrix is positive definite).
-    pub(crate) fn pivots_positive(&self) -> bool {
+    pub fn pivots_positive(&self) -> bool {
         self.inv_diag.iter().all(|&d| d > 0.0)
     }
     /// Whether the last numeric factorization succeeded.
-    pub(crate) fn is_factored(&self) -> bool {
+    pub fn is_factored(&self) -> bool {
         self.factored
     }
 
     /// Numeric factorization of the matrix with the upper-triangle `values` of the
     /// analysed pattern (`col_ptr`, `row_idx`).
-    pub(crate) fn factorize(
+    pub fn factorize(
         &mut self,
         col_ptr: &[usize],
         row_idx: &[usize],
@@ -231,13 +252,86 @@ impl Ldlt {
         Ok(())
     }
 
+    /// The Schur complement `A₂₂ − A₂₁ A₁₁⁻¹ A₁₂` of the first `n − k` unknowns of the
+    /// elimination order on the last `k`, read from the factors (`L₂₂ D₂ L₂₂ᵀ`): dense,
+    /// column-major `k × k`, row and column `j` standing for the unknown eliminated
+    /// `(n − k + j)`-th.
+    ///
+    /// With the unknowns coupled by a non-symmetric correction `E` ordered last, it gives
+    /// the exact Schur complement `S + E_22` of `A + E` for a dense LU.
+    pub fn trailing_schur_complement(&self, k: usize) -> Result<Vec<f64>, LdltError> {
+        if !self.factored {
+            return Err(LdltError(
+                "Schur complement before a successful factorization".into(),
+            ));
+        }
+        let n = self.n;
+        if k > n {
+            return Err(LdltError(format!(
+                "Schur complement on {k} of {n} unknowns"
+            )));
+        }
+        let SymbolicCholeskyRaw::Supernodal(sn) = self.symbolic.raw() else {
+            return Err(LdltError("Schur complement of a simplicial factor".into()));
+        };
+        let first = n - k;
+        let mut l22 = vec![0.0; k * k];
+        let mut d = vec![0.0; k];
+        let f = Factor {
+            begin: sn.supernode_begin(),
+            end: sn.supernode_end(),
+            rptr: sn.col_ptr_for_row_idx(),
+            vptr: sn.col_ptr_for_val(),
+            rows: sn.row_idx(),
+            values: &self.values,
+            inv_diag: &self.inv_diag,
+        };
+        for s in 0..sn.n_supernodes() {
+            let (start, w, r, block, below) = f.supernode(s);
+            if start + w <= first {
+                continue;
+            }
+            let m = w + r;
+            for j in 0..w {
+                let col = start + j;
+                if col < first {
+                    continue;
+                }
+                let cj = col - first;
+                let dst = &mut l22[cj * k..(cj + 1) * k];
+                d[cj] = block[j * m + j];
+                dst[cj] = 1.0;
+                for i in j + 1..w {
+                    dst[start + i - first] = block[j * m + i];
+                }
+                for (t, &row) in below.iter().enumerate() {
+                    dst[row - first] = block[j * m + w + t];
+                }
+            }
+        }
+        // S = (L₂₂ D₂) L₂₂ᵀ.
+        let l = faer::MatRef::from_column_major_slice(&l22, k, k);
+        let mut ld = l.to_owned();
+        for (j, &dj) in d.iter().enumerate() {
+            for v in ld.col_mut(j).iter_mut() {
+                *v *= dj;
+            }
+        }
+        let mut out = vec![0.0; k * k];
+        faer::linalg::matmul::matmul(
+            MatMut::from_column_major_slice_mut(&mut out, k, k),
+            faer::Accum::Replace,
+            ld.as_ref(),
+            l.transpose(),
+            1.0,
+            self.par,
+        );
+        Ok(out)
+    }
+
     /// Solve `A X = B` in place for the `k` columns of `B` stored column-major in `rhs`
     /// (`n · k` values): faer's supernodal solve, blocked over the columns.
-    pub(crate) fn solve_columns_in_place(
-        &mut self,
-        rhs: &mut [f64],
-        k: usize,
-    ) -> Result<(), LdltError> {
+    pub fn solve_columns_in_place(&mut self, rhs: &mut [f64], k: usize) -> Result<(), LdltError> {
         if !self.factored {
             return Err(LdltError("solve before a successful factorization".into()));
         }
@@ -265,7 +359,7 @@ impl Ldlt {
     }
 
     /// Solve `A x = b` in place (`rhs` holds `b` on entry, `x` on return).
-    pub(crate) fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LdltError> {
+    pub fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LdltError> {
         if !self.factored {
             return Err(LdltError("solve before a successful factorization".into()));
         }
@@ -670,6 +764,40 @@ mod tests {
                 assert!(res < 1e-13, "{res}");
             }
             assert_eq!((f.numeric_factorizations(), f.solves()), (1, 2));
+        }
+    }
+
+    /// The trailing Schur complement `S` on the last `m` unknowns of the elimination
+    /// order: `A⁻¹ [0; S x_T]` restricted to those unknowns is `x_T` (to 1e-10 relative),
+    /// with AMD and with a given order, for `m` inside one supernode and across several.
+    #[test]
+    fn trailing_schur_complement_inverts_the_trailing_block() {
+        for k in [12, 41] {
+            let (n, col_ptr, row_idx, vals) = quasi_definite(k);
+            let reversed: Vec<usize> = (0..n).rev().collect();
+            for perm in [None, Some(reversed.as_slice())] {
+                let mut f = Ldlt::analyse(n, &col_ptr, &row_idx, perm).unwrap();
+                f.factorize(&col_ptr, &row_idx, &vals).unwrap();
+                let order: Vec<usize> = f
+                    .permutation()
+                    .map_or_else(|| (0..n).collect(), <[usize]>::to_vec);
+                for m in [1, 5, n / 2, n] {
+                    let s = f.trailing_schur_complement(m).unwrap();
+                    let tail = &order[n - m..];
+                    let xt: Vec<f64> = (0..m).map(|i| 1.0 + ((i * 37) % 11) as f64).collect();
+                    let mut rhs = vec![0.0; n];
+                    for (i, &e) in tail.iter().enumerate() {
+                        rhs[e] = (0..m).map(|j| s[j * m + i] * xt[j]).sum();
+                    }
+                    f.solve_in_place(&mut rhs).unwrap();
+                    let scale = xt.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+                    for (i, &e) in tail.iter().enumerate() {
+                        let d = (rhs[e] - xt[i]).abs() / scale;
+                        assert!(d < 1e-10, "k {k} m {m}: {d:e}");
+                    }
+                }
+                assert!(f.trailing_schur_complement(n + 1).is_err());
+            }
         }
     }
 }

@@ -53,7 +53,7 @@ pub mod field;
 pub mod fracturing;
 pub mod heap;
 pub mod laws;
-mod ldlt;
+pub mod ldlt;
 pub mod linear;
 mod lowrank;
 pub mod ordering;

@@ -30,7 +30,8 @@ pub fn sample<const D: usize>(grid: &Grid<D>, exact: impl Fn(&Point<D>) -> Vec<f
 }
 
 /// The static solution by the sparse LU, after checking that GMRES with the multigrid
-/// preconditioner (tolerance 1e-12) converges on the same system and gives the same
+/// preconditioner, GMRES with the `LDLᵀ` preconditioner and the `LDLᵀ` + Schur complement
+/// solve (each with GMRES at tolerance 1e-12) converge on the same system and give the same
 /// solution to 1e-8 of its largest entry.
 pub fn solve_checked<const D: usize>(model: &porofrac_cosserat::Cosserat<D>) -> Vec<f64> {
     use porofrac_cosserat::{GmresOptions, LinearOptions, LinearSolver};
@@ -44,17 +45,23 @@ pub fn solve_checked<const D: usize>(model: &porofrac_cosserat::Cosserat<D>) -> 
     let (lu, _, _) = model
         .solve_static_with(0.0, &opts(LinearSolver::Lu))
         .unwrap();
-    let (gm, stats, _) = model
-        .solve_static_with(0.0, &opts(LinearSolver::GmresAmg))
-        .unwrap();
     let scale = lu.iter().fold(0.0f64, |m, x| m.max(x.abs())).max(1e-300);
-    let d = lu
-        .iter()
-        .zip(&gm)
-        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
-    assert!(
-        d <= 1e-8 * scale && stats.max_residual <= 1e-12,
-        "GMRES against LU: {d:.2e} of {scale:.2e}, {stats:?}"
-    );
+    for solver in [
+        LinearSolver::GmresAmg,
+        LinearSolver::GmresLdlt,
+        LinearSolver::LdltSchur,
+    ] {
+        let (gm, stats, used) = model.solve_static_with(0.0, &opts(solver)).unwrap();
+        assert_eq!(used, solver);
+        let d = lu
+            .iter()
+            .zip(&gm)
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        assert!(
+            d <= 1e-8 * scale && stats.max_residual <= 1e-12,
+            "{} against LU: {d:.2e} of {scale:.2e}, {stats:?}",
+            solver.name()
+        );
+    }
     lu
 }

@@ -325,6 +325,8 @@ fn run_dim<const D: usize>(
     let (linear, factorizations) = match solver.map(Linear::solver) {
         None => ("explicit", 0),
         Some(LinearSolver::GmresAmg) => ("gmres-amg", 0),
+        Some(LinearSolver::GmresLdlt) => ("gmres-ldlt", 1),
+        Some(LinearSolver::LdltSchur) => ("ldlt-schur", 1),
         Some(_) => ("sparse-lu", 1),
     };
     let mut run = Run {
