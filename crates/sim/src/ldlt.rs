@@ -232,7 +232,8 @@ impl Ldlt {
     }
 
     /// Solve `A X = B` in place for the `k` columns of `B` stored column-major in `rhs`
-    /// (`n · k` values): faer's supernodal solve, blocked over the columns.
+    /// (`n · k` values): faer's supernodal solve, blocked over the columns, the two
+    /// halves of the columns in parallel.
     pub(crate) fn solve_columns_in_place(
         &mut self,
         rhs: &mut [f64],
@@ -252,16 +253,27 @@ impl Ldlt {
             return Ok(());
         }
         self.solves += k;
-        let mut mem = MemBuffer::try_new(self.symbolic.solve_in_place_scratch::<f64>(k, Par::Seq))
-            .map_err(|_| LdltError("out of memory".into()))?;
-        let ldlt = LdltRef::<'_, usize, f64>::new(&self.symbolic, &self.values);
-        ldlt.solve_in_place_with_conj(
-            Conj::No,
-            MatMut::from_column_major_slice_mut(rhs, self.n, k),
-            Par::Seq,
-            MemStack::new(&mut mem),
-        );
-        Ok(())
+        let (symbolic, values, n) = (&self.symbolic, &self.values[..], self.n);
+        let solve = |cols: &mut [f64], k: usize| -> Result<(), LdltError> {
+            if k == 0 {
+                return Ok(());
+            }
+            let mut mem = MemBuffer::try_new(symbolic.solve_in_place_scratch::<f64>(k, Par::Seq))
+                .map_err(|_| LdltError("out of memory".into()))?;
+            LdltRef::<'_, usize, f64>::new(symbolic, values).solve_in_place_with_conj(
+                Conj::No,
+                MatMut::from_column_major_slice_mut(cols, n, k),
+                Par::Seq,
+                MemStack::new(&mut mem),
+            );
+            Ok(())
+        };
+        // The columns are independent: two halves, on two threads when there are (always
+        // split the same way, so the result does not depend on the thread count).
+        let half = k / 2;
+        let (a, b) = rhs.split_at_mut(n * half);
+        let (ra, rb) = rayon::join(|| solve(a, half), || solve(b, k - half));
+        ra.and(rb)
     }
 
     /// Solve `A x = b` in place (`rhs` holds `b` on entry, `x` on return).
