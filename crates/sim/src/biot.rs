@@ -946,7 +946,8 @@ impl Monolithic {
         })
     }
 
-    /// Use `par` for factorizing (default sequential; the solves are sequential).
+    /// Use `par` for factorizing (default sequential; a solve sweeps two independent
+    /// parts of the factor on two threads, see `crate::ldlt`).
     pub fn set_parallelism(&mut self, par: Par) {
         self.ldlt.set_parallelism(par);
     }
@@ -1134,7 +1135,7 @@ impl Monolithic {
 
 /// Changed unknowns up to which a new matrix is solved by a low-rank update of the
 /// factors (`crate::lowrank`) rather than factorized: each new unknown costs a column
-/// solve, every solve two triangular solves and a dense `m × m` one, and refinement
+/// solve, every solve a triangular solve, a dense `m × m` one and `m` column updates, and refinement
 /// steps as the update grows. On the 2D hydraulic-fracture scene 60 took 10.7 s of CPU
 /// against 11.8 s for 150 or 400 (docs/BENCHMARKS.md).
 const DEFAULT_MAX_RANK: usize = 60;

@@ -1,5 +1,6 @@
 //! Sparse `LDLᵀ` factorization of a symmetric matrix given by its upper triangle, with a
-//! triangular solve for one right-hand side at a time.
+//! triangular solve for one right-hand side at a time (on two threads where the
+//! elimination tree splits, see `Split`).
 //!
 //! # Factorization
 //!
@@ -43,6 +44,15 @@
 //! vector instructions the processor has (`pulp` picks AVX2 or plain code at run time);
 //! dot products sum in vector lanes, so the last bits of a solution may differ between
 //! processors, never between runs on one.
+//!
+//! Two subtrees of the elimination tree that are not ancestors of one another touch
+//! disjoint columns, and each writes (forward) or reads (backward) outside itself only
+//! the rows of its ancestors. When the tree has two sets of whole subtrees of comparable
+//! factor entries (`Split`, found once per pattern), each sweep runs the two sets on two
+//! threads, the second on its own copy of the vector (its forward updates of the
+//! ancestors' rows added after the join), and the remaining supernodes — the separators
+//! above them — alone. The split depends on the factor's structure only, so a solution
+//! does not depend on the number of threads.
 
 use std::ops::Range;
 
