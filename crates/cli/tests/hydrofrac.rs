@@ -41,6 +41,9 @@
 //!   compressibility of 1e-7 /Pa (coupling strength 0.03) and 4 pore volumes per hour,
 //!   both fail the same cells, the explicit update at most one step (60 s) later, and the
 //!   well pressures agree within 0.2 % at every output.
+//! * **Refinement** (ignored: minutes of run time, and the reach misses): at h/√2 and
+//!   h/2 near the well (`refine` 17 and 24, the well polygon following) the reach at 40
+//!   minutes changes by less than 10 % and the direction by less than 5°.
 //! * **No injection, no fracture**: without the source nothing fails and the pressure
 //!   stays p₀ = 1e7 Pa (to 1e-9 relative).
 
@@ -242,6 +245,58 @@ fn load_on_the_side_gives_one_crack() {
     let out = dir.join("out");
     run_ok(&side_load_scene(&dir), &out);
     check_one_crack(&out, 0.0, 1.0 / 12.0);
+}
+
+/// Reach (largest distance of a fractured centroid from the well centre, m) and
+/// direction (the axis through the well centre of the second moments of the fractured
+/// centroids, degrees from x in [0, 180)) of the crack at the end of a run.
+fn reach_and_direction(out: &Path) -> (f64, f64) {
+    let f = fractures(out);
+    assert!(!f.is_empty(), "nothing failed");
+    let (mut sxx, mut syy, mut sxy) = (0.0, 0.0, 0.0);
+    for p in &f {
+        let (dx, dy) = (p[0] - CENTER[0], p[1] - CENTER[1]);
+        sxx += dx * dx;
+        syy += dy * dy;
+        sxy += dx * dy;
+    }
+    let direction = (0.5 * (2.0 * sxy).atan2(sxx - syy).to_degrees()).rem_euclid(180.0);
+    (
+        f.iter().map(distance_to_well).fold(0.0, f64::max),
+        direction,
+    )
+}
+
+#[test]
+#[ignore = "minutes of release time (h/2: 75 268 cells, 6 min on a loaded machine) and it \
+            fails: reach 1.665 m at h/√2, 1.945 m at h/2 (+14.4 %, not < 10 %); direction \
+            90.4° and 89.2° (1.2°, < 5°) (docs/BENCHMARKS.md, scripts/hydrofrac_refinement.sh)"]
+fn refinement_changes_the_reach_and_direction_little() {
+    // The issue's criterion on the two finest of h, h/√2, h/2 near the well: the reach at
+    // 40 minutes changes by less than 10 %, the direction by less than 5°.
+    let run = |refine: usize| {
+        let dir = tmp_dir(&format!("hydrofrac-refine-{refine}"));
+        let out = dir.join("out");
+        let scene = variant(
+            &dir,
+            &seed_scene(),
+            &[("refine = 12 ", &format!("refine = {refine} "))],
+        );
+        run_ok(&scene, &out);
+        reach_and_direction(&out)
+    };
+    let (r1, d1) = run(17);
+    let (r2, d2) = run(24);
+    let change = (r2 - r1).abs() / r2;
+    assert!(
+        change < 0.10,
+        "reach {r1} m at h/√2, {r2} m at h/2: {:.1} % change",
+        100.0 * change
+    );
+    assert!(
+        axis_angle(d1, d2) < 5.0,
+        "direction {d1}° at h/√2, {d2}° at h/2"
+    );
 }
 
 /// The well pressure at the first failure and the first failed cells, for the seed's

@@ -45,8 +45,9 @@
 use nalgebra::DMatrix;
 use porofrac_grid::point::for_each_facet;
 use porofrac_grid::{Grid, Point};
-use porofrac_law::{GeometryBuffer, Scratch};
+use porofrac_law::{CellLaw, GeometryBuffer, Scratch};
 use rayon::prelude::*;
+use std::sync::{Arc, Mutex};
 
 use crate::bc::Loads;
 use crate::dofs::DofMap;
@@ -117,6 +118,171 @@ pub fn assemble<const D: usize>(
     values: &mut [f64],
     forces: &mut [f64],
 ) -> Result<()> {
+    assemble_with(grid, laws, dofs, pattern, u, values, forces, None)
+}
+
+/// The element stiffness `K_K` of every cell whose law is linear, kept between assemblies.
+///
+/// A linear law's stiffness depends on the cell's geometry only, so a fracturing run that
+/// re-linearizes at every active-set iteration needs it once per cell: only the cells
+/// whose law is nonlinear (the failed, compression-only cells) are evaluated again.
+/// A matrix is used only while the cell's law is the very law object it was computed
+/// with (compared by address), so a cell that switches law is evaluated by its new law.
+/// The assembled sum of the kept matrices of the cells that use them is kept too (for
+/// the last set of such cells, which changes only when a cell switches law): an assembly
+/// starts from it and scatters only the other cells. It equals the assembly without the
+/// cache up to the order of the sums (rounding).
+pub(crate) struct ElementCache {
+    /// Per cell: the address of the law its matrix was computed with (0: none cached).
+    law: Vec<usize>,
+    /// Per cell: its matrix in `values[start[c]..start[c + 1]]` (column-major `m × m`).
+    start: Vec<usize>,
+    values: Vec<f64>,
+    /// The assembled sum of the kept matrices over the cells flagged (see [`KeptSum`]).
+    sum: Mutex<Option<KeptSum>>,
+}
+
+/// The assembled (pattern values) sum of the kept element matrices of the cells `used`.
+struct KeptSum {
+    used: Vec<bool>,
+    values: Arc<[f64]>,
+}
+
+/// The address of a law object (the key of [`ElementCache`]).
+fn law_address<const D: usize>(law: &dyn CellLaw<D>) -> usize {
+    std::ptr::from_ref(law).cast::<()>() as usize
+}
+
+impl ElementCache {
+    /// Evaluate and keep the stiffness of every cell of `grid` whose law in `laws` is
+    /// linear. Errors: a wrong-sized or non-finite stiffness, naming the cell.
+    pub(crate) fn new<const D: usize>(grid: &Grid<D>, laws: &LawMap<'_, D>) -> Result<Self> {
+        let nc = grid.num_cells();
+        let mut start = Vec::with_capacity(nc + 1);
+        start.push(0);
+        let mut law = vec![0; nc];
+        for c in 0..nc {
+            let l = laws.law(c);
+            let m = D * grid.cell_nodes(c).len();
+            let len = if l.is_linear() { m * m } else { 0 };
+            if len > 0 {
+                law[c] = law_address(l);
+            }
+            start.push(start[c] + len);
+        }
+        let mut values = vec![0.0; start[nc]];
+        let mut w = Work::<D>::default();
+        let zero = vec![0.0; D * grid.num_nodes()];
+        for c in (0..nc).filter(|&c| law[c] != 0) {
+            w.gather(grid, c, &zero);
+            stiffness(grid, laws, c, &mut w)?;
+            values[start[c]..start[c + 1]].copy_from_slice(w.k.as_slice());
+        }
+        Ok(Self {
+            law,
+            start,
+            values,
+            sum: Mutex::new(None),
+        })
+    }
+
+    /// The assembled sum of the kept matrices of the cells whose law in `laws` is the
+    /// kept one, computed when that set of cells changed since the last call.
+    fn kept_sum<const D: usize>(
+        &self,
+        grid: &Grid<D>,
+        laws: &LawMap<'_, D>,
+        dofs: &DofMap<D>,
+        pattern: &Pattern,
+    ) -> Arc<[f64]> {
+        let used: Vec<bool> = (0..grid.num_cells())
+            .map(|c| self.matrix(c, laws.law(c)).is_some())
+            .collect();
+        // A poisoned lock only means another thread panicked while computing: recompute.
+        let mut guard = self.sum.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(k) = guard.as_ref()
+            && k.used == used
+            && k.values.len() == pattern.nnz()
+        {
+            return k.values.clone();
+        }
+        let mut values = vec![0.0; pattern.nnz()];
+        let mut parts = Vec::with_capacity(pattern.chunks.len());
+        let mut rest = &mut values[..];
+        for ch in &pattern.chunks {
+            let (v, r) = rest.split_at_mut(ch.vals.len());
+            parts.push((ch, v));
+            rest = r;
+        }
+        parts
+            .into_par_iter()
+            .for_each_init(ScatterBuffer::default, |map, (ch, vals)| {
+                for &c in &pattern.chunk_cells[ch.cells.clone()] {
+                    if used[c] {
+                        let k = &self.values[self.start[c]..self.start[c + 1]];
+                        pattern.add_cell(grid, dofs, c, k, map, ch.vals.start, vals);
+                    }
+                }
+            });
+        let values: Arc<[f64]> = Arc::from(values);
+        *guard = Some(KeptSum {
+            used,
+            values: values.clone(),
+        });
+        values
+    }
+
+    /// The kept stiffness of cell `c` if its law is `law`.
+    #[inline]
+    fn matrix<const D: usize>(&self, c: usize, law: &dyn CellLaw<D>) -> Option<&[f64]> {
+        let a = *self.law.get(c)?;
+        (a != 0 && a == law_address(law)).then(|| &self.values[self.start[c]..self.start[c + 1]])
+    }
+}
+
+/// The stiffness of cell `c` at the gathered displacement `w.u` into `w.k`, checked for
+/// its size and finiteness.
+fn stiffness<const D: usize>(
+    grid: &Grid<D>,
+    laws: &LawMap<'_, D>,
+    c: usize,
+    w: &mut Work<D>,
+) -> Result<()> {
+    let law = laws.law(c);
+    let m = w.u.len();
+    {
+        let geo = w.geo.load(grid, c);
+        law.stiffness(&geo, &w.u, &mut w.k, &mut w.scratch);
+    }
+    if w.k.nrows() != m || w.k.ncols() != m {
+        return Err(cell_error(
+            laws,
+            c,
+            format!(
+                "stiffness is {}×{}, expected {m}×{m}",
+                w.k.nrows(),
+                w.k.ncols()
+            ),
+        ));
+    }
+    if !w.k.iter().all(|v| v.is_finite()) {
+        return Err(cell_error(laws, c, "non-finite stiffness".into()));
+    }
+    Ok(())
+}
+
+/// [`assemble`], taking the stiffness of the linear cells from `cache` when given.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn assemble_with<const D: usize>(
+    grid: &Grid<D>,
+    laws: &LawMap<'_, D>,
+    dofs: &DofMap<D>,
+    pattern: &Pattern,
+    u: &[f64],
+    values: &mut [f64],
+    forces: &mut [f64],
+    cache: Option<&ElementCache>,
+) -> Result<()> {
     if dofs.num_equations() != pattern.num_equations() || grid.num_cells() != pattern.num_cells() {
         return Err(SimError::Input(format!(
             "assemble: a pattern of {} equations and {} cells for {} equations and {} cells",
@@ -141,6 +307,7 @@ pub fn assemble<const D: usize>(
         )));
     }
     let raw = dofs.raw();
+    let kept_sum = cache.map(|e| e.kept_sum(grid, laws, dofs, pattern));
     let mut parts = Vec::with_capacity(pattern.chunks.len());
     let (mut vrest, mut frest) = (values, forces);
     for ch in &pattern.chunks {
@@ -153,39 +320,30 @@ pub fn assemble<const D: usize>(
     parts
         .into_par_iter()
         .try_for_each_init(Work::<D>::default, |w, (ch, vals, frc)| {
-            vals.fill(0.0);
+            match &kept_sum {
+                Some(sum) => vals.copy_from_slice(&sum[ch.vals.clone()]),
+                None => vals.fill(0.0),
+            }
             frc.fill(0.0);
             for &c in &pattern.chunk_cells[ch.cells.clone()] {
                 let law = laws.law(c);
                 w.gather(grid, c, u);
                 let m = w.u.len();
-                {
-                    let geo = w.geo.load(grid, c);
-                    law.stiffness(&geo, &w.u, &mut w.k, &mut w.scratch);
-                }
-                if w.k.nrows() != m || w.k.ncols() != m {
-                    return Err(cell_error(
-                        laws,
+                // A kept matrix is in `kept_sum` already.
+                let kept = cache.and_then(|e| e.matrix(c, law));
+                if kept.is_none() {
+                    stiffness(grid, laws, c, w)?;
+                    pattern.add_cell(
+                        grid,
+                        dofs,
                         c,
-                        format!(
-                            "stiffness is {}×{}, expected {m}×{m}",
-                            w.k.nrows(),
-                            w.k.ncols()
-                        ),
-                    ));
+                        w.k.as_slice(),
+                        &mut w.map,
+                        ch.vals.start,
+                        vals,
+                    );
                 }
-                if !w.k.iter().all(|v| v.is_finite()) {
-                    return Err(cell_error(laws, c, "non-finite stiffness".into()));
-                }
-                pattern.add_cell(
-                    grid,
-                    dofs,
-                    c,
-                    w.k.as_slice(),
-                    &mut w.map,
-                    ch.vals.start,
-                    vals,
-                );
+                let k = kept.unwrap_or(w.k.as_slice());
                 // Internal forces: −K u for linear laws (nothing to do at u = 0), else the law's.
                 if law.is_linear() {
                     if w.u.iter().all(|&x| x == 0.0) {
@@ -196,7 +354,7 @@ pub fn assemble<const D: usize>(
                     for j in 0..m {
                         let uj = w.u[j];
                         if uj != 0.0 {
-                            for (fi, kij) in w.f.iter_mut().zip(w.k.column(j).iter()) {
+                            for (fi, kij) in w.f.iter_mut().zip(&k[j * m..(j + 1) * m]) {
                                 *fi -= kij * uj;
                             }
                         }
@@ -474,5 +632,82 @@ fn body_load_cell<const D: usize>(
         for a in 0..D {
             acc[D * (i - first) + a] += centre[a];
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bc::Displacement;
+    use porofrac_grid::generate::simplices;
+    use porofrac_law::Stiffness;
+    use porofrac_mdem::{DemLaw, DemMode, MdemLaw};
+    use porofrac_vem::VemLaw;
+
+    /// With the kept element matrices an assembly equals the one without to rounding (the
+    /// forces bitwise), at a displacement that opens some compression-only springs; a cell
+    /// that switches law (MDEM → DEM) after the cache was built is evaluated by its new
+    /// law, and switching back reuses the first sum.
+    #[test]
+    fn element_cache_gives_the_same_assembly() {
+        let grid = simplices::<2>(Point::<2>::zeros(), Point::<2>::new(2.0, 1.0), [8, 4]).unwrap();
+        let st = Stiffness::<2>::isotropic(1.0e9, 0.3).unwrap();
+        let vem = VemLaw::new(st.clone());
+        let mdem = MdemLaw::new(&st).unwrap();
+        let dem = DemLaw::new(&st, DemMode::CompressionOnly).unwrap();
+        let nc = grid.num_cells();
+        let laws: Vec<&dyn CellLaw<2>> = vec![&vem, &mdem, &dem];
+        // VEM, MDEM and a few failed (DEM) cells.
+        let of = |c: usize| match c % 7 {
+            0 => 2,
+            1 | 2 => 0,
+            _ => 1,
+        };
+        let mut map = LawMap::new(&grid, laws, (0..nc).map(of).collect()).unwrap();
+        let fix = Displacement {
+            name: "ymin".into(),
+            faces: grid.boundary("ymin").unwrap(),
+            components: [Some(0.0.into()), Some(0.0.into())],
+        };
+        let dofs = DofMap::new(&grid, std::slice::from_ref(&fix), &[]).unwrap();
+        let pattern = Pattern::new(&grid, &dofs).unwrap();
+        let cache = ElementCache::new(&grid, &map).unwrap();
+        // A displacement with stretched and compressed springs.
+        let u: Vec<f64> = (0..dofs.num_dofs())
+            .map(|i| 1e-4 * (((i * 37 + 11) % 23) as f64 - 11.0))
+            .collect();
+        let run = |map: &LawMap<'_, 2>, cache: Option<&ElementCache>| {
+            let mut v = vec![0.0; pattern.nnz()];
+            let mut f = vec![0.0; dofs.num_equations()];
+            assemble_with(&grid, map, &dofs, &pattern, &u, &mut v, &mut f, cache).unwrap();
+            (v, f)
+        };
+        // Stiffness entries equal up to the order of the sums: 1e-15 of the largest.
+        let same = |a: &(Vec<f64>, Vec<f64>), b: &(Vec<f64>, Vec<f64>)| {
+            let big = a.0.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            let dv =
+                a.0.iter()
+                    .zip(&b.0)
+                    .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+            dv <= 1e-15 * big && a.1 == b.1
+        };
+        let before = run(&map, None);
+        assert!(same(&before, &run(&map, Some(&cache))));
+        // Cells 3 and 4 (MDEM when cached) fail: the cache must not serve them.
+        map.set_law(&grid, 3, 2).unwrap();
+        map.set_law(&grid, 4, 2).unwrap();
+        let after = run(&map, Some(&cache));
+        assert!(same(&after, &run(&map, None)));
+        let big = before.0.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let dv = after
+            .0
+            .iter()
+            .zip(&before.0)
+            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+        assert!(dv > 1e-6 * big, "the failed cells changed the stiffness");
+        map.set_law(&grid, 3, 1).unwrap();
+        map.set_law(&grid, 4, 1).unwrap();
+        assert!(same(&before, &run(&map, Some(&cache))));
+        assert!(after.0.iter().chain(&after.1).all(|x| x.is_finite()));
     }
 }

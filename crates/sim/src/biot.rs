@@ -144,7 +144,7 @@ use porofrac_flow::{FlowError, FlowModel};
 use porofrac_grid::Point;
 use porofrac_law::Stiffness;
 
-use crate::assembly::{assemble, nodal_loads};
+use crate::assembly::{ElementCache, assemble, assemble_with, nodal_loads};
 use crate::error::SimError;
 use crate::ldlt::{Ldlt, LdltError};
 use crate::lowrank::LowRank;
@@ -207,6 +207,8 @@ pub struct BiotSystem<'a, const D: usize> {
     ops: Arc<Operators<D>>,
     drained_bulk: Option<Vec<f64>>,
     k_values: Arc<[f64]>,
+    /// The kept stiffness of the linear cells (see [`ElementCache`]).
+    elements: Option<Arc<ElementCache>>,
 }
 
 /// The coupling data of a grid: α and `p₀` per cell, and the node normals `N_i` of every
@@ -307,12 +309,14 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
             free_eq,
             free_w,
         });
-        Self::from_parts(mechanics, flow, ops, None)
+        Self::from_parts(mechanics, flow, ops, None, None)
     }
 
     /// A system on coupling data `ops` already validated for this grid, flow model and
     /// conditions (by [`Self::new`]), with the stiffness `k_values` of `mechanics.laws`
-    /// when it is known (`None`: assembled here at zero displacement).
+    /// when it is known (`None`: assembled here at zero displacement), taking the
+    /// stiffness of the linear cells from `elements` when given (here and in
+    /// [`Self::linearize`]).
     ///
     /// Errors: a law that is not piecewise linear, or an assembly error.
     pub(crate) fn from_parts(
@@ -320,6 +324,7 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
         flow: &'a FlowModel<D>,
         ops: Arc<Operators<D>>,
         k_values: Option<Arc<[f64]>>,
+        elements: Option<Arc<ElementCache>>,
     ) -> BiotResult<Self> {
         if !mechanics.laws.all_piecewise_linear() {
             return Err(BiotError::Input(
@@ -334,7 +339,7 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
                 let mut k = vec![0.0; mechanics.pattern.nnz()];
                 let mut forces = vec![0.0; mechanics.dofs.num_equations()];
                 let u = vec![0.0; mechanics.dofs.num_dofs()];
-                assemble(
+                assemble_with(
                     mechanics.grid,
                     mechanics.laws,
                     mechanics.dofs,
@@ -342,6 +347,7 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
                     &u,
                     &mut k,
                     &mut forces,
+                    elements.as_deref(),
                 )?;
                 Arc::from(k)
             }
@@ -352,6 +358,7 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
             ops,
             drained_bulk: None,
             k_values,
+            elements,
         })
     }
 
@@ -421,7 +428,16 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
         } = self.mech;
         let mut values = vec![0.0; pattern.nnz()];
         let mut internal = vec![0.0; dofs.num_equations()];
-        assemble(grid, laws, dofs, pattern, u, &mut values, &mut internal)?;
+        assemble_with(
+            grid,
+            laws,
+            dofs,
+            pattern,
+            u,
+            &mut values,
+            &mut internal,
+            self.elements.as_deref(),
+        )?;
         let mut full = vec![0.0; dofs.num_dofs()];
         nodal_loads(grid, loads, t, &mut full)?;
         let mut external = vec![0.0; dofs.num_equations()];
@@ -930,7 +946,8 @@ impl Monolithic {
         })
     }
 
-    /// Use `par` for factorizing (default sequential; the solves are sequential).
+    /// Use `par` for factorizing (default sequential; a solve sweeps two independent
+    /// parts of the factor on two threads, see `crate::ldlt`).
     pub fn set_parallelism(&mut self, par: Par) {
         self.ldlt.set_parallelism(par);
     }
@@ -1118,7 +1135,7 @@ impl Monolithic {
 
 /// Changed unknowns up to which a new matrix is solved by a low-rank update of the
 /// factors (`crate::lowrank`) rather than factorized: each new unknown costs a column
-/// solve, every solve two triangular solves and a dense `m × m` one, and refinement
+/// solve, every solve a triangular solve, a dense `m × m` one and `m` column updates, and refinement
 /// steps as the update grows. On the 2D hydraulic-fracture scene 60 took 10.7 s of CPU
 /// against 11.8 s for 150 or 400 (docs/BENCHMARKS.md).
 const DEFAULT_MAX_RANK: usize = 60;

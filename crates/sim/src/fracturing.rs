@@ -47,6 +47,7 @@ use rayon::prelude::*;
 use crate::bc::Loads;
 use std::sync::Arc;
 
+use crate::assembly::ElementCache;
 use crate::biot::{
     BiotCoupling, BiotError, BiotState, BiotSystem, CouplingStats, ExplicitPressure, FixedStress,
     Monolithic, Operators,
@@ -380,6 +381,8 @@ pub struct Fracturing<'a, const D: usize> {
     coords: Vec<Point<D>>,
     /// The law map and the assembled stiffness of the last failure state solved.
     cached: Option<Cached<'a, D>>,
+    /// The stiffness of the cells with a linear intact law (assembled once).
+    elements: Arc<ElementCache>,
 }
 
 /// A failure state's law map and stiffness (at zero displacement).
@@ -447,6 +450,7 @@ impl<'a, const D: usize> Fracturing<'a, D> {
             flow.p0.clone(),
         )?;
         let scheme = scheme(&system)?;
+        let elements = Arc::new(ElementCache::new(body.grid, &intact)?);
         let (operators, stiffness) = system.parts();
         drop(system);
         let cached = Some(Cached {
@@ -469,6 +473,7 @@ impl<'a, const D: usize> Fracturing<'a, D> {
                 .collect(),
             operators,
             cached,
+            elements,
         })
     }
 
@@ -526,6 +531,7 @@ impl<'a, const D: usize> Fracturing<'a, D> {
             operators,
             coords,
             cached,
+            elements,
         } = self;
         let grid = body.grid;
         let t1 = t + dt;
@@ -552,6 +558,7 @@ impl<'a, const D: usize> Fracturing<'a, D> {
                 &flow.model,
                 operators.clone(),
                 stiffness.clone(),
+                Some(elements.clone()),
             )?;
             if stiffness.is_none() {
                 *stiffness = Some(system.parts().1);

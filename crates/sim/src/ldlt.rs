@@ -1,5 +1,6 @@
 //! Sparse `LDLᵀ` factorization of a symmetric matrix given by its upper triangle, with a
-//! triangular solve for one right-hand side at a time.
+//! triangular solve for one right-hand side at a time (on two threads where the
+//! elimination tree splits, see `Split`).
 //!
 //! Public for the other solvers of the workspace: [`Ldlt::analyse`] (pattern and an
 //! optional elimination order, e.g. from [`crate::ordering::pattern_dissection`]),
@@ -48,6 +49,15 @@
 //! vector instructions the processor has (`pulp` picks AVX2 or plain code at run time);
 //! dot products sum in vector lanes, so the last bits of a solution may differ between
 //! processors, never between runs on one.
+//!
+//! Two subtrees of the elimination tree that are not ancestors of one another touch
+//! disjoint columns, and each writes (forward) or reads (backward) outside itself only
+//! the rows of its ancestors. When the tree has two sets of whole subtrees of comparable
+//! factor entries (`Split`, found once per pattern), each sweep runs the two sets on two
+//! threads, the second on its own copy of the vector (its forward updates of the
+//! ancestors' rows added after the join), and the remaining supernodes — the separators
+//! above them — alone. The split depends on the factor's structure only, so a solution
+//! does not depend on the number of threads.
 
 use std::ops::Range;
 
@@ -92,6 +102,14 @@ pub struct Ldlt {
     work: Vec<f64>,
     /// Dense buffer of the rows below a supernode.
     tmp: Vec<f64>,
+    /// Every supernode, ascending (the sequential sweeps).
+    all: Vec<usize>,
+    /// Two independent sets of subtrees of the supernodes, swept on two threads (see
+    /// [`Split`]).
+    split: Option<Split>,
+    /// The work vector and dense buffer of the second subtree.
+    work_b: Vec<f64>,
+    tmp_b: Vec<f64>,
     /// Scratch of faer's numeric factorization and of its simplicial solve.
     mem: Option<MemBuffer>,
     par: Par,
@@ -141,6 +159,21 @@ impl Ldlt {
         };
         let symbolic = factorize_symbolic_cholesky(sym, Side::Upper, ordering, params)
             .map_err(|e| LdltError(format!("symbolic LDLᵀ: {e:?}")))?;
+        let all = match symbolic.raw() {
+            SymbolicCholeskyRaw::Supernodal(sn) => (0..sn.n_supernodes()).collect(),
+            SymbolicCholeskyRaw::Simplicial(_) => Vec::new(),
+        };
+        let split = match symbolic.raw() {
+            SymbolicCholeskyRaw::Supernodal(sn) => Split::find(
+                sn.supernode_begin(),
+                sn.supernode_end(),
+                sn.col_ptr_for_row_idx(),
+                sn.col_ptr_for_val(),
+                sn.row_idx(),
+            ),
+            SymbolicCholeskyRaw::Simplicial(_) => None,
+        };
+        let nb = if split.is_some() { n } else { 0 };
         Ok(Self {
             n,
             symbolic,
@@ -148,6 +181,10 @@ impl Ldlt {
             inv_diag: Vec::new(),
             work: vec![0.0; n],
             tmp: Vec::new(),
+            all,
+            split,
+            work_b: vec![0.0; nb],
+            tmp_b: Vec::new(),
             mem: None,
             par: Par::Seq,
             factored: false,
@@ -247,6 +284,7 @@ impl Ldlt {
                 }
             }
             self.tmp.resize(widest, 0.0);
+            self.tmp_b.resize(widest, 0.0);
         }
         self.factored = true;
         Ok(())
@@ -330,7 +368,8 @@ impl Ldlt {
     }
 
     /// Solve `A X = B` in place for the `k` columns of `B` stored column-major in `rhs`
-    /// (`n · k` values): faer's supernodal solve, blocked over the columns.
+    /// (`n · k` values): faer's supernodal solve, blocked over the columns, the two
+    /// halves of the columns in parallel.
     pub fn solve_columns_in_place(&mut self, rhs: &mut [f64], k: usize) -> Result<(), LdltError> {
         if !self.factored {
             return Err(LdltError("solve before a successful factorization".into()));
@@ -346,16 +385,27 @@ impl Ldlt {
             return Ok(());
         }
         self.solves += k;
-        let mut mem = MemBuffer::try_new(self.symbolic.solve_in_place_scratch::<f64>(k, Par::Seq))
-            .map_err(|_| LdltError("out of memory".into()))?;
-        let ldlt = LdltRef::<'_, usize, f64>::new(&self.symbolic, &self.values);
-        ldlt.solve_in_place_with_conj(
-            Conj::No,
-            MatMut::from_column_major_slice_mut(rhs, self.n, k),
-            Par::Seq,
-            MemStack::new(&mut mem),
-        );
-        Ok(())
+        let (symbolic, values, n) = (&self.symbolic, &self.values[..], self.n);
+        let solve = |cols: &mut [f64], k: usize| -> Result<(), LdltError> {
+            if k == 0 {
+                return Ok(());
+            }
+            let mut mem = MemBuffer::try_new(symbolic.solve_in_place_scratch::<f64>(k, Par::Seq))
+                .map_err(|_| LdltError("out of memory".into()))?;
+            LdltRef::<'_, usize, f64>::new(symbolic, values).solve_in_place_with_conj(
+                Conj::No,
+                MatMut::from_column_major_slice_mut(cols, n, k),
+                Par::Seq,
+                MemStack::new(&mut mem),
+            );
+            Ok(())
+        };
+        // The columns are independent: two halves, on two threads when there are (always
+        // split the same way, so the result does not depend on the thread count).
+        let half = k / 2;
+        let (a, b) = rhs.split_at_mut(n * half);
+        let (ra, rb) = rayon::join(|| solve(a, half), || solve(b, k - half));
+        ra.and(rb)
     }
 
     /// Solve `A x = b` in place (`rhs` holds `b` on entry, `x` on return).
@@ -417,18 +467,46 @@ impl Ldlt {
         // The sweeps compiled for the widest vector instructions of this processor.
         let arch = pulp::Arch::new();
         let tmp = &mut self.tmp;
-        arch.dispatch(Forward {
-            f: &f,
-            sns: 0..ns,
-            x,
-            tmp,
-        });
-        arch.dispatch(Backward {
-            f: &f,
-            sns: 0..ns,
-            x,
-            tmp,
-        });
+        let forward = |sns: &[usize], x: &mut [f64], tmp: &mut [f64]| {
+            arch.dispatch(Forward { f: &f, sns, x, tmp })
+        };
+        let backward = |sns: &[usize], x: &mut [f64], tmp: &mut [f64]| {
+            arch.dispatch(Backward { f: &f, sns, x, tmp })
+        };
+        match &self.split {
+            None => {
+                let all = &self.all[..ns];
+                forward(all, x, tmp);
+                backward(all, x, tmp);
+            }
+            Some(sp) => {
+                // Forward: the subtrees of a and b on two threads, b on its own vector
+                // (its updates of the rows of the rest added after), then the rest.
+                let (xb, tmp_b) = (&mut self.work_b, &mut self.tmp_b);
+                xb.fill(0.0);
+                for c in &sp.b_cols {
+                    xb[c.clone()].copy_from_slice(&x[c.clone()]);
+                }
+                rayon::join(|| forward(&sp.a, x, tmp), || forward(&sp.b, xb, tmp_b));
+                for c in &sp.b_cols {
+                    x[c.clone()].copy_from_slice(&xb[c.clone()]);
+                }
+                for c in &sp.rest_cols {
+                    for (xi, yi) in x[c.clone()].iter_mut().zip(&xb[c.clone()]) {
+                        *xi += yi;
+                    }
+                }
+                forward(&sp.rest, x, tmp);
+                // Backward: the rest in reverse, then a and b on two threads (each reads
+                // the rest and writes only its own columns).
+                backward(&sp.rest, x, tmp);
+                xb.copy_from_slice(x);
+                rayon::join(|| backward(&sp.a, x, tmp), || backward(&sp.b, xb, tmp_b));
+                for c in &sp.b_cols {
+                    x[c.clone()].copy_from_slice(&xb[c.clone()]);
+                }
+            }
+        }
         match self.symbolic.perm() {
             Some(p) => {
                 for (r, &i) in rhs.iter_mut().zip(p.arrays().1) {
@@ -441,10 +519,147 @@ impl Ldlt {
     }
 }
 
+/// Two disjoint sets `a` and `b` of whole subtrees of the supernodal elimination tree
+/// (supernodes ascending), no supernode of one an ancestor of one of the other: the
+/// forward sweep of a subtree writes only its own columns and rows of its ancestors (in
+/// `rest`), the backward sweep reads only its own columns and those of its ancestors, so
+/// both sweeps run `a` and `b` on two threads, `rest` (the other supernodes, ascending)
+/// after them (forward) or before them (backward); a parent follows its children, so
+/// ascending order is an elimination order of every set. Chosen by opening the heaviest
+/// subtree (by factor entries) of a frontier that starts at the roots until the frontier
+/// splits into two bins of comparable weight (heaviest first into the lighter bin).
+#[derive(Debug)]
+struct Split {
+    a: Vec<usize>,
+    b: Vec<usize>,
+    /// The columns of `b`.
+    b_cols: Vec<Range<usize>>,
+    rest: Vec<usize>,
+    /// The columns of `rest`.
+    rest_cols: Vec<Range<usize>>,
+}
+
+impl Split {
+    /// The lighter bin must carry at least this fraction of the heavier's entries.
+    const BALANCE: f64 = 0.8;
+    /// Both bins together at least this fraction of all entries.
+    const WORTH: f64 = 0.6;
+    /// Subtrees opened at most.
+    const OPENINGS: usize = 256;
+
+    /// The split of the supernodes given by faer's supernodal structure (`begin`,
+    /// `end`: columns; `rptr`, `rows`: rows below each diagonal block; `vptr`: entries),
+    /// or `None` when the tree has no such split or is not postordered.
+    fn find(
+        begin: &[usize],
+        end: &[usize],
+        rptr: &[usize],
+        vptr: &[usize],
+        rows: &[usize],
+    ) -> Option<Self> {
+        let ns = begin.len();
+        if ns < 4 {
+            return None;
+        }
+        let n = end[ns - 1];
+        let mut sn_of_col = vec![0; n];
+        for s in 0..ns {
+            sn_of_col[begin[s]..end[s]].fill(s);
+        }
+        // Parent: the supernode of the first row below the diagonal block.
+        let mut parent = vec![usize::MAX; ns];
+        for s in 0..ns {
+            let w = end[s] - begin[s];
+            let r = (vptr[s + 1] - vptr[s]) / w.max(1) - w;
+            if r > 0 {
+                let first = rows[rptr[s]..rptr[s] + r].iter().copied().min()?;
+                let p = sn_of_col[first];
+                if p <= s {
+                    return None;
+                }
+                parent[s] = p;
+            }
+        }
+        // Subtree weights (children before parents).
+        let mut weight: Vec<usize> = (0..ns).map(|s| vptr[s + 1] - vptr[s]).collect();
+        for s in 0..ns {
+            if parent[s] != usize::MAX {
+                weight[parent[s]] += weight[s];
+            }
+        }
+        let mut children: Vec<Vec<usize>> = vec![Vec::new(); ns];
+        let mut frontier = Vec::new();
+        for s in 0..ns {
+            match parent[s] {
+                usize::MAX => frontier.push(s),
+                p => children[p].push(s),
+            }
+        }
+        let total: usize = frontier.iter().map(|&r| weight[r]).sum();
+        for _ in 0..Self::OPENINGS {
+            frontier.sort_by_key(|&c| (std::cmp::Reverse(weight[c]), c));
+            let (mut a, mut b) = (Vec::new(), Vec::new());
+            let (mut wa, mut wb) = (0usize, 0usize);
+            for &c in &frontier {
+                if wa <= wb {
+                    a.push(c);
+                    wa += weight[c];
+                } else {
+                    b.push(c);
+                    wb += weight[c];
+                }
+            }
+            let (lo, hi) = (wa.min(wb) as f64, wa.max(wb) as f64);
+            if lo >= Self::BALANCE * hi {
+                if lo + hi < Self::WORTH * total as f64 {
+                    return None;
+                }
+                // Bin of every supernode: 0 rest, 1 a, 2 b (subtrees by depth-first walks).
+                let mut bin = vec![0u8; ns];
+                let mut stack = Vec::new();
+                for (set, tag) in [(&a, 1u8), (&b, 2u8)] {
+                    stack.extend_from_slice(set);
+                    while let Some(q) = stack.pop() {
+                        bin[q] = tag;
+                        stack.extend_from_slice(&children[q]);
+                    }
+                }
+                let of = |tag: u8| (0..ns).filter(|&q| bin[q] == tag).collect::<Vec<_>>();
+                let cols = |set: &[usize]| {
+                    let mut out: Vec<Range<usize>> = Vec::new();
+                    for &q in set {
+                        match out.last_mut() {
+                            Some(r) if r.end == begin[q] => r.end = end[q],
+                            _ => out.push(begin[q]..end[q]),
+                        }
+                    }
+                    out
+                };
+                let (a, b, rest) = (of(1), of(2), of(0));
+                return Some(Self {
+                    b_cols: cols(&b),
+                    rest_cols: cols(&rest),
+                    a,
+                    b,
+                    rest,
+                });
+            }
+            // Open the heaviest subtree: its root joins the rest.
+            let heavy = frontier[0];
+            if children[heavy].is_empty() {
+                return None;
+            }
+            frontier.swap_remove(0);
+            frontier.extend_from_slice(&children[heavy]);
+        }
+        None
+    }
+}
+
 /// [`Factor::forward`] compiled for the instruction set `pulp` dispatches to.
 struct Forward<'a, 'f> {
     f: &'a Factor<'f>,
-    sns: Range<usize>,
+    sns: &'a [usize],
     x: &'a mut [f64],
     tmp: &'a mut [f64],
 }
@@ -460,7 +675,7 @@ impl pulp::WithSimd for Forward<'_, '_> {
 /// [`Factor::backward`] compiled for the instruction set `pulp` dispatches to.
 struct Backward<'a, 'f> {
     f: &'a Factor<'f>,
-    sns: Range<usize>,
+    sns: &'a [usize],
     x: &'a mut [f64],
     tmp: &'a mut [f64],
 }
@@ -500,10 +715,10 @@ impl Factor<'_> {
         )
     }
 
-    /// `y ← L⁻¹ y` over the supernodes `sns` (in the permuted order).
+    /// `y ← L⁻¹ y` over the supernodes `sns` (ascending, in the permuted order).
     #[inline(always)]
-    fn forward<S: Simd>(&self, simd: S, sns: Range<usize>, x: &mut [f64], buf: &mut [f64]) {
-        for s in sns {
+    fn forward<S: Simd>(&self, simd: S, sns: &[usize], x: &mut [f64], buf: &mut [f64]) {
+        for &s in sns {
             let (start, w, r, block, below) = self.supernode(s);
             let m = w + r;
             // buf = [y_top | accumulated −L_bot y_top]; column j updates the contiguous
@@ -543,10 +758,10 @@ impl Factor<'_> {
         }
     }
 
-    /// `x ← L⁻ᵀ D⁻¹ x` over the supernodes `sns`, in reverse.
+    /// `x ← L⁻ᵀ D⁻¹ x` over the supernodes `sns` (ascending), in reverse.
     #[inline(always)]
-    fn backward<S: Simd>(&self, simd: S, sns: Range<usize>, x: &mut [f64], buf: &mut [f64]) {
-        for s in sns.rev() {
+    fn backward<S: Simd>(&self, simd: S, sns: &[usize], x: &mut [f64], buf: &mut [f64]) {
+        for &s in sns.iter().rev() {
             let (start, w, r, block, below) = self.supernode(s);
             let m = w + r;
             // buf = [D⁻¹ z_top | x[R_s]]; column j reads the contiguous rows j + 1..m.
@@ -799,5 +1014,53 @@ mod tests {
                 assert!(f.trailing_schur_complement(n + 1).is_err());
             }
         }
+    }
+
+    /// On a 2D grid Laplacian (AMD: a nested-dissection-like tree) the sweeps split into
+    /// two subtrees, and the split solve satisfies the matrix like the sequential one.
+    #[test]
+    fn split_solve_matches_the_sequential_one() {
+        let k = 60;
+        let n = k * k;
+        let mut col_ptr = vec![0];
+        let (mut row_idx, mut vals) = (Vec::new(), Vec::new());
+        for a in 0..n {
+            let (i, j) = (a / k, a % k);
+            if i > 0 {
+                row_idx.push(a - k);
+                vals.push(-1.0);
+            }
+            if j > 0 {
+                row_idx.push(a - 1);
+                vals.push(-1.0);
+            }
+            row_idx.push(a);
+            vals.push(4.0 + 0.01 * (a % 7) as f64);
+            col_ptr.push(row_idx.len());
+        }
+        let b: Vec<f64> = (0..n).map(|i| ((i * 7919) % 13) as f64 - 6.0).collect();
+        let mut f = Ldlt::analyse(n, &col_ptr, &row_idx, None).unwrap();
+        f.factorize(&col_ptr, &row_idx, &vals).unwrap();
+        let sp = f.split.as_ref().expect("a split of the grid's tree");
+        assert!(!sp.a.is_empty() && !sp.b.is_empty());
+        let mut x = b.clone();
+        f.solve_in_place(&mut x).unwrap();
+        assert!(residual(&col_ptr, &row_idx, &vals, &x, &b) < 1e-13);
+        let split = f.split.take();
+        let mut y = b.clone();
+        f.solve_in_place(&mut y).unwrap();
+        assert!(residual(&col_ptr, &row_idx, &vals, &y, &b) < 1e-13);
+        let d = x
+            .iter()
+            .zip(&y)
+            .map(|(p, q)| (p - q).abs())
+            .fold(0.0, f64::max);
+        let m = y.iter().map(|v| v.abs()).fold(0.0, f64::max);
+        assert!(d <= 1e-13 * m, "split and sequential differ by {d:e}");
+        // The same split twice gives the same bits.
+        f.split = split;
+        let mut z = b.clone();
+        f.solve_in_place(&mut z).unwrap();
+        assert_eq!(x, z);
     }
 }
