@@ -439,6 +439,35 @@ fn bad_input_is_refused_with_its_name() {
     assert!(e.to_string().contains("particle 0"), "{e}");
 }
 
+/// A random pile (about 1 000 disks) between a floor, a fixed wall and a wall pushing
+/// at 0.2 m/s, 20 steps of 10 ms with `ordering`: positions, spins, sweeps and contacts.
+fn random_pile(ordering: Ordering) -> (Vec<[f64; 2]>, Vec<f64>, usize, usize) {
+    let p = porofrac_particles::RandomPacking::new([0.0, 0.0], [30.0, 15.0], 0.3, 0.5, 0.75, 5)
+        .generate()
+        .unwrap();
+    let d = Disks::new(&p.centres, &p.radii, 2000.0).unwrap();
+    let walls = vec![
+        RigidBody::segment([-1.0, 0.0], [31.0, 0.0]),
+        RigidBody::segment([0.0, 30.0], [0.0, 0.0]),
+        RigidBody::segment([30.0, 0.0], [30.0, 30.0]).moving([-0.2, 0.0]),
+    ];
+    let params = SolverParams {
+        ordering,
+        ..SolverParams::default()
+    };
+    let mut s = Nscd::new(d, walls, ContactLaw::frictional(0.4), params, [0.0, -G]).unwrap();
+    let mut sweeps = 0;
+    for _ in 0..20 {
+        sweeps += s.step(1e-2).unwrap().sweeps;
+    }
+    (
+        s.disks.x.clone(),
+        s.disks.omega.clone(),
+        sweeps,
+        s.contacts().len(),
+    )
+}
+
 /// The coloured parallel sweep: the same exact answers (column, square packing with
 /// loaded walls, which go to the ordered group), and bit-identical results in pools of
 /// one and two threads on a random pile.
@@ -461,34 +490,7 @@ fn coloured_sweep_is_exact_and_independent_of_threads() {
             .num_threads(threads)
             .build()
             .unwrap();
-        pool.install(|| {
-            let p =
-                porofrac_particles::RandomPacking::new([0.0, 0.0], [30.0, 15.0], 0.3, 0.5, 0.75, 5)
-                    .generate()
-                    .unwrap();
-            let d = Disks::new(&p.centres, &p.radii, 2000.0).unwrap();
-            let walls = vec![
-                RigidBody::segment([-1.0, 0.0], [31.0, 0.0]),
-                RigidBody::segment([0.0, 30.0], [0.0, 0.0]),
-                RigidBody::segment([30.0, 0.0], [30.0, 30.0]).moving([-0.2, 0.0]),
-            ];
-            let params = SolverParams {
-                ordering: Ordering::Coloured,
-                ..SolverParams::default()
-            };
-            let mut s =
-                Nscd::new(d, walls, ContactLaw::frictional(0.4), params, [0.0, -G]).unwrap();
-            let mut sweeps = 0;
-            for _ in 0..20 {
-                sweeps += s.step(1e-2).unwrap().sweeps;
-            }
-            (
-                s.disks.x.clone(),
-                s.disks.omega.clone(),
-                sweeps,
-                s.contacts().len(),
-            )
-        })
+        pool.install(|| random_pile(Ordering::Coloured))
     };
     let (a, b) = (run(1), run(2));
     assert!(a.3 > 500, "a dense pile: {} contacts", a.3);
@@ -522,36 +524,7 @@ fn slab_sweep_is_exact_and_repeatable() {
         }
         square_packing(Ordering::Slabs);
     });
-    let run = || {
-        pool.install(|| {
-            let p =
-                porofrac_particles::RandomPacking::new([0.0, 0.0], [30.0, 15.0], 0.3, 0.5, 0.75, 5)
-                    .generate()
-                    .unwrap();
-            let d = Disks::new(&p.centres, &p.radii, 2000.0).unwrap();
-            let walls = vec![
-                RigidBody::segment([-1.0, 0.0], [31.0, 0.0]),
-                RigidBody::segment([0.0, 30.0], [0.0, 0.0]),
-                RigidBody::segment([30.0, 0.0], [30.0, 30.0]).moving([-0.2, 0.0]),
-            ];
-            let params = SolverParams {
-                ordering: Ordering::Slabs,
-                ..SolverParams::default()
-            };
-            let mut s =
-                Nscd::new(d, walls, ContactLaw::frictional(0.4), params, [0.0, -G]).unwrap();
-            let mut sweeps = 0;
-            for _ in 0..20 {
-                sweeps += s.step(1e-2).unwrap().sweeps;
-            }
-            (
-                s.disks.x.clone(),
-                s.disks.omega.clone(),
-                sweeps,
-                s.contacts().len(),
-            )
-        })
-    };
+    let run = || pool.install(|| random_pile(Ordering::Slabs));
     let (a, b) = (run(), run());
     assert!(a.3 > 500, "a dense pile: {} contacts", a.3);
     assert_eq!(a, b, "two runs with two threads give the same state");
