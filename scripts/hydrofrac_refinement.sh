@@ -10,10 +10,12 @@
 #
 # Usage (from the repository root, after `cargo build --release -p porofrac-cli`):
 #     scripts/hydrofrac_refinement.sh [OUTDIR] [REFINE...]
-# PORO_BIN overrides the binary (default target/release/porofrac).
+# PORO_BIN overrides the binary (default target/release/porofrac); SCENE the base scene
+# (default scenes/hydrofrac_seed.toml; it must hold a line `refine = 12 ...`).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 bin=${PORO_BIN:-$root/target/release/porofrac}
+scene=${SCENE:-$root/scenes/hydrofrac_seed.toml}
 out=${1:-/tmp/hydrofrac_refinement}
 shift || true
 refines=("$@")
@@ -22,8 +24,8 @@ mkdir -p "$out"
 for r in "${refines[@]}"; do
     d=$out/refine_$r
     mkdir -p "$d"
-    sed -e "s/^refine = 12 .*/refine = $r/" -e "s/^name = \"hydrofrac_seed\"/name = \"hydrofrac_refine_$r\"/" \
-        "$root/scenes/hydrofrac_seed.toml" >"$d/scene.toml"
+    sed -e "s/^refine = 12 .*/refine = $r/" -e "0,/^name = \".*\"/s//name = \"hydrofrac_refine_$r\"/" \
+        "$scene" >"$d/scene.toml"
     grep -q "^refine = $r\$" "$d/scene.toml" || { echo "refine key not found" >&2; exit 1; }
     "$bin" run "$d/scene.toml" --out "$d/out" >"$d/log.txt" 2>&1 || { echo "refine $r failed, see $d/log.txt" >&2; exit 1; }
 done

@@ -646,3 +646,54 @@ fn every_bundled_scene_passes_check() {
         assert!(out.contains("ok"), "{}: {out}", scene.display());
     }
 }
+
+#[test]
+fn fracture_toughness_and_transmissivity_keys_are_checked() {
+    let seed = std::fs::read_to_string(root().join("scenes/hydrofrac_seed.toml")).unwrap();
+    // A toughness needs a tensile strength.
+    let text = seed.replace("tensile_strength = 2.0e5", "fracture_toughness = 1.0e5");
+    let (code, err) = check_text("toughness_alone", &text);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains(&format!(
+            "toughness_alone.toml:{}: material.rock.fracture_toughness needs tensile_strength",
+            line_of(&text, "fracture_toughness")
+        )),
+        "{err}"
+    );
+    let text = seed.replace(
+        "tensile_strength = 2.0e5",
+        "tensile_strength = 2.0e5\nfracture_toughness = -1.0",
+    );
+    let (code, err) = check_text("toughness_negative", &text);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains("material.rock.fracture_toughness = -1 must be > 0"),
+        "{err}"
+    );
+    // One of fracture_permeability and fracture_transmissivity.
+    let text = seed.replace(
+        "fracture_permeability = 1.0e-12",
+        "fracture_permeability = 1.0e-12\nfracture_transmissivity = 1.0e-13",
+    );
+    let (code, err) = check_text("both_permeabilities", &text);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains(&format!(
+            "both_permeabilities.toml:{}: physics.fracture_transmissivity and \
+             fracture_permeability both set",
+            line_of(&text, "fracture_transmissivity")
+        )),
+        "{err}"
+    );
+    let text = seed.replace(
+        "fracture_permeability = 1.0e-12",
+        "fracture_transmissivity = 0.0",
+    );
+    let (code, err) = check_text("transmissivity_zero", &text);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains("physics.fracture_transmissivity = 0 must be > 0"),
+        "{err}"
+    );
+}

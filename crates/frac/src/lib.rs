@@ -12,15 +12,19 @@
 //!   nodal field, so a criterion can be evaluated on a smoother stress near a tip.
 //! * [`tracking`]: crack tracking, so a crack grows perpendicular to the largest principal
 //!   stress rather than along mesh diagonals.
+//! * [`toughness`]: fracture toughness at crack tips ([`Toughness`], [`CrackTips`]), so a
+//!   crack grows at the same stress intensity on every grid.
 //!
 //! What a failed cell becomes is the caller's choice: in porofrac's scenes a failed MDEM
 //! cell switches to the compression-only central-force law (seed eqs. 32–33).
 
 pub mod recovery;
 pub mod resolve;
+pub mod toughness;
 pub mod tracking;
 
-pub use resolve::{FailurePolicy, ResolveError, resolve};
+pub use resolve::{CellCriteria, FailurePolicy, ResolveError, resolve};
+pub use toughness::{CrackTips, Toughness};
 pub use tracking::CrackTracking;
 
 use porofrac_law::Tensor;
@@ -179,6 +183,9 @@ pub struct Combined {
     pub tensile: Option<Tensile>,
     /// Shear criterion, if the material has a cohesion and friction angle.
     pub shear: Option<MohrCoulomb>,
+    /// Fracture toughness: a crack-tip cell also needs `K_c > K_Ic` to fail in tension
+    /// ([`toughness`]).
+    pub toughness: Option<Toughness>,
 }
 
 impl Combined {
@@ -186,29 +193,52 @@ impl Combined {
     pub fn is_empty(&self) -> bool {
         self.tensile.is_none() && self.shear.is_none()
     }
-}
 
-impl<const D: usize> FailureCriterion<D> for Combined {
-    fn check(&self, s: &Tensor<D>) -> Option<FailureMode> {
-        self.tensile
+    /// Tensile utilization; at a crack tip (`tip_radius`: the cell's equivalent radius,
+    /// see [`CrackTips::tip_radius`]) with a toughness, the smaller of `σ₁/σ_t` and
+    /// `K_c/K_Ic`: both must exceed 1.
+    fn tensile_utilization<const D: usize>(&self, s: &Tensor<D>, tip_radius: Option<f64>) -> f64 {
+        let Some(t) = &self.tensile else {
+            return 0.0;
+        };
+        let strength = FailureCriterion::<D>::utilization(t, s);
+        match (tip_radius, &self.toughness) {
+            (Some(r), Some(k)) => strength.min(k.utilization(toughness::sigma_1(s), r)),
+            _ => strength,
+        }
+    }
+
+    /// The failure mode of stress `s` in a cell that is at a crack tip with equivalent
+    /// radius `r` (`tip_radius = Some(r)`) or not (`None`): tension first, then shear.
+    pub fn check_at<const D: usize>(
+        &self,
+        s: &Tensor<D>,
+        tip_radius: Option<f64>,
+    ) -> Option<FailureMode> {
+        if self.tensile_utilization(s, tip_radius) > 1.0 {
+            return Some(FailureMode::Tensile);
+        }
+        self.shear
             .as_ref()
             .and_then(|c| FailureCriterion::<D>::check(c, s))
-            .or_else(|| {
-                self.shear
-                    .as_ref()
-                    .and_then(|c| FailureCriterion::<D>::check(c, s))
-            })
     }
-    fn utilization(&self, s: &Tensor<D>) -> f64 {
-        let t = self
-            .tensile
-            .as_ref()
-            .map_or(0.0, |c| FailureCriterion::<D>::utilization(c, s));
+
+    /// The utilization of [`Self::check_at`]: the largest over the criteria.
+    pub fn utilization_at<const D: usize>(&self, s: &Tensor<D>, tip_radius: Option<f64>) -> f64 {
         let m = self
             .shear
             .as_ref()
             .map_or(0.0, |c| FailureCriterion::<D>::utilization(c, s));
-        t.max(m)
+        self.tensile_utilization(s, tip_radius).max(m)
+    }
+}
+
+impl<const D: usize> FailureCriterion<D> for Combined {
+    fn check(&self, s: &Tensor<D>) -> Option<FailureMode> {
+        self.check_at(s, None)
+    }
+    fn utilization(&self, s: &Tensor<D>) -> f64 {
+        self.utilization_at(s, None)
     }
 }
 
@@ -342,6 +372,7 @@ mod tests {
         let c = Combined {
             tensile: Some(Tensile::new(1e5).unwrap()),
             shear: Some(MohrCoulomb::new(1e5, 30.0).unwrap()),
+            toughness: None,
         };
         assert_eq!(
             FailureCriterion::<2>::check(&c, &t2(2e5, -1e7, 0.0)),

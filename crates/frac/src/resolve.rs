@@ -10,8 +10,22 @@
 
 use porofrac_law::Tensor;
 
+use crate::toughness::CrackTips;
 use crate::tracking::CrackTracking;
-use crate::{Combined, FailureCriterion, FailureState};
+use crate::{Combined, FailureState};
+
+/// The criteria of the cells: `criteria[k]` is the criterion of class `k`,
+/// `class_of_cell[c]` the class of cell `c` (an empty [`Combined`] never fails); with
+/// `tips`, the cells next to a crack check their toughness too ([`crate::toughness`]).
+#[derive(Clone, Copy)]
+pub struct CellCriteria<'a> {
+    /// The criterion of every class.
+    pub criteria: &'a [Combined],
+    /// The class of every cell.
+    pub class_of_cell: &'a [usize],
+    /// Crack-tip cells and their radii, for the criteria with a toughness.
+    pub tips: Option<&'a CrackTips>,
+}
 
 /// Which violating cells fail in one round.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -53,8 +67,7 @@ pub enum ResolveError<E> {
 
 /// Solve, check, fail and re-solve at time `time` until no cell fails.
 ///
-/// `criteria[k]` is the criterion of class `k` and `criterion_of_cell[c]` the class of
-/// cell `c` (an empty [`Combined`] never fails). `solve` gets the current state and
+/// `criteria` gives every cell its criterion ([`CellCriteria`]). `solve` gets the current state and
 /// returns a solution and the cell stresses (effective, tension positive) used by the
 /// criteria, e.g. raw or recovered cell stresses. With `tracking`, a violating cell next
 /// to failed cells fails only where [`CrackTracking::admits`] it, and every failure records
@@ -62,8 +75,7 @@ pub enum ResolveError<E> {
 pub fn resolve<const D: usize, S, E>(
     state: &mut FailureState,
     time: f64,
-    criteria: &[Combined],
-    criterion_of_cell: &[usize],
+    criteria: CellCriteria<'_>,
     policy: FailurePolicy,
     mut tracking: Option<&mut CrackTracking<D>>,
     max_solves: usize,
@@ -78,14 +90,18 @@ pub fn resolve<const D: usize, S, E>(
             if state.is_failed(c) {
                 continue;
             }
-            let crit = &criteria[criterion_of_cell[c]];
-            if let Some(mode) = FailureCriterion::<D>::check(crit, s) {
+            let crit = &criteria.criteria[criteria.class_of_cell[c]];
+            let tip = criteria
+                .tips
+                .filter(|_| crit.toughness.is_some())
+                .and_then(|t| t.tip_radius(c, state.flags()));
+            if let Some(mode) = crit.check_at(s, tip) {
                 if let Some(t) = tracking.as_deref()
                     && !t.admits(c, s, state.flags())
                 {
                     continue;
                 }
-                violating.push((c, FailureCriterion::<D>::utilization(crit, s), mode));
+                violating.push((c, crit.utilization_at(s, tip), mode));
             }
         }
         if violating.is_empty() {
@@ -137,6 +153,7 @@ mod tests {
             .map(|&s| Combined {
                 tensile: Some(Tensile::new(s).unwrap()),
                 shear: None,
+                toughness: None,
             })
             .collect();
         let class: Vec<usize> = (0..4).collect();
@@ -145,8 +162,11 @@ mod tests {
         let (sol, stress, n, solves) = resolve::<2, f64, ()>(
             &mut st,
             5.0,
-            &criteria,
-            &class,
+            CellCriteria {
+                criteria: &criteria,
+                class_of_cell: &class,
+                tips: None,
+            },
             FailurePolicy::default(),
             None,
             10,
@@ -175,6 +195,7 @@ mod tests {
         let criteria = vec![Combined {
             tensile: Some(Tensile::new(1.0).unwrap()),
             shear: None,
+            toughness: None,
         }];
         let class = vec![0; 3];
         let mut st = FailureState::new(3);
@@ -182,8 +203,11 @@ mod tests {
         let (_, _, n, _) = resolve::<2, (), ()>(
             &mut st,
             0.0,
-            &criteria,
-            &class,
+            CellCriteria {
+                criteria: &criteria,
+                class_of_cell: &class,
+                tips: None,
+            },
             FailurePolicy::All,
             None,
             5,
@@ -205,8 +229,11 @@ mod tests {
         let err = resolve::<2, (), ()>(
             &mut st,
             0.0,
-            &criteria,
-            &class,
+            CellCriteria {
+                criteria: &criteria,
+                class_of_cell: &class,
+                tips: None,
+            },
             FailurePolicy::default(),
             None,
             1,
@@ -229,5 +256,53 @@ mod tests {
                 ..
             }
         ));
+    }
+
+    /// Three unit squares in a row with constant stresses σ₁ = 3, 2, 2 and σ_t = 1. Cell 0
+    /// fails first; then cell 1 shares a node with it (a tip cell, `K_c = 2 √(2π r)` with
+    /// `r = 1/√π`, about 3.77) and cell 2 does not. With `K_Ic = 4` the tip cell stays
+    /// intact and cell 2 fails by strength alone; with `K_Ic = 3.5` all three fail, cell 1
+    /// last (its utilization `K_c/K_Ic` ≈ 1.08 is below cell 2's 2).
+    #[test]
+    fn toughness_holds_a_tip_cell_that_the_strength_alone_would_fail() {
+        let grid = porofrac_grid::generate::cartesian([0.0, 0.0].into(), [3.0, 1.0].into(), [3, 1])
+            .unwrap();
+        let tips = CrackTips::new(&grid);
+        let stresses = [3.0, 2.0, 2.0];
+        for (k_ic, expect) in [(4.0, [true, false, true]), (3.5, [true, true, true])] {
+            let criteria = vec![Combined {
+                tensile: Some(Tensile::new(1.0).unwrap()),
+                shear: None,
+                toughness: Some(crate::Toughness::new(k_ic).unwrap()),
+            }];
+            let class = vec![0; grid.num_cells()];
+            let mut st = FailureState::new(3);
+            resolve::<2, (), ()>(
+                &mut st,
+                0.0,
+                CellCriteria {
+                    criteria: &criteria,
+                    class_of_cell: &class,
+                    tips: Some(&tips),
+                },
+                FailurePolicy::default(),
+                None,
+                10,
+                |_| {
+                    Ok((
+                        (),
+                        stresses
+                            .iter()
+                            .map(|&s| Tensor::<2>::new(s, 0.0, 0.0, 0.0))
+                            .collect(),
+                    ))
+                },
+            )
+            .unwrap();
+            assert_eq!(st.flags(), &expect, "K_Ic = {k_ic}");
+            let order: Vec<usize> = st.log().iter().map(|f| f.cell).collect();
+            let want: &[usize] = if k_ic > 3.7 { &[0, 2] } else { &[0, 2, 1] };
+            assert_eq!(order, want, "K_Ic = {k_ic}");
+        }
     }
 }

@@ -335,10 +335,18 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
             ("density", m.density),
             ("solid_bulk_modulus", m.solid_bulk_modulus),
             ("tensile_strength", m.tensile_strength),
+            ("fracture_toughness", m.fracture_toughness),
         ] {
             if let Some(v) = v {
                 positive(ls, &key(f), v)?;
             }
+        }
+        if m.fracture_toughness.is_some() && m.tensile_strength.is_none() {
+            return Err(ls.error(
+                &key("fracture_toughness"),
+                "needs tensile_strength (the toughness only holds crack tips that the strength \
+                 would fail)",
+            ));
         }
         if let Some(c) = m.cohesion {
             if !(c.is_finite() && c >= 0.0) {
@@ -517,6 +525,15 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
     }
     if let Some(kf) = s.physics.fracture_permeability {
         positive(ls, &k(&["physics", "fracture_permeability"]), kf)?;
+    }
+    if let Some(t) = s.physics.fracture_transmissivity {
+        positive(ls, &k(&["physics", "fracture_transmissivity"]), t)?;
+        if s.physics.fracture_permeability.is_some() {
+            return Err(ls.error(
+                &k(&["physics", "fracture_transmissivity"]),
+                "and fracture_permeability both set: give one of them",
+            ));
+        }
     }
     if let Some(a) = s.physics.crack_tracking
         && !(a.is_finite() && a > 0.0 && a <= 90.0)

@@ -421,6 +421,9 @@ pub struct Material {
     pub solid_bulk_modulus: Option<f64>,
     /// Tensile strength (Pa).
     pub tensile_strength: Option<f64>,
+    /// Fracture toughness `K_Ic` (Pa·√m): a crack-tip cell fails in tension only when its
+    /// stress intensity reaches it too.
+    pub fracture_toughness: Option<f64>,
     /// Mohr–Coulomb cohesion (Pa).
     pub cohesion: Option<f64>,
     /// Mohr–Coulomb friction angle (degrees).
@@ -562,6 +565,8 @@ pub struct Physics {
     pub failure_stress: Option<FailureStress>,
     /// Isotropic permeability (m²) of failed cells with flow (default 1e-12).
     pub fracture_permeability: Option<f64>,
+    /// Or the crack transmissivity (m³): a failed cell takes `T / (2 r_c)`.
+    pub fracture_transmissivity: Option<f64>,
     /// Residual stiffness ratio of open edges of failed cells (default 1e-6).
     pub open_edge_stiffness: Option<f64>,
     /// Crack tracking angle in degrees (absent: no tracking).

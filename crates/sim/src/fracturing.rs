@@ -5,11 +5,13 @@
 //!
 //! Every cell has an intact law (VEM, MDEM, ...) and a failure criterion on its
 //! effective (skeleton) stress, tension positive ([`porofrac_frac::Combined`]: tensile,
-//! seed eq. 31, and Mohr–Coulomb). A cell that fails stays failed: its law switches to the
+//! seed eq. 31, Mohr–Coulomb, and at crack tips the toughness of
+//! [`porofrac_frac::toughness`]). A cell that fails stays failed: its law switches to the
 //! post-failure law of its instance (a failed MDEM cell becomes the compression-only
 //! central-force DEM of seed eqs. 32–33; a law without a post-failure law keeps its own)
-//! and, when a fracture permeability is set, its permeability becomes that value so the
-//! fluid enters the fracture.
+//! and, when a fracture permeability is set ([`FracturePermeability`]: one value, or a
+//! crack transmissivity shared over the cell's width), its permeability becomes that
+//! value so the fluid enters the fracture.
 //!
 //! # One time step
 //!
@@ -39,7 +41,10 @@
 
 use porofrac_flow::{FlowError, FlowModel, Permeability};
 use porofrac_frac::recovery::{NodeCells, cell_average, recover_nodal};
-use porofrac_frac::{Combined, CrackTracking, FailurePolicy, FailureState, ResolveError, resolve};
+use porofrac_frac::{
+    CellCriteria, Combined, CrackTips, CrackTracking, FailurePolicy, FailureState, ResolveError,
+    resolve,
+};
 use porofrac_grid::{Grid, Point};
 use porofrac_law::{CellGeometry, CellLaw, Scratch, Tensor};
 use rayon::prelude::*;
@@ -190,6 +195,8 @@ pub struct FailureResolution<const D: usize> {
     settings: FractureSettings,
     adjacency: Option<NodeCells>,
     tracking: Option<CrackTracking<D>>,
+    /// Crack-tip cells, when a criterion has a toughness.
+    tips: Option<CrackTips>,
 }
 
 /// A step with its failures resolved: the solution and its cell stresses, the cells
@@ -221,10 +228,13 @@ impl<const D: usize> FailureResolution<D> {
             ),
             _ => None,
         };
+        let tips = (can_fail && settings.criteria.iter().any(|c| c.toughness.is_some()))
+            .then(|| CrackTips::new(grid));
         Ok(Self {
             settings,
             adjacency,
             tracking,
+            tips,
         })
     }
 
@@ -264,8 +274,11 @@ impl<const D: usize> FailureResolution<D> {
         let ((solution, stress), _, new_failures, rounds) = resolve(
             failures,
             t,
-            &self.settings.criteria,
-            &self.settings.class_of_cell,
+            CellCriteria {
+                criteria: &self.settings.criteria,
+                class_of_cell: &self.settings.class_of_cell,
+                tips: self.tips.as_ref(),
+            },
             self.settings.policy,
             self.tracking.as_mut(),
             if can_fail {
@@ -339,12 +352,44 @@ pub struct FractureFlow<const D: usize> {
     pub model: FlowModel<D>,
     /// The intact permeability of every cell.
     pub permeability: Permeability<D>,
-    /// Isotropic permeability of failed cells (m²); `None` keeps the intact value.
-    pub fracture_permeability: Option<f64>,
+    /// The isotropic permeability of failed cells; `None` keeps the intact value.
+    pub fracture_permeability: Option<FracturePermeability>,
     /// Biot coefficient per cell.
     pub alpha: Vec<f64>,
     /// Initial pressure per cell.
     pub p0: Vec<f64>,
+}
+
+/// The permeability a cell takes when it fails.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FracturePermeability {
+    /// The same permeability `k` (m²) in every failed cell: the crack's transmissivity
+    /// `k·w` then scales with the width `w` of the band of failed cells, i.e. with the
+    /// cell size.
+    Fixed(f64),
+    /// A crack transmissivity `T` (m³, `k·w` of the crack per unit length, `w³/12` for a
+    /// parallel-plate aperture `w`): a failed cell of equivalent radius `r_c` (the disk or
+    /// ball of its area or volume) takes `k = T / (2 r_c)`, so the band of failed cells,
+    /// about `2 r_c` wide, conducts `T` on every grid.
+    Transmissivity(f64),
+}
+
+impl FracturePermeability {
+    /// The permeability (m²) of a failed cell of area or volume `v`.
+    pub fn of_cell<const D: usize>(self, v: f64) -> f64 {
+        match self {
+            Self::Fixed(k) => k,
+            Self::Transmissivity(t) => {
+                t / (2.0 * porofrac_frac::toughness::equivalent_radius::<D>(v))
+            }
+        }
+    }
+
+    fn value(self) -> f64 {
+        match self {
+            Self::Fixed(v) | Self::Transmissivity(v) => v,
+        }
+    }
 }
 
 /// The result of one step.
@@ -434,10 +479,10 @@ impl<'a, const D: usize> Fracturing<'a, D> {
             )));
         }
         if let Some(k) = flow.fracture_permeability
-            && !(k.is_finite() && k > 0.0)
+            && !(k.value().is_finite() && k.value() > 0.0)
         {
             return Err(FractureError::Input(format!(
-                "fracture permeability must be finite and > 0, got {k}"
+                "fracture permeability must be finite and > 0, got {k:?}"
             )));
         }
         // Every cell must accept its failed law too.
@@ -684,9 +729,10 @@ fn update_permeability<const D: usize>(
         return Ok(());
     }
     let mut perm = flow.permeability.clone();
+    let volumes = grid.cell_volumes();
     for (c, &f) in failed.iter().enumerate() {
         if f {
-            perm.set(c, Tensor::<D>::identity() * k)?;
+            perm.set(c, Tensor::<D>::identity() * k.of_cell::<D>(volumes[c]))?;
         }
     }
     flow.model.set_permeability(grid, &perm)?;

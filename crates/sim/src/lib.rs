@@ -74,8 +74,8 @@ pub use error::{Result, SimError};
 pub use explicit::{ExplicitOptions, ExplicitSolution, ExplicitState, solve_explicit};
 pub use field::{FieldFn, ScalarField, VectorField, VectorFn};
 pub use fracturing::{
-    Body, FailureResolution, FractureError, FractureFlow, FractureLaws, FractureSettings,
-    FractureStep, Fracturing, ResolutionError, Resolved, Scheme, StressMeasure,
+    Body, FailureResolution, FractureError, FractureFlow, FractureLaws, FracturePermeability,
+    FractureSettings, FractureStep, Fracturing, ResolutionError, Resolved, Scheme, StressMeasure,
 };
 pub use laws::LawMap;
 pub use linear::{

@@ -5,7 +5,7 @@
 //! (`λ* = 2λμ/(λ + 2μ)`) holds for the intact laws, the post-failure DEM law and the
 //! drained bulk modulus of the fixed-stress split alike.
 
-use porofrac_frac::{Combined, MohrCoulomb, Tensile};
+use porofrac_frac::{Combined, MohrCoulomb, Tensile, Toughness};
 use porofrac_grid::Grid;
 use porofrac_law::{CellLaw, Stiffness};
 use porofrac_sim::{Displacement, Gravity, Loads, Platen, Traction};
@@ -152,6 +152,12 @@ pub fn compose<const D: usize>(
                 c.tensile = Some(
                     Tensile::new(t)
                         .map_err(|e| ls.error(&k(&["material", mat, "tensile_strength"]), e))?,
+                );
+            }
+            if let Some(kic) = m.fracture_toughness {
+                c.toughness = Some(
+                    Toughness::new(kic)
+                        .map_err(|e| ls.error(&k(&["material", mat, "fracture_toughness"]), e))?,
                 );
             }
             if let (Some(coh), Some(phi)) = (m.cohesion, m.friction_angle) {

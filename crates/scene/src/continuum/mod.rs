@@ -28,9 +28,9 @@ use porofrac_grid::{Grid, Point};
 use porofrac_law::{CellLaw, Tensor};
 use porofrac_sim::{
     BiotState, Body, DofMap, ExplicitOptions, ExplicitPressure, FailureResolution, FixedStress,
-    FractureFlow, FractureLaws, FractureSettings, Fracturing, LawMap, LinearSolver, Monolithic,
-    Pattern, Scheme, StaticOptions, StaticProblem, StaticSolver, StressMeasure, cell_stresses,
-    drained_bulk_modulus, solve_explicit, solve_static,
+    FractureFlow, FractureLaws, FracturePermeability, FractureSettings, Fracturing, LawMap,
+    LinearSolver, Monolithic, Pattern, Scheme, StaticOptions, StaticProblem, StaticSolver,
+    StressMeasure, cell_stresses, drained_bulk_modulus, solve_explicit, solve_static,
 };
 
 use crate::check::{LoadedScene, k, ki};
@@ -783,9 +783,15 @@ fn coupled<'a, const D: usize>(
     let flow = FractureFlow {
         model: f.model,
         permeability: f.permeability,
-        fracture_permeability: comp
-            .can_fail()
-            .then(|| s.physics.fracture_permeability.unwrap_or(1e-12)),
+        fracture_permeability: comp.can_fail().then(|| {
+            match (
+                s.physics.fracture_transmissivity,
+                s.physics.fracture_permeability,
+            ) {
+                (Some(t), _) => FracturePermeability::Transmissivity(t),
+                (None, k) => FracturePermeability::Fixed(k.unwrap_or(1e-12)),
+            }
+        }),
         alpha: f.alpha,
         p0: f.p0,
     };

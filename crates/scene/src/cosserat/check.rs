@@ -149,6 +149,10 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
         ("fracture", p.fracture.is_some()),
         ("failure_stress", p.failure_stress.is_some()),
         ("fracture_permeability", p.fracture_permeability.is_some()),
+        (
+            "fracture_transmissivity",
+            p.fracture_transmissivity.is_some(),
+        ),
         ("open_edge_stiffness", p.open_edge_stiffness.is_some()),
         ("crack_tracking", p.crack_tracking.is_some()),
         ("crack_exclusion", p.crack_exclusion.is_some()),
@@ -464,6 +468,7 @@ fn check_material(ls: &LoadedScene, name: &str, d: usize) -> Result<(), SceneErr
         ("permeability", m.permeability.is_some()),
         ("solid_bulk_modulus", m.solid_bulk_modulus.is_some()),
         ("tensile_strength", m.tensile_strength.is_some()),
+        ("fracture_toughness", m.fracture_toughness.is_some()),
         ("cohesion", m.cohesion.is_some()),
         ("friction_angle", m.friction_angle.is_some()),
     ] {
