@@ -648,7 +648,7 @@ fn every_bundled_scene_passes_check() {
 }
 
 #[test]
-fn fracture_toughness_and_transmissivity_keys_are_checked() {
+fn fracture_toughness_transmissivity_and_lag_keys_are_checked() {
     let seed = std::fs::read_to_string(root().join("scenes/hydrofrac_seed.toml")).unwrap();
     // A toughness needs a tensile strength.
     let text = seed.replace("tensile_strength = 2.0e5", "fracture_toughness = 1.0e5");
@@ -683,6 +683,20 @@ fn fracture_toughness_and_transmissivity_keys_are_checked() {
             "both_permeabilities.toml:{}: physics.fracture_transmissivity and \
              fracture_permeability both set",
             line_of(&text, "fracture_transmissivity")
+        )),
+        "{err}"
+    );
+    // No fluid lag is a property of a fracturing flow.
+    let text = seed.replace("fracture = true", "fracture = false").replace(
+        "crack_tracking = 45.0",
+        "fluid_lag = false\ncrack_tracking = 45.0",
+    );
+    let (code, err) = check_text("lag_without_fracture", &text);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains(&format!(
+            "lag_without_fracture.toml:{}: physics.fluid_lag needs fracture = true and flow = true",
+            line_of(&text, "fluid_lag")
         )),
         "{err}"
     );

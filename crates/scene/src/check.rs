@@ -526,6 +526,14 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
     if let Some(kf) = s.physics.fracture_permeability {
         positive(ls, &k(&["physics", "fracture_permeability"]), kf)?;
     }
+    if s.physics.fluid_lag.is_some()
+        && (s.physics.fracture != Some(true) || s.physics.flow != Some(true))
+    {
+        return Err(ls.error(
+            &k(&["physics", "fluid_lag"]),
+            "needs fracture = true and flow = true",
+        ));
+    }
     if let Some(t) = s.physics.fracture_transmissivity {
         positive(ls, &k(&["physics", "fracture_transmissivity"]), t)?;
         if s.physics.fracture_permeability.is_some() {

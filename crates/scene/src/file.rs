@@ -567,6 +567,9 @@ pub struct Physics {
     pub fracture_permeability: Option<f64>,
     /// Or the crack transmissivity (m³): a failed cell takes `T / (2 r_c)`.
     pub fracture_transmissivity: Option<f64>,
+    /// `false`: no fluid lag, the intact cells bordering a crack take its permeability
+    /// (default `true`: they keep the rock's).
+    pub fluid_lag: Option<bool>,
     /// Residual stiffness ratio of open edges of failed cells (default 1e-6).
     pub open_edge_stiffness: Option<f64>,
     /// Crack tracking angle in degrees (absent: no tracking).

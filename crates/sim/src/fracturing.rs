@@ -13,6 +13,16 @@
 //! crack transmissivity shared over the cell's width), its permeability becomes that
 //! value so the fluid enters the fracture.
 //!
+//! **Fluid lag.** An intact cell keeps the rock's permeability, so the cell ahead of a
+//! crack tip opens undrained: in a tight rock its pressure falls far below the crack's
+//! (the suction `Δp ≈ −M α ε_v`, `M` the Biot modulus) and holds the tip shut in
+//! effective stress, by an amount that grows as the cells shrink. With
+//! [`FractureFlow::zero_lag`] the intact cells across a face from a failed cell take the
+//! fracture permeability as well: the fluid front sits at the crack tip, the assumption of
+//! the classical plane-strain and toughness-dominated hydraulic-fracture solutions
+//! (Detournay 2004), and the tip fails once the crack's pressure and the tip's stress
+//! intensity ([`porofrac_frac::toughness`]) are enough.
+//!
 //! # One time step
 //!
 //! From the state `(uⁿ, pⁿ)` at `t` to `t + Δt`, with the failure state `F`:
@@ -354,6 +364,9 @@ pub struct FractureFlow<const D: usize> {
     pub permeability: Permeability<D>,
     /// The isotropic permeability of failed cells; `None` keeps the intact value.
     pub fracture_permeability: Option<FracturePermeability>,
+    /// No fluid lag: the intact cells across a face from a failed cell take the fracture
+    /// permeability too, so the fluid front reaches the crack's tip (see the module docs).
+    pub zero_lag: bool,
     /// Biot coefficient per cell.
     pub alpha: Vec<f64>,
     /// Initial pressure per cell.
@@ -733,6 +746,16 @@ fn update_permeability<const D: usize>(
     for (c, &f) in failed.iter().enumerate() {
         if f {
             perm.set(c, Tensor::<D>::identity() * k.of_cell::<D>(volumes[c]))?;
+            if flow.zero_lag {
+                for &face in grid.cell_faces(c) {
+                    if let (a, Some(b)) = grid.face_cells(face) {
+                        let o = if a == c { b } else { a };
+                        if !failed[o] {
+                            perm.set(o, Tensor::<D>::identity() * k.of_cell::<D>(volumes[o]))?;
+                        }
+                    }
+                }
+            }
         }
     }
     flow.model.set_permeability(grid, &perm)?;

@@ -792,6 +792,7 @@ fn coupled<'a, const D: usize>(
                 (None, k) => FracturePermeability::Fixed(k.unwrap_or(1e-12)),
             }
         }),
+        zero_lag: s.physics.fluid_lag == Some(false),
         alpha: f.alpha,
         p0: f.p0,
     };
