@@ -221,10 +221,14 @@ fn schur_unknowns(sys: SystemRef<'_>) -> Vec<bool> {
 
 impl Schur {
     /// Set up from the system and the upper triangle of the preconditioning matrix.
-    fn new(sys: SystemRef<'_>, n: usize, upper: (&[usize], &[usize], &[f64])) -> Result<Self> {
+    fn new(
+        sys: SystemRef<'_>,
+        n: usize,
+        upper: (&[usize], &[usize], &[f64]),
+        in_t: Vec<bool>,
+    ) -> Result<Self> {
         let p = sys.pattern;
         let ldlt_err = |e| CosseratError::Solve(format!("LDLᵀ of the preconditioning matrix: {e}"));
-        let in_t = schur_unknowns(sys);
         // AMD of the cells without a component in T, then T.
         let b = p.block;
         let t_cell: Vec<bool> = (0..n / b)
@@ -367,6 +371,9 @@ impl Linear {
             }
         }
         let mut stats = LinearStats::default();
+        // The unknowns where the system differs from the preconditioning matrix, when the
+        // automatic choice looked at them (reused by the Schur complement solve).
+        let mut in_t = None;
         let solver = match options.solver {
             // Measured on 2D plates only; in 3D the boundary unknowns grow as n^(2/3) and the
             // dense block with them, so 3D keeps the LU and GMRES, and a 2D system whose
@@ -378,11 +385,15 @@ impl Linear {
                     LinearSolver::GmresAmg
                 }
             }
-            LinearSolver::Auto
-                if n < AUTO_GMRES_EQUATIONS
-                    && schur_unknowns(sys).iter().filter(|&&t| t).count() > AUTO_SCHUR_UNKNOWNS =>
-            {
-                LinearSolver::GmresAmg
+            LinearSolver::Auto if n < AUTO_GMRES_EQUATIONS => {
+                let t = schur_unknowns(sys);
+                let many = t.iter().filter(|&&t| t).count() > AUTO_SCHUR_UNKNOWNS;
+                in_t = Some(t);
+                if many {
+                    LinearSolver::GmresAmg
+                } else {
+                    LinearSolver::LdltSchur
+                }
             }
             s => s.resolve(n),
         };
@@ -399,7 +410,7 @@ impl Linear {
                 let kind = if s == LinearSolver::GmresLdlt {
                     PrecondKind::Ldlt
                 } else {
-                    PrecondKind::Schur
+                    PrecondKind::Schur(in_t.take().unwrap_or_else(|| schur_unknowns(sys)))
                 };
                 let g = Gmres::new(sys, options.gmres, kind)?;
                 match &g.pre {
@@ -506,11 +517,11 @@ fn rigid_motions(centres: &[f64], dim: usize) -> Result<NearNullSpace> {
 }
 
 /// Which preconditioner [`Gmres::new`] builds.
-#[derive(Clone, Copy, PartialEq, Eq)]
 enum PrecondKind {
     Amg,
     Ldlt,
-    Schur,
+    /// With the unknowns `T` ([`schur_unknowns`]).
+    Schur(Vec<bool>),
 }
 
 /// Approximate minimum degree order of the cell graph of `pattern` (faer's AMD), each
@@ -638,8 +649,8 @@ impl Gmres {
                 f.factorize(&ucol, &urow, &uval).map_err(ldlt_err)?;
                 Precond::Ldlt(Box::new(f))
             }
-            PrecondKind::Schur => {
-                Precond::Schur(Box::new(Schur::new(sys, n, (&ucol, &urow, &uval))?))
+            PrecondKind::Schur(in_t) => {
+                Precond::Schur(Box::new(Schur::new(sys, n, (&ucol, &urow, &uval), in_t)?))
             }
         };
         Ok(Self {
