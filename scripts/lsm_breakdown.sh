@@ -26,6 +26,7 @@ if [ -z "$bin" ]; then
   cargo build --release -p porofrac-cli >&2
   bin=target/release/porofrac
 fi
+fluid_end=${LSM_BREAKDOWN_FLUID_END:-0.45}
 root=target/lsm_breakdown
 mkdir -p "$root"
 rows=$(mktemp)
@@ -48,7 +49,10 @@ for mode in ${modes//,/ }; do
         fi
         key=.breakdown_pressure ;;
       fluid)
-        sed -e "s/^seed = 1$/seed = $seed/" scenes/lsm_hydrofrac.toml > "$dir/scene.toml"
+        sed -e "s/^seed = 1$/seed = $seed/" \
+            -e "s/^end_time = 0.25$/end_time = $fluid_end/" \
+            -e "s/^steps = 25$/steps = $(printf '%.0f' "$(echo "$fluid_end * 100" | bc)")/" \
+            scenes/lsm_hydrofrac.toml > "$dir/scene.toml"
         key=.injection.breakdown_pressure ;;
       *) echo "unknown mode $mode" >&2; exit 2 ;;
     esac

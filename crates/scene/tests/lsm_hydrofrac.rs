@@ -110,8 +110,8 @@ fn run(name: &str, text: &str) -> (serde_json::Value, Vec<(f64, String)>) {
 fn injected_fluid_breaks_the_borehole_wall_in_tension_near_the_dry_breakdown_pressure() {
     let (fluid, breaks) = run("fluid", &format!("{ROCK}{FLUID}"));
     let (dry, _) = run("dry", &format!("{ROCK}{DRY}"));
-    let p_fluid = fluid["injection"]["breakdown_pressure"].as_f64().unwrap();
-    let p_dry = dry["breakdown_pressure"].as_f64().unwrap();
+    let p_fluid = fluid["initiation_pressure"].as_f64().unwrap();
+    let p_dry = dry["initiation_pressure"].as_f64().unwrap();
     let p_b = fluid["calibration"]["breakdown_estimate"].as_f64().unwrap();
     let mach = fluid["fluid"]["mach"].as_f64().unwrap();
     eprintln!(

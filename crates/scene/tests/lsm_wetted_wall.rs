@@ -66,7 +66,7 @@ fn breakdown(name: &str, loading: &str) -> f64 {
     .unwrap();
     let s: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
-    s["breakdown_pressure"].as_f64().unwrap()
+    s["initiation_pressure"].as_f64().unwrap()
 }
 
 #[test]
