@@ -89,6 +89,11 @@ fn wall_keys_are_checked() {
             "[loading]\npressure_rate = 1.0e7\nwall = \"wetted\"\nwall_spacing = -1.0\n",
             "loading.wall_spacing",
         ),
+        // the extent of the wall crack needs a pressurised hole
+        (
+            "[[output.probe]]\nname = \"e\"\nfield = \"crack_extent\"\n",
+            "field = \"crack_extent\" needs a pressurised hole",
+        ),
         // serde names the line of the key and the variants
         (
             "[loading]\npressure_rate = 1.0e7\nwall = \"wet\"\n",
