@@ -10,15 +10,17 @@
 //! - *step*: as many LSM steps as fit between two output times;
 //! - *fields*: particle probes (`x y vx vy omega fx fy radius`), tracked cells (`p q
 //!   anisotropy anisotropy_volume dilation_x dilation_y contacts broken_bonds`), scene
-//!   probes (`pressure platen_force broken broken_tensile broken_shear`), with `[lbm]`
+//!   probes (`pressure platen_force broken broken_tensile broken_shear crack_extent`), with `[lbm]`
 //!   fluid probes at a point (`fluid_pressure fluid_speed`, [`fluid::Fluid::point_values`]),
 //!   lines,
 //!   `vtk/particles_NNNN.vtp` (with `broken_bonds` per particle) and
 //!   `vtk/contacts_NNNN.vtp` (intact bonds `bonded = 1`, touching contacts `0`),
-//!   `broken.csv` (`time,i,j,x,y,mode`), field extrema and `summary.json` keys
+//!   `broken.csv` (`time,i,j,x,y,mode`), with a pressurised hole `crack.csv`
+//!   ([`crack::CrackLog`]), field extrema and `summary.json` keys
 //!   (`particles`, `bonds`, `broken_bonds`, `broken_tensile`, `broken_shear`,
 //!   `contacts`, `lsm_steps`, `dt`, `stable_dt`, `bond_updates_per_second`,
-//!   `contact_updates_per_second`, `breakdown_pressure`, `calibration`);
+//!   `contact_updates_per_second`, `initiation_pressure`, `breakdown_pressure`,
+//!   `breakdown_extent`, `crack_extent`, `calibration`);
 //! - *plots*: probe series, `particles.png` (disks coloured by displacement, broken
 //!   bonds drawn) and `breakage.png` (broken bonds against time, by mode).
 
