@@ -7,6 +7,8 @@
 //! * [`bond`]: one bond's forces and breakage test; [`contact`]: one contact's forces;
 //! * [`solid`]: [`LatticeSolid`], the state and the time step;
 //! * [`wall`]: the pressure of a borehole as forces on the particles lining it;
+//! * [`crack`]: the crack connected to a borehole wall and its radial extent (the
+//!   breakdown of a borehole as an event);
 //! * [`calibrate`]: spring stiffnesses from E and ν on a hexagonal lattice (closed form
 //!   below) and numerical calibration of random packings (uniaxial compression for E
 //!   and ν, Brazilian test for the tensile strength).
@@ -43,11 +45,13 @@
 pub mod bond;
 pub mod calibrate;
 pub mod contact;
+pub mod crack;
 pub mod law;
 pub mod solid;
 pub mod wall;
 
 pub use bond::{Bond, BondForce, BreakMode, BrokenBond};
+pub use crack::CrackExtent;
 pub use law::{BondLaw, ContactLaw, Damping, Motion, NormalLaw};
 pub use solid::{LatticeSolid, LsmSpec, StepReport};
 pub use wall::{PressureWall, WallFaces};

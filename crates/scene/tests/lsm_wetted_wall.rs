@@ -66,7 +66,7 @@ fn breakdown(name: &str, loading: &str) -> f64 {
     .unwrap();
     let s: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
-    s["breakdown_pressure"].as_f64().unwrap()
+    s["initiation_pressure"].as_f64().unwrap()
 }
 
 #[test]
@@ -88,6 +88,11 @@ fn wall_keys_are_checked() {
         (
             "[loading]\npressure_rate = 1.0e7\nwall = \"wetted\"\nwall_spacing = -1.0\n",
             "loading.wall_spacing",
+        ),
+        // the extent of the wall crack needs a pressurised hole
+        (
+            "[[output.probe]]\nname = \"e\"\nfield = \"crack_extent\"\n",
+            "field = \"crack_extent\" needs a pressurised hole",
         ),
         // serde names the line of the key and the variants
         (

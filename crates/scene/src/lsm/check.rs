@@ -43,13 +43,15 @@ pub const CELL_FIELDS: [&str; 8] = [
     "broken_bonds",
 ];
 /// Fields of the whole scene: wall pressure (Pa), platen load (N/m), broken bonds (all,
-/// tensile, shear).
-pub const GLOBAL_FIELDS: [&str; 5] = [
+/// tensile, shear), extent of the crack connected to the hole wall (m from the hole
+/// centre; scenes with a pressurised hole).
+pub const GLOBAL_FIELDS: [&str; 6] = [
     "pressure",
     "platen_force",
     "broken",
     "broken_tensile",
     "broken_shear",
+    "crack_extent",
 ];
 
 /// Fields of the fluid at a point `at = [x, y]` (scenes with `[lbm]`): gauge pressure
@@ -389,6 +391,25 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
             }
             positive(ls, &key("wall_spacing"), h)?;
         }
+    }
+    let pressurised = s.particles.as_ref().is_some_and(|p| p.hole.is_some())
+        && (s
+            .loading
+            .as_ref()
+            .is_some_and(|l| l.pressure_rate.is_some())
+            || s.injection.is_some());
+    if let Some(i) = s
+        .output
+        .probe
+        .iter()
+        .position(|p| p.field == "crack_extent")
+        && !pressurised
+    {
+        return Err(ls.error(
+            &ki("output.probe", i, &["field"]),
+            "= \"crack_extent\" needs a pressurised hole: [particles] hole with \
+             [loading] pressure_rate or [injection]",
+        ));
     }
     crate::nscd::check::check_particle_schedule(ls, "lsm")?;
     super::fluid::check(ls)?;

@@ -174,8 +174,6 @@ pub struct Fluid {
     sides: Vec<(porofrac_lbm::Side, VelocityExpr)>,
     time_dependent: bool,
     max_mach: f64,
-    /// Injection pressure at the first broken bond (Pa).
-    breakdown: Option<f64>,
     /// `time, particles, fluid, side inflow, out of the particles, carried, defect, mean
     /// particle temperature`.
     heat_rows: Vec<[f64; 8]>,
@@ -273,7 +271,6 @@ impl Fluid {
             sides,
             time_dependent,
             max_mach: 0.0,
-            breakdown: None,
             heat_rows: Vec::new(),
         };
         f.record();
@@ -287,6 +284,7 @@ impl Fluid {
         ls: &LoadedScene,
         solid: &mut LatticeSolid,
         t: f64,
+        mut crack: Option<&mut super::crack::CrackLog>,
     ) -> Result<usize, RunError> {
         let dt = self.pf.dt();
         let target = (t / dt).round() as u64;
@@ -299,8 +297,10 @@ impl Fluid {
                 set_sides(&mut self.pf, &self.sides, &u, o, time);
             }
             self.pf.step(solid).map_err(|e| coupling_error(ls, e))?;
-            if self.breakdown.is_none() && !solid.broken().is_empty() {
-                self.breakdown = Some(self.pressure());
+            if let Some(c) = crack.as_deref_mut() {
+                let p = self.pressure();
+                c.sync(solid, p)
+                    .map_err(|e| super::check::lsm_error(ls, &e))?;
             }
         }
         let speed = self
@@ -349,6 +349,11 @@ impl Fluid {
 
     fn pf_count(&self) -> usize {
         self.pf.fluid_loads().len()
+    }
+
+    /// Whether fluid is injected (an `[injection]` source).
+    pub fn injects(&self) -> bool {
+        self.pf.injection().is_some()
     }
 
     /// Gauge pressure at the injection (Pa), 0 without one.
@@ -428,7 +433,6 @@ impl Fluid {
                     "pressure": self.pressure(),
                     "target_pressure": inj.target_pressure(self.pf.time()),
                     "injected_mass": lat.injected_mass() * u.density * u.dx * u.dx,
-                    "breakdown_pressure": self.breakdown,
                     "source_nodes": inj.nodes(),
                 }),
             );

@@ -10,19 +10,22 @@
 //! - *step*: as many LSM steps as fit between two output times;
 //! - *fields*: particle probes (`x y vx vy omega fx fy radius`), tracked cells (`p q
 //!   anisotropy anisotropy_volume dilation_x dilation_y contacts broken_bonds`), scene
-//!   probes (`pressure platen_force broken broken_tensile broken_shear`), with `[lbm]`
+//!   probes (`pressure platen_force broken broken_tensile broken_shear crack_extent`), with `[lbm]`
 //!   fluid probes at a point (`fluid_pressure fluid_speed`, [`fluid::Fluid::point_values`]),
 //!   lines,
 //!   `vtk/particles_NNNN.vtp` (with `broken_bonds` per particle) and
 //!   `vtk/contacts_NNNN.vtp` (intact bonds `bonded = 1`, touching contacts `0`),
-//!   `broken.csv` (`time,i,j,x,y,mode`), field extrema and `summary.json` keys
+//!   `broken.csv` (`time,i,j,x,y,mode`), with a pressurised hole `crack.csv`
+//!   ([`crack::CrackLog`]), field extrema and `summary.json` keys
 //!   (`particles`, `bonds`, `broken_bonds`, `broken_tensile`, `broken_shear`,
 //!   `contacts`, `lsm_steps`, `dt`, `stable_dt`, `bond_updates_per_second`,
-//!   `contact_updates_per_second`, `breakdown_pressure`, `calibration`);
+//!   `contact_updates_per_second`, `initiation_pressure`, `breakdown_pressure`,
+//!   `breakdown_extent`, `crack_extent`, `calibration`);
 //! - *plots*: probe series, `particles.png` (disks coloured by displacement, broken
 //!   bonds drawn) and `breakage.png` (broken bonds against time, by mode).
 
 pub mod check;
+pub mod crack;
 pub mod file;
 pub mod fluid;
 
@@ -93,7 +96,7 @@ pub struct LsmModel<'a> {
     pressure_rate: f64,
     pressure_max: f64,
     pressure: f64,
-    breakdown: Option<f64>,
+    crack: Option<crack::CrackLog>,
     calibration: Option<Calibration>,
     lsm_steps: u64,
     step_seconds: f64,
@@ -326,6 +329,13 @@ pub fn build(ls: &LoadedScene) -> Result<LsmModel<'_>, RunError> {
         }
     }
     let fluid = fluid::Fluid::build(ls, &solid, dt)?;
+    let crack = match s.particles.as_ref().and_then(|p| p.hole) {
+        Some(h) if wall.is_some() || fluid.as_ref().is_some_and(|f| f.injects()) => Some(
+            crack::CrackLog::new(&solid, h.center, h.radius)
+                .map_err(|e| check::lsm_error(ls, &e))?,
+        ),
+        _ => None,
+    };
     Ok(LsmModel {
         ls,
         solid,
@@ -339,7 +349,7 @@ pub fn build(ls: &LoadedScene) -> Result<LsmModel<'_>, RunError> {
         pressure_rate: load.pressure_rate.unwrap_or(0.0),
         pressure_max: load.pressure_max.unwrap_or(f64::INFINITY),
         pressure: 0.0,
-        breakdown: None,
+        crack,
         calibration,
         lsm_steps: 0,
         step_seconds: 0.0,
@@ -491,10 +501,9 @@ impl Model for LsmModel<'_> {
         }
         if self.wall.is_some() {
             m.insert("final_pressure".into(), self.pressure.into());
-            m.insert(
-                "breakdown_pressure".into(),
-                self.breakdown.map_or(serde_json::Value::Null, |p| p.into()),
-            );
+        }
+        if let Some(c) = &self.crack {
+            c.summary(&mut m);
         }
         if let Some(c) = self.calibration {
             let mut cal = serde_json::json!({
@@ -522,7 +531,12 @@ impl Model for LsmModel<'_> {
         }
         if let Some(f) = &mut self.fluid {
             let t0 = Instant::now();
-            let n = f.advance(self.ls, &mut self.solid, self.times[step])?;
+            let n = f.advance(
+                self.ls,
+                &mut self.solid,
+                self.times[step],
+                self.crack.as_mut(),
+            )?;
             self.step_seconds += t0.elapsed().as_secs_f64();
             self.lsm_steps += n as u64;
             self.pressure = f.pressure();
@@ -549,8 +563,11 @@ impl Model for LsmModel<'_> {
                 .solid
                 .step(dt, &[])
                 .map_err(|e| check::lsm_error(self.ls, &e))?;
-            if r.broken > 0 && self.breakdown.is_none() && self.wall.is_some() {
-                self.breakdown = Some(self.pressure);
+            if r.broken > 0
+                && let Some(c) = &mut self.crack
+            {
+                c.sync(&self.solid, self.pressure)
+                    .map_err(|e| check::lsm_error(self.ls, &e))?;
             }
         }
         self.step_seconds += t0.elapsed().as_secs_f64();
@@ -582,6 +599,7 @@ impl Model for LsmModel<'_> {
                     "platen_force" => self.platen_force(),
                     "broken" => (t + sh) as f64,
                     "broken_tensile" => t as f64,
+                    "crack_extent" => self.crack.as_ref().map_or(f64::NAN, |c| c.extent()),
                     _ => sh as f64,
                 },
                 ProbeKind::Fluid(x, f) => self
@@ -622,6 +640,9 @@ impl Model for LsmModel<'_> {
     fn after_step(&mut self, out: &Path) -> Result<(), RunError> {
         if let Some(f) = &self.fluid {
             f.write_csv(out)?;
+        }
+        if let Some(c) = &mut self.crack {
+            c.write_csv(out)?;
         }
         let broken = self.solid.broken();
         if broken.len() == self.broken_written && self.broken_written > 0 {

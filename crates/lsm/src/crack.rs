@@ -1,0 +1,195 @@
+//! The crack that grows from a borehole: which broken bonds are connected to the hole
+//! wall, and how far from the hole centre the farthest of them lies.
+//!
+//! **Breakdown as an event.** In laboratory and field hydraulic fracturing the breakdown
+//! pressure is the pressure at which a fracture runs away from the borehole; the first
+//! microcracks start well below it. Counting broken bonds (the first, the tenth) is
+//! therefore not a measure of breakdown. What is measurable in a lattice solid is the
+//! *radial extent of the crack connected to the hole*:
+//!
+//! * the graph whose vertices are the disks plus one vertex for the hole, and whose edges
+//!   are the broken bonds, plus an edge from the hole to every disk lining it (the disks
+//!   seen from the hole centre, [`crate::WallFaces::Rays`]);
+//! * the crack connected to the hole is the connected component of the hole vertex; its
+//!   extent is `r_c = max |x_k − c|` over the broken bonds `k` of that component (`x_k`
+//!   the contact point where the bond broke, `c` the hole centre), and `0` while the
+//!   component holds no broken bond.
+//!
+//! A tensile crack in a bonded packing separates disks along a path in the dual of the
+//! bond network: two consecutive bonds it cuts belong to one bonded triangle and share a
+//! disk, so the bonds broken along one crack form a connected set of edges. A crack that
+//! crosses a pore bounded by four or more disks can be split in two by this rule (it
+//! has no edge across the pore); the extent then stops at the pore, which errs towards a
+//! later, higher breakdown. Broken bonds in the rock that are not connected to the hole
+//! (isolated microcracks, or cracks in fluid-filled pockets behind the lining that have
+//! not yet joined the wall) do not count.
+//!
+//! The extent never decreases (bonds do not heal), and is computed incrementally with a
+//! disjoint-set forest (union by size, path halving): `O(α(n))` per broken bond.
+
+use crate::LsmError;
+
+/// The crack connected to a hole wall, grown one broken bond at a time (module docs).
+#[derive(Clone, Debug, PartialEq)]
+pub struct CrackExtent {
+    centre: [f64; 2],
+    /// Parent of every disk; index `n` is the hole.
+    parent: Vec<u32>,
+    /// Size of the tree of every root.
+    size: Vec<u32>,
+    /// Largest distance from the centre of a broken bond in the tree of every root.
+    reach: Vec<f64>,
+}
+
+impl CrackExtent {
+    /// A hole of centre `centre` in a packing of `disks` disks, lined by the disks
+    /// `lining` (indices below `disks`, e.g. the members of a
+    /// [`crate::PressureWall`] built with [`crate::WallFaces::Rays`]).
+    pub fn new(disks: usize, lining: &[usize], centre: [f64; 2]) -> Result<Self, LsmError> {
+        if disks >= u32::MAX as usize {
+            return Err(LsmError::bad("disks", disks as f64, "too many particles"));
+        }
+        if !(centre[0].is_finite() && centre[1].is_finite()) {
+            return Err(LsmError::bad("centre", f64::NAN, "must be finite"));
+        }
+        if lining.is_empty() {
+            return Err(LsmError::bad("lining", 0.0, "no disk lines the hole"));
+        }
+        let mut s = Self {
+            centre,
+            parent: (0..=disks as u32).collect(),
+            size: vec![1; disks + 1],
+            reach: vec![0.0; disks + 1],
+        };
+        for &i in lining {
+            if i >= disks {
+                return Err(LsmError::bad(
+                    "lining",
+                    i as f64,
+                    "is not the index of a disk",
+                ));
+            }
+            s.union(i, disks);
+        }
+        Ok(s)
+    }
+
+    /// Record the broken bond between disks `i` and `j` that broke at `at` (m); returns
+    /// the extent of the crack connected to the hole afterwards.
+    pub fn add(&mut self, i: usize, j: usize, at: [f64; 2]) -> Result<f64, LsmError> {
+        let n = self.parent.len() - 1;
+        for (name, k) in [("i", i), ("j", j)] {
+            if k >= n {
+                return Err(LsmError::bad(name, k as f64, "is not the index of a disk"));
+            }
+        }
+        if !(at[0].is_finite() && at[1].is_finite()) {
+            return Err(LsmError::bad("at", f64::NAN, "must be finite"));
+        }
+        let d = (at[0] - self.centre[0]).hypot(at[1] - self.centre[1]);
+        let r = self.union(i, j);
+        self.reach[r] = self.reach[r].max(d);
+        Ok(self.extent())
+    }
+
+    /// The extent `r_c` of the crack connected to the hole (m from the centre), `0` while
+    /// no broken bond is connected to it.
+    pub fn extent(&self) -> f64 {
+        let mut k = self.parent.len() - 1;
+        while self.parent[k] as usize != k {
+            k = self.parent[k] as usize;
+        }
+        self.reach[k]
+    }
+
+    /// Whether disk `i` (an index below the number of disks) is connected to the hole
+    /// through broken bonds or the lining.
+    pub fn connected(&mut self, i: usize) -> bool {
+        let n = self.parent.len() - 1;
+        i < n && self.find(i) == self.find(n)
+    }
+
+    fn find(&mut self, mut k: usize) -> usize {
+        while self.parent[k] as usize != k {
+            let g = self.parent[self.parent[k] as usize];
+            self.parent[k] = g;
+            k = g as usize;
+        }
+        k
+    }
+
+    /// Join the trees of `a` and `b`; returns the root.
+    fn union(&mut self, a: usize, b: usize) -> usize {
+        let (mut ra, mut rb) = (self.find(a), self.find(b));
+        if ra == rb {
+            return ra;
+        }
+        if self.size[ra] < self.size[rb] {
+            std::mem::swap(&mut ra, &mut rb);
+        }
+        self.parent[rb] = ra as u32;
+        self.size[ra] += self.size[rb];
+        self.reach[ra] = self.reach[ra].max(self.reach[rb]);
+        ra
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A hand-made bond set around a hole of centre (1, 2): lining disks 0, 1, 2; a
+    /// chain 1–3–4–5 running out; an isolated pair 6–7 farther out; a link 5–6 that
+    /// joins them last.
+    #[test]
+    fn extent_follows_the_crack_connected_to_the_hole() {
+        let c = [1.0, 2.0];
+        let at = |r: f64| [c[0] + 0.6 * r, c[1] - 0.8 * r];
+        let mut x = CrackExtent::new(8, &[0, 1, 2], c).unwrap();
+        assert_eq!(x.extent(), 0.0);
+        // an isolated microcrack far out does not count
+        assert_eq!(x.add(6, 7, at(9.0)).unwrap(), 0.0);
+        // a bond between two lining disks: the crack mouth
+        let e = x.add(0, 1, at(3.5)).unwrap();
+        assert!((e - 3.5).abs() < 1e-12, "{e}");
+        // the chain grows from lining disk 1
+        assert!((x.add(1, 3, at(4.5)).unwrap() - 4.5).abs() < 1e-12);
+        assert!((x.add(4, 5, at(6.5)).unwrap() - 4.5).abs() < 1e-12);
+        assert!(!x.connected(4));
+        // the link 3–4 joins the chain 4–5 to the crack
+        assert!((x.add(3, 4, at(5.5)).unwrap() - 6.5).abs() < 1e-12);
+        assert!(x.connected(5) && !x.connected(6));
+        // a nearer break does not lower the extent
+        assert!((x.add(0, 2, at(3.2)).unwrap() - 6.5).abs() < 1e-12);
+        // joining the isolated pair brings its reach in
+        assert!((x.add(5, 6, at(7.0)).unwrap() - 9.0).abs() < 1e-12);
+        assert!(x.connected(7));
+    }
+
+    /// A bond of one lining disk counts (the lining is joined to the hole); a crack
+    /// that never touches the lining does not, however long.
+    #[test]
+    fn cracks_away_from_the_lining_do_not_count() {
+        let mut x = CrackExtent::new(20, &[0], [0.0, 0.0]).unwrap();
+        for k in 1..19 {
+            assert_eq!(x.add(k, k + 1, [k as f64, 0.0]).unwrap(), 0.0);
+        }
+        assert!((x.add(0, 10, [2.0, 0.0]).unwrap() - 18.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn bad_arguments_are_named() {
+        let e = CrackExtent::new(3, &[3], [0.0, 0.0]).unwrap_err();
+        assert!(e.to_string().starts_with("lining = 3"), "{e}");
+        let e = CrackExtent::new(3, &[], [0.0, 0.0]).unwrap_err();
+        assert!(e.to_string().starts_with("lining"), "{e}");
+        let e = CrackExtent::new(3, &[0], [f64::NAN, 0.0]).unwrap_err();
+        assert!(e.to_string().starts_with("centre"), "{e}");
+        let mut x = CrackExtent::new(3, &[0], [0.0, 0.0]).unwrap();
+        let e = x.add(0, 5, [1.0, 0.0]).unwrap_err();
+        assert!(e.to_string().starts_with("j = 5"), "{e}");
+        let e = x.add(0, 1, [f64::INFINITY, 0.0]).unwrap_err();
+        assert!(e.to_string().starts_with("at"), "{e}");
+        assert_eq!(x.extent(), 0.0);
+    }
+}

@@ -1,0 +1,106 @@
+//! The borehole's crack as the pressure rises: for every broken bond the hole pressure
+//! and the extent of the crack connected to the hole wall ([`porofrac_lsm::crack`]), the
+//! initiation pressure (first broken bond) and the breakdown pressure.
+//!
+//! **Breakdown** is the hole pressure at which the crack connected to the wall first
+//! reaches one hole radius beyond it: extent `r_c ≥ 2a` from the hole centre. The lining
+//! is the set of disks seen from the hole centre (the rays of
+//! [`porofrac_lsm::WallFaces::Rays`]) in the reference configuration, whatever loads the
+//! wall (rays, wetted faces or fluid), so that every loading is measured alike.
+//!
+//! Output: `crack.csv` (`time,i,j,pressure,extent`, one row per broken bond in the order
+//! of `broken.csv`), the scene-wide probe `crack_extent` (m) and the `summary.json` keys
+//! `initiation_pressure`, `breakdown_pressure`, `breakdown_extent` (`2a`, m) and
+//! `crack_extent` (m, at the end).
+
+use std::path::Path;
+
+use porofrac_lsm::{CrackExtent, LatticeSolid, LsmError, PressureWall};
+
+use crate::RunError;
+
+/// Extent of the wall crack at breakdown, in hole radii from the hole centre.
+pub const BREAKDOWN_REACH: f64 = 2.0;
+
+/// Pressure and crack extent at every broken bond of a scene with a hole.
+#[derive(Clone, Debug)]
+pub struct CrackLog {
+    extent: CrackExtent,
+    threshold: f64,
+    /// `time, i, j, pressure, extent` per broken bond processed.
+    rows: Vec<(f64, usize, usize, f64, f64)>,
+    initiation: Option<f64>,
+    breakdown: Option<f64>,
+    written: usize,
+}
+
+impl CrackLog {
+    /// The log of the hole of `centre` and `radius` in the reference configuration of
+    /// `solid`.
+    pub fn new(solid: &LatticeSolid, centre: [f64; 2], radius: f64) -> Result<Self, LsmError> {
+        let d = solid.disks();
+        let lining: Vec<usize> = PressureWall::new(d, centre, radius)?
+            .members
+            .iter()
+            .map(|m| m.0 as usize)
+            .collect();
+        Ok(Self {
+            extent: CrackExtent::new(d.len(), &lining, centre)?,
+            threshold: BREAKDOWN_REACH * radius,
+            rows: Vec::new(),
+            initiation: None,
+            breakdown: None,
+            written: 0,
+        })
+    }
+
+    /// Take in the bonds `solid` broke since the last call, at hole pressure `p` (Pa).
+    pub fn sync(&mut self, solid: &LatticeSolid, p: f64) -> Result<(), LsmError> {
+        for b in &solid.broken()[self.rows.len()..] {
+            let e = self.extent.add(b.i, b.j, [b.x, b.y])?;
+            self.initiation.get_or_insert(p);
+            if e >= self.threshold && self.breakdown.is_none() {
+                self.breakdown = Some(p);
+            }
+            self.rows.push((b.time, b.i, b.j, p, e));
+        }
+        Ok(())
+    }
+
+    /// Extent of the crack connected to the wall (m from the hole centre).
+    pub fn extent(&self) -> f64 {
+        self.extent.extent()
+    }
+
+    /// `summary.json` keys.
+    pub fn summary(&self, m: &mut serde_json::Map<String, serde_json::Value>) {
+        let opt = |v: Option<f64>| v.map_or(serde_json::Value::Null, |p| p.into());
+        m.insert("initiation_pressure".into(), opt(self.initiation));
+        m.insert("breakdown_pressure".into(), opt(self.breakdown));
+        m.insert("breakdown_extent".into(), self.threshold.into());
+        m.insert("crack_extent".into(), self.extent().into());
+    }
+
+    /// Write `crack.csv` if bonds broke since the last write (atomically).
+    pub fn write_csv(&mut self, out: &Path) -> Result<(), RunError> {
+        if self.rows.len() == self.written && self.written > 0 {
+            return Ok(());
+        }
+        let mut text = String::from("time,i,j,pressure,extent\n");
+        for (t, i, j, p, e) in &self.rows {
+            text.push_str(&format!("{t:e},{i},{j},{p:e},{e:e}\n"));
+        }
+        let path = out.join("crack.csv");
+        let tmp = out.join("crack.csv.tmp");
+        let io = |e: std::io::Error| {
+            RunError::Output(crate::output::OutputError {
+                path: path.clone(),
+                source: e,
+            })
+        };
+        std::fs::write(&tmp, text).map_err(io)?;
+        std::fs::rename(&tmp, &path).map_err(io)?;
+        self.written = self.rows.len();
+        Ok(())
+    }
+}
