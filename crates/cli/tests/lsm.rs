@@ -73,8 +73,8 @@ fn small_borehole_scene_runs_and_logs_broken_bonds() {
     assert!(s["bond_updates_per_second"].as_f64().unwrap() > 0.0);
     // The first break is at or above the pressure of a thick cylinder whose wall hoop
     // stress reaches the bond strength, within a factor of two (the lattice is coarse).
-    let pb = s["breakdown_pressure"].as_f64().unwrap();
-    assert!(pb > 0.0 && pb < 2.5e7 * 0.15, "breakdown at {pb}");
+    let pb = s["initiation_pressure"].as_f64().unwrap();
+    assert!(pb > 0.0 && pb < 2.5e7 * 0.15, "first break at {pb}");
     let text = std::fs::read_to_string(out.join("broken.csv")).unwrap();
     let mut lines = text.lines();
     assert_eq!(lines.next(), Some("time,i,j,x,y,mode"));
