@@ -93,8 +93,7 @@
 //! low-rank update of the factors (Sherman–Morrison–Woodbury, `crate::lowrank`), every
 //! such solve refined with the residual of the matrix itself to the relative residual
 //! `1e-12` of a fresh factorization (else it factorizes), and keeps the pressure scale
-//! of the factors meanwhile. Beyond `nnz(L) / n` changed unknowns (at least
-//! `MIN_MAX_RANK`) it factorizes.
+//! of the factors meanwhile. Beyond `DEFAULT_MAX_RANK` changed unknowns it factorizes.
 //!
 //! # Fixed-stress split
 //!
@@ -925,7 +924,6 @@ impl Monolithic {
         let ldlt = Ldlt::analyse(n, &col_ptr, &row_idx, Some(&perm))
             .map_err(|e| BiotError::Solver(e.0))?;
         let nnz = row_idx.len();
-        let max_rank = default_max_rank(&ldlt, n);
         Ok(Self {
             scale,
             s: 1.0,
@@ -938,7 +936,7 @@ impl Monolithic {
             values: vec![0.0; nnz],
             factor_values: Vec::new(),
             low_rank: Box::new(LowRank::new(n)),
-            max_rank,
+            max_rank: DEFAULT_MAX_RANK,
             updates: 0,
             factored: None,
             residual: 0.0,
@@ -1136,21 +1134,14 @@ impl Monolithic {
 }
 
 /// Changed unknowns up to which a new matrix is solved by a low-rank update of the
-/// factors (`crate::lowrank`) rather than factorized: `nnz(L) / n`, at least
-/// [`MIN_MAX_RANK`]. Each new unknown costs a forward sweep over its path of the
-/// elimination tree, every solve a plain one plus a dense `m × m` solve and `2m`
-/// vector updates over the paths, and refinement steps as the update grows; with this
-/// bound the kept vectors (`m · n` values) never outgrow the factor, and a solve at most
-/// doubles. On the 3D hydraulic-fracture scene at refine 6 (10 min), 60 took 13.3 s of
-/// CPU with 10 factorizations, 150 12.4 s with 3 and 400 12.1 s with 1
-/// (docs/BENCHMARKS.md).
-fn default_max_rank(ldlt: &Ldlt, n: usize) -> usize {
-    (ldlt.factor_nnz() / n.max(1)).max(MIN_MAX_RANK)
-}
-
-/// The smallest bound of [`default_max_rank`] (the bound measured best on the 2D
-/// hydraulic-fracture scene when every new unknown cost a whole solve).
-const MIN_MAX_RANK: usize = 60;
+/// factors (`crate::lowrank`) rather than factorized: each new unknown costs a forward
+/// sweep over its path of the elimination tree, every solve a plain one plus a dense
+/// `m × m` solve and `2m` vector updates over the paths, and refinement steps as the
+/// update grows. 60 keeps the answer of a factorization at every 60 changed unknowns
+/// on the hydraulic-fracture scenes; on the 3D scene (40 min) 150, 240 or 503 take 68 s
+/// of CPU against 94 s, with the same failures but the well pressure 1.1e-4 apart from
+/// t = 1200 s (docs/BENCHMARKS.md).
+const DEFAULT_MAX_RANK: usize = 60;
 
 /// Relative residual a low-rank solve is refined to (that of a fresh factorization on
 /// the hydraulic-fracture scenes, 1e-13 to 1e-12).
