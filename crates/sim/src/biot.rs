@@ -1138,9 +1138,9 @@ impl Monolithic {
 /// sweep over its path of the elimination tree, every solve a plain one plus a dense
 /// `m × m` solve and `2m` vector updates over the paths, and refinement steps as the
 /// update grows. 60 keeps the answer of a factorization at every 60 changed unknowns
-/// on the hydraulic-fracture scenes; on the 3D scene (40 min) 150, 240 or 503 take 68 s
-/// of CPU against 94 s, with the same failures but the well pressure 1.1e-4 apart from
-/// t = 1200 s (docs/BENCHMARKS.md).
+/// on the hydraulic-fracture scenes; on the 3D scene (40 min) 150, 240 or 503 take
+/// 68–73 s of CPU against 94 s (fewer factorizations, more refinement steps), with the
+/// same failures but the well pressure 1.1e-4 apart from t = 1200 s (docs/BENCHMARKS.md).
 const DEFAULT_MAX_RANK: usize = 60;
 
 /// Relative residual a low-rank solve is refined to (that of a fresh factorization on
