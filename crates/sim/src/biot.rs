@@ -1134,10 +1134,13 @@ impl Monolithic {
 }
 
 /// Changed unknowns up to which a new matrix is solved by a low-rank update of the
-/// factors (`crate::lowrank`) rather than factorized: each new unknown costs a column
-/// solve, every solve a triangular solve, a dense `m × m` one and `m` column updates, and refinement
-/// steps as the update grows. On the 2D hydraulic-fracture scene 60 took 10.7 s of CPU
-/// against 11.8 s for 150 or 400 (docs/BENCHMARKS.md).
+/// factors (`crate::lowrank`) rather than factorized: each new unknown costs a forward
+/// sweep over its path of the elimination tree, every solve a plain one plus a dense
+/// `m × m` solve and `2m` vector updates over the paths, and refinement steps as the
+/// update grows. 60 keeps the answer of a factorization at every 60 changed unknowns
+/// on the hydraulic-fracture scenes; on the 3D scene (40 min) 150, 240 or 503 take
+/// 68–73 s of CPU against 94 s (fewer factorizations, more refinement steps), with the
+/// same failures but the well pressure 1.1e-4 apart from t = 1200 s (docs/BENCHMARKS.md).
 const DEFAULT_MAX_RANK: usize = 60;
 
 /// Relative residual a low-rank solve is refined to (that of a fresh factorization on

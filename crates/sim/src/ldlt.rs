@@ -431,29 +431,213 @@ impl Ldlt {
             )));
         }
         self.solves += 1;
-        let sn = match self.symbolic.raw() {
-            SymbolicCholeskyRaw::Supernodal(sn) => sn,
-            SymbolicCholeskyRaw::Simplicial(_) => {
-                // Only for an empty matrix (supernodal is forced).
-                let ldlt = LdltRef::<'_, usize, f64>::new(&self.symbolic, &self.values);
-                let mem = match self.mem.as_mut() {
-                    Some(m) => m,
-                    None => self.mem.insert(
-                        MemBuffer::try_new(
-                            self.symbolic.solve_in_place_scratch::<f64>(1, Par::Seq),
-                        )
+        if let SymbolicCholeskyRaw::Simplicial(_) = self.symbolic.raw() {
+            // Only for an empty matrix (supernodal is forced).
+            let ldlt = LdltRef::<'_, usize, f64>::new(&self.symbolic, &self.values);
+            let mem = match self.mem.as_mut() {
+                Some(m) => m,
+                None => self.mem.insert(
+                    MemBuffer::try_new(self.symbolic.solve_in_place_scratch::<f64>(1, Par::Seq))
                         .map_err(|_| LdltError("out of memory".into()))?,
-                    ),
-                };
-                let n = self.n;
-                ldlt.solve_in_place_with_conj(
-                    Conj::No,
-                    MatMut::from_column_major_slice_mut(rhs, n, 1),
-                    Par::Seq,
-                    MemStack::new(mem),
-                );
-                return Ok(());
+                ),
+            };
+            let n = self.n;
+            ldlt.solve_in_place_with_conj(
+                Conj::No,
+                MatMut::from_column_major_slice_mut(rhs, n, 1),
+                Par::Seq,
+                MemStack::new(mem),
+            );
+            return Ok(());
+        }
+        self.permute_in(rhs);
+        self.sweep_forward();
+        self.sweep_backward();
+        self.permute_out(rhs);
+        Ok(())
+    }
+}
+
+/// The two halves of a solve, for a solver that changes the vector between them
+/// (`crate::lowrank`): `f = L⁻¹ P b` and `x = Pᵀ L⁻ᵀ D⁻¹ f`, `f` in the elimination
+/// order; and `L⁻¹ P e_u` for unit vectors, which is zero outside the supernodes on the
+/// path from the supernode of `u` to its root (the rows of `L` below a supernode belong
+/// to its ancestors), so only those are swept.
+impl Ldlt {
+    /// `rhs ← L⁻¹ P rhs` (on return in the elimination order). Counts as a solve.
+    pub(crate) fn forward_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LdltError> {
+        self.check_supernodal(rhs.len())?;
+        self.solves += 1;
+        self.permute_in(rhs);
+        self.sweep_forward();
+        rhs.copy_from_slice(&self.work);
+        Ok(())
+    }
+
+    /// `rhs ← Pᵀ L⁻ᵀ D⁻¹ rhs` (`rhs` in the elimination order on entry, as
+    /// [`Ldlt::forward_in_place`] left it).
+    pub(crate) fn backward_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LdltError> {
+        self.check_supernodal(rhs.len())?;
+        self.work.copy_from_slice(rhs);
+        self.sweep_backward();
+        self.permute_out(rhs);
+        Ok(())
+    }
+
+    /// `1/D` in the elimination order.
+    pub(crate) fn inverse_diagonal(&self) -> &[f64] {
+        &self.inv_diag
+    }
+
+    /// `L⁻¹ P e_u` for every unknown `u` of `units` into the columns of `out`
+    /// (column-major `n × units.len()`, in the elimination order, overwritten), swept over
+    /// the path of supernodes from `u`'s to its root only, the columns on two threads.
+    /// `paths[c]` receives the column ranges of the path of column `c` (outside them the
+    /// column is zero). Counts as `units.len()` solves.
+    pub(crate) fn forward_units(
+        &mut self,
+        units: &[usize],
+        out: &mut [f64],
+        paths: &mut Vec<Vec<Range<usize>>>,
+    ) -> Result<(), LdltError> {
+        let n = self.n;
+        self.check_supernodal(n)?;
+        if out.len() != n * units.len() || units.iter().any(|&u| u >= n) {
+            return Err(LdltError(format!(
+                "{} unit columns into {} values for {n} unknowns",
+                units.len(),
+                out.len()
+            )));
+        }
+        self.solves += units.len();
+        let SymbolicCholeskyRaw::Supernodal(sn) = self.symbolic.raw() else {
+            return Err(LdltError("unit solves of a simplicial factor".into()));
+        };
+        let (begin, end) = (sn.supernode_begin(), sn.supernode_end());
+        let f = Factor {
+            begin,
+            end,
+            rptr: sn.col_ptr_for_row_idx(),
+            vptr: sn.col_ptr_for_val(),
+            rows: sn.row_idx(),
+            values: &self.values,
+            inv_diag: &self.inv_diag,
+        };
+        let ns = sn.n_supernodes();
+        let mut sn_of_col = vec![0; n];
+        for s in 0..ns {
+            sn_of_col[begin[s]..end[s]].fill(s);
+        }
+        // Parent: the supernode of the first row below (a later one).
+        let parent: Vec<Option<usize>> = (0..ns)
+            .map(|s| {
+                let (_, _, _, _, below) = f.supernode(s);
+                below.iter().min().map(|&r| sn_of_col[r])
+            })
+            .collect();
+        let position: Vec<usize> = match self.symbolic.perm() {
+            Some(p) => units.iter().map(|&u| p.arrays().1[u]).collect(),
+            None => units.to_vec(),
+        };
+        let sn_paths: Vec<Vec<usize>> = position
+            .iter()
+            .map(|&k| {
+                let mut path = Vec::new();
+                let mut s = Some(sn_of_col[k]);
+                while let Some(q) = s {
+                    path.push(q);
+                    s = parent[q].filter(|&p| p > q);
+                }
+                path
+            })
+            .collect();
+        let widest = self.tmp.len();
+        let arch = pulp::Arch::new();
+        use rayon::prelude::*;
+        out.par_chunks_mut(n.max(1))
+            .zip(position.par_iter().zip(sn_paths.par_iter()))
+            .for_each_init(
+                || vec![0.0; widest],
+                |tmp, (col, (&k, path))| {
+                    col.fill(0.0);
+                    col[k] = 1.0;
+                    arch.dispatch(Forward {
+                        f: &f,
+                        sns: path,
+                        x: col,
+                        tmp,
+                    });
+                },
+            );
+        paths.clear();
+        for path in &sn_paths {
+            let mut cols: Vec<Range<usize>> = Vec::with_capacity(path.len());
+            for &q in path {
+                match cols.last_mut() {
+                    Some(r) if r.end == begin[q] => r.end = end[q],
+                    _ => cols.push(begin[q]..end[q]),
+                }
             }
+            paths.push(cols);
+        }
+        Ok(())
+    }
+
+    fn check_supernodal(&self, len: usize) -> Result<(), LdltError> {
+        if !self.factored {
+            return Err(LdltError("solve before a successful factorization".into()));
+        }
+        if len != self.n {
+            return Err(LdltError(format!(
+                "right-hand side of length {len}, want {}",
+                self.n
+            )));
+        }
+        match self.symbolic.raw() {
+            SymbolicCholeskyRaw::Supernodal(_) => Ok(()),
+            SymbolicCholeskyRaw::Simplicial(_) => {
+                Err(LdltError("split solve of a simplicial factor".into()))
+            }
+        }
+    }
+
+    /// `work ← P rhs`.
+    fn permute_in(&mut self, rhs: &[f64]) {
+        match self.symbolic.perm() {
+            Some(p) => {
+                for (xi, &i) in self.work.iter_mut().zip(p.arrays().0) {
+                    *xi = rhs[i];
+                }
+            }
+            None => self.work.copy_from_slice(rhs),
+        }
+    }
+
+    /// `rhs ← Pᵀ work`.
+    fn permute_out(&self, rhs: &mut [f64]) {
+        match self.symbolic.perm() {
+            Some(p) => {
+                for (r, &i) in rhs.iter_mut().zip(p.arrays().1) {
+                    *r = self.work[i];
+                }
+            }
+            None => rhs.copy_from_slice(&self.work),
+        }
+    }
+
+    /// `work ← L⁻¹ work` (supernodal factors), on two threads over the split.
+    fn sweep_forward(&mut self) {
+        self.sweep(true);
+    }
+
+    /// `work ← L⁻ᵀ D⁻¹ work` (supernodal factors), on two threads over the split.
+    fn sweep_backward(&mut self) {
+        self.sweep(false);
+    }
+
+    fn sweep(&mut self, forward_sweep: bool) {
+        let SymbolicCholeskyRaw::Supernodal(sn) = self.symbolic.raw() else {
+            return;
         };
         let f = Factor {
             begin: sn.supernode_begin(),
@@ -466,14 +650,6 @@ impl Ldlt {
         };
         let ns = sn.n_supernodes();
         let x = &mut self.work;
-        match self.symbolic.perm() {
-            Some(p) => {
-                for (xi, &i) in x.iter_mut().zip(p.arrays().0) {
-                    *xi = rhs[i];
-                }
-            }
-            None => x.copy_from_slice(rhs),
-        }
         // The sweeps compiled for the widest vector instructions of this processor.
         let arch = pulp::Arch::new();
         let tmp = &mut self.tmp;
@@ -486,10 +662,13 @@ impl Ldlt {
         match &self.split {
             None => {
                 let all = &self.all[..ns];
-                forward(all, x, tmp);
-                backward(all, x, tmp);
+                if forward_sweep {
+                    forward(all, x, tmp);
+                } else {
+                    backward(all, x, tmp);
+                }
             }
-            Some(sp) => {
+            Some(sp) if forward_sweep => {
                 // Forward: the subtrees of a and b on two threads, b on its own vector
                 // (its updates of the rows of the rest added after), then the rest.
                 let (xb, tmp_b) = (&mut self.work_b, &mut self.tmp_b);
@@ -507,8 +686,11 @@ impl Ldlt {
                     }
                 }
                 forward(&sp.rest, x, tmp);
+            }
+            Some(sp) => {
                 // Backward: the rest in reverse, then a and b on two threads (each reads
                 // the rest and writes only its own columns).
+                let (xb, tmp_b) = (&mut self.work_b, &mut self.tmp_b);
                 backward(&sp.rest, x, tmp);
                 xb.copy_from_slice(x);
                 rayon::join(|| backward(&sp.a, x, tmp), || backward(&sp.b, xb, tmp_b));
@@ -517,15 +699,6 @@ impl Ldlt {
                 }
             }
         }
-        match self.symbolic.perm() {
-            Some(p) => {
-                for (r, &i) in rhs.iter_mut().zip(p.arrays().1) {
-                    *r = x[i];
-                }
-            }
-            None => rhs.copy_from_slice(x),
-        }
-        Ok(())
     }
 }
 
@@ -1072,5 +1245,60 @@ mod tests {
         let mut z = b.clone();
         f.solve_in_place(&mut z).unwrap();
         assert_eq!(x, z);
+    }
+
+    /// The two halves of a solve give the solve, and the path-restricted forward sweeps
+    /// of unit vectors give the full forward sweep, zero outside the path (a 2D grid
+    /// Laplacian with a split, and the quasi-definite block matrix).
+    #[test]
+    fn forward_units_match_the_forward_sweep() {
+        let k = 40;
+        let n = k * k;
+        let mut col_ptr = vec![0];
+        let (mut row_idx, mut vals) = (Vec::new(), Vec::new());
+        for a in 0..n {
+            let (i, j) = (a / k, a % k);
+            if i > 0 {
+                row_idx.push(a - k);
+                vals.push(-1.0);
+            }
+            if j > 0 {
+                row_idx.push(a - 1);
+                vals.push(-1.0);
+            }
+            row_idx.push(a);
+            vals.push(4.0 + 0.01 * (a % 7) as f64);
+            col_ptr.push(row_idx.len());
+        }
+        let systems = [(n, col_ptr, row_idx, vals), quasi_definite(9)];
+        for (n, col_ptr, row_idx, vals) in systems {
+            let mut f = Ldlt::analyse(n, &col_ptr, &row_idx, None).unwrap();
+            f.factorize(&col_ptr, &row_idx, &vals).unwrap();
+            let b: Vec<f64> = (0..n).map(|i| ((i * 7919) % 13) as f64 - 6.0).collect();
+            let mut x = b.clone();
+            f.solve_in_place(&mut x).unwrap();
+            let mut y = b.clone();
+            f.forward_in_place(&mut y).unwrap();
+            f.backward_in_place(&mut y).unwrap();
+            assert_eq!(x, y);
+            let units = [0, n / 3, n / 2, n - 1];
+            let mut cols = vec![f64::NAN; n * units.len()];
+            let mut paths = Vec::new();
+            f.forward_units(&units, &mut cols, &mut paths).unwrap();
+            assert_eq!(paths.len(), units.len());
+            for (c, &u) in units.iter().enumerate() {
+                let mut e = vec![0.0; n];
+                e[u] = 1.0;
+                f.forward_in_place(&mut e).unwrap();
+                let col = &cols[c * n..(c + 1) * n];
+                let on_path = |i: usize| paths[c].iter().any(|r| r.contains(&i));
+                let d = (0..n).map(|i| (col[i] - e[i]).abs()).fold(0.0, f64::max);
+                let m = e.iter().map(|v| v.abs()).fold(0.0, f64::max);
+                assert!(d <= 1e-15 * m, "unit {u}: differs by {d:e}");
+                assert!((0..n).all(|i| on_path(i) || e[i] == 0.0), "unit {u}");
+                let covered: usize = paths[c].iter().map(|r| r.len()).sum();
+                assert!(covered < n, "unit {u}: the path is the whole factor");
+            }
+        }
     }
 }

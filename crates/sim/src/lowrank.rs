@@ -10,23 +10,36 @@
 //!   (I + G Δ) y = Pᵀ z ,      x = z − (A₀⁻¹ P) Δ y ,      z = A₀⁻¹ b
 //! ```
 //!
-//! (`y = Pᵀ x`; Hager 1989, *Updating the inverse of a matrix*). The columns `A₀⁻¹ P` are
-//! solves of `A₀` with unit vectors; they are kept whole for every unknown met since the
-//! last factorization (one blocked multi-column solve per batch of new unknowns, its two
-//! halves on two threads), so a later change pays only for the unknowns new to it, and
-//! `G` is their rows in `T`. A solve is then one solve with `A₀`, one with the `m × m`
-//! capacitance matrix `I + G Δ` (dense LU with partial pivoting, factorized once per
-//! change) and `m` dense column updates of length `n` — on the 2D hydraulic-fracture scene
-//! (`n` = 40 157, factor of 5.1e6 entries, `m` ≤ 60) about a quarter of the memory traffic
-//! of the second triangular solve it replaces. The caller bounds `m` and factorizes `A`
-//! afresh beyond it, and checks the residual of the result against `A` itself.
+//! (`y = Pᵀ x`; Hager 1989, *Updating the inverse of a matrix*). With the factors
+//! `Π A₀ Πᵀ = L D Lᵀ` (`Π` the elimination order) and, for every changed unknown `u`,
+//! the forward solve `v_u = L⁻¹ Π e_u`,
+//!
+//! ```text
+//!   G_uw = v_uᵀ D⁻¹ v_w ,     f = L⁻¹ Π b ,     (Pᵀ z)_u = v_uᵀ D⁻¹ f ,
+//!   x = Πᵀ L⁻ᵀ D⁻¹ (f − Σ_u (Δ y)_u v_u) ,
+//! ```
+//!
+//! so a solve is one forward and one backward sweep (as a plain solve), one solve with
+//! the `m × m` capacitance matrix `I + G Δ` (dense LU with partial pivoting, factorized
+//! once per change) and `2m` short vector operations. `v_u` is zero outside the
+//! supernodes on the path from the supernode of `u` to the root of the elimination tree
+//! (the rows of `L` below a supernode are its ancestors'), so it costs a forward sweep
+//! over that path only ([`Ldlt::forward_units`]) — on the 3D hydraulic-fracture scene a
+//! small part of the factor — and every product with it runs over the path's columns.
+//! The `v_u` and their products `G` are kept for every unknown met since the last
+//! factorization, so a later change pays only for the unknowns new to it. (The earlier
+//! form kept the whole columns `A₀⁻¹ P`, a forward *and* a backward sweep over the whole
+//! factor per unknown.) The caller bounds `m` and factorizes `A` afresh beyond it, and
+//! checks the residual of the result against `A` itself.
+
+use std::ops::Range;
 
 use faer::Mat;
 use faer::linalg::solvers::{PartialPivLu, Solve};
 
 use crate::ldlt::{Ldlt, LdltError};
 
-/// Unknowns whose columns of `A₀⁻¹` are computed in one blocked solve.
+/// Unknowns whose forward solves are computed in one call (on two threads).
 const BATCH: usize = 32;
 
 /// Marks an unknown without a slot.
@@ -39,9 +52,13 @@ pub(crate) struct LowRank {
     slot: Vec<usize>,
     /// The unknown of every slot.
     cached: Vec<usize>,
-    /// The columns of `A₀⁻¹` of the cached unknowns, column-major `n × cached.len()`:
-    /// `w[a · n + i] = (A₀⁻¹)[i, cached[a]]`.
+    /// The forward solves `v_u = L⁻¹ Π e_u` of the cached unknowns, column-major
+    /// `n × cached.len()` in the elimination order: `w[a · n + i] = (v_{cached[a]})_i`.
     w: Vec<f64>,
+    /// The columns where `v` of every slot may be nonzero (its path to the root).
+    paths: Vec<Vec<Range<usize>>>,
+    /// `G` between the slots: `gram[a][b] = v_aᵀ D⁻¹ v_b` for `b ≤ a`.
+    gram: Vec<Vec<f64>>,
     /// The unknowns `T` of the current change.
     support: Vec<usize>,
     /// Per unknown: its index in `support`, or [`NONE`].
@@ -61,6 +78,8 @@ impl LowRank {
             slot: vec![NONE; n],
             cached: Vec::new(),
             w: Vec::new(),
+            paths: Vec::new(),
+            gram: Vec::new(),
             support: Vec::new(),
             local: vec![NONE; n],
             delta: Vec::new(),
@@ -76,6 +95,8 @@ impl LowRank {
         }
         self.cached.clear();
         self.w.clear();
+        self.paths.clear();
+        self.gram.clear();
         self.clear_change();
     }
 
@@ -145,16 +166,17 @@ impl LowRank {
         let slots: Vec<usize> = self.support.iter().map(|&u| self.slot[u]).collect();
         let mut cap = Mat::<f64>::identity(m, m);
         for &(k, j, v) in &self.delta {
-            let col = &self.w[slots[k] * n..(slots[k] + 1) * n];
-            for (i, &u) in self.support.iter().enumerate() {
-                cap[(i, j)] += v * col[u];
+            for (i, &a) in slots.iter().enumerate() {
+                let b = slots[k];
+                cap[(i, j)] += v * self.gram[a.max(b)][a.min(b)];
             }
         }
         self.lu = Some(cap.partial_piv_lu());
         Ok(true)
     }
 
-    /// Cache the columns of `A₀⁻¹` of the support's unknowns not cached yet.
+    /// Cache the forward solves of the support's unknowns not cached yet, and their
+    /// products `G` with every cached one.
     fn extend_cache(&mut self, ldlt: &mut Ldlt) -> Result<(), LdltError> {
         let n = self.slot.len();
         let new: Vec<usize> = self
@@ -163,18 +185,29 @@ impl LowRank {
             .copied()
             .filter(|&u| self.slot[u] == NONE)
             .collect();
+        let mut paths = Vec::new();
         for chunk in new.chunks(BATCH) {
-            let k = chunk.len();
             let old = self.w.len();
-            self.w.resize(old + n * k, 0.0);
-            let cols = &mut self.w[old..];
-            for (c, &u) in chunk.iter().enumerate() {
-                cols[c * n + u] = 1.0;
-            }
-            ldlt.solve_columns_in_place(cols, k)?;
-            for &u in chunk {
-                self.slot[u] = self.cached.len();
+            self.w.resize(old + n * chunk.len(), 0.0);
+            ldlt.forward_units(chunk, &mut self.w[old..], &mut paths)?;
+            for (&u, path) in chunk.iter().zip(paths.drain(..)) {
+                let a = self.cached.len();
+                self.slot[u] = a;
                 self.cached.push(u);
+                self.paths.push(path);
+                let inv_d = ldlt.inverse_diagonal();
+                let va = &self.w[a * n..(a + 1) * n];
+                let row = (0..=a)
+                    .map(|b| {
+                        let vb = &self.w[b * n..(b + 1) * n];
+                        self.paths[a]
+                            .iter()
+                            .flat_map(|r| r.clone())
+                            .map(|i| va[i] * inv_d[i] * vb[i])
+                            .sum()
+                    })
+                    .collect();
+                self.gram.push(row);
             }
         }
         Ok(())
@@ -186,26 +219,39 @@ impl LowRank {
         let Some(lu) = &self.lu else {
             return ldlt.solve_in_place(rhs);
         };
-        ldlt.solve_in_place(rhs)?;
+        // f = L⁻¹ Π b; (Pᵀ z)_u = v_uᵀ D⁻¹ f.
+        ldlt.forward_in_place(rhs)?;
+        let n = rhs.len();
         let m = self.support.len();
-        let mut y = Mat::<f64>::from_fn(m, 1, |i, _| rhs[self.support[i]]);
+        let inv_d = ldlt.inverse_diagonal();
+        let mut y = Mat::<f64>::from_fn(m, 1, |i, _| {
+            let a = self.slot[self.support[i]];
+            let v = &self.w[a * n..(a + 1) * n];
+            self.paths[a]
+                .iter()
+                .flat_map(|r| r.clone())
+                .map(|k| v[k] * inv_d[k] * rhs[k])
+                .sum()
+        });
         lu.solve_in_place(y.as_mut());
-        // x = z − A₀⁻¹ P (Δ y) with the cached columns.
+        // f ← f − Σ_u (Δ y)_u v_u, then x = Πᵀ L⁻ᵀ D⁻¹ f.
         self.t.clear();
         self.t.resize(m, 0.0);
         for &(i, j, v) in &self.delta {
             self.t[i] += v * y[(j, 0)];
         }
-        let n = rhs.len();
         for (&u, &ti) in self.support.iter().zip(&self.t) {
             if ti != 0.0 {
                 let a = self.slot[u];
-                for (x, c) in rhs.iter_mut().zip(&self.w[a * n..(a + 1) * n]) {
-                    *x -= ti * c;
+                let v = &self.w[a * n..(a + 1) * n];
+                for r in &self.paths[a] {
+                    for (x, c) in rhs[r.clone()].iter_mut().zip(&v[r.clone()]) {
+                        *x -= ti * c;
+                    }
                 }
             }
         }
-        Ok(())
+        ldlt.backward_in_place(rhs)
     }
 }
 
