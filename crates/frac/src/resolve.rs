@@ -142,6 +142,40 @@ mod tests {
     use super::*;
     use crate::{FailureMode, Tensile};
 
+    /// [`resolve`] on constant uniaxial cell stresses `sigma` (σxx per cell, unchanged by
+    /// failures) with one criterion class for every cell.
+    fn resolve_constant(
+        st: &mut FailureState,
+        criterion: Combined,
+        tips: Option<&CrackTips>,
+        policy: FailurePolicy,
+        rounds: usize,
+        sigma: &[f64],
+    ) -> Result<((), Vec<Tensor<2>>, usize, usize), ResolveError<()>> {
+        let class = vec![0; sigma.len()];
+        resolve::<2, (), ()>(
+            st,
+            0.0,
+            CellCriteria {
+                criteria: std::slice::from_ref(&criterion),
+                class_of_cell: &class,
+                tips,
+            },
+            policy,
+            None,
+            rounds,
+            |_| {
+                Ok((
+                    (),
+                    sigma
+                        .iter()
+                        .map(|&s| Tensor::<2>::new(s, 0.0, 0.0, 0.0))
+                        .collect(),
+                ))
+            },
+        )
+    }
+
     /// A chain of springs in series under a prescribed total stretch: the stress is the
     /// same in every intact cell; a failed cell carries nothing, so after the weakest cell
     /// fails all stresses vanish and no further cell fails.
@@ -192,60 +226,33 @@ mod tests {
 
     #[test]
     fn policy_all_fails_every_violator_and_rounds_are_bounded() {
-        let criteria = vec![Combined {
+        let criterion = Combined {
             tensile: Some(Tensile::new(1.0).unwrap()),
             shear: None,
             toughness: None,
-        }];
-        let class = vec![0; 3];
-        let mut st = FailureState::new(3);
+        };
         let stresses = [1.5, 3.0, 0.5];
-        let (_, _, n, _) = resolve::<2, (), ()>(
+        let mut st = FailureState::new(3);
+        let (_, _, n, _) = resolve_constant(
             &mut st,
-            0.0,
-            CellCriteria {
-                criteria: &criteria,
-                class_of_cell: &class,
-                tips: None,
-            },
-            FailurePolicy::All,
+            criterion.clone(),
             None,
+            FailurePolicy::All,
             5,
-            |_| {
-                Ok((
-                    (),
-                    stresses
-                        .iter()
-                        .map(|&s| Tensor::<2>::new(s, 0.0, 0.0, 0.0))
-                        .collect(),
-                ))
-            },
+            &stresses,
         )
         .unwrap();
         assert_eq!(n, 2);
         assert_eq!(st.flags(), &[true, true, false]);
         // MostCritical with fraction 0.99 fails only cell 1 per round; one round allowed.
         let mut st = FailureState::new(3);
-        let err = resolve::<2, (), ()>(
+        let err = resolve_constant(
             &mut st,
-            0.0,
-            CellCriteria {
-                criteria: &criteria,
-                class_of_cell: &class,
-                tips: None,
-            },
-            FailurePolicy::default(),
+            criterion,
             None,
+            FailurePolicy::default(),
             1,
-            |_| {
-                Ok((
-                    (),
-                    stresses
-                        .iter()
-                        .map(|&s| Tensor::<2>::new(s, 0.0, 0.0, 0.0))
-                        .collect(),
-                ))
-            },
+            &stresses,
         )
         .unwrap_err();
         assert!(matches!(
@@ -270,33 +277,19 @@ mod tests {
         let tips = CrackTips::new(&grid);
         let stresses = [3.0, 2.0, 2.0];
         for (k_ic, expect) in [(4.0, [true, false, true]), (3.5, [true, true, true])] {
-            let criteria = vec![Combined {
+            let criterion = Combined {
                 tensile: Some(Tensile::new(1.0).unwrap()),
                 shear: None,
                 toughness: Some(crate::Toughness::new(k_ic).unwrap()),
-            }];
-            let class = vec![0; grid.num_cells()];
+            };
             let mut st = FailureState::new(3);
-            resolve::<2, (), ()>(
+            resolve_constant(
                 &mut st,
-                0.0,
-                CellCriteria {
-                    criteria: &criteria,
-                    class_of_cell: &class,
-                    tips: Some(&tips),
-                },
+                criterion,
+                Some(&tips),
                 FailurePolicy::default(),
-                None,
                 10,
-                |_| {
-                    Ok((
-                        (),
-                        stresses
-                            .iter()
-                            .map(|&s| Tensor::<2>::new(s, 0.0, 0.0, 0.0))
-                            .collect(),
-                    ))
-                },
+                &stresses,
             )
             .unwrap();
             assert_eq!(st.flags(), &expect, "K_Ic = {k_ic}");

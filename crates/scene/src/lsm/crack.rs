@@ -90,16 +90,7 @@ impl CrackLog {
         for (t, i, j, p, e) in &self.rows {
             text.push_str(&format!("{t:e},{i},{j},{p:e},{e:e}\n"));
         }
-        let path = out.join("crack.csv");
-        let tmp = out.join("crack.csv.tmp");
-        let io = |e: std::io::Error| {
-            RunError::Output(crate::output::OutputError {
-                path: path.clone(),
-                source: e,
-            })
-        };
-        std::fs::write(&tmp, text).map_err(io)?;
-        std::fs::rename(&tmp, &path).map_err(io)?;
+        crate::output::write_atomic(&out.join("crack.csv"), text.as_bytes())?;
         self.written = self.rows.len();
         Ok(())
     }

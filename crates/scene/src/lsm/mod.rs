@@ -660,16 +660,7 @@ impl Model for LsmModel<'_> {
                 b.mode.as_str()
             ));
         }
-        let path = out.join("broken.csv");
-        let tmp = out.join("broken.csv.tmp");
-        let io = |e: std::io::Error| {
-            RunError::Output(crate::output::OutputError {
-                path: path.clone(),
-                source: e,
-            })
-        };
-        std::fs::write(&tmp, text).map_err(io)?;
-        std::fs::rename(&tmp, &path).map_err(io)?;
+        crate::output::write_atomic(&out.join("broken.csv"), text.as_bytes())?;
         self.broken_written = broken.len();
         Ok(())
     }
