@@ -1199,11 +1199,9 @@ mod tests {
         }
     }
 
-    /// On a 2D grid Laplacian (AMD: a nested-dissection-like tree) the sweeps split into
-    /// two subtrees, and the split solve satisfies the matrix like the sequential one.
-    #[test]
-    fn split_solve_matches_the_sequential_one() {
-        let k = 60;
+    /// The lower triangle (CSC) of a shifted 5-point Laplacian on a `k × k` grid:
+    /// `(n, col_ptr, row_idx, vals)`.
+    fn grid_laplacian(k: usize) -> (usize, Vec<usize>, Vec<usize>, Vec<f64>) {
         let n = k * k;
         let mut col_ptr = vec![0];
         let (mut row_idx, mut vals) = (Vec::new(), Vec::new());
@@ -1221,6 +1219,14 @@ mod tests {
             vals.push(4.0 + 0.01 * (a % 7) as f64);
             col_ptr.push(row_idx.len());
         }
+        (n, col_ptr, row_idx, vals)
+    }
+
+    /// On a 2D grid Laplacian (AMD: a nested-dissection-like tree) the sweeps split into
+    /// two subtrees, and the split solve satisfies the matrix like the sequential one.
+    #[test]
+    fn split_solve_matches_the_sequential_one() {
+        let (n, col_ptr, row_idx, vals) = grid_laplacian(60);
         let b: Vec<f64> = (0..n).map(|i| ((i * 7919) % 13) as f64 - 6.0).collect();
         let mut f = Ldlt::analyse(n, &col_ptr, &row_idx, None).unwrap();
         f.factorize(&col_ptr, &row_idx, &vals).unwrap();
@@ -1252,24 +1258,7 @@ mod tests {
     /// Laplacian with a split, and the quasi-definite block matrix).
     #[test]
     fn forward_units_match_the_forward_sweep() {
-        let k = 40;
-        let n = k * k;
-        let mut col_ptr = vec![0];
-        let (mut row_idx, mut vals) = (Vec::new(), Vec::new());
-        for a in 0..n {
-            let (i, j) = (a / k, a % k);
-            if i > 0 {
-                row_idx.push(a - k);
-                vals.push(-1.0);
-            }
-            if j > 0 {
-                row_idx.push(a - 1);
-                vals.push(-1.0);
-            }
-            row_idx.push(a);
-            vals.push(4.0 + 0.01 * (a % 7) as f64);
-            col_ptr.push(row_idx.len());
-        }
+        let (n, col_ptr, row_idx, vals) = grid_laplacian(40);
         let systems = [(n, col_ptr, row_idx, vals), quasi_definite(9)];
         for (n, col_ptr, row_idx, vals) in systems {
             let mut f = Ldlt::analyse(n, &col_ptr, &row_idx, None).unwrap();
