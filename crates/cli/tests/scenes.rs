@@ -649,7 +649,9 @@ fn every_bundled_scene_passes_check() {
 
 #[test]
 fn fracture_toughness_transmissivity_and_lag_keys_are_checked() {
-    let seed = std::fs::read_to_string(root().join("scenes/hydrofrac_seed.toml")).unwrap();
+    // The seed's scene with fluid lag: a fixed fracture permeability, no toughness.
+    let seed =
+        std::fs::read_to_string(root().join("scenes/hydrofrac_seed_fluid_lag.toml")).unwrap();
     // A toughness needs a tensile strength.
     let text = seed.replace("tensile_strength = 2.0e5", "fracture_toughness = 1.0e5");
     let (code, err) = check_text("toughness_alone", &text);
@@ -696,7 +698,7 @@ fn fracture_toughness_transmissivity_and_lag_keys_are_checked() {
     assert!(
         err.contains(&format!(
             "lag_without_fracture.toml:{}: physics.fluid_lag needs fracture = true and flow = true",
-            line_of(&text, "fluid_lag")
+            line_of(&text, "fluid_lag = false")
         )),
         "{err}"
     );

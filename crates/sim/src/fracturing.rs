@@ -373,6 +373,26 @@ pub struct FractureFlow<const D: usize> {
     pub p0: Vec<f64>,
 }
 
+impl<const D: usize> FractureFlow<D> {
+    /// The cells the crack's fluid fills: the failed cells and, without fluid lag
+    /// ([`Self::zero_lag`]), the intact cells across a face from a failed cell. They take
+    /// the fracture permeability, and the explicit-pressure coupling
+    /// ([`ExplicitPressure::fractured`]) keeps their volumetric term.
+    pub fn wet_cells(&self, grid: &Grid<D>, failed: &[bool]) -> Vec<bool> {
+        let mut wet = failed.to_vec();
+        if self.zero_lag {
+            for c in (0..failed.len()).filter(|&c| failed[c]) {
+                for &face in grid.cell_faces(c) {
+                    if let (a, Some(b)) = grid.face_cells(face) {
+                        wet[if a == c { b } else { a }] = true;
+                    }
+                }
+            }
+        }
+        wet
+    }
+}
+
 /// The permeability a cell takes when it fails.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum FracturePermeability {
@@ -625,8 +645,8 @@ impl<'a, const D: usize> Fracturing<'a, D> {
                 system = system.with_drained_bulk_modulus(k_dr.clone())?;
             }
             if let Scheme::ExplicitPressure(ep, extra) = scheme {
-                ep.fractured = fs
-                    .flags()
+                ep.fractured = flow
+                    .wet_cells(grid, fs.flags())
                     .iter()
                     .zip(extra.iter())
                     .map(|(a, b)| *a || *b)
@@ -743,19 +763,9 @@ fn update_permeability<const D: usize>(
     }
     let mut perm = flow.permeability.clone();
     let volumes = grid.cell_volumes();
-    for (c, &f) in failed.iter().enumerate() {
-        if f {
+    for (c, wet) in flow.wet_cells(grid, failed).into_iter().enumerate() {
+        if wet {
             perm.set(c, Tensor::<D>::identity() * k.of_cell::<D>(volumes[c]))?;
-            if flow.zero_lag {
-                for &face in grid.cell_faces(c) {
-                    if let (a, Some(b)) = grid.face_cells(face) {
-                        let o = if a == c { b } else { a };
-                        if !failed[o] {
-                            perm.set(o, Tensor::<D>::identity() * k.of_cell::<D>(volumes[o]))?;
-                        }
-                    }
-                }
-            }
         }
     }
     flow.model.set_permeability(grid, &perm)?;
