@@ -379,18 +379,24 @@ impl<const D: usize> FractureFlow<D> {
     /// the fracture permeability, and the explicit-pressure coupling
     /// ([`ExplicitPressure::fractured`]) keeps their volumetric term.
     pub fn wet_cells(&self, grid: &Grid<D>, failed: &[bool]) -> Vec<bool> {
-        let mut wet = failed.to_vec();
-        if self.zero_lag {
-            for c in (0..failed.len()).filter(|&c| failed[c]) {
-                for &face in grid.cell_faces(c) {
-                    if let (a, Some(b)) = grid.face_cells(face) {
-                        wet[if a == c { b } else { a }] = true;
-                    }
+        wet_cells(grid, failed, self.zero_lag)
+    }
+}
+
+/// The failed cells and, when `zero_lag`, their intact face neighbours
+/// ([`FractureFlow::wet_cells`]).
+fn wet_cells<const D: usize>(grid: &Grid<D>, failed: &[bool], zero_lag: bool) -> Vec<bool> {
+    let mut wet = failed.to_vec();
+    if zero_lag {
+        for c in (0..failed.len()).filter(|&c| failed[c]) {
+            for &face in grid.cell_faces(c) {
+                if let (a, Some(b)) = grid.face_cells(face) {
+                    wet[if a == c { b } else { a }] = true;
                 }
             }
         }
-        wet
     }
+    wet
 }
 
 /// The permeability a cell takes when it fails.
@@ -884,4 +890,32 @@ fn active_set_solve<const D: usize>(
         residual,
         tolerance: limits.tolerance,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use porofrac_grid::generate::cartesian;
+
+    #[test]
+    fn wet_cells_are_the_failed_cells_and_without_lag_their_face_neighbours() {
+        // 3 × 3 squares: the centre cell shares a face with four cells and only a
+        // corner with the other four.
+        let grid = cartesian(Point::<2>::new(0.0, 0.0), Point::<2>::new(3.0, 3.0), [3, 3]).unwrap();
+        let centre = (0..9)
+            .find(|&c| {
+                let faces = grid.cell_faces(c);
+                faces.iter().all(|&f| grid.face_cells(f).1.is_some())
+            })
+            .unwrap();
+        let mut failed = vec![false; 9];
+        failed[centre] = true;
+        assert_eq!(wet_cells(&grid, &failed, false), failed);
+        let wet = wet_cells(&grid, &failed, true);
+        assert_eq!(wet.iter().filter(|&&w| w).count(), 5);
+        for &face in grid.cell_faces(centre) {
+            let (a, b) = grid.face_cells(face);
+            assert!(wet[a] && wet[b.unwrap()]);
+        }
+    }
 }
