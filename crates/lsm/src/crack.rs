@@ -35,10 +35,10 @@
 //! two disks apart with `p w` along the current centre line `n = (x_j − x_i)/|x_j − x_i|`:
 //! `+p w n` on j and `−p w n` on i (no moment: the gap faces are normal to `n`). A crack
 //! under its own pressure loads its tip with a stress intensity that grows with its
-//! length (`K_I ∝ p √(π(a + L))` for a crack of length L from a hole of radius a), so
-//! its growth is unstable past initiation; a dry crack (pressure on the hole wall only)
-//! is loaded by the hoop stress `σ_θθ ∝ p a²/r²` alone, which falls away from the wall,
-//! and it grows stably.
+//! length (roughly `K_I ∝ p √(π(a + L))` for a crack of length L from a hole of radius
+//! a, linear elastic fracture mechanics), so it keeps growing at a rising pressure; a
+//! dry crack (pressure on the hole wall only) is loaded by the hoop stress
+//! `σ_θθ ∝ p a²/r²` alone, which falls away from the wall, and it stalls.
 
 use crate::LsmError;
 use crate::bond::BrokenBond;
