@@ -26,8 +26,23 @@
 //!
 //! The extent never decreases (bonds do not heal), and is computed incrementally with a
 //! disjoint-set forest (union by size, path halving): `O(α(n))` per broken bond.
+//!
+//! **A flooded crack** ([`CrackExtent::flood_loads`]). A fluid that follows the crack
+//! (the zero-lag limit of hydraulic fracturing) puts the hole pressure `p` on its faces.
+//! A broken bond `k` between disks `i` and `j` of the hole's component is one segment of
+//! the crack; the bond carried the normal stress `F_n/w` over its width
+//! `w = 2 min(R_i, R_j)` ([`crate::law`]), so the pressure in the opened gap pushes the
+//! two disks apart with `p w` along the current centre line `n = (x_j − x_i)/|x_j − x_i|`:
+//! `+p w n` on j and `−p w n` on i (no moment: the gap faces are normal to `n`). A crack
+//! under its own pressure loads its tip with a stress intensity that grows with its
+//! length (roughly `K_I ∝ p √(π(a + L))` for a crack of length L from a hole of radius
+//! a, linear elastic fracture mechanics), so it keeps growing at a rising pressure; a
+//! dry crack (pressure on the hole wall only) is loaded by the hoop stress
+//! `σ_θθ ∝ p a²/r²` alone, which falls away from the wall, and it stalls.
 
 use crate::LsmError;
+use crate::bond::BrokenBond;
+use porofrac_particles::Disks;
 
 /// The crack connected to a hole wall, grown one broken bond at a time (module docs).
 #[derive(Clone, Debug, PartialEq)]
@@ -109,6 +124,57 @@ impl CrackExtent {
         i < n && self.find(i) == self.find(n)
     }
 
+    /// Add to `loads` (`[f_x, f_y, torque]` per disk, N/m) the forces of the pressure `p`
+    /// (Pa) in the broken bonds `broken` that belong to the crack connected to the hole
+    /// (module docs: `±p w n`), in the configuration of `disks`; returns how many bonds
+    /// are flooded. Bonds not yet [`Self::add`]ed are not connected.
+    pub fn flood_loads(
+        &mut self,
+        disks: &Disks,
+        broken: &[BrokenBond],
+        p: f64,
+        loads: &mut [[f64; 3]],
+    ) -> Result<usize, LsmError> {
+        let n = self.parent.len() - 1;
+        if disks.len() != n || loads.len() != n {
+            return Err(LsmError::bad(
+                "loads",
+                loads.len() as f64,
+                "must have one entry per disk of the hole's packing",
+            ));
+        }
+        if !p.is_finite() {
+            return Err(LsmError::bad("p", p, "must be finite"));
+        }
+        let hole = self.find(n);
+        let mut flooded = 0;
+        for b in broken {
+            if b.i >= n || b.j >= n {
+                return Err(LsmError::bad(
+                    "broken",
+                    b.i.max(b.j) as f64,
+                    "is not the index of a disk",
+                ));
+            }
+            if self.find(b.i) != hole || self.find(b.j) != hole {
+                continue;
+            }
+            let (xi, xj) = (disks.x[b.i], disks.x[b.j]);
+            let e = [xj[0] - xi[0], xj[1] - xi[1]];
+            let d = e[0].hypot(e[1]);
+            if d == 0.0 {
+                continue;
+            }
+            let f = p * 2.0 * disks.r[b.i].min(disks.r[b.j]) / d;
+            loads[b.j][0] += f * e[0];
+            loads[b.j][1] += f * e[1];
+            loads[b.i][0] -= f * e[0];
+            loads[b.i][1] -= f * e[1];
+            flooded += 1;
+        }
+        Ok(flooded)
+    }
+
     fn find(&mut self, mut k: usize) -> usize {
         while self.parent[k] as usize != k {
             let g = self.parent[self.parent[k] as usize];
@@ -175,6 +241,55 @@ mod tests {
             assert_eq!(x.add(k, k + 1, [k as f64, 0.0]).unwrap(), 0.0);
         }
         assert!((x.add(0, 10, [2.0, 0.0]).unwrap() - 18.0).abs() < 1e-12);
+    }
+
+    /// The flooded bonds of the hole's crack push their disks apart with `p · 2 min(R)`
+    /// along the centre line; a crack not connected to the hole gets nothing.
+    #[test]
+    fn flooded_crack_pushes_its_faces_apart() {
+        use crate::bond::BreakMode;
+        let centres = [[3.0, 0.0], [4.0, 1.0], [8.0, 0.0], [9.0, 0.0]];
+        let radii = [0.5, 0.8, 0.4, 0.6];
+        let disks = Disks::new(&centres, &radii, 2600.0).unwrap();
+        let bond = |i, j| BrokenBond {
+            time: 0.0,
+            i,
+            j,
+            x: 0.5 * (centres[i][0] + centres[j][0]),
+            y: 0.5 * (centres[i][1] + centres[j][1]),
+            mode: BreakMode::Tensile,
+        };
+        let broken = [bond(0, 1), bond(2, 3)];
+        let mut x = CrackExtent::new(4, &[0], [0.0, 0.0]).unwrap();
+        for b in &broken {
+            x.add(b.i, b.j, [b.x, b.y]).unwrap();
+        }
+        let mut loads = vec![[0.0; 3]; 4];
+        let p = 2.0e6;
+        assert_eq!(x.flood_loads(&disks, &broken, p, &mut loads).unwrap(), 1);
+        // bond 0-1: w = 1.0, n = (1, 1)/√2
+        let f = p * 1.0 / 2f64.sqrt();
+        for (k, sign) in [(0, -1.0), (1, 1.0)] {
+            for c in 0..2 {
+                assert!((loads[k][c] - sign * f).abs() < 1e-9 * f, "{k} {loads:?}");
+            }
+            assert_eq!(loads[k][2], 0.0);
+        }
+        assert_eq!(loads[2], [0.0; 3]);
+        assert_eq!(loads[3], [0.0; 3]);
+        // joining 1-2 floods the far pair too: w = 0.8 along x for 2-3
+        x.add(1, 2, [6.0, 0.5]).unwrap();
+        let mut loads = vec![[0.0; 3]; 4];
+        assert_eq!(x.flood_loads(&disks, &broken, p, &mut loads).unwrap(), 2);
+        assert!((loads[3][0] - p * 0.8).abs() < 1e-9 * p && loads[3][1].abs() < 1e-9 * p);
+        let e = x
+            .flood_loads(&disks, &broken, p, &mut loads[..3])
+            .unwrap_err();
+        assert!(e.to_string().starts_with("loads"), "{e}");
+        let e = x
+            .flood_loads(&disks, &broken, f64::NAN, &mut loads)
+            .unwrap_err();
+        assert!(e.to_string().starts_with("p = NaN"), "{e}");
     }
 
     #[test]

@@ -89,6 +89,8 @@ fn wall_keys_are_checked() {
             "[loading]\npressure_rate = 1.0e7\nwall = \"wetted\"\nwall_spacing = -1.0\n",
             "loading.wall_spacing",
         ),
+        // the flooded crack needs the dry pressure wall
+        ("[loading]\nflood_cracks = true\n", "loading.flood_cracks"),
         // the extent of the wall crack needs a pressurised hole
         (
             "[[output.probe]]\nname = \"e\"\nfield = \"crack_extent\"\n",

@@ -382,6 +382,9 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
             }
             positive(ls, &key("pressure_max"), m)?;
         }
+        if l.flood_cracks && l.pressure_rate.is_none() {
+            return Err(ls.error(&key("flood_cracks"), "needs pressure_rate"));
+        }
         if l.wall != super::file::WallChoice::Rays && l.pressure_rate.is_none() {
             return Err(ls.error(&key("wall"), "needs pressure_rate"));
         }

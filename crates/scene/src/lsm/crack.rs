@@ -67,6 +67,20 @@ impl CrackLog {
         Ok(())
     }
 
+    /// Set `loads` to the forces of the pressure `p` (Pa) in the broken bonds of the crack
+    /// connected to the wall ([`CrackExtent::flood_loads`]); returns how many are
+    /// flooded. Call after [`Self::sync`].
+    pub fn flood(
+        &mut self,
+        solid: &LatticeSolid,
+        p: f64,
+        loads: &mut [[f64; 3]],
+    ) -> Result<usize, LsmError> {
+        loads.fill([0.0; 3]);
+        self.extent
+            .flood_loads(solid.disks(), solid.broken(), p, loads)
+    }
+
     /// Extent of the crack connected to the wall (m from the hole centre).
     pub fn extent(&self) -> f64 {
         self.extent.extent()

@@ -136,4 +136,9 @@ pub struct LoadingSection {
     /// `wall = "wetted"`: raster spacing (m, default half the smallest radius, the
     /// lattice spacing a fluid would need).
     pub wall_spacing: Option<f64>,
+    /// The hole pressure also acts in the broken bonds of the crack connected to the
+    /// hole wall, `p · 2 min(R_i, R_j)` pushing their disks apart (a crack the fluid
+    /// follows without lag, [`porofrac_lsm::CrackExtent::flood_loads`]; default false).
+    #[serde(default)]
+    pub flood_cracks: bool,
 }

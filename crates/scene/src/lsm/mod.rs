@@ -97,6 +97,9 @@ pub struct LsmModel<'a> {
     pressure_max: f64,
     pressure: f64,
     crack: Option<crack::CrackLog>,
+    /// `[loading] flood_cracks`: the crack's pressure loads, one entry per disk (empty
+    /// without).
+    flood: Vec<[f64; 3]>,
     calibration: Option<Calibration>,
     lsm_steps: u64,
     step_seconds: f64,
@@ -350,6 +353,11 @@ pub fn build(ls: &LoadedScene) -> Result<LsmModel<'_>, RunError> {
         pressure_max: load.pressure_max.unwrap_or(f64::INFINITY),
         pressure: 0.0,
         crack,
+        flood: if load.flood_cracks && wall.is_some() {
+            vec![[0.0; 3]; count]
+        } else {
+            Vec::new()
+        },
         calibration,
         lsm_steps: 0,
         step_seconds: 0.0,
@@ -559,9 +567,15 @@ impl Model for LsmModel<'_> {
                     .set_wall_pressure(w, self.pressure)
                     .map_err(|e| check::lsm_error(self.ls, &e))?;
             }
+            if !self.flood.is_empty()
+                && let Some(c) = &mut self.crack
+            {
+                c.flood(&self.solid, self.pressure, &mut self.flood)
+                    .map_err(|e| check::lsm_error(self.ls, &e))?;
+            }
             let r = self
                 .solid
-                .step(dt, &[])
+                .step(dt, &self.flood)
                 .map_err(|e| check::lsm_error(self.ls, &e))?;
             if r.broken > 0
                 && let Some(c) = &mut self.crack
