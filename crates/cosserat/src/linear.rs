@@ -29,14 +29,31 @@
 //! ```
 //!
 //! (computed as `x_T = u_T − (S_P + E_TT)⁻¹ E_TT u_T`, `u = P⁻¹ b`, without the product
-//! with `S_P` whose rounding the condition number of `S_P` would amplify): a dense LU with partial pivoting of the `|T| × |T|` Schur complement `S_P + E_TT` of `K`
-//! and two sparse solves with `P`. This is `K⁻¹` up to rounding; it is applied as the
-//! preconditioner of GMRES, which checks the true residual (one iteration, relative
-//! residual 1e-13 on the plate meshes). The dense part costs `O(|T|³)`, small against the
+//! with `S_P` whose rounding the condition number of `S_P` would amplify): a dense LU
+//! with partial pivoting of the `|T| × |T|` Schur complement `S_P + E_TT` of `K` and one
+//! sparse solve with `P` in two halves. With `f = L⁻¹ Π b` (the forward sweep, `Π` the
+//! elimination order), `u_T = L_TT⁻ᵀ D_T⁻¹ f_T` because `T` is eliminated last; `E x_T`
+//! is zero outside `T`, so `L⁻¹ Π (b − E x_T) = f − [0; L_TT⁻¹ E_TT x_T]`, and the backward
+//! sweep of the corrected `f` gives `x` (dense triangular solves of size `|T|` between the
+//! sweeps). This is `K⁻¹` up to rounding; it is applied as the preconditioner of GMRES,
+//! which checks the true residual. The dense part costs `O(|T|³)`, small against the
 //! sparse factorisation up to 10⁵ unknowns in 2D. [`LinearSolver::GmresLdlt`] uses the
 //! `LDLᵀ` of `P` (plain AMD) as an inexact preconditioner instead (40–43 iterations on the
 //! plate from 8,640 to 61,440 unknowns).
 //!
+//! **Mixed precision** ([`FactorPrecision`], default single). The factors of `P` are
+//! computed in `f32` ([`porofrac_sim::ldlt_single`]: the same symbolic analysis, half the
+//! bytes, twice the vector lanes; 1.5–1.7 times faster than `f64` from 61,440 unknowns on
+//! the plate); `S_P`, its LU and the sums of GMRES stay in `f64`. The solve above is then
+//! `K⁻¹` up to an error of about `κ ε₃₂` that GMRES removes: with double-precision factors
+//! one iteration reaches a relative residual of 1e-13 to 5e-13 on the plate meshes, with
+//! single-precision ones 3 to 5 iterations reach 1e-13 to 9e-13 (GMRES keeps the
+//! preconditioned vectors, so a preconditioner linear only up to rounding does not slow
+//! it). A tolerance looser than [`REFINE_TOLERANCE`] is tightened to it (within
+//! [`REFINE_ITERATIONS`] iterations), so that the solution equals the double-precision
+//! direct solve's (stress concentration factor to 1e-11). A single-precision factorisation
+//! that meets a non-positive pivot (`P` too ill-conditioned for `f32`) is redone in double.
+
 //! **Choice.** [`LinearSolver::Auto`] takes, in 2D, [`LinearSolver::LdltSchur`] below
 //! [`AUTO_GMRES_EQUATIONS`] equations (with at most [`AUTO_SCHUR_UNKNOWNS`] unknowns in
 //! `T`) and GMRES with the V-cycle above (measured in docs/BENCHMARKS.md: the factor's
