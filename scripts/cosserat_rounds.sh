@@ -7,9 +7,10 @@
 # For each O-grid level L (320 L^2 triangles, written by `plate_hole mesh L 0.216 FILE`):
 #   porofrac   crates/cosserat/examples/plate_hole.rs `run FILE ... auto` (library: assembly
 #              with the reconstruction; the solver "auto" picks the LDLT + Schur complement
-#              solve below 100,000 unknowns and GMRES with the multigrid preconditioner
-#              above), REPEAT times (default 3); once `... gmres-amg` where auto is the
-#              factorisation, and up to LU_MAX_LEVEL (default 8) `... lu` (faer sparse LU)
+#              solve, single-precision factors refined by GMRES, below 150,000 unknowns and
+#              GMRES with the multigrid preconditioner above), REPEAT times (default 3);
+#              once `... gmres-amg` where auto is the factorisation, and up to LU_MAX_LEVEL
+#              (default 8) `... lu` (faer sparse LU)
 #   command    `porofrac run` on a copy of scenes/cosserat_plate_hole.toml pointing at FILE
 #              (the user's path; times from summary.json, whole process from `date`)
 #   python-dem peers/cosserat/dem.py (the same method in numpy/scipy, spsolve)
@@ -67,7 +68,7 @@ for L in "${levels[@]}"; do
         say "# load $(cut -d' ' -f1-3 /proc/loadavg)"
         "$ex" run "$mesh" "$r" "$rl" "$n" auto 2>&1 | sed "s/^RESULT {/RESULT {\"level\": $L, /" | tee -a "$log"
     done
-    if [ "$(( 960 * L * L ))" -lt 100000 ]; then
+    if [ "$(( 960 * L * L ))" -lt 150000 ]; then
         "$ex" run "$mesh" "$r" "$rl" "$n" gmres-amg | sed "s/^RESULT {\"code\": \"porofrac\"/RESULT {\"level\": $L, \"code\": \"porofrac-gmres-amg\"/" | tee -a "$log"
     fi
     if [ "$L" -le "$lu_max" ]; then

@@ -7,7 +7,8 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use porofrac_cosserat::{
-    BodyLoads, Condition, Cosserat, LinearOptions, LinearSolver, Material, Options, constant, mesh,
+    BodyLoads, Condition, Cosserat, FactorPrecision, GmresOptions, LinearOptions, LinearSolver,
+    Material, Options, constant, mesh,
 };
 use porofrac_grid::Grid;
 
@@ -44,17 +45,21 @@ fn bench(c: &mut Criterion) {
         group.sample_size(10);
         group.bench_function("assembly", |b| b.iter(|| model(g.clone())));
         let m = model(g);
-        for solver in [
-            LinearSolver::Lu,
-            LinearSolver::GmresAmg,
-            LinearSolver::GmresLdlt,
-            LinearSolver::LdltSchur,
+        for (solver, precision, suffix) in [
+            (LinearSolver::Lu, FactorPrecision::Single, ""),
+            (LinearSolver::GmresAmg, FactorPrecision::Single, ""),
+            (LinearSolver::GmresLdlt, FactorPrecision::Single, ""),
+            (LinearSolver::LdltSchur, FactorPrecision::Single, ""),
+            (LinearSolver::LdltSchur, FactorPrecision::Double, "_double"),
         ] {
             let options = LinearOptions {
                 solver,
-                ..LinearOptions::default()
+                gmres: GmresOptions {
+                    factor_precision: precision,
+                    ..GmresOptions::default()
+                },
             };
-            group.bench_function(format!("solve_{}", solver.name()), |b| {
+            group.bench_function(format!("solve_{}{suffix}", solver.name()), |b| {
                 b.iter(|| m.solve_static_with(0.0, &options).unwrap())
             });
         }

@@ -15,15 +15,21 @@ use std::time::Instant;
 
 use porofrac_cosserat::reference::hole_scf;
 use porofrac_cosserat::{
-    BodyLoads, Condition, Cosserat, LinearOptions, LinearSolver, LinearStats, Material, Options,
-    Reconstruction, constant, mesh, strain_index,
+    BodyLoads, Condition, Cosserat, FactorPrecision, GmresOptions, LinearOptions, LinearSolver,
+    LinearStats, Material, Options, Reconstruction, constant, mesh, strain_index,
 };
 
 /// SCF of the DEM: the largest cell σ22 over the applied traction T = 1.
 pub fn scf(level: usize, r: f64, n: f64, length: f64) -> (f64, usize, f64, f64) {
     let grid =
         mesh::plate_with_hole(16.2, r, 16 * level, 10 * level, 0.1 * r / level as f64).unwrap();
-    let m = scf_on(grid, n, length, LinearSolver::Lu);
+    let m = scf_on(
+        grid,
+        n,
+        length,
+        LinearSolver::Lu,
+        FactorPrecision::default(),
+    );
     (m.scf, m.cells, m.t_asm, m.t_setup + m.t_iter)
 }
 
@@ -45,7 +51,13 @@ struct Measured {
 }
 
 /// SCF on a given quarter-plate grid.
-fn scf_on(grid: porofrac_grid::Grid<2>, n: f64, length: f64, solver: LinearSolver) -> Measured {
+fn scf_on(
+    grid: porofrac_grid::Grid<2>,
+    n: f64,
+    length: f64,
+    solver: LinearSolver,
+    precision: FactorPrecision,
+) -> Measured {
     let (g, nu) = (1e3, 0.3);
     let a = n * n / (1.0 - n * n);
     let m = Material::with_length(g, nu, a * g, length).unwrap();
@@ -72,7 +84,10 @@ fn scf_on(grid: porofrac_grid::Grid<2>, n: f64, length: f64, solver: LinearSolve
     let t_asm = t0.elapsed().as_secs_f64();
     let options = LinearOptions {
         solver,
-        ..Default::default()
+        gmres: GmresOptions {
+            factor_precision: precision,
+            ..Default::default()
+        },
     };
     let t1 = Instant::now();
     let mut lin = model
@@ -129,7 +144,8 @@ fn main() {
         return;
     }
     if args.get(1).map(String::as_str) == Some("run") {
-        let usage = "plate_hole run <path.vtu> <r> <r/l> <N> [auto|lu|gmres-amg|gmres-ldlt]";
+        let usage = "plate_hole run <path.vtu> <r> <r/l> <N> \
+                     [auto|lu|gmres-amg|gmres-ldlt|ldlt-schur] [single|double]";
         let grid = porofrac_grid::io::read_vtu::<2>(&args[2]).expect("readable 2D .vtu mesh");
         let num = |i: usize| -> f64 { args.get(i).and_then(|s| s.parse().ok()).expect(usage) };
         let (r, rl, n) = (num(3), num(4), num(5));
@@ -141,13 +157,19 @@ fn main() {
             Some("ldlt-schur") => LinearSolver::LdltSchur,
             Some(_) => panic!("{usage}"),
         };
-        let m = scf_on(grid, n, r / rl, solver);
+        let precision = match args.get(7).map(String::as_str) {
+            None | Some("single") => FactorPrecision::Single,
+            Some("double") => FactorPrecision::Double,
+            Some(_) => panic!("{usage}"),
+        };
+        let m = scf_on(grid, n, r / rl, solver, precision);
         println!(
             "RESULT {{\"code\": \"porofrac\", \"mesh\": \"{}\", \"cells\": {}, \"dofs\": {}, \
              \"nnz\": {}, \"scf\": {:.15e}, \"scf_ref\": {:.15e}, \"t_assemble\": {:.6}, \
              \"t_solve\": {:.6}, \"t_reconstruction\": {:.6}, \"t_setup\": {:.6}, \
              \"t_iterations\": {:.6}, \"iterations\": {}, \"residual\": {:.3e}, \
-             \"factor_nnz\": {}, \"solver\": \"{}\", \"peak_memory_bytes\": {}}}",
+             \"factor_nnz\": {}, \"factor_precision\": \"{}\", \"solver\": \"{}\", \
+             \"peak_memory_bytes\": {}}}",
             args[2],
             m.cells,
             3 * m.cells,
@@ -162,6 +184,11 @@ fn main() {
             m.stats.iterations,
             m.stats.max_residual,
             m.stats.factor_entries,
+            match m.stats.factor_precision {
+                None => "",
+                Some(FactorPrecision::Single) => "single",
+                Some(FactorPrecision::Double) => "double",
+            },
             m.used.name(),
             peak_memory()
         );

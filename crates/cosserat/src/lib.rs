@@ -43,7 +43,7 @@ pub use conditions::{BodyLoads, Condition, Field, Slot, constant};
 pub use discrete::{Cosserat, Options, StrainVariant};
 pub use dynamics::{Dynamics, Integrator};
 pub use error::{CosseratError, Result};
-pub use krylov::{GmresOptions, GmresStats};
+pub use krylov::{FactorPrecision, GmresOptions, GmresStats};
 pub use linear::{Linear, LinearOptions, LinearSolver, LinearStats, SystemRef};
 pub use material::{Material, components, rotations, strain_index, strain_len};
 pub use pattern::{BlockPattern, SparseLu};

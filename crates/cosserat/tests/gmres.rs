@@ -4,22 +4,23 @@
 //! * the plate with a hole (level 2, 1,280 triangles, N = 0.5, r/ℓ = 1.063): each solution
 //!   at GMRES tolerance 1e-12 equals the LU's to 1e-9 of its largest entry, the stress
 //!   concentration factor to 1e-9 relative, in fewer than 150 iterations (the multigrid),
-//!   60 (the `LDLᵀ` preconditioner) and 2 (the Schur complement solve, exact up to
-//!   rounding);
+//!   60 (the `LDLᵀ` preconditioner), 2 (the Schur complement solve with double-precision
+//!   factors, exact up to rounding) and 6 (with single-precision factors, whose error of
+//!   about `κ ε₃₂` GMRES removes);
 //! * the Newmark matrix of the same plate (a step load held for 10 steps) and of a 3D
 //!   clamped box of tetrahedra under a body force: every step converges and the states
 //!   equal the LU's to 1e-8 of their largest entry (GMRES with the multigrid and the Schur
-//!   complement solve; the latter is exact up to rounding, which on the strongly graded
-//!   level-1 plate leaves a relative residual above 1e-12 that at most 3 iterations per
-//!   step remove);
+//!   complement solve; the latter with double-precision factors is exact up to rounding,
+//!   which on the strongly graded level-1 plate leaves a relative residual above 1e-12
+//!   that at most 3 iterations per step remove, with single-precision ones at most 6);
 //! * the error path: too few iterations is [`CosseratError::NotConverged`] with the
 //!   residual reached, never a NaN.
 
 mod common;
 
 use porofrac_cosserat::{
-    BodyLoads, Condition, Cosserat, CosseratError, Dynamics, GmresOptions, Integrator,
-    LinearOptions, LinearSolver, Material, Options, constant, mesh, strain_index,
+    BodyLoads, Condition, Cosserat, CosseratError, Dynamics, FactorPrecision, GmresOptions,
+    Integrator, LinearOptions, LinearSolver, Material, Options, constant, mesh, strain_index,
 };
 use porofrac_grid::Point;
 use porofrac_grid::generate::{perturb, simplices};
@@ -51,14 +52,21 @@ fn plate(level: usize) -> Cosserat<2> {
 }
 
 fn options(solver: LinearSolver, tolerance: f64) -> LinearOptions {
+    options_in(solver, tolerance, FactorPrecision::default())
+}
+
+fn options_in(solver: LinearSolver, tolerance: f64, precision: FactorPrecision) -> LinearOptions {
     LinearOptions {
         solver,
         gmres: GmresOptions {
             tolerance,
+            factor_precision: precision,
             ..GmresOptions::default()
         },
     }
 }
+
+use FactorPrecision::{Double, Single};
 
 fn max_abs(v: &[f64]) -> f64 {
     v.iter().fold(0.0, |m, x| m.max(x.abs()))
@@ -81,28 +89,29 @@ fn plate_with_hole_gmres_equals_lu() {
         .solve_static_with(0.0, &options(LinearSolver::Lu, 1e-12))
         .unwrap();
     assert_eq!(used, LinearSolver::Lu);
-    for (solver, max_its) in [
-        (LinearSolver::GmresAmg, 150),
-        (LinearSolver::GmresLdlt, 60),
-        (LinearSolver::LdltSchur, 2),
+    for (solver, precision, max_its) in [
+        (LinearSolver::GmresAmg, Single, 150),
+        (LinearSolver::GmresLdlt, Single, 60),
+        (LinearSolver::GmresLdlt, Double, 60),
+        (LinearSolver::LdltSchur, Double, 2),
+        (LinearSolver::LdltSchur, Single, 6),
     ] {
+        let name = format!("{} {precision:?}", solver.name());
         let (gm, stats, used) = model
-            .solve_static_with(0.0, &options(solver, 1e-12))
+            .solve_static_with(0.0, &options_in(solver, 1e-12, precision))
             .unwrap();
         assert_eq!(used, solver);
+        if solver != LinearSolver::GmresAmg {
+            assert_eq!(stats.factor_precision, Some(precision));
+        }
         assert!(stats.max_residual <= 1e-12, "{stats:?}");
-        assert!(stats.iterations <= max_its, "{} {stats:?}", solver.name());
+        assert!(stats.iterations <= max_its, "{name} {stats:?}");
         let d = max_diff(&lu, &gm) / max_abs(&lu);
-        assert!(
-            d < 1e-9,
-            "{}: relative difference {d:.2e} ({stats:?})",
-            solver.name()
-        );
+        assert!(d < 1e-9, "{name}: relative difference {d:.2e} ({stats:?})");
         let (s_lu, s_gm) = (scf(&model, &lu), scf(&model, &gm));
         assert!(
             ((s_gm - s_lu) / s_lu).abs() < 1e-9,
-            "{}: SCF {s_gm} against {s_lu}",
-            solver.name()
+            "{name}: SCF {s_gm} against {s_lu}"
         );
     }
 }
@@ -151,6 +160,7 @@ fn newmark_pair<const D: usize>(
     dt: f64,
     steps: usize,
     other: LinearSolver,
+    precision: FactorPrecision,
 ) -> (Vec<f64>, Vec<f64>, usize) {
     let n = model.equations();
     let mut states = Vec::new();
@@ -163,7 +173,7 @@ fn newmark_pair<const D: usize>(
             0.0,
             vec![0.0; n],
             vec![0.0; n],
-            &options(solver, 1e-12),
+            &options_in(solver, 1e-12, precision),
         )
         .unwrap();
         assert_eq!(d.solver().unwrap().solver(), solver);
@@ -186,30 +196,38 @@ fn newmark_pair<const D: usize>(
 fn newmark_gmres_equals_lu_in_2d_and_3d() {
     // The plate: a step load; dt about a tenth of the time a shear wave takes to cross it.
     let model = plate(1);
-    for (solver, max_its) in [(LinearSolver::GmresAmg, 100), (LinearSolver::LdltSchur, 3)] {
-        let (lu, gm, its) = newmark_pair(&model, 0.05, 10, solver);
+    for (solver, precision, max_its) in [
+        (LinearSolver::GmresAmg, Single, 100),
+        (LinearSolver::LdltSchur, Double, 3),
+        (LinearSolver::LdltSchur, Single, 6),
+    ] {
+        let name = format!("{} {precision:?}", solver.name());
+        let (lu, gm, its) = newmark_pair(&model, 0.05, 10, solver, precision);
         let d = max_diff(&lu, &gm) / max_abs(&lu);
         assert!(max_abs(&lu) > 0.0);
         assert!(
             d < 1e-8,
-            "2D {}: relative difference {d:.2e} (max iterations {its})",
-            solver.name()
+            "2D {name}: relative difference {d:.2e} (max iterations {its})"
         );
-        assert!(its <= max_its, "2D {}: {its} iterations", solver.name());
+        assert!(its <= max_its, "2D {name}: {its} iterations");
     }
 
     // 3D: a clamped perturbed box of tetrahedra under gravity.
     let model = clamped_box();
-    for (solver, max_its) in [(LinearSolver::GmresAmg, 100), (LinearSolver::LdltSchur, 3)] {
-        let (lu, gm, its) = newmark_pair(&model, 5e-3, 10, solver);
+    for (solver, precision, max_its) in [
+        (LinearSolver::GmresAmg, Single, 100),
+        (LinearSolver::LdltSchur, Double, 3),
+        (LinearSolver::LdltSchur, Single, 6),
+    ] {
+        let name = format!("{} {precision:?}", solver.name());
+        let (lu, gm, its) = newmark_pair(&model, 5e-3, 10, solver, precision);
         let d = max_diff(&lu, &gm) / max_abs(&lu);
         assert!(max_abs(&lu) > 0.0);
         assert!(
             d < 1e-8,
-            "3D {}: relative difference {d:.2e} (max iterations {its})",
-            solver.name()
+            "3D {name}: relative difference {d:.2e} (max iterations {its})"
         );
-        assert!(its <= max_its, "3D {}: {its} iterations", solver.name());
+        assert!(its <= max_its, "3D {name}: {its} iterations");
     }
 }
 

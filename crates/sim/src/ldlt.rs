@@ -458,6 +458,43 @@ impl Ldlt {
     }
 }
 
+/// The symbolic analysis, for numeric factors in another precision
+/// ([`crate::ldlt_single`]).
+impl Ldlt {
+    pub(crate) fn symbolic(&self) -> &SymbolicCholesky<usize> {
+        &self.symbolic
+    }
+}
+
+/// The two halves of a solve and the trailing block of the factors, public for a solver
+/// that corrects the unknowns eliminated last between the halves (see
+/// [`crate::ldlt_single::TrailingFactor`]).
+impl Ldlt {
+    /// `rhs ← L⁻¹ P rhs` (on return in the elimination order). Counts as a solve.
+    pub fn forward_solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LdltError> {
+        self.forward_in_place(rhs)
+    }
+
+    /// `rhs ← Pᵀ L⁻ᵀ D⁻¹ rhs` (`rhs` in the elimination order on entry, as
+    /// [`Ldlt::forward_solve_in_place`] left it).
+    pub fn backward_solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LdltError> {
+        self.backward_in_place(rhs)
+    }
+
+    /// The last `k` columns of the factors, dense.
+    pub fn trailing_factor(
+        &self,
+        k: usize,
+    ) -> Result<crate::ldlt_single::TrailingFactor, LdltError> {
+        if !self.factored {
+            return Err(LdltError(
+                "trailing factor before a successful factorization".into(),
+            ));
+        }
+        crate::ldlt_single::TrailingFactor::from_supernodal(&self.symbolic, &self.values, k)
+    }
+}
+
 /// The two halves of a solve, for a solver that changes the vector between them
 /// (`crate::lowrank`): `f = L⁻¹ P b` and `x = Pᵀ L⁻ᵀ D⁻¹ f`, `f` in the elimination
 /// order; and `L⁻¹ P e_u` for unit vectors, which is zero outside the supernodes on the

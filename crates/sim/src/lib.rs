@@ -54,6 +54,7 @@ pub mod fracturing;
 pub mod heap;
 pub mod laws;
 pub mod ldlt;
+pub mod ldlt_single;
 pub mod linear;
 mod lowrank;
 pub mod ordering;

@@ -31,27 +31,33 @@ pub fn sample<const D: usize>(grid: &Grid<D>, exact: impl Fn(&Point<D>) -> Vec<f
 
 /// The static solution by the sparse LU, after checking that GMRES with the multigrid
 /// preconditioner, GMRES with the `LDLᵀ` preconditioner and the `LDLᵀ` + Schur complement
-/// solve (each with GMRES at tolerance 1e-12) converge on the same system and give the same
-/// solution to 1e-8 of its largest entry.
+/// solve (the last two with single- and double-precision factors; each with GMRES at
+/// tolerance 1e-12) converge on the same system and give the same solution to 1e-8 of its
+/// largest entry.
 pub fn solve_checked<const D: usize>(model: &porofrac_cosserat::Cosserat<D>) -> Vec<f64> {
-    use porofrac_cosserat::{GmresOptions, LinearOptions, LinearSolver};
-    let opts = |solver| LinearOptions {
+    use porofrac_cosserat::{FactorPrecision, GmresOptions, LinearOptions, LinearSolver};
+    let opts = |solver, factor_precision| LinearOptions {
         solver,
         gmres: GmresOptions {
             tolerance: 1e-12,
+            factor_precision,
             ..GmresOptions::default()
         },
     };
     let (lu, _, _) = model
-        .solve_static_with(0.0, &opts(LinearSolver::Lu))
+        .solve_static_with(0.0, &opts(LinearSolver::Lu, FactorPrecision::Double))
         .unwrap();
     let scale = lu.iter().fold(0.0f64, |m, x| m.max(x.abs())).max(1e-300);
-    for solver in [
-        LinearSolver::GmresAmg,
-        LinearSolver::GmresLdlt,
-        LinearSolver::LdltSchur,
+    for (solver, precision) in [
+        (LinearSolver::GmresAmg, FactorPrecision::Single),
+        (LinearSolver::GmresLdlt, FactorPrecision::Single),
+        (LinearSolver::GmresLdlt, FactorPrecision::Double),
+        (LinearSolver::LdltSchur, FactorPrecision::Single),
+        (LinearSolver::LdltSchur, FactorPrecision::Double),
     ] {
-        let (gm, stats, used) = model.solve_static_with(0.0, &opts(solver)).unwrap();
+        let (gm, stats, used) = model
+            .solve_static_with(0.0, &opts(solver, precision))
+            .unwrap();
         assert_eq!(used, solver);
         let d = lu
             .iter()
@@ -59,7 +65,7 @@ pub fn solve_checked<const D: usize>(model: &porofrac_cosserat::Cosserat<D>) -> 
             .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
         assert!(
             d <= 1e-8 * scale && stats.max_residual <= 1e-12,
-            "{} against LU: {d:.2e} of {scale:.2e}, {stats:?}",
+            "{} {precision:?} against LU: {d:.2e} of {scale:.2e}, {stats:?}",
             solver.name()
         );
     }
