@@ -1260,6 +1260,10 @@ impl<const D: usize> BiotCoupling<D> for Monolithic {
                 accumulation: sys.flow.accumulation().to_vec(),
             });
         }
+        // The scale of the matrix now factorized or updated: a new factorization takes
+        // the scale of the new matrix, and the pressure rows of the right-hand side and
+        // the pressure of the solution must use that very scale.
+        let s = self.s;
         let (nm, nc) = (self.nm, sys.num_cells());
         let t1 = t + dt;
         let mut w = std::mem::take(&mut self.work);
