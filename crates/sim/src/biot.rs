@@ -1137,11 +1137,11 @@ impl Monolithic {
 /// factors (`crate::lowrank`) rather than factorized: each new unknown costs a forward
 /// sweep over its path of the elimination tree, every solve a plain one plus a dense
 /// `m × m` solve and `2m` vector updates over the paths, and refinement steps as the
-/// update grows. 60 keeps the answer of a factorization at every 60 changed unknowns
-/// on the hydraulic-fracture scenes; on the 3D scene (40 min) 150, 240 or 503 take
-/// 68–73 s of CPU against 94 s (fewer factorizations, more refinement steps), with the
-/// same failures but the well pressure 1.1e-4 apart from t = 1200 s (docs/BENCHMARKS.md).
-const DEFAULT_MAX_RANK: usize = 60;
+/// update grows. On the 3D hydraulic-fracture scene (40 min) 240 factorizes a few times
+/// instead of 45 (bound 60) for the same answer (docs/BENCHMARKS.md); the answer once
+/// depended on the bound only through the scale of the right-hand side after a
+/// factorization, now that of the new factors.
+const DEFAULT_MAX_RANK: usize = 240;
 
 /// Relative residual a low-rank solve is refined to (that of a fresh factorization on
 /// the hydraulic-fracture scenes, 1e-13 to 1e-12).
@@ -1260,6 +1260,10 @@ impl<const D: usize> BiotCoupling<D> for Monolithic {
                 accumulation: sys.flow.accumulation().to_vec(),
             });
         }
+        // The scale of the matrix now factorized or updated: a new factorization takes
+        // the scale of the new matrix, and the pressure rows of the right-hand side and
+        // the pressure of the solution must use that very scale.
+        let s = self.s;
         let (nm, nc) = (self.nm, sys.num_cells());
         let t1 = t + dt;
         let mut w = std::mem::take(&mut self.work);
