@@ -35,7 +35,8 @@
 //!   fractured cell within one cell size of it, cells in both layers, reaching at least
 //!   0.5 m from the axis. Here the far field puts the wall in tension before injection
 //!   (Kirsch: `3σxx − σyy = +3e6 Pa` at the top and bottom), so cells may fail at t = 0,
-//!   but only in that band; the first failures touch the well.
+//!   but only in that band; the first failures touch the well. The bundled scene
+//!   (1/8 m, 40 minutes) passes the same plane test (ignored for its run time).
 //! * **Monolithic against explicit pressure** (seed §2.5), where both apply: on the
 //!   seed's soft well the staggered explicit update diverges (coupling strength
 //!   `α²/(φ c_f K)` ≈ 30, docs/BENCHMARKS.md). With a well as stiff as the rock, a fluid
@@ -422,6 +423,28 @@ fn fractures_3d(out: &Path) -> Vec<[f64; 4]> {
         .collect()
 }
 
+/// One plane: every fractured cell of `f` within `cell` of the plane x = 15 through the
+/// well's axis normal to x (the least compressive stress), over the height (cells in both
+/// layers), and the crack reaching `min_reach` from the axis.
+fn assert_one_plane(f: &[[f64; 4]], cell: f64, min_reach: f64) {
+    for p in f {
+        let off = (p[0] - CENTER[0]).abs();
+        assert!(
+            off <= cell,
+            "fractured cell at {p:?} is {off} m off the plane (cell {cell})"
+        );
+    }
+    assert!(f.iter().any(|p| p[2] < 0.5) && f.iter().any(|p| p[2] > 0.5));
+    let reach = f
+        .iter()
+        .map(|p| distance_to_well(&[p[0], p[1], 0.0]))
+        .fold(0.0, f64::max);
+    assert!(
+        reach >= min_reach,
+        "the crack reaches only {reach} m from the axis"
+    );
+}
+
 #[test]
 fn three_d_fracture_is_the_vertical_plane_normal_to_the_least_compressive_stress() {
     let dir = tmp_dir("hydrofrac-3d");
@@ -468,25 +491,7 @@ fn three_d_fracture_is_the_vertical_plane_normal_to_the_least_compressive_stress
             "first failure at {p:?}, {r} m from the axis"
         );
     }
-    // One plane: every fractured cell within one cell size of the plane x = 15 through
-    // the well's axis normal to x (the least compressive stress), over the height: cells
-    // in both layers, and the crack reaching 0.5 m from the axis.
-    for p in &f {
-        let off = (p[0] - CENTER[0]).abs();
-        assert!(
-            off <= cell,
-            "fractured cell at {p:?} is {off} m off the plane (cell {cell})"
-        );
-    }
-    assert!(f.iter().any(|p| p[2] < 0.5) && f.iter().any(|p| p[2] > 0.5));
-    let reach = f
-        .iter()
-        .map(|p| distance_to_well(&[p[0], p[1], 0.0]))
-        .fold(0.0, f64::max);
-    assert!(
-        reach >= 0.5,
-        "the crack reaches only {reach} m from the axis"
-    );
+    assert_one_plane(&f, cell, 0.5);
     // Fields on the mid-height cross-section.
     for plot in ["pressure", "uz", "szz", "smax"] {
         assert!(
@@ -494,6 +499,19 @@ fn three_d_fracture_is_the_vertical_plane_normal_to_the_least_compressive_stress
             "{plot}"
         );
     }
+}
+
+/// The bundled 3D scene to 40 minutes (a minute or more of run time, hence ignored; it
+/// passes): one plane over the whole injection, the crack reaching 1 m from the axis.
+#[test]
+#[ignore = "runs the bundled 3D scene to 40 minutes (over a minute)"]
+fn three_d_bundled_scene_is_one_plane_for_forty_minutes() {
+    let dir = tmp_dir("hydrofrac-3d-full");
+    let out = dir.join("out");
+    run_ok(&root().join("scenes/hydrofrac_3d.toml"), &out);
+    let f = fractures_3d(&out);
+    assert!(f.len() >= 100, "only {} cells failed", f.len());
+    assert_one_plane(&f, 2f64.sqrt() / 8.0, 1.0);
 }
 
 #[test]
