@@ -255,6 +255,53 @@ impl LowRank {
     }
 }
 
+impl LowRank {
+    /// `Σ_{u ∈ T} r_u²`: the part of the residual `r` on the support of the change.
+    pub(crate) fn support_norm2(&self, r: &[f64]) -> f64 {
+        self.support.iter().map(|&u| r[u] * r[u]).sum()
+    }
+
+    /// Solve `A x = r` in place for a right-hand side that is zero outside the support
+    /// `T` of the change (only `r_T` is read): with `A⁻¹ P = A₀⁻¹ P (I + Δ G)⁻¹`
+    /// (push-through of the capacitance form) and `A₀⁻¹ P c = Πᵀ L⁻ᵀ D⁻¹ Σ_u c_u v_u`,
+    ///
+    /// ```text
+    ///   (I + Δ G) c = r_T ,      x = Πᵀ L⁻ᵀ D⁻¹ Σ_u c_u v_u ,
+    /// ```
+    ///
+    /// a solve with the transposed capacitance matrix, `m` vector updates over the paths
+    /// and one backward sweep (no forward sweep). The residual of an updated solve is
+    /// of this kind: its error is that of `y` (the capacitance matrix is formed from `G`
+    /// with rounding and can be ill-conditioned), `A (A₀⁻¹ P Δ δy) = P (I + Δ G) Δ δy`.
+    /// Plainly with `A₀` when no change is set up.
+    pub(crate) fn solve_on_support(
+        &mut self,
+        ldlt: &mut Ldlt,
+        rhs: &mut [f64],
+    ) -> Result<(), LdltError> {
+        let Some(lu) = &self.lu else {
+            return ldlt.solve_in_place(rhs);
+        };
+        let n = rhs.len();
+        let mut c = Mat::<f64>::from_fn(self.support.len(), 1, |i, _| rhs[self.support[i]]);
+        lu.solve_transpose_in_place(c.as_mut());
+        rhs.fill(0.0);
+        for (i, &u) in self.support.iter().enumerate() {
+            let ci = c[(i, 0)];
+            if ci != 0.0 {
+                let a = self.slot[u];
+                let v = &self.w[a * n..(a + 1) * n];
+                for r in &self.paths[a] {
+                    for (x, vi) in rhs[r.clone()].iter_mut().zip(&v[r.clone()]) {
+                        *x += ci * vi;
+                    }
+                }
+            }
+        }
+        ldlt.backward_in_place(rhs)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
