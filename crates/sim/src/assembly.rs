@@ -770,6 +770,14 @@ mod tests {
         map.set_law(&grid, 4, 2).unwrap();
         let after = run(&map, Some(&cache));
         assert!(same(&after, &run(&map, None)));
+        // The sum over the new set was formed from the last one where cells 3 and 4
+        // scatter: the bits of a full sum (that of a cache built for the new laws).
+        let full = |map: &LawMap<'_, 2>| {
+            ElementCache::new(&grid, map)
+                .unwrap()
+                .kept_sum(&grid, map, &dofs, &pattern)
+        };
+        assert_eq!(*cache.kept_sum(&grid, &map, &dofs, &pattern), *full(&map));
         let big = before.0.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         let dv = after
             .0
@@ -780,6 +788,7 @@ mod tests {
         map.set_law(&grid, 3, 1).unwrap();
         map.set_law(&grid, 4, 1).unwrap();
         assert!(same(&before, &run(&map, Some(&cache))));
+        assert_eq!(*cache.kept_sum(&grid, &map, &dofs, &pattern), *full(&map));
         assert!(after.0.iter().chain(&after.1).all(|x| x.is_finite()));
     }
 }

@@ -391,6 +391,21 @@ mod tests {
                 .map(|(a, b)| (a - b).abs())
                 .fold(0.0, f64::max);
             assert!(err < 1e-12, "round {round}: residual {err:e}");
+            // A right-hand side on the changed unknowns only: one backward sweep.
+            let mut r = vec![0.0; n];
+            for (k, &u) in lr.support.iter().enumerate() {
+                r[u] = b[u] + k as f64;
+            }
+            let mut x = r.clone();
+            x[0] = 1e30; // not read
+            lr.solve_on_support(&mut ldlt, &mut x).unwrap();
+            let ax = mul(n, &cp, &ri, &changed, &x);
+            let err = ax
+                .iter()
+                .zip(&r)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            assert!(err < 1e-12, "round {round}: support residual {err:e}");
         }
         assert!(lr.cached_len() > 4);
         // Too many unknowns: nothing set up, a plain solve with A₀.
