@@ -255,6 +255,53 @@ impl LowRank {
     }
 }
 
+impl LowRank {
+    /// `Σ_{u ∈ T} r_u²`: the part of the residual `r` on the support of the change.
+    pub(crate) fn support_norm2(&self, r: &[f64]) -> f64 {
+        self.support.iter().map(|&u| r[u] * r[u]).sum()
+    }
+
+    /// Solve `A x = r` in place for a right-hand side that is zero outside the support
+    /// `T` of the change (only `r_T` is read): with `A⁻¹ P = A₀⁻¹ P (I + Δ G)⁻¹`
+    /// (push-through of the capacitance form) and `A₀⁻¹ P c = Πᵀ L⁻ᵀ D⁻¹ Σ_u c_u v_u`,
+    ///
+    /// ```text
+    ///   (I + Δ G) c = r_T ,      x = Πᵀ L⁻ᵀ D⁻¹ Σ_u c_u v_u ,
+    /// ```
+    ///
+    /// a solve with the transposed capacitance matrix, `m` vector updates over the paths
+    /// and one backward sweep (no forward sweep). The residual of an updated solve is
+    /// of this kind: its error is that of `y` (the capacitance matrix is formed from `G`
+    /// with rounding and can be ill-conditioned), `A (A₀⁻¹ P Δ δy) = P (I + Δ G) Δ δy`.
+    /// Plainly with `A₀` when no change is set up.
+    pub(crate) fn solve_on_support(
+        &mut self,
+        ldlt: &mut Ldlt,
+        rhs: &mut [f64],
+    ) -> Result<(), LdltError> {
+        let Some(lu) = &self.lu else {
+            return ldlt.solve_in_place(rhs);
+        };
+        let n = rhs.len();
+        let mut c = Mat::<f64>::from_fn(self.support.len(), 1, |i, _| rhs[self.support[i]]);
+        lu.solve_transpose_in_place(c.as_mut());
+        rhs.fill(0.0);
+        for (i, &u) in self.support.iter().enumerate() {
+            let ci = c[(i, 0)];
+            if ci != 0.0 {
+                let a = self.slot[u];
+                let v = &self.w[a * n..(a + 1) * n];
+                for r in &self.paths[a] {
+                    for (x, vi) in rhs[r.clone()].iter_mut().zip(&v[r.clone()]) {
+                        *x += ci * vi;
+                    }
+                }
+            }
+        }
+        ldlt.backward_in_place(rhs)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -344,6 +391,21 @@ mod tests {
                 .map(|(a, b)| (a - b).abs())
                 .fold(0.0, f64::max);
             assert!(err < 1e-12, "round {round}: residual {err:e}");
+            // A right-hand side on the changed unknowns only: one backward sweep.
+            let mut r = vec![0.0; n];
+            for (k, &u) in lr.support.iter().enumerate() {
+                r[u] = b[u] + k as f64;
+            }
+            let mut x = r.clone();
+            x[0] = 1e30; // not read
+            lr.solve_on_support(&mut ldlt, &mut x).unwrap();
+            let ax = mul(n, &cp, &ri, &changed, &x);
+            let err = ax
+                .iter()
+                .zip(&r)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            assert!(err < 1e-12, "round {round}: support residual {err:e}");
         }
         assert!(lr.cached_len() > 4);
         // Too many unknowns: nothing set up, a plain solve with A₀.
