@@ -376,8 +376,26 @@ impl TrailingFactor {
     /// The Schur complement `L₂₂ D₂ L₂₂ᵀ`, dense column-major `k × k` (its lower triangle
     /// by faer's triangular product, mirrored).
     pub fn schur_complement(&self, par: Par) -> Vec<f64> {
+        let k = self.k;
+        let mut out = vec![0.0; k * k];
+        self.schur_complement_into(MatMut::from_column_major_slice_mut(&mut out, k, k), par);
+        out
+    }
+
+    /// [`Self::schur_complement`] into `out` (`k × k`, any strides), without allocating
+    /// it.
+    ///
+    /// # Panics
+    /// When `out` is not `k × k`.
+    pub fn schur_complement_into(&self, mut out: MatMut<'_, f64>, par: Par) {
         use faer::linalg::matmul::triangular::{BlockStructure, matmul};
         let k = self.k;
+        assert!(
+            out.nrows() == k && out.ncols() == k,
+            "Schur complement of {k} unknowns into a {} × {} matrix",
+            out.nrows(),
+            out.ncols()
+        );
         let l = faer::MatRef::from_column_major_slice(&self.l, k, k);
         let mut ld = l.to_owned();
         for (j, &dj) in self.d.iter().enumerate() {
@@ -385,9 +403,8 @@ impl TrailingFactor {
                 *v *= dj;
             }
         }
-        let mut out = vec![0.0; k * k];
         matmul(
-            MatMut::from_column_major_slice_mut(&mut out, k, k),
+            out.as_mut(),
             BlockStructure::TriangularLower,
             faer::Accum::Replace,
             ld.as_ref(),
@@ -399,10 +416,9 @@ impl TrailingFactor {
         );
         for j in 0..k {
             for i in j + 1..k {
-                out[i * k + j] = out[j * k + i];
+                out[(j, i)] = out[(i, j)];
             }
         }
-        out
     }
 }
 
