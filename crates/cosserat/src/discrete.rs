@@ -236,7 +236,7 @@ impl<const D: usize> Cosserat<D> {
         let in_t = me.schur_candidates();
         let mut values = std::mem::take(&mut me.symmetric);
         let (prepared, ()) = rayon::join(
-            || in_t.and_then(|t| SchurAnalysis::new(&me.pattern, t).ok()),
+            || in_t.and_then(|t| SchurAnalysis::new(&me.pattern, t, true).ok()),
             || {
                 // Touch the fresh pages once, sequentially: page faults taken by two
                 // threads at once were measured slower than the whole assembly.

@@ -306,15 +306,19 @@ impl Factor {
     /// factorization that fails (a non-positive pivot: too ill-conditioned for `f32`) is
     /// redone in double precision.
     fn new(
-        analysis: Ldlt,
+        analysis: Prepared,
         upper: (&[usize], &[usize], &[f64]),
         precision: FactorPrecision,
     ) -> std::result::Result<Self, LdltError> {
         let (c, r, v) = upper;
-        let mut ldlt = match precision {
-            FactorPrecision::Double => analysis,
-            FactorPrecision::Single => {
-                let mut single = LdltSingle::new(analysis);
+        let mut ldlt = match (precision, analysis) {
+            (FactorPrecision::Double, Prepared::Analysis(a)) => a,
+            (FactorPrecision::Double, Prepared::Single(s)) => s.into_analysis(),
+            (FactorPrecision::Single, analysis) => {
+                let mut single = match analysis {
+                    Prepared::Analysis(a) => LdltSingle::new(a),
+                    Prepared::Single(s) => s,
+                };
                 match single.factorize(c, r, v, true) {
                     Ok(()) => return Ok(Self::Single(single)),
                     Err(_) => single.into_analysis(),
@@ -396,7 +400,15 @@ pub struct SchurAnalysis {
     in_t: Vec<bool>,
     /// The unknowns of `T` in the elimination order.
     tail: Vec<usize>,
-    analysis: Ldlt,
+    /// The analysis, or the single-precision factors with their memory reserved.
+    analysis: Prepared,
+}
+
+/// The symbolic analysis of [`SchurAnalysis`], possibly inside single-precision factors
+/// whose memory is already allocated ([`LdltSingle::reserve`]).
+enum Prepared {
+    Analysis(Ldlt),
+    Single(LdltSingle),
 }
 
 impl std::fmt::Debug for SchurAnalysis {
@@ -409,8 +421,9 @@ impl std::fmt::Debug for SchurAnalysis {
 }
 
 impl SchurAnalysis {
-    /// The analysis of `pattern` with the unknowns marked in `in_t` eliminated last.
-    pub fn new(pattern: &BlockPattern, in_t: Vec<bool>) -> Result<Self> {
+    /// The analysis of `pattern` with the unknowns marked in `in_t` eliminated last; with
+    /// `reserve`, also the memory of single-precision factors (allocated and touched).
+    pub fn new(pattern: &BlockPattern, in_t: Vec<bool>, reserve: bool) -> Result<Self> {
         let n = pattern.equations();
         if in_t.len() != n {
             return Err(CosseratError::Input {
@@ -439,6 +452,15 @@ impl SchurAnalysis {
                 "LDLᵀ: the boundary unknowns are not eliminated last".into(),
             ));
         }
+        let analysis = if reserve {
+            let mut single = LdltSingle::new(analysis);
+            single
+                .reserve()
+                .map_err(|e| CosseratError::Solve(format!("LDLᵀ: {e}")))?;
+            Prepared::Single(single)
+        } else {
+            Prepared::Analysis(analysis)
+        };
         Ok(Self {
             in_t,
             tail,
@@ -650,7 +672,7 @@ impl Linear {
                     let in_t = in_t.take().unwrap_or_else(|| schur_unknowns(sys));
                     match prepared {
                         Some(a) if a.in_t == in_t => PrecondKind::Schur(a),
-                        _ => PrecondKind::Schur(SchurAnalysis::new(sys.pattern, in_t)?),
+                        _ => PrecondKind::Schur(SchurAnalysis::new(sys.pattern, in_t, false)?),
                     }
                 };
                 let g = Gmres::new(sys, options.gmres, kind)?;
@@ -880,7 +902,7 @@ impl Gmres {
                     let analysis =
                         Ldlt::analyse(n, full.0, full.1, Some(&perm)).map_err(ldlt_err)?;
                     let f =
-                        Factor::new(analysis, full, options.factor_precision).map_err(ldlt_err)?;
+                        Factor::new(Prepared::Analysis(analysis), full, options.factor_precision).map_err(ldlt_err)?;
                     Precond::Ldlt(Box::new(f))
                 }
                 PrecondKind::Schur(analysis) => Precond::Schur(Box::new(Schur::new(
