@@ -36,7 +36,11 @@
 //! is zero outside `T`, so `L⁻¹ Π (b − E x_T) = f − [0; L_TT⁻¹ E_TT x_T]`, and the backward
 //! sweep of the corrected `f` gives `x` (dense triangular solves of size `|T|` between the
 //! sweeps). This is `K⁻¹` up to rounding; it is applied as the preconditioner of GMRES,
-//! which checks the true residual. The dense part costs `O(|T|³)`, small against the
+//! which checks the true residual (products with `K` by columns, on a copy of its
+//! values: the few iterations do not pay for a row form). The elimination order and the
+//! symbolic analysis depend only on the pattern and on `T`: [`crate::Cosserat::new`]
+//! computes them ([`SchurAnalysis`]) on a second thread while it assembles the values, and
+//! allocates the factor there, so that the set-up is the numeric factorisation alone. The dense part costs `O(|T|³)`, small against the
 //! sparse factorisation up to 10⁵ unknowns in 2D. [`LinearSolver::GmresLdlt`] uses the
 //! `LDLᵀ` of `P` (plain AMD) as an inexact preconditioner instead (40–43 iterations on the
 //! plate from 8,640 to 61,440 unknowns).
@@ -902,7 +906,8 @@ impl Gmres {
                     let analysis =
                         Ldlt::analyse(n, full.0, full.1, Some(&perm)).map_err(ldlt_err)?;
                     let f =
-                        Factor::new(Prepared::Analysis(analysis), full, options.factor_precision).map_err(ldlt_err)?;
+                        Factor::new(Prepared::Analysis(analysis), full, options.factor_precision)
+                            .map_err(ldlt_err)?;
                     Precond::Ldlt(Box::new(f))
                 }
                 PrecondKind::Schur(analysis) => Precond::Schur(Box::new(Schur::new(

@@ -130,15 +130,12 @@ impl BlockPattern {
                     continue;
                 }
                 let stride = self.column_len(c);
-                for (ri, &r) in cells.iter().enumerate() {
+                for (ri, pos) in self.column_positions(c, cells).enumerate() {
                     let mv = local[cj * nl + ri];
                     if mv == 0.0 {
                         continue;
                     }
-                    let pos = self
-                        .position(r, c)
-                        .expect("local cells couple by construction")
-                        - offset;
+                    let pos = pos - offset;
                     for b in 0..n {
                         let dst = &mut chunk[pos + b * stride..pos + b * stride + n];
                         for (d, &qv) in dst.iter_mut().zip(&q[b * n..(b + 1) * n]) {
@@ -155,11 +152,8 @@ impl BlockPattern {
                 continue;
             }
             let stride = self.column_len(c);
-            for (ri, &r) in cells.iter().enumerate() {
-                let pos = self
-                    .position(r, c)
-                    .expect("local cells couple by construction")
-                    - offset;
+            for (ri, pos) in self.column_positions(c, cells).enumerate() {
+                let pos = pos - offset;
                 for b in 0..n {
                     let col = (cj * n + b) * m + ri * n;
                     let dst = pos + b * stride;
@@ -169,6 +163,31 @@ impl BlockPattern {
                 }
             }
         }
+    }
+
+    /// [`Self::position`] of the blocks (row cell `r`, column cell `c`) for the sorted
+    /// row cells `rows`, by one walk along the column's cells.
+    ///
+    /// # Panics
+    /// When a row cell does not couple with `c` (the local cells of an element always do).
+    fn column_positions<'a>(
+        &'a self,
+        c: usize,
+        rows: &'a [usize],
+    ) -> impl Iterator<Item = usize> + 'a {
+        let nb = &self.cells[self.nbr_pos[c]..self.nbr_pos[c + 1]];
+        let base = self.nbr_pos[c] * self.block * self.block;
+        let mut p = 0;
+        rows.iter().map(move |&r| {
+            while p < nb.len() && nb[p] < r {
+                p += 1;
+            }
+            assert!(
+                p < nb.len() && nb[p] == r,
+                "local cells couple by construction"
+            );
+            base + p * self.block
+        })
     }
 
     /// Positions of the diagonal entries, one per equation.

@@ -118,8 +118,7 @@ impl LdltSingle {
             let req = symbolic
                 .factorize_numeric_ldlt_scratch::<f32>(self.par, Default::default())
                 .or(symbolic.solve_in_place_scratch::<f32>(1, Par::Seq));
-            let mut mem =
-                MemBuffer::try_new(req).map_err(|_| LdltError("out of memory".into()))?;
+            let mut mem = MemBuffer::try_new(req).map_err(|_| LdltError("out of memory".into()))?;
             for b in mem.iter_mut().step_by(4096) {
                 b.write(0);
             }
@@ -578,6 +577,74 @@ mod tests {
 
     fn max_abs(v: &[f64]) -> f64 {
         v.iter().fold(0.0, |m, x| m.max(x.abs()))
+    }
+
+    /// Both triangles of the matrix from its upper triangle (CSC, sorted rows).
+    fn mirrored(
+        n: usize,
+        col_ptr: &[usize],
+        row_idx: &[usize],
+        vals: &[f64],
+    ) -> (Vec<usize>, Vec<usize>, Vec<f64>) {
+        let mut cols: Vec<Vec<(usize, f64)>> = vec![Vec::new(); n];
+        for j in 0..n {
+            for q in col_ptr[j]..col_ptr[j + 1] {
+                let i = row_idx[q];
+                cols[j].push((i, vals[q]));
+                if i != j {
+                    cols[i].push((j, vals[q]));
+                }
+            }
+        }
+        let (mut cp, mut ri, mut va) = (vec![0], Vec::new(), Vec::new());
+        for mut c in cols {
+            c.sort_by_key(|e| e.0);
+            ri.extend(c.iter().map(|e| e.0));
+            va.extend(c.iter().map(|e| e.1));
+            cp.push(ri.len());
+        }
+        (cp, ri, va)
+    }
+
+    /// The whole symmetric matrix in place of its upper triangle (only the upper triangle
+    /// is read), memory reserved before the factorization, and the Schur complement
+    /// written into a given matrix: bitwise the same results.
+    #[test]
+    fn whole_matrix_reserve_and_schur_into_change_nothing() {
+        let (n, col_ptr, row_idx, vals) = spd(10);
+        let (fc, fr, fv) = mirrored(n, &col_ptr, &row_idx, &vals);
+        assert!(fr.len() > row_idx.len());
+        let b: Vec<f64> = (0..n).map(|i| ((i * 5) % 7) as f64 - 3.0).collect();
+        let mut upper = LdltSingle::new(Ldlt::analyse(n, &col_ptr, &row_idx, None).unwrap());
+        upper.factorize(&col_ptr, &row_idx, &vals, true).unwrap();
+        let mut whole = LdltSingle::new(Ldlt::analyse(n, &fc, &fr, None).unwrap());
+        whole.reserve().unwrap();
+        whole.factorize(&fc, &fr, &fv, true).unwrap();
+        assert_eq!(whole.permutation(), upper.permutation());
+        let (mut x, mut y) = (b.clone(), b.clone());
+        upper.solve_in_place(&mut x).unwrap();
+        whole.solve_in_place(&mut y).unwrap();
+        assert_eq!(x, y);
+        let m = 9;
+        let t = whole.trailing_factor(m).unwrap();
+        let s = t.schur_complement(Par::Seq);
+        let mut into = faer::Mat::<f64>::zeros(m, m);
+        t.schur_complement_into(into.as_mut(), Par::Seq);
+        for j in 0..m {
+            for i in 0..m {
+                assert_eq!(into[(i, j)], s[j * m + i]);
+                assert_eq!(into[(i, j)], into[(j, i)]);
+            }
+        }
+        let mut double = Ldlt::analyse(n, &fc, &fr, None).unwrap();
+        double.factorize(&fc, &fr, &fv).unwrap();
+        let mut z = b.clone();
+        double.solve_in_place(&mut z).unwrap();
+        let mut w = b.clone();
+        let mut reference = Ldlt::analyse(n, &col_ptr, &row_idx, None).unwrap();
+        reference.factorize(&col_ptr, &row_idx, &vals).unwrap();
+        reference.solve_in_place(&mut w).unwrap();
+        assert_eq!(z, w);
     }
 
     /// The single-precision solve is the double-precision one to `f32` accuracy (10⁻⁵ of
