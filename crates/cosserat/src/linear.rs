@@ -305,7 +305,8 @@ enum Factor {
 }
 
 impl Factor {
-    /// Factorise the upper triangle `(col_ptr, row_idx, values)` of the symmetric positive
+    /// Factorise the upper triangle of `(col_ptr, row_idx, values)` (the whole matrix or
+    /// its upper triangle: only that is read) of the symmetric positive
     /// definite matrix analysed in `analysis`, in `precision`; a single-precision
     /// factorization that fails (a non-positive pivot: too ill-conditioned for `f32`) is
     /// redone in double precision.
@@ -675,8 +676,12 @@ impl Linear {
                 } else {
                     let in_t = in_t.take().unwrap_or_else(|| schur_unknowns(sys));
                     match prepared {
-                        Some(a) if a.in_t == in_t => PrecondKind::Schur(a),
-                        _ => PrecondKind::Schur(SchurAnalysis::new(sys.pattern, in_t, false)?),
+                        Some(a) if a.in_t == in_t => PrecondKind::Schur(Box::new(a)),
+                        _ => PrecondKind::Schur(Box::new(SchurAnalysis::new(
+                            sys.pattern,
+                            in_t,
+                            false,
+                        )?)),
                     }
                 };
                 let g = Gmres::new(sys, options.gmres, kind)?;
@@ -793,7 +798,7 @@ enum PrecondKind {
     Amg,
     Ldlt,
     /// With the analysis for the unknowns `T` ([`schur_unknowns`]).
-    Schur(SchurAnalysis),
+    Schur(Box<SchurAnalysis>),
 }
 
 /// Approximate minimum degree order of the cell graph of `pattern` (faer's AMD), each
@@ -914,7 +919,7 @@ impl Gmres {
                     sys,
                     n,
                     full,
-                    analysis,
+                    *analysis,
                     options.factor_precision,
                 )?)),
             })

@@ -129,6 +129,8 @@ impl LdltSingle {
 
     /// Numeric factorization in `f32` of the matrix with the upper-triangle `values`
     /// (double precision, rounded here) of the analysed pattern (`col_ptr`, `row_idx`).
+    /// The pattern may hold the whole symmetric matrix: only its upper triangle is read
+    /// (faer's `Side::Upper`).
     ///
     /// Errors: lengths; a value outside the range of `f32`; a zero, non-finite or — with
     /// `positive` — non-positive pivot (for a matrix known to be positive definite, the
