@@ -24,13 +24,25 @@
 //!
 //! The stiffness is kept in two value arrays on one pattern: the symmetric part (elastic +
 //! penalty) whose quadratic form is the stored energy, and the Nitsche part.
+//!
+//! **Parallel assembly.** The cell and facet matrices are added by threads that own
+//! disjoint ranges of column cells (contiguous in the value arrays): each walks all the
+//! cells or facets in order and adds the columns it owns, so every entry receives its
+//! contributions in the sequential order and the values are bitwise the same for any
+//! number of threads. The penalty matrix of a facet is `M ⊗ Q(n)` (`M` over the cells,
+//! `Q` over the components), added block by block.
 
 use nalgebra::DMatrix;
 use porofrac_grid::{Grid, Point};
+use rayon::prelude::*;
+use std::sync::Mutex;
 
 use crate::conditions::{BodyLoads, Condition, Field, Slot};
 use crate::error::{CosseratError, Result};
-use crate::linear::{Linear, LinearOptions, LinearSolver, LinearStats, SystemRef};
+use crate::linear::{
+    AUTO_GMRES_EQUATIONS, AUTO_SCHUR_UNKNOWNS, Linear, LinearOptions, LinearSolver, LinearStats,
+    SchurAnalysis, SystemRef,
+};
 use crate::material::{Material, components, levi_civita, rotations, strain_index, strain_len};
 use crate::pattern::{BlockPattern, SparseLu};
 use crate::recon::Reconstruction;
@@ -128,6 +140,9 @@ pub struct Cosserat<const D: usize> {
     fixed: Vec<FixedTerm>,
     loads: Vec<LoadTerm>,
     body: BodyLoads<D>,
+    /// The symbolic analysis of the Schur complement solve, prepared during the assembly
+    /// and taken by the first [`Self::linear`].
+    prepared: Mutex<Option<SchurAnalysis>>,
 }
 
 impl<const D: usize> std::fmt::Debug for Cosserat<D> {
@@ -137,6 +152,33 @@ impl<const D: usize> std::fmt::Debug for Cosserat<D> {
             .field("equations", &self.pattern.equations())
             .field("nnz", &self.pattern.nnz())
             .finish()
+    }
+}
+
+/// One local matrix over the sorted `cells`: the dense column-major matrix `k` over their
+/// components, or, when `q` is not empty, `k ⊗ q` with `k` over the cells and `q` over
+/// the components ([`BlockPattern::add_local_columns`]).
+#[derive(Default)]
+struct Local {
+    cells: Vec<usize>,
+    k: Vec<f64>,
+    q: Vec<f64>,
+}
+
+/// [`Material::acoustic`] into `q` (column-major, `n × n`), without allocating.
+fn acoustic_into(law: &DMatrix<f64>, d: usize, normal: &[f64], q: &mut [f64]) {
+    let c = components(d);
+    for b in 0..c {
+        for a in 0..c {
+            let mut v = 0.0;
+            for j in 0..d {
+                for l in 0..d {
+                    v +=
+                        normal[j] * law[(strain_index(d, a, j), strain_index(d, b, l))] * normal[l];
+                }
+            }
+            q[b * c + a] = v;
+        }
     }
 }
 
@@ -177,7 +219,8 @@ impl<const D: usize> Cosserat<D> {
         }
         let recon = Reconstruction::new(&grid)?;
         let law = material.law_matrix(D);
-        let pattern = BlockPattern::new(&neighbours(&grid, &recon), n);
+        let nbr = neighbours(&grid, &recon);
+        let pattern = BlockPattern::new(&nbr, n);
         let mut me = Self {
             symmetric: vec![0.0; pattern.nnz()],
             nitsche: vec![0.0; pattern.nnz()],
@@ -192,10 +235,25 @@ impl<const D: usize> Cosserat<D> {
             fixed: Vec::new(),
             loads: Vec::new(),
             body,
+            prepared: Mutex::new(None),
         };
-        me.assemble_cells();
-        me.assemble_penalty();
         me.assemble_conditions(conditions)?;
+        // The symbolic analysis of the solve the automatic choice takes needs only the
+        // pattern and the unknowns of the Nitsche terms: it runs beside the assembly.
+        let in_t = me.schur_candidates();
+        let mut values = std::mem::take(&mut me.symmetric);
+        let (prepared, ()) = rayon::join(
+            || in_t.and_then(|t| SchurAnalysis::new(&me.pattern, t, true).ok()),
+            || {
+                // Touch the fresh pages once, on one thread: page faults taken by two
+                // threads at once doubled the time of the cell assembly (measured).
+                values.fill(0.0);
+                me.assemble_cells(&mut values);
+                me.assemble_penalty(&mut values);
+            },
+        );
+        me.symmetric = values;
+        me.prepared = Mutex::new(prepared);
         Ok(me)
     }
 
@@ -338,88 +396,162 @@ impl<const D: usize> Cosserat<D> {
         s.bbar = bbar;
     }
 
-    fn assemble_cells(&mut self) {
-        let n = components(D);
-        let sl = strain_len(D);
-        let mut s = Scratch::default();
-        let mut values = std::mem::take(&mut self.symmetric);
-        for c in 0..self.grid.num_cells() {
-            s.cells.clear();
-            s.cells.extend_from_slice(self.recon.gradient(c).0);
-            let m = s.cells.len() * n;
-            s.k.clear();
-            s.k.resize(m * m, 0.0);
-            let cells = std::mem::take(&mut s.cells);
-            self.quadrature(c, |w, _, src| {
-                s.b.clear();
-                s.b.resize(sl * m, 0.0);
-                self.add_strain_operator(c, &cells, src, 1.0, &mut s.b);
-                add_btab(&self.law, &s.b, w, m, &mut s.ab, &mut s.k);
-            });
-            self.pattern.add_local(&mut values, &cells, &s.k);
-            s.cells = cells;
-        }
-        self.symmetric = values;
+    fn assemble_cells(&self, values: &mut [f64]) {
+        self.assemble_parallel(
+            values,
+            self.grid.num_cells(),
+            |c, cols| self.recon.gradient(c).0.iter().any(|x| cols.contains(x)),
+            |c, s, local| self.cell_local(c, s, local),
+        );
     }
 
-    fn assemble_penalty(&mut self) {
-        let n = components(D);
-        let mut s = Scratch::default();
-        let mut values = std::mem::take(&mut self.symmetric);
-        let eta = self.options.penalty;
-        for f in 0..self.grid.num_faces() {
-            let (km, Some(kp)) = self.grid.face_cells(f) else {
-                continue;
-            };
-            s.cells.clear();
-            s.cells.extend_from_slice(self.recon.gradient(km).0);
-            s.cells.extend_from_slice(self.recon.gradient(kp).0);
-            s.cells.sort_unstable();
-            s.cells.dedup();
-            let nl = s.cells.len();
-            let m = nl * n;
-            s.k.clear();
-            s.k.resize(m * m, 0.0);
-            let normal = self.grid.face_normal(f);
-            let q = Material::acoustic(&self.law, D, normal.as_slice());
-            let h = 0.5 * (self.recon.diameter[km] + self.recon.diameter[kp]);
-            let area = self.grid.face_area(f);
-            let (pts, wts, np) = facet_rule(&self.grid, f);
-            for (x, &w) in pts.iter().zip(&wts).take(np) {
-                s.beta.clear();
-                s.beta.resize(nl, 0.0);
-                for (sign, k) in [(1.0, km), (-1.0, kp)] {
-                    let xk = self.grid.cell_centroid(k);
-                    let (gc, gg) = self.recon.gradient(k);
-                    for (&cc, g) in gc.iter().zip(gg) {
-                        let l = s.cells.binary_search(&cc).unwrap();
-                        s.beta[l] += sign * g.dot(&(x - xk));
-                    }
-                    let l = s.cells.binary_search(&k).unwrap();
-                    s.beta[l] += sign;
-                }
-                let scale = eta / h * w * area;
-                for lj in 0..nl {
-                    let bj = s.beta[lj];
-                    if bj == 0.0 {
-                        continue;
-                    }
-                    for li in 0..nl {
-                        let bi = s.beta[li];
-                        if bi == 0.0 {
-                            continue;
-                        }
-                        for bb in 0..n {
-                            for a in 0..n {
-                                s.k[(lj * n + bb) * m + li * n + a] += scale * bi * bj * q[(a, bb)];
-                            }
-                        }
-                    }
+    fn assemble_penalty(&self, values: &mut [f64]) {
+        self.assemble_parallel(
+            values,
+            self.grid.num_faces(),
+            |f, cols| match self.grid.face_cells(f) {
+                (km, Some(kp)) => [km, kp]
+                    .iter()
+                    .any(|&k| self.recon.gradient(k).0.iter().any(|x| cols.contains(x))),
+                _ => false,
+            },
+            |f, s, local| self.penalty_local(f, s, local),
+        );
+    }
+
+    /// The unknowns where the system will differ from the preconditioning matrix (those
+    /// of the Nitsche terms and of the boundary penalty), when the automatic choice of
+    /// [`Linear::new`] would take the Schur complement solve for a static problem (2D,
+    /// below [`AUTO_GMRES_EQUATIONS`] equations, at most [`AUTO_SCHUR_UNKNOWNS`] of them).
+    fn schur_candidates(&self) -> Option<Vec<bool>> {
+        let p = &self.pattern;
+        let n = p.equations();
+        if D != 2 || n >= AUTO_GMRES_EQUATIONS {
+            return None;
+        }
+        let mut in_t = vec![false; n];
+        for j in 0..n {
+            for q in p.col_ptr[j]..p.col_ptr[j + 1] {
+                if self.nitsche[q] != 0.0 {
+                    in_t[j] = true;
+                    in_t[p.row_idx[q]] = true;
                 }
             }
-            self.pattern.add_local(&mut values, &s.cells, &s.k);
         }
-        self.symmetric = values;
+        for &(pos, v) in &self.boundary {
+            if v != 0.0 {
+                let j = p.col_ptr.partition_point(|&c| c <= pos) - 1;
+                in_t[j] = true;
+                in_t[p.row_idx[pos]] = true;
+            }
+        }
+        let count = in_t.iter().filter(|&&t| t).count();
+        (count > 0 && count <= AUTO_SCHUR_UNKNOWNS).then_some(in_t)
+    }
+
+    /// Add the local matrices of items `0..count` (cells or facets; `local` fills one)
+    /// into `values`, in parallel: each thread owns a range of column cells (contiguous in
+    /// `values`, about equal in size) and walks every item in order, computing the local
+    /// matrix of those that `touches` its columns and adding their part in its columns.
+    /// Every entry receives its contributions in item order, so the sums are bitwise those
+    /// of a sequential assembly for any thread count; an item that straddles two ranges
+    /// is computed twice (few: the cells of a stencil are neighbours).
+    fn assemble_parallel<T, F>(&self, values: &mut [f64], count: usize, touches: T, local: F)
+    where
+        T: Fn(usize, &std::ops::Range<usize>) -> bool + Sync,
+        F: Fn(usize, &mut Scratch, &mut Local) + Sync,
+    {
+        let p = &self.pattern;
+        let nb = p.block * p.block;
+        let nc = p.nbr_pos.len() - 1;
+        let parts = rayon::current_num_threads().clamp(1, nc.max(1));
+        let mut chunks = Vec::with_capacity(parts);
+        let mut rest = values;
+        let mut lo = 0;
+        for k in 1..=parts {
+            let target = p.nbr_pos[nc] * k / parts;
+            let hi = p.nbr_pos.partition_point(|&q| q < target).clamp(lo, nc);
+            let (head, tail) = rest.split_at_mut((p.nbr_pos[hi] - p.nbr_pos[lo]) * nb);
+            chunks.push((lo..hi, head));
+            rest = tail;
+            lo = hi;
+        }
+        chunks.into_par_iter().for_each(|(cols, chunk)| {
+            let offset = p.nbr_pos[cols.start] * nb;
+            let mut s = Scratch::default();
+            let mut loc = Local::default();
+            for item in (0..count).filter(|&i| touches(i, &cols)) {
+                local(item, &mut s, &mut loc);
+                p.add_local_columns(chunk, offset, cols.clone(), &loc.cells, &loc.k, &loc.q);
+            }
+        });
+    }
+
+    /// The local matrix of cell `c`: `Σ_q w_q B_qᵀ A B_q` over its gradient stencil.
+    fn cell_local(&self, c: usize, s: &mut Scratch, local: &mut Local) {
+        let n = components(D);
+        let sl = strain_len(D);
+        local.cells.clear();
+        local.cells.extend_from_slice(self.recon.gradient(c).0);
+        local.q.clear();
+        let m = local.cells.len() * n;
+        local.k.clear();
+        local.k.resize(m * m, 0.0);
+        self.quadrature(c, |w, _, src| {
+            s.b.clear();
+            s.b.resize(sl * m, 0.0);
+            self.add_strain_operator(c, &local.cells, src, 1.0, &mut s.b);
+            add_btab(&self.law, &s.b, w, m, &mut s.ab, &mut local.k);
+        });
+    }
+
+    /// The local interior-penalty matrix of the interior facet `f`.
+    fn penalty_local(&self, f: usize, s: &mut Scratch, local: &mut Local) {
+        let n = components(D);
+        let eta = self.options.penalty;
+        let (km, Some(kp)) = self.grid.face_cells(f) else {
+            unreachable!("interior facet");
+        };
+        let cells = &mut local.cells;
+        cells.clear();
+        cells.extend_from_slice(self.recon.gradient(km).0);
+        cells.extend_from_slice(self.recon.gradient(kp).0);
+        cells.sort_unstable();
+        cells.dedup();
+        let nl = cells.len();
+        let normal = self.grid.face_normal(f);
+        // The local matrix is M ⊗ Q: M = Σ_q (η/h) w_q |F| β_q β_qᵀ over the cells, Q(n)
+        // over the components.
+        let k = &mut local.k;
+        k.clear();
+        k.resize(nl * nl, 0.0);
+        local.q.clear();
+        local.q.resize(n * n, 0.0);
+        acoustic_into(&self.law, D, normal.as_slice(), &mut local.q);
+        let h = 0.5 * (self.recon.diameter[km] + self.recon.diameter[kp]);
+        let area = self.grid.face_area(f);
+        let (pts, wts, np) = facet_rule(&self.grid, f);
+        for (x, &w) in pts.iter().zip(&wts).take(np) {
+            s.beta.clear();
+            s.beta.resize(nl, 0.0);
+            for (sign, kk) in [(1.0, km), (-1.0, kp)] {
+                let xk = self.grid.cell_centroid(kk);
+                let (gc, gg) = self.recon.gradient(kk);
+                for (&cc, g) in gc.iter().zip(gg) {
+                    let l = cells.binary_search(&cc).unwrap();
+                    s.beta[l] += sign * g.dot(&(x - xk));
+                }
+                let l = cells.binary_search(&kk).unwrap();
+                s.beta[l] += sign;
+            }
+            let scale = eta / h * w * area;
+            for (lj, &bj) in s.beta.iter().enumerate() {
+                let f = scale * bj;
+                for (kij, &bi) in k[lj * nl..(lj + 1) * nl].iter_mut().zip(&s.beta) {
+                    *kij += f * bi;
+                }
+            }
+        }
     }
 
     fn assemble_conditions(&mut self, conditions: &[Condition<D>]) -> Result<()> {
@@ -625,7 +757,8 @@ impl<const D: usize> Cosserat<D> {
         options: &LinearOptions,
     ) -> Result<Linear> {
         let centres = self.centres();
-        Linear::new(
+        let prepared = self.prepared.lock().ok().and_then(|mut p| p.take());
+        Linear::with_analysis(
             SystemRef {
                 pattern: &self.pattern,
                 values,
@@ -634,6 +767,7 @@ impl<const D: usize> Cosserat<D> {
                 dim: D,
             },
             options,
+            prepared,
         )
     }
 

@@ -109,6 +109,87 @@ impl BlockPattern {
         }
     }
 
+    /// [`Self::add_local`] restricted to the column cells in `columns`, into `chunk`: the
+    /// values of those columns, which start at `offset` in the full value array. With a
+    /// non-empty `q` (`n × n`, column-major) the local matrix is `local ⊗ q`, `local` then
+    /// `cells.len()²` (column-major over the cells).
+    pub fn add_local_columns(
+        &self,
+        chunk: &mut [f64],
+        offset: usize,
+        columns: std::ops::Range<usize>,
+        cells: &[usize],
+        local: &[f64],
+        q: &[f64],
+    ) {
+        let n = self.block;
+        let nl = cells.len();
+        if !q.is_empty() {
+            for (cj, &c) in cells.iter().enumerate() {
+                if !columns.contains(&c) {
+                    continue;
+                }
+                let stride = self.column_len(c);
+                for (ri, pos) in self.column_positions(c, cells).enumerate() {
+                    let mv = local[cj * nl + ri];
+                    if mv == 0.0 {
+                        continue;
+                    }
+                    let pos = pos - offset;
+                    for b in 0..n {
+                        let dst = &mut chunk[pos + b * stride..pos + b * stride + n];
+                        for (d, &qv) in dst.iter_mut().zip(&q[b * n..(b + 1) * n]) {
+                            *d += mv * qv;
+                        }
+                    }
+                }
+            }
+            return;
+        }
+        let m = nl * n;
+        for (cj, &c) in cells.iter().enumerate() {
+            if !columns.contains(&c) {
+                continue;
+            }
+            let stride = self.column_len(c);
+            for (ri, pos) in self.column_positions(c, cells).enumerate() {
+                let pos = pos - offset;
+                for b in 0..n {
+                    let col = (cj * n + b) * m + ri * n;
+                    let dst = pos + b * stride;
+                    for a in 0..n {
+                        chunk[dst + a] += local[col + a];
+                    }
+                }
+            }
+        }
+    }
+
+    /// [`Self::position`] of the blocks (row cell `r`, column cell `c`) for the sorted
+    /// row cells `rows`, by one walk along the column's cells.
+    ///
+    /// # Panics
+    /// When a row cell does not couple with `c` (the local cells of an element always do).
+    fn column_positions<'a>(
+        &'a self,
+        c: usize,
+        rows: &'a [usize],
+    ) -> impl Iterator<Item = usize> + 'a {
+        let nb = &self.cells[self.nbr_pos[c]..self.nbr_pos[c + 1]];
+        let base = self.nbr_pos[c] * self.block * self.block;
+        let mut p = 0;
+        rows.iter().map(move |&r| {
+            while p < nb.len() && nb[p] < r {
+                p += 1;
+            }
+            assert!(
+                p < nb.len() && nb[p] == r,
+                "local cells couple by construction"
+            );
+            base + p * self.block
+        })
+    }
+
     /// Positions of the diagonal entries, one per equation.
     pub fn diagonal_positions(&self) -> Vec<usize> {
         let n = self.block;

@@ -249,3 +249,35 @@ fn too_few_iterations_is_an_error_with_the_residual() {
         e => panic!("unexpected error {e}"),
     }
 }
+
+/// The parallel assembly is deterministic: one and two threads give bitwise the same
+/// matrices; and the solve whose symbolic analysis was prepared beside the assembly (the
+/// first set-up of the model) gives bitwise the solution of one analysed afresh (the
+/// second).
+#[test]
+fn parallel_assembly_and_prepared_analysis_are_deterministic() {
+    let pool = |t| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(t)
+            .build()
+            .unwrap()
+    };
+    let one = pool(1).install(|| plate(1));
+    let two = pool(2).install(|| plate(1));
+    assert_eq!(one.symmetric_values(), two.symmetric_values());
+    assert_eq!(one.nitsche_values(), two.nitsche_values());
+    assert!(one.symmetric_values().iter().any(|&v| v != 0.0));
+    let opts = options(LinearSolver::LdltSchur, 1e-12);
+    let (v, p) = (two.system_values(), two.preconditioner_values());
+    let solve = |model: &Cosserat<2>| {
+        let mut lin = model.linear(&v, &p, &opts).unwrap();
+        let mut x = vec![0.0; model.equations()];
+        model.rhs(0.0, &mut x);
+        lin.solve(&mut x, None).unwrap();
+        x
+    };
+    let prepared = solve(&two);
+    let fresh = solve(&two);
+    assert_eq!(prepared, fresh);
+    assert!(prepared.iter().any(|&x| x != 0.0));
+}

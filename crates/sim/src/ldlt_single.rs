@@ -101,8 +101,36 @@ impl LdltSingle {
         self.analysis.symbolic()
     }
 
+    /// Allocate the factor and the scratch of the numeric factorization now and touch
+    /// their pages, so that the first [`Self::factorize`] finds them ready: on another
+    /// thread while the matrix is assembled, this takes the page faults of the fresh
+    /// memory (tens of MB) off the factorization.
+    ///
+    /// Errors: the scratch cannot be allocated.
+    pub fn reserve(&mut self) -> Result<(), LdltError> {
+        let symbolic = self.analysis.symbolic();
+        let n = symbolic.nrows();
+        let len = symbolic.len_val();
+        self.values.clear();
+        self.values.resize(len, 0.0);
+        self.work.resize(n, 0.0);
+        if self.mem.is_none() {
+            let req = symbolic
+                .factorize_numeric_ldlt_scratch::<f32>(self.par, Default::default())
+                .or(symbolic.solve_in_place_scratch::<f32>(1, Par::Seq));
+            let mut mem = MemBuffer::try_new(req).map_err(|_| LdltError("out of memory".into()))?;
+            for b in mem.iter_mut().step_by(4096) {
+                b.write(0);
+            }
+            self.mem = Some(mem);
+        }
+        Ok(())
+    }
+
     /// Numeric factorization in `f32` of the matrix with the upper-triangle `values`
     /// (double precision, rounded here) of the analysed pattern (`col_ptr`, `row_idx`).
+    /// The pattern may hold the whole symmetric matrix: only its upper triangle is read
+    /// (faer's `Side::Upper`).
     ///
     /// Errors: lengths; a value outside the range of `f32`; a zero, non-finite or — with
     /// `positive` — non-positive pivot (for a matrix known to be positive definite, the
@@ -376,8 +404,26 @@ impl TrailingFactor {
     /// The Schur complement `L₂₂ D₂ L₂₂ᵀ`, dense column-major `k × k` (its lower triangle
     /// by faer's triangular product, mirrored).
     pub fn schur_complement(&self, par: Par) -> Vec<f64> {
+        let k = self.k;
+        let mut out = vec![0.0; k * k];
+        self.schur_complement_into(MatMut::from_column_major_slice_mut(&mut out, k, k), par);
+        out
+    }
+
+    /// [`Self::schur_complement`] into `out` (`k × k`, any strides), without allocating
+    /// it.
+    ///
+    /// # Panics
+    /// When `out` is not `k × k`.
+    pub fn schur_complement_into(&self, mut out: MatMut<'_, f64>, par: Par) {
         use faer::linalg::matmul::triangular::{BlockStructure, matmul};
         let k = self.k;
+        assert!(
+            out.nrows() == k && out.ncols() == k,
+            "Schur complement of {k} unknowns into a {} × {} matrix",
+            out.nrows(),
+            out.ncols()
+        );
         let l = faer::MatRef::from_column_major_slice(&self.l, k, k);
         let mut ld = l.to_owned();
         for (j, &dj) in self.d.iter().enumerate() {
@@ -385,9 +431,8 @@ impl TrailingFactor {
                 *v *= dj;
             }
         }
-        let mut out = vec![0.0; k * k];
         matmul(
-            MatMut::from_column_major_slice_mut(&mut out, k, k),
+            out.as_mut(),
             BlockStructure::TriangularLower,
             faer::Accum::Replace,
             ld.as_ref(),
@@ -399,10 +444,9 @@ impl TrailingFactor {
         );
         for j in 0..k {
             for i in j + 1..k {
-                out[i * k + j] = out[j * k + i];
+                out[(j, i)] = out[(i, j)];
             }
         }
-        out
     }
 }
 
@@ -535,6 +579,74 @@ mod tests {
 
     fn max_abs(v: &[f64]) -> f64 {
         v.iter().fold(0.0, |m, x| m.max(x.abs()))
+    }
+
+    /// Both triangles of the matrix from its upper triangle (CSC, sorted rows).
+    fn mirrored(
+        n: usize,
+        col_ptr: &[usize],
+        row_idx: &[usize],
+        vals: &[f64],
+    ) -> (Vec<usize>, Vec<usize>, Vec<f64>) {
+        let mut cols: Vec<Vec<(usize, f64)>> = vec![Vec::new(); n];
+        for j in 0..n {
+            for q in col_ptr[j]..col_ptr[j + 1] {
+                let i = row_idx[q];
+                cols[j].push((i, vals[q]));
+                if i != j {
+                    cols[i].push((j, vals[q]));
+                }
+            }
+        }
+        let (mut cp, mut ri, mut va) = (vec![0], Vec::new(), Vec::new());
+        for mut c in cols {
+            c.sort_by_key(|e| e.0);
+            ri.extend(c.iter().map(|e| e.0));
+            va.extend(c.iter().map(|e| e.1));
+            cp.push(ri.len());
+        }
+        (cp, ri, va)
+    }
+
+    /// The whole symmetric matrix in place of its upper triangle (only the upper triangle
+    /// is read), memory reserved before the factorization, and the Schur complement
+    /// written into a given matrix: bitwise the same results.
+    #[test]
+    fn whole_matrix_reserve_and_schur_into_change_nothing() {
+        let (n, col_ptr, row_idx, vals) = spd(10);
+        let (fc, fr, fv) = mirrored(n, &col_ptr, &row_idx, &vals);
+        assert!(fr.len() > row_idx.len());
+        let b: Vec<f64> = (0..n).map(|i| ((i * 5) % 7) as f64 - 3.0).collect();
+        let mut upper = LdltSingle::new(Ldlt::analyse(n, &col_ptr, &row_idx, None).unwrap());
+        upper.factorize(&col_ptr, &row_idx, &vals, true).unwrap();
+        let mut whole = LdltSingle::new(Ldlt::analyse(n, &fc, &fr, None).unwrap());
+        whole.reserve().unwrap();
+        whole.factorize(&fc, &fr, &fv, true).unwrap();
+        assert_eq!(whole.permutation(), upper.permutation());
+        let (mut x, mut y) = (b.clone(), b.clone());
+        upper.solve_in_place(&mut x).unwrap();
+        whole.solve_in_place(&mut y).unwrap();
+        assert_eq!(x, y);
+        let m = 9;
+        let t = whole.trailing_factor(m).unwrap();
+        let s = t.schur_complement(Par::Seq);
+        let mut into = faer::Mat::<f64>::zeros(m, m);
+        t.schur_complement_into(into.as_mut(), Par::Seq);
+        for j in 0..m {
+            for i in 0..m {
+                assert_eq!(into[(i, j)], s[j * m + i]);
+                assert_eq!(into[(i, j)], into[(j, i)]);
+            }
+        }
+        let mut double = Ldlt::analyse(n, &fc, &fr, None).unwrap();
+        double.factorize(&fc, &fr, &fv).unwrap();
+        let mut z = b.clone();
+        double.solve_in_place(&mut z).unwrap();
+        let mut w = b.clone();
+        let mut reference = Ldlt::analyse(n, &col_ptr, &row_idx, None).unwrap();
+        reference.factorize(&col_ptr, &row_idx, &vals).unwrap();
+        reference.solve_in_place(&mut w).unwrap();
+        assert_eq!(z, w);
     }
 
     /// The single-precision solve is the double-precision one to `f32` accuracy (10⁻⁵ of
