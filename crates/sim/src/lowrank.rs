@@ -241,15 +241,7 @@ impl LowRank {
             self.t[i] += v * y[(j, 0)];
         }
         for (&u, &ti) in self.support.iter().zip(&self.t) {
-            if ti != 0.0 {
-                let a = self.slot[u];
-                let v = &self.w[a * n..(a + 1) * n];
-                for r in &self.paths[a] {
-                    for (x, c) in rhs[r.clone()].iter_mut().zip(&v[r.clone()]) {
-                        *x -= ti * c;
-                    }
-                }
-            }
+            self.add_column(u, -ti, rhs);
         }
         ldlt.backward_in_place(rhs)
     }
@@ -282,23 +274,29 @@ impl LowRank {
         let Some(lu) = &self.lu else {
             return ldlt.solve_in_place(rhs);
         };
-        let n = rhs.len();
         let mut c = Mat::<f64>::from_fn(self.support.len(), 1, |i, _| rhs[self.support[i]]);
         lu.solve_transpose_in_place(c.as_mut());
         rhs.fill(0.0);
         for (i, &u) in self.support.iter().enumerate() {
-            let ci = c[(i, 0)];
-            if ci != 0.0 {
-                let a = self.slot[u];
-                let v = &self.w[a * n..(a + 1) * n];
-                for r in &self.paths[a] {
-                    for (x, vi) in rhs[r.clone()].iter_mut().zip(&v[r.clone()]) {
-                        *x += ci * vi;
-                    }
-                }
-            }
+            self.add_column(u, c[(i, 0)], rhs);
         }
         ldlt.backward_in_place(rhs)
+    }
+
+    /// `rhs += α v_u` over the paths of `v_u` (the forward-swept column of the changed
+    /// unknown `u`); nothing when `α = 0`.
+    fn add_column(&self, u: usize, alpha: f64, rhs: &mut [f64]) {
+        if alpha == 0.0 {
+            return;
+        }
+        let n = rhs.len();
+        let a = self.slot[u];
+        let v = &self.w[a * n..(a + 1) * n];
+        for r in &self.paths[a] {
+            for (x, vi) in rhs[r.clone()].iter_mut().zip(&v[r.clone()]) {
+                *x += alpha * vi;
+            }
+        }
     }
 }
 
