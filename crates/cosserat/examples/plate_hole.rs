@@ -92,8 +92,8 @@ fn scf_on(
     let t1 = Instant::now();
     let mut lin = model
         .linear(
-            &model.system_values(),
-            &model.preconditioner_values(),
+            model.system_values(),
+            model.preconditioner_values(),
             &options,
         )
         .unwrap();

@@ -41,7 +41,7 @@ use crate::conditions::{BodyLoads, Condition, Field, Slot};
 use crate::error::{CosseratError, Result};
 use crate::linear::{
     AUTO_GMRES_EQUATIONS, AUTO_SCHUR_UNKNOWNS, Linear, LinearOptions, LinearSolver, LinearStats,
-    SchurAnalysis, SystemRef,
+    SchurAnalysis,
 };
 use crate::material::{Material, components, levi_civita, rotations, strain_index, strain_len};
 use crate::pattern::{BlockPattern, SparseLu};
@@ -143,6 +143,10 @@ pub struct Cosserat<const D: usize> {
     /// The symbolic analysis of the Schur complement solve, prepared during the assembly
     /// and taken by the first [`Self::linear`].
     prepared: Mutex<Option<SchurAnalysis>>,
+    /// The system and preconditioning values, computed beside that analysis (while it
+    /// allocates the factors) and taken by the first [`Self::system_values`] and
+    /// [`Self::preconditioner_values`].
+    prepared_values: Mutex<(Option<Vec<f64>>, Option<Vec<f64>>)>,
 }
 
 impl<const D: usize> std::fmt::Debug for Cosserat<D> {
@@ -193,6 +197,20 @@ struct Scratch {
     beta: Vec<f64>,
 }
 
+/// The system values: the symmetric part plus the Nitsche part.
+fn system_values(symmetric: &[f64], nitsche: &[f64]) -> Vec<f64> {
+    symmetric.iter().zip(nitsche).map(|(a, b)| a + b).collect()
+}
+
+/// The preconditioning values: the symmetric part plus the boundary penalty.
+fn preconditioner_values(symmetric: &[f64], boundary: &[(usize, f64)]) -> Vec<f64> {
+    let mut p = symmetric.to_vec();
+    for &(pos, v) in boundary {
+        p[pos] += PRECONDITIONER_PENALTY * v;
+    }
+    p
+}
+
 impl<const D: usize> Cosserat<D> {
     /// Build the reconstruction, the pattern and the matrices.
     ///
@@ -236,13 +254,17 @@ impl<const D: usize> Cosserat<D> {
             loads: Vec::new(),
             body,
             prepared: Mutex::new(None),
+            prepared_values: Mutex::new((None, None)),
         };
         me.assemble_conditions(conditions)?;
         // The symbolic analysis of the solve the automatic choice takes needs only the
         // pattern and the unknowns of the Nitsche terms: it runs beside the assembly.
+        // The values of the static solve are computed on the assembling thread after the
+        // assembly, while the other one still allocates the factors.
         let in_t = me.schur_candidates();
+        let static_candidate = in_t.is_some();
         let mut values = std::mem::take(&mut me.symmetric);
-        let (prepared, ()) = rayon::join(
+        let (prepared, static_values) = rayon::join(
             || in_t.and_then(|t| SchurAnalysis::new(&me.pattern, t, true).ok()),
             || {
                 // Touch the fresh pages once, on one thread: page faults taken by two
@@ -250,10 +272,19 @@ impl<const D: usize> Cosserat<D> {
                 values.fill(0.0);
                 me.assemble_cells(&mut values);
                 me.assemble_penalty(&mut values);
+                static_candidate.then(|| {
+                    (
+                        system_values(&values, &me.nitsche),
+                        preconditioner_values(&values, &me.boundary),
+                    )
+                })
             },
         );
         me.symmetric = values;
         me.prepared = Mutex::new(prepared);
+        if let Some((system, preconditioner)) = static_values {
+            me.prepared_values = Mutex::new((Some(system), Some(preconditioner)));
+        }
         Ok(me)
     }
 
@@ -291,19 +322,21 @@ impl<const D: usize> Cosserat<D> {
     /// every fixed component (it removes the rigid motions from the kernel of the
     /// symmetric part; the system itself has no penalty).
     pub fn preconditioner_values(&self) -> Vec<f64> {
-        let mut p = self.symmetric.clone();
-        for &(pos, v) in &self.boundary {
-            p[pos] += PRECONDITIONER_PENALTY * v;
-        }
-        p
+        let prepared = self
+            .prepared_values
+            .lock()
+            .ok()
+            .and_then(|mut v| v.1.take());
+        prepared.unwrap_or_else(|| preconditioner_values(&self.symmetric, &self.boundary))
     }
     /// Values of the full system matrix (symmetric + Nitsche).
     pub fn system_values(&self) -> Vec<f64> {
-        self.symmetric
-            .iter()
-            .zip(&self.nitsche)
-            .map(|(a, b)| a + b)
-            .collect()
+        let prepared = self
+            .prepared_values
+            .lock()
+            .ok()
+            .and_then(|mut v| v.0.take());
+        prepared.unwrap_or_else(|| system_values(&self.symmetric, &self.nitsche))
     }
     /// Number of unknowns.
     pub fn equations(&self) -> usize {
@@ -752,20 +785,18 @@ impl<const D: usize> Cosserat<D> {
     /// the Newmark matrix) and the preconditioning matrix with `preconditioner`.
     pub fn linear(
         &self,
-        values: &[f64],
-        preconditioner: &[f64],
+        values: Vec<f64>,
+        preconditioner: Vec<f64>,
         options: &LinearOptions,
     ) -> Result<Linear> {
         let centres = self.centres();
         let prepared = self.prepared.lock().ok().and_then(|mut p| p.take());
-        Linear::with_analysis(
-            SystemRef {
-                pattern: &self.pattern,
-                values,
-                preconditioner,
-                centres: &centres,
-                dim: D,
-            },
+        Linear::with_values(
+            &self.pattern,
+            values,
+            preconditioner,
+            &centres,
+            D,
             options,
             prepared,
         )
@@ -778,11 +809,8 @@ impl<const D: usize> Cosserat<D> {
         t: f64,
         options: &LinearOptions,
     ) -> Result<(Vec<f64>, LinearStats, LinearSolver)> {
-        let mut solver = self.linear(
-            &self.system_values(),
-            &self.preconditioner_values(),
-            options,
-        )?;
+        let mut solver =
+            self.linear(self.system_values(), self.preconditioner_values(), options)?;
         let mut x = vec![0.0; self.equations()];
         self.rhs(t, &mut x);
         solver.solve(&mut x, None)?;

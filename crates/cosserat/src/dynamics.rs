@@ -141,7 +141,7 @@ impl Dynamics {
                     solver: linear.solver.resolve_newmark(neq),
                     ..*linear
                 };
-                Some(model.linear(&eff, &pre, &linear)?)
+                Some(model.linear(eff, pre, &linear)?)
             }
         };
         Ok(Self {

@@ -258,7 +258,7 @@ impl DenseLu {
         use faer::linalg::lu::partial_pivoting::{factor, solve};
         let k = a.nrows();
         let (mut perm, mut perm_inv) = (vec![0usize; k], vec![0usize; k]);
-        let par = faer::Par::Seq;
+        let par = faer::Par::rayon(0);
         let mut mem = MemBuffer::new(factor::lu_in_place_scratch::<usize, f64>(
             k,
             k,
@@ -316,12 +316,17 @@ impl Factor {
         precision: FactorPrecision,
     ) -> std::result::Result<Self, LdltError> {
         let (c, r, v) = upper;
+        let par = faer::Par::rayon(0);
         let mut ldlt = match (precision, analysis) {
             (FactorPrecision::Double, Prepared::Analysis(a)) => a,
             (FactorPrecision::Double, Prepared::Single(s)) => s.into_analysis(),
             (FactorPrecision::Single, analysis) => {
                 let mut single = match analysis {
-                    Prepared::Analysis(a) => LdltSingle::new(a),
+                    Prepared::Analysis(a) => {
+                        let mut s = LdltSingle::new(a);
+                        s.set_parallelism(par);
+                        s
+                    }
                     Prepared::Single(s) => s,
                 };
                 match single.factorize(c, r, v, true) {
@@ -330,6 +335,7 @@ impl Factor {
                 }
             }
         };
+        ldlt.set_parallelism(par);
         ldlt.factorize(c, r, v)?;
         Ok(Self::Double(ldlt))
     }
@@ -459,6 +465,7 @@ impl SchurAnalysis {
         }
         let analysis = if reserve {
             let mut single = LdltSingle::new(analysis);
+            single.set_parallelism(faer::Par::rayon(0));
             single
                 .reserve()
                 .map_err(|e| CosseratError::Solve(format!("LDLᵀ: {e}")))?;
@@ -509,7 +516,7 @@ impl Schur {
         let ldlt = Factor::new(analysis, upper, precision).map_err(ldlt_err)?;
         let trail = ldlt.trailing_factor(k).map_err(ldlt_err)?;
         let mut sa = faer::Mat::<f64>::zeros(k, k);
-        trail.schur_complement_into(sa.as_mut(), faer::Par::Seq);
+        trail.schur_complement_into(sa.as_mut(), faer::Par::rayon(0));
         for &(i, j, v) in &e {
             sa[(i as usize, j as usize)] += v;
         }
@@ -623,6 +630,46 @@ impl Linear {
         options: &LinearOptions,
         prepared: Option<SchurAnalysis>,
     ) -> Result<Self> {
+        Self::build(sys, options, prepared, true)
+    }
+
+    /// [`Self::with_analysis`] for the system values `values` and the preconditioning
+    /// values `preconditioner` on `pattern`, taken by value: GMRES keeps `values` for its
+    /// products instead of a copy.
+    pub fn with_values(
+        pattern: &BlockPattern,
+        values: Vec<f64>,
+        preconditioner: Vec<f64>,
+        centres: &[f64],
+        dim: usize,
+        options: &LinearOptions,
+        prepared: Option<SchurAnalysis>,
+    ) -> Result<Self> {
+        let sys = SystemRef {
+            pattern,
+            values: &values,
+            preconditioner: &preconditioner,
+            centres,
+            dim,
+        };
+        let mut linear = Self::build(sys, options, prepared, false)?;
+        drop(preconditioner);
+        if let Kind::Gmres(g) = &mut linear.kind
+            && g.by_columns
+        {
+            g.row_values = values;
+        }
+        Ok(linear)
+    }
+
+    /// The solver of [`Self::with_analysis`]; without `copy_values`, the products of a
+    /// GMRES by columns are left without values (the caller moves them in).
+    fn build(
+        sys: SystemRef<'_>,
+        options: &LinearOptions,
+        prepared: Option<SchurAnalysis>,
+        copy_values: bool,
+    ) -> Result<Self> {
         let n = sys.pattern.equations();
         for (what, len) in [
             ("system values", sys.values.len()),
@@ -667,9 +714,12 @@ impl Linear {
                 lu.factorize(sys.pattern, sys.values)?;
                 Kind::Lu(Box::new(lu))
             }
-            LinearSolver::GmresAmg => {
-                Kind::Gmres(Box::new(Gmres::new(sys, options.gmres, PrecondKind::Amg)?))
-            }
+            LinearSolver::GmresAmg => Kind::Gmres(Box::new(Gmres::new(
+                sys,
+                options.gmres,
+                PrecondKind::Amg,
+                copy_values,
+            )?)),
             s @ (LinearSolver::GmresLdlt | LinearSolver::LdltSchur) => {
                 let kind = if s == LinearSolver::GmresLdlt {
                     PrecondKind::Ldlt
@@ -684,7 +734,7 @@ impl Linear {
                         )?)),
                     }
                 };
-                let g = Gmres::new(sys, options.gmres, kind)?;
+                let g = Gmres::new(sys, options.gmres, kind, copy_values)?;
                 match &g.pre {
                     Precond::Ldlt(f) => {
                         stats.factor_entries = f.analysis().factor_nnz();
@@ -853,7 +903,12 @@ fn cell_amd_masked(pattern: &BlockPattern, skip: &[bool]) -> Result<Vec<usize>> 
 }
 
 impl Gmres {
-    fn new(sys: SystemRef<'_>, options: GmresOptions, kind: PrecondKind) -> Result<Self> {
+    fn new(
+        sys: SystemRef<'_>,
+        options: GmresOptions,
+        kind: PrecondKind,
+        copy_values: bool,
+    ) -> Result<Self> {
         let p = sys.pattern;
         let n = p.equations();
         if p.nnz() > u32::MAX as usize || n > u32::MAX as usize {
@@ -873,12 +928,18 @@ impl Gmres {
         }
         // The direct preconditioners take the whole preconditioning matrix: the LDLᵀ
         // reads its upper triangle only. Their solve needs few products with K, done by
-        // columns on a copy (no transposition); the multigrid's many are done by rows.
+        // columns on a copy (no transposition; or on the values moved in by the caller);
+        // the multigrid's many are done by rows.
         let by_columns = !matches!(kind, PrecondKind::Amg);
         let product = || {
             if by_columns {
                 let col_idx: Vec<u32> = p.row_idx.iter().map(|&r| r as u32).collect();
-                (p.col_ptr.clone(), col_idx, sys.values.to_vec())
+                let values = if copy_values {
+                    sys.values.to_vec()
+                } else {
+                    Vec::new()
+                };
+                (p.col_ptr.clone(), col_idx, values)
             } else {
                 row_form(p, sys.values)
             }

@@ -270,7 +270,7 @@ fn parallel_assembly_and_prepared_analysis_are_deterministic() {
     let opts = options(LinearSolver::LdltSchur, 1e-12);
     let (v, p) = (two.system_values(), two.preconditioner_values());
     let solve = |model: &Cosserat<2>| {
-        let mut lin = model.linear(&v, &p, &opts).unwrap();
+        let mut lin = model.linear(v.clone(), p.clone(), &opts).unwrap();
         let mut x = vec![0.0; model.equations()];
         model.rhs(0.0, &mut x);
         lin.solve(&mut x, None).unwrap();

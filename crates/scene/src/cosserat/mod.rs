@@ -256,8 +256,8 @@ fn run_dim<const D: usize>(
         None => {
             let solver = model
                 .linear(
-                    &model.system_values(),
-                    &model.preconditioner_values(),
+                    model.system_values(),
+                    model.preconditioner_values(),
                     &linear_options,
                 )
                 .map_err(|e| scene_error(ls, e))?;
