@@ -132,8 +132,10 @@ pub struct Cosserat<const D: usize> {
     pattern: BlockPattern,
     /// Elastic + penalty values (symmetric).
     symmetric: Vec<f64>,
-    /// Nitsche values.
+    /// Nitsche values (zero outside the columns of `nitsche_cells`).
     nitsche: Vec<f64>,
+    /// The cells whose columns hold Nitsche values (sorted).
+    nitsche_cells: Vec<usize>,
     /// Boundary penalty of the preconditioner: `(value position, value)`.
     boundary: Vec<(usize, f64)>,
     fields: Vec<Field<D>>,
@@ -197,9 +199,22 @@ struct Scratch {
     beta: Vec<f64>,
 }
 
-/// The system values: the symmetric part plus the Nitsche part.
-fn system_values(symmetric: &[f64], nitsche: &[f64]) -> Vec<f64> {
-    symmetric.iter().zip(nitsche).map(|(a, b)| a + b).collect()
+/// The system values: the symmetric part plus the Nitsche part, which is zero outside
+/// the columns of the cells `nitsche_cells`.
+fn system_values(
+    pattern: &BlockPattern,
+    symmetric: &[f64],
+    nitsche: &[f64],
+    nitsche_cells: &[usize],
+) -> Vec<f64> {
+    let mut v = symmetric.to_vec();
+    for q in nitsche_cells
+        .iter()
+        .flat_map(|&c| pattern.col_ptr[c * pattern.block]..pattern.col_ptr[(c + 1) * pattern.block])
+    {
+        v[q] += nitsche[q];
+    }
+    v
 }
 
 /// The preconditioning values: the symmetric part plus the boundary penalty.
@@ -242,6 +257,7 @@ impl<const D: usize> Cosserat<D> {
         let mut me = Self {
             symmetric: vec![0.0; pattern.nnz()],
             nitsche: vec![0.0; pattern.nnz()],
+            nitsche_cells: Vec::new(),
             boundary: Vec::new(),
             grid,
             material,
@@ -274,7 +290,7 @@ impl<const D: usize> Cosserat<D> {
                 me.assemble_penalty(&mut values);
                 static_candidate.then(|| {
                     (
-                        system_values(&values, &me.nitsche),
+                        system_values(&me.pattern, &values, &me.nitsche, &me.nitsche_cells),
                         preconditioner_values(&values, &me.boundary),
                     )
                 })
@@ -336,7 +352,14 @@ impl<const D: usize> Cosserat<D> {
             .lock()
             .ok()
             .and_then(|mut v| v.0.take());
-        prepared.unwrap_or_else(|| system_values(&self.symmetric, &self.nitsche))
+        prepared.unwrap_or_else(|| {
+            system_values(
+                &self.pattern,
+                &self.symmetric,
+                &self.nitsche,
+                &self.nitsche_cells,
+            )
+        })
     }
     /// Number of unknowns.
     pub fn equations(&self) -> usize {
@@ -463,7 +486,11 @@ impl<const D: usize> Cosserat<D> {
             return None;
         }
         let mut in_t = vec![false; n];
-        for j in 0..n {
+        let columns = self
+            .nitsche_cells
+            .iter()
+            .flat_map(|&c| c * p.block..(c + 1) * p.block);
+        for j in columns {
             for q in p.col_ptr[j]..p.col_ptr[j + 1] {
                 if self.nitsche[q] != 0.0 {
                     in_t[j] = true;
@@ -706,9 +733,12 @@ impl<const D: usize> Cosserat<D> {
             }
             if any_fixed {
                 self.pattern.add_local(&mut values, &s.cells, &s.k);
+                self.nitsche_cells.extend_from_slice(&s.cells);
             }
         }
         self.nitsche = values;
+        self.nitsche_cells.sort_unstable();
+        self.nitsche_cells.dedup();
         Ok(())
     }
 
@@ -916,20 +946,20 @@ fn neighbours<const D: usize>(grid: &Grid<D>, recon: &Reconstruction<D>) -> Vec<
             b.map(|b| if a == k { b } else { a })
         })
     };
-    let mut out = Vec::with_capacity(nc);
-    let mut buf = Vec::new();
-    for c in 0..nc {
-        buf.clear();
-        for &k in &in_grad[c] {
-            buf.extend_from_slice(recon.gradient(k).0);
-            for k2 in face_nb(k) {
-                buf.extend_from_slice(recon.gradient(k2).0);
+    (0..nc)
+        .into_par_iter()
+        .map_init(Vec::new, |buf, c| {
+            buf.clear();
+            buf.push(c);
+            for &k in &in_grad[c] {
+                buf.extend_from_slice(recon.gradient(k).0);
+                for k2 in face_nb(k) {
+                    buf.extend_from_slice(recon.gradient(k2).0);
+                }
             }
-        }
-        buf.push(c);
-        buf.sort_unstable();
-        buf.dedup();
-        out.push(buf.clone());
-    }
-    out
+            buf.sort_unstable();
+            buf.dedup();
+            buf.clone()
+        })
+        .collect()
 }

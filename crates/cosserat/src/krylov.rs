@@ -171,7 +171,13 @@ pub fn gmres(
         }
         norm(r)
     };
-    let mut beta = residual(x, &mut r, &mut apply);
+    // From a zero guess the residual is b (no product).
+    let mut beta = if x.iter().all(|&xi| xi == 0.0) {
+        r.copy_from_slice(b);
+        bnorm
+    } else {
+        residual(x, &mut r, &mut apply)
+    };
     loop {
         let rel = beta / bnorm;
         if !rel.is_finite() {
