@@ -111,8 +111,14 @@ impl LdltSingle {
         let symbolic = self.analysis.symbolic();
         let n = symbolic.nrows();
         let len = symbolic.len_val();
-        self.values.clear();
-        self.values.resize(len, 0.0);
+        if self.values.len() != len {
+            // Zeroed memory from the allocator (fresh pages, not yet mapped), then one
+            // write per 4 KiB page: the page faults without a pass of zeros over it all.
+            self.values = vec![0.0; len];
+            for v in self.values.iter_mut().step_by(1024) {
+                *v = std::hint::black_box(0.0);
+            }
+        }
         self.work.resize(n, 0.0);
         if self.mem.is_none() {
             let req = symbolic
