@@ -148,7 +148,14 @@ pub struct Cosserat<const D: usize> {
     /// The system and preconditioning values, computed beside that analysis (while it
     /// allocates the factors) and taken by the first [`Self::system_values`] and
     /// [`Self::preconditioner_values`].
-    prepared_values: Mutex<(Option<Vec<f64>>, Option<Vec<f64>>)>,
+    prepared_values: Mutex<PreparedValues>,
+}
+
+/// The values of a static solve computed during [`Cosserat::new`], each taken once.
+#[derive(Default)]
+struct PreparedValues {
+    system: Option<Vec<f64>>,
+    preconditioner: Option<Vec<f64>>,
 }
 
 impl<const D: usize> std::fmt::Debug for Cosserat<D> {
@@ -270,7 +277,7 @@ impl<const D: usize> Cosserat<D> {
             loads: Vec::new(),
             body,
             prepared: Mutex::new(None),
-            prepared_values: Mutex::new((None, None)),
+            prepared_values: Mutex::new(PreparedValues::default()),
         };
         me.assemble_conditions(conditions)?;
         // The symbolic analysis of the solve the automatic choice takes needs only the
@@ -299,7 +306,10 @@ impl<const D: usize> Cosserat<D> {
         me.symmetric = values;
         me.prepared = Mutex::new(prepared);
         if let Some((system, preconditioner)) = static_values {
-            me.prepared_values = Mutex::new((Some(system), Some(preconditioner)));
+            me.prepared_values = Mutex::new(PreparedValues {
+                system: Some(system),
+                preconditioner: Some(preconditioner),
+            });
         }
         Ok(me)
     }
@@ -342,7 +352,7 @@ impl<const D: usize> Cosserat<D> {
             .prepared_values
             .lock()
             .ok()
-            .and_then(|mut v| v.1.take());
+            .and_then(|mut v| v.preconditioner.take());
         prepared.unwrap_or_else(|| preconditioner_values(&self.symmetric, &self.boundary))
     }
     /// Values of the full system matrix (symmetric + Nitsche).
@@ -351,7 +361,7 @@ impl<const D: usize> Cosserat<D> {
             .prepared_values
             .lock()
             .ok()
-            .and_then(|mut v| v.0.take());
+            .and_then(|mut v| v.system.take());
         prepared.unwrap_or_else(|| {
             system_values(
                 &self.pattern,
