@@ -355,6 +355,16 @@ impl<const D: usize> Cosserat<D> {
             .and_then(|mut v| v.preconditioner.take());
         prepared.unwrap_or_else(|| preconditioner_values(&self.symmetric, &self.boundary))
     }
+    /// Drop what [`Self::new`] prepared for a first static solve (the analysis and the
+    /// value arrays) when it will not be used (dynamics).
+    pub(crate) fn release_prepared(&self) {
+        if let Ok(mut p) = self.prepared.lock() {
+            p.take();
+        }
+        if let Ok(mut v) = self.prepared_values.lock() {
+            *v = PreparedValues::default();
+        }
+    }
     /// Values of the full system matrix (symmetric + Nitsche).
     pub fn system_values(&self) -> Vec<f64> {
         let prepared = self

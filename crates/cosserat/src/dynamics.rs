@@ -144,6 +144,8 @@ impl Dynamics {
                 Some(model.linear(eff, pre, &linear)?)
             }
         };
+        // What the model prepared for a static solve is not needed here.
+        model.release_prepared();
         Ok(Self {
             integrator,
             dt,
