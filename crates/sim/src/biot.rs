@@ -141,6 +141,8 @@
 
 use std::sync::Arc;
 
+use rayon::prelude::*;
+
 use faer::Par;
 use porofrac_flow::{FlowError, FlowModel};
 use porofrac_grid::Point;
@@ -428,7 +430,8 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
             pattern,
             loads,
         } = self.mech;
-        let mut values = vec![0.0; pattern.nnz()];
+        // Assembled in place in a new shared slice (one allocation, no copy into an `Arc`).
+        let mut values: Arc<[f64]> = std::iter::repeat_n(0.0, pattern.nnz()).collect();
         let mut internal = vec![0.0; dofs.num_equations()];
         assemble_with(
             grid,
@@ -436,7 +439,7 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
             dofs,
             pattern,
             u,
-            &mut values,
+            Arc::get_mut(&mut values).expect("a new allocation is not shared"),
             &mut internal,
             self.elements.as_deref(),
         )?;
@@ -450,9 +453,13 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
         let scale = norm(&external) + norm(&internal);
         let r: Vec<f64> = external.iter().zip(&internal).map(|(a, b)| a + b).collect();
         let residual = if scale > 0.0 { norm(&r) / scale } else { 0.0 };
-        let changed = *values != *self.k_values;
+        let changed = values.len() != self.k_values.len()
+            || values
+                .par_chunks(COMPARE_CHUNK)
+                .zip(self.k_values.par_chunks(COMPARE_CHUNK))
+                .any(|(a, b)| a != b);
         if changed {
-            self.k_values = Arc::from(values);
+            self.k_values = values;
         }
         Ok(Linearization { changed, residual })
     }
@@ -1159,6 +1166,10 @@ const LOW_RANK_RESIDUAL: f64 = 1e-12;
 
 /// Refinement steps of a low-rank solve before the matrix is factorized instead.
 const LOW_RANK_REFINEMENTS: usize = 3;
+
+/// Stiffness values compared per rayon task when a linearization asks whether the
+/// tangent changed.
+const COMPARE_CHUNK: usize = 1 << 14;
 
 /// Unknowns per leaf of the dissection of the block system.
 const DISSECTION_LEAF: usize = 8;

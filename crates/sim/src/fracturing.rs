@@ -74,6 +74,7 @@ use crate::error::SimError;
 use crate::laws::LawMap;
 use crate::pattern::Pattern;
 use crate::solve::StaticProblem;
+use crate::stress_cache::StressCache;
 
 /// Errors of the fracturing driver.
 #[derive(Debug, thiserror::Error)]
@@ -469,6 +470,8 @@ pub struct Fracturing<'a, const D: usize> {
     cached: Option<Cached<'a, D>>,
     /// The stiffness of the cells with a linear intact law (assembled once).
     elements: Arc<ElementCache>,
+    /// The stress operators of the cells with a linear law (built at the first solve).
+    stress_cache: Option<StressCache>,
 }
 
 /// A failure state's law map and stiffness (at zero displacement).
@@ -560,6 +563,7 @@ impl<'a, const D: usize> Fracturing<'a, D> {
             operators,
             cached,
             elements,
+            stress_cache: None,
         })
     }
 
@@ -618,6 +622,7 @@ impl<'a, const D: usize> Fracturing<'a, D> {
             coords,
             cached,
             elements,
+            stress_cache,
         } = self;
         let grid = body.grid;
         let t1 = t + dt;
@@ -668,7 +673,10 @@ impl<'a, const D: usize> Fracturing<'a, D> {
             solves += n;
             warm = Some(new.clone());
             worst = worst.max(residual);
-            let stress = stresses(grid, map, operators, coords, &new.displacement)?;
+            let cache = stress_cache.get_or_insert_with(|| {
+                StressCache::new(map, operators, coords, grid.cell_volumes())
+            });
+            let stress = stresses(grid, map, operators, coords, cache, &new.displacement)?;
             Ok((new, stress))
         };
         let done = resolution
@@ -723,6 +731,7 @@ fn stresses<const D: usize>(
     map: &LawMap<'_, D>,
     ops: &Operators<D>,
     coords: &[Point<D>],
+    cache: &StressCache,
     u: &[f64],
 ) -> FractureResult<Vec<Tensor<D>>> {
     /// Cells per block, each block evaluated by one thread; all on the calling thread
@@ -750,7 +759,11 @@ fn stresses<const D: usize>(
                 node_normals: &ops.normals[k],
                 volume: volumes[c],
             };
-            *s = map.law(c).stress(&geo, &uc, &mut scratch);
+            let law = map.law(c);
+            *s = match cache.stress(c, law, &uc) {
+                Some(s) => s,
+                None => law.stress(&geo, &uc, &mut scratch),
+            };
         }
     };
     if out.len() < PARALLEL_STRESS_CELLS {

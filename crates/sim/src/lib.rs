@@ -63,6 +63,7 @@ pub mod pattern;
 mod quadrature;
 pub mod solve;
 pub mod standard;
+mod stress_cache;
 
 pub use assembly::{assemble, nodal_loads};
 pub use bc::{Displacement, Gravity, Loads, Platen, Traction};
