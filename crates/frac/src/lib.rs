@@ -106,6 +106,26 @@ impl Tensile {
     }
 }
 
+impl Tensile {
+    /// Whether the effective stress `s` can fail this criterion. `false` when Gershgorin's
+    /// bound on the largest principal stress, `max_i (s_ii + Σ_{j≠i} |s_ij|)`, stays below
+    /// the strength by more than the rounding of an eigen-solver (1e-10 of the largest
+    /// entry): a screen of a few additions that never changes a decision of
+    /// [`FailureCriterion::check`] (a non-finite stress is never screened out).
+    pub fn may_fail<const D: usize>(&self, s: &Tensor<D>) -> bool {
+        let bound = (0..D)
+            .map(|i| {
+                s[(i, i)]
+                    + (0..D)
+                        .filter(|&j| j != i)
+                        .map(|j| s[(i, j)].abs())
+                        .sum::<f64>()
+            })
+            .fold(f64::NEG_INFINITY, f64::max);
+        !(bound + 1e-10 * s.amax() < self.strength)
+    }
+}
+
 impl<const D: usize> FailureCriterion<D> for Tensile {
     fn check(&self, s: &Tensor<D>) -> Option<FailureMode> {
         (principal_stresses(s)[0] > self.strength).then_some(FailureMode::Tensile)
@@ -192,6 +212,13 @@ impl Combined {
     /// Whether no criterion is set (the material never fails).
     pub fn is_empty(&self) -> bool {
         self.tensile.is_none() && self.shear.is_none()
+    }
+
+    /// Whether the stress `s` can fail any criterion here, at a crack tip or not: a cheap
+    /// screen ([`Tensile::may_fail`]) that is `true` whenever [`Self::check_at`] could
+    /// return a mode.
+    pub fn may_fail<const D: usize>(&self, s: &Tensor<D>) -> bool {
+        self.shear.is_some() || self.tensile.as_ref().is_some_and(|t| t.may_fail(s))
     }
 
     /// Tensile utilization; at a crack tip (`tip_radius`: the cell's equivalent radius,
@@ -302,6 +329,39 @@ mod tests {
 
     fn t2(a: f64, b: f64, c: f64) -> Tensor<2> {
         Tensor::<2>::new(a, c, c, b)
+    }
+
+    proptest::proptest! {
+        /// The screen never hides a failure: whenever `may_fail` is false, the criterion
+        /// does not fail (random symmetric stresses around the strength, 2D and 3D).
+        #[test]
+        fn tensile_screen_never_hides_a_failure(
+            e in proptest::collection::vec(-3.0f64..1.5, 6),
+        ) {
+            let t = Tensile::new(1.0).unwrap();
+            let s3 = Tensor::<3>::new(e[0], e[3], e[4], e[3], e[1], e[5], e[4], e[5], e[2]);
+            if !t.may_fail(&s3) {
+                proptest::prop_assert!(FailureCriterion::<3>::check(&t, &s3).is_none());
+            }
+            let s2 = t2(e[0], e[1], e[3]);
+            if !t.may_fail(&s2) {
+                proptest::prop_assert!(FailureCriterion::<2>::check(&t, &s2).is_none());
+            }
+        }
+    }
+
+    #[test]
+    fn tensile_screen_passes_over_compression_and_keeps_tension() {
+        let t = Tensile::new(2.0e5).unwrap();
+        let compressive = Tensor::<3>::new(-4e6, 1e5, 0.0, 1e5, -1.5e7, 2e4, 0.0, 2e4, -5.7e6);
+        assert!(!t.may_fail(&compressive));
+        // Diagonal below the strength, but a shear that lifts σ₁ above it.
+        let sheared = t2(1.0e5, 1.0e5, 1.5e5);
+        assert!(t.may_fail(&sheared));
+        assert_eq!(
+            FailureCriterion::<2>::check(&t, &sheared),
+            Some(FailureMode::Tensile)
+        );
     }
 
     #[test]

@@ -51,27 +51,81 @@ impl NodeCells {
     }
 }
 
-/// Recover nodal stresses from cell stresses (one tensor per node).
+/// Recover nodal stresses from cell stresses (one tensor per node); see
+/// [`StressRecovery`] for repeated recoveries on the same grid.
 pub fn recover_nodal<const D: usize>(
     grid: &Grid<D>,
     adjacency: &NodeCells,
     cell_stress: &[Tensor<D>],
 ) -> Vec<Tensor<D>> {
-    (0..grid.num_nodes())
-        .into_par_iter()
-        .map_init(Vec::new, |patch: &mut Vec<usize>, n| {
-            recover_node(grid, adjacency, cell_stress, n, patch)
-        })
-        .collect()
+    StressRecovery::new(grid, adjacency).nodal(cell_stress)
 }
 
-fn recover_node<const D: usize>(
+/// The recovery as a linear operator: the fit's nodal value is `a = e₀ᵀ (PᵀP)⁻¹ Pᵀ σ`
+/// for the patch's design matrix `P` (rows `[1, (x_c − x_n)/h]`), so every node keeps
+/// the weights `w = P (PᵀP)⁻¹ e₀` of its patch cells and a recovery is
+/// `σ_n = Σ_c w_c σ_c` — the least-squares fits, their degeneracy checks and the growth of
+/// the patches are done once per grid instead of once per stress field.
+#[derive(Clone, Debug)]
+pub struct StressRecovery {
+    ptr: Vec<usize>,
+    cells: Vec<usize>,
+    weights: Vec<f64>,
+}
+
+impl StressRecovery {
+    /// The weights of every node of `grid` (cells around nodes from `adjacency`).
+    pub fn new<const D: usize>(grid: &Grid<D>, adjacency: &NodeCells) -> Self {
+        let per_node: Vec<Vec<(usize, f64)>> = (0..grid.num_nodes())
+            .into_par_iter()
+            .map_init(Vec::new, |patch: &mut Vec<usize>, n| {
+                node_weights(grid, adjacency, n, patch)
+            })
+            .collect();
+        let mut ptr = Vec::with_capacity(per_node.len() + 1);
+        ptr.push(0);
+        let total = per_node.iter().map(Vec::len).sum();
+        let (mut cells, mut weights) = (Vec::with_capacity(total), Vec::with_capacity(total));
+        for w in &per_node {
+            for &(c, x) in w {
+                cells.push(c);
+                weights.push(x);
+            }
+            ptr.push(cells.len());
+        }
+        Self {
+            ptr,
+            cells,
+            weights,
+        }
+    }
+
+    /// The recovered nodal stresses of the cell stresses `cell_stress`.
+    pub fn nodal<const D: usize>(&self, cell_stress: &[Tensor<D>]) -> Vec<Tensor<D>> {
+        (0..self.ptr.len() - 1)
+            .into_par_iter()
+            .map(|n| {
+                let k = self.ptr[n]..self.ptr[n + 1];
+                self.cells[k.clone()]
+                    .iter()
+                    .zip(&self.weights[k])
+                    .fold(Tensor::<D>::zeros(), |acc, (&c, &w)| {
+                        acc + cell_stress[c] * w
+                    })
+            })
+            .collect()
+    }
+}
+
+/// The recovery weights of node `n`: the patch cells and `w = P (PᵀP)⁻¹ e₀` of the
+/// first well-posed patch (the node's cells, grown by up to three rings), or the plain
+/// average of the node's cells on a grid too small for a linear fit.
+fn node_weights<const D: usize>(
     grid: &Grid<D>,
     adjacency: &NodeCells,
-    cell_stress: &[Tensor<D>],
     n: usize,
     patch: &mut Vec<usize>,
-) -> Tensor<D> {
+) -> Vec<(usize, f64)> {
     patch.clear();
     patch.extend_from_slice(adjacency.of(n));
     let xn = *grid.node(n);
@@ -96,17 +150,11 @@ fn recover_node<const D: usize>(
                 // Reject nearly degenerate patches (collinear centroids).
                 let eig = a.symmetric_eigenvalues();
                 if eig.min() > 1e-10 * eig.max() {
-                    let mut out = Tensor::<D>::zeros();
-                    for i in 0..D {
-                        for j in i..D {
-                            let rhs =
-                                DVector::<f64>::from_fn(m, |k, _| cell_stress[patch[k]][(i, j)]);
-                            let coef = chol.solve(&(p.transpose() * rhs));
-                            out[(i, j)] = coef[0];
-                            out[(j, i)] = coef[0];
-                        }
-                    }
-                    return out;
+                    let y = chol.solve(&DVector::<f64>::from_fn(D + 1, |i, _| {
+                        if i == 0 { 1.0 } else { 0.0 }
+                    }));
+                    let w = &p * y;
+                    return patch.iter().copied().zip(w.iter().copied()).collect();
                 }
             }
         }
@@ -122,8 +170,9 @@ fn recover_node<const D: usize>(
         *patch = grown;
     }
     // A grid too small for a linear fit: the plain average of the patch.
-    let s: Tensor<D> = adjacency.of(n).iter().map(|&c| cell_stress[c]).sum();
-    s / adjacency.of(n).len().max(1) as f64
+    let cells = adjacency.of(n);
+    let w = 1.0 / cells.len().max(1) as f64;
+    cells.iter().map(|&c| (c, w)).collect()
 }
 
 /// Cell values of a nodal stress field: the mean over each cell's nodes.

@@ -91,6 +91,9 @@ pub fn resolve<const D: usize, S, E>(
                 continue;
             }
             let crit = &criteria.criteria[criteria.class_of_cell[c]];
+            if !crit.may_fail(s) {
+                continue;
+            }
             let tip = criteria
                 .tips
                 .filter(|_| crit.toughness.is_some())

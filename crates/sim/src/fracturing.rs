@@ -52,7 +52,7 @@
 //! resolution.
 
 use porofrac_flow::{FlowError, FlowModel, Permeability};
-use porofrac_frac::recovery::{NodeCells, cell_average, recover_nodal};
+use porofrac_frac::recovery::{NodeCells, StressRecovery, cell_average};
 use porofrac_frac::{
     CellCriteria, Combined, CrackTips, CrackTracking, FailurePolicy, FailureState, ResolveError,
     resolve,
@@ -206,7 +206,8 @@ impl FractureSettings {
 /// measure (cell or recovered), crack tracking and the round limit live here once.
 pub struct FailureResolution<const D: usize> {
     settings: FractureSettings,
-    adjacency: Option<NodeCells>,
+    /// The recovery operator, when the criteria read the recovered stress.
+    recovery: Option<StressRecovery>,
     tracking: Option<CrackTracking<D>>,
     /// Crack-tip cells, when a criterion has a toughness.
     tips: Option<CrackTips>,
@@ -231,8 +232,8 @@ impl<const D: usize> FailureResolution<D> {
     /// Resolution with `settings` on `grid`; an error describes an invalid tracking angle.
     pub fn new(grid: &Grid<D>, settings: FractureSettings) -> Result<Self, String> {
         let can_fail = settings.criteria.iter().any(|c| !c.is_empty());
-        let adjacency =
-            (can_fail && settings.stress == StressMeasure::Recovered).then(|| NodeCells::new(grid));
+        let recovery = (can_fail && settings.stress == StressMeasure::Recovered)
+            .then(|| StressRecovery::new(grid, &NodeCells::new(grid)));
         let tracking = match (can_fail, settings.tracking_angle) {
             (true, Some(a)) => Some(
                 CrackTracking::new(grid, a)
@@ -245,7 +246,7 @@ impl<const D: usize> FailureResolution<D> {
             .then(|| CrackTips::new(grid));
         Ok(Self {
             settings,
-            adjacency,
+            recovery,
             tracking,
             tips,
         })
@@ -283,7 +284,7 @@ impl<const D: usize> FailureResolution<D> {
                 rounds: 1,
             });
         }
-        let adjacency = &self.adjacency;
+        let recovery = &self.recovery;
         let ((solution, stress), _, new_failures, rounds) = resolve(
             failures,
             t,
@@ -301,8 +302,8 @@ impl<const D: usize> FailureResolution<D> {
             },
             |fs| {
                 let (sol, stress) = solve(fs)?;
-                let measure = match adjacency {
-                    Some(adj) => cell_average(grid, &recover_nodal(grid, adj, &stress)),
+                let measure = match recovery {
+                    Some(r) => cell_average(grid, &r.nodal(&stress)),
                     None => stress.clone(),
                 };
                 Ok(((sol, stress), measure))
