@@ -118,7 +118,7 @@ pub fn assemble<const D: usize>(
     values: &mut [f64],
     forces: &mut [f64],
 ) -> Result<()> {
-    assemble_with(grid, laws, dofs, pattern, u, values, forces, None)
+    assemble_with(grid, laws, dofs, pattern, u, values, Some(forces), None)
 }
 
 /// The element stiffness `K_K` of every cell whose law is linear, kept between assemblies.
@@ -352,7 +352,7 @@ pub(crate) fn assemble_with<const D: usize>(
     pattern: &Pattern,
     u: &[f64],
     values: &mut [f64],
-    forces: &mut [f64],
+    forces: Option<&mut [f64]>,
     cache: Option<&ElementCache>,
 ) -> Result<()> {
     if dofs.num_equations() != pattern.num_equations() || grid.num_cells() != pattern.num_cells() {
@@ -364,9 +364,10 @@ pub(crate) fn assemble_with<const D: usize>(
             grid.num_cells()
         )));
     }
+    let forces_len = forces.as_ref().map_or(pattern.num_equations(), |f| f.len());
     if u.len() != dofs.num_dofs()
         || values.len() != pattern.nnz()
-        || forces.len() != pattern.num_equations()
+        || forces_len != pattern.num_equations()
     {
         return Err(SimError::Input(format!(
             "assemble: lengths u {} (want {}), values {} (want {}), forces {} (want {})",
@@ -374,7 +375,7 @@ pub(crate) fn assemble_with<const D: usize>(
             dofs.num_dofs(),
             values.len(),
             pattern.nnz(),
-            forces.len(),
+            forces_len,
             pattern.num_equations()
         )));
     }
@@ -384,10 +385,16 @@ pub(crate) fn assemble_with<const D: usize>(
     let (mut vrest, mut frest) = (values, forces);
     for ch in &pattern.chunks {
         let (v, vr) = vrest.split_at_mut(ch.vals.len());
-        let (f, fr) = frest.split_at_mut(ch.cols.len());
+        let f = match frest.take() {
+            Some(f) => {
+                let (f, fr) = f.split_at_mut(ch.cols.len());
+                frest = Some(fr);
+                Some(f)
+            }
+            None => None,
+        };
         parts.push((ch, v, f));
         vrest = vr;
-        frest = fr;
     }
     parts
         .into_par_iter()
@@ -396,6 +403,26 @@ pub(crate) fn assemble_with<const D: usize>(
                 Some(sum) => vals.copy_from_slice(&sum[ch.vals.clone()]),
                 None => vals.fill(0.0),
             }
+            let Some(frc) = frc else {
+                // The tangent only: the cells whose matrix is not in the kept sum.
+                for &c in &pattern.chunk_cells[ch.cells.clone()] {
+                    let law = laws.law(c);
+                    if cache.and_then(|e| e.matrix(c, law)).is_none() {
+                        w.gather(grid, c, u);
+                        stiffness(grid, laws, c, w)?;
+                        pattern.add_cell(
+                            grid,
+                            dofs,
+                            c,
+                            w.k.as_slice(),
+                            &mut w.map,
+                            ch.vals.start,
+                            vals,
+                        );
+                    }
+                }
+                return Ok(());
+            };
             frc.fill(0.0);
             for &c in &pattern.chunk_cells[ch.cells.clone()] {
                 let law = laws.law(c);
@@ -751,7 +778,7 @@ mod tests {
         let run = |map: &LawMap<'_, 2>, cache: Option<&ElementCache>| {
             let mut v = vec![0.0; pattern.nnz()];
             let mut f = vec![0.0; dofs.num_equations()];
-            assemble_with(&grid, map, &dofs, &pattern, &u, &mut v, &mut f, cache).unwrap();
+            assemble_with(&grid, map, &dofs, &pattern, &u, &mut v, Some(&mut f), cache).unwrap();
             (v, f)
         };
         // Stiffness entries equal up to the order of the sums: 1e-15 of the largest.

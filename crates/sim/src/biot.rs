@@ -341,7 +341,6 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
             Some(k) if k.len() == mechanics.pattern.nnz() => k,
             _ => {
                 let mut k = vec![0.0; mechanics.pattern.nnz()];
-                let mut forces = vec![0.0; mechanics.dofs.num_equations()];
                 let u = vec![0.0; mechanics.dofs.num_dofs()];
                 assemble_with(
                     mechanics.grid,
@@ -350,7 +349,7 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
                     mechanics.pattern,
                     &u,
                     &mut k,
-                    &mut forces,
+                    None,
                     elements.as_deref(),
                 )?;
                 Arc::from(k)
@@ -423,26 +422,11 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
     pub fn linearize(&mut self, u: &[f64], p: &[f64], t: f64) -> BiotResult<Linearization> {
         check_len("displacement", u.len(), self.mech.dofs.num_dofs())?;
         check_len("pressure", p.len(), self.num_cells())?;
+        let mut internal = vec![0.0; self.mech.dofs.num_equations()];
+        let changed = self.assemble_tangent(u, Some(&mut internal))?;
         let StaticProblem {
-            grid,
-            laws,
-            dofs,
-            pattern,
-            loads,
+            grid, dofs, loads, ..
         } = self.mech;
-        // Assembled in place in a new shared slice (one allocation, no copy into an `Arc`).
-        let mut values: Arc<[f64]> = std::iter::repeat_n(0.0, pattern.nnz()).collect();
-        let mut internal = vec![0.0; dofs.num_equations()];
-        assemble_with(
-            grid,
-            laws,
-            dofs,
-            pattern,
-            u,
-            Arc::get_mut(&mut values).expect("a new allocation is not shared"),
-            &mut internal,
-            self.elements.as_deref(),
-        )?;
         let mut full = vec![0.0; dofs.num_dofs()];
         nodal_loads(grid, loads, t, &mut full)?;
         let mut external = vec![0.0; dofs.num_equations()];
@@ -453,6 +437,39 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
         let scale = norm(&external) + norm(&internal);
         let r: Vec<f64> = external.iter().zip(&internal).map(|(a, b)| a + b).collect();
         let residual = if scale > 0.0 { norm(&r) / scale } else { 0.0 };
+        Ok(Linearization { changed, residual })
+    }
+
+    /// Re-linearize the mechanics at `u` as [`Self::linearize`] does, without the
+    /// internal forces and the equilibrium residual (the stiffness only, the same
+    /// values). Returns whether the stiffness changed.
+    pub fn tangent_at(&mut self, u: &[f64]) -> BiotResult<bool> {
+        check_len("displacement", u.len(), self.mech.dofs.num_dofs())?;
+        self.assemble_tangent(u, None)
+    }
+
+    /// The tangent at `u` (and the internal forces into `internal` when given); adopts
+    /// it when it differs from the current stiffness and says whether it did.
+    fn assemble_tangent(&mut self, u: &[f64], internal: Option<&mut [f64]>) -> BiotResult<bool> {
+        let StaticProblem {
+            grid,
+            laws,
+            dofs,
+            pattern,
+            ..
+        } = self.mech;
+        // Assembled in place in a new shared slice (one allocation, no copy into an `Arc`).
+        let mut values: Arc<[f64]> = std::iter::repeat_n(0.0, pattern.nnz()).collect();
+        assemble_with(
+            grid,
+            laws,
+            dofs,
+            pattern,
+            u,
+            Arc::get_mut(&mut values).expect("a new allocation is not shared"),
+            internal,
+            self.elements.as_deref(),
+        )?;
         let changed = values.len() != self.k_values.len()
             || values
                 .par_chunks(COMPARE_CHUNK)
@@ -461,7 +478,7 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
         if changed {
             self.k_values = values;
         }
-        Ok(Linearization { changed, residual })
+        Ok(changed)
     }
 
     /// The state at rest: zero displacement everywhere (prescribed dofs included) and
@@ -1261,13 +1278,13 @@ impl<const D: usize> BiotCoupling<D> for Monolithic {
                  (the system would be a saddle point): use a small Δt > 0"
             )));
         }
-        let s_new = self.scale_for(sys);
         // With factors at hand the scale stays theirs, so that a change of a few cells
-        // changes a few entries (the solution does not depend on the scale).
+        // changes a few entries (the solution does not depend on the scale); the default
+        // scale of a new stiffness is computed only for a new factorization.
         let s = if self.ldlt.is_factored() && !self.factor_values.is_empty() {
             self.s
         } else {
-            s_new
+            self.scale_for(sys)
         };
         let fresh = !self.is_factored(sys, s, dt);
         if fresh {
@@ -1291,7 +1308,7 @@ impl<const D: usize> BiotCoupling<D> for Monolithic {
             if updated {
                 self.updates += 1;
             } else {
-                self.s = s_new;
+                self.s = self.scale_for(sys);
                 self.fill(sys, dt);
                 self.refactorize()?;
             }

@@ -844,10 +844,11 @@ fn active_set_solve<const D: usize>(
         });
     }
     let p0 = system.initial_pressure().to_vec();
+    // The first stiffness only (its residual is not used).
     match (warm, state) {
-        (Some(w), _) => system.linearize(&w.displacement, &w.pressure, t1)?,
-        (None, Some(s)) => system.linearize(&s.displacement, &s.pressure, t)?,
-        (None, None) => system.linearize(&vec![0.0; system.mechanics().dofs.num_dofs()], &p0, t)?,
+        (Some(w), _) => system.tangent_at(&w.displacement)?,
+        (None, Some(s)) => system.tangent_at(&s.displacement)?,
+        (None, None) => system.tangent_at(&vec![0.0; system.mechanics().dofs.num_dofs()])?,
     };
     // The best iterate so far: state, the pressure its mechanics balances, residual.
     let mut best: Option<(BiotState, Vec<f64>, f64)> = None;
