@@ -93,8 +93,10 @@
 //! low-rank update of the factors (Sherman–Morrison–Woodbury, `crate::lowrank`), every
 //! such solve refined with the residual of the matrix itself to the relative residual
 //! `1e-12` of a fresh factorization (else it factorizes; the residual of an updated
-//! solve lies on the changed unknowns, and its correction needs one backward sweep, see
-//! `LowRank::solve_on_support`), and keeps the pressure scale
+//! solve lies on the changed unknowns, so it is measured there from the solution at their
+//! neighbours, a backward sweep over their paths of the elimination tree only, and the
+//! correction joins the solve's own backward sweep, see `LowRank::solve_corrected`), and
+//! keeps the pressure scale
 //! of the factors meanwhile. Beyond `DEFAULT_MAX_RANK` changed unknowns it factorizes.
 //!
 //! # Fixed-stress split
@@ -139,6 +141,7 @@
 //! linear laws. The pressure `p` and `p₀` are cell values, one per grid cell, in the flow
 //! model's cell order.
 
+use std::ops::Range;
 use std::sync::Arc;
 
 use rayon::prelude::*;
@@ -151,7 +154,7 @@ use porofrac_law::Stiffness;
 use crate::assembly::{ElementCache, assemble, assemble_with, nodal_loads};
 use crate::error::SimError;
 use crate::ldlt::{Ldlt, LdltError};
-use crate::lowrank::LowRank;
+use crate::lowrank::{LowRank, UpperRows};
 use crate::solve::{DirectSolver, StaticProblem};
 
 /// Errors of the Biot coupling.
@@ -838,6 +841,8 @@ pub struct Monolithic {
     factor_values: Vec<f64>,
     /// The update of the factors to `values`.
     low_rank: Box<LowRank>,
+    /// Row access to the pattern (the residual of an updated solve on its support).
+    rows: UpperRows,
     /// At most this many changed unknowns go through `low_rank`; beyond, a factorization.
     max_rank: usize,
     /// Matrices solved by a low-rank update.
@@ -948,6 +953,7 @@ impl Monolithic {
         let n = nm + nc;
         let ldlt = block_ordering(system, &col_ptr, &row_idx)?;
         let nnz = row_idx.len();
+        let rows = UpperRows::new(&col_ptr, &row_idx);
         Ok(Self {
             scale,
             s: 1.0,
@@ -960,6 +966,7 @@ impl Monolithic {
             values: vec![0.0; nnz],
             factor_values: Vec::new(),
             low_rank: Box::new(LowRank::new(n)),
+            rows,
             max_rank: DEFAULT_MAX_RANK,
             updates: 0,
             factored: None,
@@ -1080,8 +1087,8 @@ impl Monolithic {
         }
     }
 
-    /// Iterative refinement of a low-rank solve `work.z` of `work.rhs` (every one, the
-    /// accuracy depends on the right-hand side): the updated
+    /// Iterative refinement of a low-rank solve `work.z` of `work.rhs` (corrected once
+    /// already by `LowRank::solve_corrected`): the updated
     /// solve loses digits as the change grows (the capacitance matrix pairs `G` with the
     /// large stiffness drop of a failed cell), so correct with the residual of the
     /// current matrix, `z += solve(b − A z)`, until it is at the level of a fresh
@@ -1153,16 +1160,30 @@ impl Monolithic {
         if rn > 0.0 { en / rn } else { en }
     }
 
-    /// `y += A x` with the symmetric matrix stored as its upper triangle.
+    /// `y += A x` with the symmetric matrix stored as its upper triangle: the columns in
+    /// two halves of equal entries on two threads, the second half's products summed
+    /// into a vector of its own and added after (the same sums on any number of threads).
     fn sym_mul_add(&self, x: &[f64], y: &mut [f64]) {
-        for j in 0..self.num_unknowns() {
-            for q in self.col_ptr[j]..self.col_ptr[j + 1] {
-                let (r, v) = (self.row_idx[q], self.values[q]);
-                y[r] += v * x[j];
-                if r != j {
-                    y[j] += v * x[r];
+        let n = self.num_unknowns();
+        let part = |cols: Range<usize>, y: &mut [f64]| {
+            for j in cols {
+                for q in self.col_ptr[j]..self.col_ptr[j + 1] {
+                    let (r, v) = (self.row_idx[q], self.values[q]);
+                    y[r] += v * x[j];
+                    if r != j {
+                        y[j] += v * x[r];
+                    }
                 }
             }
+        };
+        let half = self
+            .col_ptr
+            .partition_point(|&p| p < self.col_ptr[n] / 2)
+            .min(n);
+        let mut second = vec![0.0; n];
+        rayon::join(|| part(0..half, y), || part(half..n, &mut second));
+        for (a, b) in y.iter_mut().zip(&second) {
+            *a += b;
         }
     }
 }
@@ -1304,6 +1325,11 @@ impl<const D: usize> BiotCoupling<D> for Monolithic {
                         self.max_rank,
                     )
                     .map_err(|e| BiotError::Solver(e.0))?;
+                if updated {
+                    self.low_rank
+                        .prepare_correction(&self.ldlt, &self.col_ptr, &self.row_idx, &self.rows)
+                        .map_err(|e| BiotError::Solver(e.0))?;
+                }
             }
             if updated {
                 self.updates += 1;
@@ -1351,10 +1377,26 @@ impl<const D: usize> BiotCoupling<D> for Monolithic {
             }
         }
         w.z.clone_from(&w.rhs);
-        let mut solved = self.low_rank.solve(&mut self.ldlt, &mut w.z);
-        if self.low_rank.is_active() && solved.is_ok() {
-            solved = self.refine_update(&mut w);
-        }
+        let solved = if self.low_rank.is_active() {
+            // The residual row u of the current matrix at x (read at u's neighbours).
+            let (cp, ri, values, rows, b) = (
+                &self.col_ptr,
+                &self.row_idx,
+                &self.values,
+                &self.rows,
+                &w.rhs,
+            );
+            let residual = |u: usize, x: &[f64]| {
+                let mut ax = 0.0;
+                rows.for_row(u, cp, ri, |j, q| ax += values[q] * x[j]);
+                b[u] - ax
+            };
+            self.low_rank
+                .solve_corrected(&mut self.ldlt, &mut w.z, residual)
+                .and_then(|()| self.refine_update(&mut w))
+        } else {
+            self.low_rank.solve(&mut self.ldlt, &mut w.z)
+        };
         let result = solved
             .map_err(|e| BiotError::Solver(e.0))
             .and_then(|()| self.finish(sys, state, &w, fresh));

@@ -544,6 +544,80 @@ impl Ldlt {
         Ok(())
     }
 
+    /// The supernodes on the paths from the supernodes of the columns `positions` (in
+    /// the elimination order) to their roots, ascending: a set closed under the parent,
+    /// so a backward sweep over it ([`Ldlt::backward_partial`]) gives the solution at
+    /// every column of its supernodes.
+    pub(crate) fn path_union(&self, positions: &[usize]) -> Result<Vec<usize>, LdltError> {
+        self.check_supernodal(self.n)?;
+        let SymbolicCholeskyRaw::Supernodal(sn) = self.symbolic.raw() else {
+            return Err(LdltError("paths of a simplicial factor".into()));
+        };
+        let (begin, end, rptr) = (
+            sn.supernode_begin(),
+            sn.supernode_end(),
+            sn.col_ptr_for_row_idx(),
+        );
+        let ns = sn.n_supernodes();
+        let rows = sn.row_idx();
+        let mut sn_of_col = vec![0; self.n];
+        for s in 0..ns {
+            sn_of_col[begin[s]..end[s]].fill(s);
+        }
+        let mut on = vec![false; ns];
+        for &k in positions {
+            let mut s = sn_of_col[k];
+            while !on[s] {
+                on[s] = true;
+                // Parent: the supernode of the first row below (a later one).
+                let below = &rows[rptr[s]..rptr[s + 1]];
+                match below.iter().min().map(|&r| sn_of_col[r]) {
+                    Some(q) if q > s => s = q,
+                    _ => break,
+                }
+            }
+        }
+        Ok((0..ns).filter(|&s| on[s]).collect())
+    }
+
+    /// `x ← L⁻ᵀ D⁻¹ x` over the supernodes `sns` only (ascending, closed under the
+    /// parent: [`Ldlt::path_union`]), `x` in the elimination order: the columns of `sns`
+    /// get the values of a full backward sweep, the others are left as they were.
+    pub(crate) fn backward_partial(
+        &mut self,
+        sns: &[usize],
+        x: &mut [f64],
+    ) -> Result<(), LdltError> {
+        self.check_supernodal(x.len())?;
+        let SymbolicCholeskyRaw::Supernodal(sn) = self.symbolic.raw() else {
+            return Err(LdltError("partial sweep of a simplicial factor".into()));
+        };
+        let f = Factor {
+            begin: sn.supernode_begin(),
+            end: sn.supernode_end(),
+            rptr: sn.col_ptr_for_row_idx(),
+            vptr: sn.col_ptr_for_val(),
+            rows: sn.row_idx(),
+            values: &self.values,
+            inv_diag: &self.inv_diag,
+        };
+        pulp::Arch::new().dispatch(Backward {
+            f: &f,
+            sns,
+            x,
+            tmp: &mut self.tmp,
+        });
+        Ok(())
+    }
+
+    /// The position of the original unknown `u` in the elimination order.
+    pub(crate) fn position(&self, u: usize) -> usize {
+        match self.symbolic.perm() {
+            Some(p) => p.arrays().1[u],
+            None => u,
+        }
+    }
+
     fn check_supernodal(&self, len: usize) -> Result<(), LdltError> {
         if !self.factored {
             return Err(LdltError("solve before a successful factorization".into()));
@@ -1248,6 +1322,19 @@ mod tests {
                 assert!((0..n).all(|i| on_path(i) || e[i] == 0.0), "unit {u}");
                 let covered: usize = paths[c].iter().map(|r| r.len()).sum();
                 assert!(covered < n, "unit {u}: the path is the whole factor");
+            }
+            // A backward sweep over the paths of a few columns gives the full sweep's
+            // values at every column of those paths, bit for bit.
+            let mut z = b.clone();
+            f.forward_in_place(&mut z).unwrap();
+            let mut full = z.clone();
+            f.backward_in_place(&mut full).unwrap();
+            let targets: Vec<usize> = [1, n / 4, n - 2].iter().map(|&u| f.position(u)).collect();
+            let sns = f.path_union(&targets).unwrap();
+            let mut part = z.clone();
+            f.backward_partial(&sns, &mut part).unwrap();
+            for &u in &[1, n / 4, n - 2] {
+                assert_eq!(part[f.position(u)], full[u], "unknown {u}");
             }
         }
     }

@@ -69,6 +69,72 @@ pub(crate) struct LowRank {
     lu: Option<PartialPivLu<f64>>,
     /// `Δ y` over the support.
     t: Vec<f64>,
+    /// The support and its neighbours in the matrix (original indices): the unknowns
+    /// the residual on the support reads ([`LowRank::prepare_correction`]).
+    near: Vec<usize>,
+    /// The supernodes on the paths from those of `near` to the roots, ascending.
+    near_sns: Vec<usize>,
+    /// A copy of the swept vector for the partial backward sweep, and the solution at
+    /// `near` in the original order (other entries stale).
+    scratch: Vec<f64>,
+    near_x: Vec<f64>,
+}
+
+/// Row access to a symmetric matrix kept as its upper triangle in CSC (`col_ptr`,
+/// `row_idx`): per row `i`, the columns `j > i` and positions of its entries `(i, j)`.
+/// With the column itself (the entries `(r, i)`, `r ≤ i`) this is the whole row `i`.
+pub(crate) struct UpperRows {
+    ptr: Vec<usize>,
+    /// `(column, position in the CSC values)`, by row, columns ascending.
+    entries: Vec<(usize, usize)>,
+}
+
+impl UpperRows {
+    /// The row index of the upper triangle (`col_ptr`, `row_idx`).
+    pub(crate) fn new(col_ptr: &[usize], row_idx: &[usize]) -> Self {
+        let n = col_ptr.len().saturating_sub(1);
+        let mut ptr = vec![0usize; n + 1];
+        for j in 0..n {
+            for &i in &row_idx[col_ptr[j]..col_ptr[j + 1]] {
+                if i < j {
+                    ptr[i + 1] += 1;
+                }
+            }
+        }
+        for i in 0..n {
+            ptr[i + 1] += ptr[i];
+        }
+        let mut fill = ptr.clone();
+        let mut entries = vec![(0, 0); ptr[n]];
+        for j in 0..n {
+            for q in col_ptr[j]..col_ptr[j + 1] {
+                let i = row_idx[q];
+                if i < j {
+                    entries[fill[i]] = (j, q);
+                    fill[i] += 1;
+                }
+            }
+        }
+        Self { ptr, entries }
+    }
+
+    /// Call `f(j, q)` for every entry `(i, j)` of row `i` of the symmetric matrix, `q`
+    /// its position in the CSC values.
+    #[inline]
+    pub(crate) fn for_row(
+        &self,
+        i: usize,
+        col_ptr: &[usize],
+        row_idx: &[usize],
+        mut f: impl FnMut(usize, usize),
+    ) {
+        for q in col_ptr[i]..col_ptr[i + 1] {
+            f(row_idx[q], q);
+        }
+        for &(j, q) in &self.entries[self.ptr[i]..self.ptr[i + 1]] {
+            f(j, q);
+        }
+    }
 }
 
 impl LowRank {
@@ -85,6 +151,10 @@ impl LowRank {
             delta: Vec::new(),
             lu: None,
             t: Vec::new(),
+            near: Vec::new(),
+            near_sns: Vec::new(),
+            scratch: Vec::new(),
+            near_x: Vec::new(),
         }
     }
 
@@ -107,6 +177,8 @@ impl LowRank {
         self.support.clear();
         self.delta.clear();
         self.lu = None;
+        self.near.clear();
+        self.near_sns.clear();
     }
 
     /// Whether a change is set up (solves go through the capacitance matrix).
@@ -216,8 +288,92 @@ impl LowRank {
     /// Solve `A x = b` in place with the factors of `A₀` and the change set up by
     /// [`LowRank::prepare`] (plainly with `A₀` when none is).
     pub(crate) fn solve(&mut self, ldlt: &mut Ldlt, rhs: &mut [f64]) -> Result<(), LdltError> {
-        let Some(lu) = &self.lu else {
+        if self.lu.is_none() {
             return ldlt.solve_in_place(rhs);
+        }
+        self.forward_updated(ldlt, rhs)?;
+        ldlt.backward_in_place(rhs)
+    }
+
+    /// Set up [`LowRank::solve_corrected`] for the change prepared last: the support's
+    /// neighbours in the matrix (`rows` of the CSC upper triangle `col_ptr`, `row_idx`)
+    /// and the paths of their supernodes.
+    pub(crate) fn prepare_correction(
+        &mut self,
+        ldlt: &Ldlt,
+        col_ptr: &[usize],
+        row_idx: &[usize],
+        rows: &UpperRows,
+    ) -> Result<(), LdltError> {
+        let n = self.slot.len();
+        let mut seen = vec![false; n];
+        self.near.clear();
+        for &u in &self.support {
+            rows.for_row(u, col_ptr, row_idx, |j, _| {
+                if !seen[j] {
+                    seen[j] = true;
+                    self.near.push(j);
+                }
+            });
+            if !seen[u] {
+                seen[u] = true;
+                self.near.push(u);
+            }
+        }
+        let positions: Vec<usize> = self.near.iter().map(|&u| ldlt.position(u)).collect();
+        self.near_sns = ldlt.path_union(&positions)?;
+        Ok(())
+    }
+
+    /// Solve `A x = b` in place as [`LowRank::solve`], corrected once from the residual
+    /// on the support before the backward sweep. The error of an updated solve is that
+    /// of the capacitance solve, and its residual lies on the support `T`
+    /// ([`LowRank::solve_on_support`]); with `f'` the forward-swept right-hand side after
+    /// the update, the solution at the support's neighbours `N(T)` comes from a backward
+    /// sweep of a copy of `f'` over their paths only (`x = Πᵀ L⁻ᵀ D⁻¹ f'` there), which
+    /// gives the residual `ρ_u = b_u − (A x)_u` for `u ∈ T` (`residual(u, x)`, `x` read
+    /// at `N(T)` only); then `(I + Δ G)ᵀ c = ρ` and one backward sweep of
+    /// `f' + Σ_u c_u v_u` is the solution and its correction together (two sweeps
+    /// over the factor instead of three). Needs [`LowRank::prepare_correction`] after
+    /// the last [`LowRank::prepare`]; plainly with `A₀` when no change is set up.
+    pub(crate) fn solve_corrected(
+        &mut self,
+        ldlt: &mut Ldlt,
+        rhs: &mut [f64],
+        residual: impl Fn(usize, &[f64]) -> f64,
+    ) -> Result<(), LdltError> {
+        if self.lu.is_none() {
+            return ldlt.solve_in_place(rhs);
+        }
+        if self.near.is_empty() && !self.support.is_empty() {
+            return Err(LdltError("corrected solve without its set-up".into()));
+        }
+        self.forward_updated(ldlt, rhs)?;
+        let n = rhs.len();
+        self.scratch.clear();
+        self.scratch.extend_from_slice(rhs);
+        ldlt.backward_partial(&self.near_sns, &mut self.scratch)?;
+        self.near_x.resize(n, 0.0);
+        for &u in &self.near {
+            self.near_x[u] = self.scratch[ldlt.position(u)];
+        }
+        let mut c = Mat::<f64>::from_fn(self.support.len(), 1, |i, _| {
+            residual(self.support[i], &self.near_x)
+        });
+        if let Some(lu) = &self.lu {
+            lu.solve_transpose_in_place(c.as_mut());
+        }
+        for (i, &u) in self.support.iter().enumerate() {
+            self.add_column(u, c[(i, 0)], rhs);
+        }
+        ldlt.backward_in_place(rhs)
+    }
+
+    /// `rhs ← L⁻¹ Π rhs − Σ_u (Δ y)_u v_u`: the forward half of an updated solve, the
+    /// capacitance solve included (a change must be set up).
+    fn forward_updated(&mut self, ldlt: &mut Ldlt, rhs: &mut [f64]) -> Result<(), LdltError> {
+        let Some(lu) = &self.lu else {
+            return Err(LdltError("updated solve without a change".into()));
         };
         // f = L⁻¹ Π b; (Pᵀ z)_u = v_uᵀ D⁻¹ f.
         ldlt.forward_in_place(rhs)?;
@@ -243,7 +399,7 @@ impl LowRank {
         for (&u, &ti) in self.support.iter().zip(&self.t) {
             self.add_column(u, -ti, rhs);
         }
-        ldlt.backward_in_place(rhs)
+        Ok(())
     }
 }
 
@@ -389,6 +545,33 @@ mod tests {
                 .map(|(a, b)| (a - b).abs())
                 .fold(0.0, f64::max);
             assert!(err < 1e-12, "round {round}: residual {err:e}");
+            // The same solve corrected from the residual on the support, read at the
+            // support's neighbours from a backward sweep over their paths only.
+            let rows = UpperRows::new(&cp, &ri);
+            lr.prepare_correction(&ldlt, &cp, &ri, &rows).unwrap();
+            assert!(lr.near.len() > lr.support.len());
+            let mut xc = b.clone();
+            let residual = |u: usize, x: &[f64]| {
+                let mut ax = 0.0;
+                rows.for_row(u, &cp, &ri, |j, q| ax += changed[q] * x[j]);
+                b[u] - ax
+            };
+            lr.solve_corrected(&mut ldlt, &mut xc, residual).unwrap();
+            let ax = mul(n, &cp, &ri, &changed, &xc);
+            let err_c = ax
+                .iter()
+                .zip(&b)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            assert!(err_c < 1e-12, "round {round}: corrected residual {err_c:e}");
+            // The rows of the symmetric matrix: row u of A x from the row index.
+            let ones = vec![1.0; n];
+            let full = mul(n, &cp, &ri, &changed, &ones);
+            for (u, f) in full.iter().enumerate() {
+                let mut sum = 0.0;
+                rows.for_row(u, &cp, &ri, |_, q| sum += changed[q]);
+                assert!((sum - f).abs() < 1e-12, "row {u}: {sum} against {f}");
+            }
             // A right-hand side on the changed unknowns only: one backward sweep.
             let mut r = vec![0.0; n];
             for (k, &u) in lr.support.iter().enumerate() {
