@@ -118,7 +118,16 @@ pub fn assemble<const D: usize>(
     values: &mut [f64],
     forces: &mut [f64],
 ) -> Result<()> {
-    assemble_with(grid, laws, dofs, pattern, u, values, Some(forces), None)
+    assemble_with(
+        grid,
+        laws,
+        dofs,
+        pattern,
+        u,
+        Some(values),
+        Some(forces),
+        None,
+    )
 }
 
 /// The element stiffness `K_K` of every cell whose law is linear, kept between assemblies.
@@ -304,6 +313,11 @@ impl ElementCache {
             .collect()
     }
 
+    /// Whether the stiffness of cell `c` under `law` is kept.
+    pub(crate) fn keeps<const D: usize>(&self, c: usize, law: &dyn CellLaw<D>) -> bool {
+        self.matrix(c, law).is_some()
+    }
+
     /// The kept stiffness of cell `c` if its law is `law`.
     #[inline]
     fn matrix<const D: usize>(&self, c: usize, law: &dyn CellLaw<D>) -> Option<&[f64]> {
@@ -343,7 +357,27 @@ fn stiffness<const D: usize>(
     Ok(())
 }
 
-/// [`assemble`], taking the stiffness of the linear cells from `cache` when given.
+/// The stiffness matrices of `cells` at the nodal displacement `u`, appended to `out`
+/// in turn (column-major, as [`CellLaw::stiffness`] gives them). Errors as the assembly.
+pub(crate) fn cell_tangents<const D: usize>(
+    grid: &Grid<D>,
+    laws: &LawMap<'_, D>,
+    cells: &[usize],
+    u: &[f64],
+    out: &mut Vec<f64>,
+) -> Result<()> {
+    let mut w = Work::<D>::default();
+    for &c in cells {
+        w.gather(grid, c, u);
+        stiffness(grid, laws, c, &mut w)?;
+        out.extend_from_slice(w.k.as_slice());
+    }
+    Ok(())
+}
+
+/// [`assemble`], taking the stiffness of the linear cells from `cache` when given; the
+/// stiffness `values` and the internal `forces` each only when asked for (the same sums
+/// either way: every chunk adds its cells in turn).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn assemble_with<const D: usize>(
     grid: &Grid<D>,
@@ -351,7 +385,7 @@ pub(crate) fn assemble_with<const D: usize>(
     dofs: &DofMap<D>,
     pattern: &Pattern,
     u: &[f64],
-    values: &mut [f64],
+    values: Option<&mut [f64]>,
     forces: Option<&mut [f64]>,
     cache: Option<&ElementCache>,
 ) -> Result<()> {
@@ -364,52 +398,64 @@ pub(crate) fn assemble_with<const D: usize>(
             grid.num_cells()
         )));
     }
+    let values_len = values.as_ref().map_or(pattern.nnz(), |v| v.len());
     let forces_len = forces.as_ref().map_or(pattern.num_equations(), |f| f.len());
     if u.len() != dofs.num_dofs()
-        || values.len() != pattern.nnz()
+        || values_len != pattern.nnz()
         || forces_len != pattern.num_equations()
     {
         return Err(SimError::Input(format!(
             "assemble: lengths u {} (want {}), values {} (want {}), forces {} (want {})",
             u.len(),
             dofs.num_dofs(),
-            values.len(),
+            values_len,
             pattern.nnz(),
             forces_len,
             pattern.num_equations()
         )));
     }
     let raw = dofs.raw();
-    let kept_sum = cache.map(|e| e.kept_sum(grid, laws, dofs, pattern));
+    let kept_sum = match (&values, cache) {
+        (Some(_), Some(e)) => Some(e.kept_sum(grid, laws, dofs, pattern)),
+        _ => None,
+    };
+    /// The part of `rest` of length `len` (none when nothing is asked for).
+    fn take<'s>(rest: &mut Option<&'s mut [f64]>, len: usize) -> Option<&'s mut [f64]> {
+        let (part, r) = rest.take()?.split_at_mut(len);
+        *rest = Some(r);
+        Some(part)
+    }
     let mut parts = Vec::with_capacity(pattern.chunks.len());
     let (mut vrest, mut frest) = (values, forces);
     for ch in &pattern.chunks {
-        let (v, vr) = vrest.split_at_mut(ch.vals.len());
-        let f = match frest.take() {
-            Some(f) => {
-                let (f, fr) = f.split_at_mut(ch.cols.len());
-                frest = Some(fr);
-                Some(f)
-            }
-            None => None,
-        };
+        let v = take(&mut vrest, ch.vals.len());
+        let f = take(&mut frest, ch.cols.len());
         parts.push((ch, v, f));
-        vrest = vr;
     }
     parts
         .into_par_iter()
-        .try_for_each_init(Work::<D>::default, |w, (ch, vals, frc)| {
-            match &kept_sum {
-                Some(sum) => vals.copy_from_slice(&sum[ch.vals.clone()]),
-                None => vals.fill(0.0),
+        .try_for_each_init(Work::<D>::default, |w, (ch, mut vals, mut frc)| {
+            if let Some(vals) = vals.as_deref_mut() {
+                match &kept_sum {
+                    Some(sum) => vals.copy_from_slice(&sum[ch.vals.clone()]),
+                    None => vals.fill(0.0),
+                }
             }
-            let Some(frc) = frc else {
-                // The tangent only: the cells whose matrix is not in the kept sum.
-                for &c in &pattern.chunk_cells[ch.cells.clone()] {
-                    let law = laws.law(c);
-                    if cache.and_then(|e| e.matrix(c, law)).is_none() {
-                        w.gather(grid, c, u);
-                        stiffness(grid, laws, c, w)?;
+            if let Some(frc) = frc.as_deref_mut() {
+                frc.fill(0.0);
+            }
+            for &c in &pattern.chunk_cells[ch.cells.clone()] {
+                let law = laws.law(c);
+                // A kept matrix is in `kept_sum` already.
+                let kept = cache.and_then(|e| e.matrix(c, law));
+                if kept.is_some() && frc.is_none() {
+                    continue;
+                }
+                w.gather(grid, c, u);
+                let m = w.u.len();
+                if kept.is_none() && (vals.is_some() || law.is_linear()) {
+                    stiffness(grid, laws, c, w)?;
+                    if let Some(vals) = vals.as_deref_mut() {
                         pattern.add_cell(
                             grid,
                             dofs,
@@ -421,27 +467,9 @@ pub(crate) fn assemble_with<const D: usize>(
                         );
                     }
                 }
-                return Ok(());
-            };
-            frc.fill(0.0);
-            for &c in &pattern.chunk_cells[ch.cells.clone()] {
-                let law = laws.law(c);
-                w.gather(grid, c, u);
-                let m = w.u.len();
-                // A kept matrix is in `kept_sum` already.
-                let kept = cache.and_then(|e| e.matrix(c, law));
-                if kept.is_none() {
-                    stiffness(grid, laws, c, w)?;
-                    pattern.add_cell(
-                        grid,
-                        dofs,
-                        c,
-                        w.k.as_slice(),
-                        &mut w.map,
-                        ch.vals.start,
-                        vals,
-                    );
-                }
+                let Some(frc) = frc.as_deref_mut() else {
+                    continue;
+                };
                 let k = kept.unwrap_or(w.k.as_slice());
                 // Internal forces: −K u for linear laws (nothing to do at u = 0), else the law's.
                 if law.is_linear() {
@@ -778,7 +806,17 @@ mod tests {
         let run = |map: &LawMap<'_, 2>, cache: Option<&ElementCache>| {
             let mut v = vec![0.0; pattern.nnz()];
             let mut f = vec![0.0; dofs.num_equations()];
-            assemble_with(&grid, map, &dofs, &pattern, &u, &mut v, Some(&mut f), cache).unwrap();
+            assemble_with(
+                &grid,
+                map,
+                &dofs,
+                &pattern,
+                &u,
+                Some(&mut v),
+                Some(&mut f),
+                cache,
+            )
+            .unwrap();
             (v, f)
         };
         // Stiffness entries equal up to the order of the sums: 1e-15 of the largest.

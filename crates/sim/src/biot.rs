@@ -151,7 +151,7 @@ use porofrac_flow::{FlowError, FlowModel};
 use porofrac_grid::Point;
 use porofrac_law::Stiffness;
 
-use crate::assembly::{ElementCache, assemble, assemble_with, nodal_loads};
+use crate::assembly::{ElementCache, assemble, assemble_with, cell_tangents, nodal_loads};
 use crate::error::SimError;
 use crate::ldlt::{Ldlt, LdltError};
 use crate::lowrank::{LowRank, UpperRows};
@@ -216,6 +216,11 @@ pub struct BiotSystem<'a, const D: usize> {
     k_values: Arc<[f64]>,
     /// The kept stiffness of the linear cells (see [`ElementCache`]).
     elements: Option<Arc<ElementCache>>,
+    /// The cells whose stiffness is not kept in `elements` (all without it).
+    free_cells: Vec<usize>,
+    /// Their stiffness matrices in `k_values` (concatenated in the order of
+    /// `free_cells`), when `k_values` is this system's own assembly at a known point.
+    free_tangents: Option<Vec<f64>>,
 }
 
 /// The coupling data of a grid: α and `p₀` per cell, and the node normals `N_i` of every
@@ -351,13 +356,20 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
                     mechanics.dofs,
                     mechanics.pattern,
                     &u,
-                    &mut k,
+                    Some(&mut k),
                     None,
                     elements.as_deref(),
                 )?;
                 Arc::from(k)
             }
         };
+        let free_cells = (0..mechanics.grid.num_cells())
+            .filter(|&c| {
+                elements
+                    .as_deref()
+                    .is_none_or(|e| !e.keeps(c, mechanics.laws.law(c)))
+            })
+            .collect();
         Ok(Self {
             mech: mechanics,
             flow,
@@ -365,6 +377,8 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
             drained_bulk: None,
             k_values,
             elements,
+            free_cells,
+            free_tangents: None,
         })
     }
 
@@ -427,6 +441,39 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
         check_len("pressure", p.len(), self.num_cells())?;
         let mut internal = vec![0.0; self.mech.dofs.num_equations()];
         let changed = self.assemble_tangent(u, Some(&mut internal))?;
+        self.free_tangents = None;
+        let residual = self.residual_of(&internal, p, t)?;
+        Ok(Linearization { changed, residual })
+    }
+
+    /// The relative residual of the nonlinear equilibrium of `(u, p)` at time `t` that
+    /// [`Self::linearize`] measures, without touching the stiffness.
+    pub fn equilibrium_residual(&self, u: &[f64], p: &[f64], t: f64) -> BiotResult<f64> {
+        check_len("displacement", u.len(), self.mech.dofs.num_dofs())?;
+        check_len("pressure", p.len(), self.num_cells())?;
+        let StaticProblem {
+            grid,
+            laws,
+            dofs,
+            pattern,
+            ..
+        } = self.mech;
+        let mut internal = vec![0.0; dofs.num_equations()];
+        assemble_with(
+            grid,
+            laws,
+            dofs,
+            pattern,
+            u,
+            None,
+            Some(&mut internal),
+            self.elements.as_deref(),
+        )?;
+        self.residual_of(&internal, p, t)
+    }
+
+    /// `‖g(t) + Cᵀ(p − p₀) + f‖ / (‖g(t) + Cᵀ(p − p₀)‖ + ‖f‖)` for the internal forces `f`.
+    fn residual_of(&self, internal: &[f64], p: &[f64], t: f64) -> BiotResult<f64> {
         let StaticProblem {
             grid, dofs, loads, ..
         } = self.mech;
@@ -437,18 +484,40 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
         dofs.add_platen_forces(grid, t, &mut external);
         self.add_pore_pressure_equations(p, &mut external);
         let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
-        let scale = norm(&external) + norm(&internal);
-        let r: Vec<f64> = external.iter().zip(&internal).map(|(a, b)| a + b).collect();
-        let residual = if scale > 0.0 { norm(&r) / scale } else { 0.0 };
-        Ok(Linearization { changed, residual })
+        let scale = norm(&external) + norm(internal);
+        let r: Vec<f64> = external.iter().zip(internal).map(|(a, b)| a + b).collect();
+        Ok(if scale > 0.0 { norm(&r) / scale } else { 0.0 })
     }
 
     /// Re-linearize the mechanics at `u` as [`Self::linearize`] does, without the
     /// internal forces and the equilibrium residual (the stiffness only, the same
     /// values). Returns whether the stiffness changed.
+    ///
+    /// The kept (linear) cells do not depend on `u`: when the stiffness of every other
+    /// cell at `u` equals, to the last bit, the one in the last tangent this system
+    /// assembled, so does the sum, and nothing is assembled.
     pub fn tangent_at(&mut self, u: &[f64]) -> BiotResult<bool> {
         check_len("displacement", u.len(), self.mech.dofs.num_dofs())?;
-        self.assemble_tangent(u, None)
+        let tangents = self.free_cell_tangents(u)?;
+        if self.free_tangents.as_ref() == Some(&tangents) {
+            return Ok(false);
+        }
+        let changed = self.assemble_tangent(u, None)?;
+        self.free_tangents = Some(tangents);
+        Ok(changed)
+    }
+
+    /// The stiffness matrices at `u` of the cells not kept, concatenated.
+    fn free_cell_tangents(&self, u: &[f64]) -> BiotResult<Vec<f64>> {
+        let mut out = Vec::new();
+        cell_tangents(
+            self.mech.grid,
+            self.mech.laws,
+            &self.free_cells,
+            u,
+            &mut out,
+        )?;
+        Ok(out)
     }
 
     /// The tangent at `u` (and the internal forces into `internal` when given); adopts
@@ -469,7 +538,7 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
             dofs,
             pattern,
             u,
-            Arc::get_mut(&mut values).expect("a new allocation is not shared"),
+            Some(Arc::get_mut(&mut values).expect("a new allocation is not shared")),
             internal,
             self.elements.as_deref(),
         )?;
