@@ -912,6 +912,9 @@ pub struct Monolithic {
     low_rank: Box<LowRank>,
     /// Row access to the pattern (the residual of an updated solve on its support).
     rows: UpperRows,
+    /// The forward sweep `L⁻¹ Π b` of the last updated solve: the factorization it was
+    /// swept with (their count), `b` and the sweep.
+    forward: Option<(usize, Vec<f64>, Vec<f64>)>,
     /// At most this many changed unknowns go through `low_rank`; beyond, a factorization.
     max_rank: usize,
     /// Matrices solved by a low-rank update.
@@ -1036,6 +1039,7 @@ impl Monolithic {
             factor_values: Vec::new(),
             low_rank: Box::new(LowRank::new(n)),
             rows,
+            forward: None,
             max_rank: DEFAULT_MAX_RANK,
             updates: 0,
             factored: None,
@@ -1154,6 +1158,50 @@ impl Monolithic {
         for (c, m) in sys.flow.accumulation().iter().enumerate() {
             self.values[self.fpos[dpos[c]]] -= s * s * m;
         }
+    }
+
+    /// `work.z ← L⁻¹ Π work.rhs`, from the sweep of the last updated solve when the
+    /// factors are the same: every solve of a step has the same right-hand side except
+    /// for the pressure rows of the cells whose transmissibilities a failure changed, so
+    /// the new sweep is the old one plus the sweep of the difference, which runs over the
+    /// paths of its few nonzeros in the elimination tree only (`Ldlt::forward_sparse`).
+    fn forward_sweep(&mut self, work: &mut MonolithicWork) -> Result<(), LdltError> {
+        let factors = self.ldlt.numeric_factorizations();
+        let n = work.rhs.len();
+        if let Some((k, b, f)) = self.forward.as_mut()
+            && *k == factors
+            && b.len() == n
+        {
+            let changed: Vec<usize> = (0..n).filter(|&i| b[i] != work.rhs[i]).collect();
+            if changed.len() <= self.max_rank {
+                if !changed.is_empty() {
+                    let positions: Vec<usize> =
+                        changed.iter().map(|&i| self.ldlt.position(i)).collect();
+                    let mut d = vec![0.0; n];
+                    for (&i, &p) in changed.iter().zip(&positions) {
+                        d[p] = work.rhs[i] - b[i];
+                    }
+                    self.ldlt.forward_sparse(&positions, &mut d)?;
+                    for (fi, di) in f.iter_mut().zip(&d) {
+                        *fi += di;
+                    }
+                    b.clone_from(&work.rhs);
+                }
+                work.z.copy_from_slice(f);
+                return Ok(());
+            }
+        }
+        work.z.clone_from(&work.rhs);
+        self.ldlt.forward_in_place(&mut work.z)?;
+        let (mut b, mut f) = self
+            .forward
+            .take()
+            .map(|(_, b, f)| (b, f))
+            .unwrap_or_default();
+        b.clone_from(&work.rhs);
+        f.clone_from(&work.z);
+        self.forward = Some((factors, b, f));
+        Ok(())
     }
 
     /// Iterative refinement of a low-rank solve `work.z` of `work.rhs` (corrected once
@@ -1447,6 +1495,9 @@ impl<const D: usize> BiotCoupling<D> for Monolithic {
         }
         w.z.clone_from(&w.rhs);
         let solved = if self.low_rank.is_active() {
+            // f = L⁻¹ Π b: every solve of a step has the same right-hand side, so with the
+            // same factors the forward sweep is the one of the step's first solve.
+            let swept = self.forward_sweep(&mut w);
             // The residual row u of the current matrix at x (read at u's neighbours).
             let (cp, ri, values, rows, b) = (
                 &self.col_ptr,
@@ -1460,8 +1511,11 @@ impl<const D: usize> BiotCoupling<D> for Monolithic {
                 rows.for_row(u, cp, ri, |j, q| ax += values[q] * x[j]);
                 b[u] - ax
             };
-            self.low_rank
-                .solve_corrected(&mut self.ldlt, &mut w.z, residual)
+            swept
+                .and_then(|()| {
+                    self.low_rank
+                        .solve_corrected(&mut self.ldlt, &mut w.z, residual)
+                })
                 .and_then(|()| self.refine_update(&mut w))
         } else {
             self.low_rank.solve(&mut self.ldlt, &mut w.z)

@@ -610,6 +610,36 @@ impl Ldlt {
         Ok(())
     }
 
+    /// `x ← L⁻¹ x` for `x` (in the elimination order) zero outside the columns
+    /// `positions`: a forward sweep over their paths to the roots only
+    /// ([`Ldlt::path_union`]; outside them the result is zero too).
+    pub(crate) fn forward_sparse(
+        &mut self,
+        positions: &[usize],
+        x: &mut [f64],
+    ) -> Result<(), LdltError> {
+        let sns = self.path_union(positions)?;
+        let SymbolicCholeskyRaw::Supernodal(sn) = self.symbolic.raw() else {
+            return Err(LdltError("partial sweep of a simplicial factor".into()));
+        };
+        let f = Factor {
+            begin: sn.supernode_begin(),
+            end: sn.supernode_end(),
+            rptr: sn.col_ptr_for_row_idx(),
+            vptr: sn.col_ptr_for_val(),
+            rows: sn.row_idx(),
+            values: &self.values,
+            inv_diag: &self.inv_diag,
+        };
+        pulp::Arch::new().dispatch(Forward {
+            f: &f,
+            sns: &sns,
+            x,
+            tmp: &mut self.tmp,
+        });
+        Ok(())
+    }
+
     /// The position of the original unknown `u` in the elimination order.
     pub(crate) fn position(&self, u: usize) -> usize {
         match self.symbolic.perm() {

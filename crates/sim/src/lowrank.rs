@@ -291,7 +291,8 @@ impl LowRank {
         if self.lu.is_none() {
             return ldlt.solve_in_place(rhs);
         }
-        self.forward_updated(ldlt, rhs)?;
+        ldlt.forward_in_place(rhs)?;
+        self.update_forwarded(ldlt, rhs)?;
         ldlt.backward_in_place(rhs)
     }
 
@@ -335,7 +336,10 @@ impl LowRank {
     /// at `N(T)` only); then `(I + Δ G)ᵀ c = ρ` and one backward sweep of
     /// `f' + Σ_u c_u v_u` is the solution and its correction together (two sweeps
     /// over the factor instead of three). Needs [`LowRank::prepare_correction`] after
-    /// the last [`LowRank::prepare`]; plainly with `A₀` when no change is set up.
+    /// the last [`LowRank::prepare`]. `rhs` holds the forward sweep `f = L⁻¹ Π b` on
+    /// entry ([`Ldlt::forward_in_place`]: the same for every matrix solved with the same
+    /// `b` and factors, so the caller may keep it) and the solution on return; without a
+    /// change set up, the backward sweep alone (a solve with `A₀`).
     pub(crate) fn solve_corrected(
         &mut self,
         ldlt: &mut Ldlt,
@@ -343,12 +347,12 @@ impl LowRank {
         residual: impl Fn(usize, &[f64]) -> f64,
     ) -> Result<(), LdltError> {
         if self.lu.is_none() {
-            return ldlt.solve_in_place(rhs);
+            return ldlt.backward_in_place(rhs);
         }
         if self.near.is_empty() && !self.support.is_empty() {
             return Err(LdltError("corrected solve without its set-up".into()));
         }
-        self.forward_updated(ldlt, rhs)?;
+        self.update_forwarded(ldlt, rhs)?;
         let n = rhs.len();
         self.scratch.clear();
         self.scratch.extend_from_slice(rhs);
@@ -369,14 +373,13 @@ impl LowRank {
         ldlt.backward_in_place(rhs)
     }
 
-    /// `rhs ← L⁻¹ Π rhs − Σ_u (Δ y)_u v_u`: the forward half of an updated solve, the
-    /// capacitance solve included (a change must be set up).
-    fn forward_updated(&mut self, ldlt: &mut Ldlt, rhs: &mut [f64]) -> Result<(), LdltError> {
+    /// `f ← f − Σ_u (Δ y)_u v_u` for the forward sweep `f = L⁻¹ Π b` in `rhs`: the
+    /// capacitance solve of an updated solve (a change must be set up).
+    fn update_forwarded(&mut self, ldlt: &Ldlt, rhs: &mut [f64]) -> Result<(), LdltError> {
         let Some(lu) = &self.lu else {
             return Err(LdltError("updated solve without a change".into()));
         };
-        // f = L⁻¹ Π b; (Pᵀ z)_u = v_uᵀ D⁻¹ f.
-        ldlt.forward_in_place(rhs)?;
+        // (Pᵀ z)_u = v_uᵀ D⁻¹ f.
         let n = rhs.len();
         let m = self.support.len();
         let inv_d = ldlt.inverse_diagonal();
@@ -551,6 +554,7 @@ mod tests {
             lr.prepare_correction(&ldlt, &cp, &ri, &rows).unwrap();
             assert!(lr.near.len() > lr.support.len());
             let mut xc = b.clone();
+            ldlt.forward_in_place(&mut xc).unwrap();
             let residual = |u: usize, x: &[f64]| {
                 let mut ax = 0.0;
                 rows.for_row(u, &cp, &ri, |j, q| ax += changed[q] * x[j]);
