@@ -1511,10 +1511,12 @@ impl<const D: usize> BiotCoupling<D> for Monolithic {
                 rows.for_row(u, cp, ri, |j, q| ax += values[q] * x[j]);
                 b[u] - ax
             };
+            // Half the target on the support leaves room for the residual elsewhere.
+            let target = 0.5 * LOW_RANK_RESIDUAL * b.iter().map(|v| v * v).sum::<f64>().sqrt();
             swept
                 .and_then(|()| {
                     self.low_rank
-                        .solve_corrected(&mut self.ldlt, &mut w.z, residual)
+                        .solve_corrected(&mut self.ldlt, &mut w.z, target, residual)
                 })
                 .and_then(|()| self.refine_update(&mut w))
         } else {

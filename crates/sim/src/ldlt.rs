@@ -1366,6 +1366,21 @@ mod tests {
             for &u in &[1, n / 4, n - 2] {
                 assert_eq!(part[f.position(u)], full[u], "unknown {u}");
             }
+            // The forward sweep of a vector with a few nonzeros, over their paths only.
+            let mut sparse = vec![0.0; n];
+            let mut dense = vec![0.0; n];
+            for (k, &u) in [2, n / 3, n - 4].iter().enumerate() {
+                sparse[f.position(u)] = 1.5 + k as f64;
+                dense[u] = 1.5 + k as f64;
+            }
+            f.forward_sparse(&targets, &mut vec![0.0; n]).unwrap();
+            let positions: Vec<usize> = [2, n / 3, n - 4].iter().map(|&u| f.position(u)).collect();
+            f.forward_sparse(&positions, &mut sparse).unwrap();
+            f.forward_in_place(&mut dense).unwrap();
+            let d = (0..n)
+                .map(|i| (sparse[i] - dense[i]).abs())
+                .fold(0.0, f64::max);
+            assert!(d <= 1e-14, "sparse forward sweep differs by {d:e}");
         }
     }
 }
