@@ -122,7 +122,9 @@ impl Tensile {
                         .sum::<f64>()
             })
             .fold(f64::NEG_INFINITY, f64::max);
-        !(bound + 1e-10 * s.amax() < self.strength)
+        let margin = bound + 1e-10 * s.amax();
+        // NaN compares false: a non-finite stress is never screened out.
+        margin >= self.strength || margin.is_nan()
     }
 }
 
