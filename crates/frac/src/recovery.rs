@@ -8,6 +8,9 @@
 //! degenerate (boundary and corner nodes), the patch grows by one ring of neighbouring
 //! cells until the fit is well posed. The fit reproduces any linear stress field exactly.
 //!
+//! The fit is linear in the cell values: [`StressRecovery`] keeps every node's weights
+//! (computed once per grid) so that a recovery is one weighted sum per node.
+//!
 //! [`cell_average`] turns the nodal field back into cell values (the mean over the
 //! cell's nodes), which a failure criterion can use instead of the raw cell stress.
 

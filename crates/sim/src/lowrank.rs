@@ -27,7 +27,11 @@
 //! over that path only ([`Ldlt::forward_units`]) — on the 3D hydraulic-fracture scene a
 //! small part of the factor — and every product with it runs over the path's columns.
 //! The `v_u` and their products `G` are kept for every unknown met since the last
-//! factorization, so a later change pays only for the unknowns new to it. (The earlier
+//! factorization, so a later change pays only for the unknowns new to it. The error of
+//! an updated solve, that of the capacitance solve, leaves a residual on `T` only; it is
+//! measured there from the solution at `T`'s neighbours (a backward sweep over their
+//! paths) and corrected within the solve's own backward sweep
+//! ([`LowRank::solve_corrected`]). (The earlier
 //! form kept the whole columns `A₀⁻¹ P`, a forward *and* a backward sweep over the whole
 //! factor per unknown.) The caller bounds `m` and factorizes `A` afresh beyond it, and
 //! checks the residual of the result against `A` itself.
