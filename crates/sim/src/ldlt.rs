@@ -589,25 +589,7 @@ impl Ldlt {
         x: &mut [f64],
     ) -> Result<(), LdltError> {
         self.check_supernodal(x.len())?;
-        let SymbolicCholeskyRaw::Supernodal(sn) = self.symbolic.raw() else {
-            return Err(LdltError("partial sweep of a simplicial factor".into()));
-        };
-        let f = Factor {
-            begin: sn.supernode_begin(),
-            end: sn.supernode_end(),
-            rptr: sn.col_ptr_for_row_idx(),
-            vptr: sn.col_ptr_for_val(),
-            rows: sn.row_idx(),
-            values: &self.values,
-            inv_diag: &self.inv_diag,
-        };
-        pulp::Arch::new().dispatch(Backward {
-            f: &f,
-            sns,
-            x,
-            tmp: &mut self.tmp,
-        });
-        Ok(())
+        self.sweep_over(sns, x, false)
     }
 
     /// `x ← L⁻¹ x` for `x` (in the elimination order) zero outside the columns
@@ -619,6 +601,12 @@ impl Ldlt {
         x: &mut [f64],
     ) -> Result<(), LdltError> {
         let sns = self.path_union(positions)?;
+        self.sweep_over(&sns, x, true)
+    }
+
+    /// `x ← L⁻¹ x` (`forward`) or `x ← L⁻ᵀ D⁻¹ x` over the supernodes `sns` only
+    /// (ascending, closed under the parent), on the calling thread.
+    fn sweep_over(&mut self, sns: &[usize], x: &mut [f64], forward: bool) -> Result<(), LdltError> {
         let SymbolicCholeskyRaw::Supernodal(sn) = self.symbolic.raw() else {
             return Err(LdltError("partial sweep of a simplicial factor".into()));
         };
@@ -631,12 +619,12 @@ impl Ldlt {
             values: &self.values,
             inv_diag: &self.inv_diag,
         };
-        pulp::Arch::new().dispatch(Forward {
-            f: &f,
-            sns: &sns,
-            x,
-            tmp: &mut self.tmp,
-        });
+        let (arch, tmp) = (pulp::Arch::new(), &mut self.tmp);
+        if forward {
+            arch.dispatch(Forward { f: &f, sns, x, tmp });
+        } else {
+            arch.dispatch(Backward { f: &f, sns, x, tmp });
+        }
         Ok(())
     }
 
