@@ -451,24 +451,8 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
     pub fn equilibrium_residual(&self, u: &[f64], p: &[f64], t: f64) -> BiotResult<f64> {
         check_len("displacement", u.len(), self.mech.dofs.num_dofs())?;
         check_len("pressure", p.len(), self.num_cells())?;
-        let StaticProblem {
-            grid,
-            laws,
-            dofs,
-            pattern,
-            ..
-        } = self.mech;
-        let mut internal = vec![0.0; dofs.num_equations()];
-        assemble_with(
-            grid,
-            laws,
-            dofs,
-            pattern,
-            u,
-            None,
-            Some(&mut internal),
-            self.elements.as_deref(),
-        )?;
+        let mut internal = vec![0.0; self.mech.dofs.num_equations()];
+        self.assemble_at(u, None, Some(&mut internal))?;
         self.residual_of(&internal, p, t)
     }
 
@@ -507,6 +491,28 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
         Ok(changed)
     }
 
+    /// The stiffness `values` and internal `forces` at `u` (each when asked for), the
+    /// linear cells' stiffness taken from the kept element matrices.
+    fn assemble_at(
+        &self,
+        u: &[f64],
+        values: Option<&mut [f64]>,
+        forces: Option<&mut [f64]>,
+    ) -> BiotResult<()> {
+        let m = &self.mech;
+        assemble_with(
+            m.grid,
+            m.laws,
+            m.dofs,
+            m.pattern,
+            u,
+            values,
+            forces,
+            self.elements.as_deref(),
+        )?;
+        Ok(())
+    }
+
     /// The stiffness matrices at `u` of the cells not kept, concatenated.
     fn free_cell_tangents(&self, u: &[f64]) -> BiotResult<Vec<f64>> {
         let mut out = Vec::new();
@@ -523,24 +529,12 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
     /// The tangent at `u` (and the internal forces into `internal` when given); adopts
     /// it when it differs from the current stiffness and says whether it did.
     fn assemble_tangent(&mut self, u: &[f64], internal: Option<&mut [f64]>) -> BiotResult<bool> {
-        let StaticProblem {
-            grid,
-            laws,
-            dofs,
-            pattern,
-            ..
-        } = self.mech;
         // Assembled in place in a new shared slice (one allocation, no copy into an `Arc`).
-        let mut values: Arc<[f64]> = std::iter::repeat_n(0.0, pattern.nnz()).collect();
-        assemble_with(
-            grid,
-            laws,
-            dofs,
-            pattern,
+        let mut values: Arc<[f64]> = std::iter::repeat_n(0.0, self.mech.pattern.nnz()).collect();
+        self.assemble_at(
             u,
             Some(Arc::get_mut(&mut values).expect("a new allocation is not shared")),
             internal,
-            self.elements.as_deref(),
         )?;
         let changed = values.len() != self.k_values.len()
             || values

@@ -475,15 +475,7 @@ impl Ldlt {
             return Err(LdltError("unit solves of a simplicial factor".into()));
         };
         let (begin, end) = (sn.supernode_begin(), sn.supernode_end());
-        let f = Factor {
-            begin,
-            end,
-            rptr: sn.col_ptr_for_row_idx(),
-            vptr: sn.col_ptr_for_val(),
-            rows: sn.row_idx(),
-            values: &self.values,
-            inv_diag: &self.inv_diag,
-        };
+        let f = Factor::of(sn, &self.values, &self.inv_diag);
         let ns = sn.n_supernodes();
         let mut sn_of_col = vec![0; n];
         for s in 0..ns {
@@ -610,15 +602,7 @@ impl Ldlt {
         let SymbolicCholeskyRaw::Supernodal(sn) = self.symbolic.raw() else {
             return Err(LdltError("partial sweep of a simplicial factor".into()));
         };
-        let f = Factor {
-            begin: sn.supernode_begin(),
-            end: sn.supernode_end(),
-            rptr: sn.col_ptr_for_row_idx(),
-            vptr: sn.col_ptr_for_val(),
-            rows: sn.row_idx(),
-            values: &self.values,
-            inv_diag: &self.inv_diag,
-        };
+        let f = Factor::of(sn, &self.values, &self.inv_diag);
         let (arch, tmp) = (pulp::Arch::new(), &mut self.tmp);
         if forward {
             arch.dispatch(Forward { f: &f, sns, x, tmp });
@@ -692,15 +676,7 @@ impl Ldlt {
         let SymbolicCholeskyRaw::Supernodal(sn) = self.symbolic.raw() else {
             return;
         };
-        let f = Factor {
-            begin: sn.supernode_begin(),
-            end: sn.supernode_end(),
-            rptr: sn.col_ptr_for_row_idx(),
-            vptr: sn.col_ptr_for_val(),
-            rows: sn.row_idx(),
-            values: &self.values,
-            inv_diag: &self.inv_diag,
-        };
+        let f = Factor::of(sn, &self.values, &self.inv_diag);
         let ns = sn.n_supernodes();
         let x = &mut self.work;
         // The sweeps compiled for the widest vector instructions of this processor.
@@ -935,7 +911,24 @@ struct Factor<'f> {
     inv_diag: &'f [f64],
 }
 
-impl Factor<'_> {
+impl<'f> Factor<'f> {
+    /// The view of the supernodal structure `sn` with the values and `1/D` of its factors.
+    fn of(
+        sn: &'f faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky<usize>,
+        values: &'f [f64],
+        inv_diag: &'f [f64],
+    ) -> Self {
+        Factor {
+            begin: sn.supernode_begin(),
+            end: sn.supernode_end(),
+            rptr: sn.col_ptr_for_row_idx(),
+            vptr: sn.col_ptr_for_val(),
+            rows: sn.row_idx(),
+            values,
+            inv_diag,
+        }
+    }
+
     /// Supernode `s`: its first column, width `w`, rows below `r`, and the block.
     #[inline(always)]
     fn supernode(&self, s: usize) -> (usize, usize, usize, &[f64], &[usize]) {
