@@ -41,7 +41,7 @@ use crate::conditions::{BodyLoads, Condition, Field, Slot};
 use crate::error::{CosseratError, Result};
 use crate::linear::{
     AUTO_GMRES_EQUATIONS, AUTO_SCHUR_UNKNOWNS, Linear, LinearOptions, LinearSolver, LinearStats,
-    SchurAnalysis,
+    LowRankDifference, SchurAnalysis,
 };
 use crate::material::{Material, components, levi_civita, rotations, strain_index, strain_len};
 use crate::pattern::{BlockPattern, SparseLu};
@@ -88,6 +88,10 @@ struct FixedTerm {
     field: usize,
     /// `(equation, |F| (Σ̄(e_eq) n)_k)`.
     coef: Vec<(usize, f64)>,
+    /// The facet value of the component, `(equation, stencil weight)`.
+    trace: Vec<(usize, f64)>,
+    /// The preconditioner's penalty coefficient `(|F|/h_K) Q_kk(n)` (times `γ` there).
+    penalty: f64,
 }
 
 /// A loaded component of a boundary facet.
@@ -284,11 +288,11 @@ impl<const D: usize> Cosserat<D> {
         // pattern and the unknowns of the Nitsche terms: it runs beside the assembly.
         // The values of the static solve are computed on the assembling thread after the
         // assembly, while the other one still allocates the factors.
-        let in_t = me.schur_candidates();
-        let static_candidate = in_t.is_some();
+        let border = me.schur_border(LinearSolver::Auto);
+        let static_candidate = border.is_some();
         let mut values = std::mem::take(&mut me.symmetric);
         let (prepared, static_values) = rayon::join(
-            || in_t.and_then(|t| SchurAnalysis::new(&me.pattern, t, true).ok()),
+            || border.and_then(|e| SchurAnalysis::bordered(&me.pattern, &e, true).ok()),
             || {
                 // Touch the fresh pages once, on one thread: page faults taken by two
                 // threads at once doubled the time of the cell assembly (measured).
@@ -380,6 +384,28 @@ impl<const D: usize> Cosserat<D> {
                 &self.nitsche_cells,
             )
         })
+    }
+    /// The difference between the system and the preconditioning matrix,
+    /// [`Self::system_values`] − [`Self::preconditioner_values`] (also between the Newmark
+    /// matrices, which add the same mass to both), as a sum of rank-two terms, one per
+    /// fixed component `k` of a boundary facet `F`:
+    ///
+    /// ```text
+    ///   K − P = Σ_(F,k)  c wᵀ − w cᵀ − γ p w wᵀ  =  Σ_(F,k) [w c] [[−γ p, −1], [1, 0]] [w c]ᵀ
+    /// ```
+    ///
+    /// with `w` the facet value of component `k` (the stencil weights), `c = |F| T_k` the
+    /// Nitsche traction row of the facet's cell and `p = (|F|/h_K) Q_kk(n)`, `γ` =
+    /// [`PRECONDITIONER_PENALTY`].
+    pub fn boundary_difference(&self) -> LowRankDifference {
+        let mut columns = Vec::with_capacity(2 * self.fixed.len());
+        let mut blocks = Vec::with_capacity(self.fixed.len());
+        for ft in &self.fixed {
+            columns.push(ft.trace.clone());
+            columns.push(ft.coef.clone());
+            blocks.push([-PRECONDITIONER_PENALTY * ft.penalty, 1.0, -1.0, 0.0]);
+        }
+        LowRankDifference { columns, blocks }
     }
     /// Number of unknowns.
     pub fn equations(&self) -> usize {
@@ -497,36 +523,20 @@ impl<const D: usize> Cosserat<D> {
 
     /// The unknowns where the system will differ from the preconditioning matrix (those
     /// of the Nitsche terms and of the boundary penalty), when the automatic choice of
-    /// [`Linear::new`] would take the Schur complement solve for a static problem (2D,
-    /// below [`AUTO_GMRES_EQUATIONS`] equations, at most [`AUTO_SCHUR_UNKNOWNS`] of them).
-    fn schur_candidates(&self) -> Option<Vec<bool>> {
-        let p = &self.pattern;
-        let n = p.equations();
-        if D != 2 || n >= AUTO_GMRES_EQUATIONS {
-            return None;
-        }
-        let mut in_t = vec![false; n];
-        let columns = self
-            .nitsche_cells
-            .iter()
-            .flat_map(|&c| c * p.block..(c + 1) * p.block);
-        for j in columns {
-            for q in p.col_ptr[j]..p.col_ptr[j + 1] {
-                if self.nitsche[q] != 0.0 {
-                    in_t[j] = true;
-                    in_t[p.row_idx[q]] = true;
-                }
-            }
-        }
-        for &(pos, v) in &self.boundary {
-            if v != 0.0 {
-                let j = p.col_ptr.partition_point(|&c| c <= pos) - 1;
-                in_t[j] = true;
-                in_t[p.row_idx[pos]] = true;
-            }
-        }
-        let count = in_t.iter().filter(|&&t| t).count();
-        (count > 0 && count <= AUTO_SCHUR_UNKNOWNS).then_some(in_t)
+    /// The difference between the system and the preconditioning matrix
+    /// ([`Self::boundary_difference`]) when `solver` takes the Schur complement solve:
+    /// [`LinearSolver::LdltSchur`], or [`LinearSolver::Auto`] in 2D below
+    /// [`AUTO_GMRES_EQUATIONS`] equations with at most [`AUTO_SCHUR_UNKNOWNS`] columns.
+    fn schur_border(&self, solver: LinearSolver) -> Option<LowRankDifference> {
+        let n = self.pattern.equations();
+        let columns = 2 * self.fixed.len();
+        let auto = D == 2 && n < AUTO_GMRES_EQUATIONS && columns <= AUTO_SCHUR_UNKNOWNS;
+        let taken = match solver {
+            LinearSolver::LdltSchur => true,
+            LinearSolver::Auto => auto,
+            _ => false,
+        };
+        (taken && columns > 0).then(|| self.boundary_difference())
     }
 
     /// Add the local matrices of items `0..count` (cells or facets; `local` fills one)
@@ -745,10 +755,18 @@ impl<const D: usize> Cosserat<D> {
                         (v != 0.0).then_some((cc * n + a, v))
                     })
                     .collect();
+                let trace = st
+                    .cells
+                    .iter()
+                    .zip(&st.weights)
+                    .map(|(&cc, &l)| (cc * n + k, l))
+                    .collect();
                 self.fixed.push(FixedTerm {
                     face: f,
                     field,
                     coef,
+                    trace,
+                    penalty: pen,
                 });
             }
             if any_fixed {
@@ -841,6 +859,12 @@ impl<const D: usize> Cosserat<D> {
     ) -> Result<Linear> {
         let centres = self.centres();
         let prepared = self.prepared.lock().ok().and_then(|mut p| p.take());
+        // After the first solve (or for the Newmark matrix): a new analysis of the
+        // bordered matrix when the solver takes it.
+        let prepared = prepared.or_else(|| {
+            self.schur_border(options.solver)
+                .and_then(|e| SchurAnalysis::bordered(&self.pattern, &e, false).ok())
+        });
         Linear::with_values(
             &self.pattern,
             values,

@@ -14,41 +14,65 @@
 //! and `(θ × x, θ)`).
 //!
 //! **Exact solve from the symmetric factor** ([`LinearSolver::LdltSchur`]). `K` and `P`
-//! differ only in the rows and columns of the unknowns `T` that the Nitsche terms and the
-//! boundary penalty touch (the components of the cells in the stencils of the fixed
-//! boundary facets: `|T|` = 540 of 8,640 unknowns on the 2,880-triangle plate, growing as
-//! the boundary, i.e. as `√n` in 2D): `K = P + E` with `E` zero outside `T × T`. `P` is
-//! factorised `P = L D Lᵀ` by the sparse `LDLᵀ` of `porofrac-sim` with `T` eliminated last
-//! (the other cells in approximate minimum degree order, faer's AMD on the cell graph), so
-//! the last `|T|` columns of the factors hold the Schur complement
-//! `S_P = P_TT − P_TI P_II⁻¹ P_IT = L_TT D_T L_TTᵀ`, and `(P⁻¹)_TT = S_P⁻¹`. Writing
-//! `K x = b` as `P x = b − E x_T` and restricting `x = P⁻¹ b − P⁻¹ E x_T` to `T`:
+//! differ by the Nitsche terms and the boundary penalty alone, a matrix of low rank:
+//! one rank-two term per fixed component `k` of a boundary facet,
+//! `K − P = Σ c wᵀ − w cᵀ − γ p w wᵀ = Z B Zᵀ` ([`crate::Cosserat::boundary_difference`]:
+//! `w` the facet value, `c` the Nitsche traction row, `B` block diagonal with `2 × 2`
+//! blocks; 240 columns on the 2,880-triangle plate of 8,640 unknowns, growing as the
+//! boundary, `√n` in 2D). The columns are scaled to unit length (`B` scaled to match). The
+//! bordered symmetric matrix
+//!
+//! ```text
+//!   A = [ P   Z ]  =  [ L₁₁  0  ] [ D₁  0  ] [ L₁₁  0  ]ᵀ ,     L₂₂ D₂ L₂₂ᵀ = −H ,   H = Zᵀ P⁻¹ Z ,
+//!       [ Zᵀ  0 ]     [ L₂₁ L₂₂ ] [ 0   D₂ ] [ L₂₁ L₂₂ ]
+//! ```
+//!
+//! is factorised by the sparse `LDLᵀ` of `porofrac-sim` with the cells in approximate
+//! minimum degree order (faer's AMD on the cell graph of `P`) and the `m` border unknowns
+//! last, so the trailing block of the factors holds `−H` (`n` positive pivots, then `m`
+//! negative ones). Woodbury's identity for `K = P + Z B Zᵀ` is then two sweeps and dense
+//! work of order `m`: with `f = L⁻¹ Π [r; 0]` (the forward sweep, `Π` the elimination
+//! order) the border part is `f₂ = −L₂₂⁻¹ Zᵀ P⁻¹ r`, so `u = L₂₂⁻ᵀ D₂⁻¹ f₂ = H⁻¹ Zᵀ P⁻¹ r`;
+//! `y = B Zᵀ K⁻¹ r` solves `(I + B H) y = B H u`, i.e. `y = u − (I + B H)⁻¹ u`; and
+//! `K⁻¹ r = P⁻¹ (r − Z y)` is the first block of the backward sweep of `f` whose border
+//! part is replaced by `D₂ L₂₂ᵀ y = f₂ − D₂ L₂₂ᵀ (I + B H)⁻¹ u`:
+//!
+//! ```text
+//!   u = L₂₂⁻ᵀ D₂⁻¹ f₂ ,   w = (I + B H)⁻¹ u  (dense LU) ,   f₂ ← f₂ − D₂ L₂₂ᵀ w ,   x = backward sweep .
+//! ```
+//!
+//! `P` alone would need `T`, the 540 unknowns that `Z` touches, ordered last to give
+//! `(P⁻¹)_TT` from its trailing block; in the bordered matrix the cells keep their
+//! unconstrained order and only `Z`'s paths through the elimination tree fill: on the
+//! plate 4.9·10⁸ multiply–adds at 8,640 unknowns against 7.8·10⁸ with `T` last
+//! (2.96·10⁹ against 4.12·10⁹ at 24,000, 1.46·10¹⁰ against 2.28·10¹⁰ at 61,440), and a
+//! dense block of order 240 instead of 540 ([`porofrac_sim::ldlt::Ldlt::multiply_adds`]).
+//! The same identity without the low-rank form — for a [`SystemRef`] alone, or when the
+//! bordered factorisation fails (a rank-deficient `Z`) — orders the unknowns `T` of the
+//! rows and columns where `K` and `P` differ last in `P`'s factors: their trailing block is
+//! the Schur complement `S_P = L_TT D_T L_TTᵀ`, `(P⁻¹)_TT = S_P⁻¹`, and
 //!
 //! ```text
 //!   (S_P + E_TT) x_T = S_P (P⁻¹ b)_T ,      x = P⁻¹ (b − E x_T) ,
 //! ```
 //!
-//! (computed as `x_T = u_T − (S_P + E_TT)⁻¹ E_TT u_T`, `u = P⁻¹ b`, without the product
-//! with `S_P` whose rounding the condition number of `S_P` would amplify): a dense LU
-//! with partial pivoting of the `|T| × |T|` Schur complement `S_P + E_TT` of `K` and one
-//! sparse solve with `P` in two halves. With `f = L⁻¹ Π b` (the forward sweep, `Π` the
-//! elimination order), `u_T = L_TT⁻ᵀ D_T⁻¹ f_T` because `T` is eliminated last; `E x_T`
-//! is zero outside `T`, so `L⁻¹ Π (b − E x_T) = f − [0; L_TT⁻¹ E_TT x_T]`, and the backward
-//! sweep of the corrected `f` gives `x` (dense triangular solves of size `|T|` between the
-//! sweeps). This is `K⁻¹` up to rounding; it is applied as the preconditioner of GMRES,
-//! which checks the true residual (products with `K` by columns, on a copy of its
-//! values: the few iterations do not pay for a row form). The elimination order and the
-//! symbolic analysis depend only on the pattern and on `T`: [`crate::Cosserat::new`]
-//! computes them ([`SchurAnalysis`]) on a second thread while it assembles the values, and
-//! allocates the factor there, so that the set-up is the numeric factorisation alone. The dense part costs `O(|T|³)`, small against the
-//! sparse factorisation up to 10⁵ unknowns in 2D. [`LinearSolver::GmresLdlt`] uses the
-//! `LDLᵀ` of `P` (plain AMD) as an inexact preconditioner instead (40–43 iterations on the
-//! plate from 8,640 to 61,440 unknowns).
+//! computed as `x_T = u_T − (S_P + E_TT)⁻¹ E_TT u_T`, `u_T = L_TT⁻ᵀ D_T⁻¹ f_T`, and the
+//! backward sweep of `f − [0; L_TT⁻¹ E_TT x_T]` (no product with `S_P`, whose rounding
+//! its condition number would amplify). Either is `K⁻¹` up to rounding; it is applied as
+//! the preconditioner of GMRES, which checks the true residual (products with `K` by
+//! columns, on a copy of its values: the few iterations do not pay for a row form). The
+//! elimination order and the symbolic analysis depend only on the pattern and on `Z`:
+//! [`crate::Cosserat::new`] computes them ([`SchurAnalysis`]) on a second thread while it
+//! assembles the values, and allocates the factor there, so that the set-up is the
+//! numeric factorisation alone. The dense part costs `O(m³)`, small against the sparse
+//! factorisation up to 10⁵ unknowns in 2D. [`LinearSolver::GmresLdlt`] uses the `LDLᵀ` of
+//! `P` (plain AMD) as an inexact preconditioner instead (40–43 iterations on the plate
+//! from 8,640 to 61,440 unknowns).
 //!
 //! **Mixed precision** ([`FactorPrecision`], default single). The factors of `P` are
 //! computed in `f32` ([`porofrac_sim::ldlt_single`]: the same symbolic analysis, half the
 //! bytes, twice the vector lanes; 1.5–1.7 times faster than `f64` from 61,440 unknowns on
-//! the plate); `S_P`, its LU and the sums of GMRES stay in `f64`. The solve above is then
+//! the plate); the dense blocks, their LU and the sums of GMRES stay in `f64`. The solve above is then
 //! `K⁻¹` up to an error of about `κ ε₃₂` that GMRES removes: with double-precision factors
 //! one iteration reaches a relative residual of 1e-13 to 5e-13 on the plate meshes, with
 //! single-precision ones 3 to 5 iterations reach 1e-13 to 9e-13 (GMRES keeps the
@@ -56,11 +80,12 @@
 //! it). A tolerance looser than [`REFINE_TOLERANCE`] is tightened to it (within
 //! [`REFINE_ITERATIONS`] iterations), so that the solution equals the double-precision
 //! direct solve's (stress concentration factor to 1e-11). A single-precision factorisation
-//! that meets a non-positive pivot (`P` too ill-conditioned for `f32`) is redone in double.
+//! that meets a pivot of the wrong sign (`P` too ill-conditioned for `f32`) is redone in
+//! double.
 
 //! **Choice.** [`LinearSolver::Auto`] takes, in 2D, [`LinearSolver::LdltSchur`] below
-//! [`AUTO_GMRES_EQUATIONS`] equations (with at most [`AUTO_SCHUR_UNKNOWNS`] unknowns in
-//! `T`) and GMRES with the V-cycle above (measured in docs/BENCHMARKS.md: the factor's
+//! [`AUTO_GMRES_EQUATIONS`] equations (with a dense block of order at most
+//! [`AUTO_SCHUR_UNKNOWNS`]) and GMRES with the V-cycle above (measured in docs/BENCHMARKS.md: the factor's
 //! memory grows as `n^1.2` and its time as `n^1.4` on the plate; GMRES with the V-cycle
 //! stays linear in memory); in 3D, where only the LU and GMRES were measured and `T` grows
 //! as `n^(2/3)`, the LU below [`AUTO_GMRES_EQUATIONS_3D`] and GMRES above. The Newmark
@@ -87,10 +112,11 @@ pub const AUTO_GMRES_EQUATIONS: usize = 150_000;
 /// solve in 3D (below: the LU; the Schur complement solve is measured in 2D only).
 pub const AUTO_GMRES_EQUATIONS_3D: usize = 12_000;
 
-/// Largest number of boundary unknowns `T` for which [`LinearSolver::Auto`] takes
-/// [`LinearSolver::LdltSchur`] (2D): its dense `|T| × |T|` blocks then take at most 134 MB
-/// per copy and `O(|T|³)` work of a few seconds (on the plate, 1,440 unknowns at 61,440:
-/// 0.2–0.3 s; 2,160 at 138,240: 0.7 s, under a tenth of the setup).
+/// Largest order `m` of the dense block (the columns of the low-rank difference, or the
+/// boundary unknowns `T`) for which [`LinearSolver::Auto`] takes
+/// [`LinearSolver::LdltSchur`] (2D): its dense `m × m` blocks then take at most 134 MB
+/// per copy and `O(m³)` work of a few seconds (on the plate, 640 columns at 61,440
+/// unknowns, 960 at 138,240).
 pub const AUTO_SCHUR_UNKNOWNS: usize = 4_096;
 
 /// Equations from which [`LinearSolver::Auto`] takes GMRES for the Newmark matrix, solved
@@ -114,8 +140,8 @@ pub const REFINE_ITERATIONS: usize = 12;
 /// Which linear solver.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum LinearSolver {
-    /// In 2D [`Self::LdltSchur`] below [`AUTO_GMRES_EQUATIONS`] equations (and at most
-    /// [`AUTO_SCHUR_UNKNOWNS`] boundary unknowns), [`Self::GmresAmg`] otherwise; in 3D
+    /// In 2D [`Self::LdltSchur`] below [`AUTO_GMRES_EQUATIONS`] equations (and a dense
+    /// block of order at most [`AUTO_SCHUR_UNKNOWNS`]), [`Self::GmresAmg`] otherwise; in 3D
     /// [`Self::Lu`] below [`AUTO_GMRES_EQUATIONS_3D`], [`Self::GmresAmg`] from there (the
     /// Newmark matrix: [`Self::Lu`] below [`AUTO_GMRES_EQUATIONS_NEWMARK`]).
     #[default]
@@ -127,9 +153,10 @@ pub enum LinearSolver {
     /// Restarted GMRES preconditioned by the sparse `LDLᵀ` factorisation of the
     /// preconditioning matrix.
     GmresLdlt,
-    /// Direct: the sparse `LDLᵀ` of the preconditioning matrix with the unknowns where it
-    /// differs from the system ordered last, corrected exactly by a dense LU of the Schur
-    /// complement on those unknowns; GMRES checks the residual (one or two iterations).
+    /// Direct: the sparse `LDLᵀ` of the preconditioning matrix bordered by the low-rank
+    /// difference to the system (or with the unknowns where they differ ordered last),
+    /// corrected exactly by a dense LU of the order of that rank; GMRES checks the
+    /// residual (one iteration with double-precision factors, three or four with single).
     LdltSchur,
 }
 
@@ -203,8 +230,8 @@ pub struct LinearStats {
     /// Largest true relative residual of a GMRES solve.
     pub max_residual: f64,
     /// Stored entries of the `LDLᵀ` factor `L` ([`LinearSolver::GmresLdlt`]), plus the
-    /// `|T|²` of the dense Schur complement ([`LinearSolver::LdltSchur`]); 0 for the
-    /// others (faer does not report the LU's).
+    /// two dense blocks of order `m` (the trailing factor and the LU) of
+    /// [`LinearSolver::LdltSchur`]; 0 for the others (faer does not report the LU's).
     pub factor_entries: usize,
     /// Precision of those `LDLᵀ` factors (`None` without them): the requested
     /// [`GmresOptions::factor_precision`], or double after a failed single-precision
@@ -222,24 +249,30 @@ enum Precond {
     Schur(Box<Schur>),
 }
 
-/// `A = P + E` with `P` symmetric positive definite and `E` non-zero only on the `k`
-/// unknowns `T` (ordered last in `P`'s factorisation). With `S_P` the Schur complement of
-/// the others in `P` (the trailing block of its factors), `(P⁻¹)_TT = S_P⁻¹`, so
-/// `A x = b` is `x_T = u_T − (S_P + E_TT)⁻¹ E_TT u_T` with `u = P⁻¹ b` (a dense LU) and
-/// `x = P⁻¹ (b − E x_T)`: two sparse solves with `P` and one dense solve.
+/// `K⁻¹` from the `LDLᵀ` factors of a symmetric matrix and a dense correction of the size
+/// `k` of their trailing block (module documentation): the factors of the bordered
+/// matrix `[[P, Z], [Zᵀ, 0]]` with the `k` border unknowns last and the LU of
+/// `I + B H`, or those of `P` with the `k` unknowns `T` last and the LU of `S_P + E_TT`.
 struct Schur {
     ldlt: Factor,
-    /// The unknowns of `T` in the order of the dense block (the elimination order).
-    tail: Vec<usize>,
-    /// The trailing block `L_TT`, `D_T` of the factors.
+    /// The trailing block `L₂₂`, `D₂` of the factors.
     trail: TrailingFactor,
-    /// `E_TT` as `(row, column, value)` in the dense block's indices.
-    e: Vec<(u32, u32, f64)>,
-    /// LU of `S_P + E_TT`.
+    /// LU of the dense correction.
     lu: DenseLu,
+    form: SchurForm,
     /// Work vectors of length `k`.
     ut: Vec<f64>,
     xt: Vec<f64>,
+    /// Work vector of the bordered matrix, `n + k` (empty with `T` last).
+    z: Vec<f64>,
+}
+
+/// What the dense correction of [`Schur`] needs besides its LU.
+enum SchurForm {
+    /// `E = Z B Zᵀ` bordered.
+    Bordered,
+    /// `T` last: `E_TT` as `(row, column, value)` in the dense block's indices.
+    Trailing { e: Vec<(u32, u32, f64)> },
 }
 
 /// Order from which the dense blocks of the Schur complement solve are computed on all
@@ -328,6 +361,7 @@ impl Factor {
         analysis: Prepared,
         upper: (&[usize], &[usize], &[f64]),
         precision: FactorPrecision,
+        positive: usize,
     ) -> std::result::Result<Self, LdltError> {
         let (c, r, v) = upper;
         let par = faer::Par::rayon(0);
@@ -343,7 +377,7 @@ impl Factor {
                     }
                     Prepared::Single(s) => s,
                 };
-                match single.factorize(c, r, v, true) {
+                match single.factorize_signed(c, r, v, Some(positive)) {
                     Ok(()) => return Ok(Self::Single(single)),
                     Err(_) => single.into_analysis(),
                 }
@@ -351,6 +385,14 @@ impl Factor {
         };
         ldlt.set_parallelism(par);
         ldlt.factorize(c, r, v)?;
+        let size = c.len() - 1;
+        if positive < size && !ldlt.pivots_signed(positive) {
+            return Err(LdltError(format!(
+                "the bordered matrix has not {positive} positive and {} negative pivots: \
+                 the low-rank difference is not of full rank",
+                size - positive
+            )));
+        }
         Ok(Self::Double(ldlt))
     }
 
@@ -399,6 +441,16 @@ impl Factor {
     }
 }
 
+/// A matrix of low rank, `E = Σ_p Z_p B_p Z_pᵀ`: sparse columns `Z`, in pairs
+/// `Z_p = [z_2p z_2p+1]`, and one `2 × 2` block `B_p` per pair.
+#[derive(Clone, Debug, Default)]
+pub struct LowRankDifference {
+    /// The columns `z_i` as `(row, value)` lists.
+    pub columns: Vec<Vec<(usize, f64)>>,
+    /// `B_p`, column-major (`[b11, b21, b12, b22]`).
+    pub blocks: Vec<[f64; 4]>,
+}
+
 /// The unknowns `T` of the rows and columns where the system differs from the
 /// preconditioning matrix (marked `true`).
 fn schur_unknowns(sys: SystemRef<'_>) -> Vec<bool> {
@@ -417,16 +469,37 @@ fn schur_unknowns(sys: SystemRef<'_>) -> Vec<bool> {
 }
 
 /// The symbolic part of the [`LinearSolver::LdltSchur`] solve, which depends only on the
-/// pattern and on the unknowns `T`: the elimination order (AMD of the cells without a
-/// component in `T`, then `T`) and the symbolic analysis of the `LDLᵀ` in it.
+/// pattern and on where the system differs from the preconditioning matrix: the
+/// elimination order (the cells in AMD order, then the border or `T`), the symbolic
+/// analysis of the `LDLᵀ` in it, and for the bordered form the border columns.
 /// [`crate::Cosserat::new`] prepares it while it assembles the values (on another thread);
-/// [`Linear::new`] uses it when its own `T` is the same.
+/// [`Linear::new`] uses it when it fits the system.
 pub struct SchurAnalysis {
-    in_t: Vec<bool>,
-    /// The unknowns of `T` in the elimination order.
-    tail: Vec<usize>,
+    form: AnalysisForm,
     /// The analysis, or the single-precision factors with their memory reserved.
     analysis: Prepared,
+}
+
+/// The two forms of [`SchurAnalysis`].
+enum AnalysisForm {
+    /// The bordered matrix of a known low-rank difference.
+    Bordered(Box<Border>),
+    /// The unknowns `T` (marked `true`) eliminated last, `tail` in that order.
+    Trailing { in_t: Vec<bool>, tail: Vec<usize> },
+}
+
+/// The bordered matrix `[[P, Z], [Zᵀ, 0]]` of a [`LowRankDifference`] `E = Z B Zᵀ`: its
+/// upper triangle by columns (`P`'s, then the `k` border columns with their rows sorted
+/// and a zero diagonal) and the values of the border columns; the columns of `Z` that are
+/// zero are left out (with their row and column of `B`).
+struct Border {
+    col_ptr: Vec<usize>,
+    row_idx: Vec<usize>,
+    /// The values of the border columns, `row_idx[col_ptr[n]..]`.
+    values: Vec<f64>,
+    /// The blocks of `B` on the kept columns: `(first border column, size 1 or 2, values
+    /// column-major)`.
+    blocks: Vec<(usize, usize, [f64; 4])>,
 }
 
 /// The symbolic analysis of [`SchurAnalysis`], possibly inside single-precision factors
@@ -439,8 +512,8 @@ enum Prepared {
 impl std::fmt::Debug for SchurAnalysis {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("SchurAnalysis")
-            .field("n", &self.in_t.len())
-            .field("t", &self.tail.len())
+            .field("bordered", &self.is_bordered())
+            .field("k", &self.dense_len())
             .finish()
     }
 }
@@ -463,41 +536,186 @@ impl SchurAnalysis {
         let mut perm: Vec<usize> = order.iter().copied().filter(|&i| !in_t[i]).collect();
         let first = perm.len();
         perm.extend(order.iter().copied().filter(|&i| in_t[i]));
-        let tail = perm[first..].to_vec();
         // The whole pattern: the analysis reads its upper triangle.
-        let analysis =
-            Ldlt::analyse(n, &pattern.col_ptr, &pattern.row_idx, Some(&perm)).map_err(|e| {
-                CosseratError::Solve(format!("LDLᵀ of the preconditioning matrix: {e}"))
-            })?;
-        if analysis
-            .permutation()
-            .is_some_and(|a| a[first..] != tail[..])
-        {
-            return Err(CosseratError::Solve(
-                "LDLᵀ: the boundary unknowns are not eliminated last".into(),
-            ));
-        }
-        let analysis = if reserve {
-            let mut single = LdltSingle::new(analysis);
-            single.set_parallelism(faer::Par::rayon(0));
-            single
-                .reserve()
-                .map_err(|e| CosseratError::Solve(format!("LDLᵀ: {e}")))?;
-            Prepared::Single(single)
-        } else {
-            Prepared::Analysis(analysis)
-        };
+        let tail = perm[first..].to_vec();
+        let analysis = analyse_last(n, &pattern.col_ptr, &pattern.row_idx, perm, first, reserve)?;
         Ok(Self {
-            in_t,
-            tail,
+            form: AnalysisForm::Trailing { in_t, tail },
             analysis,
         })
     }
 
-    /// The unknowns `T` (marked `true`).
-    pub fn unknowns(&self) -> &[bool] {
-        &self.in_t
+    /// The analysis of the bordered matrix of `pattern` and of the difference `e` between
+    /// the system and the preconditioning matrix, the cells in AMD order and the border
+    /// last; with `reserve`, also the memory of single-precision factors.
+    ///
+    /// Errors: `e` with a row outside the pattern, a non-finite value, or not two columns
+    /// per block.
+    pub fn bordered(pattern: &BlockPattern, e: &LowRankDifference, reserve: bool) -> Result<Self> {
+        let n = pattern.equations();
+        if e.columns.len() != 2 * e.blocks.len() {
+            return Err(CosseratError::Input {
+                what: format!(
+                    "low-rank difference: {} columns for {} blocks of two",
+                    e.columns.len(),
+                    e.blocks.len()
+                ),
+            });
+        }
+        if let Some((i, &(r, v))) = e
+            .columns
+            .iter()
+            .enumerate()
+            .flat_map(|(i, c)| c.iter().map(move |x| (i, x)))
+            .find(|(_, (r, v))| *r >= n || !v.is_finite())
+        {
+            return Err(CosseratError::Input {
+                what: format!("low-rank difference: column {i} has value {v} in row {r} of {n}"),
+            });
+        }
+        if e.blocks.iter().flatten().any(|v| !v.is_finite()) {
+            return Err(CosseratError::Input {
+                what: "low-rank difference: a non-finite coupling".into(),
+            });
+        }
+        let mut col_ptr = Vec::with_capacity(n + e.columns.len() + 1);
+        let mut row_idx = Vec::with_capacity(pattern.nnz() / 2 + n);
+        col_ptr.push(0);
+        for j in 0..n {
+            let rows = &pattern.row_idx[pattern.col_ptr[j]..pattern.col_ptr[j + 1]];
+            row_idx.extend_from_slice(&rows[..rows.partition_point(|&r| r <= j)]);
+            col_ptr.push(row_idx.len());
+        }
+        let mut values = Vec::new();
+        let mut blocks = Vec::with_capacity(e.blocks.len());
+        let mut column = Vec::new();
+        let mut k = 0;
+        for (p, blk) in e.blocks.iter().enumerate() {
+            let kept: Vec<usize> = (0..2)
+                .filter(|&a| e.columns[2 * p + a].iter().any(|&(_, v)| v != 0.0))
+                .collect();
+            // Columns of unit length (the coupling scaled to match): traction rows and
+            // facet values differ by the moduli in size.
+            let norm = |a: usize| {
+                e.columns[2 * p + a]
+                    .iter()
+                    .map(|x| x.1 * x.1)
+                    .sum::<f64>()
+                    .sqrt()
+            };
+            let block = match kept[..] {
+                [_, _] => {
+                    let (s0, s1) = (norm(0), norm(1));
+                    [
+                        blk[0] * s0 * s0,
+                        blk[1] * s1 * s0,
+                        blk[2] * s0 * s1,
+                        blk[3] * s1 * s1,
+                    ]
+                }
+                [a] => [blk[3 * a] * norm(a) * norm(a), 0.0, 0.0, 0.0],
+                _ => continue,
+            };
+            if block.iter().all(|&v| v == 0.0) {
+                continue;
+            }
+            blocks.push((k, kept.len(), block));
+            for &a in &kept {
+                let scale = norm(a).recip();
+                column.clear();
+                column.extend(e.columns[2 * p + a].iter().map(|&(r, v)| (r, v * scale)));
+                column.sort_unstable_by_key(|x| x.0);
+                for &(r, v) in &column {
+                    if row_idx.len() > col_ptr[n + k] && row_idx.last() == Some(&r) {
+                        *values.last_mut().expect("a value per row") += v;
+                    } else {
+                        row_idx.push(r);
+                        values.push(v);
+                    }
+                }
+                row_idx.push(n + k);
+                values.push(0.0);
+                col_ptr.push(row_idx.len());
+                k += 1;
+            }
+        }
+        let order = cell_amd(pattern)?;
+        let mut perm = order;
+        perm.extend(n..n + k);
+        let analysis = analyse_last(n + k, &col_ptr, &row_idx, perm, n, reserve)?;
+        Ok(Self {
+            form: AnalysisForm::Bordered(Box::new(Border {
+                col_ptr,
+                row_idx,
+                values,
+                blocks,
+            })),
+            analysis,
+        })
     }
+
+    /// The unknowns of the system it was made for.
+    pub fn unknowns(&self) -> usize {
+        match &self.form {
+            AnalysisForm::Bordered(b) => {
+                b.col_ptr.len() - 1 - b.blocks.iter().map(|x| x.1).sum::<usize>()
+            }
+            AnalysisForm::Trailing { in_t, .. } => in_t.len(),
+        }
+    }
+
+    /// The unknowns `T` of the trailing form (marked `true`).
+    fn trailing_unknowns(&self) -> Option<&[bool]> {
+        match &self.form {
+            AnalysisForm::Bordered(_) => None,
+            AnalysisForm::Trailing { in_t, .. } => Some(in_t),
+        }
+    }
+
+    /// Whether this is the bordered form.
+    pub fn is_bordered(&self) -> bool {
+        matches!(self.form, AnalysisForm::Bordered(_))
+    }
+
+    /// The order `k` of the dense correction (the border or `|T|`).
+    pub fn dense_len(&self) -> usize {
+        match &self.form {
+            AnalysisForm::Bordered(b) => b.blocks.iter().map(|x| x.1).sum(),
+            AnalysisForm::Trailing { tail, .. } => tail.len(),
+        }
+    }
+}
+
+/// The symbolic analysis of the matrix `(col_ptr, row_idx)` of `size` unknowns (its upper
+/// triangle is read) in the order `perm`, checked to keep `perm[first..]` last; with
+/// `reserve`, inside single-precision factors with their memory.
+fn analyse_last(
+    size: usize,
+    col_ptr: &[usize],
+    row_idx: &[usize],
+    perm: Vec<usize>,
+    first: usize,
+    reserve: bool,
+) -> Result<Prepared> {
+    let ldlt_err = |e| CosseratError::Solve(format!("LDLᵀ of the preconditioning matrix: {e}"));
+    let analysis = Ldlt::analyse(size, col_ptr, row_idx, Some(&perm)).map_err(ldlt_err)?;
+    if analysis
+        .permutation()
+        .is_some_and(|a| a[first..] != perm[first..])
+    {
+        return Err(CosseratError::Solve(
+            "LDLᵀ: the boundary unknowns are not eliminated last".into(),
+        ));
+    }
+    let prepared = if reserve {
+        let mut single = LdltSingle::new(analysis);
+        single.set_parallelism(faer::Par::rayon(0));
+        single.reserve().map_err(ldlt_err)?;
+        Prepared::Single(single)
+    } else {
+        Prepared::Analysis(analysis)
+    };
+    Ok(prepared)
 }
 
 impl Schur {
@@ -506,35 +724,86 @@ impl Schur {
     fn new(
         sys: SystemRef<'_>,
         n: usize,
-        upper: (&[usize], &[usize], &[f64]),
+        full: (&[usize], &[usize], &[f64]),
         analysis: SchurAnalysis,
         precision: FactorPrecision,
     ) -> Result<Self> {
-        let p = sys.pattern;
         let ldlt_err = |e| CosseratError::Solve(format!("LDLᵀ of the preconditioning matrix: {e}"));
-        let SchurAnalysis { tail, analysis, .. } = analysis;
-        let k = tail.len();
-        let mut local = vec![u32::MAX; n];
-        for (j, &i) in tail.iter().enumerate() {
-            local[i] = j as u32;
-        }
-        let mut e = Vec::new();
-        for j in 0..n {
-            for q in p.col_ptr[j]..p.col_ptr[j + 1] {
-                let d = sys.values[q] - sys.preconditioner[q];
-                if d != 0.0 {
-                    e.push((local[p.row_idx[q]], local[j], d));
+        let SchurAnalysis { form, analysis } = analysis;
+        let (ldlt, trail, form, dense) = match form {
+            AnalysisForm::Bordered(border) => {
+                let Border {
+                    col_ptr,
+                    row_idx,
+                    values: border_values,
+                    blocks,
+                } = *border;
+                // P's upper triangle (a prefix of each column of the whole pattern), then
+                // the border.
+                let mut values = Vec::with_capacity(row_idx.len());
+                for j in 0..n {
+                    let q = full.0[j];
+                    values.extend_from_slice(&full.2[q..q + col_ptr[j + 1] - col_ptr[j]]);
                 }
+                values.extend_from_slice(&border_values);
+                let ldlt = Factor::new(analysis, (&col_ptr, &row_idx, &values), precision, n)
+                    .map_err(ldlt_err)?;
+                drop(values);
+                let trail = ldlt
+                    .trailing_factor(col_ptr.len() - 1 - n)
+                    .map_err(ldlt_err)?;
+                let k = trail.len();
+                // H = Zᵀ P⁻¹ Z = −L₂₂ D₂ L₂₂ᵀ, and I + B H row block by row block.
+                let mut h = faer::Mat::<f64>::zeros(k, k);
+                trail.schur_complement_into(h.as_mut(), dense_parallelism(k));
+                for j in 0..k {
+                    for v in h.col_mut(j).iter_mut() {
+                        *v = -*v;
+                    }
+                }
+                let mut m = faer::Mat::<f64>::identity(k, k);
+                for &(c0, size, b) in &blocks {
+                    for i in 0..size {
+                        for a in 0..size {
+                            let bia = b[i + size * a];
+                            if bia != 0.0 {
+                                for j in 0..k {
+                                    m[(c0 + i, j)] += bia * h[(c0 + a, j)];
+                                }
+                            }
+                        }
+                    }
+                }
+                (ldlt, trail, SchurForm::Bordered, m)
             }
-        }
-        let ldlt = Factor::new(analysis, upper, precision).map_err(ldlt_err)?;
-        let trail = ldlt.trailing_factor(k).map_err(ldlt_err)?;
-        let mut sa = faer::Mat::<f64>::zeros(k, k);
-        trail.schur_complement_into(sa.as_mut(), dense_parallelism(k));
-        for &(i, j, v) in &e {
-            sa[(i as usize, j as usize)] += v;
-        }
-        let lu = DenseLu::new(sa);
+            AnalysisForm::Trailing { tail, .. } => {
+                let p = sys.pattern;
+                let k = tail.len();
+                let ldlt = Factor::new(analysis, full, precision, n).map_err(ldlt_err)?;
+                let trail = ldlt.trailing_factor(k).map_err(ldlt_err)?;
+                let mut local = vec![u32::MAX; n];
+                for (j, &i) in tail.iter().enumerate() {
+                    local[i] = j as u32;
+                }
+                let mut e = Vec::new();
+                for j in 0..n {
+                    for q in p.col_ptr[j]..p.col_ptr[j + 1] {
+                        let d = sys.values[q] - sys.preconditioner[q];
+                        if d != 0.0 {
+                            e.push((local[p.row_idx[q]], local[j], d));
+                        }
+                    }
+                }
+                let mut sa = faer::Mat::<f64>::zeros(k, k);
+                trail.schur_complement_into(sa.as_mut(), dense_parallelism(k));
+                for &(i, j, v) in &e {
+                    sa[(i as usize, j as usize)] += v;
+                }
+                (ldlt, trail, SchurForm::Trailing { e }, sa)
+            }
+        };
+        let k = trail.len();
+        let lu = DenseLu::new(dense);
         if let Some(i) = (0..k).find(|&i| {
             let u = lu.lu[(i, i)];
             !(u.is_finite() && u != 0.0)
@@ -544,51 +813,80 @@ impl Schur {
                  missing boundary conditions or zero moduli?"
             )));
         }
+        let z = match form {
+            SchurForm::Bordered => vec![0.0; n + k],
+            SchurForm::Trailing { .. } => Vec::new(),
+        };
         Ok(Self {
             ldlt,
-            tail,
             trail,
-            e,
             lu,
+            form,
             ut: vec![0.0; k],
             xt: vec![0.0; k],
+            z,
         })
     }
 
-    /// `z = A⁻¹ r`, in one forward and one backward sweep: with `f = L⁻¹ P r` (the
-    /// forward sweep), `u_T = L_TT⁻ᵀ D_T⁻¹ f_T` is the `T` part of `P⁻¹ r` (`T` is
-    /// eliminated last); `x_T = u_T − (S_P + E_TT)⁻¹ E_TT u_T`; and since `E x_T` is zero
-    /// outside `T`, `L⁻¹ P (r − E x_T) = f − [0; L_TT⁻¹ E_TT x_T]`, so
-    /// `z = P⁻¹ (r − E x_T)` is the backward sweep of `f` corrected on `T` (dense
-    /// triangular solves of size `|T|` in between).
+    /// `z = K⁻¹ r` in one forward and one backward sweep of the factors, with dense
+    /// operations of order `k` between them (module documentation).
     fn apply(&mut self, r: &[f64], z: &mut [f64]) -> Result<()> {
         let err = |e| CosseratError::Solve(format!("LDLᵀ solve: {e}"));
-        let k = self.tail.len();
-        let first = z.len() - k;
-        z.copy_from_slice(r);
-        self.ldlt.forward(z).map_err(err)?;
-        self.ut.copy_from_slice(&z[first..]);
-        self.trail.backward(&mut self.ut);
-        // x_T = u_T − (S_P + E)⁻¹ E u_T (no product with S_P: its rounding would be
-        // amplified by the condition number of S_P).
-        self.xt.fill(0.0);
-        for &(i, j, v) in &self.e {
-            self.xt[i as usize] += v * self.ut[j as usize];
+        let n = r.len();
+        match &self.form {
+            SchurForm::Bordered => {
+                // f = L⁻¹ Π [r; 0]; u = L₂₂⁻ᵀ D₂⁻¹ f₂ = H⁻¹ Zᵀ P⁻¹ r; w = (I + B H)⁻¹ u;
+                // f₂ += L₂₂⁻¹ H w; the backward sweep gives K⁻¹ r in its first n entries.
+                let y = &mut self.z;
+                y[..n].copy_from_slice(r);
+                y[n..].fill(0.0);
+                self.ldlt.forward(y).map_err(err)?;
+                self.ut.copy_from_slice(&y[n..]);
+                self.trail.backward(&mut self.ut);
+                self.xt.copy_from_slice(&self.ut);
+                self.lu.solve_in_place(&mut self.xt);
+                // L₂₂⁻¹ H w = −D₂ L₂₂ᵀ w (no product with H: its rounding would be
+                // amplified by L₂₂⁻¹).
+                self.trail.upper_product(&mut self.xt);
+                for (f, &c) in y[n..].iter_mut().zip(&self.xt) {
+                    *f -= c;
+                }
+                self.ldlt.backward(y).map_err(err)?;
+                z.copy_from_slice(&y[..n]);
+                Ok(())
+            }
+            SchurForm::Trailing { e } => {
+                // With f = L⁻¹ Π r (the forward sweep), u_T = L_TT⁻ᵀ D_T⁻¹ f_T is the T
+                // part of P⁻¹ r (T is eliminated last); x_T = u_T − (S_P + E)⁻¹ E u_T; and
+                // since E x_T is zero outside T, L⁻¹ Π (r − E x_T) = f − [0; L_TT⁻¹ E_TT x_T],
+                // so z = P⁻¹ (r − E x_T) is the backward sweep of f corrected on T.
+                let k = self.trail.len();
+                let first = n - k;
+                z.copy_from_slice(r);
+                self.ldlt.forward(z).map_err(err)?;
+                self.ut.copy_from_slice(&z[first..]);
+                self.trail.backward(&mut self.ut);
+                // No product with S_P: its rounding would be amplified by the condition
+                // number of S_P.
+                self.xt.fill(0.0);
+                for &(i, j, v) in e {
+                    self.xt[i as usize] += v * self.ut[j as usize];
+                }
+                self.lu.solve_in_place(&mut self.xt);
+                for (x, &u) in self.xt.iter_mut().zip(&self.ut) {
+                    *x = u - *x;
+                }
+                self.ut.fill(0.0);
+                for &(i, j, v) in e {
+                    self.ut[i as usize] += v * self.xt[j as usize];
+                }
+                self.trail.forward(&mut self.ut);
+                for (f, &c) in z[first..].iter_mut().zip(&self.ut) {
+                    *f -= c;
+                }
+                self.ldlt.backward(z).map_err(err)
+            }
         }
-        self.lu.solve_in_place(&mut self.xt);
-        for (x, &u) in self.xt.iter_mut().zip(&self.ut) {
-            *x = u - *x;
-        }
-        // f_T −= L_TT⁻¹ E_TT x_T.
-        self.ut.fill(0.0);
-        for &(i, j, v) in &self.e {
-            self.ut[i as usize] += v * self.xt[j as usize];
-        }
-        self.trail.forward(&mut self.ut);
-        for (f, &c) in z[first..].iter_mut().zip(&self.ut) {
-            *f -= c;
-        }
-        self.ldlt.backward(z).map_err(err)
     }
 }
 
@@ -711,10 +1009,16 @@ impl Linear {
                 }
             }
             LinearSolver::Auto if n < AUTO_GMRES_EQUATIONS => {
-                let t = schur_unknowns(sys);
-                let many = t.iter().filter(|&&t| t).count() > AUTO_SCHUR_UNKNOWNS;
-                in_t = Some(t);
-                if many {
+                let dense = match &prepared {
+                    Some(a) if a.is_bordered() && a.unknowns() == n => a.dense_len(),
+                    _ => {
+                        let t = schur_unknowns(sys);
+                        let count = t.iter().filter(|&&t| t).count();
+                        in_t = Some(t);
+                        count
+                    }
+                };
+                if dense > AUTO_SCHUR_UNKNOWNS {
                     LinearSolver::GmresAmg
                 } else {
                     LinearSolver::LdltSchur
@@ -738,14 +1042,23 @@ impl Linear {
                 let kind = if s == LinearSolver::GmresLdlt {
                     PrecondKind::Ldlt
                 } else {
-                    let in_t = in_t.take().unwrap_or_else(|| schur_unknowns(sys));
                     match prepared {
-                        Some(a) if a.in_t == in_t => PrecondKind::Schur(Box::new(a)),
-                        _ => PrecondKind::Schur(Box::new(SchurAnalysis::new(
-                            sys.pattern,
-                            in_t,
-                            false,
-                        )?)),
+                        Some(a) if a.is_bordered() && a.unknowns() == n => {
+                            PrecondKind::Schur(Box::new(a))
+                        }
+                        prepared => {
+                            let in_t = in_t.take().unwrap_or_else(|| schur_unknowns(sys));
+                            match prepared {
+                                Some(a) if a.trailing_unknowns() == Some(&in_t[..]) => {
+                                    PrecondKind::Schur(Box::new(a))
+                                }
+                                _ => PrecondKind::Schur(Box::new(SchurAnalysis::new(
+                                    sys.pattern,
+                                    in_t,
+                                    false,
+                                )?)),
+                            }
+                        }
                     }
                 };
                 let g = Gmres::new(sys, options.gmres, kind, copy_values)?;
@@ -755,8 +1068,12 @@ impl Linear {
                         stats.factor_precision = Some(f.precision());
                     }
                     Precond::Schur(f) => {
+                        let dense = match f.form {
+                            SchurForm::Bordered => 2,
+                            SchurForm::Trailing { .. } => 2,
+                        };
                         stats.factor_entries =
-                            f.ldlt.analysis().factor_nnz() + 2 * f.tail.len().pow(2);
+                            f.ldlt.analysis().factor_nnz() + dense * f.trail.len().pow(2);
                         stats.factor_precision = Some(f.ldlt.precision());
                     }
                     Precond::Amg(_) => {}
@@ -985,18 +1302,29 @@ impl Gmres {
                     let perm = cell_amd(p)?;
                     let analysis =
                         Ldlt::analyse(n, full.0, full.1, Some(&perm)).map_err(ldlt_err)?;
-                    let f =
-                        Factor::new(Prepared::Analysis(analysis), full, options.factor_precision)
-                            .map_err(ldlt_err)?;
+                    let f = Factor::new(
+                        Prepared::Analysis(analysis),
+                        full,
+                        options.factor_precision,
+                        n,
+                    )
+                    .map_err(ldlt_err)?;
                     Precond::Ldlt(Box::new(f))
                 }
-                PrecondKind::Schur(analysis) => Precond::Schur(Box::new(Schur::new(
-                    sys,
-                    n,
-                    full,
-                    *analysis,
-                    options.factor_precision,
-                )?)),
+                PrecondKind::Schur(analysis) => {
+                    let bordered = analysis.is_bordered();
+                    let precision = options.factor_precision;
+                    match Schur::new(sys, n, full, *analysis, precision) {
+                        Ok(s) => Precond::Schur(Box::new(s)),
+                        // A difference that does not match the system or is rank
+                        // deficient: the form from the values themselves.
+                        Err(_) if bordered => {
+                            let t = SchurAnalysis::new(p, schur_unknowns(sys), false)?;
+                            Precond::Schur(Box::new(Schur::new(sys, n, full, t, precision)?))
+                        }
+                        Err(e) => return Err(e),
+                    }
+                }
             })
         };
         let ((row_ptr, col_idx, row_values), pre) = rayon::join(product, preconditioner);

@@ -116,6 +116,106 @@ fn plate_with_hole_gmres_equals_lu() {
     }
 }
 
+/// The model's boundary difference `Z B Zᵀ` is the system minus the preconditioning
+/// matrix, entry by entry (to rounding), and has two columns per fixed component of a
+/// boundary facet.
+#[test]
+fn boundary_difference_is_system_minus_preconditioner() {
+    let model = plate(2);
+    let (k, p) = (model.system_values(), model.preconditioner_values());
+    let e = model.boundary_difference();
+    let pat = model.pattern();
+    let n = pat.equations();
+    // Fixed: u_x and φ on the facets of x = 0, u_y and φ on those of y = 0.
+    let facets = |name| model.grid().boundary(name).unwrap().len();
+    assert_eq!(e.blocks.len(), 2 * (facets("xmin") + facets("ymin")));
+    assert_eq!(e.columns.len(), 2 * e.blocks.len());
+    let mut zbz = std::collections::HashMap::<(usize, usize), f64>::new();
+    for (b, pair) in e.blocks.iter().zip(e.columns.chunks(2)) {
+        for (a, za) in pair.iter().enumerate() {
+            for (c, zc) in pair.iter().enumerate() {
+                for &(i, vi) in za {
+                    for &(j, vj) in zc {
+                        *zbz.entry((i, j)).or_default() += b[a + 2 * c] * vi * vj;
+                    }
+                }
+            }
+        }
+    }
+    let mut scale = 0.0f64;
+    let mut worst = 0.0f64;
+    for j in 0..n {
+        for q in pat.col_ptr[j]..pat.col_ptr[j + 1] {
+            let d = k[q] - p[q];
+            scale = scale.max(d.abs());
+            let z = zbz.remove(&(pat.row_idx[q], j)).unwrap_or(0.0);
+            worst = worst.max((d - z).abs());
+        }
+    }
+    assert!(scale > 0.0);
+    assert!(
+        worst <= 1e-12 * scale,
+        "|K − P − Z B Zᵀ| = {worst:e} of {scale:e}"
+    );
+    // Nothing outside the pattern.
+    assert!(zbz.values().all(|v| v.abs() <= 1e-12 * scale));
+}
+
+/// Both forms of the Schur complement solve — the bordered matrix of the model's boundary
+/// difference and the unknowns `T` ordered last, found from the values alone — give the
+/// LU's solution; with double-precision factors each is exact up to rounding (one
+/// iteration).
+#[test]
+fn bordered_and_trailing_schur_solves_equal_lu() {
+    use porofrac_cosserat::linear::{Linear, SchurAnalysis, SystemRef};
+    let model = plate(2);
+    let (lu, _, _) = model
+        .solve_static_with(0.0, &options(LinearSolver::Lu, 1e-12))
+        .unwrap();
+    let (values, pre, centres) = (
+        model.system_values(),
+        model.preconditioner_values(),
+        model.centres(),
+    );
+    let sys = SystemRef {
+        pattern: model.pattern(),
+        values: &values,
+        preconditioner: &pre,
+        centres: &centres,
+        dim: 2,
+    };
+    let mut rhs = vec![0.0; model.equations()];
+    model.rhs(0.0, &mut rhs);
+    let difference = model.boundary_difference();
+    for bordered in [true, false] {
+        for precision in [Double, Single] {
+            let name = if bordered { "bordered" } else { "T last" };
+            // The single-precision analysis with its factor's memory reserved, as the
+            // model prepares it.
+            let analysis = bordered.then(|| {
+                SchurAnalysis::bordered(model.pattern(), &difference, precision == Single).unwrap()
+            });
+            if let Some(a) = &analysis {
+                assert!(a.is_bordered());
+                assert_eq!(a.dense_len(), difference.columns.len());
+            }
+            let opts = options_in(LinearSolver::LdltSchur, 1e-12, precision);
+            let mut lin = Linear::with_analysis(sys, &opts, analysis).unwrap();
+            let mut x = rhs.clone();
+            lin.solve(&mut x, None).unwrap();
+            let st = lin.stats();
+            let max_its = if precision == Double { 1 } else { 6 };
+            assert!(st.max_iterations <= max_its, "{name} {precision:?}: {st:?}");
+            assert!(st.max_residual <= 1e-12, "{name} {precision:?}: {st:?}");
+            let d = max_diff(&lu, &x) / max_abs(&lu);
+            assert!(
+                d < 1e-9,
+                "{name} {precision:?}: relative difference {d:.2e}"
+            );
+        }
+    }
+}
+
 /// `auto`: the Schur complement solve for a static 2D plate, the LU for a small 3D box.
 #[test]
 fn auto_takes_the_schur_solve_for_a_static_plate() {

@@ -207,6 +207,38 @@ impl Ldlt {
     pub fn factor_nnz(&self) -> usize {
         self.symbolic.len_val()
     }
+    /// Multiply–adds of one numeric factorization, `Σ_j c_j (c_j − 1) / 2` over the
+    /// columns `j` of the supernodal `L` with `c_j` stored entries (explicit zeros of
+    /// amalgamated supernodes included), the dense kernels' work.
+    pub fn multiply_adds(&self) -> f64 {
+        match self.symbolic.raw() {
+            SymbolicCholeskyRaw::Supernodal(sn) => {
+                let (begin, end) = (sn.supernode_begin(), sn.supernode_end());
+                let rptr = sn.col_ptr_for_row_idx();
+                (0..sn.n_supernodes())
+                    .map(|s| {
+                        let w = end[s] - begin[s];
+                        let r = rptr[s + 1] - rptr[s];
+                        (0..w)
+                            .map(|k| {
+                                let c = (w - k + r) as f64;
+                                c * (c - 1.0) / 2.0
+                            })
+                            .sum::<f64>()
+                    })
+                    .sum()
+            }
+            SymbolicCholeskyRaw::Simplicial(sm) => {
+                let cp = sm.col_ptr();
+                (0..self.n)
+                    .map(|j| {
+                        let c = (cp[j + 1] - cp[j]) as f64;
+                        c * (c - 1.0) / 2.0
+                    })
+                    .sum()
+            }
+        }
+    }
     /// Numeric factorizations done.
     pub fn numeric_factorizations(&self) -> usize {
         self.numeric
@@ -218,6 +250,12 @@ impl Ldlt {
     /// Whether every pivot of `D` is positive (the matrix is positive definite).
     pub fn pivots_positive(&self) -> bool {
         self.inv_diag.iter().all(|&d| d > 0.0)
+    }
+    /// Whether the first `p` pivots of `D` (in the elimination order) are positive and
+    /// the others negative (see [`crate::ldlt_single::LdltSingle::factorize_signed`]).
+    pub fn pivots_signed(&self, p: usize) -> bool {
+        let p = p.min(self.inv_diag.len());
+        self.inv_diag[..p].iter().all(|&d| d > 0.0) && self.inv_diag[p..].iter().all(|&d| d < 0.0)
     }
     /// Whether the last numeric factorization succeeded.
     pub fn is_factored(&self) -> bool {
@@ -1186,6 +1224,47 @@ mod tests {
     /// The solve against the matrix (relative residual below 1e-13) with AMD and with a
     /// given ordering, twice with the same factors, on a small matrix and on one whose
     /// supernodes are wide (every path of the sweeps).
+    /// A dense matrix has one supernode: `Σ_(c=1..n) c (c − 1) / 2 = (n³ − n) / 6`
+    /// multiply–adds.
+    #[test]
+    fn multiply_adds_of_a_dense_matrix() {
+        let n = 10;
+        let col_ptr: Vec<usize> = (0..=n).map(|j| j * (j + 1) / 2).collect();
+        let row_idx: Vec<usize> = (0..n).flat_map(|j| 0..=j).collect();
+        let f = Ldlt::analyse(n, &col_ptr, &row_idx, None).unwrap();
+        // One supernode, its square block stored whole.
+        assert_eq!(f.factor_nnz(), n * n);
+        assert_eq!(f.multiply_adds(), ((n * n * n - n) / 6) as f64);
+    }
+
+    /// The quasi-definite matrix `[[H, Bᵀ], [B, −G]]` in its own order has `k²` positive
+    /// pivots, then `k` negative ones.
+    #[test]
+    fn pivot_signs_of_a_quasi_definite_matrix() {
+        let k = 6;
+        let (n, col_ptr, row_idx, vals) = quasi_definite(k);
+        let identity: Vec<usize> = (0..n).collect();
+        let mut f = Ldlt::analyse(n, &col_ptr, &row_idx, Some(&identity)).unwrap();
+        f.factorize(&col_ptr, &row_idx, &vals).unwrap();
+        assert!(f.pivots_signed(k * k));
+        assert!(!f.pivots_signed(k * k - 1) && !f.pivots_signed(k * k + 1));
+        assert!(!f.pivots_positive());
+        let mut single = crate::ldlt_single::LdltSingle::new(
+            Ldlt::analyse(n, &col_ptr, &row_idx, Some(&identity)).unwrap(),
+        );
+        single
+            .factorize_signed(&col_ptr, &row_idx, &vals, Some(k * k))
+            .unwrap();
+        for wrong in [Some(k * k - 1), Some(n)] {
+            assert!(
+                single
+                    .factorize_signed(&col_ptr, &row_idx, &vals, wrong)
+                    .is_err()
+            );
+        }
+        assert!(single.factorize(&col_ptr, &row_idx, &vals, false).is_ok());
+    }
+
     #[test]
     fn solve_matches_the_matrix() {
         for k in [12, 41] {

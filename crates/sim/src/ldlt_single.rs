@@ -148,6 +148,21 @@ impl LdltSingle {
         values: &[f64],
         positive: bool,
     ) -> Result<(), LdltError> {
+        let n = self.analysis.symbolic().nrows();
+        self.factorize_signed(col_ptr, row_idx, values, positive.then_some(n))
+    }
+
+    /// [`Self::factorize`] of a matrix with known inertia: with `Some(p)`, the first `p`
+    /// pivots (in the elimination order) must be positive and the others negative — the
+    /// bordered matrix `[[P, Z], [Zᵀ, 0]]` of a positive definite `P` and a `Z` of full
+    /// column rank, the border last, has `p = n(P)`.
+    pub fn factorize_signed(
+        &mut self,
+        col_ptr: &[usize],
+        row_idx: &[usize],
+        values: &[f64],
+        positive: Option<usize>,
+    ) -> Result<(), LdltError> {
         self.factored = false;
         let symbolic = self.analysis.symbolic();
         let n = symbolic.nrows();
@@ -207,7 +222,8 @@ impl LdltSingle {
                 let block = &self.values[vptr[s]..vptr[s + 1]];
                 for j in 0..w {
                     let d = block[j * m + j];
-                    if !(d.is_finite() && d != 0.0) || (positive && d <= 0.0) {
+                    let sign_ok = positive.is_none_or(|p| (d > 0.0) == (begin[s] + j < p));
+                    if !(d.is_finite() && d != 0.0 && sign_ok) {
                         return Err(LdltError(format!(
                             "pivot {d:e} of column {} in single precision",
                             begin[s] + j
@@ -391,6 +407,19 @@ impl TrailingFactor {
                     *x -= c * vj;
                 }
             }
+        }
+    }
+
+    /// `v ← D₂ L₂₂ᵀ v` (`k` values).
+    pub fn upper_product(&self, v: &mut [f64]) {
+        let k = self.k;
+        for j in 0..k {
+            let s: f64 = v[j + 1..]
+                .iter()
+                .zip(&self.l[j * k + j + 1..(j + 1) * k])
+                .map(|(x, c)| x * c)
+                .sum();
+            v[j] = self.d[j] * (v[j] + s);
         }
     }
 
