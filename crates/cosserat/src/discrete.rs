@@ -850,7 +850,11 @@ impl<const D: usize> Cosserat<D> {
     }
 
     /// Set up the solver `options` for the system matrix with `values` (the system or
-    /// the Newmark matrix) and the preconditioning matrix with `preconditioner`.
+    /// the Newmark matrix) and the preconditioning matrix with `preconditioner`. The
+    /// Schur complement solve takes their difference to be
+    /// [`Self::boundary_difference`] (as for the system and the Newmark matrix, which adds
+    /// the same mass to both); for other values it is an inexact preconditioner, and
+    /// GMRES, which checks the true residual, needs more iterations.
     pub fn linear(
         &self,
         values: Vec<f64>,
