@@ -490,8 +490,9 @@ enum AnalysisForm {
 
 /// The bordered matrix `[[P, Z], [Zᵀ, 0]]` of a [`LowRankDifference`] `E = Z B Zᵀ`: its
 /// upper triangle by columns (`P`'s, then the `k` border columns with their rows sorted
-/// and a zero diagonal) and the values of the border columns; the columns of `Z` that are
-/// zero are left out (with their row and column of `B`).
+/// and a zero diagonal) and the values of the border columns, each scaled to unit length
+/// (`B` scaled to match: `Z B Zᵀ` unchanged); the columns of `Z` that are zero are left out
+/// (with their row and column of `B`).
 struct Border {
     col_ptr: Vec<usize>,
     row_idx: Vec<usize>,
