@@ -285,7 +285,8 @@ impl<const D: usize> Cosserat<D> {
         };
         me.assemble_conditions(conditions)?;
         // The symbolic analysis of the solve the automatic choice takes needs only the
-        // pattern and the unknowns of the Nitsche terms: it runs beside the assembly.
+        // pattern and the boundary difference (from the Nitsche terms above): it runs
+        // beside the assembly.
         // The values of the static solve are computed on the assembling thread after the
         // assembly, while the other one still allocates the factors.
         let border = me.schur_border(LinearSolver::Auto);
@@ -521,8 +522,6 @@ impl<const D: usize> Cosserat<D> {
         );
     }
 
-    /// The unknowns where the system will differ from the preconditioning matrix (those
-    /// of the Nitsche terms and of the boundary penalty), when the automatic choice of
     /// The difference between the system and the preconditioning matrix
     /// ([`Self::boundary_difference`]) when `solver` takes the Schur complement solve:
     /// [`LinearSolver::LdltSchur`], or [`LinearSolver::Auto`] in 2D below
