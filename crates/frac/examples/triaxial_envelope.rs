@@ -29,7 +29,10 @@ fn main() -> Result<(), FracError> {
     let s = phi_deg.to_radians().sin();
     let c = phi_deg.to_radians().cos();
     println!("Mohr–Coulomb, c = {cohesion:.1e} Pa, φ = {phi_deg}°");
-    println!("{:>12} {:>16} {:>16} {:>10}", "p (Pa)", "q_f bisection", "q_f closed form", "rel. diff");
+    println!(
+        "{:>12} {:>16} {:>16} {:>10}",
+        "p (Pa)", "q_f bisection", "q_f closed form", "rel. diff"
+    );
     for p in [0.0, 5.0e6, 10.0e6, 20.0e6, 40.0e6] {
         // Bracket: intact at q = p (hydrostatic), failed at a very large axial load.
         let (mut lo, mut hi) = (p, p + 1.0e10);

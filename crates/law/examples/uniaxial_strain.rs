@@ -28,8 +28,16 @@ fn main() -> Result<(), LawError> {
     strain[(0, 0)] = eps0;
     let s = d3.stress(&strain);
     println!("uniaxial strain ε₀ = {eps0:e}");
-    println!("  σ11 = {:.6e} Pa   (λ + 2μ) ε₀ = {:.6e}", s[(0, 0)], (lambda + 2.0 * mu) * eps0);
-    println!("  σ22 = {:.6e} Pa   λ ε₀        = {:.6e}", s[(1, 1)], lambda * eps0);
+    println!(
+        "  σ11 = {:.6e} Pa   (λ + 2μ) ε₀ = {:.6e}",
+        s[(0, 0)],
+        (lambda + 2.0 * mu) * eps0
+    );
+    println!(
+        "  σ22 = {:.6e} Pa   λ ε₀        = {:.6e}",
+        s[(1, 1)],
+        lambda * eps0
+    );
     println!(
         "  energy density {:.6e} J/m³ = ½ σ11 ε₀ = {:.6e}",
         d3.energy_density(&strain),
@@ -43,7 +51,12 @@ fn main() -> Result<(), LawError> {
     strain2[(1, 1)] = -nu * eps0;
     let s2 = d2.stress(&strain2);
     println!("plane stress, ε = (ε₀, −ν ε₀)");
-    println!("  σ11 = {:.6e} Pa   E ε₀ = {:.6e}; σ22 = {:.1e} Pa", s2[(0, 0)], e * eps0, s2[(1, 1)]);
+    println!(
+        "  σ11 = {:.6e} Pa   E ε₀ = {:.6e}; σ22 = {:.1e} Pa",
+        s2[(0, 0)],
+        e * eps0,
+        s2[(1, 1)]
+    );
 
     // Pure shear: principal stresses ±μγ along the diagonals.
     let gamma = 2.0e-4;

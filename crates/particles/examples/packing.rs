@@ -29,10 +29,7 @@ fn main() -> Result<(), ParticleError> {
     // Pairs closer than an alert distance, by cell lists and by brute force.
     let alert = 0.05;
     let mut cells = CellList::new();
-    cells.build(
-        &packing.centres,
-        2.0 * max_radius(&packing.radii) + alert,
-    );
+    cells.build(&packing.centres, 2.0 * max_radius(&packing.radii) + alert);
     let mut pairs = Vec::new();
     cells.pairs(&packing.centres, &packing.radii, alert, &mut pairs);
     let brute = brute_force_pairs(&packing.centres, &packing.radii, alert);
@@ -40,7 +37,11 @@ fn main() -> Result<(), ParticleError> {
         "pairs within {alert} m: {} by cell lists, {} by brute force ({})",
         pairs.len(),
         brute.len(),
-        if pairs == brute { "the same" } else { "DIFFERENT" }
+        if pairs == brute {
+            "the same"
+        } else {
+            "DIFFERENT"
+        }
     );
     Ok(())
 }
