@@ -93,7 +93,7 @@ fn tagged<const D: usize>(mut g: Grid<D>) -> Grid<D> {
 
 fn round_trip<const D: usize>(g: &Grid<D>, name: &str) {
     let dir = tmp_dir("roundtrip");
-    for enc in [Encoding::Ascii, Encoding::Base64] {
+    for enc in [Encoding::Ascii, Encoding::Base64, Encoding::Appended] {
         let path = dir.join(format!("{name}_{enc:?}.vtu"));
         write_vtu_with(&path, g, &[], &[], enc).unwrap();
         let back: Grid<D> = read_vtu(&path).unwrap();

@@ -1,12 +1,13 @@
-//! VTK PolyData files (`.vtp`) for particles and contacts, written atomically (to a
-//! temporary file, then renamed) and streamed: nothing is held in memory but the write
-//! buffer.
+//! VTK PolyData files (`.vtp`) for particles and contacts, written with
+//! [`porofrac_vtk`]: atomically (a temporary file, then a rename) and streamed to the file
+//! (the flattened vector arrays are the only copies made).
 //!
-//! * particles: one vertex per disk, point data `radius`, `velocity` (3 components,
-//!   z = 0), `omega`, `displacement` (3 components), `id`;
+//! * particles: one vertex per disk, point data `radius` (the active scalars), `velocity`
+//!   (3 components, z = 0), `omega`, `displacement` (3 components), `id` (`Int64`), then
+//!   the caller's extra scalars;
 //! * contacts: one line per contact between the two centres (or the centre and the
-//!   contact point on a rigid body), cell data `normal_force`, `tangential_force`,
-//!   `bonded` (0/1).
+//!   contact point on a rigid body), cell data `normal_force` (the active scalars),
+//!   `tangential_force`, `bonded` (`Int64` 0/1).
 //!
 //! Arrays are `format="binary"`: each is one base64 stream of a `UInt64` byte count
 //! followed by the little-endian values (`header_type="UInt64"`), which ParaView and the
@@ -14,12 +15,9 @@
 //! the bytes and needs no float formatting (a million bonded disks: 14 s of output per
 //! frame in ASCII).
 
-use std::fs::File;
-use std::io::{BufWriter, Write};
 use std::path::Path;
 
-use base64::engine::general_purpose::STANDARD;
-use base64::write::EncoderWriter;
+use porofrac_vtk::{Attributes, CellArray, DataArray, Encoding, PolyData, VtkError};
 
 use crate::{Disks, ParticleError};
 
@@ -38,80 +36,20 @@ pub struct ContactLine {
     pub bonded: bool,
 }
 
-/// Write `path` through `body` into a temporary file, then rename it into place.
-fn write_atomic(
-    path: &Path,
-    body: impl FnOnce(&mut BufWriter<File>) -> std::io::Result<()>,
-) -> Result<(), ParticleError> {
-    let err = |e: std::io::Error| ParticleError::Io {
+fn io_err(path: &Path) -> impl Fn(VtkError) -> ParticleError + '_ {
+    move |e| ParticleError::Io {
         path: path.display().to_string(),
-        message: e.to_string(),
-    };
-    let tmp = path.with_extension("vtp.tmp");
-    let mut w = BufWriter::with_capacity(1 << 20, File::create(&tmp).map_err(err)?);
-    body(&mut w).and_then(|()| w.flush()).map_err(err)?;
-    drop(w);
-    std::fs::rename(&tmp, path).map_err(err)
-}
-
-/// The element types of the arrays.
-#[derive(Clone, Copy)]
-enum Kind {
-    Float64,
-    Int64,
-}
-
-/// One `DataArray` of `count` values (`count` known before the values are streamed).
-fn array(
-    w: &mut impl Write,
-    kind: Kind,
-    name: &str,
-    comps: usize,
-    count: usize,
-    values: impl Iterator<Item = f64>,
-) -> std::io::Result<()> {
-    let ty = match kind {
-        Kind::Float64 => "Float64",
-        Kind::Int64 => "Int64",
-    };
-    writeln!(
-        w,
-        "<DataArray type=\"{ty}\" Name=\"{name}\" NumberOfComponents=\"{comps}\" format=\"binary\">"
-    )?;
-    {
-        // values gathered in blocks: the encoder is fast on long writes only
-        const BLOCK: usize = 3 << 13;
-        let mut enc = EncoderWriter::new(&mut *w, &STANDARD);
-        let mut buf = Vec::with_capacity(BLOCK + 8);
-        buf.extend_from_slice(&(8 * count as u64).to_le_bytes());
-        let mut written = 0usize;
-        for v in values {
-            match kind {
-                Kind::Float64 => buf.extend_from_slice(&v.to_le_bytes()),
-                Kind::Int64 => buf.extend_from_slice(&(v as i64).to_le_bytes()),
-            }
-            written += 1;
-            if buf.len() >= BLOCK {
-                enc.write_all(&buf)?;
-                buf.clear();
-            }
-        }
-        enc.write_all(&buf)?;
-        debug_assert_eq!(written, count, "{name}: value count");
-        enc.finish()?;
+        message: match e {
+            VtkError::Io { source, .. } => source.to_string(),
+            other => other.to_string(),
+        },
     }
-    w.write_all(b"\n</DataArray>\n")
 }
 
-/// The file's opening up to the `Piece` element.
-fn header(w: &mut impl Write, piece: &str) -> std::io::Result<()> {
-    writeln!(
-        w,
-        "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<PolyData>\n{piece}"
-    )
+/// `[x, y, 0]` per point, flat.
+fn plane_to_3d(v: impl Iterator<Item = [f64; 2]>) -> Vec<f64> {
+    v.flat_map(|p| [p[0], p[1], 0.0]).collect()
 }
-
-const FOOTER: &[u8] = b"</Piece>\n</PolyData>\n</VTKFile>\n";
 
 /// Write the disks as vertices with their point data.
 pub fn write_particles(path: &Path, d: &Disks) -> Result<(), ParticleError> {
@@ -132,107 +70,58 @@ pub fn write_particles_with(
             message: format!("point data `{name}` has {} values for {n} disks", v.len()),
         });
     }
-    write_atomic(path, |w| {
-        header(
-            w,
-            &format!(
-                "<Piece NumberOfPoints=\"{n}\" NumberOfVerts=\"{n}\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n<Points>"
-            ),
-        )?;
-        let (f, i) = (Kind::Float64, Kind::Int64);
-        array(
-            w,
-            f,
-            "Points",
-            3,
-            3 * n,
-            d.x.iter().flat_map(|p| [p[0], p[1], 0.0]),
-        )?;
-        w.write_all(b"</Points>\n<Verts>\n")?;
-        array(w, i, "connectivity", 1, n, (0..n).map(|k| k as f64))?;
-        array(w, i, "offsets", 1, n, (1..=n).map(|k| k as f64))?;
-        w.write_all(b"</Verts>\n<PointData Scalars=\"radius\">\n")?;
-        array(w, f, "radius", 1, n, d.r.iter().copied())?;
-        array(
-            w,
-            f,
-            "velocity",
-            3,
-            3 * n,
-            d.v.iter().flat_map(|v| [v[0], v[1], 0.0]),
-        )?;
-        array(w, f, "omega", 1, n, d.omega.iter().copied())?;
-        array(
-            w,
-            f,
-            "displacement",
-            3,
-            3 * n,
-            (0..n).flat_map(|k| {
-                let u = d.displacement(k);
-                [u[0], u[1], 0.0]
-            }),
-        )?;
-        array(w, i, "id", 1, n, (0..n).map(|k| k as f64))?;
-        for (name, values) in extra {
-            array(w, f, name, 1, n, values.iter().copied())?;
-        }
-        w.write_all(b"</PointData>\n")?;
-        w.write_all(FOOTER)
-    })
+    let points = plane_to_3d(d.x.iter().copied());
+    let velocity = plane_to_3d(d.v.iter().copied());
+    let displacement = plane_to_3d((0..n).map(|k| d.displacement(k)));
+    let ids: Vec<i64> = (0..n as i64).collect();
+    let offsets: Vec<i64> = (1..=n as i64).collect();
+    let mut arrays = vec![
+        DataArray::new("radius", 1, &d.r[..]),
+        DataArray::new("velocity", 3, &velocity[..]),
+        DataArray::new("omega", 1, &d.omega[..]),
+        DataArray::new("displacement", 3, &displacement[..]),
+        DataArray::new("id", 1, &ids[..]),
+    ];
+    arrays.extend(extra.iter().map(|(name, v)| DataArray::new(name, 1, *v)));
+    PolyData {
+        points: &points,
+        verts: CellArray {
+            connectivity: &ids,
+            offsets: &offsets,
+        },
+        point_data: Attributes::new(&arrays).with_scalars("radius"),
+        ..PolyData::default()
+    }
+    .write(path, Encoding::Base64)
+    .map_err(io_err(path))
 }
 
 /// Write contacts as lines with cell data.
 pub fn write_contacts(path: &Path, lines: &[ContactLine]) -> Result<(), ParticleError> {
     let n = lines.len();
-    write_atomic(path, |w| {
-        header(
-            w,
-            &format!(
-                "<Piece NumberOfPoints=\"{}\" NumberOfVerts=\"0\" NumberOfLines=\"{n}\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n<Points>",
-                2 * n
-            ),
-        )?;
-        let (f, i) = (Kind::Float64, Kind::Int64);
-        array(
-            w,
-            f,
-            "Points",
-            3,
-            6 * n,
-            lines
-                .iter()
-                .flat_map(|l| [l.a[0], l.a[1], 0.0, l.b[0], l.b[1], 0.0]),
-        )?;
-        w.write_all(b"</Points>\n<Lines>\n")?;
-        array(w, i, "connectivity", 1, 2 * n, (0..2 * n).map(|k| k as f64))?;
-        array(w, i, "offsets", 1, n, (1..=n).map(|k| 2.0 * k as f64))?;
-        w.write_all(b"</Lines>\n<CellData Scalars=\"normal_force\">\n")?;
-        array(
-            w,
-            f,
-            "normal_force",
-            1,
-            n,
-            lines.iter().map(|l| l.normal_force),
-        )?;
-        array(
-            w,
-            f,
-            "tangential_force",
-            1,
-            n,
-            lines.iter().map(|l| l.tangential_force),
-        )?;
-        array(
-            w,
-            i,
-            "bonded",
-            1,
-            n,
-            lines.iter().map(|l| l.bonded as u8 as f64),
-        )?;
-        w.write_all(b"</CellData>\n")?;
-        w.write_all(FOOTER)
-    })
+    let points: Vec<f64> = lines
+        .iter()
+        .flat_map(|l| [l.a[0], l.a[1], 0.0, l.b[0], l.b[1], 0.0])
+        .collect();
+    let connectivity: Vec<i64> = (0..2 * n as i64).collect();
+    let offsets: Vec<i64> = (1..=n as i64).map(|k| 2 * k).collect();
+    let normal: Vec<f64> = lines.iter().map(|l| l.normal_force).collect();
+    let tangential: Vec<f64> = lines.iter().map(|l| l.tangential_force).collect();
+    let bonded: Vec<i64> = lines.iter().map(|l| i64::from(l.bonded)).collect();
+    let arrays = [
+        DataArray::new("normal_force", 1, &normal[..]),
+        DataArray::new("tangential_force", 1, &tangential[..]),
+        DataArray::new("bonded", 1, &bonded[..]),
+    ];
+    PolyData {
+        points: &points,
+        lines: CellArray {
+            connectivity: &connectivity,
+            offsets: &offsets,
+        },
+        cell_data: Attributes::new(&arrays).with_scalars("normal_force"),
+        ..PolyData::default()
+    }
+    .write(path, Encoding::Base64)
+    .map_err(io_err(path))
 }

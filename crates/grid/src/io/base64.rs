@@ -1,5 +1,5 @@
-//! Standard base64 (RFC 4648, alphabet `A–Z a–z 0–9 + /`, `=` padding) for VTK's binary
-//! data, on top of the `base64` crate.
+//! Standard base64 (RFC 4648, alphabet `A–Z a–z 0–9 + /`, `=` padding) for reading VTK's
+//! binary data, on top of the `base64` crate.
 //!
 //! VTK writes some arrays as *several* base64 streams back to back: with compression, the
 //! block header and the compressed blocks are encoded separately, so `=` padding may end a
@@ -9,7 +9,8 @@
 use base64::Engine as _;
 use base64::engine::general_purpose::STANDARD;
 
-/// Append the base64 encoding of `bytes` to `out`.
+/// Append the base64 encoding of `bytes` to `out` (test data).
+#[cfg(test)]
 pub(crate) fn encode_into(bytes: &[u8], out: &mut String) {
     STANDARD.encode_string(bytes, out);
 }

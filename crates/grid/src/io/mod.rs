@@ -1,6 +1,6 @@
 //! Mesh import and export: Gmsh 4.1 `.msh`, ASCII or binary (read), VTK XML `.vtu` (read
-//! and write; ASCII, base64, appended and zlib-compressed data) and ParaView `.pvd` time
-//! series (write).
+//! ASCII, base64, appended and zlib-compressed data; write through [`porofrac_vtk`]) and
+//! ParaView `.pvd` time series (write).
 //!
 //! # Cells and face orientation
 //!
@@ -127,16 +127,17 @@ mod gmsh;
 pub mod grdecl;
 mod pvd;
 mod vtu;
+mod vtu_write;
 mod xml;
 
 pub use gmsh::{parse_msh, parse_msh_bytes, read_msh};
 pub use grdecl::{read_grdecl, read_grdecl_with};
 pub use pvd::PvdWriter;
-pub use vtu::{Encoding, Field, kelvin_to_vtk_sym, read_vtu, write_vtu, write_vtu_with};
+pub use vtu::read_vtu;
+pub use vtu_write::{Encoding, Field, kelvin_to_vtk_sym, write_vtu, write_vtu_with};
 
 use std::fs;
-use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use crate::builder::CellFaceLoops;
 use crate::error::{GridError, Result};
@@ -388,55 +389,10 @@ fn signed_volume<const D: usize>(
     (vol, (hi - lo).amax())
 }
 
-/// Write a file atomically: the content goes to a temporary file in the same directory,
-/// which is then renamed over `path` (a killed run leaves the old or the new file, never a
-/// partial one).
-pub(crate) fn write_atomic(path: &Path, content: &[u8]) -> Result<()> {
-    let io_err = |p: &Path, source| GridError::Io {
-        path: p.to_path_buf(),
-        source,
-    };
-    let name = path.file_name().ok_or_else(|| {
-        io_err(
-            path,
-            std::io::Error::new(std::io::ErrorKind::InvalidInput, "not a file path"),
-        )
-    })?;
-    let mut tmp_name = std::ffi::OsString::from(".");
-    tmp_name.push(name);
-    tmp_name.push(format!(".tmp{}", std::process::id()));
-    let tmp: PathBuf = path.with_file_name(tmp_name);
-    let result = (|| {
-        let mut f = fs::File::create(&tmp)?;
-        f.write_all(content)?;
-        f.sync_all()?;
-        drop(f);
-        fs::rename(&tmp, path)
-    })();
-    result.map_err(|e| {
-        let _ = fs::remove_file(&tmp);
-        io_err(path, e)
-    })
-}
-
 /// Read a whole file, mapping failures to [`GridError::Io`] with the path.
 pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>> {
     fs::read(path).map_err(|source| GridError::Io {
         path: path.to_path_buf(),
         source,
     })
-}
-
-/// Escape a string for an XML attribute value.
-pub(crate) fn xml_escape(s: &str, out: &mut String) {
-    for ch in s.chars() {
-        match ch {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&apos;"),
-            c => out.push(c),
-        }
-    }
 }

@@ -1,4 +1,5 @@
-//! ParaView `.pvd` collection (time series) writer.
+//! ParaView `.pvd` collection (time series) writer: [`porofrac_vtk::PvdWriter`] with the
+//! grid's error type.
 //!
 //! ```text
 //! <VTKFile type="Collection" version="0.1" byte_order="LittleEndian">
@@ -11,75 +12,36 @@
 //! The whole file is rewritten atomically after every [`PvdWriter::add`], so a run that is
 //! killed leaves a valid collection of the steps written so far.
 
-use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-use crate::error::{GridError, Result};
-use crate::io::{write_atomic, xml_escape};
+use crate::error::Result;
+use crate::io::vtu_write::vtk_err;
 
 /// Writes a `.pvd` time series, one `DataSet` per [`add`](Self::add).
 #[derive(Clone, Debug)]
-pub struct PvdWriter {
-    path: PathBuf,
-    entries: Vec<(f64, String)>,
-}
+pub struct PvdWriter(porofrac_vtk::PvdWriter);
 
 impl PvdWriter {
     /// Create the collection file at `path` (an empty collection is written at once).
     pub fn create(path: impl AsRef<Path>) -> Result<Self> {
-        let w = Self {
-            path: path.as_ref().to_path_buf(),
-            entries: Vec::new(),
-        };
-        w.flush()?;
-        Ok(w)
+        porofrac_vtk::PvdWriter::create(path)
+            .map(Self)
+            .map_err(vtk_err)
     }
 
     /// Append a step at `time` whose data set is `file` (a path relative to the `.pvd`
     /// file's directory, written with `/` separators), and rewrite the collection.
     pub fn add(&mut self, time: f64, file: impl AsRef<Path>) -> Result<()> {
-        if !time.is_finite() {
-            return Err(GridError::Input(format!("pvd: time {time} is not finite")));
-        }
-        let file = file.as_ref();
-        if file.is_absolute() {
-            return Err(GridError::Input(format!(
-                "pvd: data set path {} must be relative to the .pvd file",
-                file.display()
-            )));
-        }
-        let rel: Vec<String> = file
-            .components()
-            .map(|c| c.as_os_str().to_string_lossy().into_owned())
-            .collect();
-        self.entries.push((time, rel.join("/")));
-        self.flush()
+        self.0.add(time, file).map_err(vtk_err)
     }
 
     /// The collection file.
     pub fn path(&self) -> &Path {
-        &self.path
+        self.0.path()
     }
 
     /// The steps so far: time and relative data-set path.
     pub fn entries(&self) -> &[(f64, String)] {
-        &self.entries
-    }
-
-    fn flush(&self) -> Result<()> {
-        let mut s = String::from(
-            "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" \
-             byte_order=\"LittleEndian\">\n  <Collection>\n",
-        );
-        for (t, f) in &self.entries {
-            let _ = write!(
-                s,
-                "    <DataSet timestep=\"{t:?}\" group=\"\" part=\"0\" file=\""
-            );
-            xml_escape(f, &mut s);
-            s.push_str("\"/>\n");
-        }
-        s.push_str("  </Collection>\n</VTKFile>\n");
-        write_atomic(&self.path, s.as_bytes())
+        self.0.entries()
     }
 }

@@ -1,26 +1,4 @@
-//! VTK XML UnstructuredGrid (`.vtu`) writer and reader.
-//!
-//! # Writing
-//!
-//! * 2D cells are `VTK_POLYGON` (7) with the counter-clockwise [`Grid::cell_nodes`] and
-//!   points at `z = 0`. 3D cells are `VTK_POLYHEDRON` (42) with the `faces` / `faceoffsets`
-//!   arrays (the layout ParaView 5.x and meshio read): per cell the number of faces, then
-//!   for each face its node count and nodes, in the cell's outward order. A face seen from
-//!   its second cell is written reversed and rotated so that reading the file back gives
-//!   the same cell node order, hence the identical grid (`read(write(g)) == g`).
-//! * Tags. For every cell tag an `Int32` cell-data array `tag:<name>` holding 1 on the
-//!   tagged cells and 0 elsewhere (names are exact, tags may overlap), and one plain `tag`
-//!   array: the 1-based position (in name order) of the last tag holding the cell, 0 for
-//!   none (for colouring in ParaView). Face tags, which VTK cannot attach to polyhedron
-//!   faces, go to the grid's `FieldData` as `Int64` arrays `facetag:<name>` of face
-//!   indices; the reader rebuilds the same face numbering, so they round-trip exactly.
-//!   The names `tag` and `tag:…` are reserved in cell data.
-//! * Data: [`Field`] scalars, vectors (3 components, z = 0 in 2D), symmetric tensors
-//!   (written as 9 components, row-major, which ParaView shows as a tensor) and `Int32`
-//!   arrays. [`Encoding::Base64`] (default; inline binary, `header_type="UInt64"`,
-//!   little-endian, no compression) or [`Encoding::Ascii`] (floats in Rust's shortest
-//!   round-trip form, so both encodings are bit-exact).
-//! * The file is written atomically (temporary file in the same directory, then rename).
+//! VTK XML UnstructuredGrid (`.vtu`) reader (the writer is [`crate::io::write_vtu`]).
 //!
 //! # Reading
 //!
@@ -35,7 +13,6 @@
 
 use std::borrow::Cow;
 use std::collections::BTreeMap;
-use std::fmt::Write as _;
 use std::io::Read as _;
 use std::path::Path;
 
@@ -45,397 +22,11 @@ use crate::builder::CellFaceLoops;
 use crate::error::{GridError, Result};
 use crate::grid::Grid;
 use crate::io::xml::{self, Element, LineIndex};
-use crate::io::{Origin, RawMesh, Shape, base64, read_file, write_atomic, xml_escape};
+use crate::io::{Origin, RawMesh, Shape, base64, read_file};
 use crate::point::{Point, assert_dim};
 
-/// A data array to write, borrowed from the caller. Lengths must equal the number of
-/// points (point data) or cells (cell data).
-#[derive(Clone, Copy, Debug)]
-pub enum Field<'a, const D: usize> {
-    /// One value per entity.
-    Scalars(&'a [f64]),
-    /// One vector per entity, written with 3 components (z = 0 in 2D).
-    Vectors(&'a [Point<D>]),
-    /// One symmetric tensor per entity as `[xx, yy, zz, xy, yz, xz]` (plain components,
-    /// not Kelvin-scaled; see [`kelvin_to_vtk_sym`]), written as 9 components row-major.
-    SymTensors(&'a [[f64; 6]]),
-    /// One integer per entity (`Int32`).
-    Ints(&'a [i32]),
-}
-
-impl<const D: usize> Field<'_, D> {
-    fn len(&self) -> usize {
-        match self {
-            Field::Scalars(v) => v.len(),
-            Field::Vectors(v) => v.len(),
-            Field::SymTensors(v) => v.len(),
-            Field::Ints(v) => v.len(),
-        }
-    }
-}
-
-/// Convert a Kelvin vector (2D `[a11, a22, √2 a12]`, 3D
-/// `[a11, a22, a33, √2 a23, √2 a13, √2 a12]`) to VTK's symmetric order
-/// `[xx, yy, zz, xy, yz, xz]`. Returns `None` for any other length.
-pub fn kelvin_to_vtk_sym(k: &[f64]) -> Option<[f64; 6]> {
-    let s = std::f64::consts::FRAC_1_SQRT_2;
-    match k.len() {
-        3 => Some([k[0], k[1], 0.0, k[2] * s, 0.0, 0.0]),
-        6 => Some([k[0], k[1], k[2], k[5] * s, k[3] * s, k[4] * s]),
-        _ => None,
-    }
-}
-
-/// How data arrays are encoded in the file.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Encoding {
-    /// Text; floats in shortest round-trip form.
-    Ascii,
-    /// Inline base64 of little-endian binary with a `UInt64` byte-count header.
-    #[default]
-    Base64,
-}
-
-trait Scalar: Copy {
-    const VTK: &'static str;
-    const SIZE: usize;
-    fn put_le(self, out: &mut Vec<u8>);
-    fn put_text(self, out: &mut String);
-}
-
-macro_rules! scalar {
-    ($t:ty, $name:literal, $fmt:literal) => {
-        impl Scalar for $t {
-            const VTK: &'static str = $name;
-            const SIZE: usize = std::mem::size_of::<$t>();
-            fn put_le(self, out: &mut Vec<u8>) {
-                out.extend_from_slice(&self.to_le_bytes());
-            }
-            fn put_text(self, out: &mut String) {
-                let _ = write!(out, $fmt, self);
-            }
-        }
-    };
-}
-scalar!(f64, "Float64", "{:?}");
-scalar!(i32, "Int32", "{}");
-scalar!(i64, "Int64", "{}");
-scalar!(u8, "UInt8", "{}");
-
-fn data_array<T: Scalar>(
-    out: &mut String,
-    enc: Encoding,
-    indent: &str,
-    name: &str,
-    ncomp: usize,
-    values: &[T],
-    bytes: &mut Vec<u8>,
-) {
-    let _ = write!(out, "{indent}<DataArray type=\"{}\" Name=\"", T::VTK);
-    xml_escape(name, out);
-    out.push('"');
-    // One component is VTK's default; meshio reads an explicit 1 as an n × 1 array.
-    if ncomp != 1 {
-        let _ = write!(out, " NumberOfComponents=\"{ncomp}\"");
-    }
-    if ncomp > 0 && values.len().is_multiple_of(ncomp) {
-        let _ = write!(out, " NumberOfTuples=\"{}\"", values.len() / ncomp);
-    }
-    match enc {
-        Encoding::Ascii => {
-            out.push_str(" format=\"ascii\">\n");
-            let per_line = (12 / ncomp.max(1)).max(1) * ncomp.max(1);
-            for (k, chunk) in values.chunks(per_line).enumerate() {
-                let _ = k;
-                out.push_str(indent);
-                out.push_str("  ");
-                for (i, &v) in chunk.iter().enumerate() {
-                    if i > 0 {
-                        out.push(' ');
-                    }
-                    v.put_text(out);
-                }
-                out.push('\n');
-            }
-        }
-        Encoding::Base64 => {
-            out.push_str(" format=\"binary\">\n");
-            bytes.clear();
-            bytes.extend_from_slice(&((values.len() * T::SIZE) as u64).to_le_bytes());
-            for &v in values {
-                v.put_le(bytes);
-            }
-            out.push_str(indent);
-            out.push_str("  ");
-            base64::encode_into(bytes, out);
-            out.push('\n');
-        }
-    }
-    let _ = writeln!(out, "{indent}</DataArray>");
-}
-
-fn write_field<const D: usize>(
-    out: &mut String,
-    enc: Encoding,
-    name: &str,
-    field: &Field<'_, D>,
-    bytes: &mut Vec<u8>,
-) {
-    const IND: &str = "        ";
-    match field {
-        Field::Scalars(v) => data_array(out, enc, IND, name, 1, v, bytes),
-        Field::Ints(v) => data_array(out, enc, IND, name, 1, v, bytes),
-        Field::Vectors(v) => {
-            let flat: Vec<f64> = v
-                .iter()
-                .flat_map(|p| (0..3).map(move |a| if a < D { p[a] } else { 0.0 }))
-                .collect();
-            data_array(out, enc, IND, name, 3, &flat, bytes);
-        }
-        Field::SymTensors(v) => {
-            let flat: Vec<f64> = v
-                .iter()
-                .flat_map(|t| {
-                    let [xx, yy, zz, xy, yz, xz] = *t;
-                    [xx, xy, xz, xy, yy, yz, xz, yz, zz]
-                })
-                .collect();
-            data_array(out, enc, IND, name, 9, &flat, bytes);
-        }
-    }
-}
-
-/// Write `grid` with point and cell data to a `.vtu` file (inline base64 binary; see the
-/// module docs for the layout and the tag arrays).
-pub fn write_vtu<const D: usize>(
-    path: impl AsRef<Path>,
-    grid: &Grid<D>,
-    point_data: &[(&str, Field<'_, D>)],
-    cell_data: &[(&str, Field<'_, D>)],
-) -> Result<()> {
-    write_vtu_with(path, grid, point_data, cell_data, Encoding::Base64)
-}
-
-/// [`write_vtu`] with a chosen data [`Encoding`].
-pub fn write_vtu_with<const D: usize>(
-    path: impl AsRef<Path>,
-    grid: &Grid<D>,
-    point_data: &[(&str, Field<'_, D>)],
-    cell_data: &[(&str, Field<'_, D>)],
-    enc: Encoding,
-) -> Result<()> {
-    const { assert_dim::<D>() };
-    let text = vtu_text(grid, point_data, cell_data, enc)?;
-    write_atomic(path.as_ref(), text.as_bytes())
-}
-
-fn check_fields<const D: usize>(
-    fields: &[(&str, Field<'_, D>)],
-    n: usize,
-    what: &str,
-    reserve_tags: bool,
-) -> Result<()> {
-    for (k, (name, f)) in fields.iter().enumerate() {
-        if name.is_empty() {
-            return Err(GridError::Input(format!(
-                "{what} array {k} has an empty name"
-            )));
-        }
-        if fields[..k].iter().any(|(m, _)| m == name) {
-            return Err(GridError::Input(format!(
-                "{what} array `{name}` given twice"
-            )));
-        }
-        if reserve_tags && (*name == "tag" || name.starts_with("tag:")) {
-            return Err(GridError::Input(format!(
-                "{what} array name `{name}` is reserved for cell tags"
-            )));
-        }
-        if f.len() != n {
-            return Err(GridError::Input(format!(
-                "{what} array `{name}` has {} values, expected {n}",
-                f.len()
-            )));
-        }
-    }
-    Ok(())
-}
-
-fn vtu_text<const D: usize>(
-    grid: &Grid<D>,
-    point_data: &[(&str, Field<'_, D>)],
-    cell_data: &[(&str, Field<'_, D>)],
-    enc: Encoding,
-) -> Result<String> {
-    check_fields(point_data, grid.num_nodes(), "point data", false)?;
-    check_fields(cell_data, grid.num_cells(), "cell data", true)?;
-    let nc = grid.num_cells();
-    let mut out = String::new();
-    let mut bytes = Vec::new();
-    out.push_str(
-        "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" \
-         byte_order=\"LittleEndian\" header_type=\"UInt64\">\n  <UnstructuredGrid>\n",
-    );
-    let edge_order = if D == 2 { edge_order(grid) } else { None };
-    if !grid.face_tags().is_empty() || edge_order.is_some() {
-        out.push_str("    <FieldData>\n");
-        for (name, faces) in grid.face_tags() {
-            let v: Vec<i64> = faces.iter().map(|&f| f as i64).collect();
-            data_array(
-                &mut out,
-                enc,
-                "      ",
-                &format!("facetag:{name}"),
-                1,
-                &v,
-                &mut bytes,
-            );
-        }
-        if let Some(v) = &edge_order {
-            data_array(&mut out, enc, "      ", EDGE_ORDER, 1, v, &mut bytes);
-        }
-        out.push_str("    </FieldData>\n");
-    }
-    let _ = writeln!(
-        out,
-        "    <Piece NumberOfPoints=\"{}\" NumberOfCells=\"{nc}\">",
-        grid.num_nodes()
-    );
-    out.push_str("      <PointData>\n");
-    for (name, f) in point_data {
-        write_field(&mut out, enc, name, f, &mut bytes);
-    }
-    out.push_str("      </PointData>\n      <CellData>\n");
-    if !grid.cell_tags().is_empty() {
-        let mut plain = vec![0i32; nc];
-        let mut one = vec![0i32; nc];
-        let mut per_tag = Vec::new();
-        for (k, (name, cells)) in grid.cell_tags().iter().enumerate() {
-            one.iter_mut().for_each(|x| *x = 0);
-            for &c in cells {
-                one[c] = 1;
-                plain[c] = k as i32 + 1;
-            }
-            per_tag.push((format!("tag:{name}"), one.clone()));
-        }
-        write_field(&mut out, enc, "tag", &Field::<D>::Ints(&plain), &mut bytes);
-        for (name, v) in &per_tag {
-            write_field(&mut out, enc, name, &Field::<D>::Ints(v), &mut bytes);
-        }
-    }
-    for (name, f) in cell_data {
-        write_field(&mut out, enc, name, f, &mut bytes);
-    }
-    out.push_str("      </CellData>\n      <Points>\n");
-    let pts: Vec<f64> = grid
-        .nodes()
-        .iter()
-        .flat_map(|p| (0..3).map(move |a| if a < D { p[a] } else { 0.0 }))
-        .collect();
-    data_array(&mut out, enc, "        ", "Points", 3, &pts, &mut bytes);
-    drop(pts);
-    out.push_str("      </Points>\n      <Cells>\n");
-    let mut conn: Vec<i64> = Vec::with_capacity(grid.cell_nodes.len());
-    let mut offsets: Vec<i64> = Vec::with_capacity(nc);
-    for c in 0..nc {
-        conn.extend(grid.cell_nodes(c).iter().map(|&n| n as i64));
-        offsets.push(conn.len() as i64);
-    }
-    const IND: &str = "        ";
-    data_array(&mut out, enc, IND, "connectivity", 1, &conn, &mut bytes);
-    data_array(&mut out, enc, IND, "offsets", 1, &offsets, &mut bytes);
-    let types = vec![if D == 2 { 7u8 } else { 42u8 }; nc];
-    data_array(&mut out, enc, IND, "types", 1, &types, &mut bytes);
-    if D == 3 {
-        let (faces, faceoffsets) = polyhedron_faces(grid);
-        data_array(&mut out, enc, IND, "faces", 1, &faces, &mut bytes);
-        data_array(
-            &mut out,
-            enc,
-            IND,
-            "faceoffsets",
-            1,
-            &faceoffsets,
-            &mut bytes,
-        );
-    }
-    out.push_str("      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n");
-    Ok(out)
-}
-
 /// Name of the 2D field-data array that keeps the order of each cell's faces.
-const EDGE_ORDER: &str = "porofrac:edge_order";
-
-/// In 2D, the position along the polygon ([`Grid::cell_nodes`]) of each of a cell's faces
-/// in [`Grid::cell_faces`] order, for all cells; `None` when every cell lists its faces
-/// along the polygon (then the polygon alone restores the grid).
-fn edge_order<const D: usize>(grid: &Grid<D>) -> Option<Vec<i64>> {
-    let mut out = Vec::with_capacity(grid.cell_faces.len());
-    let mut trivial = true;
-    for c in 0..grid.num_cells() {
-        let cn = grid.cell_nodes(c);
-        for (k, (&f, &o)) in grid
-            .cell_faces(c)
-            .iter()
-            .zip(grid.cell_face_outward(c))
-            .enumerate()
-        {
-            let start = grid.oriented_face_nodes(f, o).next().unwrap_or(usize::MAX);
-            let pos = cn.iter().position(|&n| n == start).unwrap_or(k);
-            trivial &= pos == k;
-            out.push(pos as i64);
-        }
-    }
-    (!trivial).then_some(out)
-}
-
-/// The `faces` stream and `faceoffsets` (end positions) of all cells as polyhedra.
-///
-/// Outward faces are written as stored; a face seen from its second cell is reversed and
-/// rotated so that the order of first appearance of the nodes equals
-/// [`Grid::cell_nodes`] (a loop rotation that does this exists because the grid was built
-/// from such loops).
-fn polyhedron_faces<const D: usize>(grid: &Grid<D>) -> (Vec<i64>, Vec<i64>) {
-    let mut faces = Vec::with_capacity(grid.face_nodes.len() * 2 + grid.cell_faces.len());
-    let mut offsets = Vec::with_capacity(grid.num_cells());
-    let mut buf: Vec<usize> = Vec::new();
-    for c in 0..grid.num_cells() {
-        let target = grid.cell_nodes(c);
-        let mut seen = 0;
-        faces.push(grid.cell_faces(c).len() as i64);
-        for (&f, &outw) in grid.cell_faces(c).iter().zip(grid.cell_face_outward(c)) {
-            buf.clear();
-            buf.extend(grid.oriented_face_nodes(f, outw));
-            let m = buf.len();
-            let fits = |r: usize| {
-                let mut k = seen;
-                for j in 0..m {
-                    let n = buf[(r + j) % m];
-                    if !target[..seen].contains(&n) {
-                        if target.get(k) != Some(&n) {
-                            return None;
-                        }
-                        k += 1;
-                    }
-                }
-                Some(k)
-            };
-            let (rot, next) = if outw {
-                (0, fits(0))
-            } else {
-                (0..m)
-                    .find_map(|r| fits(r).map(|k| (r, Some(k))))
-                    .unwrap_or((0, None))
-            };
-            // `next` is always Some for a grid built from loops; fall back gracefully.
-            seen = next.unwrap_or(seen);
-            faces.push(m as i64);
-            faces.extend((0..m).map(|j| buf[(rot + j) % m] as i64));
-        }
-        offsets.push(faces.len() as i64);
-    }
-    (faces, offsets)
-}
+pub(crate) const EDGE_ORDER: &str = "porofrac:edge_order";
 
 // ---------------------------------------------------------------------------- reading
 
@@ -1367,6 +958,7 @@ fn parse_vtu<const D: usize>(
 mod tests {
     use super::*;
     use crate::generate::cartesian;
+    use crate::io::vtu_write::{Encoding, Field, vtu_bytes};
 
     /// Field arrays are written with the right layout in both encodings.
     #[test]
@@ -1377,14 +969,22 @@ mod tests {
         let vecs = [Point::<2>::new(1.0, 2.0), Point::<2>::new(3.0, 4.0)];
         let t = [[1.0, 2.0, 3.0, 4.0, 5.0, 6.0]; 2];
         let ints = [7, -8];
+        let full: Vec<f64> = (0..18).map(|k| k as f64 - 0.5).collect();
         let cd = [
             ("s", Field::Scalars(&s)),
             ("v", Field::Vectors(&vecs)),
             ("t", Field::SymTensors(&t)),
             ("i", Field::Ints(&ints)),
+            (
+                "f",
+                Field::Components {
+                    components: 9,
+                    values: &full,
+                },
+            ),
         ];
         for enc in [Encoding::Ascii, Encoding::Base64] {
-            let text = vtu_text(&g, &[], &cd, enc).unwrap();
+            let text = String::from_utf8(vtu_bytes(&g, &[], &cd, enc).unwrap()).unwrap();
             let cx = Ctx {
                 path: Path::new("x.vtu"),
                 lines: LineIndex::new(&text),
@@ -1411,10 +1011,23 @@ mod tests {
                 &[1.0, 4.0, 6.0, 4.0, 2.0, 5.0, 6.0, 5.0, 3.0]
             );
             assert_eq!(get("i", 1), vec![7.0, -8.0]);
+            assert_eq!(get("f", 9), full);
         }
+        // A component count that does not divide the values is an error.
+        let odd = [(
+            "f",
+            Field::<2>::Components {
+                components: 4,
+                values: &full,
+            },
+        )];
+        let e = vtu_bytes(&g, &[], &odd, Encoding::Ascii)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("not a multiple of its 4 components"), "{e}");
         // Bad lengths and reserved names are errors.
-        assert!(vtu_text(&g, &[("p", Field::Scalars(&s))], &[], Encoding::Ascii).is_err());
-        assert!(vtu_text(&g, &[], &[("tag", Field::Ints(&ints))], Encoding::Ascii).is_err());
+        assert!(vtu_bytes(&g, &[("p", Field::Scalars(&s))], &[], Encoding::Ascii).is_err());
+        assert!(vtu_bytes(&g, &[], &[("tag", Field::Ints(&ints))], Encoding::Ascii).is_err());
     }
 
     /// VTK's own variant: a UInt32 header encoded as a separate base64 stream, big-endian.
@@ -1571,19 +1184,5 @@ mod tests {
         assert!(m.contains("800 bytes, only 16 follow"), "{m}");
         let m = unpack_err(&cx, &raw[..3], None);
         assert!(m.contains("no 4-byte size header"), "{m}");
-    }
-
-    #[test]
-    fn kelvin_conversion() {
-        let r = std::f64::consts::SQRT_2;
-        let k2 = kelvin_to_vtk_sym(&[1.0, 2.0, 3.0 * r]).unwrap();
-        for (a, b) in k2.iter().zip([1.0, 2.0, 0.0, 3.0, 0.0, 0.0]) {
-            assert!((a - b).abs() <= 1e-15 * 3.0, "{a} vs {b}");
-        }
-        let k = kelvin_to_vtk_sym(&[1.0, 2.0, 3.0, 4.0 * r, 5.0 * r, 6.0 * r]).unwrap();
-        for (a, b) in k.iter().zip([1.0, 2.0, 3.0, 6.0, 4.0, 5.0]) {
-            assert!((a - b).abs() <= 1e-15 * b, "{a} vs {b}");
-        }
-        assert_eq!(kelvin_to_vtk_sym(&[1.0]), None);
     }
 }
