@@ -1,6 +1,7 @@
-//! The direct solve on the coarsest level: sparse Cholesky `P A Pᵀ = L Lᵀ` (faer, AMD
-//! ordering). The symbolic factorization is computed once; new values on the same pattern
-//! only refactorize numerically.
+//! The direct solve on the coarsest level: sparse Cholesky `P A Pᵀ = L Lᵀ` (AMD ordering,
+//! [`porofrac_sparse::Cholesky`]) of the upper triangle of the coarsest operator. The
+//! symbolic factorization is computed once; new values on the same pattern only
+//! refactorize numerically.
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::SparseColMatRef;

@@ -7,6 +7,10 @@
 //! keep their order. Each node's equations stay together. On grids with a geometric
 //! embedding (every grid here) this is a good, cheap nested dissection without a graph
 //! partitioner.
+//!
+//! [`pattern_dissection`] places the unknowns of a bare pattern at grid points for
+//! [`porofrac_sparse::ordering::pattern_dissection`], which splits by those positions and
+//! the pattern alone.
 
 use porofrac_grid::{Grid, Point};
 

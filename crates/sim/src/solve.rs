@@ -2,10 +2,10 @@
 //!
 //! [`DirectSolver`] factorises the reduced stiffness `A = Tᵀ K_ff T` (symmetric positive
 //! definite once the rigid modes are removed) by a sparse Cholesky factorization
-//! `P A Pᵀ = L Lᵀ` (faer, AMD ordering `P`). The symbolic part (ordering, elimination
-//! tree, the pattern of `L`) depends only on the [`Pattern`] and is computed once in
-//! [`DirectSolver::new`]; [`DirectSolver::factorize`] recomputes only the numbers, so time
-//! steps and law switches reuse it.
+//! `P A Pᵀ = L Lᵀ` ([`porofrac_sparse::Cholesky`], AMD ordering `P`). The symbolic part
+//! (ordering, elimination tree, the pattern of `L`) depends only on the [`Pattern`] and
+//! is computed once in [`DirectSolver::new`]; [`DirectSolver::factorize`] recomputes only
+//! the numbers, so time steps and law switches reuse it.
 //!
 //! [`solve_static`] solves `Σ_K F_K(u) + f_ext = 0` for the free dofs with prescribed
 //! values `u_p(t)`: Newton's method `A(u) Δx = f_ext + Tᵀ F(u)`, `u_f ← u_f + T Δx`, which
