@@ -25,8 +25,8 @@
 //! * The time plotted is assembly + solve. Like the peer script (`common.best_of`), a
 //!   point is repeated (up to 3 passes) while one pass is cheap (below 20 s, and all
 //!   passes below 60 s), and each of the two times is the minimum over the passes. The
-//!   process keeps freed memory, as the `porofrac` command does
-//!   ([`porofrac::sim::heap`]).
+//!   process keeps freed memory, as the `porofrac` command does (`retain_freed_memory`
+//!   below, the policy of `crates/cli/src/heap.rs`).
 //! * **L2 error** `‖u − u_h‖_L2`: the piecewise-linear reconstruction of the nodal field on
 //!   the face-facet / vertex-average sub-simplices of each cell (on simplices the P1 field
 //!   itself), degree-5 quadrature (`tests/common`, shared with `tests/convergence.rs`).
@@ -695,8 +695,25 @@ fn load_average() -> String {
         .unwrap_or_else(|_| "?".into())
 }
 
+/// glibc's heap keeps freed memory for reuse: no `mmap` for large blocks, no trimming
+/// (the policy of the `porofrac` binary, `crates/cli/src/heap.rs`, which explains it).
+/// Elsewhere than Linux with glibc it does nothing.
+#[cfg(all(target_os = "linux", target_env = "gnu"))]
+#[allow(unsafe_code)]
+fn retain_freed_memory() {
+    // SAFETY: `mallopt` only sets allocator parameters; it is called with constants glibc
+    // documents, before any other thread starts.
+    unsafe {
+        libc::mallopt(libc::M_MMAP_MAX, 0);
+        libc::mallopt(libc::M_TRIM_THRESHOLD, i32::MAX);
+    }
+}
+
+#[cfg(not(all(target_os = "linux", target_env = "gnu")))]
+fn retain_freed_memory() {}
+
 fn main() -> Result<(), BoxError> {
-    porofrac::sim::heap::retain_freed_memory();
+    retain_freed_memory();
     let args = parse_args()?;
     let mut rows: Vec<Row> = Vec::new();
     if args.plot_only {

@@ -19,8 +19,9 @@
 //!    Galerkin operator `Pᵀ A P`, row by row with dense accumulators, without storing
 //!    `A P` or the transpose of `P`.
 //! 5. [`smoother`]: the Lanczos estimate of `ρ(D⁻¹A)` and the Chebyshev smoother.
-//! 6. [`hierarchy`]: levels until a coarse size, sparse Cholesky on the coarsest, the
-//!    V-cycle, and the numeric rebuild for new values on the same pattern.
+//! 6. [`hierarchy`]: levels until a coarse size, sparse Cholesky on the coarsest
+//!    (`porofrac-sparse`), the V-cycle, and the numeric rebuild for new values on the
+//!    same pattern.
 //! 7. [`pcg`]: preconditioned CG that reports its iterations and residual and fails loudly;
 //!    with a hierarchy stored in single precision ([`Precision`]) it multiplies by the
 //!    caller's double-precision upper triangle ([`upper`]).

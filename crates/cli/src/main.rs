@@ -7,6 +7,8 @@
 //! finished steps' files are complete and `summary.json` says
 //! `"status": "interrupted at t = …"`).
 
+mod heap;
+
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
@@ -49,7 +51,7 @@ enum Command {
 const INTERRUPTED: u8 = 130;
 
 fn main() -> ExitCode {
-    porofrac_sim::heap::retain_freed_memory();
+    heap::retain_freed_memory();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Check { scene } => Scene::load(&scene)

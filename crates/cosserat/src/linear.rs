@@ -27,7 +27,7 @@
 //!       [ Zᵀ  0 ]     [ L₂₁ L₂₂ ] [ 0   D₂ ] [ L₂₁ L₂₂ ]
 //! ```
 //!
-//! is factorised by the sparse `LDLᵀ` of `porofrac-sim` with the cells in approximate
+//! is factorised by the sparse `LDLᵀ` of `porofrac-sparse` with the cells in approximate
 //! minimum degree order (faer's AMD on the cell graph of `P`) and the `m` border unknowns
 //! last, so the trailing block of the factors holds `−H` (`n` positive pivots, then `m`
 //! negative ones). Woodbury's identity for `K = P + Z B Zᵀ` is then two sweeps and dense
@@ -46,7 +46,7 @@
 //! unconstrained order and only `Z`'s paths through the elimination tree fill: on the
 //! plate 4.9·10⁸ multiply–adds at 8,640 unknowns against 7.8·10⁸ with `T` last
 //! (2.96·10⁹ against 4.12·10⁹ at 24,000, 1.46·10¹⁰ against 2.28·10¹⁰ at 61,440), and a
-//! dense block of order 240 instead of 540 ([`porofrac_sim::ldlt::Ldlt::multiply_adds`]).
+//! dense block of order 240 instead of 540 ([`porofrac_sparse::Ldlt::multiply_adds`]).
 //! The same identity without the low-rank form — for a [`SystemRef`] alone, or when the
 //! bordered factorisation fails (a rank-deficient `Z`) — orders the unknowns `T` of the
 //! rows and columns where `K` and `P` differ last in `P`'s factors: their trailing block is
@@ -70,7 +70,7 @@
 //! from 8,640 to 61,440 unknowns).
 //!
 //! **Mixed precision** ([`FactorPrecision`], default single). The factors of `P` are
-//! computed in `f32` ([`porofrac_sim::ldlt_single`]: the same symbolic analysis, half the
+//! computed in `f32` ([`porofrac_sparse::ldlt_single`]: the same symbolic analysis, half the
 //! bytes, twice the vector lanes; 1.5–1.7 times faster than `f64` from 61,440 unknowns on
 //! the plate); the dense blocks, their LU and the sums of GMRES stay in `f64`. The solve above is then
 //! `K⁻¹` up to an error of about `κ ε₃₂` that GMRES removes: with double-precision factors
@@ -92,8 +92,8 @@
 //! matrix, solved at every step, keeps the LU below [`AUTO_GMRES_EQUATIONS_NEWMARK`].
 
 use porofrac_amg::{Amg, AmgOptions, NearNullSpace, Precision, SymCsr};
-use porofrac_sim::ldlt::{Ldlt, LdltError};
-use porofrac_sim::ldlt_single::{LdltSingle, TrailingFactor};
+use porofrac_sparse::{Ldlt, LdltError};
+use porofrac_sparse::{LdltSingle, TrailingFactor};
 use rayon::prelude::*;
 
 use crate::error::{CosseratError, Result};

@@ -6,11 +6,11 @@
 //! blocks, built once from the cell neighbour lists and stored in compressed sparse column
 //! form with sorted rows. Every assembly writes into the same value array
 //! ([`BlockPattern::position`]); the LU's symbolic analysis (ordering, elimination
-//! structure) is done once per pattern and reused by every numeric factorisation.
+//! structure) is done once per pattern and reused by every numeric factorisation
+//! ([`porofrac_sparse::Lu`]).
 
-use faer::sparse::linalg::LuError;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
-use faer::{Conj, MatMut};
+use porofrac_sparse::{Lu, LuError};
 
 use crate::error::{CosseratError, Result};
 
@@ -237,83 +237,64 @@ impl BlockPattern {
     }
 }
 
-/// Sparse LU with partial pivoting (faer), the symbolic analysis shared by every
-/// factorisation of one pattern. Fits the non-symmetric Nitsche matrix.
+/// Sparse LU with partial pivoting ([`porofrac_sparse::Lu`]) on a [`BlockPattern`], the
+/// symbolic analysis shared by every factorisation of one pattern. Fits the non-symmetric
+/// Nitsche matrix.
+#[derive(Debug)]
 pub struct SparseLu {
-    symbolic: faer::sparse::linalg::solvers::SymbolicLu<usize>,
-    lu: Option<faer::sparse::linalg::solvers::Lu<usize, f64>>,
-    n: usize,
-    factorizations: usize,
-}
-
-impl std::fmt::Debug for SparseLu {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("SparseLu")
-            .field("n", &self.n)
-            .field("factorizations", &self.factorizations)
-            .finish()
-    }
+    lu: Lu,
 }
 
 fn lu_error(e: LuError) -> CosseratError {
     match e {
-        LuError::SymbolicSingular { index } => CosseratError::Solve(format!(
+        LuError::StructurallySingular { index } => CosseratError::Solve(format!(
             "the matrix is structurally singular at equation {index}"
         )),
-        LuError::Generic(e) => CosseratError::Solve(format!("{e:?}")),
+        LuError::Symbolic(e) | LuError::Numeric(e) => CosseratError::Solve(format!("{e:?}")),
+        e => CosseratError::Solve(e.to_string()),
     }
 }
 
 impl SparseLu {
     /// Symbolic analysis of `pattern`.
     pub fn new(pattern: &BlockPattern) -> Result<Self> {
-        let symbolic = faer::sparse::linalg::solvers::SymbolicLu::try_new(pattern.symbolic())
-            .map_err(|e| CosseratError::Solve(format!("{e:?}")))?;
         Ok(Self {
-            symbolic,
-            lu: None,
-            n: pattern.equations(),
-            factorizations: 0,
+            lu: Lu::analyse(pattern.symbolic()).map_err(lu_error)?,
         })
     }
 
     /// Numeric factorisation of the matrix with `values` on `pattern`.
     pub fn factorize(&mut self, pattern: &BlockPattern, values: &[f64]) -> Result<()> {
-        if values.len() != pattern.nnz() || pattern.equations() != self.n {
+        if values.len() != pattern.nnz() || pattern.equations() != self.lu.dim() {
             return Err(CosseratError::Input {
                 what: format!(
                     "factorize: {} values for a pattern of {} entries ({} equations, LU built for {})",
                     values.len(),
                     pattern.nnz(),
                     pattern.equations(),
-                    self.n
+                    self.lu.dim()
                 ),
             });
         }
-        self.lu = None;
         let mat = SparseColMatRef::new(pattern.symbolic(), values);
-        let lu =
-            faer::sparse::linalg::solvers::Lu::try_new_with_symbolic(self.symbolic.clone(), mat)
-                .map_err(lu_error)?;
-        self.lu = Some(lu);
-        self.factorizations += 1;
-        Ok(())
+        self.lu.factorize(mat).map_err(lu_error)
     }
 
     /// Solve in place; a non-finite result (a numerically singular matrix) is an error.
     pub fn solve_in_place(&self, rhs: &mut [f64]) -> Result<()> {
-        use faer::linalg::solvers::SolveCore;
-        let lu = self
-            .lu
-            .as_ref()
-            .ok_or_else(|| CosseratError::Solve("solve before factorisation".into()))?;
-        if rhs.len() != self.n {
+        if !self.lu.is_factored() {
+            return Err(CosseratError::Solve("solve before factorisation".into()));
+        }
+        if rhs.len() != self.lu.dim() {
             return Err(CosseratError::Input {
-                what: format!("right-hand side of length {}, want {}", rhs.len(), self.n),
+                what: format!(
+                    "right-hand side of length {}, want {}",
+                    rhs.len(),
+                    self.lu.dim()
+                ),
             });
         }
-        let n = self.n;
-        lu.solve_in_place_with_conj(Conj::No, MatMut::from_column_major_slice_mut(rhs, n, 1));
+        self.lu.solve_in_place(rhs).map_err(lu_error)?;
         if let Some(i) = rhs.iter().position(|v| !v.is_finite()) {
             return Err(CosseratError::Solve(format!(
                 "non-finite solution at equation {i}: the system is singular (missing \
@@ -325,6 +306,6 @@ impl SparseLu {
 
     /// Numeric factorisations done so far.
     pub fn factorizations(&self) -> usize {
-        self.factorizations
+        self.lu.numeric_factorizations()
     }
 }

@@ -29,7 +29,7 @@
 //! accumulation diagonal, `A` the symmetric flux matrix (with Dirichlet and well terms)
 //! and `b` the forcing; all three are public so that a Biot coupling (seed eq. 30) can add
 //! its blocks. The system is symmetric positive definite and solved by sparse Cholesky
-//! (faer) with the symbolic factorization reused across steps.
+//! (`porofrac_sparse::Cholesky`) with the symbolic factorization reused across steps.
 //!
 //! Sources ([`problem::Source`]) are total rates or pore volumes per hour spread over a set
 //! of cells in proportion to their volumes; wells ([`problem::Well`], [`well`]) use

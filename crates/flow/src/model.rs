@@ -29,10 +29,8 @@
 //! Gravity is not included.
 
 use faer::Side;
-use faer::col::ColMut;
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
+use porofrac_sparse::{Cholesky, CholeskyError};
 use porofrac_grid::{Grid, NO_CELL, Point};
 use rayon::prelude::*;
 
@@ -104,8 +102,10 @@ pub struct FlowModel<const D: usize> {
     /// Connected regions without a pressure anchor: (a cell of the region, whether the
     /// region has storage).
     floating: Vec<(usize, bool)>,
-    symbolic: Option<SymbolicLlt<usize>>,
-    numeric: Option<(f64, Llt<usize, f64>)>,
+    /// The Cholesky factorization of `M/Δt + A` (analysed on the first solve) and the
+    /// `1/Δt` of its numeric factors (`None`: not factorized).
+    cholesky: Option<Cholesky>,
+    factored_inv_dt: Option<f64>,
     sys_vals: Vec<f64>,
     linear: FlowLinearSolver,
     /// CG-AMG: the hierarchy and the `1/Δt` it was built for.
@@ -369,8 +369,8 @@ impl<const D: usize> FlowModel<D> {
             source_totals,
             wells,
             floating: Vec::new(),
-            symbolic: None,
-            numeric: None,
+            cholesky: None,
+            factored_inv_dt: None,
             linear: FlowLinearSolver::Cholesky,
             amg: None,
             cg_iterations: 0,
@@ -557,8 +557,10 @@ impl<const D: usize> FlowModel<D> {
         match self.linear {
             FlowLinearSolver::Cholesky => {
                 self.factorize(inv_dt)?;
-                let (_, llt) = self.numeric.as_ref().expect("factorized above");
-                llt.solve_in_place(ColMut::from_slice_mut(&mut p));
+                let cholesky = self.cholesky.as_ref().expect("factorized above");
+                cholesky
+                    .solve_in_place(&mut p, faer::get_global_parallelism())
+                    .map_err(|e| FlowError::Solver(format!("Cholesky solve: {e}")))?;
             }
             FlowLinearSolver::CgAmg { tolerance } => {
                 self.amg_setup(inv_dt)?;
@@ -630,26 +632,38 @@ impl<const D: usize> FlowModel<D> {
 
     /// Assemble `M·inv_dt + A` and factorize it (symbolic once, numeric when needed).
     fn factorize(&mut self, inv_dt: f64) -> Result<()> {
-        if let Some((cached, _)) = &self.numeric
+        if let Some(cached) = self.factored_inv_dt
             && cached.to_bits() == inv_dt.to_bits()
         {
             return Ok(());
         }
-        self.numeric = None;
+        self.factored_inv_dt = None;
         self.fill_system(inv_dt);
-        if self.symbolic.is_none() {
-            let sym = SymbolicLlt::try_new(self.pattern.as_ref(), Side::Lower)
-                .map_err(|e| FlowError::Solver(format!("symbolic Cholesky: {e:?}")))?;
-            self.symbolic = Some(sym);
+        if self.cholesky.is_none() {
+            let c = Cholesky::analyse(self.pattern.as_ref(), Side::Lower, None).map_err(|e| {
+                let e = match e {
+                    CholeskyError::Symbolic(e) => format!("{e:?}"),
+                    e => e.to_string(),
+                };
+                FlowError::Solver(format!("symbolic Cholesky: {e}"))
+            })?;
+            self.cholesky = Some(c);
         }
-        let sym = self.symbolic.clone().expect("set above");
+        let cholesky = self.cholesky.as_mut().expect("set above");
         let mat = SparseColMatRef::new(self.pattern.as_ref(), &self.sys_vals);
-        let llt = Llt::try_new_with_symbolic(sym, mat, Side::Lower).map_err(|e| {
-            FlowError::Singular(format!(
-                "Cholesky factorization failed ({e}); the system is not positive definite"
-            ))
-        })?;
-        self.numeric = Some((inv_dt, llt));
+        cholesky
+            .factorize(mat, faer::get_global_parallelism())
+            .map_err(|e| {
+                // faer's error, as faer prints it.
+                let e = match e {
+                    CholeskyError::NonPositivePivot { source, .. } => source,
+                    _ => faer::sparse::linalg::LltError::Generic(faer::sparse::FaerError::OutOfMemory),
+                };
+                FlowError::Singular(format!(
+                    "Cholesky factorization failed ({e}); the system is not positive definite"
+                ))
+            })?;
+        self.factored_inv_dt = Some(inv_dt);
         Ok(())
     }
 
@@ -754,7 +768,7 @@ impl<const D: usize> FlowModel<D> {
                 self.floating.push((c, stored[r]));
             }
         }
-        self.numeric = None;
+        self.factored_inv_dt = None;
     }
 }
 

@@ -16,7 +16,8 @@
 //! `AMG_PRECISION=double` stores the hierarchy's finest matrix in double instead of single
 //! precision (`AmgSolver::set_precision`);
 //! `SYSTEM_HEAP=1` leaves glibc's heap policy as it is instead of keeping freed memory
-//! ([`porofrac_sim::heap`]).
+//! (`retain_freed_memory` below, the policy of the `porofrac` binary: the figures in
+//! docs/BENCHMARKS.md were measured with it).
 //!
 //! Grids: E2 = n × n squares split in two triangles, E3 = n³ cubes split in six
 //! tetrahedra (P1 = VEM on simplices), E = 1, ν = 0.3 (plane strain in 2D), Dirichlet on
@@ -205,9 +206,26 @@ fn run<const D: usize>(n: usize, solver: &str, tol: f64, problem: &Manufactured<
     (t_asm, t_setup + t_solve)
 }
 
+/// glibc's heap keeps freed memory for reuse: no `mmap` for large blocks, no trimming
+/// (the policy of the `porofrac` binary, `crates/cli/src/heap.rs`, which explains it).
+/// Elsewhere than Linux with glibc it does nothing.
+#[cfg(all(target_os = "linux", target_env = "gnu"))]
+#[allow(unsafe_code)]
+fn retain_freed_memory() {
+    // SAFETY: `mallopt` only sets allocator parameters; it is called with constants glibc
+    // documents, before any other thread starts.
+    unsafe {
+        libc::mallopt(libc::M_MMAP_MAX, 0);
+        libc::mallopt(libc::M_TRIM_THRESHOLD, i32::MAX);
+    }
+}
+
+#[cfg(not(all(target_os = "linux", target_env = "gnu")))]
+fn retain_freed_memory() {}
+
 fn main() {
     if std::env::var_os("SYSTEM_HEAP").is_none() {
-        porofrac_sim::heap::retain_freed_memory();
+        retain_freed_memory();
     }
     let args: Vec<String> = std::env::args().skip(1).collect();
     if args.len() < 3 {

@@ -150,11 +150,10 @@ use faer::Par;
 use porofrac_flow::{FlowError, FlowModel};
 use porofrac_grid::Point;
 use porofrac_law::Stiffness;
+use porofrac_sparse::{Ldlt, LdltError, LowRank, UpperRows};
 
 use crate::assembly::{ElementCache, assemble, assemble_with, cell_tangents, nodal_loads};
 use crate::error::SimError;
-use crate::ldlt::{Ldlt, LdltError};
-use crate::lowrank::{LowRank, UpperRows};
 use crate::solve::{DirectSolver, StaticProblem};
 
 /// Errors of the Biot coupling.

@@ -1,4 +1,14 @@
-//! porofrac-sim: mechanics assembly, boundary conditions and the static direct solve.
+//! porofrac-sim: the continuum model composed — mechanics assembly, boundary conditions,
+//! the static and explicit solves, Biot coupling with the flow, fracturing.
+//!
+//! sim composes the continuum crates and adds only what needs them together: the cell
+//! laws of `porofrac-law` (implemented by `porofrac-vem`, `porofrac-mdem`), the TPFA flow
+//! of `porofrac-flow`, the failure criteria of `porofrac-frac`, and the solvers of
+//! `porofrac-sparse` (sparse Cholesky, `LDLᵀ`, low-rank updates, orderings) and
+//! `porofrac-amg` (CG with algebraic multigrid). It knows no particles or lattices: the
+//! particle–fluid coupling is `porofrac-particle-fluid`, the Cosserat model
+//! `porofrac-cosserat`. How the process manages its heap is the binary's business
+//! (`porofrac-cli`), not this library's.
 //!
 //! The pieces, in the order a static solve uses them:
 //!
@@ -7,22 +17,27 @@
 //! 2. [`dofs::DofMap`]: dof → equation map; prescribed dofs are eliminated, platen nodes
 //!    share equations; conflicting conditions and free rigid-body modes are errors.
 //! 3. [`pattern::Pattern`]: the sparsity pattern of the reduced stiffness (upper triangle,
-//!    CSC), built once, with per-cell scatter maps for a parallel, race-free fill.
+//!    CSC: a [`porofrac_sparse::UpperPattern`]), built once, with per-cell scatter maps
+//!    for a parallel, race-free fill.
 //! 4. [`assembly`]: reduced stiffness and internal forces from the cell laws
 //!    ([`porofrac_law::CellLaw`], chosen per cell by a [`LawMap`]), and the nodal loads.
 //! 5. [`solve`]: sparse Cholesky with the symbolic factorization reused
-//!    ([`DirectSolver`]), [`solve_static`], cell stresses and reaction forces;
-//!    [`linear`]: the choice of linear solver ([`LinearSolver`]: Cholesky, CG with
-//!    algebraic multigrid, or automatic by size).
+//!    ([`DirectSolver`], on [`porofrac_sparse::Cholesky`]), [`solve_static`], cell
+//!    stresses and reaction forces; [`linear`]: the choice of linear solver
+//!    ([`LinearSolver`]: Cholesky, CG with algebraic multigrid, or automatic by size);
+//!    [`ordering`]: nested-dissection orderings of a grid's equations.
+//!
+//! Then the time-dependent and coupled models: [`explicit`] (damped explicit dynamics),
+//! [`biot`] (poroelasticity: monolithic, fixed-stress and explicit-pressure couplings;
+//! the monolithic one on [`porofrac_sparse::Ldlt`] with low-rank updates of its
+//! factors), [`fracturing`] (failure, law switches, fracture permeability). [`norms`]
+//! measures errors of nodal fields against exact ones.
 //!
 //! State that changes (displacements, time) is passed explicitly; the types above are
 //! built once per grid and set of conditions.
 //!
-//! [`particle_fluid`] couples a particle model (any [`particle_fluid::ParticleSolver`]:
-//! the lattice solid model, or free rigid disks) with the lattice Boltzmann fluid and heat
-//! of `porofrac-lbm` (seed 002, §002.6): disks rasterised as moving obstacles every fluid
-//! step, momentum-exchange loads in SI, particles sub-cycled, injection by a mass source,
-//! heat books.
+//! With the cargo feature `fixtures`, `standard` adds the manufactured solutions E2 and
+//! E3 used by the tests, benchmarks and examples.
 //!
 //! ```no_run
 //! # use porofrac_sim::*;
@@ -51,17 +66,14 @@ pub mod error;
 pub mod explicit;
 pub mod field;
 pub mod fracturing;
-pub mod heap;
 pub mod laws;
-pub mod ldlt;
-pub mod ldlt_single;
 pub mod linear;
-mod lowrank;
+pub mod norms;
 pub mod ordering;
-pub mod particle_fluid;
 pub mod pattern;
 mod quadrature;
 pub mod solve;
+#[cfg(feature = "fixtures")]
 pub mod standard;
 mod stress_cache;
 

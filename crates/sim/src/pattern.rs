@@ -38,6 +38,7 @@
 use std::ops::Range;
 
 use porofrac_grid::Grid;
+use porofrac_sparse::UpperPattern;
 use rayon::prelude::*;
 
 use crate::dofs::DofMap;
@@ -65,9 +66,7 @@ pub(crate) struct Chunk {
 /// Upper-triangular CSC pattern of the reduced stiffness with per-cell scatter maps.
 #[derive(Clone, Debug)]
 pub struct Pattern {
-    n: usize,
-    col_ptr: Vec<usize>,
-    row_idx: Vec<usize>,
+    upper: UpperPattern,
     maps: StoredMaps,
     pub(crate) chunks: Vec<Chunk>,
     pub(crate) chunk_cells: Vec<usize>,
@@ -596,9 +595,7 @@ impl Pattern {
             });
         }
         Ok(Self {
-            n,
-            col_ptr,
-            row_idx,
+            upper: UpperPattern::new(n, col_ptr, row_idx),
             maps,
             chunks,
             chunk_cells,
@@ -606,21 +603,25 @@ impl Pattern {
         })
     }
 
+    /// The upper-triangle CSC pattern itself (for the sparse factorizations).
+    pub fn upper(&self) -> &UpperPattern {
+        &self.upper
+    }
     /// Number of equations (rows and columns).
     pub fn num_equations(&self) -> usize {
-        self.n
+        self.upper.dim()
     }
     /// Number of stored entries (upper triangle with diagonal).
     pub fn nnz(&self) -> usize {
-        self.row_idx.len()
+        self.upper.nnz()
     }
     /// Column offsets (length `n + 1`).
     pub fn col_ptr(&self) -> &[usize] {
-        &self.col_ptr
+        self.upper.col_ptr()
     }
     /// Row index of each stored entry, sorted within each column.
     pub fn row_idx(&self) -> &[usize] {
-        &self.row_idx
+        self.upper.row_idx()
     }
     /// The scatter map of cell `c` of the `grid` and `dofs` the pattern was built for,
     /// written to `buf`: for the local pair `i ≤ j` at [`upper_pair`]`(i, j)`, the value
@@ -639,7 +640,7 @@ impl Pattern {
         match nodes {
             Some(nodes) => {
                 map.resize(m * (m + 1) / 2, NONE);
-                for_each_by_nodes::<D>(nodes, &self.col_ptr, stored, |i, j, p| {
+                for_each_by_nodes::<D>(nodes, self.upper.col_ptr(), stored, |i, j, p| {
                     map[upper_pair(i, j)] = p as u32;
                 });
             }
@@ -687,7 +688,7 @@ impl Pattern {
         let m = buf.eqs.len();
         let vlen = vals.len();
         if let Some(nodes) = nodes {
-            for_each_by_nodes::<D>(nodes, &self.col_ptr, stored, |i, j, p| {
+            for_each_by_nodes::<D>(nodes, self.upper.col_ptr(), stored, |i, j, p| {
                 let at = p.wrapping_sub(v0);
                 if at < vlen {
                     vals[at] += k[i + m * j];
@@ -723,16 +724,9 @@ impl Pattern {
     pub fn duplication(&self) -> f64 {
         self.chunk_cells.len() as f64 / self.num_cells.max(1) as f64
     }
-    /// `y += A x` for the symmetric matrix with these upper-triangle `values`.
+    /// `y += A x` for the symmetric matrix with these upper-triangle `values`
+    /// ([`UpperPattern::mul_add`]).
     pub fn mul_add(&self, values: &[f64], x: &[f64], y: &mut [f64]) {
-        for c in 0..self.n {
-            for p in self.col_ptr[c]..self.col_ptr[c + 1] {
-                let r = self.row_idx[p];
-                y[r] += values[p] * x[c];
-                if r != c {
-                    y[c] += values[p] * x[r];
-                }
-            }
-        }
+        self.upper.mul_add(values, x, y);
     }
 }

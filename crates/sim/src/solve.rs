@@ -2,10 +2,10 @@
 //!
 //! [`DirectSolver`] factorises the reduced stiffness `A = Tᵀ K_ff T` (symmetric positive
 //! definite once the rigid modes are removed) by a sparse Cholesky factorization
-//! `P A Pᵀ = L Lᵀ` (faer, AMD ordering `P`). The symbolic part (ordering, elimination
-//! tree, the pattern of `L`) depends only on the [`Pattern`] and is computed once in
-//! [`DirectSolver::new`]; [`DirectSolver::factorize`] recomputes only the numbers, so time
-//! steps and law switches reuse it.
+//! `P A Pᵀ = L Lᵀ` ([`porofrac_sparse::Cholesky`], AMD ordering `P`). The symbolic part
+//! (ordering, elimination tree, the pattern of `L`) depends only on the [`Pattern`] and
+//! is computed once in [`DirectSolver::new`]; [`DirectSolver::factorize`] recomputes only
+//! the numbers, so time steps and law switches reuse it.
 //!
 //! [`solve_static`] solves `Σ_K F_K(u) + f_ext = 0` for the free dofs with prescribed
 //! values `u_p(t)`: Newton's method `A(u) Δx = f_ext + Tᵀ F(u)`, `u_f ← u_f + T Δx`, which
@@ -18,14 +18,11 @@
 //! [`DirectSolver`], [`crate::linear::AmgSolver`] or the [`crate::linear::StaticSolver`]
 //! chosen by a [`crate::linear::LinearSolver`].
 
-use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::sparse::linalg::cholesky::{
-    CholeskySymbolicParams, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
-};
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
-use faer::{Conj, MatMut, Side};
+use faer::Side;
+use faer::sparse::SparseColMatRef;
 use porofrac_grid::{Grid, Point};
 use porofrac_law::Tensor;
+use porofrac_sparse::{Cholesky, CholeskyError, PermutationError};
 use rayon::prelude::*;
 
 pub use faer::Par;
@@ -59,17 +56,13 @@ pub fn default_parallelism(factor_nnz: usize) -> Par {
 }
 
 /// Sparse Cholesky solver for the reduced stiffness, with the symbolic factorization
-/// computed once per pattern and reused for every numeric factorization.
+/// computed once per pattern and reused for every numeric factorization
+/// ([`porofrac_sparse::Cholesky`] on the upper triangle of the [`Pattern`]).
 #[derive(Debug)]
 pub struct DirectSolver {
-    symbolic: SymbolicCholesky<usize>,
-    l_values: Vec<f64>,
+    cholesky: Cholesky,
     par: Par,
-    n: usize,
-    nnz: usize,
     symbolic_count: usize,
-    numeric_count: usize,
-    factored: bool,
 }
 
 impl DirectSolver {
@@ -89,47 +82,27 @@ impl DirectSolver {
 
     fn analyse(pattern: &Pattern, perm: Option<&[usize]>) -> Result<Self> {
         let n = pattern.num_equations();
-        let sym =
-            SymbolicSparseColMatRef::new_checked(n, n, pattern.col_ptr(), None, pattern.row_idx());
-        let inverse: Vec<usize>;
-        let ordering = match perm {
-            None => SymmetricOrdering::Amd,
-            Some(fwd) => {
-                let mut inv = vec![usize::MAX; n];
-                for (k, &e) in fwd.iter().enumerate() {
-                    if e >= n || inv[e] != usize::MAX {
-                        return Err(SimError::Input(format!(
-                            "ordering is not a permutation of the {n} equations (entry {k} = {e})"
-                        )));
+        let cholesky =
+            Cholesky::analyse(pattern.upper().symbolic(), Side::Upper, perm).map_err(|e| {
+                match e {
+                    CholeskyError::Ordering(PermutationError::Length { len, .. }) => {
+                        SimError::Input(format!("ordering has {len} entries for {n} equations"))
                     }
-                    inv[e] = k;
+                    CholeskyError::Ordering(PermutationError::Entry { index, value }) => {
+                        SimError::Input(format!(
+                            "ordering is not a permutation of the {n} equations (entry {index} = {value})"
+                        ))
+                    }
+                    CholeskyError::Symbolic(e) => {
+                        SimError::LinearAlgebra(format!("symbolic Cholesky: {e:?}"))
+                    }
+                    e => SimError::LinearAlgebra(format!("symbolic Cholesky: {e}")),
                 }
-                if fwd.len() != n {
-                    return Err(SimError::Input(format!(
-                        "ordering has {} entries for {n} equations",
-                        fwd.len()
-                    )));
-                }
-                inverse = inv;
-                SymmetricOrdering::Custom(faer::perm::PermRef::new_checked(fwd, &inverse, n))
-            }
-        };
-        let symbolic = factorize_symbolic_cholesky(
-            sym,
-            Side::Upper,
-            ordering,
-            CholeskySymbolicParams::default(),
-        )
-        .map_err(|e| SimError::LinearAlgebra(format!("symbolic Cholesky: {e:?}")))?;
+            })?;
         Ok(Self {
-            l_values: Vec::new(),
-            par: default_parallelism(symbolic.len_val()),
-            symbolic,
-            n,
-            nnz: pattern.nnz(),
+            par: default_parallelism(cholesky.factor_nnz()),
+            cholesky,
             symbolic_count: 1,
-            numeric_count: 0,
-            factored: false,
         })
     }
 
@@ -144,11 +117,11 @@ impl DirectSolver {
     }
     /// Number of numeric factorizations done.
     pub fn numeric_factorizations(&self) -> usize {
-        self.numeric_count
+        self.cholesky.numeric_factorizations()
     }
     /// Number of stored entries of the factor `L`.
     pub fn factor_nnz(&self) -> usize {
-        self.symbolic.len_val()
+        self.cholesky.factor_nnz()
     }
 
     /// Numeric factorization of the matrix with the given upper-triangle `values` of the
@@ -157,90 +130,40 @@ impl DirectSolver {
     /// Error [`SimError::NotPositiveDefinite`] names the failing equation in the original
     /// numbering (its `location` says `equation e`; [`solve_static`] maps it to the node).
     pub fn factorize(&mut self, pattern: &Pattern, values: &[f64]) -> Result<()> {
-        if pattern.num_equations() != self.n
-            || pattern.nnz() != self.nnz
-            || values.len() != self.nnz
-        {
+        let (n, nnz) = (self.cholesky.dim(), self.cholesky.pattern_nnz());
+        if pattern.num_equations() != n || pattern.nnz() != nnz || values.len() != nnz {
             return Err(SimError::Input(format!(
                 "factorize: pattern of {} equations / {} entries and {} values, solver built for {} / {}",
                 pattern.num_equations(),
                 pattern.nnz(),
                 values.len(),
-                self.n,
-                self.nnz
+                n,
+                nnz
             )));
         }
-        self.factored = false;
-        let sym = SymbolicSparseColMatRef::new_checked(
-            self.n,
-            self.n,
-            pattern.col_ptr(),
-            None,
-            pattern.row_idx(),
-        );
-        let mat = SparseColMatRef::new(sym, values);
-        self.l_values.resize(self.symbolic.len_val(), 0.0);
-        let req = self
-            .symbolic
-            .factorize_numeric_llt_scratch::<f64>(self.par, Default::default());
-        let mut mem =
-            MemBuffer::try_new(req).map_err(|_| SimError::LinearAlgebra("out of memory".into()))?;
-        let res = self.symbolic.factorize_numeric_llt(
-            &mut self.l_values,
-            mat,
-            Side::Upper,
-            Default::default(),
-            self.par,
-            MemStack::new(&mut mem),
-            Default::default(),
-        );
-        self.numeric_count += 1;
-        match res {
-            Ok(_) => {
-                self.factored = true;
-                Ok(())
-            }
-            Err(faer::linalg::solvers::LltError::NonPositivePivot { index }) => {
-                let equation = match self.symbolic.perm() {
-                    Some(p) => p.arrays().0[index],
-                    None => index,
-                };
-                Err(SimError::NotPositiveDefinite {
-                    equation,
-                    location: format!("equation {equation}"),
-                })
-            }
-        }
+        let mat = SparseColMatRef::new(pattern.upper().symbolic(), values);
+        self.cholesky.factorize(mat, self.par).map_err(|e| match e {
+            CholeskyError::NonPositivePivot { index, .. } => SimError::NotPositiveDefinite {
+                equation: index,
+                location: format!("equation {index}"),
+            },
+            _ => SimError::LinearAlgebra("out of memory".into()),
+        })
     }
 
     /// Solve `A x = b` in place (`rhs` holds `b` on entry and `x` on return).
     pub fn solve_in_place(&self, rhs: &mut [f64]) -> Result<()> {
-        if !self.factored {
-            return Err(SimError::Input(
-                "solve before a successful factorization".into(),
-            ));
-        }
-        if rhs.len() != self.n {
-            return Err(SimError::Input(format!(
-                "right-hand side of length {}, want {}",
-                rhs.len(),
-                self.n
-            )));
-        }
-        let llt = faer::sparse::linalg::cholesky::LltRef::<'_, usize, f64>::new(
-            &self.symbolic,
-            &self.l_values,
-        );
-        let mut mem = MemBuffer::try_new(self.symbolic.solve_in_place_scratch::<f64>(1, self.par))
-            .map_err(|_| SimError::LinearAlgebra("out of memory".into()))?;
-        let n = self.n;
-        llt.solve_in_place_with_conj(
-            Conj::No,
-            MatMut::from_column_major_slice_mut(rhs, n, 1),
-            self.par,
-            MemStack::new(&mut mem),
-        );
-        Ok(())
+        self.cholesky
+            .solve_in_place(rhs, self.par)
+            .map_err(|e| match e {
+                CholeskyError::NotFactored => {
+                    SimError::Input("solve before a successful factorization".into())
+                }
+                CholeskyError::Dimension { got, want, .. } => SimError::Input(format!(
+                    "right-hand side of length {got}, want {want}"
+                )),
+                _ => SimError::LinearAlgebra("out of memory".into()),
+            })
     }
 }
 

@@ -711,7 +711,7 @@ impl<const D: usize> Model for Stepper<'_, D> {
         };
         let t = self.times.get(self.done).copied().unwrap_or(0.0);
         let exact = crate::file::vector_field::<D>(exact);
-        let l2 = porofrac_sim::standard::l2_error_p1_field(self.body.grid, &self.u, &exact, t)
+        let l2 = porofrac_sim::norms::l2_error_p1_field(self.body.grid, &self.u, &exact, t)
             .ok_or_else(|| {
                 self.ls.error(
                     &k(&["output", "exact_displacement"]),

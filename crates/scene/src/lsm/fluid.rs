@@ -1,5 +1,5 @@
 //! Fluid and heat in a lattice solid scene (seed 002, §002.6): with `[lbm]` the disks are
-//! carried by a lattice Boltzmann fluid ([`porofrac_sim::particle_fluid`]); `[thermal]`
+//! carried by a lattice Boltzmann fluid ([`porofrac_particle_fluid`]); `[thermal]`
 //! adds temperature (conjugate: the disks' nodes carry `solid_diffusivity`), `[injection]`
 //! a ramped mass source at the borehole.
 //!
@@ -18,7 +18,7 @@ use serde::Deserialize;
 
 use porofrac_lbm::Lattice;
 use porofrac_lsm::LatticeSolid;
-use porofrac_sim::particle_fluid::{
+use porofrac_particle_fluid::{
     CouplingError, CouplingOptions, InjectionControl, LoadAveraging, ParticleFluid, ThermalSetup,
 };
 

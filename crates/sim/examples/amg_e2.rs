@@ -3,15 +3,15 @@
 //! solved by CG with the smoothed-aggregation preconditioner; compared with the sparse
 //! Cholesky solution (AMD) up to `--cholesky-max` (default 300).
 //!
-//! `cargo run --release -p porofrac-amg --example e2 -- 300 1000 [--tol 1e-8]`
+//! `cargo run --release -p porofrac-sim --features fixtures --example amg_e2 -- 300 1000 [--tol 1e-8]`
 
-mod common;
+mod amg_common;
 
 fn main() {
-    let args = common::args(&[300, 1000], 300);
-    common::header();
+    let args = amg_common::args(&[300, 1000], 300);
+    amg_common::header();
     for &n in &args.sizes {
-        let sys = common::e2(n);
-        common::run("E2", n, &sys, &args);
+        let sys = amg_common::e2(n);
+        amg_common::run("E2", n, &sys, &args);
     }
 }

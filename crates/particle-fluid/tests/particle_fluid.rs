@@ -13,7 +13,7 @@ use porofrac_lbm::{
     Collision, Lattice, LatticeConfig, Obstacle, Shape, SideKind, ThermalSide, Units,
 };
 use porofrac_particles::Disks;
-use porofrac_sim::particle_fluid::{
+use porofrac_particle_fluid::{
     CouplingError, CouplingOptions, LoadAveraging, ParticleFluid, RigidDisks, ThermalSetup,
 };
 
@@ -246,7 +246,7 @@ fn a_disk_below_two_spacings_is_an_error_naming_it() {
 
 #[test]
 fn injection_adds_the_ramped_mass_and_reaches_the_ramped_pressure() {
-    use porofrac_sim::particle_fluid::InjectionControl;
+    use porofrac_particle_fluid::InjectionControl;
     let (n, tau) = (40usize, 0.8);
     let u = units(tau);
     let mut cfg = LatticeConfig::periodic(n, n, tau);

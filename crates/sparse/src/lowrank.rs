@@ -60,7 +60,7 @@ const NONE: usize = usize::MAX;
 
 /// The update of a factorized matrix `A₀` to a matrix of the same pattern differing in
 /// few unknowns (see the module docs).
-pub(crate) struct LowRank {
+pub struct LowRank {
     /// Per unknown: its slot among the cached columns, or [`NONE`].
     slot: Vec<usize>,
     /// The unknown of every slot.
@@ -96,7 +96,7 @@ pub(crate) struct LowRank {
 /// Row access to a symmetric matrix kept as its upper triangle in CSC (`col_ptr`,
 /// `row_idx`): per row `i`, the columns `j > i` and positions of its entries `(i, j)`.
 /// With the column itself (the entries `(r, i)`, `r ≤ i`) this is the whole row `i`.
-pub(crate) struct UpperRows {
+pub struct UpperRows {
     ptr: Vec<usize>,
     /// `(column, position in the CSC values)`, by row, columns ascending.
     entries: Vec<(usize, usize)>,
@@ -104,7 +104,7 @@ pub(crate) struct UpperRows {
 
 impl UpperRows {
     /// The row index of the upper triangle (`col_ptr`, `row_idx`).
-    pub(crate) fn new(col_ptr: &[usize], row_idx: &[usize]) -> Self {
+    pub fn new(col_ptr: &[usize], row_idx: &[usize]) -> Self {
         let n = col_ptr.len().saturating_sub(1);
         let mut ptr = vec![0usize; n + 1];
         for j in 0..n {
@@ -134,7 +134,7 @@ impl UpperRows {
     /// Call `f(j, q)` for every entry `(i, j)` of row `i` of the symmetric matrix, `q`
     /// its position in the CSC values.
     #[inline]
-    pub(crate) fn for_row(
+    pub fn for_row(
         &self,
         i: usize,
         col_ptr: &[usize],
@@ -152,7 +152,7 @@ impl UpperRows {
 
 impl LowRank {
     /// No cached columns, no change, for `n` unknowns.
-    pub(crate) fn new(n: usize) -> Self {
+    pub fn new(n: usize) -> Self {
         Self {
             slot: vec![NONE; n],
             cached: Vec::new(),
@@ -172,7 +172,7 @@ impl LowRank {
     }
 
     /// Forget the cached columns and the change (after a new factorization of `A₀`).
-    pub(crate) fn clear(&mut self) {
+    pub fn clear(&mut self) {
         for &u in &self.cached {
             self.slot[u] = NONE;
         }
@@ -195,20 +195,20 @@ impl LowRank {
     }
 
     /// Whether a change is set up (solves go through the capacitance matrix).
-    pub(crate) fn is_active(&self) -> bool {
+    pub fn is_active(&self) -> bool {
         self.lu.is_some()
     }
 
     /// Unknowns whose columns of `A₀⁻¹` are cached.
     #[cfg(test)]
-    pub(crate) fn cached_len(&self) -> usize {
+    pub fn cached_len(&self) -> usize {
         self.cached.len()
     }
 
     /// Set up the change from the factorized upper triangle `base` to `values` (the same
     /// CSC pattern `col_ptr`, `row_idx`). Returns `false`, with nothing set up, when more
     /// than `max_rank` unknowns changed.
-    pub(crate) fn prepare(
+    pub fn prepare(
         &mut self,
         ldlt: &mut Ldlt,
         col_ptr: &[usize],
@@ -300,7 +300,7 @@ impl LowRank {
 
     /// Solve `A x = b` in place with the factors of `A₀` and the change set up by
     /// [`LowRank::prepare`] (plainly with `A₀` when none is).
-    pub(crate) fn solve(&mut self, ldlt: &mut Ldlt, rhs: &mut [f64]) -> Result<(), LdltError> {
+    pub fn solve(&mut self, ldlt: &mut Ldlt, rhs: &mut [f64]) -> Result<(), LdltError> {
         if self.lu.is_none() {
             return ldlt.solve_in_place(rhs);
         }
@@ -312,7 +312,7 @@ impl LowRank {
     /// Set up [`LowRank::solve_corrected`] for the change prepared last: the support's
     /// neighbours in the matrix (`rows` of the CSC upper triangle `col_ptr`, `row_idx`)
     /// and the paths of their supernodes.
-    pub(crate) fn prepare_correction(
+    pub fn prepare_correction(
         &mut self,
         ldlt: &Ldlt,
         col_ptr: &[usize],
@@ -353,7 +353,7 @@ impl LowRank {
     /// entry ([`Ldlt::forward_in_place`]: the same for every matrix solved with the same
     /// `b` and factors, so the caller may keep it) and the solution on return; without a
     /// change set up, the backward sweep alone (a solve with `A₀`).
-    pub(crate) fn solve_corrected(
+    pub fn solve_corrected(
         &mut self,
         ldlt: &mut Ldlt,
         rhs: &mut [f64],
@@ -428,7 +428,7 @@ impl LowRank {
 
 impl LowRank {
     /// `Σ_{u ∈ T} r_u²`: the part of the residual `r` on the support of the change.
-    pub(crate) fn support_norm2(&self, r: &[f64]) -> f64 {
+    pub fn support_norm2(&self, r: &[f64]) -> f64 {
         self.support.iter().map(|&u| r[u] * r[u]).sum()
     }
 
@@ -445,7 +445,7 @@ impl LowRank {
     /// of this kind: its error is that of `y` (the capacitance matrix is formed from `G`
     /// with rounding and can be ill-conditioned), `A (A₀⁻¹ P Δ δy) = P (I + Δ G) Δ δy`.
     /// Plainly with `A₀` when no change is set up.
-    pub(crate) fn solve_on_support(
+    pub fn solve_on_support(
         &mut self,
         ldlt: &mut Ldlt,
         rhs: &mut [f64],

@@ -4,7 +4,7 @@
 //! default of the mechanics solver), whose CG multiplies by the double-precision upper
 //! triangle (`*_single`: setup, V-cycle, solve).
 
-#[path = "../tests/common/mod.rs"]
+#[path = "../tests/elasticity_systems/mod.rs"]
 #[allow(missing_docs)]
 mod common;
 

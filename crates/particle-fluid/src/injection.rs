@@ -12,7 +12,7 @@
 
 use porofrac_lbm::{Lattice, Units};
 
-use super::CouplingError;
+use crate::CouplingError;
 
 /// How the injection is driven.
 #[derive(Clone, Copy, Debug, PartialEq)]

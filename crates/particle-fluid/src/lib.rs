@@ -1,4 +1,5 @@
-//! Particles carried by a lattice Boltzmann fluid, with heat (seed 002, §002.6).
+//! porofrac-particle-fluid: particles carried by a lattice Boltzmann fluid, with heat (seed
+//! 002, §002.6).
 //!
 //! One coupled step advances the fluid by one lattice step `Δt` and the particles by the
 //! same time in `n_sub` sub-steps of their own stable step:

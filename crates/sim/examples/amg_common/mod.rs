@@ -2,7 +2,7 @@
 //! Cholesky, print a table row.
 #![allow(dead_code)]
 
-#[path = "../../tests/common/mod.rs"]
+#[path = "../../tests/elasticity_systems/mod.rs"]
 mod systems;
 
 use std::time::Instant;

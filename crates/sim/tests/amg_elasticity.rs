@@ -2,9 +2,9 @@
 //! solution, iteration counts, eliminated dofs, numeric rebuild, and a deficient
 //! near-null space.
 
-mod common;
+mod elasticity_systems;
 
-use common::{System, build, e2, e3, rel_diff};
+use elasticity_systems::{System, build, e2, e3, rel_diff};
 use porofrac_amg::{Amg, AmgError, AmgOptions, NearNullSpace, Precision, SymCsr};
 use porofrac_grid::{Point, generate};
 use porofrac_law::Stiffness;

@@ -1,4 +1,4 @@
-//! The coupled particle–fluid step (`porofrac_sim::particle_fluid`) with N moving disks on
+//! The coupled particle–fluid step (`porofrac_particle_fluid`) with N moving disks on
 //! a 512² periodic lattice: the whole step, the lattice step alone without disks, and the
 //! rasterisation of N moving disks alone (placement, covered/uncovered nodes, `δ` of the
 //! cut links). The split of the coupled step between fluid and particles is printed from
@@ -7,7 +7,7 @@
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use porofrac_lbm::{Lattice, LatticeConfig, ObstacleMotion, Units};
 use porofrac_particles::Disks;
-use porofrac_sim::particle_fluid::{CouplingOptions, ParticleFluid, RigidDisks};
+use porofrac_particle_fluid::{CouplingOptions, ParticleFluid, RigidDisks};
 
 const N_LATTICE: usize = 512;
 

@@ -17,7 +17,7 @@
 //!
 //! computed by faer's supernodal sparse Cholesky without pivoting. It exists for every
 //! symmetric ordering of a *quasi-definite* matrix `[[H, Bᵀ], [B, −G]]` with `H`, `G`
-//! positive definite (Vanderbei 1995), the block systems of [`crate::biot::Monolithic`],
+//! positive definite (Vanderbei 1995), the block systems of a monolithic Biot solve,
 //! and for every symmetric positive definite matrix (then `D > 0`). The symbolic analysis
 //! (elimination tree, supernodes) is done once per pattern; a numeric factorization
 //! reuses it.
@@ -65,12 +65,14 @@ use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::SparseColMatRef;
 use faer::sparse::SymbolicSparseColMatRef;
 use faer::sparse::linalg::cholesky::{
-    CholeskySymbolicParams, LdltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
+    CholeskySymbolicParams, LdltRef, SymbolicCholesky, SymbolicCholeskyRaw,
     factorize_symbolic_cholesky,
 };
 use faer::sparse::linalg::{SupernodalThreshold, SymbolicSupernodalParams};
 use faer::{Conj, MatMut, Par, Side};
 use pulp::Simd;
+
+use crate::ordering::symmetric_ordering;
 
 /// Supernode amalgamation (faer's rule: merge a child into its parent when the merged
 /// block has `n` columns and a fraction of explicit zeros below the bound for `n`).
@@ -129,29 +131,9 @@ impl Ldlt {
         perm: Option<&[usize]>,
     ) -> Result<Self, LdltError> {
         let sym = SymbolicSparseColMatRef::new_checked(n, n, col_ptr, None, row_idx);
-        let inverse: Vec<usize>;
-        let ordering = match perm {
-            None => SymmetricOrdering::Amd,
-            Some(fwd) => {
-                let mut inv = vec![usize::MAX; n];
-                if fwd.len() != n {
-                    return Err(LdltError(format!(
-                        "ordering has {} entries for {n} unknowns",
-                        fwd.len()
-                    )));
-                }
-                for (k, &e) in fwd.iter().enumerate() {
-                    if e >= n || inv[e] != usize::MAX {
-                        return Err(LdltError(format!(
-                            "ordering is not a permutation (entry {k} = {e})"
-                        )));
-                    }
-                    inv[e] = k;
-                }
-                inverse = inv;
-                SymmetricOrdering::Custom(faer::perm::PermRef::new_checked(fwd, &inverse, n))
-            }
-        };
+        let mut inverse = Vec::new();
+        let ordering = symmetric_ordering(perm, &mut inverse, n)
+            .map_err(|e| LdltError(e.to_string()))?;
         let params = CholeskySymbolicParams {
             supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
             supernodal_params: SymbolicSupernodalParams { relax: RELAX },
@@ -464,7 +446,7 @@ impl Ldlt {
 /// to its ancestors), so only those are swept.
 impl Ldlt {
     /// `rhs ← L⁻¹ P rhs` (on return in the elimination order). Counts as a solve.
-    pub(crate) fn forward_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LdltError> {
+    pub fn forward_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LdltError> {
         self.check_supernodal(rhs.len())?;
         self.solves += 1;
         self.permute_in(rhs);
@@ -475,7 +457,7 @@ impl Ldlt {
 
     /// `rhs ← Pᵀ L⁻ᵀ D⁻¹ rhs` (`rhs` in the elimination order on entry, as
     /// [`Ldlt::forward_in_place`] left it).
-    pub(crate) fn backward_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LdltError> {
+    pub fn backward_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LdltError> {
         self.check_supernodal(rhs.len())?;
         self.work.copy_from_slice(rhs);
         self.sweep_backward();
@@ -484,7 +466,7 @@ impl Ldlt {
     }
 
     /// `1/D` in the elimination order.
-    pub(crate) fn inverse_diagonal(&self) -> &[f64] {
+    pub fn inverse_diagonal(&self) -> &[f64] {
         &self.inv_diag
     }
 
@@ -493,7 +475,7 @@ impl Ldlt {
     /// the path of supernodes from `u`'s to its root only, the columns on two threads.
     /// `paths[c]` receives the column ranges of the path of column `c` (outside them the
     /// column is zero). Counts as `units.len()` solves.
-    pub(crate) fn forward_units(
+    pub fn forward_units(
         &mut self,
         units: &[usize],
         out: &mut [f64],
@@ -578,7 +560,7 @@ impl Ldlt {
     /// the elimination order) to their roots, ascending: a set closed under the parent,
     /// so a backward sweep over it ([`Ldlt::backward_partial`]) gives the solution at
     /// every column of its supernodes.
-    pub(crate) fn path_union(&self, positions: &[usize]) -> Result<Vec<usize>, LdltError> {
+    pub fn path_union(&self, positions: &[usize]) -> Result<Vec<usize>, LdltError> {
         self.check_supernodal(self.n)?;
         let SymbolicCholeskyRaw::Supernodal(sn) = self.symbolic.raw() else {
             return Err(LdltError("paths of a simplicial factor".into()));
@@ -613,7 +595,7 @@ impl Ldlt {
     /// `x ← L⁻ᵀ D⁻¹ x` over the supernodes `sns` only (ascending, closed under the
     /// parent: [`Ldlt::path_union`]), `x` in the elimination order: the columns of `sns`
     /// get the values of a full backward sweep, the others are left as they were.
-    pub(crate) fn backward_partial(
+    pub fn backward_partial(
         &mut self,
         sns: &[usize],
         x: &mut [f64],
@@ -625,7 +607,7 @@ impl Ldlt {
     /// `x ← L⁻¹ x` for `x` (in the elimination order) zero outside the columns
     /// `positions`: a forward sweep over their paths to the roots only
     /// ([`Ldlt::path_union`]; outside them the result is zero too).
-    pub(crate) fn forward_sparse(
+    pub fn forward_sparse(
         &mut self,
         positions: &[usize],
         x: &mut [f64],
@@ -651,7 +633,7 @@ impl Ldlt {
     }
 
     /// The position of the original unknown `u` in the elimination order.
-    pub(crate) fn position(&self, u: usize) -> usize {
+    pub fn position(&self, u: usize) -> usize {
         match self.symbolic.perm() {
             Some(p) => p.arrays().1[u],
             None => u,

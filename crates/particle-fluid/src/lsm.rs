@@ -3,7 +3,7 @@
 use porofrac_lsm::{LatticeSolid, LsmError};
 use porofrac_particles::Disks;
 
-use super::ParticleSolver;
+use crate::ParticleSolver;
 
 /// Bonded disks carried by the fluid: one coupling sub-step is one velocity-Verlet step of
 /// the lattice solid, with the fluid loads added to the bond and contact forces

@@ -3,15 +3,15 @@
 //! smoothed-aggregation preconditioner; compared with the sparse Cholesky solution
 //! (nested dissection) up to `--cholesky-max` (default 30).
 //!
-//! `cargo run --release -p porofrac-amg --example e3 -- 10 20 30 40 [--tol 1e-8]`
+//! `cargo run --release -p porofrac-sim --features fixtures --example amg_e3 -- 10 20 30 40 [--tol 1e-8]`
 
-mod common;
+mod amg_common;
 
 fn main() {
-    let args = common::args(&[10, 20, 30, 40], 30);
-    common::header();
+    let args = amg_common::args(&[10, 20, 30, 40], 30);
+    amg_common::header();
     for &n in &args.sizes {
-        let sys = common::e3(n);
-        common::run("E3", n, &sys, &args);
+        let sys = amg_common::e3(n);
+        amg_common::run("E3", n, &sys, &args);
     }
 }

@@ -1,4 +1,4 @@
-//! Heap policy of a simulation process: keep freed memory for reuse.
+//! Heap policy of the `porofrac` process: keep freed memory for reuse.
 //!
 //! A solve allocates and frees many large arrays: the pattern's passes, the strength
 //! graph, aggregates and prolongators of each multigrid level, work vectors. glibc's
@@ -6,17 +6,19 @@
 //! first) with a fresh `mmap` and returns it to the kernel on `free`, so the next array
 //! of that size faults in and zeroes its pages again, one 4 kB page at a time, and page
 //! faults are dear on the virtual machines this runs on. In three interleaved pairs of E2
-//! n = 1000 runs (`--example solvers`, with and without `SYSTEM_HEAP=1`, docs/BENCHMARKS.md)
-//! assembly + setup + solve took 4.70 / 4.87 / 4.63 s against 5.87 / 5.35 / 4.94 s, most of
-//! the difference in the multigrid setup (1.43–1.52 against 1.60–2.07 s).
+//! n = 1000 runs (`porofrac-sim`'s `--example solvers`, which applies the same policy,
+//! with and without `SYSTEM_HEAP=1`, docs/BENCHMARKS.md) assembly + setup + solve took
+//! 4.70 / 4.87 / 4.63 s against 5.87 / 5.35 / 4.94 s, most of the difference in the
+//! multigrid setup (1.43–1.52 against 1.60–2.07 s).
 //!
 //! [`retain_freed_memory`] turns both off for the calling process: blocks come from the
 //! heap, and freed memory stays with the process for the next allocation instead of being
 //! trimmed. The peak resident size of one E2 n = 1000 run stayed at 1.56–1.60 GB; the
 //! resident size after a peak stays at the peak until the process ends, and repeated
 //! solves in one process can hold somewhat more than the largest live set (three E2 runs:
-//! 1.70–1.89 GB), which suits a batch simulation. Call it first thing in `main`, before
-//! threads start. Elsewhere than Linux with glibc it does nothing.
+//! 1.70–1.89 GB), which suits a batch simulation. A process-wide setting, so it belongs
+//! to the binary: `main` calls it first thing, before threads start. Elsewhere than Linux
+//! with glibc it does nothing.
 
 /// Keep freed heap memory in the process (see the module docs). Returns whether the
 /// policy was applied (Linux with glibc).
