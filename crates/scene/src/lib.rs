@@ -29,33 +29,23 @@
 //! expressions nest at most [`expr::MAX_NESTING`] deep, and the number of steps, cells
 //! and unknowns a scene asks for is bounded by what the machine has ([`limits`]).
 
-pub mod check;
+pub mod common;
 pub mod continuum;
 pub mod cosserat;
-pub mod driver;
-pub mod expr;
-pub mod file;
-pub mod laws;
 pub mod lbm;
-pub mod limits;
 pub mod lsm;
-pub mod model;
 pub mod nscd;
-pub mod output;
-pub mod particle_output;
-pub mod particles;
-pub mod plots;
-pub mod sample;
 
 use std::path::{Path, PathBuf};
 
-pub use check::SceneError;
-pub use driver::{Observer, Silent, StepReport};
-pub use laws::LawRegistry;
-pub use model::RunError;
-pub use output::Summary;
+pub use common::driver::{Observer, Silent, StepReport};
+pub use common::laws::{self, LawRegistry};
+pub use common::loaded::SceneError;
+pub use common::model::RunError;
+pub use common::output::Summary;
+pub use common::{driver, expr, limits, model, output};
 
-use check::LoadedScene;
+use common::loaded::{self as check, LoadedScene};
 
 /// A scene file read and validated: every key known, every value checked, every
 /// expression compiled once.
@@ -88,7 +78,7 @@ impl Scene {
     }
 
     /// The typed content of the file.
-    pub fn file(&self) -> &file::SceneFile {
+    pub fn file(&self) -> &common::sections::SceneFile {
         &self.loaded.scene
     }
 
@@ -114,7 +104,7 @@ impl Scene {
     /// complete files and `"status": "interrupted at t = …"` ([`Summary::interrupted`]).
     pub fn run(&self, out: &Path, observer: &mut dyn Observer) -> Result<Summary, RunError> {
         let start = std::time::Instant::now();
-        let result = model::run(&self.loaded, &self.laws, out, observer);
+        let result = common::model::run(&self.loaded, &self.laws, out, observer);
         if let Err(e) = &result {
             output::write_failed_summary(&self.loaded, out, &e.to_string(), start);
         }

@@ -1,11 +1,13 @@
 //! Checks of a `model = "cosserat"` scene (SCENE-MODELS.md, "Cosserat media"), and the
 //! refusal of the Cosserat keys in continuum scenes. Every problem names its key.
 
-use crate::check::{LoadedScene, SceneError, expr_ok, k, ki};
-use crate::file::{DiagonalsChoice, GridKind, KeyPart, LinearChoice, NumOrExpr, Select};
+use crate::common::loaded::{LoadedScene, SceneError, expr_ok, k, ki};
+use crate::common::sections::{
+    DiagonalsChoice, GridKind, KeyPart, LinearChoice, NumOrExpr, Select,
+};
 
 use super::fields::Field;
-use super::keys::PerRotation;
+use crate::common::rotation_keys::PerRotation;
 
 /// The only law of the model.
 pub const LAW: &str = "cosserat-dem";
@@ -330,7 +332,8 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
                 }
                 _ => return Err(ls.error(&k(&["schedule"]), "needs exactly one of dt and steps")),
             }
-            if crate::check::step_count_f64(sch) > crate::limits::MAX_STEPS as f64 {
+            if crate::common::loaded::step_count_f64(sch) > crate::common::limits::MAX_STEPS as f64
+            {
                 return Err(ls.error(&k(&["schedule"]), "asks for too many steps"));
             }
             let m = &s.material[name];
@@ -377,7 +380,7 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
         Field::parse(&l.field, d).map_err(|e| ls.error(&ki("output.line", i, &["field"]), e))?;
         len_is(ls, &ki("output.line", i, &["from"]), l.from.len(), d)?;
         len_is(ls, &ki("output.line", i, &["to"]), l.to.len(), d)?;
-        crate::check::line_points_and_name(ls, i, l)?;
+        crate::common::loaded::line_points_and_name(ls, i, l)?;
     }
     Ok(())
 }
@@ -439,7 +442,7 @@ fn check_grid(ls: &LoadedScene, d: usize) -> Result<(), SceneError> {
         }
     }
     match &g.cells {
-        Some(crate::file::CellCount::PerAxis(v)) => {
+        Some(crate::common::sections::CellCount::PerAxis(v)) => {
             len_is(ls, &key("cells"), v.len(), d)?;
             if v.iter().any(|&n| n < 1) {
                 return Err(ls.error(&key("cells"), format!("= {v:?} must all be ≥ 1")));

@@ -2,8 +2,8 @@
 //! and the model named, every value checked (the bond law is built here, so that a bad
 //! stiffness or strength names its key).
 
-use crate::check::{LoadedScene, SceneError, k, ki};
-use crate::file::KeyPart;
+use crate::common::loaded::{LoadedScene, SceneError, k, ki};
+use crate::common::sections::KeyPart;
 use porofrac_lsm::{BondLaw, LsmError};
 
 use super::file::{DampingChoice, NormalChoice};
@@ -274,7 +274,7 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
             "belongs to model \"continuum\", not \"lsm\"",
         ));
     }
-    crate::particles::check(ls, "lsm")?;
+    crate::common::particles::check(ls, "lsm")?;
     bond_law(ls)?;
     if let Some(c) = &s.contacts {
         let key = |f: &str| k(&["contacts", f]);
@@ -414,10 +414,10 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
              [loading] pressure_rate or [injection]",
         ));
     }
-    crate::nscd::check::check_particle_schedule(ls, "lsm")?;
+    crate::common::particles::check_particle_schedule(ls, "lsm")?;
     super::fluid::check(ls)?;
     let shared = check_fluid_probes(ls)?;
-    crate::nscd::check::check_output_of(
+    crate::common::particles::check_output_of(
         shared.as_ref().unwrap_or(ls),
         "lsm",
         &CELL_FIELDS,

@@ -1,6 +1,6 @@
 //! The sections of a lattice solid scene (`[scene] model = "lsm"`), parsed strictly
-//! like the rest of the file ([`crate::file`]). `[particles]` is shared with the other
-//! particle model ([`crate::particles`]).
+//! like the rest of the file ([`crate::common::sections`]). `[particles]` is shared with the other
+//! particle model ([`crate::common::particles`]).
 
 use serde::Deserialize;
 

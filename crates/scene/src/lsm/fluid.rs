@@ -22,10 +22,10 @@ use porofrac_sim::particle_fluid::{
     CouplingError, CouplingOptions, InjectionControl, LoadAveraging, ParticleFluid, ThermalSetup,
 };
 
-use crate::check::{LoadedScene, SceneError, k};
-use crate::lbm::{LatticeParts, VelocityExpr};
-use crate::model::RunError;
-use crate::output::write_atomic;
+use crate::common::lattice::{LatticeParts, VelocityExpr};
+use crate::common::loaded::{LoadedScene, SceneError, k};
+use crate::common::model::RunError;
+use crate::common::output::write_atomic;
 
 /// Top-level sections of model `lbm` that a lattice solid scene may have (its fluid);
 /// `[injection]` is the model's own.
@@ -49,7 +49,11 @@ pub struct InjectionSection {
     pub gain: Option<f64>,
 }
 
-fn positive(ls: &LoadedScene, key: &[crate::file::KeyPart], v: f64) -> Result<(), SceneError> {
+fn positive(
+    ls: &LoadedScene,
+    key: &[crate::common::sections::KeyPart],
+    v: f64,
+) -> Result<(), SceneError> {
     if v.is_finite() && v > 0.0 {
         Ok(())
     } else {
@@ -79,13 +83,13 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
     };
     if let Some(i) = s.output.probe.iter().position(|p| p.obstacle.is_some()) {
         return Err(ls.error(
-            &crate::check::ki("output.probe", i, &["obstacle"]),
+            &crate::common::loaded::ki("output.probe", i, &["obstacle"]),
             "belongs to model \"lbm\", not \"lsm\"",
         ));
     }
-    let (units, seen) = crate::lbm::check::check_section(ls)?;
+    let (units, seen) = crate::common::lattice::check::check_section(ls)?;
     if let Some(t) = &s.thermal {
-        crate::lbm::check::check_thermal(ls, &units, seen)?;
+        crate::common::lattice::check::check_thermal(ls, &units, seen)?;
         if let Some(c) = t.heat_capacity {
             positive(ls, &k(&["thermal", "heat_capacity"]), c)?;
         }
@@ -206,8 +210,8 @@ impl Fluid {
             units,
             origin,
             sides,
-        } = crate::lbm::lattice_of(ls)?;
-        crate::lbm::set_side_velocities(&mut lat, &sides, &units, origin, 0.0);
+        } = crate::common::lattice::lattice_of(ls)?;
+        crate::common::lattice::set_side_velocities(&mut lat, &sides, &units, origin, 0.0);
         let options = CouplingOptions {
             particle_dt_fraction: (dt / solid.stable_dt()).clamp(1e-9, 1.0),
             heat_capacity: s
@@ -226,11 +230,11 @@ impl Fluid {
         let mut pf = ParticleFluid::new(solid, lat, units, origin, options)
             .map_err(|e| coupling_error(ls, e))?;
         if let Some(t) = &s.thermal {
-            let init = crate::lbm::thermal_initial(t);
+            let init = crate::common::lattice::thermal_initial(t);
             let setup = ThermalSetup {
                 diffusivity: t.diffusivity,
                 solid_diffusivity: t.solid_diffusivity.unwrap_or(t.diffusivity),
-                sides: crate::lbm::thermal_sides(t, &units),
+                sides: crate::common::lattice::thermal_sides(t, &units),
             };
             let d = solid.disks();
             let temps: Vec<f64> = (0..d.len())
@@ -491,14 +495,14 @@ impl Fluid {
                 solid_mask.push(lat.is_solid(i, j));
             }
         }
-        crate::lbm::images::field_png(
+        crate::common::lattice::images::field_png(
             &dir.join("fluid_speed.png"),
             [nx, ny],
             &speed,
             &solid_mask,
             false,
         )?;
-        crate::lbm::images::field_png(
+        crate::common::lattice::images::field_png(
             &dir.join("fluid_pressure.png"),
             [nx, ny],
             &pressure,
@@ -511,7 +515,7 @@ impl Fluid {
                 .map(|(i, j)| th.temperature(i, j))
                 .collect();
             let none = vec![false; nx * ny];
-            crate::lbm::images::field_png(
+            crate::common::lattice::images::field_png(
                 &dir.join("temperature.png"),
                 [nx, ny],
                 &t,
@@ -529,7 +533,7 @@ impl Fluid {
                     (a.min(v), b.max(v))
                 });
             let span = (hi - lo).max(1e-300);
-            crate::particle_output::draw_disks(
+            crate::common::particle_output::draw_disks(
                 &dir.join("particles_temperature.png"),
                 d,
                 |i| super::ramp((temps[i] - lo) / span),
@@ -548,5 +552,5 @@ fn set_sides(
     t: f64,
 ) {
     let lat: &mut Lattice = pf.lattice_mut();
-    crate::lbm::set_side_velocities(lat, sides, u, o, t);
+    crate::common::lattice::set_side_velocities(lat, sides, u, o, t);
 }

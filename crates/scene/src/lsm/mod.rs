@@ -1,7 +1,7 @@
 //! The lattice solid model (seed 002.5, `[scene] model = "lsm"`): bonded disks
 //! ([`porofrac_lsm`]).
 //!
-//! - *build*: the disks of `[particles]` ([`crate::particles`]), the bond law of
+//! - *build*: the disks of `[particles]` ([`crate::common::particles`]), the bond law of
 //!   `[bonds]` (E and ν through the hexagonal closed form, or k_n, k_s), `[contacts]`,
 //!   `[lsm]` (time step, damping, gravity) and `[loading]` (platens, a pressure ramp on
 //!   the hole, on the faces seen from its centre or on the faces a fluid would wet,
@@ -45,11 +45,11 @@ use porofrac_particles::tracked::CellContact;
 use porofrac_particles::vtk::ContactLine;
 use porofrac_particles::{Disks, RandomPacking, TrackedCell};
 
-use crate::check::{LoadedScene, SceneError, k, ki, step_count};
-use crate::driver::{Observer, drive};
-use crate::model::{Model, RunError, Sizes, StepStats};
-use crate::output::{SolverStats, Summary, WallSeconds};
-use crate::particle_output::{self, PARTICLE_FIELDS};
+use crate::common::driver::{Observer, drive};
+use crate::common::loaded::{LoadedScene, SceneError, k, ki, step_count};
+use crate::common::model::{Model, RunError, Sizes, StepStats};
+use crate::common::output::{SolverStats, Summary, WallSeconds};
+use crate::common::particle_output::{self, PARTICLE_FIELDS};
 
 use file::{DampingChoice, NormalChoice, WallChoice};
 
@@ -211,7 +211,7 @@ fn calibrate(ls: &LoadedScene, spec: &LsmSpec) -> Result<Calibration, SceneError
 /// Build the model of a checked lattice solid scene.
 pub fn build(ls: &LoadedScene) -> Result<LsmModel<'_>, RunError> {
     let s = &ls.scene;
-    let disks = crate::particles::generate(ls)?;
+    let disks = crate::common::particles::generate(ls)?;
     let spec = spec_of(ls)?;
     let calibration = if s.bonds.as_ref().is_some_and(|b| b.calibrate) {
         Some(calibrate(ls, &spec)?)
@@ -674,7 +674,7 @@ impl Model for LsmModel<'_> {
                 b.mode.as_str()
             ));
         }
-        crate::output::write_atomic(&out.join("broken.csv"), text.as_bytes())?;
+        crate::common::output::write_atomic(&out.join("broken.csv"), text.as_bytes())?;
         self.broken_written = broken.len();
         Ok(())
     }
@@ -727,7 +727,12 @@ impl Model for LsmModel<'_> {
             .zip(series)
             .map(|(p, v)| (p.name.clone(), p.field.clone(), v.clone()))
             .collect();
-        crate::nscd::plots::probe_plots(dir, &self.ls.scene.scene.name, written, &probes)?;
+        crate::common::particle_plots::probe_plots(
+            dir,
+            &self.ls.scene.scene.name,
+            written,
+            &probes,
+        )?;
         if let Some(f) = &self.fluid {
             f.plots(dir, &self.solid)?;
         }
@@ -766,7 +771,7 @@ impl Model for LsmModel<'_> {
                 self.history.iter().map(|h| h[1] + h[2]).collect(),
             ),
         ];
-        crate::plots::time_series(
+        crate::common::plots::time_series(
             &dir.join("breakage.png"),
             &times,
             &columns,

@@ -1,9 +1,9 @@
 //! The sections of an NSCD scene (`[scene] model = "nscd"`), parsed strictly like the
-//! rest of the file ([`crate::file`]).
+//! rest of the file ([`crate::common::sections`]).
 
 use serde::Deserialize;
 
-pub use crate::particles::{ParticleKind, ParticlesSection, RadiusSpec};
+pub use crate::common::particles::{ParticleKind, ParticlesSection, RadiusSpec};
 
 /// A velocity component of a wall: a number (m/s) or `"free"`.
 #[derive(Clone, Debug, Deserialize, PartialEq)]

@@ -18,7 +18,6 @@
 pub mod check;
 pub mod fault;
 pub mod file;
-pub mod plots;
 
 use std::cell::RefCell;
 use std::collections::BTreeMap;
@@ -27,14 +26,14 @@ use std::time::Instant;
 
 use porofrac_grid::io::PvdWriter;
 
-use crate::particle_output;
+use crate::common::particle_output;
 use porofrac_nscd::{Axis, ContactLaw, Nscd, NscdError, Ordering, RigidBody, SolverParams};
 use porofrac_particles::TrackedCell;
 
-use crate::check::{LoadedScene, k, ki, step_count};
-use crate::driver::{Observer, drive};
-use crate::model::{Model, RunError, Sizes, StepStats};
-use crate::output::{SolverStats, Summary, WallSeconds};
+use crate::common::driver::{Observer, drive};
+use crate::common::loaded::{LoadedScene, k, ki, step_count};
+use crate::common::model::{Model, RunError, Sizes, StepStats};
+use crate::common::output::{SolverStats, Summary, WallSeconds};
 
 use file::{OrderingChoice, WallComponent};
 
@@ -136,7 +135,7 @@ fn walls(ls: &LoadedScene) -> Vec<RigidBody> {
 /// Build the model of a checked NSCD scene.
 pub fn build(ls: &LoadedScene) -> Result<NscdModel<'_>, RunError> {
     let s = &ls.scene;
-    let disks = crate::particles::generate(ls)?;
+    let disks = crate::common::particles::generate(ls)?;
     let c = s.contact.clone().unwrap_or_default();
     let mu = c.mu.unwrap_or(0.0);
     let law = ContactLaw {
@@ -427,8 +426,13 @@ impl Model for NscdModel<'_> {
             .zip(series)
             .map(|(p, v)| (p.name.clone(), p.field.clone(), v.clone()))
             .collect();
-        plots::probe_plots(dir, &self.ls.scene.scene.name, written, &probes)?;
-        plots::layers(&dir.join("layers.png"), &self.sys.disks)?;
+        crate::common::particle_plots::probe_plots(
+            dir,
+            &self.ls.scene.scene.name,
+            written,
+            &probes,
+        )?;
+        crate::common::particle_plots::layers(&dir.join("layers.png"), &self.sys.disks)?;
         Ok(())
     }
 

@@ -4,12 +4,12 @@
 use std::fmt;
 use std::path::{Path, PathBuf};
 
-use crate::expr::Expr;
-use crate::file::{
+use crate::common::expr::Expr;
+use crate::common::laws::LawRegistry;
+use crate::common::sections::{
     Bc, CellCount, Component, GridKind, KeyPart, LinearChoice, NumOrExpr, Permeability, SceneFile,
     Select, key_text, line_of_offset, locate,
 };
-use crate::laws::LawRegistry;
 use porofrac_grid::Point;
 use porofrac_grid::generate::RoundWellSpec;
 
@@ -204,15 +204,15 @@ fn len_is(ls: &LoadedScene, path: &[KeyPart], got: usize, want: usize) -> Result
 pub(crate) fn line_points_and_name(
     ls: &LoadedScene,
     i: usize,
-    l: &crate::file::Line,
+    l: &crate::common::sections::Line,
 ) -> Result<(), SceneError> {
-    if !(2..=crate::limits::MAX_LINE_POINTS as i64).contains(&l.points) {
+    if !(2..=crate::common::limits::MAX_LINE_POINTS as i64).contains(&l.points) {
         return Err(ls.error(
             &ki("output.line", i, &["points"]),
             format!(
                 "= {} must be in 2..={}",
                 l.points,
-                crate::limits::MAX_LINE_POINTS
+                crate::common::limits::MAX_LINE_POINTS
             ),
         ));
     }
@@ -244,9 +244,9 @@ pub(crate) fn expr_ok(
     }
 }
 
-/// Number of steps of a schedule (before the [`crate::limits::MAX_STEPS`] bound; as
+/// Number of steps of a schedule (before the [`crate::common::limits::MAX_STEPS`] bound; as
 /// a float so absurd requests do not overflow).
-pub fn step_count_f64(sch: &crate::file::Schedule) -> f64 {
+pub fn step_count_f64(sch: &crate::common::sections::Schedule) -> f64 {
     match (sch.dt, sch.steps) {
         (Some(dt), _) => (sch.end_time / dt - 1e-9).ceil().max(1.0),
         (None, Some(n)) => n.max(1) as f64,
@@ -255,7 +255,7 @@ pub fn step_count_f64(sch: &crate::file::Schedule) -> f64 {
 }
 
 /// Number of steps of a checked schedule.
-pub fn step_count(sch: &crate::file::Schedule) -> u64 {
+pub fn step_count(sch: &crate::common::sections::Schedule) -> u64 {
     step_count_f64(sch) as u64
 }
 
@@ -908,9 +908,9 @@ fn check_wells(ls: &LoadedScene, d: usize) -> Result<(), SceneError> {
 }
 
 /// Bound steps, output series and generated grids before anything is allocated
-/// ([`crate::limits`]).
+/// ([`crate::common::limits`]).
 fn check_sizes(ls: &LoadedScene, d: usize) -> Result<(), SceneError> {
-    use crate::limits::{MAX_CELLS, MAX_STEPS, fits_in_memory, run_bytes};
+    use crate::common::limits::{MAX_CELLS, MAX_STEPS, fits_in_memory, run_bytes};
     let s = &ls.scene;
     if let Some(sch) = &s.schedule {
         let n = step_count_f64(sch);

@@ -4,7 +4,7 @@
 //! state from one output time to the next (*step*), and answers what the shared outputs
 //! ask of it (*fields*): the value of each probe and of each line point, the VTK file of
 //! a written step, the extrema of its fields, its plots and its part of `summary.json`.
-//! The loop of [`crate::driver`] does the rest the same way for every model.
+//! The loop of [`crate::common::driver`] does the rest the same way for every model.
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -12,10 +12,10 @@ use std::path::Path;
 use porofrac_grid::GridError;
 use porofrac_sim::SimError;
 
-use crate::check::{LoadedScene, SceneError, k};
-use crate::driver::Observer;
-use crate::laws::LawRegistry;
-use crate::output::{OutputError, SolverStats, Summary, WallSeconds};
+use crate::common::driver::Observer;
+use crate::common::laws::LawRegistry;
+use crate::common::loaded::{LoadedScene, SceneError, k};
+use crate::common::output::{OutputError, SolverStats, Summary, WallSeconds};
 
 /// Anything that ends a run.
 #[derive(Debug, thiserror::Error)]
@@ -43,7 +43,7 @@ pub enum RunError {
     Biot(#[from] porofrac_sim::BiotError),
     /// A plot could not be drawn.
     #[error("plot: {0}")]
-    Plot(#[from] crate::plots::PlotError),
+    Plot(#[from] crate::common::plots::PlotError),
     /// The coupled fracturing step failed.
     #[error("{0}")]
     Coupled(#[from] porofrac_sim::FractureError),
