@@ -46,6 +46,17 @@ pub use common::output::Summary;
 pub use common::{driver, expr, limits, model, output};
 
 use common::loaded::{self as check, LoadedScene};
+use common::model::ModelKind;
+
+/// The models of the registry: `[scene] model` is looked up here. A new model is one
+/// folder (its sections, checks, build and [`model::Model`]) and one line here.
+pub static MODELS: &[&'static dyn ModelKind] = &[
+    &continuum::KIND,
+    &nscd::KIND,
+    &lbm::KIND,
+    &cosserat::KIND,
+    &lsm::KIND,
+];
 
 /// A scene file read and validated: every key known, every value checked, every
 /// expression compiled once.
@@ -64,16 +75,16 @@ impl Scene {
     /// Read, parse and validate a scene file whose regions may use the laws of `laws`
     /// (the built-in ones and the user's, [`LawRegistry::register`]).
     pub fn load_with(path: &Path, laws: LawRegistry) -> Result<Self, SceneError> {
-        let loaded = check::load(path)?;
-        check::check(&loaded, &laws)?;
+        let loaded = check::load(path, MODELS)?;
+        check::check(&loaded, &laws, MODELS)?;
         Ok(Self { loaded, laws })
     }
 
     /// Parse and validate scene text; `path` names it in errors and anchors relative
     /// paths (mesh files).
     pub fn parse(text: &str, path: &Path, laws: LawRegistry) -> Result<Self, SceneError> {
-        let loaded = check::parse(text, path)?;
-        check::check(&loaded, &laws)?;
+        let loaded = check::parse(text, path, MODELS)?;
+        check::check(&loaded, &laws, MODELS)?;
         Ok(Self { loaded, laws })
     }
 

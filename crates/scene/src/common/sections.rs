@@ -198,7 +198,31 @@ pub enum LinearChoice {
     GmresAmg,
 }
 
-/// A whole scene file.
+/// The top-level sections of [`SceneFile`]: those every model may read, and those two
+/// models share. Every other top-level section belongs to one model, which reads it
+/// ([`crate::common::model::ModelKind::sections_of`]).
+pub const SHARED_SECTIONS: [&str; 17] = [
+    "scene",
+    "grid",
+    "region",
+    "material",
+    "fluid",
+    "bc",
+    "loads",
+    "source",
+    "well",
+    "initial",
+    "schedule",
+    "physics",
+    "solver",
+    "output",
+    "particles",
+    "lbm",
+    "thermal",
+];
+
+/// The sections of a scene file that every model may read or two models share
+/// ([`SHARED_SECTIONS`]).
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneFile {
@@ -242,28 +266,8 @@ pub struct SceneFile {
     pub output: Output,
     /// `[particles]` (models `nscd` and `lsm`).
     pub particles: Option<crate::common::particles::ParticlesSection>,
-    /// `[[wall]]`: rigid bodies (model `nscd`).
-    #[serde(default)]
-    pub wall: Vec<crate::nscd::file::WallSection>,
-    /// `[contact]`: the contact law (model `nscd`).
-    pub contact: Option<crate::nscd::file::ContactSection>,
-    /// `[nscd]`: the solver (model `nscd`).
-    pub nscd: Option<crate::nscd::file::NscdSection>,
-    /// `[bonds]` (model `lsm`).
-    pub bonds: Option<crate::lsm::file::BondsSection>,
-    /// `[contacts]` (model `lsm`).
-    pub contacts: Option<crate::lsm::file::ContactsSection>,
-    /// `[lsm]` (model `lsm`).
-    pub lsm: Option<crate::lsm::file::LsmSection>,
-    /// `[loading]` (model `lsm`).
-    pub loading: Option<crate::lsm::file::LoadingSection>,
-    /// `[injection]` (model `lsm` with `[lbm]`).
-    pub injection: Option<crate::lsm::fluid::InjectionSection>,
     /// `[lbm]` (lattice Boltzmann model).
     pub lbm: Option<crate::common::lattice::sections::LbmSection>,
-    /// `[[obstacle]]` (lattice Boltzmann model).
-    #[serde(default)]
-    pub obstacle: Vec<crate::common::lattice::sections::ObstacleSection>,
     /// `[thermal]` (lattice Boltzmann model).
     pub thermal: Option<crate::common::lattice::sections::ThermalSection>,
 }
@@ -676,7 +680,7 @@ pub struct Line {
 }
 
 /// One step of a key path: a table key or an index into an array of tables.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum KeyPart {
     /// A key.
     Key(String),

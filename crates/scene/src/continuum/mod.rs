@@ -12,10 +12,14 @@
 //! - *fields*: displacement, stress, principal stresses, pressure and the failure flag
 //!   ([`fields`]) for probes, lines, VTK and `field_extrema`, and the plots ([`plots`]).
 
+pub mod check;
 pub mod compose;
 pub mod fields;
 pub mod flow;
 pub mod plots;
+
+use crate::common::loaded::SceneError;
+use crate::common::model::ModelKind;
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -860,4 +864,31 @@ fn locate_outputs<const D: usize>(
         lines.push((f, pts));
     }
     Ok((probes, lines))
+}
+
+/// The model `continuum` in the registry ([`crate::MODELS`]).
+pub struct ContinuumKind;
+
+/// The registry's value of the model.
+pub static KIND: ContinuumKind = ContinuumKind;
+
+impl ModelKind for ContinuumKind {
+    fn name(&self) -> &'static str {
+        "continuum"
+    }
+    fn sections(&self) -> &'static [&'static str] {
+        &["grid", "region", "material", "fluid", "bc", "loads", "source", "well", "initial", "physics"]
+    }
+    fn check(&self, ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
+        check::check(ls, laws)
+    }
+    fn run(
+        &self,
+        ls: &LoadedScene,
+        laws: &LawRegistry,
+        out: &Path,
+        observer: &mut dyn Observer,
+    ) -> Result<Summary, RunError> {
+        run(ls, laws, out, observer)
+    }
 }

@@ -23,58 +23,6 @@ fn other_model(ls: &LoadedScene, path: &[KeyPart], model: &str) -> SceneError {
     )
 }
 
-/// In a continuum scene: the Cosserat-only keys are errors naming key and model, and a
-/// missing `youngs_modulus` is reported as missing.
-pub fn refuse_in_continuum(ls: &LoadedScene) -> Result<(), SceneError> {
-    let s = &ls.scene;
-    let cos = |path: Vec<KeyPart>| {
-        ls.error(
-            &path,
-            format!(
-                "is a key of model \"cosserat\", the scene's model is \"{}\"",
-                ls.model()
-            ),
-        )
-    };
-    for (name, m) in &s.material {
-        for (key, set) in [
-            ("shear_modulus", m.shear_modulus.is_some()),
-            ("cosserat_shear_modulus", m.cosserat_shear_modulus.is_some()),
-            ("characteristic_length", m.characteristic_length.is_some()),
-            ("couple_moduli", m.couple_moduli.is_some()),
-            ("micro_inertia", m.micro_inertia.is_some()),
-        ] {
-            if set {
-                return Err(cos(k(&["material", name, key])));
-            }
-        }
-        if m.youngs_modulus.is_nan() {
-            return Err(ls.error(&k(&["material", name, "youngs_modulus"]), "is missing"));
-        }
-    }
-    for (i, bc) in s.bc.iter().enumerate() {
-        if bc.rotation.is_some() {
-            return Err(cos(ki("bc", i, &["rotation"])));
-        }
-        if bc.couple_traction.is_some() {
-            return Err(cos(ki("bc", i, &["couple_traction"])));
-        }
-    }
-    if s.loads.as_ref().is_some_and(|l| l.body_couple.is_some()) {
-        return Err(cos(k(&["loads", "body_couple"])));
-    }
-    if s.solver.penalty.is_some() {
-        return Err(cos(k(&["solver", "penalty"])));
-    }
-    if s.solver.time_integration.is_some() {
-        return Err(cos(k(&["solver", "time_integration"])));
-    }
-    if s.grid.diagonals == Some(DiagonalsChoice::Crossed) {
-        return Err(cos(k(&["grid", "diagonals"])));
-    }
-    Ok(())
-}
-
 fn positive(ls: &LoadedScene, path: &[KeyPart], v: f64) -> Result<(), SceneError> {
     if !(v.is_finite() && v > 0.0) {
         return Err(ls.error(path, format!("= {v} must be > 0")));
@@ -125,6 +73,7 @@ fn per_rotation(
 
 /// Check a cosserat scene.
 pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
+    crate::common::lattice::check::refuse_obstacle_probes(ls, "cosserat")?;
     let s = &ls.scene;
     let d = s.scene.dim as usize;
     let model = "cosserat";

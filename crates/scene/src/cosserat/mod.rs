@@ -20,6 +20,10 @@ pub mod vtk;
 #[cfg(test)]
 mod tests;
 
+use crate::common::laws::LawRegistry;
+use crate::common::loaded::SceneError;
+use crate::common::model::ModelKind;
+
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::Arc;
@@ -556,5 +560,37 @@ impl<const D: usize> Model for Run<'_, D> {
 
     fn wall_seconds(&self) -> WallSeconds {
         self.wall
+    }
+}
+
+/// The model `cosserat` in the registry ([`crate::MODELS`]).
+pub struct CosseratKind;
+
+/// The registry's value of the model.
+pub static KIND: CosseratKind = CosseratKind;
+
+impl ModelKind for CosseratKind {
+    fn name(&self) -> &'static str {
+        "cosserat"
+    }
+    fn sections(&self) -> &'static [&'static str] {
+        &[]
+    }
+    fn reads(&self) -> &'static [&'static str] {
+        &["grid", "region", "material", "fluid", "bc", "loads", "source", "well", "initial", "physics"]
+    }
+    fn check(&self, ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
+        let _ = laws;
+        check::check(ls)
+    }
+    fn run(
+        &self,
+        ls: &LoadedScene,
+        laws: &LawRegistry,
+        out: &Path,
+        observer: &mut dyn Observer,
+    ) -> Result<Summary, RunError> {
+        let _ = laws;
+        run(ls, out, observer)
     }
 }

@@ -15,27 +15,6 @@ pub const FIELDS: [&str; 5] = ["vx", "vy", "pressure", "density", "temperature"]
 /// Obstacle probe fields.
 pub const OBSTACLE_FIELDS: [&str; 3] = ["fx", "fy", "torque"];
 
-/// Refuse the keys of the lattice Boltzmann model in a scene of another `model`.
-pub fn refuse_sections(ls: &LoadedScene, model: &str) -> Result<(), SceneError> {
-    let s = &ls.scene;
-    let key = if s.lbm.is_some() {
-        Some(k(&["lbm"]))
-    } else if !s.obstacle.is_empty() {
-        Some(ki("obstacle", 0, &[]))
-    } else if s.thermal.is_some() {
-        Some(k(&["thermal"]))
-    } else {
-        s.output
-            .probe
-            .iter()
-            .position(|p| p.obstacle.is_some())
-            .map(|i| ki("output.probe", i, &["obstacle"]))
-    };
-    match key {
-        Some(key) => Err(ls.error(&key, format!("belongs to model \"lbm\", not \"{model}\""))),
-        None => Ok(()),
-    }
-}
 
 /// Check a scene with `[scene] model = "lbm"`.
 pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
@@ -51,46 +30,6 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
             &k(&["scene", "name"]),
             "must be a non-empty name without slashes",
         ));
-    }
-    // Keys of the continuum model.
-    let foreign: Option<Vec<KeyPart>> = if crate::nscd::check::has_section(ls, "grid") {
-        Some(k(&["grid"]))
-    } else if s.scene.plane.is_some() {
-        Some(k(&["scene", "plane"]))
-    } else if !s.region.is_empty() {
-        Some(ki("region", 0, &[]))
-    } else if let Some(m) = s.material.keys().next() {
-        Some(k(&["material", m]))
-    } else if s.fluid.is_some() {
-        Some(k(&["fluid"]))
-    } else if !s.bc.is_empty() {
-        Some(ki("bc", 0, &[]))
-    } else if s.loads.is_some() {
-        Some(k(&["loads"]))
-    } else if !s.source.is_empty() {
-        Some(ki("source", 0, &[]))
-    } else if !s.well.is_empty() {
-        Some(ki("well", 0, &[]))
-    } else if s.initial.is_some() {
-        Some(k(&["initial"]))
-    } else if s.physics.flow.is_some()
-        || s.physics.coupling.is_some()
-        || s.physics.fracture.is_some()
-        || s.physics.failure_stress.is_some()
-    {
-        Some(k(&["physics"]))
-    } else if s.solver.mechanics.is_some()
-        || s.solver.linear.is_some()
-        || s.solver.tolerance.is_some()
-    {
-        Some(k(&["solver"]))
-    } else if s.output.exact_displacement.is_some() {
-        Some(k(&["output", "exact_displacement"]))
-    } else {
-        None
-    };
-    if let Some(key) = foreign {
-        return Err(ls.error(&key, "belongs to model \"continuum\", not \"lbm\""));
     }
     if let Some(t) = &s.thermal {
         for (name, set) in [
@@ -110,7 +49,7 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
     let mut names = std::collections::BTreeSet::new();
     let (x0, y0) = (l.extent[0][0], l.extent[0][1]);
     let (x1, y1) = (l.extent[1][0], l.extent[1][1]);
-    for (i, o) in s.obstacle.iter().enumerate() {
+    for (i, o) in super::own(ls).obstacle.iter().enumerate() {
         let ok = |f: &str| ki("obstacle", i, &[f]);
         if o.name.is_empty() || !names.insert(o.name.clone()) {
             return Err(ls.error(
@@ -284,6 +223,53 @@ fn field(ls: &LoadedScene, key: &[KeyPart], f: &str) -> Result<(), SceneError> {
                 FIELDS.join(" ")
             ),
         ));
+    }
+    Ok(())
+}
+
+/// The keys of the continuum model in a lattice Boltzmann scene, refused by name (an
+/// array of tables by its first element, a material by its name).
+pub(crate) fn refuse_continuum(ls: &LoadedScene) -> Result<(), SceneError> {
+    let s = &ls.scene;
+    // Keys of the continuum model.
+    let foreign: Option<Vec<KeyPart>> = if ls.has_section("grid") {
+        Some(k(&["grid"]))
+    } else if s.scene.plane.is_some() {
+        Some(k(&["scene", "plane"]))
+    } else if !s.region.is_empty() {
+        Some(ki("region", 0, &[]))
+    } else if let Some(m) = s.material.keys().next() {
+        Some(k(&["material", m]))
+    } else if s.fluid.is_some() {
+        Some(k(&["fluid"]))
+    } else if !s.bc.is_empty() {
+        Some(ki("bc", 0, &[]))
+    } else if s.loads.is_some() {
+        Some(k(&["loads"]))
+    } else if !s.source.is_empty() {
+        Some(ki("source", 0, &[]))
+    } else if !s.well.is_empty() {
+        Some(ki("well", 0, &[]))
+    } else if s.initial.is_some() {
+        Some(k(&["initial"]))
+    } else if s.physics.flow.is_some()
+        || s.physics.coupling.is_some()
+        || s.physics.fracture.is_some()
+        || s.physics.failure_stress.is_some()
+    {
+        Some(k(&["physics"]))
+    } else if s.solver.mechanics.is_some()
+        || s.solver.linear.is_some()
+        || s.solver.tolerance.is_some()
+    {
+        Some(k(&["solver"]))
+    } else if s.output.exact_displacement.is_some() {
+        Some(k(&["output", "exact_displacement"]))
+    } else {
+        None
+    };
+    if let Some(key) = foreign {
+        return Err(ls.error(&key, "belongs to model \"continuum\", not \"lbm\""));
     }
     Ok(())
 }

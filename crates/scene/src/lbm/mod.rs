@@ -17,6 +17,12 @@
 pub mod check;
 mod vti;
 
+use crate::common::laws::LawRegistry;
+use crate::common::loaded::SceneError;
+use crate::common::model::ModelKind;
+use crate::common::model::{OwnSections, own_sections};
+use crate::common::sections::KeyPart;
+
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::time::Instant;
@@ -104,7 +110,7 @@ fn build(ls: &LoadedScene) -> Result<LbmModel<'_>, RunError> {
         sides,
     } = lattice_of(ls)?;
     let mut motions = Vec::new();
-    for (i, o) in s.obstacle.iter().enumerate() {
+    for (i, o) in own(ls).obstacle.iter().enumerate() {
         let shape = match &o.shape {
             ShapeChoice::Circle(c) => Shape::Circle {
                 center: [
@@ -171,7 +177,7 @@ fn build(ls: &LoadedScene) -> Result<LbmModel<'_>, RunError> {
     for p in &s.output.probe {
         model.probes.push(match &p.obstacle {
             Some(o) => {
-                let idx = s
+                let idx = own(ls)
                     .obstacle
                     .iter()
                     .position(|x| &x.name == o)
@@ -644,4 +650,63 @@ impl Model for LbmModel<'_> {
             ..WallSeconds::default()
         }
     }
+}
+
+/// The model `lbm` in the registry ([`crate::MODELS`]).
+pub struct LbmKind;
+
+/// The registry's value of the model.
+pub static KIND: LbmKind = LbmKind;
+
+impl ModelKind for LbmKind {
+    fn name(&self) -> &'static str {
+        "lbm"
+    }
+    fn sections(&self) -> &'static [&'static str] {
+        &["lbm", "obstacle", "thermal"]
+    }
+    fn refused_as(&self, section: &str) -> Vec<KeyPart> {
+        if section == "obstacle" {
+            ki("obstacle", 0, &[])
+        } else {
+            k(&[section])
+        }
+    }
+    fn refuse(&self, ls: &LoadedScene) -> Result<(), SceneError> {
+        check::refuse_continuum(ls)
+    }
+    fn sections_of(
+        &self,
+        doc: toml::Spanned<toml::de::DeTable<'_>>,
+    ) -> Result<std::sync::Arc<dyn OwnSections>, toml::de::Error> {
+        own_sections::<LbmSections>(doc)
+    }
+    fn check(&self, ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
+        let _ = laws;
+        check::check(ls)
+    }
+    fn run(
+        &self,
+        ls: &LoadedScene,
+        laws: &LawRegistry,
+        out: &Path,
+        observer: &mut dyn Observer,
+    ) -> Result<Summary, RunError> {
+        let _ = laws;
+        run(ls, out, observer)
+    }
+}
+
+/// The sections of model `lbm` read by the model itself (`[lbm]` and `[thermal]` are
+/// shared with model `lsm`).
+#[derive(Clone, Debug, Default, serde::Deserialize)]
+pub struct LbmSections {
+    /// `[[obstacle]]`.
+    #[serde(default)]
+    pub obstacle: Vec<crate::common::lattice::sections::ObstacleSection>,
+}
+
+/// The model's own sections of a checked scene.
+pub(crate) fn own(ls: &LoadedScene) -> &LbmSections {
+    ls.own::<LbmSections>()
 }

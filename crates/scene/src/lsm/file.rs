@@ -142,3 +142,19 @@ pub struct LoadingSection {
     #[serde(default)]
     pub flood_cracks: bool,
 }
+
+/// The sections of model `lsm` read by the model itself (`[particles]` is shared with
+/// model `nscd`, `[lbm]` and `[thermal]` with model `lbm`).
+#[derive(Clone, Debug, Default, Deserialize)]
+pub struct LsmSections {
+    /// `[bonds]`.
+    pub bonds: Option<BondsSection>,
+    /// `[contacts]`.
+    pub contacts: Option<ContactsSection>,
+    /// `[lsm]`.
+    pub lsm: Option<LsmSection>,
+    /// `[loading]`.
+    pub loading: Option<LoadingSection>,
+    /// `[injection]` (with `[lbm]`).
+    pub injection: Option<super::fluid::InjectionSection>,
+}

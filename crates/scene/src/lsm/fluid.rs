@@ -67,13 +67,13 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
     let Some(_) = &s.lbm else {
         for (name, set) in [
             ("thermal", s.thermal.is_some()),
-            ("injection", s.injection.is_some()),
+            ("injection", super::own(ls).injection.is_some()),
         ] {
             if set {
                 return Err(ls.error(&k(&[name]), "needs [lbm]: the fluid that carries it"));
             }
         }
-        if s.lsm.as_ref().is_some_and(|l| l.seal_bonds.is_some()) {
+        if super::own(ls).lsm.as_ref().is_some_and(|l| l.seal_bonds.is_some()) {
             return Err(ls.error(
                 &k(&["lsm", "seal_bonds"]),
                 "needs [lbm]: it sets what the fluid sees",
@@ -102,7 +102,7 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
             ));
         }
     }
-    if let Some(inj) = &s.injection {
+    if let Some(inj) = &super::own(ls).injection {
         let key = |f: &str| k(&["injection", f]);
         let hole = s.particles.as_ref().and_then(|p| p.hole);
         if inj.center.is_none() && hole.is_none() {
@@ -159,7 +159,7 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
         {
             return Err(ls.error(&key("gain"), format!("= {g} must be in (0, 1]")));
         }
-        if s.loading
+        if super::own(ls).loading
             .as_ref()
             .is_some_and(|l| l.pressure_rate.is_some())
         {
@@ -220,8 +220,8 @@ impl Fluid {
                 .and_then(|t| t.heat_capacity)
                 .unwrap_or(CouplingOptions::default().heat_capacity),
             loads: LoadAveraging::TwoSteps,
-            fluid_radius_factor: if s.lsm.as_ref().and_then(|l| l.seal_bonds) == Some(true) {
-                1.0 + s.bonds.as_ref().and_then(|b| b.tolerance).unwrap_or(0.05)
+            fluid_radius_factor: if super::own(ls).lsm.as_ref().and_then(|l| l.seal_bonds) == Some(true) {
+                1.0 + super::own(ls).bonds.as_ref().and_then(|b| b.tolerance).unwrap_or(0.05)
             } else {
                 1.0
             },
@@ -247,7 +247,7 @@ impl Fluid {
                 .with_thermal(setup, |x| init.eval(&x, 0.0), &temps)
                 .map_err(|e| coupling_error(ls, e))?;
         }
-        if let Some(inj) = &s.injection {
+        if let Some(inj) = &super::own(ls).injection {
             let hole = s.particles.as_ref().and_then(|p| p.hole);
             let center = inj.center.or(hole.map(|h| h.center)).expect("checked");
             let radius = inj

@@ -29,6 +29,11 @@ pub mod crack;
 pub mod file;
 pub mod fluid;
 
+use crate::common::laws::LawRegistry;
+use crate::common::loaded::SceneError;
+use crate::common::model::ModelKind;
+use crate::common::model::{OwnSections, own_sections};
+
 use std::cell::RefCell;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -46,7 +51,7 @@ use porofrac_particles::vtk::ContactLine;
 use porofrac_particles::{Disks, RandomPacking, TrackedCell};
 
 use crate::common::driver::{Observer, drive};
-use crate::common::loaded::{LoadedScene, SceneError, k, ki, step_count};
+use crate::common::loaded::{LoadedScene, k, ki, step_count};
 use crate::common::model::{Model, RunError, Sizes, StepStats};
 use crate::common::output::{SolverStats, Summary, WallSeconds};
 use crate::common::particle_output::{self, PARTICLE_FIELDS};
@@ -110,11 +115,10 @@ pub struct LsmModel<'a> {
 }
 
 fn spec_of(ls: &LoadedScene) -> Result<LsmSpec, SceneError> {
-    let s = &ls.scene;
     let law = check::bond_law(ls)?;
     let mut spec = LsmSpec::new(law);
-    spec.bond_tolerance = s.bonds.as_ref().and_then(|b| b.tolerance).unwrap_or(0.05);
-    let c = s.contacts.clone().unwrap_or_default();
+    spec.bond_tolerance = own(ls).bonds.as_ref().and_then(|b| b.tolerance).unwrap_or(0.05);
+    let c = own(ls).contacts.clone().unwrap_or_default();
     spec.contacts = ContactLaw {
         normal: match c.normal {
             NormalChoice::Linear => NormalLaw::Linear,
@@ -127,7 +131,7 @@ fn spec_of(ls: &LoadedScene) -> Result<LsmSpec, SceneError> {
         ks: c.ks.unwrap_or(law.ks),
         friction: c.friction.unwrap_or(0.6),
     };
-    let l = s.lsm.clone().unwrap_or_default();
+    let l = own(ls).lsm.clone().unwrap_or_default();
     spec.damping = match l.damping {
         DampingChoice::None => Damping::None,
         DampingChoice::Local => Damping::Local {
@@ -213,13 +217,13 @@ pub fn build(ls: &LoadedScene) -> Result<LsmModel<'_>, RunError> {
     let s = &ls.scene;
     let disks = crate::common::particles::generate(ls)?;
     let spec = spec_of(ls)?;
-    let calibration = if s.bonds.as_ref().is_some_and(|b| b.calibrate) {
+    let calibration = if own(ls).bonds.as_ref().is_some_and(|b| b.calibrate) {
         Some(calibrate(ls, &spec)?)
     } else {
         None
     };
     let mut solid = LatticeSolid::new(disks, spec).map_err(|e| check::lsm_error(ls, &e))?;
-    let l = s.lsm.clone().unwrap_or_default();
+    let l = own(ls).lsm.clone().unwrap_or_default();
     let stable = solid.stable_dt();
     let dt = match l.dt {
         Some(dt) if dt > stable => {
@@ -233,7 +237,7 @@ pub fn build(ls: &LoadedScene) -> Result<LsmModel<'_>, RunError> {
         Some(dt) => dt,
         None => l.dt_fraction.unwrap_or(0.5) * stable,
     };
-    let load = s.loading.clone().unwrap_or_default();
+    let load = own(ls).loading.clone().unwrap_or_default();
     let (mut top, mut bottom) = (Vec::new(), Vec::new());
     if let Some(pl) = load.platens {
         let d = solid.disks();
@@ -810,4 +814,47 @@ impl Model for LsmModel<'_> {
             ..WallSeconds::default()
         }
     }
+}
+
+/// The model `lsm` in the registry ([`crate::MODELS`]).
+pub struct LsmKind;
+
+/// The registry's value of the model.
+pub static KIND: LsmKind = LsmKind;
+
+impl ModelKind for LsmKind {
+    fn name(&self) -> &'static str {
+        "lsm"
+    }
+    fn sections(&self) -> &'static [&'static str] {
+        &["bonds", "contacts", "lsm", "loading", "injection"]
+    }
+    fn reads(&self) -> &'static [&'static str] {
+        &["particles", "lbm", "thermal"]
+    }
+    fn sections_of(
+        &self,
+        doc: toml::Spanned<toml::de::DeTable<'_>>,
+    ) -> Result<std::sync::Arc<dyn OwnSections>, toml::de::Error> {
+        own_sections::<file::LsmSections>(doc)
+    }
+    fn check(&self, ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
+        let _ = laws;
+        check::check(ls)
+    }
+    fn run(
+        &self,
+        ls: &LoadedScene,
+        laws: &LawRegistry,
+        out: &Path,
+        observer: &mut dyn Observer,
+    ) -> Result<Summary, RunError> {
+        let _ = laws;
+        run(ls, out, observer)
+    }
+}
+
+/// The model's own sections of a checked scene.
+pub(crate) fn own(ls: &LoadedScene) -> &file::LsmSections {
+    ls.own::<file::LsmSections>()
 }

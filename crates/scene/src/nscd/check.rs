@@ -7,14 +7,6 @@ use crate::common::sections::KeyPart;
 
 use super::file::WallComponent;
 
-/// Top-level sections of the NSCD model.
-pub const SECTIONS: [&str; 4] = ["particles", "wall", "contact", "nscd"];
-/// Top-level sections every model reads.
-const SHARED: [&str; 4] = ["scene", "schedule", "output", "solver"];
-/// Top-level sections of the continuum model.
-const CONTINUUM: [&str; 10] = [
-    "grid", "region", "material", "fluid", "bc", "loads", "source", "well", "initial", "physics",
-];
 
 pub use crate::common::particle_output::PARTICLE_FIELDS;
 /// Fields of a tracked cell (`cell = { center, radius }` probes).
@@ -29,29 +21,8 @@ pub const CELL_FIELDS: [&str; 8] = [
     "broken_bonds",
 ];
 
-fn top_level(ls: &LoadedScene) -> Vec<String> {
-    toml::from_str::<toml::Table>(&ls.text)
-        .map(|t| t.keys().cloned().collect())
-        .unwrap_or_default()
-}
 
-/// Whether the scene text has the top-level section `name`.
-pub fn has_section(ls: &LoadedScene, name: &str) -> bool {
-    top_level(ls).iter().any(|s| s == name)
-}
 
-/// Refuse the NSCD sections in a scene of another `model`.
-pub fn refuse_sections(ls: &LoadedScene, model: &str) -> Result<(), SceneError> {
-    for key in top_level(ls) {
-        if SECTIONS.contains(&key.as_str()) {
-            return Err(ls.error(
-                &k(&[&key]),
-                format!("belongs to model \"nscd\", not \"{model}\""),
-            ));
-        }
-    }
-    Ok(())
-}
 
 fn finite(ls: &LoadedScene, key: &[KeyPart], v: f64) -> Result<(), SceneError> {
     if v.is_finite() {
@@ -82,17 +53,7 @@ pub use crate::common::particles::MAX_PARTICLES;
 /// Check an NSCD scene.
 pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
     let s = &ls.scene;
-    for key in top_level(ls) {
-        if SECTIONS.contains(&key.as_str()) || SHARED.contains(&key.as_str()) {
-            continue;
-        }
-        let msg = if CONTINUUM.contains(&key.as_str()) {
-            "belongs to model \"continuum\", not \"nscd\"".to_string()
-        } else {
-            "belongs to another model, not \"nscd\"".to_string()
-        };
-        return Err(ls.error(&k(&[&key]), msg));
-    }
+    crate::common::lattice::check::refuse_obstacle_probes(ls, "nscd")?;
     if s.scene.dim != 2 {
         return Err(ls.error(
             &k(&["scene", "dim"]),
@@ -139,7 +100,7 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
     }
     crate::common::particles::check(ls, "nscd")?;
     check_walls(ls)?;
-    if let Some(c) = &s.contact {
+    if let Some(c) = &super::own(ls).contact {
         let key = |f: &str| k(&["contact", f]);
         for (f, v) in [
             ("mu", c.mu),
@@ -152,7 +113,7 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
             }
         }
     }
-    if let Some(n) = &s.nscd {
+    if let Some(n) = &super::own(ls).nscd {
         let key = |f: &str| k(&["nscd", f]);
         if let Some(t) = n.theta
             && !(0.5..=1.0).contains(&t)
@@ -245,7 +206,7 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
 }
 
 fn check_walls(ls: &LoadedScene) -> Result<(), SceneError> {
-    for (i, w) in ls.scene.wall.iter().enumerate() {
+    for (i, w) in super::own(ls).wall.iter().enumerate() {
         let key = |f: &str| ki("wall", i, &[f]);
         match (&w.from, &w.to, &w.polygon) {
             (Some(a), Some(b), None) => {

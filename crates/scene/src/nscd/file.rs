@@ -122,3 +122,16 @@ pub struct FaultSection {
     /// Band height of the limit-angle measure (m, default 4 × the largest radius).
     pub band: Option<f64>,
 }
+
+/// The sections of model `nscd` read by the model itself: `[[wall]]`, `[contact]`,
+/// `[nscd]` (`[particles]` is shared with model `lsm`).
+#[derive(Clone, Debug, Default, Deserialize)]
+pub struct NscdSections {
+    /// `[[wall]]`: rigid bodies.
+    #[serde(default)]
+    pub wall: Vec<WallSection>,
+    /// `[contact]`: the contact law.
+    pub contact: Option<ContactSection>,
+    /// `[nscd]`: the solver.
+    pub nscd: Option<NscdSection>,
+}

@@ -19,6 +19,11 @@ pub mod check;
 pub mod fault;
 pub mod file;
 
+use crate::common::laws::LawRegistry;
+use crate::common::loaded::SceneError;
+use crate::common::model::ModelKind;
+use crate::common::model::{OwnSections, own_sections};
+
 use std::cell::RefCell;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -108,7 +113,7 @@ fn scene_error(ls: &LoadedScene, e: &NscdError) -> RunError {
 }
 
 fn walls(ls: &LoadedScene) -> Vec<RigidBody> {
-    ls.scene
+    own(ls)
         .wall
         .iter()
         .map(|w| {
@@ -136,7 +141,7 @@ fn walls(ls: &LoadedScene) -> Vec<RigidBody> {
 pub fn build(ls: &LoadedScene) -> Result<NscdModel<'_>, RunError> {
     let s = &ls.scene;
     let disks = crate::common::particles::generate(ls)?;
-    let c = s.contact.clone().unwrap_or_default();
+    let c = own(ls).contact.clone().unwrap_or_default();
     let mu = c.mu.unwrap_or(0.0);
     let law = ContactLaw {
         mu_static: c.mu_static.unwrap_or(mu),
@@ -144,7 +149,7 @@ pub fn build(ls: &LoadedScene) -> Result<NscdModel<'_>, RunError> {
         cohesion: c.cohesion.unwrap_or(0.0),
         cohesion_distance: c.d_w.unwrap_or(0.0),
     };
-    let n = s.nscd.clone().unwrap_or_default();
+    let n = own(ls).nscd.clone().unwrap_or_default();
     let defaults = SolverParams::default();
     let params = SolverParams {
         theta: n.theta.unwrap_or(defaults.theta),
@@ -468,4 +473,44 @@ impl Model for NscdModel<'_> {
             ..WallSeconds::default()
         }
     }
+}
+
+/// The model `nscd` in the registry ([`crate::MODELS`]).
+pub struct NscdKind;
+
+/// The registry's value of the model.
+pub static KIND: NscdKind = NscdKind;
+
+impl ModelKind for NscdKind {
+    fn name(&self) -> &'static str {
+        "nscd"
+    }
+    fn sections(&self) -> &'static [&'static str] {
+        &["particles", "wall", "contact", "nscd"]
+    }
+    fn sections_of(
+        &self,
+        doc: toml::Spanned<toml::de::DeTable<'_>>,
+    ) -> Result<std::sync::Arc<dyn OwnSections>, toml::de::Error> {
+        own_sections::<file::NscdSections>(doc)
+    }
+    fn check(&self, ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
+        let _ = laws;
+        check::check(ls)
+    }
+    fn run(
+        &self,
+        ls: &LoadedScene,
+        laws: &LawRegistry,
+        out: &Path,
+        observer: &mut dyn Observer,
+    ) -> Result<Summary, RunError> {
+        let _ = laws;
+        run(ls, out, observer)
+    }
+}
+
+/// The model's own sections of a checked scene.
+pub(crate) fn own(ls: &LoadedScene) -> &file::NscdSections {
+    ls.own::<file::NscdSections>()
 }
