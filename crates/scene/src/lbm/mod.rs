@@ -665,6 +665,10 @@ impl ModelKind for LbmKind {
     fn sections(&self) -> &'static [&'static str] {
         &["lbm", "obstacle", "thermal"]
     }
+    fn reads(&self) -> &'static [&'static str] {
+        // Refused by `refuse` when they hold a key of the continuum model.
+        &["material", "physics"]
+    }
     fn refused_as(&self, section: &str) -> Vec<KeyPart> {
         if section == "obstacle" {
             ki("obstacle", 0, &[])
