@@ -14,14 +14,19 @@
 //!
 //! # Shape
 //!
-//! A scene names its model (`[scene] model`, default `"continuum"`). Every model is one
-//! module of the same shape: its section of the file is parsed into typed values
-//! ([`mod@file`]) and validated ([`mod@check`]); it *builds* its state from them, *steps* from
-//! one output time to the next, and offers *fields* to the shared outputs
-//! ([`model::Model`]). The loop that writes `probes.csv`, `lines/`, VTK and
-//! `summary.json`, reports progress and honours interruption ([`driver`]) is the same
-//! for every model. Cell laws are chosen by name through one [`laws::LawRegistry`], to
-//! which a user adds their own laws.
+//! The crate is a registry of models. [`common`] holds what every model shares: the
+//! loaded scene, its errors with the lines of the parser's spans ([`common::loaded`]),
+//! the shared sections ([`common::sections`]), the [`model::Model`] trait and the loop
+//! that drives it ([`driver`]: `probes.csv`, `lines/`, VTK, `summary.json`, progress and
+//! interruption), outputs, plots, limits, expressions and cell laws
+//! ([`laws::LawRegistry`], to which a user adds their own), and what two models share
+//! (particles, the lattice, the grid builder). Each model is one folder ([`continuum`],
+//! [`cosserat`], [`lbm`], [`lsm`], [`nscd`]) holding its own sections, checks, build and
+//! [`model::Model`] implementation, importing [`common`] only; it exposes one
+//! [`model::ModelKind`] value, and [`MODELS`] lists them. `[scene] model` (default
+//! `"continuum"`) is looked up there; the file is parsed once, and a section of one model
+//! in another model's scene is refused by name from the sections each model declares.
+//! `docs/ADDING_A_MODEL.md` shows how a model is added.
 //!
 //! # Hostile input
 //!

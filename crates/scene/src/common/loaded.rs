@@ -81,7 +81,8 @@ impl LoadedScene {
     /// (a model asks for its own type only).
     pub fn own<T: OwnSections>(&self) -> &T {
         let own: &dyn std::any::Any = self.own.as_deref().expect("the model's sections are read");
-        own.downcast_ref::<T>().expect("a model reads its own sections")
+        own.downcast_ref::<T>()
+            .expect("a model reads its own sections")
     }
     /// The top-level keys of the file, in the parser's order.
     pub fn top_level(&self) -> &[String] {
@@ -248,7 +249,10 @@ pub fn parse(
             return Err(SceneError {
                 file: path.to_path_buf(),
                 line: lines.line(&[KeyPart::Key(key.clone())]),
-                message: format!("unknown field `{key}`, expected one of {}", known.join(", ")),
+                message: format!(
+                    "unknown field `{key}`, expected one of {}",
+                    known.join(", ")
+                ),
             });
         }
     }
@@ -344,7 +348,12 @@ pub(crate) fn positive(ls: &LoadedScene, path: &[KeyPart], v: f64) -> Result<(),
 }
 
 /// A vector has as many components as the scene has dimensions.
-pub(crate) fn len_is(ls: &LoadedScene, path: &[KeyPart], got: usize, want: usize) -> Result<(), SceneError> {
+pub(crate) fn len_is(
+    ls: &LoadedScene,
+    path: &[KeyPart],
+    got: usize,
+    want: usize,
+) -> Result<(), SceneError> {
     if got != want {
         return Err(ls.error(path, format!("has {got} components, the scene is {want}D")));
     }
@@ -452,8 +461,7 @@ pub fn check(
     kind.refuse(ls)?;
     for key in ls.top_level() {
         let key = key.as_str();
-        if ALWAYS.contains(&key) || kind.sections().contains(&key) || kind.reads().contains(&key)
-        {
+        if ALWAYS.contains(&key) || kind.sections().contains(&key) || kind.reads().contains(&key) {
             continue;
         }
         let owner = models.iter().find(|m| m.sections().contains(&key));

@@ -16,8 +16,8 @@ use porofrac_sim::SimError;
 use crate::common::driver::Observer;
 use crate::common::laws::LawRegistry;
 use crate::common::loaded::{LoadedScene, SceneError, k};
-use crate::common::sections::KeyPart;
 use crate::common::output::{OutputError, SolverStats, Summary, WallSeconds};
+use crate::common::sections::KeyPart;
 
 /// Anything that ends a run.
 #[derive(Debug, thiserror::Error)]

@@ -4,11 +4,11 @@
 
 use crate::common::laws::LawRegistry;
 use crate::common::loaded::{
-    LoadedScene, SceneError, expr_ok, k, ki, len_is, line_points_and_name, positive,
-    step_count_f64,
+    LoadedScene, SceneError, expr_ok, k, ki, len_is, line_points_and_name, positive, step_count_f64,
 };
 use crate::common::sections::{
-    Bc, DiagonalsChoice, CellCount, Component, GridKind, KeyPart, LinearChoice, Permeability, Select,
+    Bc, CellCount, Component, DiagonalsChoice, GridKind, KeyPart, LinearChoice, Permeability,
+    Select,
 };
 use porofrac_grid::Point;
 use porofrac_grid::generate::RoundWellSpec;
@@ -753,4 +753,3 @@ fn refuse_cosserat_keys(ls: &LoadedScene) -> Result<(), SceneError> {
     }
     Ok(())
 }
-

@@ -321,7 +321,7 @@ mod tests {
              select = {{ all = true }}\nlaw = \"mdem\"\nmaterial = \"m\"\n[material.m]\n\
              youngs_modulus = 1.0e9\npoisson_ratio = 0.3\n"
         );
-        crate::common::loaded::parse(&text, std::path::Path::new("s.toml")).unwrap()
+        crate::common::loaded::parse(&text, std::path::Path::new("s.toml"), crate::MODELS).unwrap()
     }
 
     #[test]

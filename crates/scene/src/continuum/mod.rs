@@ -877,7 +877,10 @@ impl ModelKind for ContinuumKind {
         "continuum"
     }
     fn sections(&self) -> &'static [&'static str] {
-        &["grid", "region", "material", "fluid", "bc", "loads", "source", "well", "initial", "physics"]
+        &[
+            "grid", "region", "material", "fluid", "bc", "loads", "source", "well", "initial",
+            "physics",
+        ]
     }
     fn check(&self, ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
         check::check(ls, laws)

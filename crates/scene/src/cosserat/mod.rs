@@ -577,7 +577,10 @@ impl ModelKind for CosseratKind {
         &[]
     }
     fn reads(&self) -> &'static [&'static str] {
-        &["grid", "region", "material", "fluid", "bc", "loads", "source", "well", "initial", "physics"]
+        &[
+            "grid", "region", "material", "fluid", "bc", "loads", "source", "well", "initial",
+            "physics",
+        ]
     }
     fn check(&self, ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
         let _ = laws;

@@ -15,7 +15,6 @@ pub const FIELDS: [&str; 5] = ["vx", "vy", "pressure", "density", "temperature"]
 /// Obstacle probe fields.
 pub const OBSTACLE_FIELDS: [&str; 3] = ["fx", "fy", "torque"];
 
-
 /// Check a scene with `[scene] model = "lbm"`.
 pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
     let s = &ls.scene;

@@ -8,7 +8,6 @@ use porofrac_lsm::{BondLaw, LsmError};
 
 use super::file::{DampingChoice, NormalChoice};
 
-
 /// Fields of a tracked cell.
 pub const CELL_FIELDS: [&str; 8] = [
     "p",
@@ -87,8 +86,6 @@ fn check_fluid_probes(ls: &LoadedScene) -> Result<Option<LoadedScene>, SceneErro
     }
     Ok(out)
 }
-
-
 
 /// The key path of a library parameter name such as `bonds.kn`.
 pub fn key_of(name: &str) -> Vec<KeyPart> {

@@ -73,7 +73,11 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
                 return Err(ls.error(&k(&[name]), "needs [lbm]: the fluid that carries it"));
             }
         }
-        if super::own(ls).lsm.as_ref().is_some_and(|l| l.seal_bonds.is_some()) {
+        if super::own(ls)
+            .lsm
+            .as_ref()
+            .is_some_and(|l| l.seal_bonds.is_some())
+        {
             return Err(ls.error(
                 &k(&["lsm", "seal_bonds"]),
                 "needs [lbm]: it sets what the fluid sees",
@@ -159,7 +163,8 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
         {
             return Err(ls.error(&key("gain"), format!("= {g} must be in (0, 1]")));
         }
-        if super::own(ls).loading
+        if super::own(ls)
+            .loading
             .as_ref()
             .is_some_and(|l| l.pressure_rate.is_some())
         {
@@ -220,8 +225,14 @@ impl Fluid {
                 .and_then(|t| t.heat_capacity)
                 .unwrap_or(CouplingOptions::default().heat_capacity),
             loads: LoadAveraging::TwoSteps,
-            fluid_radius_factor: if super::own(ls).lsm.as_ref().and_then(|l| l.seal_bonds) == Some(true) {
-                1.0 + super::own(ls).bonds.as_ref().and_then(|b| b.tolerance).unwrap_or(0.05)
+            fluid_radius_factor: if super::own(ls).lsm.as_ref().and_then(|l| l.seal_bonds)
+                == Some(true)
+            {
+                1.0 + super::own(ls)
+                    .bonds
+                    .as_ref()
+                    .and_then(|b| b.tolerance)
+                    .unwrap_or(0.05)
             } else {
                 1.0
             },

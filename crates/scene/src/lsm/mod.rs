@@ -117,7 +117,11 @@ pub struct LsmModel<'a> {
 fn spec_of(ls: &LoadedScene) -> Result<LsmSpec, SceneError> {
     let law = check::bond_law(ls)?;
     let mut spec = LsmSpec::new(law);
-    spec.bond_tolerance = own(ls).bonds.as_ref().and_then(|b| b.tolerance).unwrap_or(0.05);
+    spec.bond_tolerance = own(ls)
+        .bonds
+        .as_ref()
+        .and_then(|b| b.tolerance)
+        .unwrap_or(0.05);
     let c = own(ls).contacts.clone().unwrap_or_default();
     spec.contacts = ContactLaw {
         normal: match c.normal {

@@ -7,7 +7,6 @@ use crate::common::sections::KeyPart;
 
 use super::file::WallComponent;
 
-
 pub use crate::common::particle_output::PARTICLE_FIELDS;
 /// Fields of a tracked cell (`cell = { center, radius }` probes).
 pub const CELL_FIELDS: [&str; 8] = [
@@ -20,9 +19,6 @@ pub const CELL_FIELDS: [&str; 8] = [
     "contacts",
     "broken_bonds",
 ];
-
-
-
 
 fn finite(ls: &LoadedScene, key: &[KeyPart], v: f64) -> Result<(), SceneError> {
     if v.is_finite() {

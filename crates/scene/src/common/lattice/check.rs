@@ -273,7 +273,13 @@ pub(crate) fn check_thermal(
 
 /// In a scene of `model` without a lattice: probes of an obstacle are refused.
 pub fn refuse_obstacle_probes(ls: &LoadedScene, model: &str) -> Result<(), SceneError> {
-    match ls.scene.output.probe.iter().position(|p| p.obstacle.is_some()) {
+    match ls
+        .scene
+        .output
+        .probe
+        .iter()
+        .position(|p| p.obstacle.is_some())
+    {
         Some(i) => Err(ls.error(
             &ki("output.probe", i, &["obstacle"]),
             format!("belongs to model \"lbm\", not \"{model}\""),
