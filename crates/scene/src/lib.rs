@@ -14,14 +14,19 @@
 //!
 //! # Shape
 //!
-//! A scene names its model (`[scene] model`, default `"continuum"`). Every model is one
-//! module of the same shape: its section of the file is parsed into typed values
-//! ([`mod@file`]) and validated ([`mod@check`]); it *builds* its state from them, *steps* from
-//! one output time to the next, and offers *fields* to the shared outputs
-//! ([`model::Model`]). The loop that writes `probes.csv`, `lines/`, VTK and
-//! `summary.json`, reports progress and honours interruption ([`driver`]) is the same
-//! for every model. Cell laws are chosen by name through one [`laws::LawRegistry`], to
-//! which a user adds their own laws.
+//! The crate is a registry of models. [`common`] holds what every model shares: the
+//! loaded scene, its errors with the lines of the parser's spans ([`common::loaded`]),
+//! the shared sections ([`common::sections`]), the [`model::Model`] trait and the loop
+//! that drives it ([`driver`]: `probes.csv`, `lines/`, VTK, `summary.json`, progress and
+//! interruption), outputs, plots, limits, expressions and cell laws
+//! ([`laws::LawRegistry`], to which a user adds their own), and what two models share
+//! (particles, the lattice, the grid builder). Each model is one folder ([`continuum`],
+//! [`cosserat`], [`lbm`], [`lsm`], [`nscd`]) holding its own sections, checks, build and
+//! [`model::Model`] implementation, importing [`common`] only; it exposes one
+//! [`model::ModelKind`] value, and [`MODELS`] lists them. `[scene] model` (default
+//! `"continuum"`) is looked up there; the file is parsed once, and a section of one model
+//! in another model's scene is refused by name from the sections each model declares.
+//! `docs/ADDING_A_MODEL.md` shows how a model is added.
 //!
 //! # Hostile input
 //!
@@ -29,33 +34,34 @@
 //! expressions nest at most [`expr::MAX_NESTING`] deep, and the number of steps, cells
 //! and unknowns a scene asks for is bounded by what the machine has ([`limits`]).
 
-pub mod check;
+pub mod common;
 pub mod continuum;
 pub mod cosserat;
-pub mod driver;
-pub mod expr;
-pub mod file;
-pub mod laws;
 pub mod lbm;
-pub mod limits;
 pub mod lsm;
-pub mod model;
 pub mod nscd;
-pub mod output;
-pub mod particle_output;
-pub mod particles;
-pub mod plots;
-pub mod sample;
 
 use std::path::{Path, PathBuf};
 
-pub use check::SceneError;
-pub use driver::{Observer, Silent, StepReport};
-pub use laws::LawRegistry;
-pub use model::RunError;
-pub use output::Summary;
+pub use common::driver::{Observer, Silent, StepReport};
+pub use common::laws::{self, LawRegistry};
+pub use common::loaded::SceneError;
+pub use common::model::RunError;
+pub use common::output::Summary;
+pub use common::{driver, expr, limits, model, output};
 
-use check::LoadedScene;
+use common::loaded::{self as check, LoadedScene};
+use common::model::ModelKind;
+
+/// The models of the registry: `[scene] model` is looked up here. A new model is one
+/// folder (its sections, checks, build and [`model::Model`]) and one line here.
+pub static MODELS: &[&'static dyn ModelKind] = &[
+    &continuum::KIND,
+    &nscd::KIND,
+    &lbm::KIND,
+    &cosserat::KIND,
+    &lsm::KIND,
+];
 
 /// A scene file read and validated: every key known, every value checked, every
 /// expression compiled once.
@@ -74,21 +80,21 @@ impl Scene {
     /// Read, parse and validate a scene file whose regions may use the laws of `laws`
     /// (the built-in ones and the user's, [`LawRegistry::register`]).
     pub fn load_with(path: &Path, laws: LawRegistry) -> Result<Self, SceneError> {
-        let loaded = check::load(path)?;
-        check::check(&loaded, &laws)?;
+        let loaded = check::load(path, MODELS)?;
+        check::check(&loaded, &laws, MODELS)?;
         Ok(Self { loaded, laws })
     }
 
     /// Parse and validate scene text; `path` names it in errors and anchors relative
     /// paths (mesh files).
     pub fn parse(text: &str, path: &Path, laws: LawRegistry) -> Result<Self, SceneError> {
-        let loaded = check::parse(text, path)?;
-        check::check(&loaded, &laws)?;
+        let loaded = check::parse(text, path, MODELS)?;
+        check::check(&loaded, &laws, MODELS)?;
         Ok(Self { loaded, laws })
     }
 
     /// The typed content of the file.
-    pub fn file(&self) -> &file::SceneFile {
+    pub fn file(&self) -> &common::sections::SceneFile {
         &self.loaded.scene
     }
 
@@ -114,7 +120,7 @@ impl Scene {
     /// complete files and `"status": "interrupted at t = …"` ([`Summary::interrupted`]).
     pub fn run(&self, out: &Path, observer: &mut dyn Observer) -> Result<Summary, RunError> {
         let start = std::time::Instant::now();
-        let result = model::run(&self.loaded, &self.laws, out, observer);
+        let result = common::model::run(&self.loaded, &self.laws, out, observer);
         if let Err(e) = &result {
             output::write_failed_summary(&self.loaded, out, &e.to_string(), start);
         }

@@ -10,12 +10,12 @@ use porofrac_grid::Grid;
 use porofrac_law::{CellLaw, Stiffness};
 use porofrac_sim::{Displacement, Gravity, Loads, Platen, Traction};
 
-use crate::check::{LoadedScene, k, ki};
-use crate::file::{Material, Plane};
-use crate::laws::{LawRegistry, PostFailure};
-use crate::model::RunError;
+use crate::common::laws::{LawRegistry, PostFailure};
+use crate::common::loaded::{LoadedScene, k, ki};
+use crate::common::model::RunError;
+use crate::common::sections::{Material, Plane};
 
-use super::grid::{DeckCells, point, select_cells};
+use crate::common::grid::{DeckCells, point, select_cells};
 
 /// The stiffness of a material in the scene's setting (3D, 2D plane strain or plane
 /// stress).
@@ -254,7 +254,7 @@ pub fn conditions<const D: usize>(
     }
     if let Some(l) = &s.loads {
         if let Some(b) = &l.body_force {
-            out.loads.body_force = Some(crate::file::vector_field::<D>(b));
+            out.loads.body_force = Some(crate::common::sections::vector_field::<D>(b));
         }
         if let Some(g) = &l.gravity {
             let mut density = vec![0.0; grid.num_cells()];
@@ -321,7 +321,7 @@ mod tests {
              select = {{ all = true }}\nlaw = \"mdem\"\nmaterial = \"m\"\n[material.m]\n\
              youngs_modulus = 1.0e9\npoisson_ratio = 0.3\n"
         );
-        crate::check::parse(&text, std::path::Path::new("s.toml")).unwrap()
+        crate::common::loaded::parse(&text, std::path::Path::new("s.toml"), crate::MODELS).unwrap()
     }
 
     #[test]

@@ -6,13 +6,13 @@ use porofrac_flow::{
 };
 use porofrac_grid::Grid;
 
-use crate::check::{LoadedScene, k, ki};
-use crate::file::Permeability as ScenePerm;
-use crate::model::RunError;
-use crate::sample::locate;
+use crate::common::loaded::{LoadedScene, k, ki};
+use crate::common::model::RunError;
+use crate::common::sample::locate;
+use crate::common::sections::Permeability as ScenePerm;
 
 use super::compose::boundary_faces;
-use super::grid::{DeckCells, point, select_cells};
+use crate::common::grid::{DeckCells, point, select_cells};
 
 /// Flow model, initial pressure per cell and Biot coefficient per cell.
 pub struct FlowSetup<const D: usize> {

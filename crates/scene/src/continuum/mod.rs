@@ -12,11 +12,14 @@
 //! - *fields*: displacement, stress, principal stresses, pressure and the failure flag
 //!   ([`fields`]) for probes, lines, VTK and `field_extrema`, and the plots ([`plots`]).
 
+pub mod check;
 pub mod compose;
 pub mod fields;
 pub mod flow;
-pub mod grid;
 pub mod plots;
+
+use crate::common::loaded::SceneError;
+use crate::common::model::ModelKind;
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -33,20 +36,20 @@ use porofrac_sim::{
     StressMeasure, cell_stresses, drained_bulk_modulus, solve_explicit, solve_static,
 };
 
-use crate::check::{LoadedScene, k, ki};
-use crate::driver::{Observer, drive};
-use crate::file::{
+use crate::common::driver::{Observer, drive};
+use crate::common::laws::LawRegistry;
+use crate::common::loaded::{LoadedScene, k, ki};
+use crate::common::model::{Model, RunError, Sizes, StepStats};
+use crate::common::output::{CsvTable, SolverStats, Summary, WallSeconds};
+use crate::common::sample::{Location, locate};
+use crate::common::sections::{
     CouplingChoice, FailureStress, InitialMechanics, LinearChoice, MechanicsSolver, Plane,
 };
-use crate::laws::LawRegistry;
-use crate::model::{Model, RunError, Sizes, StepStats};
-use crate::output::{CsvTable, SolverStats, Summary, WallSeconds};
-use crate::sample::{Location, locate};
 
+use crate::common::grid::{AnyGrid, DeckCells, build_grid, point};
 use compose::{Composition, compose, conditions, material_stiffness};
 use fields::Field;
 use flow::{FlowSetup, flow_setup};
-use grid::{AnyGrid, DeckCells, build_grid, point};
 
 /// Run a checked continuum scene.
 pub(crate) fn run(
@@ -78,8 +81,8 @@ fn run_dim<const D: usize>(
     // Mesh files are counted only once read: bound the run before assembling it.
     let flow_on = ls.scene.physics.flow == Some(true);
     let unknowns = (D * grid.num_nodes() + if flow_on { grid.num_cells() } else { 0 }) as f64;
-    crate::limits::fits_in_memory(
-        crate::limits::run_bytes(grid.num_cells() as f64, unknowns),
+    crate::common::limits::fits_in_memory(
+        crate::common::limits::run_bytes(grid.num_cells() as f64, unknowns),
         &format!(
             "the grid has {} cells and {} unknowns",
             grid.num_cells(),
@@ -161,7 +164,8 @@ fn check_supported(ls: &LoadedScene) -> Result<(), RunError> {
 fn output_times(ls: &LoadedScene) -> Vec<f64> {
     let mut t = vec![0.0];
     if let Some(sch) = &ls.scene.schedule {
-        let n = crate::check::step_count(sch).min(crate::limits::MAX_STEPS) as usize;
+        let n =
+            crate::common::loaded::step_count(sch).min(crate::common::limits::MAX_STEPS) as usize;
         let dt = sch.dt.unwrap_or(sch.end_time / n as f64);
         t.reserve(n);
         for k in 1..=n {
@@ -710,7 +714,7 @@ impl<const D: usize> Model for Stepper<'_, D> {
             return Ok(out);
         };
         let t = self.times.get(self.done).copied().unwrap_or(0.0);
-        let exact = crate::file::vector_field::<D>(exact);
+        let exact = crate::common::sections::vector_field::<D>(exact);
         let l2 = porofrac_sim::norms::l2_error_p1_field(self.body.grid, &self.u, &exact, t)
             .ok_or_else(|| {
                 self.ls.error(
@@ -827,7 +831,7 @@ fn locate_outputs<const D: usize>(
 ) -> Result<(Vec<(Field, Location)>, Vec<(Field, LinePoints<D>)>), RunError> {
     let s = &ls.scene;
     let flow = s.physics.flow == Some(true);
-    let field = |name: &str, key: Vec<crate::file::KeyPart>| {
+    let field = |name: &str, key: Vec<crate::common::sections::KeyPart>| {
         Field::parse(name, D, flow).map_err(|e| RunError::from(ls.error(&key, e)))
     };
     let mut probes = Vec::new();
@@ -860,4 +864,34 @@ fn locate_outputs<const D: usize>(
         lines.push((f, pts));
     }
     Ok((probes, lines))
+}
+
+/// The model `continuum` in the registry ([`crate::MODELS`]).
+pub struct ContinuumKind;
+
+/// The registry's value of the model.
+pub static KIND: ContinuumKind = ContinuumKind;
+
+impl ModelKind for ContinuumKind {
+    fn name(&self) -> &'static str {
+        "continuum"
+    }
+    fn sections(&self) -> &'static [&'static str] {
+        &[
+            "grid", "region", "material", "fluid", "bc", "loads", "source", "well", "initial",
+            "physics",
+        ]
+    }
+    fn check(&self, ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
+        check::check(ls, laws)
+    }
+    fn run(
+        &self,
+        ls: &LoadedScene,
+        laws: &LawRegistry,
+        out: &Path,
+        observer: &mut dyn Observer,
+    ) -> Result<Summary, RunError> {
+        run(ls, laws, out, observer)
+    }
 }

@@ -9,8 +9,8 @@ use porofrac_frac::recovery::{NodeCells, recover_nodal};
 use porofrac_grid::{Grid, Point};
 use porofrac_law::{Tensor, principal};
 
-use crate::check::LoadedScene;
-use crate::model::RunError;
+use crate::common::loaded::LoadedScene;
+use crate::common::model::RunError;
 
 /// What the end-of-run plots show: the probe series at the written times, the last
 /// displacement and cell stresses, the failures and the pressure.
@@ -54,7 +54,7 @@ pub(crate) fn write_plots<const D: usize>(
         .zip(series.iter().cloned())
         .collect();
     if !columns.is_empty() {
-        crate::plots::time_series(
+        crate::common::plots::time_series(
             &dir.join("probes.png"),
             written_times,
             &columns,
@@ -65,12 +65,12 @@ pub(crate) fn write_plots<const D: usize>(
         // 2D: the grid; 3D: its cross-section at mid-height (shifted off a layer of
         // nodes by 1e-4 of the height, so extruded grids are cut inside a layer).
         let (canvas, where_) = match (as_2d(grid), as_3d(grid)) {
-            (Some(g2), _) => (crate::plots::Canvas::of_grid(g2), String::new()),
+            (Some(g2), _) => (crate::common::plots::Canvas::of_grid(g2), String::new()),
             (_, Some(g3)) => {
                 let (lo, hi) = g3.bounding_box();
                 let z = lo[2] + (0.5 + 1e-4) * (hi[2] - lo[2]);
                 (
-                    crate::plots::Canvas::z_slice(g3, z),
+                    crate::common::plots::Canvas::z_slice(g3, z),
                     format!(" on z = {:.4}", 0.5 * (lo[2] + hi[2])),
                 )
             }
@@ -113,10 +113,10 @@ pub(crate) fn write_plots<const D: usize>(
         let t_last = written_times.last().copied().unwrap_or(0.0);
         for (name, vals) in &plots {
             let title = format!("{name} at t = {t_last} s{where_}");
-            crate::plots::field(
+            crate::common::plots::field(
                 &dir.join(format!("{name}.png")),
-                &crate::plots::FieldPlot::new(&canvas, &title, &marked),
-                crate::plots::Values::Cell(vals),
+                &crate::common::plots::FieldPlot::new(&canvas, &title, &marked),
+                crate::common::plots::Values::Cell(vals),
             )?;
         }
         if let (Some(g2), true) = (as_2d(grid), failures.count() > 0) {
@@ -192,7 +192,7 @@ fn window_around(grid: &Grid<2>, pts: &[Point<2>], pad: f64) -> ([f64; 2], [f64;
 fn fracture_plots(
     dir: &Path,
     grid: &Grid<2>,
-    canvas: &crate::plots::Canvas,
+    canvas: &crate::common::plots::Canvas,
     plots: &[(&str, Vec<f64>)],
     stress: &[Tensor<2>],
     marked: &[bool],
@@ -207,17 +207,17 @@ fn fracture_plots(
         stress.iter().map(principal_directions).unzip();
     for (name, vals) in plots {
         let title = format!("{name} at t = {t} s, near the fracture");
-        let mut plot = crate::plots::FieldPlot::new(canvas, &title, marked);
+        let mut plot = crate::common::plots::FieldPlot::new(canvas, &title, marked);
         plot.window = Some(window);
         plot.directions = match *name {
             "smax" => Some(&dmax),
             "smin" => Some(&dmin),
             _ => None,
         };
-        crate::plots::field(
+        crate::common::plots::field(
             &dir.join(format!("{name}.png")),
             &plot,
-            crate::plots::Values::Cell(vals),
+            crate::common::plots::Values::Cell(vals),
         )?;
     }
     // Fig. 5: cell stress against recovered stress at the tip.
@@ -233,17 +233,17 @@ fn fracture_plots(
         (
             "tip_smax_cell.png",
             format!("smax of the cells near the tip, t = {t} s"),
-            crate::plots::Values::Cell(&smax_cell),
+            crate::common::plots::Values::Cell(&smax_cell),
         ),
         (
             "tip_smax_recovered.png",
             format!("smax recovered (ZZ patch) near the tip, t = {t} s"),
-            crate::plots::Values::Nodal(&smax_nodal),
+            crate::common::plots::Values::Nodal(&smax_nodal),
         ),
     ] {
-        let mut plot = crate::plots::FieldPlot::new(canvas, &title, marked);
+        let mut plot = crate::common::plots::FieldPlot::new(canvas, &title, marked);
         plot.window = Some(tip_window);
-        crate::plots::field(&dir.join(file), &plot, values)?;
+        crate::common::plots::field(&dir.join(file), &plot, values)?;
     }
     Ok(())
 }

@@ -1,11 +1,13 @@
 //! Checks of a `model = "cosserat"` scene (SCENE-MODELS.md, "Cosserat media"), and the
 //! refusal of the Cosserat keys in continuum scenes. Every problem names its key.
 
-use crate::check::{LoadedScene, SceneError, expr_ok, k, ki};
-use crate::file::{DiagonalsChoice, GridKind, KeyPart, LinearChoice, NumOrExpr, Select};
+use crate::common::loaded::{LoadedScene, SceneError, expr_ok, k, ki};
+use crate::common::sections::{
+    DiagonalsChoice, GridKind, KeyPart, LinearChoice, NumOrExpr, Select,
+};
 
 use super::fields::Field;
-use super::keys::PerRotation;
+use crate::common::rotation_keys::PerRotation;
 
 /// The only law of the model.
 pub const LAW: &str = "cosserat-dem";
@@ -19,58 +21,6 @@ fn other_model(ls: &LoadedScene, path: &[KeyPart], model: &str) -> SceneError {
             model
         ),
     )
-}
-
-/// In a continuum scene: the Cosserat-only keys are errors naming key and model, and a
-/// missing `youngs_modulus` is reported as missing.
-pub fn refuse_in_continuum(ls: &LoadedScene) -> Result<(), SceneError> {
-    let s = &ls.scene;
-    let cos = |path: Vec<KeyPart>| {
-        ls.error(
-            &path,
-            format!(
-                "is a key of model \"cosserat\", the scene's model is \"{}\"",
-                ls.model()
-            ),
-        )
-    };
-    for (name, m) in &s.material {
-        for (key, set) in [
-            ("shear_modulus", m.shear_modulus.is_some()),
-            ("cosserat_shear_modulus", m.cosserat_shear_modulus.is_some()),
-            ("characteristic_length", m.characteristic_length.is_some()),
-            ("couple_moduli", m.couple_moduli.is_some()),
-            ("micro_inertia", m.micro_inertia.is_some()),
-        ] {
-            if set {
-                return Err(cos(k(&["material", name, key])));
-            }
-        }
-        if m.youngs_modulus.is_nan() {
-            return Err(ls.error(&k(&["material", name, "youngs_modulus"]), "is missing"));
-        }
-    }
-    for (i, bc) in s.bc.iter().enumerate() {
-        if bc.rotation.is_some() {
-            return Err(cos(ki("bc", i, &["rotation"])));
-        }
-        if bc.couple_traction.is_some() {
-            return Err(cos(ki("bc", i, &["couple_traction"])));
-        }
-    }
-    if s.loads.as_ref().is_some_and(|l| l.body_couple.is_some()) {
-        return Err(cos(k(&["loads", "body_couple"])));
-    }
-    if s.solver.penalty.is_some() {
-        return Err(cos(k(&["solver", "penalty"])));
-    }
-    if s.solver.time_integration.is_some() {
-        return Err(cos(k(&["solver", "time_integration"])));
-    }
-    if s.grid.diagonals == Some(DiagonalsChoice::Crossed) {
-        return Err(cos(k(&["grid", "diagonals"])));
-    }
-    Ok(())
 }
 
 fn positive(ls: &LoadedScene, path: &[KeyPart], v: f64) -> Result<(), SceneError> {
@@ -123,6 +73,7 @@ fn per_rotation(
 
 /// Check a cosserat scene.
 pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
+    crate::common::lattice::check::refuse_obstacle_probes(ls, "cosserat")?;
     let s = &ls.scene;
     let d = s.scene.dim as usize;
     let model = "cosserat";
@@ -330,7 +281,8 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
                 }
                 _ => return Err(ls.error(&k(&["schedule"]), "needs exactly one of dt and steps")),
             }
-            if crate::check::step_count_f64(sch) > crate::limits::MAX_STEPS as f64 {
+            if crate::common::loaded::step_count_f64(sch) > crate::common::limits::MAX_STEPS as f64
+            {
                 return Err(ls.error(&k(&["schedule"]), "asks for too many steps"));
             }
             let m = &s.material[name];
@@ -377,7 +329,7 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
         Field::parse(&l.field, d).map_err(|e| ls.error(&ki("output.line", i, &["field"]), e))?;
         len_is(ls, &ki("output.line", i, &["from"]), l.from.len(), d)?;
         len_is(ls, &ki("output.line", i, &["to"]), l.to.len(), d)?;
-        crate::check::line_points_and_name(ls, i, l)?;
+        crate::common::loaded::line_points_and_name(ls, i, l)?;
     }
     Ok(())
 }
@@ -439,7 +391,7 @@ fn check_grid(ls: &LoadedScene, d: usize) -> Result<(), SceneError> {
         }
     }
     match &g.cells {
-        Some(crate::file::CellCount::PerAxis(v)) => {
+        Some(crate::common::sections::CellCount::PerAxis(v)) => {
             len_is(ls, &key("cells"), v.len(), d)?;
             if v.iter().any(|&n| n < 1) {
                 return Err(ls.error(&key("cells"), format!("= {v:?} must all be ≥ 1")));

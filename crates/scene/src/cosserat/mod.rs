@@ -15,11 +15,14 @@
 
 pub mod check;
 pub mod fields;
-pub mod keys;
 pub mod vtk;
 
 #[cfg(test)]
 mod tests;
+
+use crate::common::laws::LawRegistry;
+use crate::common::loaded::SceneError;
+use crate::common::model::ModelKind;
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -34,16 +37,16 @@ use porofrac_cosserat::{
 use porofrac_grid::generate::perturb;
 use porofrac_grid::{Grid, Point};
 
-use crate::check::{LoadedScene, k, ki};
-use crate::continuum::grid::{AnyGrid, build_grid, point};
-use crate::driver::{Observer, drive};
-use crate::file::{DiagonalsChoice, GridKind, LinearChoice, NumOrExpr};
-use crate::model::{Model, RunError, Sizes, StepStats};
-use crate::output::{SolverStats, Summary, WallSeconds};
-use crate::plots::{Canvas, FieldPlot, Values};
+use crate::common::driver::{Observer, drive};
+use crate::common::grid::{AnyGrid, build_grid, point};
+use crate::common::loaded::{LoadedScene, k, ki};
+use crate::common::model::{Model, RunError, Sizes, StepStats};
+use crate::common::output::{SolverStats, Summary, WallSeconds};
+use crate::common::plots::{Canvas, FieldPlot, Values};
+use crate::common::sections::{DiagonalsChoice, GridKind, LinearChoice, NumOrExpr};
 
+use crate::common::rotation_keys::TimeIntegration;
 use fields::Field;
-use keys::TimeIntegration;
 
 /// Run a checked cosserat scene.
 pub(crate) fn run(
@@ -56,7 +59,7 @@ pub(crate) fn run(
     let grid = if g.kind == GridKind::Triangles && g.diagonals == Some(DiagonalsChoice::Crossed) {
         let ext = g.extent.clone().expect("checked");
         let n = match &g.cells {
-            Some(crate::file::CellCount::PerAxis(v)) => [v[0] as usize, v[1] as usize],
+            Some(crate::common::sections::CellCount::PerAxis(v)) => [v[0] as usize, v[1] as usize],
             _ => unreachable!("checked"),
         };
         let grid = porofrac_cosserat::mesh::crossed(point(&ext[0]), point(&ext[1]), n)
@@ -265,7 +268,7 @@ fn run_dim<const D: usize>(
         }
         Some(sch) => {
             // Uniform output steps (a dt that does not divide end_time is shortened).
-            let n = crate::check::step_count(sch) as usize;
+            let n = crate::common::loaded::step_count(sch) as usize;
             let dt_out = sch.end_time / n as f64;
             times.extend((1..=n).map(|i| i as f64 * dt_out));
             let integ = ls.scene.solver.time_integration.unwrap_or_default();
@@ -293,7 +296,7 @@ fn run_dim<const D: usize>(
         }
     };
     let grid = model.grid();
-    let locate = |x: &Point<D>| crate::sample::locate(grid, x).map(|l| l.cell);
+    let locate = |x: &Point<D>| crate::common::sample::locate(grid, x).map(|l| l.cell);
     let mut probes = Vec::new();
     for (i, p) in ls.scene.output.probe.iter().enumerate() {
         let x = point::<D>(&p.at);
@@ -489,7 +492,7 @@ impl<const D: usize> Model for Run<'_, D> {
             ] {
                 let f = Field::parse(name, 2).expect("2D field");
                 let v: Vec<f64> = (0..nc).map(|c| self.cell_value(f, c)).collect();
-                crate::plots::field(
+                crate::common::plots::field(
                     &dir.join(format!("{name}.png")),
                     &FieldPlot::new(&canvas, title, &[]),
                     Values::Cell(&v),
@@ -504,7 +507,7 @@ impl<const D: usize> Model for Run<'_, D> {
             let x = g2.cell_centroid(peak);
             let mut plot = FieldPlot::new(&canvas, "σ_yy (Pa) near its peak", &[]);
             plot.window = Some(([x[0] - h, x[1] - h], [x[0] + h, x[1] + h]));
-            crate::plots::field(&dir.join("syy_peak.png"), &plot, Values::Cell(&v))?;
+            crate::common::plots::field(&dir.join("syy_peak.png"), &plot, Values::Cell(&v))?;
         }
         if written.len() > 1 && !self.probes.is_empty() {
             let columns: Vec<(String, Vec<f64>)> = self
@@ -516,7 +519,12 @@ impl<const D: usize> Model for Run<'_, D> {
                 .enumerate()
                 .map(|(i, p)| (p.name.clone(), series[i].clone()))
                 .collect();
-            crate::plots::time_series(&dir.join("probes.png"), written, &columns, "probes")?;
+            crate::common::plots::time_series(
+                &dir.join("probes.png"),
+                written,
+                &columns,
+                "probes",
+            )?;
         }
         Ok(())
     }
@@ -552,5 +560,40 @@ impl<const D: usize> Model for Run<'_, D> {
 
     fn wall_seconds(&self) -> WallSeconds {
         self.wall
+    }
+}
+
+/// The model `cosserat` in the registry ([`crate::MODELS`]).
+pub struct CosseratKind;
+
+/// The registry's value of the model.
+pub static KIND: CosseratKind = CosseratKind;
+
+impl ModelKind for CosseratKind {
+    fn name(&self) -> &'static str {
+        "cosserat"
+    }
+    fn sections(&self) -> &'static [&'static str] {
+        &[]
+    }
+    fn reads(&self) -> &'static [&'static str] {
+        &[
+            "grid", "region", "material", "fluid", "bc", "loads", "source", "well", "initial",
+            "physics",
+        ]
+    }
+    fn check(&self, ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
+        let _ = laws;
+        check::check(ls)
+    }
+    fn run(
+        &self,
+        ls: &LoadedScene,
+        laws: &LawRegistry,
+        out: &Path,
+        observer: &mut dyn Observer,
+    ) -> Result<Summary, RunError> {
+        let _ = laws;
+        run(ls, out, observer)
     }
 }

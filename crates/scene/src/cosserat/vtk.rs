@@ -9,7 +9,7 @@ use std::path::Path;
 use porofrac_cosserat::{components, strain_index};
 use porofrac_grid::Grid;
 
-use crate::output::{OutputError, write_atomic};
+use crate::common::output::{OutputError, write_atomic};
 
 /// Write `path` for the cell field `w` (`n` per cell) and the cell stresses `stress`.
 pub fn write<const D: usize>(

@@ -1,67 +1,19 @@
 //! Checking a lattice Boltzmann scene: keys of other models are refused by name, every
 //! value is checked, and the lattice it asks for is bounded, before anything is allocated.
 
-use porofrac_lbm::{MAX_MACH, TAU_MIN, Units};
+use porofrac_lbm::Units;
 
-use super::file::{BoundaryKindChoice, PrecisionChoice, ShapeChoice};
-use crate::check::{LoadedScene, SceneError, k, ki};
-use crate::expr::Expr;
-use crate::file::{KeyPart, NumOrExpr};
+use crate::common::lattice::check::{
+    check_section, check_thermal, expr, mach_of, positive, vector,
+};
+use crate::common::lattice::sections::ShapeChoice;
+use crate::common::loaded::{LoadedScene, SceneError, k, ki};
+use crate::common::sections::KeyPart;
 
 /// Probe and line fields of the model.
 pub const FIELDS: [&str; 5] = ["vx", "vy", "pressure", "density", "temperature"];
 /// Obstacle probe fields.
 pub const OBSTACLE_FIELDS: [&str; 3] = ["fx", "fy", "torque"];
-/// Most lattice nodes a scene may ask for.
-pub const MAX_NODES: f64 = 1.0e9;
-
-fn positive(ls: &LoadedScene, key: &[KeyPart], v: f64) -> Result<(), SceneError> {
-    if !(v.is_finite() && v > 0.0) {
-        return Err(ls.error(key, format!("= {v} must be > 0")));
-    }
-    Ok(())
-}
-
-fn expr(ls: &LoadedScene, key: &[KeyPart], v: &NumOrExpr) -> Result<(), SceneError> {
-    match v {
-        NumOrExpr::Num(x) if !x.is_finite() => {
-            Err(ls.error(key, format!("= {x} is not a finite number")))
-        }
-        NumOrExpr::Num(_) => Ok(()),
-        NumOrExpr::Expr(s) => Expr::parse(s)
-            .map(|_| ())
-            .map_err(|e| ls.error(key, format!("= \"{s}\": bad expression at {e}"))),
-    }
-}
-
-fn vector(ls: &LoadedScene, key: &[KeyPart], v: &[NumOrExpr]) -> Result<(), SceneError> {
-    if v.len() != 2 {
-        return Err(ls.error(key, format!("has {} components, the scene is 2D", v.len())));
-    }
-    v.iter().try_for_each(|c| expr(ls, key, c))
-}
-
-/// Refuse the keys of the lattice Boltzmann model in a scene of another `model`.
-pub fn refuse_sections(ls: &LoadedScene, model: &str) -> Result<(), SceneError> {
-    let s = &ls.scene;
-    let key = if s.lbm.is_some() {
-        Some(k(&["lbm"]))
-    } else if !s.obstacle.is_empty() {
-        Some(ki("obstacle", 0, &[]))
-    } else if s.thermal.is_some() {
-        Some(k(&["thermal"]))
-    } else {
-        s.output
-            .probe
-            .iter()
-            .position(|p| p.obstacle.is_some())
-            .map(|i| ki("output.probe", i, &["obstacle"]))
-    };
-    match key {
-        Some(key) => Err(ls.error(&key, format!("belongs to model \"lbm\", not \"{model}\""))),
-        None => Ok(()),
-    }
-}
 
 /// Check a scene with `[scene] model = "lbm"`.
 pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
@@ -77,46 +29,6 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
             &k(&["scene", "name"]),
             "must be a non-empty name without slashes",
         ));
-    }
-    // Keys of the continuum model.
-    let foreign: Option<Vec<KeyPart>> = if crate::nscd::check::has_section(ls, "grid") {
-        Some(k(&["grid"]))
-    } else if s.scene.plane.is_some() {
-        Some(k(&["scene", "plane"]))
-    } else if !s.region.is_empty() {
-        Some(ki("region", 0, &[]))
-    } else if let Some(m) = s.material.keys().next() {
-        Some(k(&["material", m]))
-    } else if s.fluid.is_some() {
-        Some(k(&["fluid"]))
-    } else if !s.bc.is_empty() {
-        Some(ki("bc", 0, &[]))
-    } else if s.loads.is_some() {
-        Some(k(&["loads"]))
-    } else if !s.source.is_empty() {
-        Some(ki("source", 0, &[]))
-    } else if !s.well.is_empty() {
-        Some(ki("well", 0, &[]))
-    } else if s.initial.is_some() {
-        Some(k(&["initial"]))
-    } else if s.physics.flow.is_some()
-        || s.physics.coupling.is_some()
-        || s.physics.fracture.is_some()
-        || s.physics.failure_stress.is_some()
-    {
-        Some(k(&["physics"]))
-    } else if s.solver.mechanics.is_some()
-        || s.solver.linear.is_some()
-        || s.solver.tolerance.is_some()
-    {
-        Some(k(&["solver"]))
-    } else if s.output.exact_displacement.is_some() {
-        Some(k(&["output", "exact_displacement"]))
-    } else {
-        None
-    };
-    if let Some(key) = foreign {
-        return Err(ls.error(&key, "belongs to model \"continuum\", not \"lbm\""));
     }
     if let Some(t) = &s.thermal {
         for (name, set) in [
@@ -136,7 +48,7 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
     let mut names = std::collections::BTreeSet::new();
     let (x0, y0) = (l.extent[0][0], l.extent[0][1]);
     let (x1, y1) = (l.extent[1][0], l.extent[1][1]);
-    for (i, o) in s.obstacle.iter().enumerate() {
+    for (i, o) in super::own(ls).obstacle.iter().enumerate() {
         let ok = |f: &str| ki("obstacle", i, &[f]);
         if o.name.is_empty() || !names.insert(o.name.clone()) {
             return Err(ls.error(
@@ -184,32 +96,6 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
     check_output(ls, &names)
 }
 
-/// Constant velocities above the Mach limit are refused here; expressions are checked at
-/// every step of the run.
-fn mach_of(
-    ls: &LoadedScene,
-    key: &[KeyPart],
-    v: &[NumOrExpr],
-    units: &Units,
-) -> Result<(), SceneError> {
-    if let (NumOrExpr::Num(a), NumOrExpr::Num(b)) = (&v[0], &v[1]) {
-        let speed = (a * a + b * b).sqrt();
-        let ma = units.mach(speed);
-        if ma > MAX_MACH {
-            return Err(ls.error(
-                key,
-                format!(
-                    "= {speed} m/s is Mach {ma:.3} on this lattice (limit {MAX_MACH}): refine the spacing, lower tau or the velocity"
-                ),
-            ));
-        }
-        if units.velocity(speed) >= 1.0 {
-            return Err(ls.error(key, "moves a node or more per step"));
-        }
-    }
-    Ok(())
-}
-
 fn check_schedule(ls: &LoadedScene, units: &Units) -> Result<(), SceneError> {
     let Some(sch) = &ls.scene.schedule else {
         return Err(ls.error(&k(&["schedule"]), "is required by model \"lbm\" (end_time)"));
@@ -226,7 +112,7 @@ fn check_schedule(ls: &LoadedScene, units: &Units) -> Result<(), SceneError> {
         _ => {}
     }
     let lattice_steps = sch.end_time / units.dt;
-    if lattice_steps > crate::limits::MAX_STEPS as f64 * 100.0 {
+    if lattice_steps > crate::common::limits::MAX_STEPS as f64 * 100.0 {
         return Err(ls.error(
             &k(&["schedule", "end_time"]),
             format!(
@@ -235,12 +121,12 @@ fn check_schedule(ls: &LoadedScene, units: &Units) -> Result<(), SceneError> {
             ),
         ));
     }
-    if crate::check::step_count_f64(sch) > crate::limits::MAX_STEPS as f64 {
+    if crate::common::loaded::step_count_f64(sch) > crate::common::limits::MAX_STEPS as f64 {
         return Err(ls.error(
             &k(&["schedule"]),
             format!(
                 "asks for more than {} output steps",
-                crate::limits::MAX_STEPS
+                crate::common::limits::MAX_STEPS
             ),
         ));
     }
@@ -319,7 +205,7 @@ fn check_output(
                 return Err(ls.error(&lk(f), "must be two finite numbers (m)"));
             }
         }
-        crate::check::line_points_and_name(ls, i, l)?;
+        crate::common::loaded::line_points_and_name(ls, i, l)?;
     }
     Ok(())
 }
@@ -340,203 +226,49 @@ fn field(ls: &LoadedScene, key: &[KeyPart], f: &str) -> Result<(), SceneError> {
     Ok(())
 }
 
-/// Check `[lbm]` and its `[[lbm.boundary]]`s (every model that has a fluid). Returns the
-/// units and the periodic axes.
-pub(crate) fn check_section(ls: &LoadedScene) -> Result<(Units, [bool; 2]), SceneError> {
+/// The keys of the continuum model in a lattice Boltzmann scene, refused by name (an
+/// array of tables by its first element, a material by its name).
+pub(crate) fn refuse_continuum(ls: &LoadedScene) -> Result<(), SceneError> {
     let s = &ls.scene;
-    let Some(l) = &s.lbm else {
-        return Err(ls.error(
-            &k(&["lbm"]),
-            format!("is required by model \"{}\"", ls.model()),
-        ));
-    };
-    let key = |f: &str| k(&["lbm", f]);
-    for a in 0..2 {
-        if l.extent[a].len() != 2 {
-            return Err(ls.error(&key("extent"), "must be [[x0, y0], [x1, y1]]"));
-        }
-    }
-    for a in 0..2 {
-        let (lo, hi) = (l.extent[0][a], l.extent[1][a]);
-        if !(lo.is_finite() && hi.is_finite() && hi > lo) {
-            return Err(ls.error(&key("extent"), format!("needs min < max on axis {a}")));
-        }
-    }
-    positive(ls, &key("spacing"), l.spacing)?;
-    positive(ls, &key("density"), l.density)?;
-    positive(ls, &key("viscosity"), l.viscosity)?;
-    if !(l.tau > TAU_MIN && l.tau.is_finite()) {
-        return Err(ls.error(
-            &key("tau"),
-            format!(
-                "= {} must be above {TAU_MIN} (tau = 1/2 is zero viscosity)",
-                l.tau
-            ),
-        ));
-    }
-    if let Some(m) = l.magic {
-        if l.collision != super::file::CollisionChoice::Trt {
-            return Err(ls.error(&key("magic"), "applies to collision = \"trt\" only"));
-        }
-        positive(ls, &key("magic"), m)?;
-    }
-    if l.precision == PrecisionChoice::Single {
-        return Err(ls.error(
-            &key("precision"),
-            "= \"single\" is not available in this version of porofrac (double only)",
-        ));
-    }
-    let (nx, ny) = super::nodes(l);
-    if !((2.0..=32768.0).contains(&nx) && (2.0..=32768.0).contains(&ny)) || nx * ny > MAX_NODES {
-        return Err(ls.error(
-            &key("spacing"),
-            format!(
-                "= {} gives {nx} × {ny} nodes: each side needs 2 to 32768 nodes",
-                l.spacing
-            ),
-        ));
-    }
-    crate::limits::fits_in_memory(nx * ny * 100.0, &format!("a lattice of {nx} × {ny} nodes"))
-        .map_err(|e| ls.error(&key("spacing"), e))?;
-    let units = Units::from_viscosity(l.spacing, l.viscosity, l.density, l.tau)
-        .map_err(|e| ls.error(&key("tau"), e))?;
-    if let Some(b) = &l.body_force
-        && (b.len() != 2 || !b.iter().all(|v| v.is_finite()))
+    // Keys of the continuum model.
+    let foreign: Option<Vec<KeyPart>> = if ls.has_section("grid") {
+        Some(k(&["grid"]))
+    } else if s.scene.plane.is_some() {
+        Some(k(&["scene", "plane"]))
+    } else if !s.region.is_empty() {
+        Some(ki("region", 0, &[]))
+    } else if let Some(m) = s.material.keys().next() {
+        Some(k(&["material", m]))
+    } else if s.fluid.is_some() {
+        Some(k(&["fluid"]))
+    } else if !s.bc.is_empty() {
+        Some(ki("bc", 0, &[]))
+    } else if s.loads.is_some() {
+        Some(k(&["loads"]))
+    } else if !s.source.is_empty() {
+        Some(ki("source", 0, &[]))
+    } else if !s.well.is_empty() {
+        Some(ki("well", 0, &[]))
+    } else if s.initial.is_some() {
+        Some(k(&["initial"]))
+    } else if s.physics.flow.is_some()
+        || s.physics.coupling.is_some()
+        || s.physics.fracture.is_some()
+        || s.physics.failure_stress.is_some()
     {
-        return Err(ls.error(&key("body_force"), "must be two finite numbers (m/s²)"));
-    }
-    if let Some(v) = &l.initial_velocity {
-        vector(ls, &key("initial_velocity"), v)?;
-    }
-    let mut seen = [false; 2];
-    for &a in &l.periodic {
-        let i = a as usize;
-        if seen[i] {
-            return Err(ls.error(&key("periodic"), "names an axis twice"));
-        }
-        seen[i] = true;
-    }
-    let mut sides = std::collections::BTreeSet::new();
-    for (i, b) in l.boundary.iter().enumerate() {
-        let bk = |f: &str| ki("lbm.boundary", i, &[f]);
-        let axis = match b.side {
-            super::file::SideChoice::Xmin | super::file::SideChoice::Xmax => 0,
-            _ => 1,
-        };
-        if seen[axis] {
-            return Err(ls.error(
-                &bk("side"),
-                format!("= \"{}\" is on a periodic axis", b.side.as_str()),
-            ));
-        }
-        if !sides.insert(b.side.as_str()) {
-            return Err(ls.error(
-                &bk("side"),
-                format!("= \"{}\" is given twice", b.side.as_str()),
-            ));
-        }
-        match b.kind {
-            BoundaryKindChoice::Pressure => {
-                if b.velocity.is_some() {
-                    return Err(ls.error(&bk("velocity"), "does not apply to kind = \"pressure\""));
-                }
-                let Some(p) = b.pressure else {
-                    return Err(ls.error(&bk("pressure"), "is required for kind = \"pressure\""));
-                };
-                if !p.is_finite() {
-                    return Err(ls.error(&bk("pressure"), format!("= {p} is not a finite number")));
-                }
-                let rho = units.pressure_density(p);
-                if !(rho > 0.5 && rho < 1.5) {
-                    return Err(ls.error(
-                        &bk("pressure"),
-                        format!(
-                            "= {p} Pa is a lattice density of {rho:.3}: keep it within 1 ± 0.5"
-                        ),
-                    ));
-                }
-            }
-            BoundaryKindChoice::Wall | BoundaryKindChoice::Velocity => {
-                if b.pressure.is_some() {
-                    return Err(ls.error(&bk("pressure"), "applies to kind = \"pressure\" only"));
-                }
-                if let Some(v) = &b.velocity {
-                    vector(ls, &bk("velocity"), v)?;
-                    mach_of(ls, &bk("velocity"), v, &units)?;
-                } else if b.kind == BoundaryKindChoice::Velocity {
-                    return Err(ls.error(&bk("velocity"), "is required for kind = \"velocity\""));
-                }
-            }
-        }
-    }
-    Ok((units, seen))
-}
-
-/// Check `[thermal]` against the lattice of `units` with periodic axes `seen`.
-pub(crate) fn check_thermal(
-    ls: &LoadedScene,
-    units: &Units,
-    seen: [bool; 2],
-) -> Result<(), SceneError> {
-    let s = &ls.scene;
-    if let Some(t) = &s.thermal {
-        let tk = |f: &str| k(&["thermal", f]);
-        for (f, chi) in [
-            ("diffusivity", Some(t.diffusivity)),
-            ("solid_diffusivity", t.solid_diffusivity),
-        ] {
-            let Some(chi) = chi else { continue };
-            positive(ls, &tk(f), chi)?;
-            let tau = super::thermal_tau(chi, units);
-            if !(tau > TAU_MIN && tau.is_finite()) {
-                return Err(ls.error(
-                    &tk(f),
-                    format!(
-                        "= {chi} m²/s gives a thermal relaxation time of {tau:.4} on this lattice (must exceed {TAU_MIN}): raise lbm.tau or refine lbm.spacing"
-                    ),
-                ));
-            }
-        }
-        if let Some(v) = &t.initial {
-            expr(ls, &tk("initial"), v)?;
-        }
-        let mut tsides = std::collections::BTreeSet::new();
-        for (i, b) in t.boundary.iter().enumerate() {
-            let bk = |f: &str| ki("thermal.boundary", i, &[f]);
-            let axis = match b.side {
-                super::file::SideChoice::Xmin | super::file::SideChoice::Xmax => 0,
-                _ => 1,
-            };
-            if seen[axis] {
-                return Err(ls.error(
-                    &bk("side"),
-                    format!("= \"{}\" is on a periodic axis", b.side.as_str()),
-                ));
-            }
-            if !tsides.insert(b.side.as_str()) {
-                return Err(ls.error(
-                    &bk("side"),
-                    format!("= \"{}\" is given twice", b.side.as_str()),
-                ));
-            }
-            let given = b.temperature.is_some() as u8 + b.flux.is_some() as u8 + b.outflow as u8;
-            if given != 1 {
-                return Err(ls.error(
-                    &bk("side"),
-                    "needs exactly one of temperature, flux and outflow = true",
-                ));
-            }
-            if let Some(v) = b.temperature
-                && !v.is_finite()
-            {
-                return Err(ls.error(&bk("temperature"), format!("= {v} is not a finite number")));
-            }
-            if let Some(v) = b.flux
-                && !v.is_finite()
-            {
-                return Err(ls.error(&bk("flux"), format!("= {v} is not a finite number")));
-            }
-        }
+        Some(k(&["physics"]))
+    } else if s.solver.mechanics.is_some()
+        || s.solver.linear.is_some()
+        || s.solver.tolerance.is_some()
+    {
+        Some(k(&["solver"]))
+    } else if s.output.exact_displacement.is_some() {
+        Some(k(&["output", "exact_displacement"]))
+    } else {
+        None
+    };
+    if let Some(key) = foreign {
+        return Err(ls.error(&key, "belongs to model \"continuum\", not \"lbm\""));
     }
     Ok(())
 }

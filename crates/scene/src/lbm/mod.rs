@@ -15,81 +15,34 @@
 //! second of stepping).
 
 pub mod check;
-pub mod file;
-pub(crate) mod images;
 mod vti;
+
+use crate::common::laws::LawRegistry;
+use crate::common::loaded::SceneError;
+use crate::common::model::ModelKind;
+use crate::common::model::{OwnSections, own_sections};
+use crate::common::sections::KeyPart;
 
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::time::Instant;
 
-use porofrac_lbm::{
-    Collision, Lattice, LatticeConfig, MAX_MACH, MomentumExchange, Obstacle, Shape, Side, SideKind,
-    Thermal, ThermalSide, Units,
-};
+use porofrac_lbm::{Lattice, MAX_MACH, Obstacle, Shape, Side, Thermal, Units};
 
 pub use check::check;
 
-use crate::check::{LoadedScene, k, ki};
-use crate::driver::{Observer, drive};
-use crate::expr::Expr;
-use crate::file::NumOrExpr;
-use crate::model::{Model, RunError, Sizes, StepStats};
-use crate::output::{SolverStats, Summary, WallSeconds, write_atomic};
-use file::{
-    AxisChoice, BoundaryKindChoice, CollisionChoice, ExchangeChoice, LbmSection, ShapeChoice,
-    SideChoice,
+use crate::common::driver::{Observer, drive};
+use crate::common::expr::Expr;
+use crate::common::lattice::images;
+use crate::common::lattice::sections::{CollisionChoice, ShapeChoice};
+use crate::common::lattice::{
+    LatticeParts, VelocityExpr, lattice_of, set_side_velocities, thermal_initial, thermal_sides,
+    thermal_tau,
 };
-
-/// Thermal relaxation time of diffusivity `chi` (m²/s): `τ_g = ½ + 3 χ Δt/Δx²`.
-pub(crate) fn thermal_tau(chi: f64, u: &Units) -> f64 {
-    0.5 + 3.0 * chi * u.dt / (u.dx * u.dx)
-}
-
-/// Nodes along x and y for the extent and spacing (as floats, for checks).
-pub(crate) fn nodes(l: &LbmSection) -> (f64, f64) {
-    let n = |a: usize| {
-        ((l.extent[1][a] - l.extent[0][a]) / l.spacing)
-            .round()
-            .max(0.0)
-    };
-    (n(0), n(1))
-}
-
-/// A velocity given as numbers or expressions.
-#[derive(Clone, Debug)]
-pub(crate) enum VelocityExpr {
-    Const([f64; 2]),
-    Vary([Expr; 2]),
-}
-
-impl VelocityExpr {
-    pub(crate) fn new(v: &[NumOrExpr]) -> Self {
-        let e: Vec<Expr> = v
-            .iter()
-            .map(|c| match c {
-                NumOrExpr::Num(x) => Expr::constant(*x),
-                NumOrExpr::Expr(s) => Expr::parse(s).unwrap_or_else(|_| Expr::constant(f64::NAN)),
-            })
-            .collect();
-        match (e[0].as_constant(), e[1].as_constant()) {
-            (Some(a), Some(b)) => VelocityExpr::Const([a, b]),
-            _ => VelocityExpr::Vary([e[0].clone(), e[1].clone()]),
-        }
-    }
-    pub(crate) fn at(&self, x: [f64; 2], t: f64) -> [f64; 2] {
-        match self {
-            VelocityExpr::Const(v) => *v,
-            VelocityExpr::Vary(e) => [e[0].eval(&x, t), e[1].eval(&x, t)],
-        }
-    }
-    pub(crate) fn varies_in_time(&self) -> bool {
-        match self {
-            VelocityExpr::Const(_) => false,
-            VelocityExpr::Vary(e) => e.iter().any(Expr::depends_on_time),
-        }
-    }
-}
+use crate::common::loaded::{LoadedScene, k, ki};
+use crate::common::model::{Model, RunError, Sizes, StepStats};
+use crate::common::output::{SolverStats, Summary, WallSeconds, write_atomic};
+use crate::common::sections::NumOrExpr;
 
 /// What a probe reads.
 enum ProbeKind {
@@ -147,127 +100,6 @@ pub(crate) fn run(
     drive(ls, &mut model, out, observer, start, build_seconds, 2)
 }
 
-/// The lattice of `[lbm]` without obstacles: units, the SI corner, the lattice and the
-/// velocities of its sides (every model that has a fluid).
-pub(crate) struct LatticeParts {
-    /// The lattice.
-    pub lat: Lattice,
-    /// SI ↔ lattice units.
-    pub units: Units,
-    /// SI position of the lattice corner.
-    pub origin: [f64; 2],
-    /// Sides with a prescribed velocity.
-    pub sides: Vec<(Side, VelocityExpr)>,
-}
-
-/// Set the velocities of `sides` at time `t` (lattice corner at `origin`).
-pub(crate) fn set_side_velocities(
-    lat: &mut Lattice,
-    sides: &[(Side, VelocityExpr)],
-    units: &Units,
-    origin: [f64; 2],
-    t: f64,
-) {
-    let (u, o, dx) = (*units, origin, units.dx);
-    for (side, v) in sides {
-        lat.set_side_velocity(*side, |p| {
-            let w = v.at([o[0] + p[0] * dx, o[1] + p[1] * dx], t);
-            [u.velocity(w[0]), u.velocity(w[1])]
-        });
-    }
-}
-
-fn side_of(s: SideChoice) -> Side {
-    match s {
-        SideChoice::Xmin => Side::XMin,
-        SideChoice::Xmax => Side::XMax,
-        SideChoice::Ymin => Side::YMin,
-        SideChoice::Ymax => Side::YMax,
-    }
-}
-
-/// Build the lattice of a checked `[lbm]`.
-pub(crate) fn lattice_of(ls: &LoadedScene) -> Result<LatticeParts, RunError> {
-    let s = &ls.scene;
-    let l = s.lbm.as_ref().expect("checked");
-    let units = Units::from_viscosity(l.spacing, l.viscosity, l.density, l.tau)
-        .map_err(|e| ls.error(&k(&["lbm", "tau"]), e))?;
-    let (nx, ny) = nodes(l);
-    let (nx, ny) = (nx as usize, ny as usize);
-    let origin = [l.extent[0][0], l.extent[0][1]];
-    let mut periodic = [false; 2];
-    for a in &l.periodic {
-        periodic[match a {
-            AxisChoice::X => 0,
-            AxisChoice::Y => 1,
-        }] = true;
-    }
-    let mut kinds = [SideKind::Wall; 4];
-    let mut sides = Vec::new();
-    for b in &l.boundary {
-        let side = side_of(b.side);
-        kinds[side.index()] = match b.kind {
-            BoundaryKindChoice::Wall => SideKind::Wall,
-            BoundaryKindChoice::Velocity => SideKind::Velocity,
-            BoundaryKindChoice::Pressure => SideKind::Pressure {
-                density: units.pressure_density(b.pressure.unwrap_or(0.0)),
-            },
-        };
-        if let Some(v) = &b.velocity {
-            sides.push((side, VelocityExpr::new(v)));
-        }
-    }
-    let body = l.body_force.clone().unwrap_or(vec![0.0, 0.0]);
-    let cfg = LatticeConfig {
-        nx,
-        ny,
-        tau: l.tau,
-        collision: match l.collision {
-            CollisionChoice::Bgk => Collision::Bgk,
-            CollisionChoice::Trt => Collision::Trt {
-                magic: l.magic.unwrap_or(3.0 / 16.0),
-            },
-        },
-        periodic,
-        sides: kinds,
-        accel: [units.acceleration(body[0]), units.acceleration(body[1])],
-        momentum_exchange: match l.momentum_exchange {
-            ExchangeChoice::Standard => MomentumExchange::Standard,
-            ExchangeChoice::GalileanInvariant => MomentumExchange::GalileanInvariant,
-        },
-        obstacle_mass: porofrac_lbm::ObstacleMass::Conserved,
-    };
-    let lat = Lattice::new(cfg).map_err(|e| ls.error(&k(&["lbm"]), e))?;
-    Ok(LatticeParts {
-        lat,
-        units,
-        origin,
-        sides,
-    })
-}
-
-/// The thermal side conditions of a checked `[thermal]`.
-pub(crate) fn thermal_sides(t: &file::ThermalSection, units: &Units) -> [ThermalSide; 4] {
-    let mut tsides = [ThermalSide::Adiabatic; 4];
-    for b in &t.boundary {
-        tsides[side_of(b.side).index()] = match (b.temperature, b.flux, b.outflow) {
-            (_, _, true) => ThermalSide::Outflow,
-            (Some(v), _, _) => ThermalSide::Temperature(v),
-            (None, f, _) => ThermalSide::Flux(f.unwrap_or(0.0) * units.dt / units.dx),
-        };
-    }
-    tsides
-}
-
-/// The initial temperature of a checked `[thermal]` (0 if not given).
-pub(crate) fn thermal_initial(t: &file::ThermalSection) -> Expr {
-    match &t.initial {
-        None => Expr::constant(0.0),
-        Some(NumOrExpr::Num(x)) => Expr::constant(*x),
-        Some(NumOrExpr::Expr(e)) => Expr::parse(e).unwrap_or_else(|_| Expr::constant(f64::NAN)),
-    }
-}
-
 fn build(ls: &LoadedScene) -> Result<LbmModel<'_>, RunError> {
     let s = &ls.scene;
     let l = s.lbm.as_ref().expect("checked");
@@ -278,7 +110,7 @@ fn build(ls: &LoadedScene) -> Result<LbmModel<'_>, RunError> {
         sides,
     } = lattice_of(ls)?;
     let mut motions = Vec::new();
-    for (i, o) in s.obstacle.iter().enumerate() {
+    for (i, o) in own(ls).obstacle.iter().enumerate() {
         let shape = match &o.shape {
             ShapeChoice::Circle(c) => Shape::Circle {
                 center: [
@@ -345,7 +177,7 @@ fn build(ls: &LoadedScene) -> Result<LbmModel<'_>, RunError> {
     for p in &s.output.probe {
         model.probes.push(match &p.obstacle {
             Some(o) => {
-                let idx = s
+                let idx = own(ls)
                     .obstacle
                     .iter()
                     .position(|x| &x.name == o)
@@ -376,7 +208,8 @@ fn build(ls: &LoadedScene) -> Result<LbmModel<'_>, RunError> {
 fn output_times(ls: &LoadedScene) -> Vec<f64> {
     let mut t = vec![0.0];
     if let Some(sch) = &ls.scene.schedule {
-        let n = crate::check::step_count(sch).min(crate::limits::MAX_STEPS) as usize;
+        let n =
+            crate::common::loaded::step_count(sch).min(crate::common::limits::MAX_STEPS) as usize;
         let dt = sch.dt.unwrap_or(sch.end_time / n as f64);
         for k in 1..=n {
             t.push((k as f64 * dt).min(sch.end_time));
@@ -762,7 +595,7 @@ impl Model for LbmModel<'_> {
             .map(|(p, s)| (p.name.clone(), s.clone()))
             .collect();
         if !forces.is_empty() {
-            crate::plots::time_series(
+            crate::common::plots::time_series(
                 &dir.join("obstacle_forces.png"),
                 written,
                 &forces,
@@ -776,7 +609,7 @@ impl Model for LbmModel<'_> {
             .map(|(p, s)| (p.name.clone(), s.clone()))
             .collect();
         if !fields.is_empty() {
-            crate::plots::time_series(
+            crate::common::plots::time_series(
                 &dir.join("probes.png"),
                 written,
                 &fields,
@@ -817,4 +650,67 @@ impl Model for LbmModel<'_> {
             ..WallSeconds::default()
         }
     }
+}
+
+/// The model `lbm` in the registry ([`crate::MODELS`]).
+pub struct LbmKind;
+
+/// The registry's value of the model.
+pub static KIND: LbmKind = LbmKind;
+
+impl ModelKind for LbmKind {
+    fn name(&self) -> &'static str {
+        "lbm"
+    }
+    fn sections(&self) -> &'static [&'static str] {
+        &["lbm", "obstacle", "thermal"]
+    }
+    fn reads(&self) -> &'static [&'static str] {
+        // Refused by `refuse` when they hold a key of the continuum model.
+        &["material", "physics"]
+    }
+    fn refused_as(&self, section: &str) -> Vec<KeyPart> {
+        if section == "obstacle" {
+            ki("obstacle", 0, &[])
+        } else {
+            k(&[section])
+        }
+    }
+    fn refuse(&self, ls: &LoadedScene) -> Result<(), SceneError> {
+        check::refuse_continuum(ls)
+    }
+    fn sections_of(
+        &self,
+        doc: toml::Spanned<toml::de::DeTable<'_>>,
+    ) -> Result<std::sync::Arc<dyn OwnSections>, toml::de::Error> {
+        own_sections::<LbmSections>(doc)
+    }
+    fn check(&self, ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
+        let _ = laws;
+        check::check(ls)
+    }
+    fn run(
+        &self,
+        ls: &LoadedScene,
+        laws: &LawRegistry,
+        out: &Path,
+        observer: &mut dyn Observer,
+    ) -> Result<Summary, RunError> {
+        let _ = laws;
+        run(ls, out, observer)
+    }
+}
+
+/// The sections of model `lbm` read by the model itself (`[lbm]` and `[thermal]` are
+/// shared with model `lsm`).
+#[derive(Clone, Debug, Default, serde::Deserialize)]
+pub struct LbmSections {
+    /// `[[obstacle]]`.
+    #[serde(default)]
+    pub obstacle: Vec<crate::common::lattice::sections::ObstacleSection>,
+}
+
+/// The model's own sections of a checked scene.
+pub(crate) fn own(ls: &LoadedScene) -> &LbmSections {
+    ls.own::<LbmSections>()
 }

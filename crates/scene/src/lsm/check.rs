@@ -2,34 +2,11 @@
 //! and the model named, every value checked (the bond law is built here, so that a bad
 //! stiffness or strength names its key).
 
-use crate::check::{LoadedScene, SceneError, k, ki};
-use crate::file::KeyPart;
+use crate::common::loaded::{LoadedScene, SceneError, k, ki};
+use crate::common::sections::KeyPart;
 use porofrac_lsm::{BondLaw, LsmError};
 
 use super::file::{DampingChoice, NormalChoice};
-
-/// Top-level sections of the model (besides `[particles]`, shared with `nscd`, and
-/// `[lbm]`, `[thermal]`, shared with `lbm`).
-pub const SECTIONS: [&str; 5] = ["bonds", "contacts", "lsm", "loading", "injection"];
-const SHARED: [&str; 5] = ["scene", "schedule", "output", "solver", "particles"];
-const OTHERS: [(&str, &str); 16] = [
-    ("wall", "nscd"),
-    ("contact", "nscd"),
-    ("nscd", "nscd"),
-    ("lbm", "lbm"),
-    ("obstacle", "lbm"),
-    ("thermal", "lbm"),
-    ("grid", "continuum"),
-    ("region", "continuum"),
-    ("material", "continuum"),
-    ("fluid", "continuum"),
-    ("bc", "continuum"),
-    ("loads", "continuum"),
-    ("source", "continuum"),
-    ("well", "continuum"),
-    ("initial", "continuum"),
-    ("physics", "continuum"),
-];
 
 /// Fields of a tracked cell.
 pub const CELL_FIELDS: [&str; 8] = [
@@ -110,25 +87,6 @@ fn check_fluid_probes(ls: &LoadedScene) -> Result<Option<LoadedScene>, SceneErro
     Ok(out)
 }
 
-fn top_level(ls: &LoadedScene) -> Vec<String> {
-    toml::from_str::<toml::Table>(&ls.text)
-        .map(|t| t.keys().cloned().collect())
-        .unwrap_or_default()
-}
-
-/// Refuse the lattice solid sections in a scene of another `model`.
-pub fn refuse_sections(ls: &LoadedScene, model: &str) -> Result<(), SceneError> {
-    for key in top_level(ls) {
-        if SECTIONS.contains(&key.as_str()) {
-            return Err(ls.error(
-                &k(&[&key]),
-                format!("belongs to model \"lsm\", not \"{model}\""),
-            ));
-        }
-    }
-    Ok(())
-}
-
 /// The key path of a library parameter name such as `bonds.kn`.
 pub fn key_of(name: &str) -> Vec<KeyPart> {
     let parts: Vec<&str> = name.split('.').collect();
@@ -167,7 +125,7 @@ fn positive(ls: &LoadedScene, key: &[KeyPart], v: f64) -> Result<(), SceneError>
 
 /// The bond law of `[bonds]`.
 pub fn bond_law(ls: &LoadedScene) -> Result<BondLaw, SceneError> {
-    let Some(b) = &ls.scene.bonds else {
+    let Some(b) = &super::own(ls).bonds else {
         return Err(ls.error(&k(&["bonds"]), "is missing: model \"lsm\" needs [bonds]"));
     };
     let key = |f: &str| k(&["bonds", f]);
@@ -228,22 +186,6 @@ pub fn bond_law(ls: &LoadedScene) -> Result<BondLaw, SceneError> {
 /// Check a lattice solid scene.
 pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
     let s = &ls.scene;
-    for key in top_level(ls) {
-        if SECTIONS.contains(&key.as_str())
-            || SHARED.contains(&key.as_str())
-            || super::fluid::SECTIONS.contains(&key.as_str())
-        {
-            continue;
-        }
-        let owner = OTHERS
-            .iter()
-            .find(|o| o.0 == key)
-            .map_or("another model", |o| o.1);
-        return Err(ls.error(
-            &k(&[&key]),
-            format!("belongs to model \"{owner}\", not \"lsm\""),
-        ));
-    }
     if s.scene.dim != 2 {
         return Err(ls.error(
             &k(&["scene", "dim"]),
@@ -274,9 +216,9 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
             "belongs to model \"continuum\", not \"lsm\"",
         ));
     }
-    crate::particles::check(ls, "lsm")?;
+    crate::common::particles::check(ls, "lsm")?;
     bond_law(ls)?;
-    if let Some(c) = &s.contacts {
+    if let Some(c) = &super::own(ls).contacts {
         let key = |f: &str| k(&["contacts", f]);
         for (f, v) in [("friction", c.friction), ("kn", c.kn), ("ks", c.ks)] {
             if let Some(v) = v
@@ -309,7 +251,7 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
             }
         }
     }
-    if let Some(l) = &s.lsm {
+    if let Some(l) = &super::own(ls).lsm {
         let key = |f: &str| k(&["lsm", f]);
         if let Some(dt) = l.dt {
             positive(ls, &key("dt"), dt)?;
@@ -349,7 +291,7 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
             return Err(ls.error(&key("gravity"), "must be finite"));
         }
     }
-    if let Some(l) = &s.loading {
+    if let Some(l) = &super::own(ls).loading {
         let key = |f: &str| k(&["loading", f]);
         if let Some(p) = l.platens {
             positive(ls, &key("platens"), p.velocity).map_err(|_| {
@@ -396,11 +338,11 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
         }
     }
     let pressurised = s.particles.as_ref().is_some_and(|p| p.hole.is_some())
-        && (s
+        && (super::own(ls)
             .loading
             .as_ref()
             .is_some_and(|l| l.pressure_rate.is_some())
-            || s.injection.is_some());
+            || super::own(ls).injection.is_some());
     if let Some(i) = s
         .output
         .probe
@@ -414,10 +356,10 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
              [loading] pressure_rate or [injection]",
         ));
     }
-    crate::nscd::check::check_particle_schedule(ls, "lsm")?;
+    crate::common::particles::check_particle_schedule(ls, "lsm")?;
     super::fluid::check(ls)?;
     let shared = check_fluid_probes(ls)?;
-    crate::nscd::check::check_output_of(
+    crate::common::particles::check_output_of(
         shared.as_ref().unwrap_or(ls),
         "lsm",
         &CELL_FIELDS,

@@ -104,7 +104,7 @@ impl CrackLog {
         for (t, i, j, p, e) in &self.rows {
             text.push_str(&format!("{t:e},{i},{j},{p:e},{e:e}\n"));
         }
-        crate::output::write_atomic(&out.join("crack.csv"), text.as_bytes())?;
+        crate::common::output::write_atomic(&out.join("crack.csv"), text.as_bytes())?;
         self.written = self.rows.len();
         Ok(())
     }

@@ -1,6 +1,6 @@
 //! The sections of a lattice solid scene (`[scene] model = "lsm"`), parsed strictly
-//! like the rest of the file ([`crate::file`]). `[particles]` is shared with the other
-//! particle model ([`crate::particles`]).
+//! like the rest of the file ([`crate::common::sections`]). `[particles]` is shared with the other
+//! particle model ([`crate::common::particles`]).
 
 use serde::Deserialize;
 
@@ -141,4 +141,20 @@ pub struct LoadingSection {
     /// follows without lag, [`porofrac_lsm::CrackExtent::flood_loads`]; default false).
     #[serde(default)]
     pub flood_cracks: bool,
+}
+
+/// The sections of model `lsm` read by the model itself (`[particles]` is shared with
+/// model `nscd`, `[lbm]` and `[thermal]` with model `lbm`).
+#[derive(Clone, Debug, Default, Deserialize)]
+pub struct LsmSections {
+    /// `[bonds]`.
+    pub bonds: Option<BondsSection>,
+    /// `[contacts]`.
+    pub contacts: Option<ContactsSection>,
+    /// `[lsm]`.
+    pub lsm: Option<LsmSection>,
+    /// `[loading]`.
+    pub loading: Option<LoadingSection>,
+    /// `[injection]` (with `[lbm]`).
+    pub injection: Option<super::fluid::InjectionSection>,
 }

@@ -22,10 +22,10 @@ use porofrac_particle_fluid::{
     CouplingError, CouplingOptions, InjectionControl, LoadAveraging, ParticleFluid, ThermalSetup,
 };
 
-use crate::check::{LoadedScene, SceneError, k};
-use crate::lbm::{LatticeParts, VelocityExpr};
-use crate::model::RunError;
-use crate::output::write_atomic;
+use crate::common::lattice::{LatticeParts, VelocityExpr};
+use crate::common::loaded::{LoadedScene, SceneError, k};
+use crate::common::model::RunError;
+use crate::common::output::write_atomic;
 
 /// Top-level sections of model `lbm` that a lattice solid scene may have (its fluid);
 /// `[injection]` is the model's own.
@@ -49,7 +49,11 @@ pub struct InjectionSection {
     pub gain: Option<f64>,
 }
 
-fn positive(ls: &LoadedScene, key: &[crate::file::KeyPart], v: f64) -> Result<(), SceneError> {
+fn positive(
+    ls: &LoadedScene,
+    key: &[crate::common::sections::KeyPart],
+    v: f64,
+) -> Result<(), SceneError> {
     if v.is_finite() && v > 0.0 {
         Ok(())
     } else {
@@ -63,13 +67,17 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
     let Some(_) = &s.lbm else {
         for (name, set) in [
             ("thermal", s.thermal.is_some()),
-            ("injection", s.injection.is_some()),
+            ("injection", super::own(ls).injection.is_some()),
         ] {
             if set {
                 return Err(ls.error(&k(&[name]), "needs [lbm]: the fluid that carries it"));
             }
         }
-        if s.lsm.as_ref().is_some_and(|l| l.seal_bonds.is_some()) {
+        if super::own(ls)
+            .lsm
+            .as_ref()
+            .is_some_and(|l| l.seal_bonds.is_some())
+        {
             return Err(ls.error(
                 &k(&["lsm", "seal_bonds"]),
                 "needs [lbm]: it sets what the fluid sees",
@@ -79,13 +87,13 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
     };
     if let Some(i) = s.output.probe.iter().position(|p| p.obstacle.is_some()) {
         return Err(ls.error(
-            &crate::check::ki("output.probe", i, &["obstacle"]),
+            &crate::common::loaded::ki("output.probe", i, &["obstacle"]),
             "belongs to model \"lbm\", not \"lsm\"",
         ));
     }
-    let (units, seen) = crate::lbm::check::check_section(ls)?;
+    let (units, seen) = crate::common::lattice::check::check_section(ls)?;
     if let Some(t) = &s.thermal {
-        crate::lbm::check::check_thermal(ls, &units, seen)?;
+        crate::common::lattice::check::check_thermal(ls, &units, seen)?;
         if let Some(c) = t.heat_capacity {
             positive(ls, &k(&["thermal", "heat_capacity"]), c)?;
         }
@@ -98,7 +106,7 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
             ));
         }
     }
-    if let Some(inj) = &s.injection {
+    if let Some(inj) = &super::own(ls).injection {
         let key = |f: &str| k(&["injection", f]);
         let hole = s.particles.as_ref().and_then(|p| p.hole);
         if inj.center.is_none() && hole.is_none() {
@@ -155,7 +163,8 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
         {
             return Err(ls.error(&key("gain"), format!("= {g} must be in (0, 1]")));
         }
-        if s.loading
+        if super::own(ls)
+            .loading
             .as_ref()
             .is_some_and(|l| l.pressure_rate.is_some())
         {
@@ -206,8 +215,8 @@ impl Fluid {
             units,
             origin,
             sides,
-        } = crate::lbm::lattice_of(ls)?;
-        crate::lbm::set_side_velocities(&mut lat, &sides, &units, origin, 0.0);
+        } = crate::common::lattice::lattice_of(ls)?;
+        crate::common::lattice::set_side_velocities(&mut lat, &sides, &units, origin, 0.0);
         let options = CouplingOptions {
             particle_dt_fraction: (dt / solid.stable_dt()).clamp(1e-9, 1.0),
             heat_capacity: s
@@ -216,8 +225,14 @@ impl Fluid {
                 .and_then(|t| t.heat_capacity)
                 .unwrap_or(CouplingOptions::default().heat_capacity),
             loads: LoadAveraging::TwoSteps,
-            fluid_radius_factor: if s.lsm.as_ref().and_then(|l| l.seal_bonds) == Some(true) {
-                1.0 + s.bonds.as_ref().and_then(|b| b.tolerance).unwrap_or(0.05)
+            fluid_radius_factor: if super::own(ls).lsm.as_ref().and_then(|l| l.seal_bonds)
+                == Some(true)
+            {
+                1.0 + super::own(ls)
+                    .bonds
+                    .as_ref()
+                    .and_then(|b| b.tolerance)
+                    .unwrap_or(0.05)
             } else {
                 1.0
             },
@@ -226,11 +241,11 @@ impl Fluid {
         let mut pf = ParticleFluid::new(solid, lat, units, origin, options)
             .map_err(|e| coupling_error(ls, e))?;
         if let Some(t) = &s.thermal {
-            let init = crate::lbm::thermal_initial(t);
+            let init = crate::common::lattice::thermal_initial(t);
             let setup = ThermalSetup {
                 diffusivity: t.diffusivity,
                 solid_diffusivity: t.solid_diffusivity.unwrap_or(t.diffusivity),
-                sides: crate::lbm::thermal_sides(t, &units),
+                sides: crate::common::lattice::thermal_sides(t, &units),
             };
             let d = solid.disks();
             let temps: Vec<f64> = (0..d.len())
@@ -243,7 +258,7 @@ impl Fluid {
                 .with_thermal(setup, |x| init.eval(&x, 0.0), &temps)
                 .map_err(|e| coupling_error(ls, e))?;
         }
-        if let Some(inj) = &s.injection {
+        if let Some(inj) = &super::own(ls).injection {
             let hole = s.particles.as_ref().and_then(|p| p.hole);
             let center = inj.center.or(hole.map(|h| h.center)).expect("checked");
             let radius = inj
@@ -491,14 +506,14 @@ impl Fluid {
                 solid_mask.push(lat.is_solid(i, j));
             }
         }
-        crate::lbm::images::field_png(
+        crate::common::lattice::images::field_png(
             &dir.join("fluid_speed.png"),
             [nx, ny],
             &speed,
             &solid_mask,
             false,
         )?;
-        crate::lbm::images::field_png(
+        crate::common::lattice::images::field_png(
             &dir.join("fluid_pressure.png"),
             [nx, ny],
             &pressure,
@@ -511,7 +526,7 @@ impl Fluid {
                 .map(|(i, j)| th.temperature(i, j))
                 .collect();
             let none = vec![false; nx * ny];
-            crate::lbm::images::field_png(
+            crate::common::lattice::images::field_png(
                 &dir.join("temperature.png"),
                 [nx, ny],
                 &t,
@@ -529,7 +544,7 @@ impl Fluid {
                     (a.min(v), b.max(v))
                 });
             let span = (hi - lo).max(1e-300);
-            crate::particle_output::draw_disks(
+            crate::common::particle_output::draw_disks(
                 &dir.join("particles_temperature.png"),
                 d,
                 |i| super::ramp((temps[i] - lo) / span),
@@ -548,5 +563,5 @@ fn set_sides(
     t: f64,
 ) {
     let lat: &mut Lattice = pf.lattice_mut();
-    crate::lbm::set_side_velocities(lat, sides, u, o, t);
+    crate::common::lattice::set_side_velocities(lat, sides, u, o, t);
 }

@@ -1,7 +1,7 @@
 //! The lattice solid model (seed 002.5, `[scene] model = "lsm"`): bonded disks
 //! ([`porofrac_lsm`]).
 //!
-//! - *build*: the disks of `[particles]` ([`crate::particles`]), the bond law of
+//! - *build*: the disks of `[particles]` ([`crate::common::particles`]), the bond law of
 //!   `[bonds]` (E and ν through the hexagonal closed form, or k_n, k_s), `[contacts]`,
 //!   `[lsm]` (time step, damping, gravity) and `[loading]` (platens, a pressure ramp on
 //!   the hole, on the faces seen from its centre or on the faces a fluid would wet,
@@ -29,6 +29,11 @@ pub mod crack;
 pub mod file;
 pub mod fluid;
 
+use crate::common::laws::LawRegistry;
+use crate::common::loaded::SceneError;
+use crate::common::model::ModelKind;
+use crate::common::model::{OwnSections, own_sections};
+
 use std::cell::RefCell;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -45,11 +50,11 @@ use porofrac_particles::tracked::CellContact;
 use porofrac_particles::vtk::ContactLine;
 use porofrac_particles::{Disks, RandomPacking, TrackedCell};
 
-use crate::check::{LoadedScene, SceneError, k, ki, step_count};
-use crate::driver::{Observer, drive};
-use crate::model::{Model, RunError, Sizes, StepStats};
-use crate::output::{SolverStats, Summary, WallSeconds};
-use crate::particle_output::{self, PARTICLE_FIELDS};
+use crate::common::driver::{Observer, drive};
+use crate::common::loaded::{LoadedScene, k, ki, step_count};
+use crate::common::model::{Model, RunError, Sizes, StepStats};
+use crate::common::output::{SolverStats, Summary, WallSeconds};
+use crate::common::particle_output::{self, PARTICLE_FIELDS};
 
 use file::{DampingChoice, NormalChoice, WallChoice};
 
@@ -110,11 +115,14 @@ pub struct LsmModel<'a> {
 }
 
 fn spec_of(ls: &LoadedScene) -> Result<LsmSpec, SceneError> {
-    let s = &ls.scene;
     let law = check::bond_law(ls)?;
     let mut spec = LsmSpec::new(law);
-    spec.bond_tolerance = s.bonds.as_ref().and_then(|b| b.tolerance).unwrap_or(0.05);
-    let c = s.contacts.clone().unwrap_or_default();
+    spec.bond_tolerance = own(ls)
+        .bonds
+        .as_ref()
+        .and_then(|b| b.tolerance)
+        .unwrap_or(0.05);
+    let c = own(ls).contacts.clone().unwrap_or_default();
     spec.contacts = ContactLaw {
         normal: match c.normal {
             NormalChoice::Linear => NormalLaw::Linear,
@@ -127,7 +135,7 @@ fn spec_of(ls: &LoadedScene) -> Result<LsmSpec, SceneError> {
         ks: c.ks.unwrap_or(law.ks),
         friction: c.friction.unwrap_or(0.6),
     };
-    let l = s.lsm.clone().unwrap_or_default();
+    let l = own(ls).lsm.clone().unwrap_or_default();
     spec.damping = match l.damping {
         DampingChoice::None => Damping::None,
         DampingChoice::Local => Damping::Local {
@@ -211,15 +219,15 @@ fn calibrate(ls: &LoadedScene, spec: &LsmSpec) -> Result<Calibration, SceneError
 /// Build the model of a checked lattice solid scene.
 pub fn build(ls: &LoadedScene) -> Result<LsmModel<'_>, RunError> {
     let s = &ls.scene;
-    let disks = crate::particles::generate(ls)?;
+    let disks = crate::common::particles::generate(ls)?;
     let spec = spec_of(ls)?;
-    let calibration = if s.bonds.as_ref().is_some_and(|b| b.calibrate) {
+    let calibration = if own(ls).bonds.as_ref().is_some_and(|b| b.calibrate) {
         Some(calibrate(ls, &spec)?)
     } else {
         None
     };
     let mut solid = LatticeSolid::new(disks, spec).map_err(|e| check::lsm_error(ls, &e))?;
-    let l = s.lsm.clone().unwrap_or_default();
+    let l = own(ls).lsm.clone().unwrap_or_default();
     let stable = solid.stable_dt();
     let dt = match l.dt {
         Some(dt) if dt > stable => {
@@ -233,7 +241,7 @@ pub fn build(ls: &LoadedScene) -> Result<LsmModel<'_>, RunError> {
         Some(dt) => dt,
         None => l.dt_fraction.unwrap_or(0.5) * stable,
     };
-    let load = s.loading.clone().unwrap_or_default();
+    let load = own(ls).loading.clone().unwrap_or_default();
     let (mut top, mut bottom) = (Vec::new(), Vec::new());
     if let Some(pl) = load.platens {
         let d = solid.disks();
@@ -674,7 +682,7 @@ impl Model for LsmModel<'_> {
                 b.mode.as_str()
             ));
         }
-        crate::output::write_atomic(&out.join("broken.csv"), text.as_bytes())?;
+        crate::common::output::write_atomic(&out.join("broken.csv"), text.as_bytes())?;
         self.broken_written = broken.len();
         Ok(())
     }
@@ -727,7 +735,12 @@ impl Model for LsmModel<'_> {
             .zip(series)
             .map(|(p, v)| (p.name.clone(), p.field.clone(), v.clone()))
             .collect();
-        crate::nscd::plots::probe_plots(dir, &self.ls.scene.scene.name, written, &probes)?;
+        crate::common::particle_plots::probe_plots(
+            dir,
+            &self.ls.scene.scene.name,
+            written,
+            &probes,
+        )?;
         if let Some(f) = &self.fluid {
             f.plots(dir, &self.solid)?;
         }
@@ -766,7 +779,7 @@ impl Model for LsmModel<'_> {
                 self.history.iter().map(|h| h[1] + h[2]).collect(),
             ),
         ];
-        crate::plots::time_series(
+        crate::common::plots::time_series(
             &dir.join("breakage.png"),
             &times,
             &columns,
@@ -805,4 +818,47 @@ impl Model for LsmModel<'_> {
             ..WallSeconds::default()
         }
     }
+}
+
+/// The model `lsm` in the registry ([`crate::MODELS`]).
+pub struct LsmKind;
+
+/// The registry's value of the model.
+pub static KIND: LsmKind = LsmKind;
+
+impl ModelKind for LsmKind {
+    fn name(&self) -> &'static str {
+        "lsm"
+    }
+    fn sections(&self) -> &'static [&'static str] {
+        &["bonds", "contacts", "lsm", "loading", "injection"]
+    }
+    fn reads(&self) -> &'static [&'static str] {
+        &["particles", "lbm", "thermal"]
+    }
+    fn sections_of(
+        &self,
+        doc: toml::Spanned<toml::de::DeTable<'_>>,
+    ) -> Result<std::sync::Arc<dyn OwnSections>, toml::de::Error> {
+        own_sections::<file::LsmSections>(doc)
+    }
+    fn check(&self, ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
+        let _ = laws;
+        check::check(ls)
+    }
+    fn run(
+        &self,
+        ls: &LoadedScene,
+        laws: &LawRegistry,
+        out: &Path,
+        observer: &mut dyn Observer,
+    ) -> Result<Summary, RunError> {
+        let _ = laws;
+        run(ls, out, observer)
+    }
+}
+
+/// The model's own sections of a checked scene.
+pub(crate) fn own(ls: &LoadedScene) -> &file::LsmSections {
+    ls.own::<file::LsmSections>()
 }

@@ -1,21 +1,13 @@
 //! Validation of an NSCD scene: every value checked, every key of another model refused
 //! with the key and the model named.
 
-use crate::check::{LoadedScene, SceneError, k, ki, step_count_f64};
-use crate::file::KeyPart;
+use crate::common::loaded::{LoadedScene, SceneError, k, ki};
+use crate::common::particles::{check_output_of, check_particle_schedule};
+use crate::common::sections::KeyPart;
 
 use super::file::WallComponent;
 
-/// Top-level sections of the NSCD model.
-pub const SECTIONS: [&str; 4] = ["particles", "wall", "contact", "nscd"];
-/// Top-level sections every model reads.
-const SHARED: [&str; 4] = ["scene", "schedule", "output", "solver"];
-/// Top-level sections of the continuum model.
-const CONTINUUM: [&str; 10] = [
-    "grid", "region", "material", "fluid", "bc", "loads", "source", "well", "initial", "physics",
-];
-
-pub use crate::particle_output::PARTICLE_FIELDS;
+pub use crate::common::particle_output::PARTICLE_FIELDS;
 /// Fields of a tracked cell (`cell = { center, radius }` probes).
 pub const CELL_FIELDS: [&str; 8] = [
     "p",
@@ -27,30 +19,6 @@ pub const CELL_FIELDS: [&str; 8] = [
     "contacts",
     "broken_bonds",
 ];
-
-fn top_level(ls: &LoadedScene) -> Vec<String> {
-    toml::from_str::<toml::Table>(&ls.text)
-        .map(|t| t.keys().cloned().collect())
-        .unwrap_or_default()
-}
-
-/// Whether the scene text has the top-level section `name`.
-pub fn has_section(ls: &LoadedScene, name: &str) -> bool {
-    top_level(ls).iter().any(|s| s == name)
-}
-
-/// Refuse the NSCD sections in a scene of another `model`.
-pub fn refuse_sections(ls: &LoadedScene, model: &str) -> Result<(), SceneError> {
-    for key in top_level(ls) {
-        if SECTIONS.contains(&key.as_str()) {
-            return Err(ls.error(
-                &k(&[&key]),
-                format!("belongs to model \"nscd\", not \"{model}\""),
-            ));
-        }
-    }
-    Ok(())
-}
 
 fn finite(ls: &LoadedScene, key: &[KeyPart], v: f64) -> Result<(), SceneError> {
     if v.is_finite() {
@@ -76,22 +44,12 @@ fn non_negative(ls: &LoadedScene, key: &[KeyPart], v: f64) -> Result<(), SceneEr
     }
 }
 
-pub use crate::particles::MAX_PARTICLES;
+pub use crate::common::particles::MAX_PARTICLES;
 
 /// Check an NSCD scene.
 pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
     let s = &ls.scene;
-    for key in top_level(ls) {
-        if SECTIONS.contains(&key.as_str()) || SHARED.contains(&key.as_str()) {
-            continue;
-        }
-        let msg = if CONTINUUM.contains(&key.as_str()) {
-            "belongs to model \"continuum\", not \"nscd\"".to_string()
-        } else {
-            "belongs to another model, not \"nscd\"".to_string()
-        };
-        return Err(ls.error(&k(&[&key]), msg));
-    }
+    crate::common::lattice::check::refuse_obstacle_probes(ls, "nscd")?;
     if s.scene.dim != 2 {
         return Err(ls.error(
             &k(&["scene", "dim"]),
@@ -136,9 +94,9 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
             "belongs to model \"continuum\", not \"nscd\"",
         ));
     }
-    crate::particles::check(ls, "nscd")?;
+    crate::common::particles::check(ls, "nscd")?;
     check_walls(ls)?;
-    if let Some(c) = &s.contact {
+    if let Some(c) = &super::own(ls).contact {
         let key = |f: &str| k(&["contact", f]);
         for (f, v) in [
             ("mu", c.mu),
@@ -151,7 +109,7 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
             }
         }
     }
-    if let Some(n) = &s.nscd {
+    if let Some(n) = &super::own(ls).nscd {
         let key = |f: &str| k(&["nscd", f]);
         if let Some(t) = n.theta
             && !(0.5..=1.0).contains(&t)
@@ -243,41 +201,8 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
     check_output_of(ls, "nscd", &CELL_FIELDS, &[])
 }
 
-/// The `[schedule]` of a particle model: present, `end_time > 0`, `dt > 0` or `steps ≥ 1`,
-/// and no more output steps than a run may take.
-pub(crate) fn check_particle_schedule(ls: &LoadedScene, model: &str) -> Result<(), SceneError> {
-    let Some(sch) = &ls.scene.schedule else {
-        return Err(ls.error(
-            &k(&["schedule"]),
-            format!("is missing: model \"{model}\" needs end_time and dt or steps"),
-        ));
-    };
-    positive(ls, &k(&["schedule", "end_time"]), sch.end_time)?;
-    match (sch.dt, sch.steps) {
-        (Some(dt), _) => positive(ls, &k(&["schedule", "dt"]), dt)?,
-        (None, Some(n)) if n >= 1 => {}
-        (None, Some(n)) => {
-            return Err(ls.error(&k(&["schedule", "steps"]), format!("= {n} must be ≥ 1")));
-        }
-        (None, None) => {
-            return Err(ls.error(&k(&["schedule", "dt"]), "is missing: give dt or steps"));
-        }
-    }
-    let n = step_count_f64(sch);
-    if n > crate::limits::MAX_STEPS as f64 {
-        return Err(ls.error(
-            &k(&["schedule", if sch.dt.is_some() { "dt" } else { "steps" }]),
-            format!(
-                "gives {n:.3e} steps, more than the {} a run may take",
-                crate::limits::MAX_STEPS
-            ),
-        ));
-    }
-    Ok(())
-}
-
 fn check_walls(ls: &LoadedScene) -> Result<(), SceneError> {
-    for (i, w) in ls.scene.wall.iter().enumerate() {
+    for (i, w) in super::own(ls).wall.iter().enumerate() {
         let key = |f: &str| ki("wall", i, &[f]);
         match (&w.from, &w.to, &w.polygon) {
             (Some(a), Some(b), None) => {
@@ -340,109 +265,6 @@ fn check_walls(ls: &LoadedScene) -> Result<(), SceneError> {
                 finite(ls, &key("force"), v)?;
             }
         }
-    }
-    Ok(())
-}
-
-/// Check the probes and lines of a particle scene of `model`: particle fields with
-/// `particle = N`, `cell_fields` with `cell = { center, radius }`, `global_fields` with
-/// neither.
-pub fn check_output_of(
-    ls: &LoadedScene,
-    model: &str,
-    cell_fields: &[&str],
-    global_fields: &[&str],
-) -> Result<(), SceneError> {
-    let s = &ls.scene;
-    if s.output.every < 1 {
-        return Err(ls.error(
-            &k(&["output", "every"]),
-            format!("= {} must be ≥ 1", s.output.every),
-        ));
-    }
-    let mut names = std::collections::BTreeSet::new();
-    for (i, p) in s.output.probe.iter().enumerate() {
-        let key = |f: &str| ki("output.probe", i, &[f]);
-        if !names.insert(p.name.clone()) || p.name == "time" || p.name.contains(',') {
-            return Err(ls.error(
-                &key("name"),
-                format!("= \"{}\" is repeated, reserved or contains a comma", p.name),
-            ));
-        }
-        if !p.at.is_empty() {
-            return Err(ls.error(
-                &key("at"),
-                format!("is for grid models; model \"{model}\" probes a particle or a cell"),
-            ));
-        }
-        let f = p.field.as_str();
-        if PARTICLE_FIELDS.contains(&f) {
-            match (p.particle, &p.cell) {
-                (Some(n), None) if n >= 0 => {}
-                (Some(n), None) => {
-                    return Err(ls.error(&key("particle"), format!("= {n} must be ≥ 0")));
-                }
-                _ => {
-                    return Err(ls.error(
-                        &key("particle"),
-                        format!("is required (and cell is not allowed) for field \"{f}\""),
-                    ));
-                }
-            }
-        } else if global_fields.contains(&f) {
-            if p.particle.is_some() || p.cell.is_some() {
-                return Err(ls.error(
-                    &key(if p.particle.is_some() {
-                        "particle"
-                    } else {
-                        "cell"
-                    }),
-                    format!("is not allowed for field \"{f}\" (a value of the whole scene)"),
-                ));
-            }
-        } else if cell_fields.contains(&f) {
-            match (p.particle, &p.cell) {
-                (None, Some(c)) => {
-                    if c.center.len() != 2 || !c.center.iter().all(|v| v.is_finite()) {
-                        return Err(ls.error(&key("cell"), "center must be [x, y]"));
-                    }
-                    positive(ls, &key("cell"), c.radius)?;
-                }
-                _ => {
-                    return Err(ls.error(
-                        &key("cell"),
-                        format!("is required (and particle is not allowed) for field \"{f}\""),
-                    ));
-                }
-            }
-        } else {
-            return Err(ls.error(
-                &key("field"),
-                format!(
-                    "= \"{f}\" is not a field of model \"{model}\" (particle: {}; cell: {}; scene: {})",
-                    PARTICLE_FIELDS.join(" "),
-                    cell_fields.join(" "),
-                    global_fields.join(" ")
-                ),
-            ));
-        }
-    }
-    for (i, l) in s.output.line.iter().enumerate() {
-        let key = |f: &str| ki("output.line", i, &[f]);
-        if !PARTICLE_FIELDS.contains(&l.field.as_str()) {
-            return Err(ls.error(
-                &key("field"),
-                format!(
-                    "= \"{}\" must be a particle field: {}",
-                    l.field,
-                    PARTICLE_FIELDS.join(" ")
-                ),
-            ));
-        }
-        if l.from.len() != 2 || l.to.len() != 2 {
-            return Err(ls.error(&key("from"), "and to must be [x, y]"));
-        }
-        crate::check::line_points_and_name(ls, i, l)?;
     }
     Ok(())
 }

@@ -1,9 +1,9 @@
 //! The sections of an NSCD scene (`[scene] model = "nscd"`), parsed strictly like the
-//! rest of the file ([`crate::file`]).
+//! rest of the file ([`crate::common::sections`]).
 
 use serde::Deserialize;
 
-pub use crate::particles::{ParticleKind, ParticlesSection, RadiusSpec};
+pub use crate::common::particles::{ParticleKind, ParticlesSection, RadiusSpec};
 
 /// A velocity component of a wall: a number (m/s) or `"free"`.
 #[derive(Clone, Debug, Deserialize, PartialEq)]
@@ -121,4 +121,17 @@ pub struct FaultSection {
     pub half_apex: Option<f64>,
     /// Band height of the limit-angle measure (m, default 4 × the largest radius).
     pub band: Option<f64>,
+}
+
+/// The sections of model `nscd` read by the model itself: `[[wall]]`, `[contact]`,
+/// `[nscd]` (`[particles]` is shared with model `lsm`).
+#[derive(Clone, Debug, Default, Deserialize)]
+pub struct NscdSections {
+    /// `[[wall]]`: rigid bodies.
+    #[serde(default)]
+    pub wall: Vec<WallSection>,
+    /// `[contact]`: the contact law.
+    pub contact: Option<ContactSection>,
+    /// `[nscd]`: the solver.
+    pub nscd: Option<NscdSection>,
 }

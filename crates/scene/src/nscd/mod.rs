@@ -18,7 +18,11 @@
 pub mod check;
 pub mod fault;
 pub mod file;
-pub mod plots;
+
+use crate::common::laws::LawRegistry;
+use crate::common::loaded::SceneError;
+use crate::common::model::ModelKind;
+use crate::common::model::{OwnSections, own_sections};
 
 use std::cell::RefCell;
 use std::collections::BTreeMap;
@@ -27,14 +31,14 @@ use std::time::Instant;
 
 use porofrac_grid::io::PvdWriter;
 
-use crate::particle_output;
+use crate::common::particle_output;
 use porofrac_nscd::{Axis, ContactLaw, Nscd, NscdError, Ordering, RigidBody, SolverParams};
 use porofrac_particles::TrackedCell;
 
-use crate::check::{LoadedScene, k, ki, step_count};
-use crate::driver::{Observer, drive};
-use crate::model::{Model, RunError, Sizes, StepStats};
-use crate::output::{SolverStats, Summary, WallSeconds};
+use crate::common::driver::{Observer, drive};
+use crate::common::loaded::{LoadedScene, k, ki, step_count};
+use crate::common::model::{Model, RunError, Sizes, StepStats};
+use crate::common::output::{SolverStats, Summary, WallSeconds};
 
 use file::{OrderingChoice, WallComponent};
 
@@ -109,7 +113,7 @@ fn scene_error(ls: &LoadedScene, e: &NscdError) -> RunError {
 }
 
 fn walls(ls: &LoadedScene) -> Vec<RigidBody> {
-    ls.scene
+    own(ls)
         .wall
         .iter()
         .map(|w| {
@@ -136,8 +140,8 @@ fn walls(ls: &LoadedScene) -> Vec<RigidBody> {
 /// Build the model of a checked NSCD scene.
 pub fn build(ls: &LoadedScene) -> Result<NscdModel<'_>, RunError> {
     let s = &ls.scene;
-    let disks = crate::particles::generate(ls)?;
-    let c = s.contact.clone().unwrap_or_default();
+    let disks = crate::common::particles::generate(ls)?;
+    let c = own(ls).contact.clone().unwrap_or_default();
     let mu = c.mu.unwrap_or(0.0);
     let law = ContactLaw {
         mu_static: c.mu_static.unwrap_or(mu),
@@ -145,7 +149,7 @@ pub fn build(ls: &LoadedScene) -> Result<NscdModel<'_>, RunError> {
         cohesion: c.cohesion.unwrap_or(0.0),
         cohesion_distance: c.d_w.unwrap_or(0.0),
     };
-    let n = s.nscd.clone().unwrap_or_default();
+    let n = own(ls).nscd.clone().unwrap_or_default();
     let defaults = SolverParams::default();
     let params = SolverParams {
         theta: n.theta.unwrap_or(defaults.theta),
@@ -427,8 +431,13 @@ impl Model for NscdModel<'_> {
             .zip(series)
             .map(|(p, v)| (p.name.clone(), p.field.clone(), v.clone()))
             .collect();
-        plots::probe_plots(dir, &self.ls.scene.scene.name, written, &probes)?;
-        plots::layers(&dir.join("layers.png"), &self.sys.disks)?;
+        crate::common::particle_plots::probe_plots(
+            dir,
+            &self.ls.scene.scene.name,
+            written,
+            &probes,
+        )?;
+        crate::common::particle_plots::layers(&dir.join("layers.png"), &self.sys.disks)?;
         Ok(())
     }
 
@@ -464,4 +473,44 @@ impl Model for NscdModel<'_> {
             ..WallSeconds::default()
         }
     }
+}
+
+/// The model `nscd` in the registry ([`crate::MODELS`]).
+pub struct NscdKind;
+
+/// The registry's value of the model.
+pub static KIND: NscdKind = NscdKind;
+
+impl ModelKind for NscdKind {
+    fn name(&self) -> &'static str {
+        "nscd"
+    }
+    fn sections(&self) -> &'static [&'static str] {
+        &["particles", "wall", "contact", "nscd"]
+    }
+    fn sections_of(
+        &self,
+        doc: toml::Spanned<toml::de::DeTable<'_>>,
+    ) -> Result<std::sync::Arc<dyn OwnSections>, toml::de::Error> {
+        own_sections::<file::NscdSections>(doc)
+    }
+    fn check(&self, ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
+        let _ = laws;
+        check::check(ls)
+    }
+    fn run(
+        &self,
+        ls: &LoadedScene,
+        laws: &LawRegistry,
+        out: &Path,
+        observer: &mut dyn Observer,
+    ) -> Result<Summary, RunError> {
+        let _ = laws;
+        run(ls, out, observer)
+    }
+}
+
+/// The model's own sections of a checked scene.
+pub(crate) fn own(ls: &LoadedScene) -> &file::NscdSections {
+    ls.own::<file::NscdSections>()
 }

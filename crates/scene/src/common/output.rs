@@ -184,7 +184,7 @@ pub struct Summary {
     pub errors: std::collections::BTreeMap<String, f64>,
     /// porofrac version.
     pub version: String,
-    /// Keys a model adds ([`crate::model::Model::summary_extras`]: the `lattice` block
+    /// Keys a model adds ([`crate::common::model::Model::summary_extras`]: the `lattice` block
     /// and `mlups` of the lattice Boltzmann model, the particle statistics of contact
     /// dynamics).
     #[serde(flatten)]
@@ -220,7 +220,7 @@ pub fn peak_memory_bytes() -> u64 {
 /// Write an error status into `summary.json` of a failed run (best effort: the run's own
 /// error is what the caller reports).
 pub(crate) fn write_failed_summary(
-    ls: &crate::check::LoadedScene,
+    ls: &crate::common::loaded::LoadedScene,
     out: &Path,
     error: &str,
     start: std::time::Instant,

@@ -4,18 +4,20 @@
 //! state from one output time to the next (*step*), and answers what the shared outputs
 //! ask of it (*fields*): the value of each probe and of each line point, the VTK file of
 //! a written step, the extrema of its fields, its plots and its part of `summary.json`.
-//! The loop of [`crate::driver`] does the rest the same way for every model.
+//! The loop of [`crate::common::driver`] does the rest the same way for every model.
 
 use std::collections::BTreeMap;
 use std::path::Path;
+use std::sync::Arc;
 
 use porofrac_grid::GridError;
 use porofrac_sim::SimError;
 
-use crate::check::{LoadedScene, SceneError, k};
-use crate::driver::Observer;
-use crate::laws::LawRegistry;
-use crate::output::{OutputError, SolverStats, Summary, WallSeconds};
+use crate::common::driver::Observer;
+use crate::common::laws::LawRegistry;
+use crate::common::loaded::{LoadedScene, SceneError, k};
+use crate::common::output::{OutputError, SolverStats, Summary, WallSeconds};
+use crate::common::sections::KeyPart;
 
 /// Anything that ends a run.
 #[derive(Debug, thiserror::Error)]
@@ -43,7 +45,7 @@ pub enum RunError {
     Biot(#[from] porofrac_sim::BiotError),
     /// A plot could not be drawn.
     #[error("plot: {0}")]
-    Plot(#[from] crate::plots::PlotError),
+    Plot(#[from] crate::common::plots::PlotError),
     /// The coupled fracturing step failed.
     #[error("{0}")]
     Coupled(#[from] porofrac_sim::FractureError),
@@ -108,8 +110,71 @@ pub trait Model {
     }
 }
 
-/// Run a validated scene: dispatch on `[scene] model`, in the thread pool the scene asks
-/// for, and write `summary.json`.
+/// A model's own sections, read from the parsed file by [`ModelKind::sections_of`] and
+/// reached with [`LoadedScene::own`].
+pub trait OwnSections: std::any::Any + std::fmt::Debug + Send + Sync {}
+
+impl<T: std::any::Any + std::fmt::Debug + Send + Sync> OwnSections for T {}
+
+/// One model of the registry: its name, the top-level sections it declares, how it reads,
+/// checks and runs a scene. Each model folder exposes one value of a type implementing it
+/// (`KIND`); the crate's list of them is [`crate::MODELS`].
+pub trait ModelKind: Sync {
+    /// The name of `[scene] model`.
+    fn name(&self) -> &'static str;
+    /// The top-level sections that belong to this model: in a scene of another model
+    /// (that does not [`ModelKind::reads`] them) each is refused with
+    /// `belongs to model "<name>", not "<model>"`.
+    fn sections(&self) -> &'static [&'static str];
+    /// Sections of other models this model reads too (none by default).
+    fn reads(&self) -> &'static [&'static str] {
+        &[]
+    }
+    /// How a section of this model is named when another model refuses it (the section
+    /// itself by default).
+    fn refused_as(&self, section: &str) -> Vec<KeyPart> {
+        vec![KeyPart::Key(section.to_string())]
+    }
+    /// Keys of other models the model refuses its own way, before the sections are
+    /// refused by their declared owners (nothing by default).
+    fn refuse(&self, ls: &LoadedScene) -> Result<(), SceneError> {
+        let _ = ls;
+        Ok(())
+    }
+    /// Read the model's own sections (types, unknown keys) from the top-level sections of
+    /// the document that are not shared ones. Errors keep the parser's spans.
+    fn sections_of(
+        &self,
+        doc: toml::Spanned<toml::de::DeTable<'_>>,
+    ) -> Result<Arc<dyn OwnSections>, toml::de::Error> {
+        let _ = doc;
+        Ok(Arc::new(()))
+    }
+    /// Check every value the model reads (after the checks every model shares).
+    fn check(&self, ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError>;
+    /// Build the model and drive it through the schedule, writing its outputs to `out`.
+    fn run(
+        &self,
+        ls: &LoadedScene,
+        laws: &LawRegistry,
+        out: &Path,
+        observer: &mut dyn Observer,
+    ) -> Result<Summary, RunError>;
+}
+
+/// Read a model's own sections from the non-shared part of a document.
+pub fn own_sections<T>(
+    doc: toml::Spanned<toml::de::DeTable<'_>>,
+) -> Result<Arc<dyn OwnSections>, toml::de::Error>
+where
+    T: OwnSections + for<'de> serde::Deserialize<'de>,
+{
+    let t: T = serde::Deserialize::deserialize(toml::de::Deserializer::from(doc))?;
+    Ok(Arc::new(t))
+}
+
+/// Run a validated scene with its model, in the thread pool the scene asks for, and
+/// write `summary.json`.
 pub(crate) fn run(
     ls: &LoadedScene,
     laws: &LawRegistry,
@@ -136,21 +201,18 @@ fn run_model(
     out: &Path,
     observer: &mut dyn Observer,
 ) -> Result<Summary, RunError> {
-    let summary = match ls.model() {
-        "continuum" => crate::continuum::run(ls, laws, out, observer)?,
-        "nscd" => crate::nscd::run(ls, out, observer)?,
-        "lbm" => crate::lbm::run(ls, out, observer)?,
-        "cosserat" => crate::cosserat::run(ls, out, observer)?,
-        "lsm" => crate::lsm::run(ls, out, observer)?,
-        other => {
-            return Err(ls
-                .error(
-                    &k(&["scene", "model"]),
-                    format!("= \"{other}\" is not available in this version of porofrac"),
-                )
-                .into());
-        }
+    let Some(kind) = ls.kind() else {
+        return Err(ls
+            .error(
+                &k(&["scene", "model"]),
+                format!(
+                    "= \"{}\" is not available in this version of porofrac",
+                    ls.model()
+                ),
+            )
+            .into());
     };
+    let summary = kind.run(ls, laws, out, observer)?;
     summary.write(out)?;
     Ok(summary)
 }

@@ -1,323 +1,30 @@
-//! Reading and checking a scene file: every problem is a [`SceneError`] with the file,
-//! line and key.
+//! Checks of a continuum scene (SCENE.md): the grid, materials, regions, boundary
+//! conditions, loads, sources, wells, schedule, physics, solver and outputs, and the
+//! sizes a scene asks for. Every problem is a [`SceneError`] naming its key and line.
 
-use std::fmt;
-use std::path::{Path, PathBuf};
-
-use crate::expr::Expr;
-use crate::file::{
-    Bc, CellCount, Component, GridKind, KeyPart, LinearChoice, NumOrExpr, Permeability, SceneFile,
-    Select, key_text, line_of_offset, locate,
+use crate::common::laws::LawRegistry;
+use crate::common::loaded::{
+    LoadedScene, SceneError, expr_ok, k, ki, len_is, line_points_and_name, positive, step_count_f64,
 };
-use crate::laws::LawRegistry;
+use crate::common::sections::{
+    Bc, CellCount, Component, DiagonalsChoice, GridKind, KeyPart, LinearChoice, Permeability,
+    Select,
+};
 use porofrac_grid::Point;
 use porofrac_grid::generate::RoundWellSpec;
 
-/// A problem in a scene file.
-#[derive(Clone, Debug, PartialEq)]
-pub struct SceneError {
-    /// The scene file.
-    pub file: PathBuf,
-    /// 1-based line.
-    pub line: usize,
-    /// What is wrong, starting with the key (`material.rock.poisson_ratio = 0.5 must be < 0.5`).
-    pub message: String,
-}
-
-impl fmt::Display for SceneError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let name = self.file.file_name().map_or_else(
-            || self.file.display().to_string(),
-            |n| n.to_string_lossy().into_owned(),
-        );
-        write!(f, "{name}:{}: {}", self.line, self.message)
-    }
-}
-
-impl std::error::Error for SceneError {}
-
-/// A parsed scene with its source text (for locating keys in later errors).
-#[derive(Clone, Debug)]
-pub struct LoadedScene {
-    /// The typed scene.
-    pub scene: SceneFile,
-    /// The file it came from.
-    pub path: PathBuf,
-    /// Its text.
-    pub text: String,
-}
-
-impl LoadedScene {
-    /// An error at a key path.
-    pub fn error(&self, path: &[KeyPart], message: impl fmt::Display) -> SceneError {
-        SceneError {
-            file: self.path.clone(),
-            line: locate(&self.text, path),
-            message: format!("{} {}", key_text(path), message),
-        }
-    }
-    /// The model of the scene (`[scene] model`, default `"continuum"`).
-    pub fn model(&self) -> &str {
-        self.scene.scene.model.as_deref().unwrap_or("continuum")
-    }
-    /// Resolve a path written in the scene (relative to the scene file's directory).
-    pub fn resolve(&self, p: &str) -> PathBuf {
-        let p = Path::new(p);
-        if p.is_absolute() {
-            p.to_path_buf()
-        } else {
-            self.path.parent().unwrap_or(Path::new(".")).join(p)
-        }
-    }
-}
-
-/// Key path helper: `k(&["material", "rock", "poisson_ratio"])`.
-pub fn k(parts: &[&str]) -> Vec<KeyPart> {
-    parts.iter().map(|p| KeyPart::Key(p.to_string())).collect()
-}
-
-/// Key path with an index: `ki("bc", 2, &["traction"])`.
-pub fn ki(table: &str, index: usize, rest: &[&str]) -> Vec<KeyPart> {
-    let mut v = k(&table.split('.').collect::<Vec<_>>());
-    v.push(KeyPart::Index(index));
-    v.extend(rest.iter().map(|p| KeyPart::Key(p.to_string())));
-    v
-}
-
-/// Largest scene file read (bytes): a scene is a page of text, not data.
-pub const MAX_SCENE_BYTES: u64 = 16 << 20;
-
-/// Read and parse a scene file (syntax, types, unknown keys).
-pub fn load(path: &Path) -> Result<LoadedScene, SceneError> {
-    let cannot = |e: String| SceneError {
-        file: path.to_path_buf(),
-        line: 0,
-        message: format!("cannot read the scene file: {e}"),
-    };
-    let size = std::fs::metadata(path)
-        .map_err(|e| cannot(e.to_string()))?
-        .len();
-    if size > MAX_SCENE_BYTES {
-        return Err(cannot(format!(
-            "it has {size} bytes, more than the {MAX_SCENE_BYTES} a scene file may have"
-        )));
-    }
-    let text = std::fs::read_to_string(path).map_err(|e| cannot(e.to_string()))?;
-    parse(&text, path)
-}
-
-/// Deepest nesting of TOML arrays and tables in a scene file. The TOML parser recurses
-/// per level, so deeper text is refused before it is parsed.
-pub const MAX_TOML_NESTING: usize = 32;
-
-/// Parse scene text (syntax, types, unknown keys); `path` names it in errors.
-pub fn parse(text: &str, path: &Path) -> Result<LoadedScene, SceneError> {
-    if let Some((offset, depth)) = too_deep(text) {
-        return Err(SceneError {
-            file: path.to_path_buf(),
-            line: line_of_offset(text, offset),
-            message: format!(
-                "arrays and tables nest {depth} levels deep here, more than the \
-                 {MAX_TOML_NESTING} a scene may use"
-            ),
-        });
-    }
-    let text = text.to_string();
-    let scene: SceneFile = toml::from_str(&text).map_err(|e| SceneError {
-        file: path.to_path_buf(),
-        line: e.span().map_or(1, |s| line_of_offset(&text, s.start)),
-        message: e.message().trim().replace('\n', " "),
-    })?;
-    Ok(LoadedScene {
-        scene,
-        path: path.to_path_buf(),
-        text,
-    })
-}
-
-/// The offset and depth where `[`/`{` nesting (outside strings and comments) first
-/// exceeds [`MAX_TOML_NESTING`].
-fn too_deep(text: &str) -> Option<(usize, usize)> {
-    let bytes = text.as_bytes();
-    let mut depth = 0usize;
-    let mut i = 0;
-    let mut at_line_start = true;
-    while i < bytes.len() {
-        let b = bytes[i];
-        match b {
-            b'#' => {
-                while i < bytes.len() && bytes[i] != b'\n' {
-                    i += 1;
-                }
-                continue;
-            }
-            b'"' | b'\'' => {
-                // Skip a string (basic strings honour backslash escapes; triple quotes
-                // are three empty-or-not strings in a row, which skips the same way).
-                let quote = b;
-                i += 1;
-                while i < bytes.len() && bytes[i] != quote {
-                    if quote == b'"' && bytes[i] == b'\\' {
-                        i += 1;
-                    }
-                    i += 1;
-                }
-            }
-            b'[' | b'{' if depth > 0 || !(at_line_start && b == b'[') => {
-                depth += 1;
-                if depth > MAX_TOML_NESTING {
-                    return Some((i, depth));
-                }
-            }
-            b']' | b'}' => depth = depth.saturating_sub(1),
-            b'\n' => {
-                at_line_start = true;
-                i += 1;
-                continue;
-            }
-            _ => {}
-        }
-        if !b.is_ascii_whitespace() {
-            at_line_start = false;
-        }
-        i += 1;
-    }
-    None
-}
-
-fn positive(ls: &LoadedScene, path: &[KeyPart], v: f64) -> Result<(), SceneError> {
-    if !(v.is_finite() && v > 0.0) {
-        return Err(ls.error(path, format!("= {v} must be > 0")));
-    }
-    Ok(())
-}
-
-fn len_is(ls: &LoadedScene, path: &[KeyPart], got: usize, want: usize) -> Result<(), SceneError> {
-    if got != want {
-        return Err(ls.error(path, format!("has {got} components, the scene is {want}D")));
-    }
-    Ok(())
-}
-
-/// The part of `[[output.line]]` number `i` every model checks alike: `points` in
-/// `2..=MAX_LINE_POINTS` and a name that is a file name.
-pub(crate) fn line_points_and_name(
-    ls: &LoadedScene,
-    i: usize,
-    l: &crate::file::Line,
-) -> Result<(), SceneError> {
-    if !(2..=crate::limits::MAX_LINE_POINTS as i64).contains(&l.points) {
-        return Err(ls.error(
-            &ki("output.line", i, &["points"]),
-            format!(
-                "= {} must be in 2..={}",
-                l.points,
-                crate::limits::MAX_LINE_POINTS
-            ),
-        ));
-    }
-    if l.name.is_empty() || l.name.contains(['/', '\\']) {
-        return Err(ls.error(
-            &ki("output.line", i, &["name"]),
-            "must be a non-empty file name",
-        ));
-    }
-    Ok(())
-}
-
-/// A number (finite) or an expression that parses (or `"free"` where allowed).
-pub(crate) fn expr_ok(
-    ls: &LoadedScene,
-    path: &[KeyPart],
-    v: &NumOrExpr,
-    allow_free: bool,
-) -> Result<(), SceneError> {
-    match v {
-        NumOrExpr::Num(x) if !x.is_finite() => {
-            Err(ls.error(path, format!("= {x} is not a finite number")))
-        }
-        NumOrExpr::Num(_) => Ok(()),
-        NumOrExpr::Expr(s) if allow_free && s == "free" => Ok(()),
-        NumOrExpr::Expr(s) => Expr::parse(s)
-            .map(|_| ())
-            .map_err(|e| ls.error(path, format!("= \"{s}\": bad expression at {e}"))),
-    }
-}
-
-/// Number of steps of a schedule (before the [`crate::limits::MAX_STEPS`] bound; as
-/// a float so absurd requests do not overflow).
-pub fn step_count_f64(sch: &crate::file::Schedule) -> f64 {
-    match (sch.dt, sch.steps) {
-        (Some(dt), _) => (sch.end_time / dt - 1e-9).ceil().max(1.0),
-        (None, Some(n)) => n.max(1) as f64,
-        _ => 1.0,
-    }
-}
-
-/// Number of steps of a checked schedule.
-pub fn step_count(sch: &crate::file::Schedule) -> u64 {
-    step_count_f64(sch) as u64
-}
-
-/// Check every value of a parsed scene. Returns the first problem found.
+/// Check a scene with `[scene] model = "continuum"` (the default), after the checks every
+/// model shares.
 pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
     let s = &ls.scene;
-    let dim = s.scene.dim;
-    if dim != 2 && dim != 3 {
-        return Err(ls.error(&k(&["scene", "dim"]), format!("= {dim} must be 2 or 3")));
-    }
-    let d = dim as usize;
-    if s.scene.name.is_empty() || s.scene.name.contains(['/', '\\']) {
+    let d = s.scene.dim as usize;
+    crate::common::lattice::check::refuse_obstacle_probes(ls, "continuum")?;
+    refuse_cosserat_keys(ls)?;
+    if !ls.has_section("grid") {
         return Err(ls.error(
-            &k(&["scene", "name"]),
-            "must be a non-empty name without slashes",
+            &k(&["grid"]),
+            "is missing: a continuum scene needs a [grid]",
         ));
-    }
-    if s.scene.plane.is_some() && d == 3 {
-        return Err(ls.error(&k(&["scene", "plane"]), "applies to 2D scenes only"));
-    }
-    match ls.model() {
-        "nscd" => {
-            crate::lbm::check::refuse_sections(ls, "nscd")?;
-            crate::lsm::check::refuse_sections(ls, "nscd")?;
-            return crate::nscd::check::check(ls);
-        }
-        "lbm" => {
-            crate::nscd::check::refuse_sections(ls, "lbm")?;
-            crate::lsm::check::refuse_sections(ls, "lbm")?;
-            return crate::lbm::check(ls);
-        }
-        "continuum" => {
-            crate::nscd::check::refuse_sections(ls, "continuum")?;
-            crate::lbm::check::refuse_sections(ls, "continuum")?;
-            crate::lsm::check::refuse_sections(ls, "continuum")?;
-            crate::cosserat::check::refuse_in_continuum(ls)?;
-            if !crate::nscd::check::has_section(ls, "grid") {
-                return Err(ls.error(
-                    &k(&["grid"]),
-                    "is missing: a continuum scene needs a [grid]",
-                ));
-            }
-        }
-        "lsm" => {
-            // [lbm] and [thermal] are the fluid of a lattice solid scene
-            return crate::lsm::check::check(ls);
-        }
-        "cosserat" => {
-            crate::nscd::check::refuse_sections(ls, "cosserat")?;
-            crate::lbm::check::refuse_sections(ls, "cosserat")?;
-            crate::lsm::check::refuse_sections(ls, "cosserat")?;
-            return crate::cosserat::check::check(ls);
-        }
-        other => {
-            return Err(ls.error(
-                &k(&["scene", "model"]),
-                format!(
-                    "= \"{other}\" is not available in this version of porofrac (available: \
-                     continuum, nscd, lbm, cosserat, lsm)"
-                ),
-            ));
-        }
     }
     check_grid(ls, d)?;
     // Materials.
@@ -908,9 +615,9 @@ fn check_wells(ls: &LoadedScene, d: usize) -> Result<(), SceneError> {
 }
 
 /// Bound steps, output series and generated grids before anything is allocated
-/// ([`crate::limits`]).
+/// ([`crate::common::limits`]).
 fn check_sizes(ls: &LoadedScene, d: usize) -> Result<(), SceneError> {
-    use crate::limits::{MAX_CELLS, MAX_STEPS, fits_in_memory, run_bytes};
+    use crate::common::limits::{MAX_CELLS, MAX_STEPS, fits_in_memory, run_bytes};
     let s = &ls.scene;
     if let Some(sch) = &s.schedule {
         let n = step_count_f64(sch);
@@ -993,4 +700,56 @@ fn check_sizes(ls: &LoadedScene, d: usize) -> Result<(), SceneError> {
         &format!("asks for {cells:.3e} cells and {unknowns:.3e} unknowns"),
     )
     .map_err(|e| ls.error(&key, e))
+}
+
+/// In a continuum scene: the Cosserat-only keys are errors naming key and model, and a
+/// missing `youngs_modulus` is reported as missing.
+fn refuse_cosserat_keys(ls: &LoadedScene) -> Result<(), SceneError> {
+    let s = &ls.scene;
+    let cos = |path: Vec<KeyPart>| {
+        ls.error(
+            &path,
+            format!(
+                "is a key of model \"cosserat\", the scene's model is \"{}\"",
+                ls.model()
+            ),
+        )
+    };
+    for (name, m) in &s.material {
+        for (key, set) in [
+            ("shear_modulus", m.shear_modulus.is_some()),
+            ("cosserat_shear_modulus", m.cosserat_shear_modulus.is_some()),
+            ("characteristic_length", m.characteristic_length.is_some()),
+            ("couple_moduli", m.couple_moduli.is_some()),
+            ("micro_inertia", m.micro_inertia.is_some()),
+        ] {
+            if set {
+                return Err(cos(k(&["material", name, key])));
+            }
+        }
+        if m.youngs_modulus.is_nan() {
+            return Err(ls.error(&k(&["material", name, "youngs_modulus"]), "is missing"));
+        }
+    }
+    for (i, bc) in s.bc.iter().enumerate() {
+        if bc.rotation.is_some() {
+            return Err(cos(ki("bc", i, &["rotation"])));
+        }
+        if bc.couple_traction.is_some() {
+            return Err(cos(ki("bc", i, &["couple_traction"])));
+        }
+    }
+    if s.loads.as_ref().is_some_and(|l| l.body_couple.is_some()) {
+        return Err(cos(k(&["loads", "body_couple"])));
+    }
+    if s.solver.penalty.is_some() {
+        return Err(cos(k(&["solver", "penalty"])));
+    }
+    if s.solver.time_integration.is_some() {
+        return Err(cos(k(&["solver", "time_integration"])));
+    }
+    if s.grid.diagonals == Some(DiagonalsChoice::Crossed) {
+        return Err(cos(k(&["grid", "diagonals"])));
+    }
+    Ok(())
 }

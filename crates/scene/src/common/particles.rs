@@ -8,7 +8,8 @@ use serde::Deserialize;
 use porofrac_particles::packing::{Hole, RadiusDistribution, Region, hexagonal_in};
 use porofrac_particles::{Disks, RandomPacking};
 
-use crate::check::{LoadedScene, SceneError, k};
+use crate::common::loaded::{LoadedScene, SceneError, k, ki, step_count_f64};
+use crate::common::particle_output::PARTICLE_FIELDS;
 
 /// `[particles] kind`: how the disks are generated.
 #[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
@@ -349,4 +350,153 @@ pub fn generate(ls: &LoadedScene) -> Result<Disks, SceneError> {
     }
     Disks::new(&centres, &radii, p.density)
         .map_err(|e| ls.error(&k(&["particles"]), format!(": {e}")))
+}
+
+/// The `[schedule]` of a particle model: present, `end_time > 0`, `dt > 0` or `steps ≥ 1`,
+/// and no more output steps than a run may take.
+pub fn check_particle_schedule(ls: &LoadedScene, model: &str) -> Result<(), SceneError> {
+    let Some(sch) = &ls.scene.schedule else {
+        return Err(ls.error(
+            &k(&["schedule"]),
+            format!("is missing: model \"{model}\" needs end_time and dt or steps"),
+        ));
+    };
+    positive_at(ls, &k(&["schedule", "end_time"]), sch.end_time)?;
+    match (sch.dt, sch.steps) {
+        (Some(dt), _) => positive_at(ls, &k(&["schedule", "dt"]), dt)?,
+        (None, Some(n)) if n >= 1 => {}
+        (None, Some(n)) => {
+            return Err(ls.error(&k(&["schedule", "steps"]), format!("= {n} must be ≥ 1")));
+        }
+        (None, None) => {
+            return Err(ls.error(&k(&["schedule", "dt"]), "is missing: give dt or steps"));
+        }
+    }
+    let n = step_count_f64(sch);
+    if n > crate::common::limits::MAX_STEPS as f64 {
+        return Err(ls.error(
+            &k(&["schedule", if sch.dt.is_some() { "dt" } else { "steps" }]),
+            format!(
+                "gives {n:.3e} steps, more than the {} a run may take",
+                crate::common::limits::MAX_STEPS
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Check the probes and lines of a particle scene of `model`: particle fields with
+/// `particle = N`, `cell_fields` with `cell = { center, radius }`, `global_fields` with
+/// neither.
+pub fn check_output_of(
+    ls: &LoadedScene,
+    model: &str,
+    cell_fields: &[&str],
+    global_fields: &[&str],
+) -> Result<(), SceneError> {
+    let s = &ls.scene;
+    if s.output.every < 1 {
+        return Err(ls.error(
+            &k(&["output", "every"]),
+            format!("= {} must be ≥ 1", s.output.every),
+        ));
+    }
+    let mut names = std::collections::BTreeSet::new();
+    for (i, p) in s.output.probe.iter().enumerate() {
+        let key = |f: &str| ki("output.probe", i, &[f]);
+        if !names.insert(p.name.clone()) || p.name == "time" || p.name.contains(',') {
+            return Err(ls.error(
+                &key("name"),
+                format!("= \"{}\" is repeated, reserved or contains a comma", p.name),
+            ));
+        }
+        if !p.at.is_empty() {
+            return Err(ls.error(
+                &key("at"),
+                format!("is for grid models; model \"{model}\" probes a particle or a cell"),
+            ));
+        }
+        let f = p.field.as_str();
+        if PARTICLE_FIELDS.contains(&f) {
+            match (p.particle, &p.cell) {
+                (Some(n), None) if n >= 0 => {}
+                (Some(n), None) => {
+                    return Err(ls.error(&key("particle"), format!("= {n} must be ≥ 0")));
+                }
+                _ => {
+                    return Err(ls.error(
+                        &key("particle"),
+                        format!("is required (and cell is not allowed) for field \"{f}\""),
+                    ));
+                }
+            }
+        } else if global_fields.contains(&f) {
+            if p.particle.is_some() || p.cell.is_some() {
+                return Err(ls.error(
+                    &key(if p.particle.is_some() {
+                        "particle"
+                    } else {
+                        "cell"
+                    }),
+                    format!("is not allowed for field \"{f}\" (a value of the whole scene)"),
+                ));
+            }
+        } else if cell_fields.contains(&f) {
+            match (p.particle, &p.cell) {
+                (None, Some(c)) => {
+                    if c.center.len() != 2 || !c.center.iter().all(|v| v.is_finite()) {
+                        return Err(ls.error(&key("cell"), "center must be [x, y]"));
+                    }
+                    positive_at(ls, &key("cell"), c.radius)?;
+                }
+                _ => {
+                    return Err(ls.error(
+                        &key("cell"),
+                        format!("is required (and particle is not allowed) for field \"{f}\""),
+                    ));
+                }
+            }
+        } else {
+            return Err(ls.error(
+                &key("field"),
+                format!(
+                    "= \"{f}\" is not a field of model \"{model}\" (particle: {}; cell: {}; scene: {})",
+                    PARTICLE_FIELDS.join(" "),
+                    cell_fields.join(" "),
+                    global_fields.join(" ")
+                ),
+            ));
+        }
+    }
+    for (i, l) in s.output.line.iter().enumerate() {
+        let key = |f: &str| ki("output.line", i, &[f]);
+        if !PARTICLE_FIELDS.contains(&l.field.as_str()) {
+            return Err(ls.error(
+                &key("field"),
+                format!(
+                    "= \"{}\" must be a particle field: {}",
+                    l.field,
+                    PARTICLE_FIELDS.join(" ")
+                ),
+            ));
+        }
+        if l.from.len() != 2 || l.to.len() != 2 {
+            return Err(ls.error(&key("from"), "and to must be [x, y]"));
+        }
+        crate::common::loaded::line_points_and_name(ls, i, l)?;
+    }
+    Ok(())
+}
+
+/// `v` is a finite number > 0.
+fn positive_at(
+    ls: &crate::common::loaded::LoadedScene,
+    key: &[crate::common::sections::KeyPart],
+    v: f64,
+) -> Result<(), crate::common::loaded::SceneError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(ls.error(key, format!("= {v} must be a positive number")))
+    }
 }

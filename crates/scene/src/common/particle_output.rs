@@ -12,9 +12,9 @@ use porofrac_grid::io::PvdWriter;
 use porofrac_particles::Disks;
 use porofrac_particles::vtk::{ContactLine, write_contacts, write_particles_with};
 
-use crate::check::LoadedScene;
-use crate::model::RunError;
-use crate::plots::PlotError;
+use crate::common::loaded::LoadedScene;
+use crate::common::model::RunError;
+use crate::common::plots::PlotError;
 
 /// Fields of one particle (`particle = N` probes, lines).
 pub const PARTICLE_FIELDS: [&str; 8] = ["x", "y", "vx", "vy", "omega", "fx", "fy", "radius"];
@@ -117,7 +117,7 @@ pub fn write_vtk(
     contacts_pvd: &RefCell<Option<PvdWriter>>,
 ) -> Result<String, RunError> {
     let io = |e: porofrac_particles::ParticleError| {
-        RunError::Output(crate::output::OutputError {
+        RunError::Output(crate::common::output::OutputError {
             path: dir.to_path_buf(),
             source: std::io::Error::other(e.to_string()),
         })

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use crate::plots::PlotError;
+use crate::common::plots::PlotError;
 
 /// Write `values` (x-fastest, `n[0] × n[1]`) as a PNG; `solid` nodes are drawn grey.
 pub(crate) fn field_png(

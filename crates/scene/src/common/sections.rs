@@ -3,7 +3,7 @@
 //!
 //! Parsing is strict: unknown keys, wrong types and choices that are not one of the
 //! listed words are errors that name the file, line and key; values are checked in
-//! [`crate::check`]. Every choice is an enum here, so nothing downstream compares
+//! [`crate::common::loaded`]. Every choice is an enum here, so nothing downstream compares
 //! strings.
 
 use std::collections::BTreeMap;
@@ -16,19 +16,19 @@ use serde::Deserialize;
 pub enum NumOrExpr {
     /// A constant.
     Num(f64),
-    /// An expression (see [`crate::expr`]).
+    /// An expression (see [`crate::common::expr`]).
     Expr(String),
 }
 
 impl NumOrExpr {
     /// The value as a field of position and time (expressions compiled once; a constant
     /// expression becomes a constant). Checked scenes only: an expression that does not
-    /// parse here would have been refused by [`crate::check`], and gives NaN.
+    /// parse here would have been refused by [`crate::common::loaded`], and gives NaN.
     pub fn to_field(&self) -> porofrac_grid::ScalarField {
         use porofrac_grid::ScalarField;
         match self {
             Self::Num(x) => ScalarField::Const(*x),
-            Self::Expr(s) => match crate::expr::Expr::parse(s) {
+            Self::Expr(s) => match crate::common::expr::Expr::parse(s) {
                 Ok(e) => match e.as_constant() {
                     Some(c) => ScalarField::Const(c),
                     None => ScalarField::from_fn(move |x, t| e.eval(x, t)),
@@ -49,9 +49,9 @@ impl NumOrExpr {
 
 /// The components of a vector given as numbers or expressions (body force, exact
 /// displacement) as one field: the expressions are compiled together
-/// ([`crate::expr::Program`]), so subexpressions the components share are evaluated once.
+/// ([`crate::common::expr::Program`]), so subexpressions the components share are evaluated once.
 pub fn vector_field<const D: usize>(values: &[NumOrExpr]) -> porofrac_sim::VectorField<D> {
-    use crate::expr::{Expr, Program};
+    use crate::common::expr::{Expr, Program};
     use porofrac_sim::VectorField;
     if values
         .iter()
@@ -198,13 +198,37 @@ pub enum LinearChoice {
     GmresAmg,
 }
 
-/// A whole scene file.
+/// The top-level sections of [`SceneFile`]: those every model may read, and those two
+/// models share. Every other top-level section belongs to one model, which reads it
+/// ([`crate::common::model::ModelKind::sections_of`]).
+pub const SHARED_SECTIONS: [&str; 17] = [
+    "scene",
+    "grid",
+    "region",
+    "material",
+    "fluid",
+    "bc",
+    "loads",
+    "source",
+    "well",
+    "initial",
+    "schedule",
+    "physics",
+    "solver",
+    "output",
+    "particles",
+    "lbm",
+    "thermal",
+];
+
+/// The sections of a scene file that every model may read or two models share
+/// ([`SHARED_SECTIONS`]).
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneFile {
     /// `[scene]`.
     pub scene: SceneSection,
-    /// `[grid]` (required by the continuum model, [`crate::check`]; other models have
+    /// `[grid]` (required by the continuum model, [`crate::common::loaded`]; other models have
     /// none).
     #[serde(default)]
     pub grid: GridSection,
@@ -241,31 +265,11 @@ pub struct SceneFile {
     #[serde(default)]
     pub output: Output,
     /// `[particles]` (models `nscd` and `lsm`).
-    pub particles: Option<crate::particles::ParticlesSection>,
-    /// `[[wall]]`: rigid bodies (model `nscd`).
-    #[serde(default)]
-    pub wall: Vec<crate::nscd::file::WallSection>,
-    /// `[contact]`: the contact law (model `nscd`).
-    pub contact: Option<crate::nscd::file::ContactSection>,
-    /// `[nscd]`: the solver (model `nscd`).
-    pub nscd: Option<crate::nscd::file::NscdSection>,
-    /// `[bonds]` (model `lsm`).
-    pub bonds: Option<crate::lsm::file::BondsSection>,
-    /// `[contacts]` (model `lsm`).
-    pub contacts: Option<crate::lsm::file::ContactsSection>,
-    /// `[lsm]` (model `lsm`).
-    pub lsm: Option<crate::lsm::file::LsmSection>,
-    /// `[loading]` (model `lsm`).
-    pub loading: Option<crate::lsm::file::LoadingSection>,
-    /// `[injection]` (model `lsm` with `[lbm]`).
-    pub injection: Option<crate::lsm::fluid::InjectionSection>,
+    pub particles: Option<crate::common::particles::ParticlesSection>,
     /// `[lbm]` (lattice Boltzmann model).
-    pub lbm: Option<crate::lbm::file::LbmSection>,
-    /// `[[obstacle]]` (lattice Boltzmann model).
-    #[serde(default)]
-    pub obstacle: Vec<crate::lbm::file::ObstacleSection>,
+    pub lbm: Option<crate::common::lattice::sections::LbmSection>,
     /// `[thermal]` (lattice Boltzmann model).
-    pub thermal: Option<crate::lbm::file::ThermalSection>,
+    pub thermal: Option<crate::common::lattice::sections::ThermalSection>,
 }
 
 /// `[scene]`.
@@ -471,9 +475,9 @@ pub struct Bc {
     /// Rigid platen.
     pub platen: Option<Platen>,
     /// `model = "cosserat"`: micro-rotation (2D one value, 3D three; or `"free"`).
-    pub rotation: Option<crate::cosserat::keys::PerRotation>,
+    pub rotation: Option<crate::common::rotation_keys::PerRotation>,
     /// `model = "cosserat"`: couple traction (N/m).
-    pub couple_traction: Option<crate::cosserat::keys::PerRotation>,
+    pub couple_traction: Option<crate::common::rotation_keys::PerRotation>,
 }
 
 /// `platen = { force = [...] }`.
@@ -493,7 +497,7 @@ pub struct Loads {
     /// Body force (N/m³) per component.
     pub body_force: Option<Vec<NumOrExpr>>,
     /// `model = "cosserat"`: body couple (N/m²).
-    pub body_couple: Option<crate::cosserat::keys::PerRotation>,
+    pub body_couple: Option<crate::common::rotation_keys::PerRotation>,
 }
 
 /// `[[source]]`.
@@ -593,7 +597,7 @@ pub struct Solver {
     /// `model = "cosserat"`: η of the interior penalty.
     pub penalty: Option<f64>,
     /// `model = "cosserat"`: time integrator with a `[schedule]`.
-    pub time_integration: Option<crate::cosserat::keys::TimeIntegration>,
+    pub time_integration: Option<crate::common::rotation_keys::TimeIntegration>,
 }
 
 /// `[output]`.
@@ -676,7 +680,7 @@ pub struct Line {
 }
 
 /// One step of a key path: a table key or an index into an array of tables.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum KeyPart {
     /// A key.
     Key(String),

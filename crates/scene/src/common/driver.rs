@@ -11,9 +11,9 @@ use std::time::Instant;
 
 use porofrac_grid::io::PvdWriter;
 
-use crate::check::LoadedScene;
-use crate::model::{Model, RunError};
-use crate::output::{CsvTable, OutputError, Summary, WallSeconds, peak_memory_bytes};
+use crate::common::loaded::LoadedScene;
+use crate::common::model::{Model, RunError};
+use crate::common::output::{CsvTable, OutputError, Summary, WallSeconds, peak_memory_bytes};
 
 /// Where a run is, after each step.
 #[derive(Clone, Copy, Debug)]

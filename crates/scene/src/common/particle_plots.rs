@@ -8,7 +8,7 @@ use std::path::Path;
 use plotters::prelude::*;
 use porofrac_particles::Disks;
 
-use crate::plots::{PlotError, time_series};
+use crate::common::plots::{PlotError, time_series};
 
 /// Probe series: `stress.png` (p, q), `dilation.png`, `probes.png` (the others).
 pub fn probe_plots(
@@ -78,7 +78,7 @@ pub fn layers(path: &Path, d: &Disks) -> Result<(), PlotError> {
                 (a.min(p[1] - r), b.max(p[1] + r))
             });
     let band = (hi - lo).max(1e-9) / palette.len() as f64;
-    crate::particle_output::draw_disks(
+    crate::common::particle_output::draw_disks(
         path,
         d,
         |i| palette[(((d.x0[i][1] - lo) / band) as usize).min(palette.len() - 1)],

@@ -10,9 +10,9 @@ use porofrac_grid::io::grdecl::{CornerPointGrid, DeckLimit, fault_faces};
 use porofrac_grid::io::{read_grdecl_with, read_msh, read_vtu};
 use porofrac_grid::{Grid, GridError, Point};
 
-use crate::check::{LoadedScene, k};
-use crate::file::{CellCount, DiagonalsChoice, GridKind, Select};
-use crate::model::RunError;
+use crate::common::loaded::{LoadedScene, k};
+use crate::common::model::RunError;
+use crate::common::sections::{CellCount, DiagonalsChoice, GridKind, Select};
 
 /// What a grid read from a corner-point deck brings besides its cells: each cell's
 /// `(i, j, k)` (0-based) and the deck's rock properties, per grid cell.
@@ -95,14 +95,16 @@ pub fn build_grid(ls: &LoadedScene) -> Result<(AnyGrid, DeckCells), RunError> {
                     .into());
             }
             let limit =
-                crate::limits::machine_memory().map_or_else(DeckLimit::default, |m| DeckLimit {
-                    cells: (m / crate::limits::BYTES_PER_DECK_CELL) as usize,
-                    why: format!(
-                        "a corner-point grid and its run need about {} kB per deck cell; this \
+                crate::common::limits::machine_memory().map_or_else(DeckLimit::default, |m| {
+                    DeckLimit {
+                        cells: (m / crate::common::limits::BYTES_PER_DECK_CELL) as usize,
+                        why: format!(
+                            "a corner-point grid and its run need about {} kB per deck cell; this \
                          machine has {} for a run",
-                        crate::limits::BYTES_PER_DECK_CELL / 1000,
-                        crate::limits::bytes_text(m as f64)
-                    ),
+                            crate::common::limits::BYTES_PER_DECK_CELL / 1000,
+                            crate::common::limits::bytes_text(m as f64)
+                        ),
+                    }
                 });
             let (deck, cp) = read_grdecl_with(&path, &limit).map_err(at_path)?;
             let cells = DeckCells::from_deck(&deck, &cp);
@@ -353,7 +355,7 @@ pub(crate) fn distance_to_path<const D: usize>(x: &Point<D>, path: &[Point<D>]) 
 /// Which cells a selection picks (by centroid).
 pub(crate) fn select_cells<const D: usize>(
     ls: &LoadedScene,
-    key: &[crate::file::KeyPart],
+    key: &[crate::common::sections::KeyPart],
     grid: &Grid<D>,
     deck: &DeckCells,
     sel: &Select,

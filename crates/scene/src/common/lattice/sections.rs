@@ -3,7 +3,7 @@
 
 use serde::Deserialize;
 
-use crate::file::NumOrExpr;
+use crate::common::sections::NumOrExpr;
 
 /// `[lbm]`.
 #[derive(Clone, Debug, Deserialize)]

@@ -4,7 +4,7 @@
 
 use serde::Deserialize;
 
-use crate::file::NumOrExpr;
+use crate::common::sections::NumOrExpr;
 
 /// One value per rotation component: a single value in 2D, three in 3D.
 #[derive(Clone, Debug, Deserialize, PartialEq)]

@@ -1,0 +1,476 @@
+//! Reading and checking a scene file: every problem is a [`SceneError`] with the file,
+//! line and key.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+use serde::Deserialize;
+use toml::Spanned;
+use toml::de::{DeTable, DeValue};
+
+use crate::common::expr::Expr;
+use crate::common::laws::LawRegistry;
+use crate::common::model::{ModelKind, OwnSections};
+use crate::common::sections::{
+    KeyPart, NumOrExpr, SHARED_SECTIONS, SceneFile, key_text, line_of_offset,
+};
+
+/// A problem in a scene file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneError {
+    /// The scene file.
+    pub file: PathBuf,
+    /// 1-based line.
+    pub line: usize,
+    /// What is wrong, starting with the key (`material.rock.poisson_ratio = 0.5 must be < 0.5`).
+    pub message: String,
+}
+
+impl fmt::Display for SceneError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let name = self.file.file_name().map_or_else(
+            || self.file.display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        );
+        write!(f, "{name}:{}: {}", self.line, self.message)
+    }
+}
+
+impl std::error::Error for SceneError {}
+
+/// A parsed scene: the shared sections, the model's own sections, and the line of every
+/// key of the file (from the spans of the TOML parser), for the errors of later checks.
+#[derive(Clone, Debug)]
+pub struct LoadedScene {
+    /// The sections every model reads.
+    pub scene: SceneFile,
+    /// The file it came from.
+    pub path: PathBuf,
+    /// Its text.
+    pub text: String,
+    /// The model of `[scene] model` (`None`: a name no model of the registry has).
+    kind: Option<Kind>,
+    /// The model's own sections, as its [`ModelKind::sections_of`] read them.
+    own: Option<Arc<dyn OwnSections>>,
+    /// Line of every key path of the file.
+    lines: KeyLines,
+}
+
+impl LoadedScene {
+    /// An error at a key path: the line is that of the deepest part of the path written
+    /// in the file (1 if none is).
+    pub fn error(&self, path: &[KeyPart], message: impl fmt::Display) -> SceneError {
+        SceneError {
+            file: self.path.clone(),
+            line: self.lines.line(path),
+            message: format!("{} {}", key_text(path), message),
+        }
+    }
+    /// The model of the scene (`[scene] model`, default `"continuum"`).
+    pub fn model(&self) -> &str {
+        self.scene.scene.model.as_deref().unwrap_or("continuum")
+    }
+    /// The model of the registry the scene names, if there is one.
+    pub fn kind(&self) -> Option<&'static dyn ModelKind> {
+        self.kind.map(|k| k.0)
+    }
+    /// The model's own sections. Panics if `T` is not the type the scene's model reads
+    /// (a model asks for its own type only).
+    pub fn own<T: OwnSections>(&self) -> &T {
+        let own: &dyn std::any::Any = self.own.as_deref().expect("the model's sections are read");
+        own.downcast_ref::<T>()
+            .expect("a model reads its own sections")
+    }
+    /// The top-level keys of the file, in the parser's order.
+    pub fn top_level(&self) -> &[String] {
+        &self.lines.top
+    }
+    /// Whether the file has the top-level section `name`.
+    pub fn has_section(&self, name: &str) -> bool {
+        self.lines.top.iter().any(|s| s == name)
+    }
+    /// Resolve a path written in the scene (relative to the scene file's directory).
+    pub fn resolve(&self, p: &str) -> PathBuf {
+        let p = Path::new(p);
+        if p.is_absolute() {
+            p.to_path_buf()
+        } else {
+            self.path.parent().unwrap_or(Path::new(".")).join(p)
+        }
+    }
+}
+
+/// A model of the registry, shown by its name.
+#[derive(Clone, Copy)]
+struct Kind(&'static dyn ModelKind);
+
+impl fmt::Debug for Kind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.0.name())
+    }
+}
+
+/// The 1-based line of every key path of a file, from the spans of the parsed document: a
+/// table key's line is where the key is written (for `[a.b]`, the header), an element of
+/// an array of tables is at its `[[...]]` header.
+#[derive(Clone, Debug, Default)]
+struct KeyLines {
+    lines: BTreeMap<Vec<KeyPart>, usize>,
+    top: Vec<String>,
+}
+
+impl KeyLines {
+    fn of(doc: &DeTable<'_>, text: &str) -> Self {
+        let mut lines = BTreeMap::new();
+        let mut path = Vec::new();
+        Self::walk(doc, text, &mut path, &mut lines);
+        let top = doc.keys().map(|k| k.get_ref().to_string()).collect();
+        Self { lines, top }
+    }
+
+    fn walk(
+        table: &DeTable<'_>,
+        text: &str,
+        path: &mut Vec<KeyPart>,
+        lines: &mut BTreeMap<Vec<KeyPart>, usize>,
+    ) {
+        for (key, value) in table {
+            path.push(KeyPart::Key(key.get_ref().to_string()));
+            lines.insert(path.clone(), line_of_offset(text, key.span().start));
+            match value.get_ref() {
+                DeValue::Table(t) => Self::walk(t, text, path, lines),
+                DeValue::Array(items) => {
+                    for (i, item) in items.into_iter().enumerate() {
+                        if let DeValue::Table(t) = item.get_ref() {
+                            path.push(KeyPart::Index(i));
+                            lines.insert(path.clone(), line_of_offset(text, item.span().start));
+                            Self::walk(t, text, path, lines);
+                            path.pop();
+                        }
+                    }
+                }
+                _ => {}
+            }
+            path.pop();
+        }
+    }
+
+    /// The line of the longest prefix of `path` written in the file; 1 if none is.
+    fn line(&self, path: &[KeyPart]) -> usize {
+        (1..=path.len())
+            .rev()
+            .find_map(|n| self.lines.get(&path[..n]).copied())
+            .unwrap_or(1)
+    }
+}
+
+/// Key path helper: `k(&["material", "rock", "poisson_ratio"])`.
+pub fn k(parts: &[&str]) -> Vec<KeyPart> {
+    parts.iter().map(|p| KeyPart::Key(p.to_string())).collect()
+}
+
+/// Key path with an index: `ki("bc", 2, &["traction"])`.
+pub fn ki(table: &str, index: usize, rest: &[&str]) -> Vec<KeyPart> {
+    let mut v = k(&table.split('.').collect::<Vec<_>>());
+    v.push(KeyPart::Index(index));
+    v.extend(rest.iter().map(|p| KeyPart::Key(p.to_string())));
+    v
+}
+
+/// Largest scene file read (bytes): a scene is a page of text, not data.
+pub const MAX_SCENE_BYTES: u64 = 16 << 20;
+
+/// Read and parse a scene file (syntax, types, unknown keys).
+/// Models are those of `models`, as for [`parse`].
+pub fn load(path: &Path, models: &[&'static dyn ModelKind]) -> Result<LoadedScene, SceneError> {
+    let cannot = |e: String| SceneError {
+        file: path.to_path_buf(),
+        line: 0,
+        message: format!("cannot read the scene file: {e}"),
+    };
+    let size = std::fs::metadata(path)
+        .map_err(|e| cannot(e.to_string()))?
+        .len();
+    if size > MAX_SCENE_BYTES {
+        return Err(cannot(format!(
+            "it has {size} bytes, more than the {MAX_SCENE_BYTES} a scene file may have"
+        )));
+    }
+    let text = std::fs::read_to_string(path).map_err(|e| cannot(e.to_string()))?;
+    parse(&text, path, models)
+}
+
+/// Deepest nesting of TOML arrays and tables in a scene file. The TOML parser recurses
+/// per level, so deeper text is refused before it is parsed.
+pub const MAX_TOML_NESTING: usize = 32;
+
+/// Parse scene text once (syntax, types, unknown keys): the shared sections, and the
+/// own sections of the model of `[scene] model` found in `models`; `path` names the file
+/// in errors.
+pub fn parse(
+    text: &str,
+    path: &Path,
+    models: &[&'static dyn ModelKind],
+) -> Result<LoadedScene, SceneError> {
+    if let Some((offset, depth)) = too_deep(text) {
+        return Err(SceneError {
+            file: path.to_path_buf(),
+            line: line_of_offset(text, offset),
+            message: format!(
+                "arrays and tables nest {depth} levels deep here, more than the \
+                 {MAX_TOML_NESTING} a scene may use"
+            ),
+        });
+    }
+    let text = text.to_string();
+    let toml_error = |e: toml::de::Error| SceneError {
+        file: path.to_path_buf(),
+        line: e.span().map_or(1, |s| line_of_offset(&text, s.start)),
+        message: e.message().trim().replace('\n', " "),
+    };
+    let doc = DeTable::parse(&text).map_err(toml_error)?;
+    let lines = KeyLines::of(doc.get_ref(), &text);
+    // Top-level keys: the shared sections, or a section some model declares.
+    let owned = |key: &str| models.iter().any(|m| m.sections().contains(&key));
+    for key in &lines.top {
+        if !SHARED_SECTIONS.contains(&key.as_str()) && !owned(key) {
+            let mut known: Vec<&str> = SHARED_SECTIONS.to_vec();
+            for m in models {
+                for s in m.sections() {
+                    if !known.contains(s) {
+                        known.push(s);
+                    }
+                }
+            }
+            let known: Vec<String> = known.iter().map(|s| format!("`{s}`")).collect();
+            return Err(SceneError {
+                file: path.to_path_buf(),
+                line: lines.line(&[KeyPart::Key(key.clone())]),
+                message: format!(
+                    "unknown field `{key}`, expected one of {}",
+                    known.join(", ")
+                ),
+            });
+        }
+    }
+    let (shared, own) = split_document(doc);
+    let scene = SceneFile::deserialize(toml::de::Deserializer::from(shared)).map_err(toml_error)?;
+    let name = scene.scene.model.as_deref().unwrap_or("continuum");
+    let kind = models.iter().copied().find(|m| m.name() == name);
+    let own = match kind {
+        Some(m) => Some(m.sections_of(own).map_err(toml_error)?),
+        None => None,
+    };
+    Ok(LoadedScene {
+        scene,
+        path: path.to_path_buf(),
+        text,
+        kind: kind.map(Kind),
+        own,
+        lines,
+    })
+}
+
+/// Split a document into the shared sections ([`SHARED_SECTIONS`]) and the rest (the
+/// sections of the models).
+fn split_document(doc: Spanned<DeTable<'_>>) -> (Spanned<DeTable<'_>>, Spanned<DeTable<'_>>) {
+    let span = doc.span();
+    let (mut shared, mut own) = (DeTable::new(), DeTable::new());
+    for (key, value) in doc.into_inner() {
+        if SHARED_SECTIONS.contains(&key.get_ref().as_ref()) {
+            shared.insert(key, value);
+        } else {
+            own.insert(key, value);
+        }
+    }
+    (Spanned::new(span.clone(), shared), Spanned::new(span, own))
+}
+
+/// The offset and depth where `[`/`{` nesting (outside strings and comments) first
+/// exceeds [`MAX_TOML_NESTING`].
+fn too_deep(text: &str) -> Option<(usize, usize)> {
+    let bytes = text.as_bytes();
+    let mut depth = 0usize;
+    let mut i = 0;
+    let mut at_line_start = true;
+    while i < bytes.len() {
+        let b = bytes[i];
+        match b {
+            b'#' => {
+                while i < bytes.len() && bytes[i] != b'\n' {
+                    i += 1;
+                }
+                continue;
+            }
+            b'"' | b'\'' => {
+                // Skip a string (basic strings honour backslash escapes; triple quotes
+                // are three empty-or-not strings in a row, which skips the same way).
+                let quote = b;
+                i += 1;
+                while i < bytes.len() && bytes[i] != quote {
+                    if quote == b'"' && bytes[i] == b'\\' {
+                        i += 1;
+                    }
+                    i += 1;
+                }
+            }
+            b'[' | b'{' if depth > 0 || !(at_line_start && b == b'[') => {
+                depth += 1;
+                if depth > MAX_TOML_NESTING {
+                    return Some((i, depth));
+                }
+            }
+            b']' | b'}' => depth = depth.saturating_sub(1),
+            b'\n' => {
+                at_line_start = true;
+                i += 1;
+                continue;
+            }
+            _ => {}
+        }
+        if !b.is_ascii_whitespace() {
+            at_line_start = false;
+        }
+        i += 1;
+    }
+    None
+}
+
+/// `v` is a finite number > 0.
+pub(crate) fn positive(ls: &LoadedScene, path: &[KeyPart], v: f64) -> Result<(), SceneError> {
+    if !(v.is_finite() && v > 0.0) {
+        return Err(ls.error(path, format!("= {v} must be > 0")));
+    }
+    Ok(())
+}
+
+/// A vector has as many components as the scene has dimensions.
+pub(crate) fn len_is(
+    ls: &LoadedScene,
+    path: &[KeyPart],
+    got: usize,
+    want: usize,
+) -> Result<(), SceneError> {
+    if got != want {
+        return Err(ls.error(path, format!("has {got} components, the scene is {want}D")));
+    }
+    Ok(())
+}
+
+/// The part of `[[output.line]]` number `i` every model checks alike: `points` in
+/// `2..=MAX_LINE_POINTS` and a name that is a file name.
+pub(crate) fn line_points_and_name(
+    ls: &LoadedScene,
+    i: usize,
+    l: &crate::common::sections::Line,
+) -> Result<(), SceneError> {
+    if !(2..=crate::common::limits::MAX_LINE_POINTS as i64).contains(&l.points) {
+        return Err(ls.error(
+            &ki("output.line", i, &["points"]),
+            format!(
+                "= {} must be in 2..={}",
+                l.points,
+                crate::common::limits::MAX_LINE_POINTS
+            ),
+        ));
+    }
+    if l.name.is_empty() || l.name.contains(['/', '\\']) {
+        return Err(ls.error(
+            &ki("output.line", i, &["name"]),
+            "must be a non-empty file name",
+        ));
+    }
+    Ok(())
+}
+
+/// A number (finite) or an expression that parses (or `"free"` where allowed).
+pub(crate) fn expr_ok(
+    ls: &LoadedScene,
+    path: &[KeyPart],
+    v: &NumOrExpr,
+    allow_free: bool,
+) -> Result<(), SceneError> {
+    match v {
+        NumOrExpr::Num(x) if !x.is_finite() => {
+            Err(ls.error(path, format!("= {x} is not a finite number")))
+        }
+        NumOrExpr::Num(_) => Ok(()),
+        NumOrExpr::Expr(s) if allow_free && s == "free" => Ok(()),
+        NumOrExpr::Expr(s) => Expr::parse(s)
+            .map(|_| ())
+            .map_err(|e| ls.error(path, format!("= \"{s}\": bad expression at {e}"))),
+    }
+}
+
+/// Number of steps of a schedule (before the [`crate::common::limits::MAX_STEPS`] bound; as
+/// a float so absurd requests do not overflow).
+pub fn step_count_f64(sch: &crate::common::sections::Schedule) -> f64 {
+    match (sch.dt, sch.steps) {
+        (Some(dt), _) => (sch.end_time / dt - 1e-9).ceil().max(1.0),
+        (None, Some(n)) => n.max(1) as f64,
+        _ => 1.0,
+    }
+}
+
+/// Number of steps of a checked schedule.
+pub fn step_count(sch: &crate::common::sections::Schedule) -> u64 {
+    step_count_f64(sch) as u64
+}
+
+/// The top-level keys every model may have: `[scene]`, `[schedule]`, `[output]`,
+/// `[solver]`.
+const ALWAYS: [&str; 4] = ["scene", "schedule", "output", "solver"];
+
+/// Check a parsed scene: the keys of `[scene]`, the sections of other models (refused
+/// with the model they belong to, from the sections every model of `models` declares),
+/// then the model's own checks. Returns the first problem found.
+pub fn check(
+    ls: &LoadedScene,
+    laws: &LawRegistry,
+    models: &[&'static dyn ModelKind],
+) -> Result<(), SceneError> {
+    let s = &ls.scene;
+    let dim = s.scene.dim;
+    if dim != 2 && dim != 3 {
+        return Err(ls.error(&k(&["scene", "dim"]), format!("= {dim} must be 2 or 3")));
+    }
+    let d = dim as usize;
+    if s.scene.name.is_empty() || s.scene.name.contains(['/', '\\']) {
+        return Err(ls.error(
+            &k(&["scene", "name"]),
+            "must be a non-empty name without slashes",
+        ));
+    }
+    if s.scene.plane.is_some() && d == 3 {
+        return Err(ls.error(&k(&["scene", "plane"]), "applies to 2D scenes only"));
+    }
+    let Some(kind) = ls.kind() else {
+        let names: Vec<&str> = models.iter().map(|m| m.name()).collect();
+        return Err(ls.error(
+            &k(&["scene", "model"]),
+            format!(
+                "= \"{}\" is not available in this version of porofrac (available: {})",
+                ls.model(),
+                names.join(", ")
+            ),
+        ));
+    };
+    kind.refuse(ls)?;
+    for key in ls.top_level() {
+        let key = key.as_str();
+        if ALWAYS.contains(&key) || kind.sections().contains(&key) || kind.reads().contains(&key) {
+            continue;
+        }
+        let owner = models.iter().find(|m| m.sections().contains(&key));
+        let path = owner.map_or_else(|| k(&[key]), |m| m.refused_as(key));
+        let owner = owner.map_or("another model", |m| m.name());
+        return Err(ls.error(
+            &path,
+            format!("belongs to model \"{owner}\", not \"{}\"", kind.name()),
+        ));
+    }
+    kind.check(ls, laws)
+}
