@@ -705,62 +705,6 @@ pub fn key_text(path: &[KeyPart]) -> String {
     s
 }
 
-/// The 1-based line where a key path is written in the TOML text (best effort: the line of
-/// the deepest table header or key found; 1 if nothing matches).
-pub fn locate(text: &str, path: &[KeyPart]) -> usize {
-    let mut header: Vec<KeyPart> = Vec::new();
-    let mut counts: BTreeMap<String, usize> = BTreeMap::new();
-    let mut best = (0usize, 1usize); // (matched parts, line)
-    for (no, raw) in text.lines().enumerate() {
-        let line = raw.split('#').next().unwrap_or("").trim();
-        let line_no = no + 1;
-        if let Some(inner) = line.strip_prefix("[[").and_then(|l| l.split("]]").next()) {
-            let name = inner.trim().to_string();
-            let k = counts.entry(name.clone()).or_insert(0);
-            header = name
-                .split('.')
-                .map(|p| KeyPart::Key(p.trim().to_string()))
-                .collect();
-            header.push(KeyPart::Index(*k));
-            *k += 1;
-            let m = common_prefix(&header, path);
-            if m > best.0 {
-                best = (m, line_no);
-            }
-            continue;
-        }
-        if let Some(inner) = line.strip_prefix('[').and_then(|l| l.split(']').next()) {
-            header = inner
-                .split('.')
-                .map(|p| KeyPart::Key(p.trim().to_string()))
-                .collect();
-            let m = common_prefix(&header, path);
-            if m > best.0 {
-                best = (m, line_no);
-            }
-            continue;
-        }
-        if let Some((key, _)) = line.split_once('=') {
-            let mut full = header.clone();
-            full.extend(
-                key.split('.')
-                    .map(|p| KeyPart::Key(p.trim().trim_matches('"').to_string())),
-            );
-            let m = common_prefix(&full, path);
-            if m > best.0 || (m == best.0 && m == full.len() && m > 0 && best.1 == 0) {
-                best = (m, line_no);
-            }
-        }
-    }
-    best.1
-}
-
-fn common_prefix(a: &[KeyPart], b: &[KeyPart]) -> usize {
-    let m = a.iter().zip(b).take_while(|(x, y)| x == y).count();
-    // A header or key counts only if it matched completely.
-    if m == a.len() { m } else { 0 }
-}
-
 /// The 1-based line of a byte offset.
 pub fn line_of_offset(text: &str, offset: usize) -> usize {
     text[..offset.min(text.len())]

@@ -1,7 +1,7 @@
 //! The continuum model (seed 000, `[scene] model = "continuum"`): VEM, MDEM and DEM cell
 //! laws, TPFA flow, Biot coupling and fracturing on a polyhedral grid.
 //!
-//! - *build*: the grid ([`mod@grid`]), the law and material of every cell and the conditions
+//! - *build*: the grid ([`crate::common::grid`]), the law and material of every cell and the conditions
 //!   ([`mod@compose`]), the flow model ([`mod@flow`]), the dof map, the stiffness pattern and the
 //!   solver;
 //! - *step*: one of three drivers, chosen by the scene: static mechanics at every output

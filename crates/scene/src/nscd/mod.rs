@@ -13,7 +13,7 @@
 //!   `<name>_contacts.pvd`, field extrema, and `summary.json` with `particles`,
 //!   `contacts`, `sweeps` (mean, max), `final_residual`, `not_converged_steps` and
 //!   `contact_updates_per_second` (local solves per second of NLGS wall time);
-//! - *plots* ([`plots`]): probe series and the disks coloured by initial layer.
+//! - *plots* ([`crate::common::particle_plots`]): probe series and the disks coloured by initial layer.
 
 pub mod check;
 pub mod fault;

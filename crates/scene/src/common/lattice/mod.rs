@@ -1,6 +1,6 @@
 //! The lattice of `[lbm]` and the heat of `[thermal]`, shared by every model that has a
 //! fluid (model `lbm`, and model `lsm` with a fluid): the sections ([`sections`]), their
-//! checks ([`check`]), the lattice without obstacles ([`lattice_of`]) and field images
+//! checks ([`check`]), the lattice without obstacles (`lattice_of`) and field images
 //! ([`images`]).
 //!
 //! Nodes sit at the centres of the `Δx` cells covering `extent`; SI values are converted
