@@ -176,7 +176,7 @@ impl<'w> Doc<'w> {
         }
         self.indent()?;
         self.w.write_all(head.as_bytes())?;
-        let nbytes = (values.len() * size_of::<T>()) as u64;
+        let nbytes = size_of_val(values) as u64;
         match self.enc {
             Encoding::Ascii => {
                 self.w.write_all(b" format=\"ascii\">\n")?;

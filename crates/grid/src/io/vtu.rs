@@ -1014,9 +1014,9 @@ mod tests {
             assert_eq!(get("f", 9), full);
         }
         // A component count that does not divide the values is an error.
-        let odd = [(
+        let odd: [(&str, Field<'_, 2>); 1] = [(
             "f",
-            Field::<2>::Components {
+            Field::Components {
                 components: 4,
                 values: &full,
             },
