@@ -202,7 +202,7 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
             .filter(|&c| {
                 elements
                     .as_deref()
-                    .is_none_or(|e| !e.keeps(c, mechanics.laws.law(c)))
+                    .is_none_or(|e| !e.keeps(c, mechanics.laws.law_index(c)))
             })
             .collect();
         Ok(Self {
