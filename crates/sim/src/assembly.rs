@@ -862,4 +862,94 @@ mod tests {
         assert_eq!(*cache.kept_sum(&grid, &map, &dofs, &pattern), *full(&map));
         assert!(after.0.iter().chain(&after.1).all(|x| x.is_finite()));
     }
+
+    /// A law that fails on a cell: the assembly, the element cache and the stresses
+    /// return its error with the cell and the law's name.
+    #[test]
+    fn law_errors_name_the_cell() {
+        /// VEM, except that its `bad`-th stiffness or stress evaluation (from 0) fails.
+        struct Failing {
+            inner: VemLaw<2>,
+            bad: usize,
+            calls: std::sync::atomic::AtomicUsize,
+        }
+        impl Failing {
+            fn fail(&self) -> std::result::Result<(), LawError> {
+                let k = self
+                    .calls
+                    .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                if k == self.bad {
+                    return Err(LawError::Evaluation("refused".into()));
+                }
+                Ok(())
+            }
+        }
+        impl CellLaw<2> for Failing {
+            fn name(&self) -> &str {
+                "failing"
+            }
+            fn energy(
+                &self,
+                cell: &porofrac_law::CellGeometry<'_, 2>,
+                u: &[f64],
+                s: &mut Scratch,
+            ) -> std::result::Result<f64, LawError> {
+                self.inner.energy(cell, u, s)
+            }
+            fn forces(
+                &self,
+                cell: &porofrac_law::CellGeometry<'_, 2>,
+                u: &[f64],
+                out: &mut [f64],
+                s: &mut Scratch,
+            ) -> std::result::Result<(), LawError> {
+                self.inner.forces(cell, u, out, s)
+            }
+            fn stiffness(
+                &self,
+                cell: &porofrac_law::CellGeometry<'_, 2>,
+                u: &[f64],
+                out: &mut DMatrix<f64>,
+                s: &mut Scratch,
+            ) -> std::result::Result<(), LawError> {
+                self.fail()?;
+                self.inner.stiffness(cell, u, out, s)
+            }
+            fn stress(
+                &self,
+                cell: &porofrac_law::CellGeometry<'_, 2>,
+                u: &[f64],
+                s: &mut Scratch,
+            ) -> std::result::Result<porofrac_law::Tensor<2>, LawError> {
+                self.fail()?;
+                self.inner.stress(cell, u, s)
+            }
+        }
+        let grid = simplices::<2>(Point::<2>::zeros(), Point::<2>::new(2.0, 1.0), [2, 1]).unwrap();
+        let st = Stiffness::<2>::isotropic(1.0e9, 0.3).unwrap();
+        let vem = VemLaw::new(st);
+        // Only cell 3 uses the failing law, so its first call fails.
+        let failing = Failing {
+            inner: vem.clone(),
+            bad: 0,
+            calls: Default::default(),
+        };
+        let laws: Vec<&dyn CellLaw<2>> = vec![&vem, &failing];
+        let of = (0..grid.num_cells()).map(|c| usize::from(c == 3)).collect();
+        let map = LawMap::new(&grid, laws, of).unwrap();
+        let expect = |e: SimError| match e {
+            SimError::Law { cell, law, source } => {
+                assert_eq!((cell, law.as_str()), (3, "failing"));
+                assert_eq!(source, LawError::Evaluation("refused".into()));
+            }
+            other => panic!("expected a law error, got {other:?}"),
+        };
+        let Err(e) = ElementCache::new(&grid, &map) else {
+            panic!("the failing cell was accepted");
+        };
+        expect(e);
+        failing.calls.store(0, std::sync::atomic::Ordering::Relaxed);
+        let u = vec![0.0; 2 * grid.num_nodes()];
+        expect(crate::solve::cell_stresses(&grid, &map, &u).unwrap_err());
+    }
 }
