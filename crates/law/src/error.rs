@@ -1,8 +1,11 @@
 //! Errors of the law crate.
 
-/// Everything that can go wrong when building a material or checking a law.
+/// Everything that can go wrong when building a material, checking a law or evaluating
+/// a cell law.
 ///
-/// Every variant names the offending parameter or matrix entry and its value.
+/// Every variant names the offending parameter, matrix entry or cell property and its
+/// value. A law does not know the index of the cell it evaluates: the caller that does
+/// (assembly, stress recovery) adds it to its own error.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum LawError {
     /// A scalar material parameter is out of its admissible range or not finite.
@@ -59,6 +62,37 @@ pub enum LawError {
         /// What the matrix is.
         what: &'static str,
     },
+    /// The law cannot evaluate a cell with this many nodes (e.g. MDEM and DEM need a
+    /// simplex, `D + 1` nodes).
+    #[error("cell has {nodes} nodes; the law needs {expected} nodes")]
+    UnsupportedNodeCount {
+        /// Nodes of the cell.
+        nodes: usize,
+        /// Nodes the law needs.
+        expected: usize,
+    },
+    /// The cell is degenerate: (almost) zero or negative volume for its size.
+    #[error("degenerate cell: volume {volume:e} for length scale {scale:e}")]
+    DegenerateCell {
+        /// Volume (area in 2D).
+        volume: f64,
+        /// The length the volume was compared with (e.g. the longest edge).
+        scale: f64,
+    },
+    /// A slice or matrix passed to the law has the wrong length.
+    #[error("{what} has length {got}, expected {expected}")]
+    WrongLength {
+        /// Which argument.
+        what: &'static str,
+        /// Length given.
+        got: usize,
+        /// Length required.
+        expected: usize,
+    },
+    /// Any other failure of a law to evaluate a cell (for laws defined outside
+    /// porofrac), with the law's own message.
+    #[error("{0}")]
+    Evaluation(String),
 }
 
 /// Result type of the law crate.

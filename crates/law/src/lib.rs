@@ -35,6 +35,7 @@ pub use kelvin::{Kelvin, KelvinMatrix, kelvin_len};
 pub use principal::{Principal, principal};
 pub use stiffness::Stiffness;
 
+use error::Result;
 use nalgebra::{DMatrix, SMatrix};
 use porofrac_grid::{Grid, Point};
 
@@ -69,6 +70,56 @@ pub struct CellGeometry<'a, const D: usize> {
     pub node_normals: &'a [Point<D>],
     /// Cell volume (area in 2D).
     pub volume: f64,
+}
+
+impl<const D: usize> CellGeometry<'_, D> {
+    /// Check that a law can evaluate the cell: as many node normals as nodes, and a
+    /// positive, finite volume. Errors: [`LawError::WrongLength`] or
+    /// [`LawError::DegenerateCell`] (with the largest node distance as the length scale).
+    #[inline]
+    pub fn check(&self) -> Result<()> {
+        if self.node_normals.len() != self.coords.len() {
+            return Err(LawError::WrongLength {
+                what: "node normals",
+                got: self.node_normals.len(),
+                expected: self.coords.len(),
+            });
+        }
+        if !(self.volume > 0.0 && self.volume.is_finite()) {
+            return Err(self.degenerate());
+        }
+        Ok(())
+    }
+
+    /// Check that a nodal slice (`what`: displacements, forces) has `D` entries per node.
+    #[inline]
+    pub fn check_len(&self, what: &'static str, len: usize) -> Result<()> {
+        if len == D * self.coords.len() {
+            Ok(())
+        } else {
+            Err(LawError::WrongLength {
+                what,
+                got: len,
+                expected: D * self.coords.len(),
+            })
+        }
+    }
+
+    /// [`LawError::DegenerateCell`] for this cell, with its largest node distance as the
+    /// length scale.
+    #[cold]
+    pub fn degenerate(&self) -> LawError {
+        let mut scale: f64 = 0.0;
+        for (i, a) in self.coords.iter().enumerate() {
+            for b in &self.coords[i + 1..] {
+                scale = scale.max((a - b).norm());
+            }
+        }
+        LawError::DegenerateCell {
+            volume: self.volume,
+            scale,
+        }
+    }
 }
 
 /// Reusable buffers that let one thread evaluate many cells without allocating.
@@ -137,10 +188,20 @@ pub trait CellLaw<const D: usize>: Send + Sync {
     }
 
     /// Elastic energy of the cell for nodal displacements `u` (length `D·n`).
-    fn energy(&self, cell: &CellGeometry<'_, D>, u: &[f64], scratch: &mut Scratch) -> f64;
+    ///
+    /// Errors: a cell the law cannot evaluate ([`LawError::UnsupportedNodeCount`],
+    /// [`LawError::DegenerateCell`], [`LawError::WrongLength`]); the same for every
+    /// method below.
+    fn energy(&self, cell: &CellGeometry<'_, D>, u: &[f64], scratch: &mut Scratch) -> Result<f64>;
 
     /// Forces the cell exerts on its nodes, `F = −∂E/∂u`, written to `out` (length `D·n`).
-    fn forces(&self, cell: &CellGeometry<'_, D>, u: &[f64], out: &mut [f64], scratch: &mut Scratch);
+    fn forces(
+        &self,
+        cell: &CellGeometry<'_, D>,
+        u: &[f64],
+        out: &mut [f64],
+        scratch: &mut Scratch,
+    ) -> Result<()>;
 
     /// Local stiffness `K = ∂²E/∂u²` at `u`, written to `out` (resized to `D·n × D·n`).
     fn stiffness(
@@ -149,8 +210,13 @@ pub trait CellLaw<const D: usize>: Send + Sync {
         u: &[f64],
         out: &mut DMatrix<f64>,
         scratch: &mut Scratch,
-    );
+    ) -> Result<()>;
 
     /// Cell stress for nodal displacements `u` (tension positive).
-    fn stress(&self, cell: &CellGeometry<'_, D>, u: &[f64], scratch: &mut Scratch) -> Tensor<D>;
+    fn stress(
+        &self,
+        cell: &CellGeometry<'_, D>,
+        u: &[f64],
+        scratch: &mut Scratch,
+    ) -> Result<Tensor<D>>;
 }

@@ -13,6 +13,9 @@
 //! | [`check_rigid_body_motions`] | translations and linearized rotations `u = W (x − x̄)`, `W = −Wᵀ`, give zero force and energy | `exact_tol` |
 //! | [`check_linear_field`] | `u = A x + b`: `E = |K| · ½ ε : C : ε` and `σ = C : ε` with `ε = sym(A)` | `exact_tol` |
 //!
+//! A law that returns an error where a check evaluates it fails that check, with an
+//! infinite discrepancy and the law's error as the location.
+//!
 //! Discrepancies are relative: `max |a − b| / max |b|` over the compared entries, with the
 //! stiffness checks scaled by `max |K|` and the rigid-body ones by `max |K| · max |u|`
 //! (forces) and `max |K| · max |u|²` (energy). The finite-difference step is
@@ -24,7 +27,7 @@ use nalgebra::DMatrix;
 use porofrac_grid::Point;
 
 use crate::stiffness::Stiffness;
-use crate::{CellGeometry, CellLaw, Scratch, Tensor};
+use crate::{CellGeometry, CellLaw, LawError, Scratch, Tensor};
 
 /// Parameters of the checks.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -101,6 +104,16 @@ fn verdict(
             tol,
             location: location(),
         })
+    }
+}
+
+/// A law that fails to evaluate fails the check it was called in.
+fn law_failed(check: &'static str, tol: f64) -> impl FnOnce(LawError) -> KitFailure {
+    move |e| KitFailure {
+        check,
+        error: f64::INFINITY,
+        tol,
+        location: format!("the law failed: {e}"),
     }
 }
 
@@ -189,15 +202,16 @@ pub fn check_forces_gradient<const D: usize, L: CellLaw<D> + ?Sized>(
 ) -> Result<f64, KitFailure> {
     let n = u.len();
     let h = fd_step(cell, opts);
+    let failed = || law_failed("forces = -grad energy", opts.fd_tol);
     let mut f = vec![0.0; n];
-    law.forces(cell, u, &mut f, scratch);
+    law.forces(cell, u, &mut f, scratch).map_err(failed())?;
     let mut w = u.to_vec();
     let (mut worst, mut at, mut scale) = (0.0_f64, 0, 0.0_f64);
     for j in 0..n {
         w[j] = u[j] + h;
-        let ep = law.energy(cell, &w, scratch);
+        let ep = law.energy(cell, &w, scratch).map_err(failed())?;
         w[j] = u[j] - h;
-        let em = law.energy(cell, &w, scratch);
+        let em = law.energy(cell, &w, scratch).map_err(failed())?;
         w[j] = u[j];
         let fd = -(ep - em) / (2.0 * h);
         scale = scale.max(fd.abs()).max(f[j].abs());
@@ -226,16 +240,17 @@ pub fn check_stiffness_jacobian<const D: usize, L: CellLaw<D> + ?Sized>(
 ) -> Result<f64, KitFailure> {
     let n = u.len();
     let h = fd_step(cell, opts);
+    let failed = || law_failed("stiffness = -d forces/du", opts.fd_tol);
     let mut k = DMatrix::zeros(n, n);
-    law.stiffness(cell, u, &mut k, scratch);
+    law.stiffness(cell, u, &mut k, scratch).map_err(failed())?;
     let (mut fp, mut fm) = (vec![0.0; n], vec![0.0; n]);
     let mut w = u.to_vec();
     let (mut worst, mut at) = (0.0_f64, (0, 0));
     for j in 0..n {
         w[j] = u[j] + h;
-        law.forces(cell, &w, &mut fp, scratch);
+        law.forces(cell, &w, &mut fp, scratch).map_err(failed())?;
         w[j] = u[j] - h;
-        law.forces(cell, &w, &mut fm, scratch);
+        law.forces(cell, &w, &mut fm, scratch).map_err(failed())?;
         w[j] = u[j];
         for i in 0..n {
             let fd = -(fp[i] - fm[i]) / (2.0 * h);
@@ -264,7 +279,8 @@ pub fn check_stiffness_symmetric<const D: usize, L: CellLaw<D> + ?Sized>(
 ) -> Result<f64, KitFailure> {
     let n = u.len();
     let mut k = DMatrix::zeros(n, n);
-    law.stiffness(cell, u, &mut k, scratch);
+    law.stiffness(cell, u, &mut k, scratch)
+        .map_err(law_failed("stiffness symmetric", opts.exact_tol))?;
     let (mut worst, mut at) = (0.0_f64, (0, 0));
     for i in 0..n {
         for j in i + 1..n {
@@ -322,17 +338,32 @@ pub fn check_rigid_body_motions<const D: usize, L: CellLaw<D> + ?Sized>(
     scratch: &mut Scratch,
 ) -> Result<f64, KitFailure> {
     let n = D * cell.coords.len();
+    let failed = || law_failed("rigid-body motions", opts.exact_tol);
     let mut k = DMatrix::zeros(n, n);
-    law.stiffness(cell, &vec![0.0; n], &mut k, scratch);
+    law.stiffness(cell, &vec![0.0; n], &mut k, scratch)
+        .map_err(failed())?;
     let kmax = k.amax();
     let mut f = vec![0.0; n];
     let (mut worst, mut at) = (0.0_f64, String::new());
+    let mut error = None;
     for_each_rigid_motion(cell, opts.amplitude, |name, u| {
+        if error.is_some() {
+            return;
+        }
         let umax = u.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-        law.forces(cell, u, &mut f, scratch);
+        let energy = law
+            .forces(cell, u, &mut f, scratch)
+            .and_then(|()| law.energy(cell, u, scratch));
+        let energy = match energy {
+            Ok(e) => e,
+            Err(e) => {
+                error = Some(e);
+                return;
+            }
+        };
         let fmax = f.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
         let ef = rel(fmax, kmax * umax);
-        let ee = rel(law.energy(cell, u, scratch).abs(), kmax * umax * umax);
+        let ee = rel(energy.abs(), kmax * umax * umax);
         if ef > worst {
             worst = ef;
             at = format!("{name}: forces");
@@ -342,6 +373,9 @@ pub fn check_rigid_body_motions<const D: usize, L: CellLaw<D> + ?Sized>(
             at = format!("{name}: energy");
         }
     });
+    if let Some(e) = error {
+        return Err(failed()(e));
+    }
     verdict("rigid-body motions", worst, opts.exact_tol, || at)
 }
 
@@ -361,7 +395,9 @@ pub fn check_linear_field<const D: usize, L: CellLaw<D> + ?Sized>(
     linear_field(cell, grad, shift, &mut u);
     let eps = (grad + grad.transpose()) * 0.5;
     let e_exact = cell.volume * material.energy_density(&eps);
-    let e = law.energy(cell, &u, scratch);
+    let e = law
+        .energy(cell, &u, scratch)
+        .map_err(law_failed("linear field energy", opts.exact_tol))?;
     let ee = verdict(
         "linear field energy",
         rel((e - e_exact).abs(), e_exact.abs()),
@@ -369,7 +405,9 @@ pub fn check_linear_field<const D: usize, L: CellLaw<D> + ?Sized>(
         || format!("energy {e:e}, expected {e_exact:e}"),
     )?;
     let s_exact = material.stress(&eps);
-    let s = law.stress(cell, &u, scratch);
+    let s = law
+        .stress(cell, &u, scratch)
+        .map_err(law_failed("linear field stress", opts.exact_tol))?;
     let es = verdict(
         "linear field stress",
         rel((s - s_exact).amax(), s_exact.amax()),

@@ -5,7 +5,9 @@ use nalgebra::DMatrix;
 use porofrac_grid::{CellFaceLoops, Grid, Point};
 use porofrac_law::kelvin::{from_kelvin, kelvin_sym_outer};
 use porofrac_law::testkit::{self, KitOptions, check_all};
-use porofrac_law::{CellGeometry, CellLaw, GeometryBuffer, Kelvin, Scratch, Stiffness, Tensor};
+use porofrac_law::{
+    CellGeometry, CellLaw, GeometryBuffer, Kelvin, LawError, Scratch, Stiffness, Tensor,
+};
 
 /// Constant-strain law on any cell: energy |K|·½ ε:C:ε with ε from the node normals
 /// (exact on simplices), plus an optional deliberate defect.
@@ -23,6 +25,8 @@ enum Defect {
     Asymmetric,
     /// A spring to the origin: translations cost energy.
     Anchor,
+    /// Every evaluation fails, as on a degenerate cell.
+    Fails,
 }
 
 impl<const D: usize> ConstantStrain<D> {
@@ -33,21 +37,44 @@ impl<const D: usize> ConstantStrain<D> {
         }
         e / cell.volume
     }
+
+    fn fails(&self, cell: &CellGeometry<'_, D>) -> Result<(), LawError> {
+        if self.defect == Defect::Fails {
+            return Err(LawError::DegenerateCell {
+                volume: cell.volume,
+                scale: 1.0,
+            });
+        }
+        Ok(())
+    }
 }
 
 impl<const D: usize> CellLaw<D> for ConstantStrain<D> {
     fn name(&self) -> &str {
         "constant-strain"
     }
-    fn energy(&self, cell: &CellGeometry<'_, D>, u: &[f64], _: &mut Scratch) -> f64 {
+    fn energy(
+        &self,
+        cell: &CellGeometry<'_, D>,
+        u: &[f64],
+        _: &mut Scratch,
+    ) -> Result<f64, LawError> {
+        self.fails(cell)?;
         let e = Self::strain(cell, u);
         let mut w = 0.5 * cell.volume * e.dot(&self.material.stress_kelvin(&e));
         if self.defect == Defect::Anchor {
             w += 0.5 * u.iter().map(|v| v * v).sum::<f64>();
         }
-        w
+        Ok(w)
     }
-    fn forces(&self, cell: &CellGeometry<'_, D>, u: &[f64], out: &mut [f64], _: &mut Scratch) {
+    fn forces(
+        &self,
+        cell: &CellGeometry<'_, D>,
+        u: &[f64],
+        out: &mut [f64],
+        _: &mut Scratch,
+    ) -> Result<(), LawError> {
+        self.fails(cell)?;
         let s = from_kelvin::<D>(&self.material.stress_kelvin(&Self::strain(cell, u)));
         let scale = if self.defect == Defect::ForceScale {
             1.01
@@ -61,6 +88,7 @@ impl<const D: usize> CellLaw<D> for ConstantStrain<D> {
         if self.defect == Defect::Anchor {
             out.iter_mut().zip(u).for_each(|(f, v)| *f -= v);
         }
+        Ok(())
     }
     fn stiffness(
         &self,
@@ -68,7 +96,8 @@ impl<const D: usize> CellLaw<D> for ConstantStrain<D> {
         _u: &[f64],
         out: &mut DMatrix<f64>,
         _: &mut Scratch,
-    ) {
+    ) -> Result<(), LawError> {
+        self.fails(cell)?;
         let n = cell.coords.len();
         porofrac_law::zero_matrix(out, D * n, D * n);
         for i in 0..n {
@@ -88,9 +117,18 @@ impl<const D: usize> CellLaw<D> for ConstantStrain<D> {
             Defect::Anchor => (0..D * n).for_each(|k| out[(k, k)] += 1.0),
             _ => {}
         }
+        Ok(())
     }
-    fn stress(&self, cell: &CellGeometry<'_, D>, u: &[f64], _: &mut Scratch) -> Tensor<D> {
-        from_kelvin::<D>(&self.material.stress_kelvin(&Self::strain(cell, u)))
+    fn stress(
+        &self,
+        cell: &CellGeometry<'_, D>,
+        u: &[f64],
+        _: &mut Scratch,
+    ) -> Result<Tensor<D>, LawError> {
+        self.fails(cell)?;
+        Ok(from_kelvin::<D>(
+            &self.material.stress_kelvin(&Self::strain(cell, u)),
+        ))
     }
 }
 
@@ -234,6 +272,31 @@ fn laws_as_trait_objects() {
         .collect();
     assert_eq!(results, [true, false]);
     assert_eq!(laws[0].name(), "constant-strain");
+}
+
+/// A law that returns an error fails the first check that evaluates it, naming the error.
+#[test]
+fn failing_law_fails_the_checks() {
+    let m = Stiffness::<2>::isotropic(1.0, 0.3).unwrap();
+    let law = ConstantStrain {
+        material: m.clone(),
+        defect: Defect::Fails,
+    };
+    let g = triangle();
+    let mut buf = GeometryBuffer::default();
+    let cell = buf.load(&g, 0);
+    let e = check_all(&law, &cell, Some(&m), &KitOptions::default()).unwrap_err();
+    assert_eq!(e.check, "forces = -grad energy");
+    assert_eq!(e.error, f64::INFINITY);
+    assert!(e.location.contains("degenerate cell"), "{e}");
+    let e = testkit::check_rigid_body_motions(
+        &law,
+        &cell,
+        &KitOptions::default(),
+        &mut Scratch::default(),
+    )
+    .unwrap_err();
+    assert_eq!(e.check, "rigid-body motions");
 }
 
 /// zero_matrix reuses the buffer and zeroes it.

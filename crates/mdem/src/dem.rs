@@ -19,10 +19,10 @@
 
 use nalgebra::{DMatrix, SMatrix, SVector};
 use porofrac_grid::Point;
-use porofrac_law::{CellGeometry, CellLaw, Scratch, Stiffness, Tensor};
+use porofrac_law::{CellGeometry, CellLaw, LawError, Scratch, Stiffness, Tensor};
 
 use crate::MdemError;
-use crate::mdem::{Material, check_len, nan_fill, nan_matrix};
+use crate::mdem::{Material, check_len};
 use crate::simplex::{Frame, tensor_from_kelvin, with_k};
 
 /// Which edges carry load.
@@ -46,8 +46,8 @@ pub enum EdgeState {
 /// The central-force DEM law on simplices; see the module docs.
 ///
 /// Misuse through the [`CellLaw`] trait (a cell that is not a simplex, a degenerate
-/// simplex, slices of the wrong length) yields NaN outputs, as for
-/// [`crate::MdemLaw`]; the `try_*` methods return the error.
+/// simplex, slices of the wrong length) returns a [`porofrac_law::LawError`], as for
+/// [`crate::MdemLaw`]; the `try_*` methods return the [`MdemError`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct DemLaw<const D: usize> {
     mat: Material,
@@ -254,8 +254,13 @@ impl<const D: usize> CellLaw<D> for DemLaw<D> {
         (D == 2 || D == 3) && num_nodes == D + 1
     }
 
-    fn energy(&self, cell: &CellGeometry<'_, D>, u: &[f64], _scratch: &mut Scratch) -> f64 {
-        self.try_energy(cell, u).unwrap_or(f64::NAN)
+    fn energy(
+        &self,
+        cell: &CellGeometry<'_, D>,
+        u: &[f64],
+        _scratch: &mut Scratch,
+    ) -> Result<f64, LawError> {
+        Ok(self.try_energy(cell, u)?)
     }
 
     fn forces(
@@ -264,10 +269,8 @@ impl<const D: usize> CellLaw<D> for DemLaw<D> {
         u: &[f64],
         out: &mut [f64],
         _scratch: &mut Scratch,
-    ) {
-        if self.try_forces(cell, u, out).is_err() {
-            nan_fill(out);
-        }
+    ) -> Result<(), LawError> {
+        Ok(self.try_forces(cell, u, out)?)
     }
 
     fn stiffness(
@@ -276,14 +279,16 @@ impl<const D: usize> CellLaw<D> for DemLaw<D> {
         u: &[f64],
         out: &mut DMatrix<f64>,
         _scratch: &mut Scratch,
-    ) {
-        if self.try_stiffness(cell, u, out).is_err() {
-            nan_matrix(cell, out);
-        }
+    ) -> Result<(), LawError> {
+        Ok(self.try_stiffness(cell, u, out)?)
     }
 
-    fn stress(&self, cell: &CellGeometry<'_, D>, u: &[f64], _scratch: &mut Scratch) -> Tensor<D> {
-        self.try_stress(cell, u)
-            .unwrap_or_else(|_| Tensor::<D>::from_element(f64::NAN))
+    fn stress(
+        &self,
+        cell: &CellGeometry<'_, D>,
+        u: &[f64],
+        _scratch: &mut Scratch,
+    ) -> Result<Tensor<D>, LawError> {
+        Ok(self.try_stress(cell, u)?)
     }
 }

@@ -81,3 +81,30 @@ pub enum MdemError {
         why: &'static str,
     },
 }
+
+/// A law evaluation's failure as the [`CellLaw`](porofrac_law::CellLaw) error: a cell that
+/// is not a simplex, a degenerate simplex, a slice of the wrong length. (The material
+/// and lattice variants arise when a law is built, not when it evaluates a cell; they
+/// keep their message.)
+impl From<MdemError> for porofrac_law::LawError {
+    fn from(e: MdemError) -> Self {
+        use porofrac_law::LawError;
+        match e {
+            MdemError::NotASimplex { got, expected } => LawError::UnsupportedNodeCount {
+                nodes: got,
+                expected,
+            },
+            MdemError::Degenerate { volume, scale } => LawError::DegenerateCell { volume, scale },
+            MdemError::Length {
+                what,
+                got,
+                expected,
+            } => LawError::WrongLength {
+                what,
+                got,
+                expected,
+            },
+            other => LawError::Evaluation(other.to_string()),
+        }
+    }
+}

@@ -2,7 +2,7 @@
 
 use nalgebra::{DMatrix, SMatrix, SVector};
 use porofrac_grid::Point;
-use porofrac_law::{CellGeometry, CellLaw, Scratch, Stiffness, Tensor};
+use porofrac_law::{CellGeometry, CellLaw, LawError, Scratch, Stiffness, Tensor};
 
 use crate::MdemError;
 use crate::simplex::{Frame, kelvin_size, tensor_from_kelvin, with_k};
@@ -91,10 +91,10 @@ pub(crate) fn check_len(what: &'static str, got: usize, expected: usize) -> Resu
 ///
 /// [`CellLaw::supports`] is true only for `D + 1` nodes. Evaluating the law through the
 /// [`CellLaw`] trait on any other cell, on a degenerate simplex, or with slices of the
-/// wrong length does not panic: the energy is NaN and every output entry is set to
-/// NaN (`stiffness` is resized to `D·n × D·n` first). The fallible methods
-/// ([`MdemLaw::try_energy`], [`MdemLaw::try_forces`], ...) return the
-/// [`MdemError`] instead. A scene rejects such a composition before evaluating.
+/// wrong length does not panic: it returns the [`porofrac_law::LawError`] (a wrong
+/// node count, a degenerate cell, a wrong length) and leaves the outputs untouched. The
+/// methods [`MdemLaw::try_energy`], [`MdemLaw::try_forces`], ... return the
+/// [`MdemError`] itself. A scene rejects such a composition before evaluating.
 #[derive(Clone, Debug, PartialEq)]
 pub struct MdemLaw<const D: usize> {
     mat: Material,
@@ -234,18 +234,6 @@ impl<const D: usize> MdemLaw<D> {
     }
 }
 
-pub(crate) fn nan_fill(out: &mut [f64]) {
-    out.fill(f64::NAN);
-}
-
-pub(crate) fn nan_matrix<const D: usize>(cell: &CellGeometry<'_, D>, out: &mut DMatrix<f64>) {
-    let n = D * cell.coords.len();
-    if out.shape() != (n, n) {
-        *out = DMatrix::zeros(n, n);
-    }
-    out.fill(f64::NAN);
-}
-
 impl<const D: usize> CellLaw<D> for MdemLaw<D> {
     fn name(&self) -> &str {
         "mdem"
@@ -255,8 +243,13 @@ impl<const D: usize> CellLaw<D> for MdemLaw<D> {
         (D == 2 || D == 3) && num_nodes == D + 1
     }
 
-    fn energy(&self, cell: &CellGeometry<'_, D>, u: &[f64], _scratch: &mut Scratch) -> f64 {
-        self.try_energy(cell, u).unwrap_or(f64::NAN)
+    fn energy(
+        &self,
+        cell: &CellGeometry<'_, D>,
+        u: &[f64],
+        _scratch: &mut Scratch,
+    ) -> Result<f64, LawError> {
+        Ok(self.try_energy(cell, u)?)
     }
 
     fn forces(
@@ -265,10 +258,8 @@ impl<const D: usize> CellLaw<D> for MdemLaw<D> {
         u: &[f64],
         out: &mut [f64],
         _scratch: &mut Scratch,
-    ) {
-        if self.try_forces(cell, u, out).is_err() {
-            nan_fill(out);
-        }
+    ) -> Result<(), LawError> {
+        Ok(self.try_forces(cell, u, out)?)
     }
 
     fn stiffness(
@@ -277,14 +268,16 @@ impl<const D: usize> CellLaw<D> for MdemLaw<D> {
         _u: &[f64],
         out: &mut DMatrix<f64>,
         _scratch: &mut Scratch,
-    ) {
-        if self.try_stiffness(cell, out).is_err() {
-            nan_matrix(cell, out);
-        }
+    ) -> Result<(), LawError> {
+        Ok(self.try_stiffness(cell, out)?)
     }
 
-    fn stress(&self, cell: &CellGeometry<'_, D>, u: &[f64], _scratch: &mut Scratch) -> Tensor<D> {
-        self.try_stress(cell, u)
-            .unwrap_or_else(|_| Tensor::<D>::from_element(f64::NAN))
+    fn stress(
+        &self,
+        cell: &CellGeometry<'_, D>,
+        u: &[f64],
+        _scratch: &mut Scratch,
+    ) -> Result<Tensor<D>, LawError> {
+        Ok(self.try_stress(cell, u)?)
     }
 }

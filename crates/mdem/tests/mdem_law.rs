@@ -7,7 +7,7 @@ use common::{Simplex, anisotropic, rel_diff, tetrahedron, triangle};
 use nalgebra::{DMatrix, DVector};
 use porofrac_grid::Point;
 use porofrac_law::testkit::{KitOptions, check_all, linear_field};
-use porofrac_law::{CellLaw, Scratch, Stiffness, Tensor};
+use porofrac_law::{CellLaw, LawError, Scratch, Stiffness, Tensor};
 use porofrac_mdem::{MdemError, MdemLaw, edge_matrix, edges};
 
 fn kelvin<const D: usize>(t: &Tensor<D>) -> DVector<f64> {
@@ -93,14 +93,15 @@ fn identities<const D: usize>(s: &Simplex<D>) {
         let sig18 = m.transpose() * &fv / s.volume;
         let de = &d * &eps;
         assert!((&sig18 - &de).amax() / de.amax() < 1e-12);
-        let sig = law.stress(&cell, &u, &mut Scratch::default());
+        let sig = law.stress(&cell, &u, &mut Scratch::default()).unwrap();
         let err_s = (kelvin::<D>(&sig) - &de).amax() / de.amax();
         assert!(err_s < 1e-12, "stress: {err_s:e}");
 
         // Nodal forces are the edge forces along the edges, restoring: node a gets
         // +F t, node b gets −F t.
         let mut fn_ = vec![0.0; D * (D + 1)];
-        law.forces(&cell, &u, &mut fn_, &mut Scratch::default());
+        law.forces(&cell, &u, &mut fn_, &mut Scratch::default())
+            .unwrap();
         let mut expect = vec![0.0; D * (D + 1)];
         for (e, &(p, q)) in edges(D).iter().enumerate() {
             let t = (s.coords[q] - s.coords[p]).normalize();
@@ -115,7 +116,7 @@ fn identities<const D: usize>(s: &Simplex<D>) {
         }
 
         // Energy ½ UᵀKU = |K| ½ ε·Dε.
-        let e = law.energy(&cell, &u, &mut Scratch::default());
+        let e = law.energy(&cell, &u, &mut Scratch::default()).unwrap();
         let e_ref = 0.5 * s.volume * eps.dot(&(&d * &eps));
         assert!((e - e_ref).abs() <= 1e-13 * e_ref, "{e} vs {e_ref}");
         let e_edges = 0.5 * DVector::from_column_slice(&du).dot(&fv);
@@ -138,7 +139,8 @@ fn p1<const D: usize>(s: &Simplex<D>) {
         let law = MdemLaw::<D>::new(&mat).unwrap();
         let mut k = DMatrix::zeros(0, 0);
         let u = vec![0.0; D * (D + 1)];
-        law.stiffness(&s.cell(), &u, &mut k, &mut Scratch::default());
+        law.stiffness(&s.cell(), &u, &mut k, &mut Scratch::default())
+            .unwrap();
         let err = rel_diff(&k, &s.p1_stiffness(&mat.to_dmatrix()));
         println!("{D}D MDEM vs P1: relative difference {err:e}");
         assert!(err < 1e-12, "{D}D MDEM vs P1: {err:e}");
@@ -152,7 +154,7 @@ fn stiffness_equals_p1_on_fixed_cells() {
 }
 
 #[test]
-fn non_simplex_cells_give_nan_and_errors() {
+fn non_simplex_cells_give_errors() {
     let law = MdemLaw::<2>::new(&Stiffness::<2>::isotropic(1.0, 0.25).unwrap()).unwrap();
     assert!(law.supports(3));
     assert!(!law.supports(4));
@@ -173,15 +175,23 @@ fn non_simplex_cells_give_nan_and_errors() {
     };
     let u = [0.0; 8];
     let mut s = Scratch::default();
-    assert!(law.energy(&cell, &u, &mut s).is_nan());
+    let unsupported = LawError::UnsupportedNodeCount {
+        nodes: 4,
+        expected: 3,
+    };
+    assert_eq!(law.energy(&cell, &u, &mut s), Err(unsupported.clone()));
     let mut f = [0.0; 8];
-    law.forces(&cell, &u, &mut f, &mut s);
-    assert!(f.iter().all(|v| v.is_nan()));
+    assert_eq!(
+        law.forces(&cell, &u, &mut f, &mut s),
+        Err(unsupported.clone())
+    );
+    assert!(f.iter().all(|&v| v == 0.0));
     let mut k = DMatrix::zeros(1, 1);
-    law.stiffness(&cell, &u, &mut k, &mut s);
-    assert_eq!(k.shape(), (8, 8));
-    assert!(k.iter().all(|v| v.is_nan()));
-    assert!(law.stress(&cell, &u, &mut s).iter().all(|v| v.is_nan()));
+    assert_eq!(
+        law.stiffness(&cell, &u, &mut k, &mut s),
+        Err(unsupported.clone())
+    );
+    assert_eq!(law.stress(&cell, &u, &mut s), Err(unsupported));
     assert_eq!(
         law.try_energy(&cell, &u),
         Err(MdemError::NotASimplex {

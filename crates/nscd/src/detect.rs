@@ -83,16 +83,20 @@ impl Contact {
     }
 }
 
-/// Reused buffers of the detection.
+/// Reused buffers of the detection: the broad phase's candidate pairs, the narrow
+/// phase's exact gaps.
 #[derive(Clone, Debug, Default)]
 pub struct Detector {
     cells: CellList,
     pairs: Vec<(u32, u32)>,
+    /// Disk–body candidates `(body, disk)` in body-major order.
+    body_pairs: Vec<(u32, u32)>,
 }
 
 impl Detector {
     /// Every disk–disk and disk–body pair with a gap below `alert`, at centres `x` and
-    /// body offsets `offsets`, into `out` (cleared first), sorted.
+    /// body offsets `offsets`, into `out` (cleared first), sorted: the broad phase
+    /// ([`Detector::broad_phase`]) then the narrow phase ([`Detector::narrow_phase`]).
     pub fn detect(
         &mut self,
         x: &[[f64; 2]],
@@ -102,10 +106,55 @@ impl Detector {
         alert: f64,
         out: &mut Vec<Contact>,
     ) {
-        out.clear();
+        self.broad_phase(x, r, bodies, offsets, alert);
+        self.narrow_phase(x, r, bodies, offsets, alert, out);
+    }
+
+    /// The candidate pairs: disk pairs from a cell list of side `2 r_max + alert` whose
+    /// gap is below `alert`, sorted by `(i, j)`, and the disks within `r_max + alert`
+    /// of each body's bounding box.
+    pub fn broad_phase(
+        &mut self,
+        x: &[[f64; 2]],
+        r: &[f64],
+        bodies: &[RigidBody],
+        offsets: &[[f64; 2]],
+        alert: f64,
+    ) {
         let r_max = porofrac_particles::cells::max_radius(r);
         self.cells.build(x, 2.0 * r_max + alert);
         self.cells.pairs(x, r, alert, &mut self.pairs);
+        self.body_pairs.clear();
+        for (k, body) in bodies.iter().enumerate() {
+            let (lo, hi) = body.bounds(offsets[k]);
+            let grow = r_max + alert;
+            for (i, c) in x.iter().enumerate() {
+                if c[0] < lo[0] - grow
+                    || c[0] > hi[0] + grow
+                    || c[1] < lo[1] - grow
+                    || c[1] > hi[1] + grow
+                {
+                    continue;
+                }
+                self.body_pairs.push((k as u32, i as u32));
+            }
+        }
+    }
+
+    /// The contacts of the broad phase's candidates: normal, gap and contact point of
+    /// every disk pair, and of every disk–body candidate whose exact gap (to the body's
+    /// closest point) is below `alert`; into `out` (cleared first), sorted by
+    /// (candidate, antagonist), disks before bodies.
+    pub fn narrow_phase(
+        &self,
+        x: &[[f64; 2]],
+        r: &[f64],
+        bodies: &[RigidBody],
+        offsets: &[[f64; 2]],
+        alert: f64,
+        out: &mut Vec<Contact>,
+    ) {
+        out.clear();
         for &(i, j) in &self.pairs {
             let (a, b) = (i as usize, j as usize);
             let d = [x[a][0] - x[b][0], x[a][1] - x[b][1]];
@@ -127,30 +176,20 @@ impl Detector {
             ));
         }
         let start = out.len();
-        for (k, body) in bodies.iter().enumerate() {
-            let (lo, hi) = body.bounds(offsets[k]);
-            let grow = r_max + alert;
-            for (i, c) in x.iter().enumerate() {
-                if c[0] < lo[0] - grow
-                    || c[0] > hi[0] + grow
-                    || c[1] < lo[1] - grow
-                    || c[1] > hi[1] + grow
-                {
-                    continue;
-                }
-                let (dist, n, point) = body.closest(offsets[k], *c);
-                let gap = dist - r[i];
-                if gap < alert {
-                    out.push(Contact::new(
-                        i as u32,
-                        Antagonist::Body(k as u32),
-                        n,
-                        gap,
-                        r[i],
-                        0.0,
-                        point,
-                    ));
-                }
+        for &(k, i) in &self.body_pairs {
+            let (k, i) = (k as usize, i as usize);
+            let (dist, n, point) = bodies[k].closest(offsets[k], x[i]);
+            let gap = dist - r[i];
+            if gap < alert {
+                out.push(Contact::new(
+                    i as u32,
+                    Antagonist::Body(k as u32),
+                    n,
+                    gap,
+                    r[i],
+                    0.0,
+                    point,
+                ));
             }
         }
         // Disk pairs are sorted by (i, j); merge in the body contacts by candidate.

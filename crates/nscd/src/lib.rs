@@ -8,11 +8,19 @@
 //! * [`law`]: the contact law (Signorini, Coulomb with static and dynamic friction, the
 //!   cohesive "non-smooth Lennard-Jones" law) and the exact solution of one local 2×2
 //!   problem;
-//! * [`detect`]: contact detection at the predicted configuration, by cell lists with an
-//!   alert distance, into local frames;
-//! * [`solver`]: the θ-scheme on velocities (eq. 3) and the non-linear Gauss–Seidel
-//!   sweeps over the contacts (eq. 5, Table 1) with body-velocity accumulation, warm
-//!   start and the convergence test;
+//! * [`integrator`]: the one-step integrator, the Moreau–Jean θ-scheme on velocities
+//!   (eq. 3): predicted configuration, free velocities, the update of velocities and
+//!   positions;
+//! * [`detect`]: contact detection at the predicted configuration, broad phase (cell
+//!   lists with an alert distance, body bounding boxes) then narrow phase (exact gaps,
+//!   local frames);
+//! * [`contacts`]: the contacts of a step, which keep their impulses for the next step's
+//!   warm start;
+//! * [`problem`]: the one-step contact problem: the local blocks of the Delassus
+//!   operator, the law of each contact for the step, `M⁻¹ H`;
+//! * [`nlgs`]: the local solver, non-linear Gauss–Seidel sweeps (eq. 5, Table 1) with
+//!   body-velocity accumulation and the convergence test, and its options;
+//! * [`solver`]: the system ([`Nscd`]) and its step, composed of the stages above;
 //! * [`colour`]: the coloured parallel sweep (deterministic for any thread count);
 //! * [`settle`]: gravity settling of a sample before its loading.
 //!
@@ -21,14 +29,19 @@
 
 pub mod body;
 pub mod colour;
+pub mod contacts;
 pub mod detect;
+pub mod integrator;
 pub mod law;
+pub mod nlgs;
+pub mod problem;
 pub mod settle;
 pub mod slabs;
 pub mod solver;
 
 pub use body::{Axis, RigidBody};
 pub use law::ContactLaw;
+pub use nlgs::NlgsOptions;
 pub use settle::{SettleParams, SettleStats};
 pub use solver::{Nscd, Ordering, SolverParams, StepStats};
 

@@ -18,7 +18,9 @@ use nalgebra::DMatrix;
 use porofrac_grid::{Grid, Point};
 use porofrac_law::kelvin::{from_kelvin, kelvin_sym_outer};
 use porofrac_law::testkit::{KitOptions, check_all};
-use porofrac_law::{CellGeometry, CellLaw, GeometryBuffer, Kelvin, Scratch, Stiffness, Tensor};
+use porofrac_law::{
+    CellGeometry, CellLaw, GeometryBuffer, Kelvin, LawError, Scratch, Stiffness, Tensor,
+};
 use porofrac_scene::laws::{LawFamily, PostFailure};
 use porofrac_scene::{LawRegistry, Scene, Silent};
 
@@ -47,18 +49,30 @@ impl<const D: usize> CellLaw<D> for SimplexP1<D> {
         num_nodes == D + 1
     }
 
-    fn energy(&self, cell: &CellGeometry<'_, D>, u: &[f64], _: &mut Scratch) -> f64 {
+    fn energy(
+        &self,
+        cell: &CellGeometry<'_, D>,
+        u: &[f64],
+        _: &mut Scratch,
+    ) -> Result<f64, LawError> {
         let e = Self::strain(cell, u);
-        0.5 * cell.volume * e.dot(&self.material.stress_kelvin(&e))
+        Ok(0.5 * cell.volume * e.dot(&self.material.stress_kelvin(&e)))
     }
 
-    fn forces(&self, cell: &CellGeometry<'_, D>, u: &[f64], out: &mut [f64], _: &mut Scratch) {
+    fn forces(
+        &self,
+        cell: &CellGeometry<'_, D>,
+        u: &[f64],
+        out: &mut [f64],
+        _: &mut Scratch,
+    ) -> Result<(), LawError> {
         // F_i = −∂E/∂u_i = −σ N_i.
         let sigma = from_kelvin::<D>(&self.material.stress_kelvin(&Self::strain(cell, u)));
         for (i, n) in cell.node_normals.iter().enumerate() {
             let f = -(sigma * n);
             out[D * i..D * i + D].copy_from_slice(f.as_slice());
         }
+        Ok(())
     }
 
     fn stiffness(
@@ -67,7 +81,7 @@ impl<const D: usize> CellLaw<D> for SimplexP1<D> {
         _u: &[f64],
         out: &mut DMatrix<f64>,
         _: &mut Scratch,
-    ) {
+    ) -> Result<(), LawError> {
         // K_(ia),(jb) = (1/|K|) B_ia · D B_jb with B_ia the Kelvin strain of a unit
         // displacement of node i in direction a.
         let n = cell.coords.len();
@@ -90,10 +104,18 @@ impl<const D: usize> CellLaw<D> for SimplexP1<D> {
                 }
             }
         }
+        Ok(())
     }
 
-    fn stress(&self, cell: &CellGeometry<'_, D>, u: &[f64], _: &mut Scratch) -> Tensor<D> {
-        from_kelvin::<D>(&self.material.stress_kelvin(&Self::strain(cell, u)))
+    fn stress(
+        &self,
+        cell: &CellGeometry<'_, D>,
+        u: &[f64],
+        _: &mut Scratch,
+    ) -> Result<Tensor<D>, LawError> {
+        Ok(from_kelvin::<D>(
+            &self.material.stress_kelvin(&Self::strain(cell, u)),
+        ))
     }
 }
 

@@ -45,7 +45,7 @@
 use nalgebra::DMatrix;
 use porofrac_grid::point::for_each_facet;
 use porofrac_grid::{Grid, Point};
-use porofrac_law::{CellLaw, GeometryBuffer, Scratch};
+use porofrac_law::{GeometryBuffer, LawError, Scratch};
 use rayon::prelude::*;
 use std::sync::{Arc, Mutex};
 
@@ -81,15 +81,22 @@ impl<const D: usize> Work<D> {
         let geo = self.geo.load(grid, c);
         self.f.clear();
         self.f.resize(self.u.len(), 0.0);
-        law.forces(&geo, &self.u, &mut self.f, &mut self.scratch);
-        if let Some(i) = self.f.iter().position(|v| !v.is_finite()) {
-            return Err(cell_error(
-                laws,
-                c,
-                format!("non-finite nodal force at local dof {i}"),
-            ));
-        }
-        Ok(())
+        law.forces(&geo, &self.u, &mut self.f, &mut self.scratch)
+            .map_err(law_error(laws, c))
+    }
+}
+
+/// The error of cell `c`'s law, with the cell and the law's name.
+///
+/// The closure allocates (the name) only when it is called, on the error path.
+pub(crate) fn law_error<'m, const D: usize>(
+    laws: &'m LawMap<'_, D>,
+    c: usize,
+) -> impl FnOnce(LawError) -> SimError + 'm {
+    move |source| SimError::Law {
+        cell: c,
+        law: laws.law(c).name().to_string(),
+        source,
     }
 }
 
@@ -108,7 +115,7 @@ pub(crate) fn cell_error<const D: usize>(laws: &LawMap<'_, D>, c: usize, what: S
 /// triangle; `forces` (length = equations) receives `Tᵀ F(u)`, the restoring forces of the
 /// cells summed into the equations. Both are overwritten. Cells are evaluated in parallel
 /// (see [`crate::pattern`] for the race-free partition). Errors name the cell whose law
-/// returned a wrong-sized or non-finite stiffness or force.
+/// failed on it or returned a wrong-sized stiffness.
 pub fn assemble<const D: usize>(
     grid: &Grid<D>,
     laws: &LawMap<'_, D>,
@@ -135,8 +142,10 @@ pub fn assemble<const D: usize>(
 /// A linear law's stiffness depends on the cell's geometry only, so a fracturing run that
 /// re-linearizes at every active-set iteration needs it once per cell: only the cells
 /// whose law is nonlinear (the failed, compression-only cells) are evaluated again.
-/// A matrix is used only while the cell's law is the very law object it was computed
-/// with (compared by address), so a cell that switches law is evaluated by its new law.
+/// A matrix is kept with the index of the law it was computed with in the [`LawMap`], and
+/// used only while the cell has that law, so a cell that switches law is evaluated by its
+/// new law. The cache serves every map over the same list of laws as the one it was
+/// built from (the maps of a run differ only in the law of each cell).
 /// The assembled sum of the kept matrices of the cells that use them is kept too (for
 /// the last set of such cells, which changes only when a cell switches law): an assembly
 /// starts from it and scatters only the other cells. It equals the assembly without the
@@ -145,7 +154,8 @@ pub fn assemble<const D: usize>(
 /// scatter into, to the same bits as a full sum (`ElementCache::resum`): on the 3D
 /// hydraulic-fracture scene with `refine = 6` 1.1 s of sums become 0.13 s.
 pub(crate) struct ElementCache {
-    /// Per cell: the address of the law its matrix was computed with (0: none cached).
+    /// Per cell: the index in the law map of the law its matrix was computed with
+    /// ([`NOT_KEPT`]: none).
     law: Vec<usize>,
     /// Per cell: its matrix in `values[start[c]..start[c + 1]]` (column-major `m × m`).
     start: Vec<usize>,
@@ -164,32 +174,30 @@ struct KeptSum {
     values: Arc<[f64]>,
 }
 
-/// The address of a law object (the key of [`ElementCache`]).
-fn law_address<const D: usize>(law: &dyn CellLaw<D>) -> usize {
-    std::ptr::from_ref(law).cast::<()>() as usize
-}
+/// The law key of a cell of [`ElementCache`] without a kept matrix.
+const NOT_KEPT: usize = usize::MAX;
 
 impl ElementCache {
     /// Evaluate and keep the stiffness of every cell of `grid` whose law in `laws` is
-    /// linear. Errors: a wrong-sized or non-finite stiffness, naming the cell.
+    /// linear. Errors: a law failing on a cell or a wrong-sized stiffness, naming the cell.
     pub(crate) fn new<const D: usize>(grid: &Grid<D>, laws: &LawMap<'_, D>) -> Result<Self> {
         let nc = grid.num_cells();
         let mut start = Vec::with_capacity(nc + 1);
         start.push(0);
-        let mut law = vec![0; nc];
+        let mut law = vec![NOT_KEPT; nc];
         for c in 0..nc {
             let l = laws.law(c);
             let m = D * grid.cell_nodes(c).len();
             let len = if l.is_linear() { m * m } else { 0 };
             if len > 0 {
-                law[c] = law_address(l);
+                law[c] = laws.law_index(c);
             }
             start.push(start[c] + len);
         }
         let mut values = vec![0.0; start[nc]];
         let mut w = Work::<D>::default();
         let zero = vec![0.0; D * grid.num_nodes()];
-        for c in (0..nc).filter(|&c| law[c] != 0) {
+        for c in (0..nc).filter(|&c| law[c] != NOT_KEPT) {
             w.gather(grid, c, &zero);
             stiffness(grid, laws, c, &mut w)?;
             values[start[c]..start[c + 1]].copy_from_slice(w.k.as_slice());
@@ -212,7 +220,7 @@ impl ElementCache {
         pattern: &Pattern,
     ) -> Arc<[f64]> {
         let used: Vec<bool> = (0..grid.num_cells())
-            .map(|c| self.matrix(c, laws.law(c)).is_some())
+            .map(|c| self.matrix(c, laws.law_index(c)).is_some())
             .collect();
         // A poisoned lock only means another thread panicked while computing: recompute.
         let mut guard = self.sum.lock().unwrap_or_else(|e| e.into_inner());
@@ -313,21 +321,21 @@ impl ElementCache {
             .collect()
     }
 
-    /// Whether the stiffness of cell `c` under `law` is kept.
-    pub(crate) fn keeps<const D: usize>(&self, c: usize, law: &dyn CellLaw<D>) -> bool {
+    /// Whether the stiffness of cell `c` under the law of index `law` is kept.
+    pub(crate) fn keeps(&self, c: usize, law: usize) -> bool {
         self.matrix(c, law).is_some()
     }
 
-    /// The kept stiffness of cell `c` if its law is `law`.
+    /// The kept stiffness of cell `c` if its law is the law of index `law`.
     #[inline]
-    fn matrix<const D: usize>(&self, c: usize, law: &dyn CellLaw<D>) -> Option<&[f64]> {
+    fn matrix(&self, c: usize, law: usize) -> Option<&[f64]> {
         let a = *self.law.get(c)?;
-        (a != 0 && a == law_address(law)).then(|| &self.values[self.start[c]..self.start[c + 1]])
+        (a != NOT_KEPT && a == law).then(|| &self.values[self.start[c]..self.start[c + 1]])
     }
 }
 
 /// The stiffness of cell `c` at the gathered displacement `w.u` into `w.k`, checked for
-/// its size and finiteness.
+/// its size.
 fn stiffness<const D: usize>(
     grid: &Grid<D>,
     laws: &LawMap<'_, D>,
@@ -338,7 +346,8 @@ fn stiffness<const D: usize>(
     let m = w.u.len();
     {
         let geo = w.geo.load(grid, c);
-        law.stiffness(&geo, &w.u, &mut w.k, &mut w.scratch);
+        law.stiffness(&geo, &w.u, &mut w.k, &mut w.scratch)
+            .map_err(law_error(laws, c))?;
     }
     if w.k.nrows() != m || w.k.ncols() != m {
         return Err(cell_error(
@@ -351,14 +360,11 @@ fn stiffness<const D: usize>(
             ),
         ));
     }
-    if !w.k.iter().all(|v| v.is_finite()) {
-        return Err(cell_error(laws, c, "non-finite stiffness".into()));
-    }
     Ok(())
 }
 
 /// The stiffness matrices of `cells` at the nodal displacement `u`, appended to `out`
-/// in turn (column-major, as [`CellLaw::stiffness`] gives them). Errors as the assembly.
+/// in turn (column-major, as [`CellLaw::stiffness`](porofrac_law::CellLaw::stiffness) gives them). Errors as the assembly.
 pub(crate) fn cell_tangents<const D: usize>(
     grid: &Grid<D>,
     laws: &LawMap<'_, D>,
@@ -447,7 +453,7 @@ pub(crate) fn assemble_with<const D: usize>(
             for &c in &pattern.chunk_cells[ch.cells.clone()] {
                 let law = laws.law(c);
                 // A kept matrix is in `kept_sum` already.
-                let kept = cache.and_then(|e| e.matrix(c, law));
+                let kept = cache.and_then(|e| e.matrix(c, laws.law_index(c)));
                 if kept.is_some() && frc.is_none() {
                     continue;
                 }
@@ -767,7 +773,7 @@ mod tests {
     use super::*;
     use crate::bc::Displacement;
     use porofrac_grid::generate::simplices;
-    use porofrac_law::Stiffness;
+    use porofrac_law::{CellLaw, Stiffness};
     use porofrac_mdem::{DemLaw, DemMode, MdemLaw};
     use porofrac_vem::VemLaw;
 
@@ -855,5 +861,95 @@ mod tests {
         assert!(same(&before, &run(&map, Some(&cache))));
         assert_eq!(*cache.kept_sum(&grid, &map, &dofs, &pattern), *full(&map));
         assert!(after.0.iter().chain(&after.1).all(|x| x.is_finite()));
+    }
+
+    /// A law that fails on a cell: the assembly, the element cache and the stresses
+    /// return its error with the cell and the law's name.
+    #[test]
+    fn law_errors_name_the_cell() {
+        /// VEM, except that its `bad`-th stiffness or stress evaluation (from 0) fails.
+        struct Failing {
+            inner: VemLaw<2>,
+            bad: usize,
+            calls: std::sync::atomic::AtomicUsize,
+        }
+        impl Failing {
+            fn fail(&self) -> std::result::Result<(), LawError> {
+                let k = self
+                    .calls
+                    .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                if k == self.bad {
+                    return Err(LawError::Evaluation("refused".into()));
+                }
+                Ok(())
+            }
+        }
+        impl CellLaw<2> for Failing {
+            fn name(&self) -> &str {
+                "failing"
+            }
+            fn energy(
+                &self,
+                cell: &porofrac_law::CellGeometry<'_, 2>,
+                u: &[f64],
+                s: &mut Scratch,
+            ) -> std::result::Result<f64, LawError> {
+                self.inner.energy(cell, u, s)
+            }
+            fn forces(
+                &self,
+                cell: &porofrac_law::CellGeometry<'_, 2>,
+                u: &[f64],
+                out: &mut [f64],
+                s: &mut Scratch,
+            ) -> std::result::Result<(), LawError> {
+                self.inner.forces(cell, u, out, s)
+            }
+            fn stiffness(
+                &self,
+                cell: &porofrac_law::CellGeometry<'_, 2>,
+                u: &[f64],
+                out: &mut DMatrix<f64>,
+                s: &mut Scratch,
+            ) -> std::result::Result<(), LawError> {
+                self.fail()?;
+                self.inner.stiffness(cell, u, out, s)
+            }
+            fn stress(
+                &self,
+                cell: &porofrac_law::CellGeometry<'_, 2>,
+                u: &[f64],
+                s: &mut Scratch,
+            ) -> std::result::Result<porofrac_law::Tensor<2>, LawError> {
+                self.fail()?;
+                self.inner.stress(cell, u, s)
+            }
+        }
+        let grid = simplices::<2>(Point::<2>::zeros(), Point::<2>::new(2.0, 1.0), [2, 1]).unwrap();
+        let st = Stiffness::<2>::isotropic(1.0e9, 0.3).unwrap();
+        let vem = VemLaw::new(st);
+        // Only cell 3 uses the failing law, so its first call fails.
+        let failing = Failing {
+            inner: vem.clone(),
+            bad: 0,
+            calls: Default::default(),
+        };
+        let laws: Vec<&dyn CellLaw<2>> = vec![&vem, &failing];
+        let of = (0..grid.num_cells()).map(|c| usize::from(c == 3)).collect();
+        let map = LawMap::new(&grid, laws, of).unwrap();
+        let expect = |e: SimError| match e {
+            SimError::Law { cell, law, source } => {
+                assert_eq!((cell, law.as_str()), (3, "failing"));
+                assert_eq!(source, LawError::Evaluation("refused".into()));
+            }
+            other => panic!("expected a law error, got {other:?}"),
+        };
+        let Err(e) = ElementCache::new(&grid, &map) else {
+            panic!("the failing cell was accepted");
+        };
+        expect(e);
+        failing.calls.store(0, std::sync::atomic::Ordering::Relaxed);
+        let u = vec![0.0; 2 * grid.num_nodes()];
+        expect(crate::solve::cell_stresses(&grid, &map, &u).unwrap_err());
     }
 }

@@ -1,6 +1,7 @@
 //! The error type of the crate.
 
 use porofrac_grid::GridError;
+use porofrac_law::LawError;
 
 /// Everything that can go wrong when setting up or solving a mechanics problem.
 ///
@@ -64,6 +65,18 @@ pub enum SimError {
         law: String,
         /// What is wrong.
         what: String,
+    },
+    /// A cell law failed to evaluate a cell (a degenerate cell, a node count it does not
+    /// support, a slice of the wrong length).
+    #[error("cell {cell} (law `{law}`): {source}")]
+    Law {
+        /// The cell.
+        cell: usize,
+        /// The law's name.
+        law: String,
+        /// What the law reported.
+        #[source]
+        source: LawError,
     },
     /// A boundary condition refers to a face that cannot carry it.
     #[error("{condition}: face {face} {what}")]

@@ -113,7 +113,7 @@ use porofrac_grid::{Grid, Point};
 use porofrac_law::CellGeometry;
 use rayon::prelude::*;
 
-use crate::assembly::{Work, cell_error, nodal_loads};
+use crate::assembly::{Work, cell_error, law_error, nodal_loads};
 use crate::error::{AXES, Result, SimError, fmt_point};
 use crate::laws::LawMap;
 use crate::pattern::Pattern;
@@ -304,7 +304,9 @@ fn internal_forces<const D: usize>(
         }
         w.f.clear();
         w.f.resize(w.u.len(), 0.0);
-        law.forces(&geo.cell(grid, c), &w.u, &mut w.f, &mut w.scratch);
+        law.forces(&geo.cell(grid, c), &w.u, &mut w.f, &mut w.scratch)
+            .map_err(law_error(laws, c))?;
+        // Divergence: finite laws give non-finite forces only from non-finite motion.
         if let Some(i) = w.f.iter().position(|v| !v.is_finite()) {
             let n = grid.cell_nodes(c)[i / D];
             return Err(cell_error(
@@ -376,7 +378,8 @@ impl<'a, const D: usize> ExplicitState<'a, D> {
     /// entries are ignored, a platen equation takes the mean of its dofs).
     ///
     /// Errors: wrong lengths, a non-positive or non-finite density (naming the cell), bad
-    /// options, a law returning non-finite forces or stiffness (naming the cell), an
+    /// options, a law failing on a cell or returning a wrong-sized stiffness, or
+    /// non-finite forces (naming the cell), an
     /// equation without mass or stiffness (naming its node), and the load errors.
     pub fn new(
         problem: &StaticProblem<'a, D>,
@@ -483,13 +486,14 @@ impl<'a, const D: usize> ExplicitState<'a, D> {
                             }
                         }
                     }
-                    law.stiffness(&g, &w.u, &mut w.k, &mut w.scratch);
-                    if w.k.nrows() != m || w.k.ncols() != m || !w.k.iter().all(|v| v.is_finite()) {
+                    law.stiffness(&g, &w.u, &mut w.k, &mut w.scratch)
+                        .map_err(law_error(laws, c))?;
+                    if w.k.nrows() != m || w.k.ncols() != m {
                         return Err(cell_error(
                             laws,
                             c,
                             format!(
-                                "stiffness is {}×{} (expected {m}×{m}) or not finite",
+                                "stiffness is {}×{}, expected {m}×{m}",
                                 w.k.nrows(),
                                 w.k.ncols()
                             ),
@@ -730,7 +734,11 @@ impl<'a, const D: usize> ExplicitState<'a, D> {
             let en = laws
                 .law(c)
                 .energy(&self.geo.cell(grid, c), &w.u, &mut w.scratch);
-            let en = if en.is_finite() { en } else { f64::INFINITY };
+            // A cell whose law fails or gives a non-finite energy is the worst.
+            let en = match en {
+                Ok(en) if en.is_finite() => en,
+                _ => f64::INFINITY,
+            };
             if en > cell.1 {
                 cell = (c, en);
             }
@@ -822,9 +830,11 @@ impl<'a, const D: usize> ExplicitState<'a, D> {
             .into_par_iter()
             .map_init(Work::<D>::default, |w, c| {
                 w.gather(grid, c, u);
-                laws.law(c).energy(&geo.cell(grid, c), &w.u, &mut w.scratch)
+                laws.law(c)
+                    .energy(&geo.cell(grid, c), &w.u, &mut w.scratch)
+                    .map_err(law_error(laws, c))
             })
-            .sum();
+            .sum::<Result<f64>>()?;
         if !e.is_finite() {
             return Err(SimError::NotFinite {
                 location: format!("the strain energy at explicit step {}", self.steps),

@@ -64,7 +64,7 @@ use rayon::prelude::*;
 use crate::bc::Loads;
 use std::sync::Arc;
 
-use crate::assembly::ElementCache;
+use crate::assembly::{ElementCache, law_error};
 use crate::biot::{
     BiotCoupling, BiotError, BiotState, BiotSystem, CouplingStats, ExplicitPressure, FixedStress,
     Monolithic, Operators,
@@ -760,17 +760,20 @@ fn stresses<const D: usize>(
                 node_normals: &ops.normals[k],
                 volume: volumes[c],
             };
-            let law = map.law(c);
-            *s = match cache.stress(c, law, &uc) {
+            *s = match cache.stress(c, map.law_index(c), &uc) {
                 Some(s) => s,
-                None => law.stress(&geo, &uc, &mut scratch),
+                None => map
+                    .law(c)
+                    .stress(&geo, &uc, &mut scratch)
+                    .map_err(law_error(map, c))?,
             };
         }
+        Ok::<_, SimError>(())
     };
     if out.len() < PARALLEL_STRESS_CELLS {
-        out.chunks_mut(BLOCK).enumerate().for_each(block);
+        out.chunks_mut(BLOCK).enumerate().try_for_each(block)?;
     } else {
-        out.par_chunks_mut(BLOCK).enumerate().for_each(block);
+        out.par_chunks_mut(BLOCK).enumerate().try_for_each(block)?;
     }
     Ok(out)
 }

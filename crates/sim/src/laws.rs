@@ -78,6 +78,15 @@ impl<'a, const D: usize> LawMap<'a, D> {
     pub fn law(&self, c: usize) -> &'a dyn CellLaw<D> {
         self.laws[self.law_of_cell[c]]
     }
+    /// The index (into the laws of the map) of the law of cell `c`.
+    #[inline]
+    pub fn law_index(&self, c: usize) -> usize {
+        self.law_of_cell[c]
+    }
+    /// The number of laws of the map.
+    pub fn num_laws(&self) -> usize {
+        self.laws.len()
+    }
     /// The index of the law of every cell.
     pub fn law_of_cell(&self) -> &[usize] {
         &self.law_of_cell

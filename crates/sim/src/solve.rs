@@ -27,7 +27,7 @@ use rayon::prelude::*;
 
 pub use faer::Par;
 
-use crate::assembly::{Work, assemble, nodal_loads};
+use crate::assembly::{Work, assemble, law_error, nodal_loads};
 use crate::bc::Loads;
 use crate::dofs::DofMap;
 use crate::error::{Result, SimError};
@@ -364,11 +364,15 @@ pub fn cell_stresses<const D: usize>(
     let mut out = vec![Tensor::<D>::zeros(); grid.num_cells()];
     out.par_iter_mut()
         .enumerate()
-        .for_each_init(Work::<D>::default, |w, (c, s)| {
+        .try_for_each_init(Work::<D>::default, |w, (c, s)| {
             w.gather(grid, c, u);
             let geo = w.geo.load(grid, c);
-            *s = laws.law(c).stress(&geo, &w.u, &mut w.scratch);
-        });
+            *s = laws
+                .law(c)
+                .stress(&geo, &w.u, &mut w.scratch)
+                .map_err(law_error(laws, c))?;
+            Ok::<_, SimError>(())
+        })?;
     Ok(out)
 }
 

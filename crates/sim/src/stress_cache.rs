@@ -1,7 +1,7 @@
 //! Cell stresses of linear laws as one cached product.
 //!
 //! For a law whose stiffness does not depend on the displacement
-//! ([`CellLaw::is_linear`]) the cell stress is linear in the cell's nodal displacements
+//! ([`CellLaw::is_linear`](porofrac_law::CellLaw::is_linear)) the cell stress is linear in the cell's nodal displacements
 //! (seed eq. 18 for MDEM, the projected strain for VEM):
 //!
 //! ```text
@@ -11,14 +11,15 @@
 //! with `e_j` the unit displacement of local dof `j`. [`StressCache`] probes `B_K` once
 //! from the law for every cell with a linear law, so a cell's stress is a `D² × m`
 //! product instead of a law evaluation (MDEM builds its frame from the coordinates on
-//! every call). Entries are keyed by the law's address like
-//! [`crate::assembly::ElementCache`]: a cell whose law changed since (a failed cell
-//! takes its post-failure law) is evaluated by its law. A law with `σ(0) ≠ 0` or a
-//! non-finite probe is not cached. The product sums in another order than the law, so
+//! every call). Entries are keyed by the index of the law in the [`LawMap`] like
+//! [`crate::assembly::ElementCache`] (the cache serves the maps over the same list of
+//! laws, which differ only in the law of each cell): a cell whose law changed since (a
+//! failed cell takes its post-failure law) is evaluated by its law. A law with
+//! `σ(0) ≠ 0` or a probe that fails is not cached. The product sums in another order than the law, so
 //! the stresses agree with the law's to rounding.
 
 use porofrac_grid::Point;
-use porofrac_law::{CellGeometry, CellLaw, Scratch, Tensor};
+use porofrac_law::{CellGeometry, Scratch, Tensor};
 use rayon::prelude::*;
 
 use crate::biot::Operators;
@@ -29,17 +30,16 @@ const BLOCK: usize = 1024;
 
 /// The stress operators `B_K` of the cells with a linear law (see the module docs).
 pub(crate) struct StressCache {
-    /// Per cell: the address of the law `B_K` belongs to, 0 when none is kept.
+    /// Per cell: the index in the law map of the law `B_K` belongs to, [`NONE`] when
+    /// none is kept.
     law: Vec<usize>,
     /// Per cell: the start of `B_K` in `values` (column-major, `D²` rows); `len + 1`.
     start: Vec<usize>,
     values: Vec<f64>,
 }
 
-/// The address of a law object (the cache key).
-fn law_address<const D: usize>(law: &dyn CellLaw<D>) -> usize {
-    std::ptr::from_ref(law).cast::<()>() as usize
-}
+/// The key of a cell without a kept operator.
+const NONE: usize = usize::MAX;
 
 /// The geometry of cell `c` from the coupling data.
 fn geometry<'g, const D: usize>(
@@ -74,7 +74,7 @@ impl StressCache {
             start.push(start[c] + len);
         }
         let mut values = vec![0.0; start[nc]];
-        let mut law = vec![0; nc];
+        let mut law = vec![NONE; nc];
         // Per block of cells: its slice of `values` and of `law`.
         let mut parts = Vec::with_capacity(nc.div_ceil(BLOCK));
         let (mut vrest, mut lrest) = (&mut values[..], &mut law[..]);
@@ -101,16 +101,21 @@ impl StressCache {
                 uc.clear();
                 uc.resize(m, 0.0);
                 let at_rest = l.stress(&geo, &uc, &mut scratch);
-                let mut ok = at_rest.iter().all(|&s| s == 0.0);
+                let mut ok = at_rest.is_ok_and(|s| s.iter().all(|&s| s == 0.0));
                 for j in 0..m {
+                    if !ok {
+                        break;
+                    }
                     uc[j] = 1.0;
                     let s = l.stress(&geo, &uc, &mut scratch);
                     uc[j] = 0.0;
-                    ok &= s.iter().all(|v| v.is_finite());
-                    b[D * D * j..D * D * (j + 1)].copy_from_slice(s.as_slice());
+                    match s {
+                        Ok(s) => b[D * D * j..D * D * (j + 1)].copy_from_slice(s.as_slice()),
+                        Err(_) => ok = false,
+                    }
                 }
                 if ok {
-                    laws[i] = law_address(l);
+                    laws[i] = map.law_index(c);
                 }
             }
         });
@@ -118,16 +123,16 @@ impl StressCache {
     }
 
     /// The stress of cell `c` at its gathered displacement `uc` if `B_K` is kept for its
-    /// law `law`.
+    /// law, the law of index `law` in the map.
     #[inline]
     pub(crate) fn stress<const D: usize>(
         &self,
         c: usize,
-        law: &dyn CellLaw<D>,
+        law: usize,
         uc: &[f64],
     ) -> Option<Tensor<D>> {
         let a = *self.law.get(c)?;
-        if a == 0 || a != law_address(law) {
+        if a == NONE || a != law {
             return None;
         }
         let b = &self.values[self.start[c]..self.start[c + 1]];
@@ -150,7 +155,7 @@ impl StressCache {
 mod tests {
     use super::*;
     use porofrac_grid::generate::simplices;
-    use porofrac_law::Stiffness;
+    use porofrac_law::{CellLaw, Stiffness};
     use porofrac_mdem::{DemLaw, DemMode, MdemLaw};
     use porofrac_vem::VemLaw;
 
@@ -210,8 +215,8 @@ mod tests {
             let law = map.law(c);
             let geo = geometry(&ops, &coords, grid.cell_volumes(), c);
             let uc = u(c, 3 * geo.coords.len());
-            let want = law.stress(&geo, &uc, &mut scratch);
-            match cache.stress(c, law, &uc) {
+            let want = law.stress(&geo, &uc, &mut scratch).unwrap();
+            match cache.stress(c, map.law_index(c), &uc) {
                 Some(got) => {
                     kept += 1;
                     assert!(law.is_linear(), "cell {c}");
@@ -228,8 +233,8 @@ mod tests {
         assert_eq!(kept, (0..nc).filter(|&c| of(c) != 2).count());
         // Cell 3 (MDEM when cached) fails: its kept operator must not serve it.
         map.set_law(&grid, 3, 2).unwrap();
-        assert!(cache.stress(3, map.law(3), &u(3, 12)).is_none());
+        assert!(cache.stress::<3>(3, map.law_index(3), &u(3, 12)).is_none());
         map.set_law(&grid, 3, 1).unwrap();
-        assert!(cache.stress(3, map.law(3), &u(3, 12)).is_some());
+        assert!(cache.stress::<3>(3, map.law_index(3), &u(3, 12)).is_some());
     }
 }

@@ -86,7 +86,7 @@
 use nalgebra::DMatrix;
 use porofrac_grid::Point;
 use porofrac_law::kelvin::{Kelvin, from_kelvin, kelvin_len, kelvin_pair, to_kelvin};
-use porofrac_law::{CellGeometry, CellLaw, Scratch, Stiffness, Tensor, zero_matrix};
+use porofrac_law::{CellGeometry, CellLaw, LawError, Scratch, Stiffness, Tensor, zero_matrix};
 
 /// Errors of the VEM crate.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -500,7 +500,14 @@ impl<const D: usize> CellLaw<D> for VemLaw<D> {
         "vem"
     }
 
-    fn energy(&self, cell: &CellGeometry<'_, D>, u: &[f64], _scratch: &mut Scratch) -> f64 {
+    fn energy(
+        &self,
+        cell: &CellGeometry<'_, D>,
+        u: &[f64],
+        _scratch: &mut Scratch,
+    ) -> Result<f64, LawError> {
+        cell.check()?;
+        cell.check_len("displacements", u.len())?;
         let f = Frame::new(cell);
         let (ubar, g) = Self::kinematics(cell, &f, u);
         let eps = to_kelvin::<D>(&g);
@@ -512,7 +519,7 @@ impl<const D: usize> CellLaw<D> for VemLaw<D> {
             stab += r.dot(&self.node_weights(w, cell, &f, i).component_mul(&r));
         }
         e += 0.5 * stab;
-        e
+        Ok(e)
     }
 
     fn forces(
@@ -521,7 +528,10 @@ impl<const D: usize> CellLaw<D> for VemLaw<D> {
         u: &[f64],
         out: &mut [f64],
         _scratch: &mut Scratch,
-    ) {
+    ) -> Result<(), LawError> {
+        cell.check()?;
+        cell.check_len("displacements", u.len())?;
+        cell.check_len("forces", out.len())?;
         let f = Frame::new(cell);
         let (ubar, g) = Self::kinematics(cell, &f, u);
         let sigma = from_kelvin::<D>(&self.material.stress_kelvin(&to_kelvin::<D>(&g)));
@@ -546,6 +556,7 @@ impl<const D: usize> CellLaw<D> for VemLaw<D> {
             let fi = -(sigma * nj) - (t - tbar - td * nj);
             out[D * i..D * i + D].copy_from_slice(fi.as_slice());
         }
+        Ok(())
     }
 
     fn stiffness(
@@ -554,11 +565,20 @@ impl<const D: usize> CellLaw<D> for VemLaw<D> {
         _u: &[f64],
         out: &mut DMatrix<f64>,
         scratch: &mut Scratch,
-    ) {
+    ) -> Result<(), LawError> {
+        cell.check()?;
         self.local_stiffness(cell, out, scratch);
+        Ok(())
     }
 
-    fn stress(&self, cell: &CellGeometry<'_, D>, u: &[f64], _scratch: &mut Scratch) -> Tensor<D> {
+    fn stress(
+        &self,
+        cell: &CellGeometry<'_, D>,
+        u: &[f64],
+        _scratch: &mut Scratch,
+    ) -> Result<Tensor<D>, LawError> {
+        cell.check()?;
+        cell.check_len("displacements", u.len())?;
         // G = (1/|K|) Σ_j u_j ⊗ N_j, as in `kinematics` (no frame needed).
         let mut g = Tensor::<D>::zeros();
         for (j, nj) in cell.node_normals.iter().enumerate() {
@@ -568,9 +588,11 @@ impl<const D: usize> CellLaw<D> for VemLaw<D> {
         if let Some((lam, mu)) = self.lame {
             // Isotropic: σ = λ tr(ε) I + 2μ ε, ε = sym G.
             let eps = (g + g.transpose()) * 0.5;
-            return Tensor::<D>::identity() * (lam * eps.trace()) + eps * (2.0 * mu);
+            return Ok(Tensor::<D>::identity() * (lam * eps.trace()) + eps * (2.0 * mu));
         }
-        from_kelvin::<D>(&self.material.stress_kelvin(&to_kelvin::<D>(&g)))
+        Ok(from_kelvin::<D>(
+            &self.material.stress_kelvin(&to_kelvin::<D>(&g)),
+        ))
     }
 }
 

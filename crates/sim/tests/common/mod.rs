@@ -3,7 +3,7 @@
 
 use nalgebra::{DMatrix, SMatrix};
 use porofrac_grid::{CellFaceLoops, Grid, Point};
-use porofrac_law::{CellGeometry, CellLaw, Scratch, Tensor};
+use porofrac_law::{CellGeometry, CellLaw, LawError, Scratch, Tensor};
 use porofrac_sim::{Displacement, ScalarField};
 
 /// Index pairs of the Kelvin components: 2D [11, 22, 12], 3D [11, 22, 33, 23, 13, 12].
@@ -64,11 +64,16 @@ impl<const D: usize> CellLaw<D> for P1Law {
     fn supports(&self, num_nodes: usize) -> bool {
         num_nodes == D + 1
     }
-    fn energy(&self, cell: &CellGeometry<'_, D>, u: &[f64], scratch: &mut Scratch) -> f64 {
+    fn energy(
+        &self,
+        cell: &CellGeometry<'_, D>,
+        u: &[f64],
+        scratch: &mut Scratch,
+    ) -> Result<f64, LawError> {
         let mut k = DMatrix::zeros(0, 0);
-        self.stiffness(cell, u, &mut k, scratch);
+        self.stiffness(cell, u, &mut k, scratch)?;
         let uv = nalgebra::DVector::from_column_slice(u);
-        0.5 * uv.dot(&(&k * &uv))
+        Ok(0.5 * uv.dot(&(&k * &uv)))
     }
     fn forces(
         &self,
@@ -76,13 +81,14 @@ impl<const D: usize> CellLaw<D> for P1Law {
         u: &[f64],
         out: &mut [f64],
         scratch: &mut Scratch,
-    ) {
+    ) -> Result<(), LawError> {
         let mut k = std::mem::take(&mut scratch.mats[1]);
-        self.stiffness(cell, u, &mut k, scratch);
+        self.stiffness(cell, u, &mut k, scratch)?;
         for (i, o) in out.iter_mut().enumerate() {
             *o = -(0..u.len()).map(|j| k[(i, j)] * u[j]).sum::<f64>();
         }
         scratch.mats[1] = k;
+        Ok(())
     }
     fn stiffness(
         &self,
@@ -90,13 +96,19 @@ impl<const D: usize> CellLaw<D> for P1Law {
         _u: &[f64],
         out: &mut DMatrix<f64>,
         scratch: &mut Scratch,
-    ) {
+    ) -> Result<(), LawError> {
         let mut b = std::mem::take(&mut scratch.mats[0]);
         self.b_matrix(cell, &mut b);
         *out = b.transpose() * &self.d * &b * cell.volume;
         scratch.mats[0] = b;
+        Ok(())
     }
-    fn stress(&self, cell: &CellGeometry<'_, D>, u: &[f64], scratch: &mut Scratch) -> Tensor<D> {
+    fn stress(
+        &self,
+        cell: &CellGeometry<'_, D>,
+        u: &[f64],
+        scratch: &mut Scratch,
+    ) -> Result<Tensor<D>, LawError> {
         let mut b = std::mem::take(&mut scratch.mats[0]);
         self.b_matrix(cell, &mut b);
         let eps = &b * nalgebra::DVector::from_column_slice(u);
@@ -112,7 +124,7 @@ impl<const D: usize> CellLaw<D> for P1Law {
                 t[(c, a)] = s * sig[r];
             }
         }
-        t
+        Ok(t)
     }
 }
 

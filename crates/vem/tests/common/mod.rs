@@ -286,7 +286,7 @@ pub fn patch_errors<const D: usize>(
             scale = scale.max(load[c].abs());
         }
     }
-    let s = law.stress(cell, &u, &mut scratch);
+    let s = law.stress(cell, &u, &mut scratch).unwrap();
     ((err / scale), (s - sigma).amax() / sigma.amax())
 }
 
