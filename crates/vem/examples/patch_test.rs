@@ -52,14 +52,14 @@ fn main() -> Result<(), Box<dyn Error>> {
             }
         };
         field(&a, &mut u);
-        let s = law.stress(&cell, &u, &mut scratch);
+        let s = law.stress(&cell, &u, &mut scratch)?;
         stress_error = stress_error.max((s - stress).amax() / stress.amax());
-        let e = law.energy(&cell, &u, &mut scratch);
+        let e = law.energy(&cell, &u, &mut scratch)?;
         let exact = cell.volume * energy_density;
         energy_error = energy_error.max((e - exact).abs() / exact);
         field(&rotation, &mut u);
         f.resize(u.len(), 0.0);
-        law.forces(&cell, &u, &mut f, &mut scratch);
+        law.forces(&cell, &u, &mut f, &mut scratch)?;
         let scale = material.max_eigenvalue() * 1.0e-3 * cell.volume.sqrt();
         rigid_force = rigid_force.max(f.iter().fold(0.0_f64, |m, v| m.max(v.abs())) / scale);
     }

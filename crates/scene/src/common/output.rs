@@ -24,11 +24,10 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir).map_err(err)?;
     }
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(".tmp");
-    let tmp = PathBuf::from(tmp);
-    std::fs::write(&tmp, bytes).map_err(err)?;
-    std::fs::rename(&tmp, path).map_err(err)
+    porofrac_vtk::write_atomic(path, bytes).map_err(|e| match e {
+        porofrac_vtk::VtkError::Io { source, .. } => err(source),
+        other => err(std::io::Error::other(other.to_string())),
+    })
 }
 
 /// A CSV table kept in memory and rewritten atomically: when it is created, after a row

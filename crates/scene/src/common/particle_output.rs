@@ -184,23 +184,26 @@ pub fn draw_disks(
             height as i32 - ((p[1] - b[2]) * scale) as i32,
         )
     };
-    let tmp = path.with_extension("tmp.png");
-    {
-        let root = BitMapBackend::new(&tmp, (width, height)).into_drawing_area();
-        root.fill(&WHITE).map_err(perr(path))?;
-        for i in 0..d.len() {
-            let r = ((d.r[i] * scale).round() as i32).max(1);
-            root.draw(&Circle::new(px(d.x[i]), r, colour(i).filled()))
+    crate::common::plots::atomic_png(
+        path,
+        |tmp| {
+            let root = BitMapBackend::new(tmp, (width, height)).into_drawing_area();
+            root.fill(&WHITE).map_err(perr(path))?;
+            for i in 0..d.len() {
+                let r = ((d.r[i] * scale).round() as i32).max(1);
+                root.draw(&Circle::new(px(d.x[i]), r, colour(i).filled()))
+                    .map_err(perr(path))?;
+            }
+            for (a, c) in segments {
+                root.draw(&PathElement::new(
+                    vec![px(*a), px(*c)],
+                    BLACK.stroke_width(3),
+                ))
                 .map_err(perr(path))?;
-        }
-        for (a, c) in segments {
-            root.draw(&PathElement::new(
-                vec![px(*a), px(*c)],
-                BLACK.stroke_width(3),
-            ))
-            .map_err(perr(path))?;
-        }
-        root.present().map_err(perr(path))?;
-    }
-    std::fs::rename(&tmp, path).map_err(perr(path))
+            }
+            root.present().map_err(perr(path))?;
+            Ok(())
+        },
+        perr::<String>(path),
+    )
 }

@@ -15,7 +15,6 @@
 //! second of stepping).
 
 pub mod check;
-mod vti;
 
 use crate::common::laws::LawRegistry;
 use crate::common::loaded::SceneError;
@@ -41,8 +40,9 @@ use crate::common::lattice::{
 };
 use crate::common::loaded::{LoadedScene, k, ki};
 use crate::common::model::{Model, RunError, Sizes, StepStats};
-use crate::common::output::{SolverStats, Summary, WallSeconds, write_atomic};
+use crate::common::output::{OutputError, SolverStats, Summary, WallSeconds, write_atomic};
 use crate::common::sections::NumOrExpr;
+use porofrac_vtk::{Attributes, DataArray, Encoding, ImageData};
 
 /// What a probe reads.
 enum ProbeKind {
@@ -524,17 +524,31 @@ impl Model for LbmModel<'_> {
                 .collect(),
             None => Vec::new(),
         };
-        let mut arrays: Vec<(&str, usize, &[f64])> = vec![
-            ("velocity", 3, &velocity),
-            ("pressure", 1, &pressure),
-            ("density", 1, &density),
-            ("solid", 1, &solid),
+        let mut arrays = vec![
+            DataArray::new("velocity", 3, &velocity[..]),
+            DataArray::new("pressure", 1, &pressure[..]),
+            DataArray::new("density", 1, &density[..]),
+            DataArray::new("solid", 1, &solid[..]),
         ];
         if self.thermal.is_some() {
-            arrays.push(("temperature", 1, &temperature));
+            arrays.push(DataArray::new("temperature", 1, &temperature[..]));
         }
-        let bytes = vti::image_data([nx, ny], origin, self.units.dx, &arrays);
-        write_atomic(&dir.join(&name), &bytes)?;
+        let image = ImageData {
+            size: [nx, ny, 1],
+            origin: [origin[0], origin[1], 0.0],
+            spacing: [self.units.dx; 3],
+            field_data: &[],
+            point_data: Attributes::new(&arrays),
+            cell_data: Attributes::default(),
+        };
+        let path = dir.join(&name);
+        let bytes = image
+            .to_bytes(Encoding::Appended)
+            .map_err(|e| OutputError {
+                path: path.clone(),
+                source: std::io::Error::other(e.to_string()),
+            })?;
+        write_atomic(&path, &bytes)?;
         Ok(name)
     }
 

@@ -44,24 +44,27 @@ pub(crate) fn field_png(
     } else if hi <= lo {
         (lo, hi) = (lo - 0.5, lo + 0.5);
     }
-    let tmp = path.with_extension("tmp.png");
-    {
-        let root = BitMapBackend::new(&tmp, (width as u32, height as u32)).into_drawing_area();
-        for py in 0..height {
-            let j = ((height - 1 - py) * ny / height).min(ny - 1);
-            for px in 0..width {
-                let i = (px * nx / width).min(nx - 1);
-                let k = j * nx + i;
-                let color = if solid[k] || !values[k].is_finite() {
-                    RGBColor(128, 128, 128)
-                } else {
-                    ViridisRGB::get_color_normalized(values[k], lo, hi)
-                };
-                root.draw_pixel((px as i32, py as i32), &color)
-                    .map_err(|e| err(e.to_string()))?;
+    crate::common::plots::atomic_png(
+        path,
+        |tmp| {
+            let root = BitMapBackend::new(tmp, (width as u32, height as u32)).into_drawing_area();
+            for py in 0..height {
+                let j = ((height - 1 - py) * ny / height).min(ny - 1);
+                for px in 0..width {
+                    let i = (px * nx / width).min(nx - 1);
+                    let k = j * nx + i;
+                    let color = if solid[k] || !values[k].is_finite() {
+                        RGBColor(128, 128, 128)
+                    } else {
+                        ViridisRGB::get_color_normalized(values[k], lo, hi)
+                    };
+                    root.draw_pixel((px as i32, py as i32), &color)
+                        .map_err(|e| err(e.to_string()))?;
+                }
             }
-        }
-        root.present().map_err(|e| err(e.to_string()))?;
-    }
-    std::fs::rename(&tmp, path).map_err(|e| err(e.to_string()))
+            root.present().map_err(|e| err(e.to_string()))?;
+            Ok(())
+        },
+        err,
+    )
 }
