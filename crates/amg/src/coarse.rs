@@ -44,12 +44,13 @@ impl CoarseSolver {
             col_ptr.push(row_idx.len());
         }
         let upper = UpperPattern::new(n, col_ptr, row_idx);
-        let cholesky = Cholesky::analyse(upper.symbolic(), Side::Upper, None).map_err(|e| match e {
-            CholeskyError::Symbolic(e) => {
-                AmgError::Input(format!("coarse symbolic Cholesky: {e:?}"))
-            }
-            e => AmgError::Input(format!("coarse symbolic Cholesky: {e}")),
-        })?;
+        let cholesky =
+            Cholesky::analyse(upper.symbolic(), Side::Upper, None).map_err(|e| match e {
+                CholeskyError::Symbolic(e) => {
+                    AmgError::Input(format!("coarse symbolic Cholesky: {e:?}"))
+                }
+                e => AmgError::Input(format!("coarse symbolic Cholesky: {e}")),
+            })?;
         let nnz = upper.nnz();
         Ok(Self {
             level,
@@ -72,18 +73,14 @@ impl CoarseSolver {
             *u = vals[s];
         }
         let mat = SparseColMatRef::new(self.upper.symbolic(), &self.values);
-        self.cholesky
-            .factorize(mat, Par::Seq)
-            .map_err(|e| match e {
-                CholeskyError::NonPositivePivot { index, .. } => {
-                    AmgError::CoarseNotPositiveDefinite {
-                        level: self.level,
-                        size: self.upper.dim(),
-                        equation: index,
-                    }
-                }
-                _ => AmgError::Input("out of memory in the coarse factorization".into()),
-            })
+        self.cholesky.factorize(mat, Par::Seq).map_err(|e| match e {
+            CholeskyError::NonPositivePivot { index, .. } => AmgError::CoarseNotPositiveDefinite {
+                level: self.level,
+                size: self.upper.dim(),
+                equation: index,
+            },
+            _ => AmgError::Input("out of memory in the coarse factorization".into()),
+        })
     }
 
     /// Solve in place (`rhs` holds `b` on entry and `x` on return).

@@ -30,8 +30,8 @@
 
 use faer::Side;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
-use porofrac_sparse::{Cholesky, CholeskyError};
 use porofrac_grid::{Grid, NO_CELL, Point};
+use porofrac_sparse::{Cholesky, CholeskyError};
 use rayon::prelude::*;
 
 use crate::error::{FlowError, Result, cell_err};
@@ -657,7 +657,9 @@ impl<const D: usize> FlowModel<D> {
                 // faer's error, as faer prints it.
                 let e = match e {
                     CholeskyError::NonPositivePivot { source, .. } => source,
-                    _ => faer::sparse::linalg::LltError::Generic(faer::sparse::FaerError::OutOfMemory),
+                    _ => faer::sparse::linalg::LltError::Generic(
+                        faer::sparse::FaerError::OutOfMemory,
+                    ),
                 };
                 FlowError::Singular(format!(
                     "Cholesky factorization failed ({e}); the system is not positive definite"

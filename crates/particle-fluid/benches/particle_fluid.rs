@@ -6,8 +6,8 @@
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use porofrac_lbm::{Lattice, LatticeConfig, ObstacleMotion, Units};
-use porofrac_particles::Disks;
 use porofrac_particle_fluid::{CouplingOptions, ParticleFluid, RigidDisks};
+use porofrac_particles::Disks;
 
 const N_LATTICE: usize = 512;
 

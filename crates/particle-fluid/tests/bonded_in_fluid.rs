@@ -11,8 +11,8 @@
 
 use porofrac_lbm::{Lattice, LatticeConfig, Units};
 use porofrac_lsm::{BondLaw, Damping, LatticeSolid, LsmSpec, calibrate};
-use porofrac_particles::{Disks, Hole, RandomPacking, Region};
 use porofrac_particle_fluid::{CouplingOptions, LoadAveraging, ParticleFluid};
+use porofrac_particles::{Disks, Hole, RandomPacking, Region};
 
 const DX: f64 = 0.05;
 

@@ -12,10 +12,10 @@
 use porofrac_lbm::{
     Collision, Lattice, LatticeConfig, Obstacle, Shape, SideKind, ThermalSide, Units,
 };
-use porofrac_particles::Disks;
 use porofrac_particle_fluid::{
     CouplingError, CouplingOptions, LoadAveraging, ParticleFluid, RigidDisks, ThermalSetup,
 };
+use porofrac_particles::Disks;
 
 const DX: f64 = 1e-4;
 const NU: f64 = 1e-6;

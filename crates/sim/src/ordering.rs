@@ -88,7 +88,6 @@ pub fn pattern_dissection<const D: usize>(
     porofrac_sparse::ordering::pattern_dissection(&pos, col_ptr, row_idx, leaf)
 }
 
-
 struct Dissection<'g, const D: usize> {
     grid: &'g Grid<D>,
     pos: Vec<usize>,

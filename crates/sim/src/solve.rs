@@ -159,9 +159,9 @@ impl DirectSolver {
                 CholeskyError::NotFactored => {
                     SimError::Input("solve before a successful factorization".into())
                 }
-                CholeskyError::Dimension { got, want, .. } => SimError::Input(format!(
-                    "right-hand side of length {got}, want {want}"
-                )),
+                CholeskyError::Dimension { got, want, .. } => {
+                    SimError::Input(format!("right-hand side of length {got}, want {want}"))
+                }
                 _ => SimError::LinearAlgebra("out of memory".into()),
             })
     }

@@ -286,7 +286,10 @@ mod tests {
                 }
             }
         }
-        ax.iter().zip(b).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max)
+        ax.iter()
+            .zip(b)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max)
     }
 
     #[test]
@@ -301,7 +304,8 @@ mod tests {
                 for v in vals.iter_mut().filter(|v| **v > 0.0) {
                     *v = d;
                 }
-                chol.factorize(SparseColMatRef::new(sym, &vals), Par::Seq).unwrap();
+                chol.factorize(SparseColMatRef::new(sym, &vals), Par::Seq)
+                    .unwrap();
                 let mut x = b.clone();
                 chol.solve_in_place(&mut x, Par::Seq).unwrap();
                 assert!(residual(&cp, &ri, &vals, &x, &b) < 1e-12 * n as f64);
@@ -359,7 +363,10 @@ mod tests {
         let sym = SymbolicSparseColMatRef::new_checked(3, 3, &cp, None, &ri);
         assert!(matches!(
             Cholesky::analyse(sym, Side::Upper, Some(&[0, 1, 1])),
-            Err(CholeskyError::Ordering(PermutationError::Entry { index: 2, value: 1 }))
+            Err(CholeskyError::Ordering(PermutationError::Entry {
+                index: 2,
+                value: 1
+            }))
         ));
     }
 }

@@ -132,8 +132,8 @@ impl Ldlt {
     ) -> Result<Self, LdltError> {
         let sym = SymbolicSparseColMatRef::new_checked(n, n, col_ptr, None, row_idx);
         let mut inverse = Vec::new();
-        let ordering = symmetric_ordering(perm, &mut inverse, n)
-            .map_err(|e| LdltError(e.to_string()))?;
+        let ordering =
+            symmetric_ordering(perm, &mut inverse, n).map_err(|e| LdltError(e.to_string()))?;
         let params = CholeskySymbolicParams {
             supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
             supernodal_params: SymbolicSupernodalParams { relax: RELAX },
@@ -595,11 +595,7 @@ impl Ldlt {
     /// `x ← L⁻ᵀ D⁻¹ x` over the supernodes `sns` only (ascending, closed under the
     /// parent: [`Ldlt::path_union`]), `x` in the elimination order: the columns of `sns`
     /// get the values of a full backward sweep, the others are left as they were.
-    pub fn backward_partial(
-        &mut self,
-        sns: &[usize],
-        x: &mut [f64],
-    ) -> Result<(), LdltError> {
+    pub fn backward_partial(&mut self, sns: &[usize], x: &mut [f64]) -> Result<(), LdltError> {
         self.check_supernodal(x.len())?;
         self.sweep_over(sns, x, false)
     }
@@ -607,11 +603,7 @@ impl Ldlt {
     /// `x ← L⁻¹ x` for `x` (in the elimination order) zero outside the columns
     /// `positions`: a forward sweep over their paths to the roots only
     /// ([`Ldlt::path_union`]; outside them the result is zero too).
-    pub fn forward_sparse(
-        &mut self,
-        positions: &[usize],
-        x: &mut [f64],
-    ) -> Result<(), LdltError> {
+    pub fn forward_sparse(&mut self, positions: &[usize], x: &mut [f64]) -> Result<(), LdltError> {
         let sns = self.path_union(positions)?;
         self.sweep_over(&sns, x, true)
     }

@@ -445,11 +445,7 @@ impl LowRank {
     /// of this kind: its error is that of `y` (the capacitance matrix is formed from `G`
     /// with rounding and can be ill-conditioned), `A (A₀⁻¹ P Δ δy) = P (I + Δ G) Δ δy`.
     /// Plainly with `A₀` when no change is set up.
-    pub fn solve_on_support(
-        &mut self,
-        ldlt: &mut Ldlt,
-        rhs: &mut [f64],
-    ) -> Result<(), LdltError> {
+    pub fn solve_on_support(&mut self, ldlt: &mut Ldlt, rhs: &mut [f64]) -> Result<(), LdltError> {
         let Some(lu) = &self.lu else {
             return ldlt.solve_in_place(rhs);
         };

@@ -104,10 +104,11 @@ impl Lu {
                 want: self.n,
             });
         }
-        let lu = FaerLu::try_new_with_symbolic(self.symbolic.clone(), matrix).map_err(|e| match e {
-            FaerLuError::SymbolicSingular { index } => LuError::StructurallySingular { index },
-            FaerLuError::Generic(e) => LuError::Numeric(e),
-        })?;
+        let lu =
+            FaerLu::try_new_with_symbolic(self.symbolic.clone(), matrix).map_err(|e| match e {
+                FaerLuError::SymbolicSingular { index } => LuError::StructurallySingular { index },
+                FaerLuError::Generic(e) => LuError::Numeric(e),
+            })?;
         self.lu = Some(lu);
         self.numeric += 1;
         Ok(())
@@ -152,7 +153,13 @@ mod tests {
             let mut vals = Vec::new();
             for j in 0..n {
                 for &i in &ri[cp[j]..cp[j + 1]] {
-                    vals.push(if i == j { d } else if i < j { -1.0 } else { 0.5 });
+                    vals.push(if i == j {
+                        d
+                    } else if i < j {
+                        -1.0
+                    } else {
+                        0.5
+                    });
                 }
             }
             lu.factorize(SparseColMatRef::new(sym, &vals)).unwrap();
@@ -165,7 +172,11 @@ mod tests {
                     ax[ri[q]] += vals[q] * x[j];
                 }
             }
-            let err = ax.iter().zip(&b).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+            let err = ax
+                .iter()
+                .zip(&b)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
             assert!(err < 1e-12 * n as f64, "{err}");
         }
         assert_eq!(lu.numeric_factorizations(), 2);

@@ -40,10 +40,7 @@ pub enum PermutationError {
 /// entry in turn.
 pub fn inverse_permutation(perm: &[usize], n: usize) -> Result<Vec<usize>, PermutationError> {
     if perm.len() != n {
-        return Err(PermutationError::Length {
-            len: perm.len(),
-            n,
-        });
+        return Err(PermutationError::Length { len: perm.len(), n });
     }
     let mut inv = vec![usize::MAX; n];
     for (k, &e) in perm.iter().enumerate() {
@@ -111,10 +108,7 @@ pub fn pattern_dissection<const D: usize>(
             }
         }
     }
-    let points: Vec<[f64; D]> = pos
-        .iter()
-        .map(|p| p.unwrap_or([0.0; D]))
-        .collect();
+    let points: Vec<[f64; D]> = pos.iter().map(|p| p.unwrap_or([0.0; D])).collect();
     let mut ctx = PatternDissection {
         points: &points,
         ptr: deg,

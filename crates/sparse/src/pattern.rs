@@ -22,7 +22,11 @@ impl UpperPattern {
     /// decreasing offsets, rows out of range, below the diagonal, unsorted or repeated
     /// (the invariants faer's factorizations rely on).
     pub fn new(n: usize, col_ptr: Vec<usize>, row_idx: Vec<usize>) -> Self {
-        assert_eq!(col_ptr.len(), n + 1, "column offsets of an {n} × {n} pattern");
+        assert_eq!(
+            col_ptr.len(),
+            n + 1,
+            "column offsets of an {n} × {n} pattern"
+        );
         assert_eq!(col_ptr[n], row_idx.len(), "last column offset = entries");
         for j in 0..n {
             assert!(col_ptr[j] <= col_ptr[j + 1], "column offsets increase");
