@@ -139,7 +139,7 @@ mod tests {
     /// values on the kept analysis.
     #[test]
     fn solves_a_non_symmetric_matrix() {
-        let n = 40;
+        let n: usize = 40;
         let (mut cp, mut ri) = (vec![0], Vec::new());
         for j in 0..n {
             for i in j.saturating_sub(1)..(j + 2).min(n) {
