@@ -77,6 +77,13 @@ const WORK_KEYS: [&str; 9] = [
 /// The outcome of an error that names no input file (noted, not a failure).
 const NO_FILE: &str = "refused, naming no file";
 
+/// The outcome of a run past the bound that stopped on Ctrl-C after a mutation of a
+/// key that sets the amount of work (noted, not a failure).
+const LONG: &str = "long run, stopped by Ctrl-C";
+
+/// Separates a failure's class from its detail.
+const DETAIL: &str = " | ";
+
 /// One input file of the corpus.
 struct Input {
     /// Path under `scenes/` with `/` separators.
@@ -106,6 +113,8 @@ struct Tally {
     failures: Vec<Failure>,
     /// Refusals that name no file: the mutation and the message.
     unlocated: Vec<String>,
+    /// Long runs stopped by Ctrl-C: the mutation.
+    long: Vec<String>,
 }
 
 fn scenes_dir() -> PathBuf {
@@ -258,15 +267,16 @@ fn judge(
         End::Exit(101) => Err("exit 101 (panic)".into()),
         End::Signal(s) => Err(format!("killed by signal {s}")),
         End::Timeout(None) => Err("timeout, ignores Ctrl-C (killed)".into()),
-        End::Timeout(Some(130)) if out.is_some() && work_key => {
-            Ok("long run stopped by Ctrl-C".into())
-        }
+        End::Timeout(Some(130)) if out.is_some() && work_key => Ok(LONG.into()),
         End::Timeout(Some(c)) => Err(format!("timeout (stopped by Ctrl-C with status {c})")),
         End::Exit(1) => {
             let msg = o.stderr.trim();
             if msg.is_empty() {
                 Err("exit 1 without a message".into())
-            } else if !msg.starts_with("error: ") || !msg.chars().any(char::is_alphabetic) {
+            } else if !o.stderr.lines().any(|l| {
+                l.strip_prefix("error: ")
+                    .is_some_and(|m| m.chars().any(char::is_alphabetic))
+            }) {
                 Err("exit 1 without an `error:` line".into())
             } else if names.iter().any(|n| msg.contains(n)) {
                 Ok("refused, naming the file".into())
@@ -284,7 +294,10 @@ fn judge(
                 if bad.is_empty() {
                     Ok("ran".into())
                 } else {
-                    Err(format!("exit 0 with non-finite output: {}", bad.join("; ")))
+                    Err(format!(
+                        "exit 0 with non-finite output{DETAIL}{}",
+                        bad.join("; ")
+                    ))
                 }
             }
         },
@@ -362,18 +375,26 @@ fn one(input: &Input, round: Option<u64>, seed: u64, root: &Path, tally: &Mutex<
                     let first = o.stderr.lines().find(|l| l.starts_with("error: "));
                     let note = format!("{id}: {} => {}", m.what, first.unwrap_or(""));
                     t.unlocated.push(note);
+                } else if v == LONG {
+                    t.long.push(format!("{id}: {}", m.what));
                 }
                 *t.outcomes.entry(format!("{kind}: {v}")).or_default() += 1
             }
             Err(class) => {
                 *t.outcomes.entry(format!("{kind}: FAILED")).or_default() += 1;
                 failed = true;
+                let (class, extra) = class.split_once(DETAIL).unwrap_or((&class, ""));
                 t.failures.push(Failure {
                     class: format!("{kind}: {class}"),
                     mutant: id.clone(),
                     what: m.what.clone(),
                     command: command_line(args),
-                    detail: format!("after {:.1} s; stderr: {}", o.seconds, excerpt(&o.stderr)),
+                    detail: format!(
+                        "after {:.1} s; {extra}{}stderr: {}",
+                        o.seconds,
+                        if extra.is_empty() { "" } else { "; " },
+                        excerpt(&o.stderr)
+                    ),
                 });
             }
         }
@@ -499,6 +520,15 @@ fn every_mutant_of_every_bundled_input_is_refused_cleanly_or_runs() {
         ));
         for u in &unlocated {
             report.push_str(&format!("  {u}\n"));
+        }
+    }
+    if !t.long.is_empty() {
+        report.push_str(&format!(
+            "long runs stopped by Ctrl-C (not failures; {}):\n",
+            t.long.len()
+        ));
+        for l in &t.long {
+            report.push_str(&format!("  {l}\n"));
         }
     }
     let list = root.join("failures.txt");
