@@ -18,10 +18,10 @@ pub const CHECK_TIMEOUT: Duration = Duration::from_secs(10);
 
 /// Wall-time bound of a `run` of a mutant of a fast scene (unmutated runs take well
 /// under a second on this machine).
-pub const RUN_TIMEOUT: Duration = Duration::from_secs(10);
+pub const RUN_TIMEOUT: Duration = Duration::from_secs(8);
 
 /// How long an interrupted run may take to stop after Ctrl-C.
-pub const STOP_GRACE: Duration = Duration::from_secs(5);
+pub const STOP_GRACE: Duration = Duration::from_secs(4);
 
 /// How a child ended.
 #[derive(Debug)]
