@@ -93,10 +93,10 @@ fn capped(text: &str) -> String {
         let t = l.trim();
         if t.starts_with('[') {
             section = t.to_string();
-        } else if section == "[schedule]" {
-            if let Some((k, v)) = value(t) {
-                sch.insert(k, v);
-            }
+        } else if section == "[schedule]"
+            && let Some((k, v)) = value(t)
+        {
+            sch.insert(k, v);
         }
     }
     let end = match (sch.get("dt"), sch.get("steps"), sch.get("end_time")) {
