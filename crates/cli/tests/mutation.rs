@@ -23,7 +23,7 @@
 //!
 //! Environment: `POROFRAC_MUTATION_SEED` (default 20250611), `POROFRAC_MUTATION_BUDGET_S`
 //! (wall-time budget in seconds, default 100; mutants are drawn round after round over
-//! all files until it is spent), `POROFRAC_MUTATION_JOBS` (parallel children, default
+//! all files, meshes and decks four times a round, until it is spent), `POROFRAC_MUTATION_JOBS` (parallel children, default
 //! 2), `POROFRAC_MUTATION_FILE` (only files whose path under `scenes/` contains this).
 //! Failing mutants stay in `target/mutants/<seed>/` with their stdout and stderr; the
 //! full list of failures is printed and written to `target/mutants/<seed>/failures.txt`
@@ -123,6 +123,9 @@ fn capped(text: &str) -> String {
     }
     out
 }
+
+/// Mutants of each mesh and deck per round (of each scene: 1).
+const DATA_WEIGHT: u64 = 4;
 
 /// Keys that set the amount of work of a run: a mutant of one of these may ask for a
 /// long run, which is stopped with Ctrl-C after the bound.
@@ -524,6 +527,18 @@ fn every_mutant_of_every_bundled_input_is_refused_cleanly_or_runs() {
             inputs[i].reader.is_some() || FAST.contains(&r) || CAPPED.contains(&r)
         })
         .collect();
+    // A round mutates every scene once and every mesh and deck DATA_WEIGHT times (each
+    // is a single file of its kind, and its runs are short).
+    let slots: Vec<(usize, u64)> = (0..inputs.len())
+        .flat_map(|i| {
+            let w = if inputs[i].kind == Kind::Scene {
+                1
+            } else {
+                DATA_WEIGHT
+            };
+            (0..w).map(move |sub| (i, sub))
+        })
+        .collect();
     let tally = Mutex::new(Tally::default());
     let next = AtomicUsize::new(0);
     let start = Instant::now();
@@ -540,8 +555,9 @@ fn every_mutant_of_every_bundled_input_is_refused_cleanly_or_runs() {
                         break;
                     }
                     let k = n - base.len();
-                    let round = (k / inputs.len()) as u64;
-                    one(&inputs[k % inputs.len()], Some(round), seed, &root, &tally);
+                    let (i, sub) = slots[k % slots.len()];
+                    let round = (k / slots.len()) as u64 * DATA_WEIGHT + sub;
+                    one(&inputs[i], Some(round), seed, &root, &tally);
                 }
             });
         }
