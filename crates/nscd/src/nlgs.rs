@@ -319,7 +319,8 @@ mod tests {
         d.v[0] = [0.0, -2.0];
         let floor = [RigidBody::segment([-2.0, 0.0], [2.0, 0.0])];
         let mut set = ContactSet::default();
-        set.detect(&mut Detector::default(), &d.x, &d, &floor, &[[0.0; 2]], 0.1);
+        set.detect(&mut Detector::default(), &d.x, &d, &floor, &[[0.0; 2]], 0.1)
+            .unwrap();
         assert_eq!(set.as_slice().len(), 1);
         let (inv_m, inv_i) = ([1.0 / d.mass[0]], [1.0 / d.inertia[0]]);
         let body_inv = [[0.0; 2]];

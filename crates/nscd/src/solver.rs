@@ -190,7 +190,7 @@ impl Nscd {
         let mut found = Vec::new();
         s.detector.detect(
             &s.disks.x, &s.disks.r, &s.bodies, &offsets, s.alert, &mut found,
-        );
+        )?;
         if let Some(c) = found.iter().find(|c| c.gap < -s.alert) {
             return Err(NscdError::InitialOverlap {
                 i: c.i as usize,
@@ -292,7 +292,7 @@ impl Nscd {
             &self.bodies,
             ig.predicted_offsets(),
             self.alert,
-        );
+        )?;
         ig.free_velocities(&mut self.disks, &self.bodies, self.gravity, &self.force, h);
         crate::problem::build(
             &mut self.contacts,

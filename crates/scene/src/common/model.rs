@@ -49,6 +49,10 @@ pub enum RunError {
     /// The coupled fracturing step failed.
     #[error("{0}")]
     Coupled(#[from] porofrac_sim::FractureError),
+    /// A stop was requested inside a long phase (the build of a model, or a step); the
+    /// run ends as interrupted ([`crate::common::driver`]), not as an error.
+    #[error("interrupted")]
+    Interrupted,
 }
 
 /// What a step did, for progress and statistics.
@@ -212,7 +216,14 @@ fn run_model(
             )
             .into());
     };
-    let summary = kind.run(ls, laws, out, observer)?;
+    let start = std::time::Instant::now();
+    let summary = match kind.run(ls, laws, out, observer) {
+        // Stopped while the model was built: nothing was stepped.
+        Err(RunError::Interrupted) => {
+            crate::common::driver::interrupted_in_setup(ls, start, ls.scene.scene.dim as usize)
+        }
+        r => r?,
+    };
     summary.write(out)?;
     Ok(summary)
 }
