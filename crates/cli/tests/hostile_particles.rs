@@ -68,7 +68,8 @@ fn a_particle_far_away_is_refused_by_check() {
 
 #[test]
 fn an_alert_distance_above_the_largest_radius_is_refused() {
-    let text = scene("nscd/pile.toml").replace("max_sweeps = 100", "max_sweeps = 100\nalert = 30.0");
+    let text =
+        scene("nscd/pile.toml").replace("max_sweeps = 100", "max_sweeps = 100\nalert = 30.0");
     let err = refused("alert", &text, "alert =", "nscd.alert");
     assert!(err.contains("largest particle radius 0.6"), "{err}");
 }
@@ -92,19 +93,31 @@ fn dt_and_steps_together_are_refused_by_the_particle_models() {
 
 #[test]
 fn keys_without_effect_are_refused() {
-    let text = scene("nscd/column.toml").replace(
-        "kind = \"list\"",
-        "kind = \"list\"\npacking_fraction = nan",
+    let text = scene("nscd/column.toml")
+        .replace("kind = \"list\"", "kind = \"list\"\npacking_fraction = nan");
+    let err = refused(
+        "phi_list",
+        &text,
+        "packing_fraction",
+        "particles.packing_fraction",
     );
-    let err = refused("phi_list", &text, "packing_fraction", "particles.packing_fraction");
     assert!(err.contains("has no effect with kind = \"list\""), "{err}");
     let text = scene("nscd/pile.toml")
         .replace("kind = \"random\"", "kind = \"hexagonal\"")
         .replace("radius = [0.4, 0.6]", "radius = 0.5")
         .replace("seed = 1\n", "");
-    let err = refused("phi_hex", &text, "packing_fraction", "particles.packing_fraction");
-    assert!(err.contains("has no effect with kind = \"hexagonal\""), "{err}");
-    let text = scene("nscd/pile.toml").replace("max_sweeps = 100", "max_sweeps = 100\nsettle_dt = 1e-3");
+    let err = refused(
+        "phi_hex",
+        &text,
+        "packing_fraction",
+        "particles.packing_fraction",
+    );
+    assert!(
+        err.contains("has no effect with kind = \"hexagonal\""),
+        "{err}"
+    );
+    let text =
+        scene("nscd/pile.toml").replace("max_sweeps = 100", "max_sweeps = 100\nsettle_dt = 1e-3");
     let err = refused("settle_dt", &text, "settle_dt", "nscd.settle_dt");
     assert!(err.contains("without settle_ratio"), "{err}");
     let text = scene("lsm/brazilian.toml").replace("[lsm]", "[lsm]\ndt = 1e-6\ndt_fraction = 0.5");
@@ -125,8 +138,10 @@ fn end_times_below_one_step_are_refused() {
 
 #[test]
 fn lbm_probes_and_lines_outside_the_lattice_are_refused() {
-    let text = scene("lbm/taylor_green.toml")
-        .replace("at = [0.0001953125, 0.0251953125]", "at = [0.0001953125, 1.5]");
+    let text = scene("lbm/taylor_green.toml").replace(
+        "at = [0.0001953125, 0.0251953125]",
+        "at = [0.0001953125, 1.5]",
+    );
     let err = refused("lbm_probe", &text, "at = [", "output.probe[0].at");
     assert!(err.contains("outside the lattice"), "{err}");
     let text = format!(
@@ -143,11 +158,17 @@ fn lbm_output_times_between_lattice_steps_are_refused_with_the_nearest_valid_one
     let err = refused("lbm_every", &text, "steps = 3", "schedule.steps");
     assert!(err.contains("0.0152587890625 s"), "{err}");
     // 333 and 334 lattice steps.
-    assert!(err.contains("5.08117675781") && err.contains("5.09643554688"), "{err}");
-    let text = scene("lbm/taylor_green.toml")
-        .replace("end_time = 15.2587890625", "end_time = 15.2");
-    let err = refused("lbm_end", &text, "end_time", "schedule.end_time");
-    assert!(err.contains("use 15.1977539063 s or 15.2130126953 s"), "{err}");
+    assert!(
+        err.contains("5.08117675781") && err.contains("5.09643554688"),
+        "{err}"
+    );
+    let text =
+        scene("lbm/taylor_green.toml").replace("end_time = 15.2587890625", "end_time = 15.2");
+    let err = refused("lbm_end", &text, "end_time = 15.2", "schedule.end_time");
+    assert!(
+        err.contains("use 15.1977539063 s or 15.2130126953 s"),
+        "{err}"
+    );
     let path = write("lbm_valid", &scene("lbm/taylor_green.toml"));
     let (code, _, err) = porofrac(&["check", path.to_str().unwrap()]);
     assert_eq!(code, 0, "{err}");
@@ -168,10 +189,15 @@ fn lbm_inputs_that_diverge_name_their_key() {
     ]);
     assert_eq!(code, 1, "{err}");
     let at = format!("lbm_iv.toml:{}:", line_of(&text, "initial_velocity"));
-    assert!(err.contains(&at) && err.contains("lbm.initial_velocity"), "{err}");
+    assert!(
+        err.contains(&at) && err.contains("lbm.initial_velocity"),
+        "{err}"
+    );
     assert!(err.contains("not a finite velocity"), "{err}");
-    let text = scene("lbm/taylor_green.toml")
-        .replace("periodic = [\"x\", \"y\"]", "periodic = [\"x\", \"y\"]\nbody_force = [1e300, 0.0]");
+    let text = scene("lbm/taylor_green.toml").replace(
+        "periodic = [\"x\", \"y\"]",
+        "periodic = [\"x\", \"y\"]\nbody_force = [1e300, 0.0]",
+    );
     let err = refused("lbm_body", &text, "body_force", "lbm.body_force");
     assert!(err.contains("Mach limit"), "{err}");
 }
@@ -181,7 +207,12 @@ fn lbm_inputs_that_diverge_name_their_key() {
 fn interrupt_when(path: &PathBuf, cue: &str) -> (i32, serde_json::Value, PathBuf) {
     let out = path.with_extension("out");
     let mut child = Command::new(env!("CARGO_BIN_EXE_porofrac"))
-        .args(["run", path.to_str().unwrap(), "--out", out.to_str().unwrap()])
+        .args([
+            "run",
+            path.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
@@ -197,13 +228,18 @@ fn interrupt_when(path: &PathBuf, cue: &str) -> (i32, serde_json::Value, PathBuf
         seen.push(l);
     }
     let pid = child.id().to_string();
-    assert!(Command::new("kill").args(["-INT", &pid]).status().unwrap().success());
+    assert!(
+        Command::new("kill")
+            .args(["-INT", &pid])
+            .status()
+            .unwrap()
+            .success()
+    );
     // Drain stderr so the child never blocks on a full pipe.
     for _ in lines {}
     let status = child.wait().unwrap();
     let summary: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
-            .unwrap();
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
     (status.code().unwrap_or(-1), summary, out)
 }
 

@@ -374,7 +374,11 @@ impl RandomPacking {
         let omega = self.relaxation;
         let mut worst = 0.0;
         for sweep in 0..self.max_sweeps {
-            if poll(crate::Progress::new("relaxing overlaps, sweep", sweep, self.max_sweeps)) {
+            if poll(crate::Progress::new(
+                "relaxing overlaps, sweep",
+                sweep,
+                self.max_sweeps,
+            )) {
                 return Err(ParticleError::Interrupted);
             }
             if build {
@@ -386,7 +390,11 @@ impl RandomPacking {
             worst = 0.0f64;
             for (k, &(i, j)) in pairs.iter().enumerate() {
                 if k % POLL_EVERY == POLL_EVERY - 1
-                    && poll(crate::Progress::new("relaxing overlaps, sweep", sweep, self.max_sweeps))
+                    && poll(crate::Progress::new(
+                        "relaxing overlaps, sweep",
+                        sweep,
+                        self.max_sweeps,
+                    ))
                 {
                     return Err(ParticleError::Interrupted);
                 }

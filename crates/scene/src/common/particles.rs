@@ -216,11 +216,7 @@ pub fn check(ls: &LoadedScene, model: &str) -> Result<(), SceneError> {
         ),
         ("radius", p.radius.is_some(), p.kind != ParticleKind::List),
         ("region", p.region.is_some(), p.kind != ParticleKind::List),
-        (
-            "centres",
-            p.centres.is_some(),
-            p.kind == ParticleKind::List,
-        ),
+        ("centres", p.centres.is_some(), p.kind == ParticleKind::List),
         ("radii", p.radii.is_some(), p.kind == ParticleKind::List),
     ] {
         if set && !applies {
@@ -436,9 +432,7 @@ pub fn generate(ls: &LoadedScene, setup: &mut SetupPoll<'_>) -> Result<Disks, Ru
                     Ok(p) => p,
                     Err(ParticleError::Interrupted) => return Err(RunError::Interrupted),
                     Err(e) => {
-                        return Err(ls
-                            .error(&key("packing_fraction"), format!(": {e}"))
-                            .into());
+                        return Err(ls.error(&key("packing_fraction"), format!(": {e}")).into());
                     }
                 }
             };

@@ -43,8 +43,7 @@ use plotters::style::RGBColor;
 use porofrac_grid::io::PvdWriter;
 use porofrac_lsm::calibrate::{QuasiStatic, brazilian_polled, hexagonal_moduli, uniaxial_polled};
 use porofrac_lsm::{
-    BreakMode, ContactLaw, Damping, LatticeSolid, LsmError, LsmSpec, Motion, NormalLaw,
-    WallFaces,
+    BreakMode, ContactLaw, Damping, LatticeSolid, LsmError, LsmSpec, Motion, NormalLaw, WallFaces,
 };
 use porofrac_particles::packing::Region;
 use porofrac_particles::tracked::CellContact;
@@ -185,9 +184,9 @@ fn calibrate(
     };
     setup.phase("calibration");
     let packing = |lo: [f64; 2],
-                       hi: [f64; 2],
-                       region: &Region,
-                       setup: &mut SetupPoll<'_>|
+                   hi: [f64; 2],
+                   region: &Region,
+                   setup: &mut SetupPoll<'_>|
      -> Result<Disks, RunError> {
         let mut rp = RandomPacking::new(
             lo,
