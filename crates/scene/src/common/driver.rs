@@ -16,9 +16,11 @@
 //! `"status": "interrupted at t = 0"` and no step; during a step the loop ends at the
 //! last written time, as an interruption between steps does.
 //!
-//! **No inf or NaN in the files.** Before a step is written, its probe values and the
-//! extrema of its fields are checked: a value that is not finite ends the run with an
-//! error naming the probe (or the field) and the time, instead of a file holding it.
+//! **No inf or NaN in the files.** Before a step is written, its probe values, line
+//! values and the extrema of its fields are checked: a value that is not finite ends the
+//! run with an error naming the probe, line (or field) and the time, instead of a file
+//! holding it. The one exception is a probe the model declares possibly undefined
+//! ([`Model::probe_may_be_undefined`]: a fluid probe inside a solid disk is NaN).
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -240,9 +242,14 @@ fn check_finite(
     t: f64,
     probes: &[f64],
     extrema: &BTreeMap<String, [f64; 2]>,
+    may_be_undefined: &dyn Fn(usize) -> bool,
 ) -> Result<(), RunError> {
     let s = &ls.scene;
-    if let Some((i, v)) = probes.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+    if let Some((i, v)) = probes
+        .iter()
+        .enumerate()
+        .find(|(i, v)| v.is_infinite() || (v.is_nan() && !may_be_undefined(*i)))
+    {
         let key = ki("output.probe", i, &["field"]);
         return Err(ls
             .error(
@@ -330,7 +337,6 @@ pub(crate) fn drive(
     let mut steps = 0;
     let mut interrupted = None;
     let mut row = Vec::new();
-    let mut rows = Vec::new();
     for (step, &t) in times.iter().enumerate() {
         let stats = match model.step(step) {
             Err(RunError::Interrupted) => {
@@ -352,14 +358,33 @@ pub(crate) fn drive(
             let first = row.len();
             model.probes(&mut row);
             let step_extrema = model.field_extrema();
-            check_finite(ls, t, &row[first..], &step_extrema)?;
+            check_finite(ls, t, &row[first..], &step_extrema, &|i| {
+                model.probe_may_be_undefined(i)
+            })?;
+            // Every line of the step, checked before anything of the step is written.
+            let mut line_rows: Vec<Vec<Vec<f64>>> = Vec::with_capacity(lines.len());
+            for i in 0..lines.len() {
+                let mut rows = Vec::new();
+                model.line(i, &mut rows);
+                if let Some(v) = rows.iter().flatten().find(|v| !v.is_finite()) {
+                    return Err(ls
+                        .error(
+                            &ki("output.line", i, &["field"]),
+                            format!(
+                                "= \"{}\" is {v} at a point of the line at t = {t:e} s: the \
+                                 run diverged or the value is undefined there",
+                                s.output.line[i].field
+                            ),
+                        )
+                        .into());
+                }
+                line_rows.push(rows);
+            }
             for (j, v) in row[first..].iter().enumerate() {
                 series[j].push(*v);
             }
             probes.push(&row)?;
-            for (i, table) in lines.iter_mut().enumerate() {
-                rows.clear();
-                model.line(i, &mut rows);
+            for (table, mut rows) in lines.iter_mut().zip(line_rows) {
                 for r in &mut rows {
                     r.insert(0, t);
                 }
@@ -425,4 +450,44 @@ pub(crate) fn drive(
         version: env!("CARGO_PKG_VERSION").into(),
         extra: model.summary_extras(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A value that is not finite names its probe (and its line in the file) or the
+    /// field; finite values pass.
+    #[test]
+    fn values_that_are_not_finite_name_their_probe_or_field() {
+        let text = std::fs::read_to_string(
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/nscd/column.toml"),
+        )
+        .unwrap();
+        let ls = crate::common::loaded::parse(&text, Path::new("c.toml"), crate::MODELS).unwrap();
+        let mut ext = BTreeMap::new();
+        ext.insert("vx".to_string(), [-1.0, 1.0]);
+        assert!(check_finite(&ls, 0.1, &[1.0, 2.0, 3.0], &ext, &|_| false).is_ok());
+        let e = check_finite(&ls, 0.1, &[1.0, f64::INFINITY, 3.0], &ext, &|_| true)
+            .unwrap_err()
+            .to_string();
+        let line = text
+            .lines()
+            .position(|l| l.contains("field = \"y\""))
+            .unwrap()
+            + 1;
+        assert!(e.contains(&format!("c.toml:{line}:")), "{e}");
+        assert!(
+            e.contains("output.probe[1]") && e.contains("is inf at t = 1e-1 s"),
+            "{e}"
+        );
+        // NaN passes where the model says the value may be undefined, not elsewhere.
+        assert!(check_finite(&ls, 0.1, &[f64::NAN, 2.0, 3.0], &ext, &|i| i == 0).is_ok());
+        assert!(check_finite(&ls, 0.1, &[1.0, 2.0, f64::NAN], &ext, &|i| i == 0).is_err());
+        ext.insert("speed".to_string(), [0.0, f64::NAN]);
+        let e = check_finite(&ls, 0.1, &[1.0, 2.0, 3.0], &ext, &|_| false)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("field speed reaches [0, NaN]"), "{e}");
+    }
 }

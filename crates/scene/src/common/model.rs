@@ -107,6 +107,14 @@ pub trait Model {
     fn errors(&self) -> Result<BTreeMap<String, f64>, RunError>;
     /// Wall time of the model's phases so far (assembly, solve, flow, its own output).
     fn wall_seconds(&self) -> WallSeconds;
+    /// Whether probe number `probe` may be NaN in a valid state: a value undefined at
+    /// the probe's place (a fluid probe inside a solid disk). No by default: a probe that
+    /// is NaN or infinite ends the run ([`crate::common::driver`]); an infinite value
+    /// always does.
+    fn probe_may_be_undefined(&self, probe: usize) -> bool {
+        let _ = probe;
+        false
+    }
     /// Keys of the model's own in `summary.json`, besides the shared ones (none by
     /// default).
     fn summary_extras(&self) -> serde_json::Map<String, serde_json::Value> {

@@ -589,6 +589,11 @@ impl Model for LsmModel<'_> {
         &self.times
     }
 
+    fn probe_may_be_undefined(&self, probe: usize) -> bool {
+        // A fluid probe inside a solid disk has no fluid value.
+        matches!(self.probes.get(probe), Some(ProbeKind::Fluid(..)))
+    }
+
     fn step(&mut self, step: usize) -> Result<StepStats, RunError> {
         if step == 0 {
             return Ok(StepStats::default());
