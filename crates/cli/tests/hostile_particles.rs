@@ -274,3 +274,17 @@ fn ctrl_c_inside_a_long_lsm_step_ends_the_run_as_interrupted() {
     assert_eq!(rows.len(), 1);
     assert_eq!(rows[0][0], 0.0);
 }
+
+#[test]
+fn ctrl_c_inside_the_sweeps_of_an_nscd_step_ends_the_run_as_interrupted() {
+    // 1e8 sweeps per step on the 10 000-disk pile: the first step would take hours.
+    let text = scene("nscd/pile.toml")
+        .replace("min_sweeps = 100", "min_sweeps = 100000000")
+        .replace("max_sweeps = 100", "max_sweeps = 100000000")
+        .replace("every = 40", "every = 1");
+    let path = write("ctrlc_nscd", &text);
+    let (code, summary, out) = interrupt_when(&path, "step 1/41");
+    assert_eq!(code, 130, "{summary}");
+    assert_eq!(summary["status"], "interrupted at t = 0");
+    assert!(out.join("probes.csv").is_file());
+}

@@ -205,6 +205,12 @@ impl Nscd {
         Ok(s)
     }
 
+    /// A flag checked before every NLGS sweep (of steps and of the settling): once set,
+    /// the step ends with [`NscdError::Interrupted`] and the state is partial.
+    pub fn set_interrupt(&mut self, flag: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>) {
+        self.nlgs.interrupt = flag;
+    }
+
     /// The alert distance in use (m).
     pub fn alert(&self) -> f64 {
         self.alert
@@ -330,6 +336,9 @@ impl Nscd {
                 body: &ig.body_inv,
             },
         );
+        if solved.interrupted {
+            return Err(NscdError::Interrupted);
+        }
         let num_contacts = self.contacts.list.len();
         let stats = StepStats {
             contacts: num_contacts,

@@ -139,7 +139,7 @@ fn huge_alert_distances_are_refused_and_settling_can_be_interrupted() {
         ..SolverParams::default()
     };
     let law = ContactLaw::default();
-    match Nscd::new(disks.clone(), vec![], law.clone(), params, [0.0, -9.81]) {
+    match Nscd::new(disks.clone(), vec![], law, params, [0.0, -9.81]) {
         Err(NscdError::TooManyCandidates { found, disks, .. }) => {
             assert_eq!(disks, n);
             assert!(found > porofrac_nscd::detect::CANDIDATES_PER_DISK * n);

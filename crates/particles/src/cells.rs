@@ -69,7 +69,7 @@ impl CellList {
         };
         let max_cells = (4 * n + 16) as f64;
         let (mut fx, mut fy) = cells(side);
-        while !(fx * fy <= max_cells) {
+        while fx * fy > max_cells {
             side *= 2.0;
             (fx, fy) = cells(side);
         }

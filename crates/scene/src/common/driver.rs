@@ -133,6 +133,11 @@ impl Stop {
         Self(Some(flag))
     }
 
+    /// The flag itself, for the model crates that take one (`None`: never stops).
+    pub fn flag(&self) -> Option<Arc<AtomicBool>> {
+        self.0.clone()
+    }
+
     /// Whether the run should stop now.
     pub fn requested(&self) -> bool {
         self.0.as_ref().is_some_and(|f| f.load(Ordering::Relaxed))

@@ -175,8 +175,11 @@ pub fn build<'a>(
         },
     };
     let gravity = n.gravity.unwrap_or([0.0, -9.81]);
+    setup.check()?;
     let mut sys =
         Nscd::new(disks, walls(ls), law, params, gravity).map_err(|e| scene_error(ls, &e))?;
+    // Ctrl-C stops the NLGS sweeps of the settling and of every step.
+    sys.set_interrupt(setup.stop_handle().flag());
     let sch = s.schedule.as_ref().expect("checked: [schedule] present");
     let steps = step_count(sch) as usize;
     let dt = sch.dt.unwrap_or(sch.end_time / steps as f64);

@@ -141,7 +141,7 @@ pub(crate) fn check_section(ls: &LoadedScene) -> Result<(Units, [bool; 2]), Scen
         let g = b[0].hypot(b[1]);
         let per_step = units.acceleration(g);
         let limit = MAX_MACH * (1.0f64 / 3.0).sqrt();
-        if !(per_step < limit) {
+        if !per_step.is_finite() || per_step >= limit {
             return Err(ls.error(
                 &key("body_force"),
                 format!(
