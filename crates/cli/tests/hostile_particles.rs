@@ -21,7 +21,7 @@
 mod common;
 
 use std::io::{BufRead, BufReader};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
 use common::{porofrac, read_csv, root, tmp_dir};
@@ -204,7 +204,7 @@ fn lbm_inputs_that_diverge_name_their_key() {
 
 /// Start `porofrac run` on `path`, wait until a stderr line contains `cue`, send SIGINT:
 /// exit status, the summary and the output directory.
-fn interrupt_when(path: &PathBuf, cue: &str) -> (i32, serde_json::Value, PathBuf) {
+fn interrupt_when(path: &Path, cue: &str) -> (i32, serde_json::Value, PathBuf) {
     let out = path.with_extension("out");
     let mut child = Command::new(env!("CARGO_BIN_EXE_porofrac"))
         .args([

@@ -128,7 +128,7 @@ pub fn uniaxial_polled(
 ) -> Result<Uniaxial, LsmError> {
     q.check()?;
     let mut polled = |steps: usize| {
-        if steps % POLL_EVERY == 0
+        if steps.is_multiple_of(POLL_EVERY)
             && poll(porofrac_particles::Progress::new(
                 "uniaxial test, step",
                 steps,
@@ -309,7 +309,7 @@ pub fn brazilian_polled(
     let mut steps = 0;
     let every = 50;
     while steps < q.max_steps {
-        if steps % POLL_EVERY == 0
+        if steps.is_multiple_of(POLL_EVERY)
             && poll(porofrac_particles::Progress::new(
                 "Brazilian test, step",
                 steps,

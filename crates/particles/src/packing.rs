@@ -342,7 +342,7 @@ impl RandomPacking {
         let mean_r = 0.5 * (self.r_min + self.r_max);
         let expected = (target / (std::f64::consts::PI * mean_r * mean_r)).min(1e15) as usize;
         loop {
-            if p.radii.len() % POLL_EVERY == 0
+            if p.radii.len().is_multiple_of(POLL_EVERY)
                 && poll(crate::Progress::new(
                     "placing disks",
                     p.radii.len(),
