@@ -6,7 +6,7 @@
 //!   `[[obstacle]]`s are placed on the lattice. Nodes sit at the centres of the `Δx` cells
 //!   covering `extent`, so walls on the sides lie halfway between nodes;
 //! - *step*: from one output time to the next, `t/Δt` lattice steps in total (output
-//!   times are whole numbers of lattice steps, checked by [`check`]: an interval between
+//!   times are whole numbers of lattice steps, checked by [`check`](mod@check): an interval between
 //!   two lattice steps is refused with the nearest valid values, as lbmpy and Palabos
 //!   users expect outputs every N iterations); velocities given as expressions are
 //!   evaluated at every lattice step; the stop request is polled between lattice steps;
