@@ -15,7 +15,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use clap::{Parser, Subcommand};
-use porofrac_scene::{Observer, Scene, StepReport};
+use porofrac_scene::{Observer, Scene, SetupReport, StepReport, Stop};
 
 /// Simulate fracturing of porous rock: run scene files, write ParaView files, CSV and plots.
 #[derive(Parser, Debug)]
@@ -154,7 +154,18 @@ impl Observer for Progress {
         }
     }
 
+    fn setup(&mut self, r: &SetupReport<'_>) {
+        match &self.bar {
+            Some(bar) => bar.set_message(r.to_string()),
+            None => eprintln!("{r}"),
+        }
+    }
+
     fn stop_requested(&self) -> bool {
         self.stop.load(Ordering::Relaxed)
+    }
+
+    fn stop_handle(&self) -> Stop {
+        Stop::from_flag(Arc::clone(&self.stop))
     }
 }

@@ -111,7 +111,35 @@ pub fn uniaxial(
     strain: f64,
     q: &QuasiStatic,
 ) -> Result<Uniaxial, LsmError> {
+    uniaxial_polled(disks, spec, strain, q, &mut |_| false)
+}
+
+/// Steps between two calls of the progress callback of the calibration tests.
+const POLL_EVERY: usize = 100;
+
+/// [`uniaxial`], calling `poll` every few steps with the steps taken and
+/// [`QuasiStatic::max_steps`]: `true` stops the test with [`LsmError::Interrupted`].
+pub fn uniaxial_polled(
+    disks: Disks,
+    spec: LsmSpec,
+    strain: f64,
+    q: &QuasiStatic,
+    poll: &mut dyn FnMut(porofrac_particles::Progress) -> bool,
+) -> Result<Uniaxial, LsmError> {
     q.check()?;
+    let mut polled = |steps: usize| {
+        if steps.is_multiple_of(POLL_EVERY)
+            && poll(porofrac_particles::Progress::new(
+                "uniaxial test, step",
+                steps,
+                q.max_steps,
+            ))
+        {
+            Err(LsmError::Interrupted)
+        } else {
+            Ok(())
+        }
+    };
     if !(strain > 0.0 && strain < 0.05) {
         return Err(LsmError::bad("strain", strain, "must be in (0, 0.05)"));
     }
@@ -174,6 +202,7 @@ pub fn uniaxial(
     }
     let mut steps = 0;
     for _ in 0..ramp_steps {
+        polled(steps)?;
         s.step(dt, &[])?;
         steps += 1;
     }
@@ -188,6 +217,7 @@ pub fn uniaxial(
     }
     // Hold until the kinetic energy is small against the stored energy.
     loop {
+        polled(0)?;
         for _ in 0..200 {
             s.step(dt, &[])?;
         }
@@ -240,6 +270,18 @@ pub fn brazilian(
     cap: f64,
     q: &QuasiStatic,
 ) -> Result<Brazilian, LsmError> {
+    brazilian_polled(disks, spec, cap, q, &mut |_| false)
+}
+
+/// [`brazilian`], calling `poll` every few steps with the steps taken and
+/// [`QuasiStatic::max_steps`]: `true` stops the test with [`LsmError::Interrupted`].
+pub fn brazilian_polled(
+    disks: Disks,
+    spec: LsmSpec,
+    cap: f64,
+    q: &QuasiStatic,
+    poll: &mut dyn FnMut(porofrac_particles::Progress) -> bool,
+) -> Result<Brazilian, LsmError> {
     q.check()?;
     let (lo, hi) = bounds(&disks);
     let radius = 0.25 * (hi[0] - lo[0] + hi[1] - lo[1]);
@@ -267,6 +309,15 @@ pub fn brazilian(
     let mut steps = 0;
     let every = 50;
     while steps < q.max_steps {
+        if steps.is_multiple_of(POLL_EVERY)
+            && poll(porofrac_particles::Progress::new(
+                "Brazilian test, step",
+                steps,
+                q.max_steps,
+            ))
+        {
+            return Err(LsmError::Interrupted);
+        }
         s.step(dt, &[])?;
         steps += 1;
         let load = 0.5

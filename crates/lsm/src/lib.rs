@@ -110,6 +110,9 @@ pub enum LsmError {
     /// A calibration that could not be carried out.
     #[error("calibration: {0}")]
     Calibration(String),
+    /// The progress callback asked to stop.
+    #[error("interrupted")]
+    Interrupted,
 }
 
 impl LsmError {

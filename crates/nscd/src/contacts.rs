@@ -49,8 +49,8 @@ impl ContactSet {
         bodies: &[RigidBody],
         offsets: &[[f64; 2]],
         alert: f64,
-    ) {
-        detector.detect(x, &disks.r, bodies, offsets, alert, &mut self.list);
+    ) -> Result<(), crate::NscdError> {
+        detector.detect(x, &disks.r, bodies, offsets, alert, &mut self.list)
     }
 
     /// The impulse and stick status the contact `key` ended the previous step with, or

@@ -11,6 +11,19 @@
 
 use porofrac_particles::CellList;
 
+use crate::NscdError;
+
+/// Most disk–disk candidates per disk the broad phase keeps (plus [`EXTRA_CANDIDATES`]):
+/// with the alert distance at most the largest radius, a disk has its touching
+/// neighbours and part of the next ring within reach, a few dozen at most even for
+/// wide radius ranges. More means the alert distance takes in far disks and the
+/// candidates grow as `n²`: the detection stops with
+/// [`NscdError::TooManyCandidates`] before allocating them.
+pub const CANDIDATES_PER_DISK: usize = 64;
+
+/// Candidates allowed on top of [`CANDIDATES_PER_DISK`] per disk, for small systems.
+pub const EXTRA_CANDIDATES: usize = 1024;
+
 use crate::body::RigidBody;
 use crate::law::Block;
 
@@ -105,14 +118,16 @@ impl Detector {
         offsets: &[[f64; 2]],
         alert: f64,
         out: &mut Vec<Contact>,
-    ) {
-        self.broad_phase(x, r, bodies, offsets, alert);
+    ) -> Result<(), NscdError> {
+        self.broad_phase(x, r, bodies, offsets, alert)?;
         self.narrow_phase(x, r, bodies, offsets, alert, out);
+        Ok(())
     }
 
     /// The candidate pairs: disk pairs from a cell list of side `2 r_max + alert` whose
     /// gap is below `alert`, sorted by `(i, j)`, and the disks within `r_max + alert`
-    /// of each body's bounding box.
+    /// of each body's bounding box. More than [`CANDIDATES_PER_DISK`] disk pairs per
+    /// disk (plus [`EXTRA_CANDIDATES`]) is [`NscdError::TooManyCandidates`].
     pub fn broad_phase(
         &mut self,
         x: &[[f64; 2]],
@@ -120,10 +135,20 @@ impl Detector {
         bodies: &[RigidBody],
         offsets: &[[f64; 2]],
         alert: f64,
-    ) {
+    ) -> Result<(), NscdError> {
         let r_max = porofrac_particles::cells::max_radius(r);
         self.cells.build(x, 2.0 * r_max + alert);
-        self.cells.pairs(x, r, alert, &mut self.pairs);
+        let max = CANDIDATES_PER_DISK
+            .saturating_mul(x.len())
+            .saturating_add(EXTRA_CANDIDATES);
+        if let Err(found) = self.cells.pairs_at_most(x, r, alert, max, &mut self.pairs) {
+            self.pairs = Vec::new();
+            return Err(NscdError::TooManyCandidates {
+                found,
+                disks: x.len(),
+                alert,
+            });
+        }
         self.body_pairs.clear();
         for (k, body) in bodies.iter().enumerate() {
             let (lo, hi) = body.bounds(offsets[k]);
@@ -139,6 +164,7 @@ impl Detector {
                 self.body_pairs.push((k as u32, i as u32));
             }
         }
+        Ok(())
     }
 
     /// The contacts of the broad phase's candidates: normal, gap and contact point of

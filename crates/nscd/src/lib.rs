@@ -98,6 +98,22 @@ pub enum NscdError {
         /// Its radius (m).
         radius: f64,
     },
+    /// The alert distance takes in too many disk pairs (the candidates would grow as
+    /// `n²`); see [`detect::CANDIDATES_PER_DISK`].
+    #[error(
+        "the alert distance {alert:.3e} m gives more than {found} contact candidates for {disks} disks; lower alert (at most the largest radius)"
+    )]
+    TooManyCandidates {
+        /// Candidates found when the search stopped.
+        found: usize,
+        /// Disks.
+        disks: usize,
+        /// The alert distance (m).
+        alert: f64,
+    },
+    /// The progress callback asked to stop.
+    #[error("interrupted")]
+    Interrupted,
     /// Gravity settling did not reach its kinetic-energy criterion.
     #[error(
         "settling not finished after {steps} steps: kinetic energy {kinetic:.3e} J/m against {released:.3e} J/m of potential energy released"

@@ -111,6 +111,8 @@ pub struct NlgsStats {
     pub residual: f64,
     /// The sweeps stopped on the tolerance or a fixed point (not on `max_sweeps`).
     pub converged: bool,
+    /// The sweeps stopped because the interrupt flag was set ([`Nlgs::interrupt`]).
+    pub interrupted: bool,
 }
 
 /// The velocities the sweeps update: the disks' `v` and `ω`, the bodies' `v`.
@@ -144,6 +146,8 @@ pub struct Nlgs {
     masks: Vec<u64>,
     starts: Vec<usize>,
     slabs: crate::slabs::Slabs,
+    /// Checked before every sweep: once set, the sweeps stop (a caller's Ctrl-C).
+    pub interrupt: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
 }
 
 impl Nlgs {
@@ -196,6 +200,14 @@ impl Nlgs {
         }
         if !contacts.is_empty() {
             for k in 1..=options.max_sweeps {
+                if self
+                    .interrupt
+                    .as_ref()
+                    .is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed))
+                {
+                    stats.interrupted = true;
+                    break;
+                }
                 let (num, den) = if coloured {
                     crate::colour::sweep(
                         contacts,
@@ -319,7 +331,8 @@ mod tests {
         d.v[0] = [0.0, -2.0];
         let floor = [RigidBody::segment([-2.0, 0.0], [2.0, 0.0])];
         let mut set = ContactSet::default();
-        set.detect(&mut Detector::default(), &d.x, &d, &floor, &[[0.0; 2]], 0.1);
+        set.detect(&mut Detector::default(), &d.x, &d, &floor, &[[0.0; 2]], 0.1)
+            .unwrap();
         assert_eq!(set.as_slice().len(), 1);
         let (inv_m, inv_i) = ([1.0 / d.mass[0]], [1.0 / d.inertia[0]]);
         let body_inv = [[0.0; 2]];

@@ -41,6 +41,17 @@ impl Nscd {
     /// `max_steps`, [`NscdError::NotSettled`] when `max_steps` is reached, and any error
     /// of [`Nscd::step`].
     pub fn settle(&mut self, p: SettleParams) -> Result<SettleStats, NscdError> {
+        self.settle_polled(p, &mut |_| false)
+    }
+
+    /// [`Nscd::settle`], calling `poll` before every step with the steps done and
+    /// `max_steps`: `true` from `poll` stops the settling with
+    /// [`NscdError::Interrupted`] (the bodies get their motion back as after any end).
+    pub fn settle_polled(
+        &mut self,
+        p: SettleParams,
+        poll: &mut dyn FnMut(porofrac_particles::Progress) -> bool,
+    ) -> Result<SettleStats, NscdError> {
         let bad = |name, value, message| NscdError::BadParameter {
             name,
             value,
@@ -79,7 +90,15 @@ impl Nscd {
             kinetic: 0.0,
             released: 0.0,
         });
-        for _ in 0..p.max_steps {
+        for k in 0..p.max_steps {
+            if poll(porofrac_particles::Progress::new(
+                "settling, step",
+                k,
+                p.max_steps,
+            )) {
+                result = Err(NscdError::Interrupted);
+                break;
+            }
             match self.step(p.dt) {
                 Ok(st) => stats.sweeps += st.sweeps,
                 Err(e) => {

@@ -190,7 +190,7 @@ impl Nscd {
         let mut found = Vec::new();
         s.detector.detect(
             &s.disks.x, &s.disks.r, &s.bodies, &offsets, s.alert, &mut found,
-        );
+        )?;
         if let Some(c) = found.iter().find(|c| c.gap < -s.alert) {
             return Err(NscdError::InitialOverlap {
                 i: c.i as usize,
@@ -203,6 +203,12 @@ impl Nscd {
             });
         }
         Ok(s)
+    }
+
+    /// A flag checked before every NLGS sweep (of steps and of the settling): once set,
+    /// the step ends with [`NscdError::Interrupted`] and the state is partial.
+    pub fn set_interrupt(&mut self, flag: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>) {
+        self.nlgs.interrupt = flag;
     }
 
     /// The alert distance in use (m).
@@ -292,7 +298,7 @@ impl Nscd {
             &self.bodies,
             ig.predicted_offsets(),
             self.alert,
-        );
+        )?;
         ig.free_velocities(&mut self.disks, &self.bodies, self.gravity, &self.force, h);
         crate::problem::build(
             &mut self.contacts,
@@ -330,6 +336,9 @@ impl Nscd {
                 body: &ig.body_inv,
             },
         );
+        if solved.interrupted {
+            return Err(NscdError::Interrupted);
+        }
         let num_contacts = self.contacts.list.len();
         let stats = StepStats {
             contacts: num_contacts,

@@ -123,3 +123,42 @@ fn settling_errors() {
         }
     }
 }
+
+/// An alert distance that takes in every pair of a large packing stops the detection
+/// with `TooManyCandidates` (before the `n²` candidates are allocated); the settling
+/// stops at the first poll that asks to.
+#[test]
+fn huge_alert_distances_are_refused_and_settling_can_be_interrupted() {
+    use porofrac_nscd::{ContactLaw, Nscd, NscdError, SettleParams, SolverParams};
+    use porofrac_particles::{Disks, packing::hexagonal};
+    let p = hexagonal([0.0; 2], [20.0; 2], 0.25).unwrap();
+    let n = p.len();
+    let disks = Disks::new(&p.centres, &p.radii, 1000.0).unwrap();
+    let params = SolverParams {
+        alert: Some(30.0),
+        ..SolverParams::default()
+    };
+    let law = ContactLaw::default();
+    match Nscd::new(disks.clone(), vec![], law, params, [0.0, -9.81]) {
+        Err(NscdError::TooManyCandidates { found, disks, .. }) => {
+            assert_eq!(disks, n);
+            assert!(found > porofrac_nscd::detect::CANDIDATES_PER_DISK * n);
+        }
+        other => panic!("{other:?}"),
+    }
+    let mut sys = Nscd::new(disks, vec![], law, SolverParams::default(), [0.0, -9.81]).unwrap();
+    let mut polls = 0;
+    let r = sys.settle_polled(
+        SettleParams {
+            dt: 1e-3,
+            ratio: 1e-6,
+            max_steps: 1000,
+        },
+        &mut |p| {
+            polls += 1;
+            p.done == 3
+        },
+    );
+    assert_eq!(r, Err(NscdError::Interrupted));
+    assert_eq!(polls, 4);
+}

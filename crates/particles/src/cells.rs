@@ -10,7 +10,12 @@
 //! result does not depend on the cell layout.
 //!
 //! If the disks are spread far apart (a disk thrown away), the cell side grows so that
-//! there are at most `4 n + 16` cells: the search stays linear in memory.
+//! there are at most `4 n + 16` cells: the search stays linear in memory. The cell
+//! counts are computed in floating point before anything is allocated, so centres as
+//! far apart as `±f64::MAX` still give a bounded grid; a centre that is not finite is
+//! put in the first cell and pairs with nothing. [`CellList::pairs_at_most`] stops once
+//! a given number of pairs is found, for callers that must bound their memory (a huge
+//! alert distance makes the pairs grow as `n²`).
 
 /// A cell list over disk centres.
 #[derive(Clone, Debug, Default)]
@@ -41,26 +46,34 @@ impl CellList {
                 hi[a] = hi[a].max(p[a]);
             }
         }
-        if n == 0 {
+        if n == 0 || !(lo[0] <= hi[0] && lo[1] <= hi[1]) {
+            // No disk, or no finite centre.
             lo = [0.0; 2];
             hi = [0.0; 2];
         }
+        // Extents that overflow (centres near ±f64::MAX) count as the largest float.
+        let extent = [0, 1].map(|a| {
+            let e = hi[a] - lo[a];
+            if e.is_finite() { e } else { f64::MAX }
+        });
         let mut side = if min_side > 0.0 && min_side.is_finite() {
             min_side
         } else {
             1.0
         };
+        // Cells per axis as floats: `as usize` would saturate and wrap for far centres.
         let cells = |side: f64| {
-            let nx = ((hi[0] - lo[0]) / side).floor() as usize + 1;
-            let ny = ((hi[1] - lo[1]) / side).floor() as usize + 1;
+            let nx = (extent[0] / side).floor() + 1.0;
+            let ny = (extent[1] / side).floor() + 1.0;
             (nx, ny)
         };
-        let max_cells = 4 * n + 16;
-        let (mut nx, mut ny) = cells(side);
-        while (nx as f64) * (ny as f64) > max_cells as f64 {
+        let max_cells = (4 * n + 16) as f64;
+        let (mut fx, mut fy) = cells(side);
+        while fx * fy > max_cells {
             side *= 2.0;
-            (nx, ny) = cells(side);
+            (fx, fy) = cells(side);
         }
+        let (nx, ny) = (fx as usize, fy as usize);
         self.lo = lo;
         self.side = side;
         self.nx = nx;
@@ -90,6 +103,8 @@ impl CellList {
         self.cell_of = fill;
     }
 
+    /// The cell of a centre; centres outside the box (or not finite) are clamped into
+    /// it (`as usize` maps NaN and negative values to 0 and saturates large ones).
     fn cell_index(&self, p: &[f64; 2]) -> usize {
         let cx = (((p[0] - self.lo[0]) / self.side) as usize).min(self.nx - 1);
         let cy = (((p[1] - self.lo[1]) / self.side) as usize).min(self.ny - 1);
@@ -105,6 +120,21 @@ impl CellList {
     /// sorted, into `out` (cleared first). The list must have been built from the same
     /// `x` with a side of at least `2 r_max + alert`.
     pub fn pairs(&self, x: &[[f64; 2]], r: &[f64], alert: f64, out: &mut Vec<(u32, u32)>) {
+        // Without a bound the search always completes.
+        let _ = self.pairs_at_most(x, r, alert, usize::MAX, out);
+    }
+
+    /// [`CellList::pairs`], stopping as soon as more than `max` pairs are found:
+    /// `Err(found)` then (with `found > max`, `out` holding the pairs found so far),
+    /// so the memory of the search stays below `max + 1` pairs.
+    pub fn pairs_at_most(
+        &self,
+        x: &[[f64; 2]],
+        r: &[f64],
+        alert: f64,
+        max: usize,
+        out: &mut Vec<(u32, u32)>,
+    ) -> Result<(), usize> {
         out.clear();
         let (nx, ny) = (self.nx, self.ny);
         let mut push = |i: u32, j: u32| {
@@ -113,6 +143,7 @@ impl CellList {
             if d - r[a] - r[b] < alert {
                 out.push(if i < j { (i, j) } else { (j, i) });
             }
+            out.len() > max
         };
         for cy in 0..ny {
             for cx in 0..nx {
@@ -120,7 +151,9 @@ impl CellList {
                 let own = &self.items[self.start[c]..self.start[c + 1]];
                 for (k, &i) in own.iter().enumerate() {
                     for &j in &own[k + 1..] {
-                        push(i, j);
+                        if push(i, j) {
+                            return Err(out.len());
+                        }
                     }
                 }
                 let neighbours = [(1i64, 0i64), (-1, 1), (0, 1), (1, 1)];
@@ -133,13 +166,16 @@ impl CellList {
                     let other = &self.items[self.start[o]..self.start[o + 1]];
                     for &i in own {
                         for &j in other {
-                            push(i, j);
+                            if push(i, j) {
+                                return Err(out.len());
+                            }
                         }
                     }
                 }
             }
         }
         out.sort_unstable();
+        Ok(())
     }
 }
 

@@ -30,6 +30,30 @@ pub use disks::Disks;
 pub use packing::{Hole, Packing, RadiusDistribution, RandomPacking, Region};
 pub use tracked::{CellContact, CellState, TrackedCell};
 
+/// Where a long computation is, for a progress callback: `done` of `total` units of the
+/// phase `what` (disks placed, sweeps done, steps taken...).
+///
+/// The long computations of the particle crates (packing, settling, calibration) take a
+/// callback `&mut dyn FnMut(Progress) -> bool`, call it every few thousand units of work,
+/// and stop with an `Interrupted` error when it returns `true`: this is how a caller
+/// shows progress and honours Ctrl-C without these crates knowing either.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Progress {
+    /// What is being done ("placing disks", "settling, step"...).
+    pub what: &'static str,
+    /// Units done.
+    pub done: usize,
+    /// Units in all (an estimate where the end is not known in advance).
+    pub total: usize,
+}
+
+impl Progress {
+    /// `done` of `total` units of `what`.
+    pub fn new(what: &'static str, done: usize, total: usize) -> Self {
+        Self { what, done, total }
+    }
+}
+
 /// A bad particle set or packing request. Every variant names the offending index or
 /// argument.
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]
@@ -87,6 +111,9 @@ pub enum ParticleError {
         /// Sweeps done.
         sweeps: usize,
     },
+    /// The progress callback asked to stop.
+    #[error("interrupted")]
+    Interrupted,
     /// Writing a file failed.
     #[error("{path}: {message}")]
     Io {

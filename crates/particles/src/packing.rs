@@ -24,6 +24,10 @@ use crate::ParticleError;
 use crate::cells::{CellList, max_radius};
 use crate::rng::SplitMix64;
 
+/// How many disks placed (or pairs relaxed) between two calls of the progress callback
+/// of [`RandomPacking::generate_polled`].
+const POLL_EVERY: usize = 1 << 16;
+
 /// Centres and radii.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Packing {
@@ -239,15 +243,37 @@ impl RandomPacking {
     /// Generate the packing in the box, then keep the disks lying wholly inside `region`
     /// and outside every hole ([`carve`]). The packing fraction is that of the box.
     pub fn generate_in(&self, region: &Region, holes: &[Hole]) -> Result<Packing, ParticleError> {
+        self.generate_in_polled(region, holes, &mut |_| false)
+    }
+
+    /// [`RandomPacking::generate_in`], reporting progress to `poll` (see
+    /// [`RandomPacking::generate_polled`]).
+    pub fn generate_in_polled(
+        &self,
+        region: &Region,
+        holes: &[Hole],
+        poll: &mut dyn FnMut(crate::Progress) -> bool,
+    ) -> Result<Packing, ParticleError> {
         region.check()?;
         for h in holes {
             h.check()?;
         }
-        Ok(carve(&self.generate()?, region, holes))
+        Ok(carve(&self.generate_polled(poll)?, region, holes))
     }
 
     /// Generate the packing.
     pub fn generate(&self) -> Result<Packing, ParticleError> {
+        self.generate_polled(&mut |_| false)
+    }
+
+    /// Generate the packing, calling `poll` every few thousand disks placed and pairs
+    /// relaxed with where the generation is ([`crate::Progress`]): `true` from `poll`
+    /// stops it with [`ParticleError::Interrupted`]. The packing does not depend on
+    /// `poll`.
+    pub fn generate_polled(
+        &self,
+        poll: &mut dyn FnMut(crate::Progress) -> bool,
+    ) -> Result<Packing, ParticleError> {
         if let RadiusDistribution::List(list) = &self.distribution {
             if list.is_empty() {
                 return Err(ParticleError::BadArgument {
@@ -312,7 +338,19 @@ impl RandomPacking {
         let target = self.packing_fraction * (hi[0] - lo[0]) * (hi[1] - lo[1]);
         let mut p = Packing::default();
         let mut solid = 0.0;
+        // Expected number of disks, for progress only.
+        let mean_r = 0.5 * (self.r_min + self.r_max);
+        let expected = (target / (std::f64::consts::PI * mean_r * mean_r)).min(1e15) as usize;
         loop {
+            if p.radii.len().is_multiple_of(POLL_EVERY)
+                && poll(crate::Progress::new(
+                    "placing disks",
+                    p.radii.len(),
+                    expected.max(p.radii.len()),
+                ))
+            {
+                return Err(ParticleError::Interrupted);
+            }
             let r = self.draw_radius(&mut rng);
             let a = std::f64::consts::PI * r * r;
             if solid + a > target {
@@ -335,7 +373,14 @@ impl RandomPacking {
         let mut build = true;
         let omega = self.relaxation;
         let mut worst = 0.0;
-        for _ in 0..self.max_sweeps {
+        for sweep in 0..self.max_sweeps {
+            if poll(crate::Progress::new(
+                "relaxing overlaps, sweep",
+                sweep,
+                self.max_sweeps,
+            )) {
+                return Err(ParticleError::Interrupted);
+            }
             if build {
                 cells.build(&p.centres, side);
                 cells.pairs(&p.centres, &p.radii, skin, &mut pairs);
@@ -343,7 +388,16 @@ impl RandomPacking {
                 build = false;
             }
             worst = 0.0f64;
-            for &(i, j) in &pairs {
+            for (k, &(i, j)) in pairs.iter().enumerate() {
+                if k % POLL_EVERY == POLL_EVERY - 1
+                    && poll(crate::Progress::new(
+                        "relaxing overlaps, sweep",
+                        sweep,
+                        self.max_sweeps,
+                    ))
+                {
+                    return Err(ParticleError::Interrupted);
+                }
                 let (i, j) = (i as usize, j as usize);
                 let (xi, xj) = (p.centres[i], p.centres[j]);
                 let d = dist(xi, xj);

@@ -281,3 +281,81 @@ fn packings_in_a_disk_with_a_hole_and_in_a_polygon() {
         assert!(listed.radii.contains(&r));
     }
 }
+
+/// Centres at 1e20, ±f64::MAX, infinity and NaN: the cell list stays within `4 n + 16`
+/// cells and in bounds, and the pairs among the ordinary disks equal the brute-force
+/// ones (a centre that is not finite pairs with nothing).
+#[test]
+fn cell_list_survives_centres_far_away_or_not_finite() {
+    let base: Vec<[f64; 2]> = (0..30)
+        .map(|i| [(i % 6) as f64 * 0.9, (i / 6) as f64 * 0.9])
+        .collect();
+    for outlier in [
+        [1e20, 0.5],
+        [f64::MAX, -f64::MAX],
+        [-f64::MAX, f64::MAX],
+        [f64::INFINITY, 0.0],
+        [f64::NAN, 1.0],
+        [0.0, f64::NEG_INFINITY],
+    ] {
+        let mut x = base.clone();
+        x.push(outlier);
+        let r = vec![0.5; x.len()];
+        let mut cells = CellList::new();
+        cells.build(&x, 1.2);
+        let mut pairs = Vec::new();
+        cells.pairs(&x, &r, 0.1, &mut pairs);
+        let expected = brute_force_pairs(&base, &r[..base.len()], 0.1);
+        let far = pairs.iter().filter(|p| p.1 as usize == base.len()).count();
+        assert_eq!(far, 0, "{outlier:?}");
+        // With one disk far away every ordinary disk sits in one cell: same pairs.
+        assert_eq!(pairs, expected, "{outlier:?}");
+    }
+}
+
+/// `pairs_at_most` stops past its bound with the count found, and equals `pairs` below.
+#[test]
+fn bounded_pair_search_stops_past_its_bound() {
+    let p = hexagonal([0.0; 2], [10.0; 2], 0.25).unwrap();
+    let mut cells = CellList::new();
+    cells.build(&p.centres, 2.0 * 0.25 + 5.0);
+    let mut all = Vec::new();
+    cells.pairs(&p.centres, &p.radii, 5.0, &mut all);
+    assert!(all.len() > 1000);
+    let mut some = Vec::new();
+    assert_eq!(
+        cells.pairs_at_most(&p.centres, &p.radii, 5.0, 1000, &mut some),
+        Err(1001)
+    );
+    assert!(some.len() <= 1001);
+    assert_eq!(
+        cells.pairs_at_most(&p.centres, &p.radii, 5.0, all.len(), &mut some),
+        Ok(())
+    );
+    assert_eq!(some, all);
+}
+
+/// The progress callback sees the placement and the sweeps, does not change the
+/// packing, and stops it with `Interrupted` when it returns `true`.
+#[test]
+fn packing_progress_is_reported_and_interrupts() {
+    let spec = RandomPacking::new([0.0; 2], [30.0; 2], 0.4, 0.6, 0.8, 3);
+    let plain = spec.generate().unwrap();
+    let mut seen = Vec::new();
+    let polled = spec
+        .generate_polled(&mut |p| {
+            seen.push(p);
+            false
+        })
+        .unwrap();
+    assert_eq!(plain, polled);
+    assert_eq!(seen[0].what, "placing disks");
+    assert!(seen.iter().any(|p| p.what.starts_with("relaxing")));
+    let mut calls = 0;
+    let stopped = spec.generate_polled(&mut |_| {
+        calls += 1;
+        calls == 2
+    });
+    assert_eq!(stopped, Err(porofrac_particles::ParticleError::Interrupted));
+    assert_eq!(calls, 2);
+}

@@ -43,7 +43,7 @@ pub mod nscd;
 
 use std::path::{Path, PathBuf};
 
-pub use common::driver::{Observer, Silent, StepReport};
+pub use common::driver::{Observer, SetupReport, Silent, StepReport, Stop};
 pub use common::laws::{self, LawRegistry};
 pub use common::loaded::SceneError;
 pub use common::model::RunError;

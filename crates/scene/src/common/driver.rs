@@ -4,14 +4,33 @@
 //!
 //! Every file is rewritten atomically after each written step, so whatever stops a run
 //! (an error, Ctrl-C, a killed process) leaves complete files of the finished steps.
+//!
+//! **Stopping inside long phases.** The loop polls [`Observer::stop_requested`] between
+//! steps. Phases that can take long on their own — building a model (packing, settling,
+//! calibration, lattice set-up) and the inner sub-steps of one output step — poll too:
+//! a model's build gets a [`SetupPoll`] (progress lines such as
+//! `packing: placing disks 1.2 M / 6.5 M` through [`Observer::setup`], and the stop
+//! request), and keeps the observer's [`Stop`] handle for its steps. The model crates
+//! below know neither: they take a callback that returns `true` to stop. A phase that
+//! stops returns [`RunError::Interrupted`]: during the build the run ends with
+//! `"status": "interrupted at t = 0"` and no step; during a step the loop ends at the
+//! last written time, as an interruption between steps does.
+//!
+//! **No inf or NaN in the files.** Before a step is written, its probe values, line
+//! values and the extrema of its fields are checked: a value that is not finite ends the
+//! run with an error naming the probe, line (or field) and the time, instead of a file
+//! holding it. The one exception is a probe the model declares possibly undefined
+//! ([`Model::probe_may_be_undefined`]: a fluid probe inside a solid disk is NaN).
 
 use std::collections::BTreeMap;
 use std::path::Path;
-use std::time::Instant;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
 
 use porofrac_grid::io::PvdWriter;
 
-use crate::common::loaded::LoadedScene;
+use crate::common::loaded::{LoadedScene, k, ki};
 use crate::common::model::{Model, RunError};
 use crate::common::output::{CsvTable, OutputError, Summary, WallSeconds, peak_memory_bytes};
 
@@ -32,17 +51,237 @@ pub struct StepReport {
     pub failed: usize,
 }
 
-/// Watches a run: progress after every step, and a way to stop it between steps.
+/// Where the build of a model is: `done` of `total` units of a phase (see
+/// [`Observer::setup`]).
+#[derive(Clone, Copy, Debug)]
+pub struct SetupReport<'a> {
+    /// The phase and what it counts, e.g. `"packing: placing disks"`.
+    pub what: &'a str,
+    /// Units done.
+    pub done: usize,
+    /// Units in all (an estimate where the end is not known in advance).
+    pub total: usize,
+}
+
+impl std::fmt::Display for SetupReport<'_> {
+    /// `packing: placing disks 1.2 M / 6.5 M`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} {} / {}",
+            self.what,
+            count_text(self.done),
+            count_text(self.total)
+        )
+    }
+}
+
+/// `950`, `12.3 k`, `1.2 M`.
+fn count_text(n: usize) -> String {
+    let x = n as f64;
+    if x >= 1e6 {
+        format!("{:.1} M", x / 1e6)
+    } else if x >= 1e4 {
+        format!("{:.1} k", x / 1e3)
+    } else {
+        n.to_string()
+    }
+}
+
+/// Watches a run: progress after every step and during set-up, and a way to stop it.
 pub trait Observer: Send {
     /// Called after every step.
     fn step(&mut self, report: &StepReport) {
         let _ = report;
     }
-    /// Polled after every step: `true` ends the run there, with complete files and
-    /// `"status": "interrupted at t = …"`.
+    /// Called now and then (at most a few times a second) while a model is built.
+    fn setup(&mut self, report: &SetupReport<'_>) {
+        let _ = report;
+    }
+    /// Polled after every step and during set-up: `true` ends the run there, with
+    /// complete files and `"status": "interrupted at t = …"`.
     fn stop_requested(&self) -> bool {
         false
     }
+    /// A handle a model keeps to poll the same request inside a long step (never stops
+    /// by default: an observer whose [`Observer::stop_requested`] can become `true`
+    /// should return a handle that reads the same flag, [`Stop::from_flag`]).
+    fn stop_handle(&self) -> Stop {
+        Stop::never()
+    }
+}
+
+/// A cheap, clonable handle on a run's stop request, polled by the inner loops of long
+/// steps (see the module docs).
+#[derive(Clone, Default)]
+pub struct Stop(Option<Arc<AtomicBool>>);
+
+impl std::fmt::Debug for Stop {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Stop({})", self.requested())
+    }
+}
+
+impl Stop {
+    /// A handle that never asks to stop.
+    pub fn never() -> Self {
+        Self(None)
+    }
+
+    /// A handle that asks to stop once `flag` is set (e.g. by a Ctrl-C handler).
+    pub fn from_flag(flag: Arc<AtomicBool>) -> Self {
+        Self(Some(flag))
+    }
+
+    /// The flag itself, for the model crates that take one (`None`: never stops).
+    pub fn flag(&self) -> Option<Arc<AtomicBool>> {
+        self.0.clone()
+    }
+
+    /// Whether the run should stop now.
+    pub fn requested(&self) -> bool {
+        self.0.as_ref().is_some_and(|f| f.load(Ordering::Relaxed))
+    }
+}
+
+/// What a model's build polls: it reports progress to the observer (at most five times
+/// a second) and says whether to stop. Made by the driver's caller from the observer;
+/// [`SetupPoll::callback`] gives the `FnMut(Progress) -> bool` the particle crates take.
+pub struct SetupPoll<'o> {
+    observer: &'o mut dyn Observer,
+    phase: &'static str,
+    last: Option<Instant>,
+}
+
+impl<'o> SetupPoll<'o> {
+    /// Poll `observer` during a build.
+    pub fn new(observer: &'o mut dyn Observer) -> Self {
+        Self {
+            observer,
+            phase: "",
+            last: None,
+        }
+    }
+
+    /// Name the phase that follows (`"packing"`, `"settling"`, ...), shown before the
+    /// unit of each report.
+    pub fn phase(&mut self, phase: &'static str) -> &mut Self {
+        self.phase = phase;
+        self
+    }
+
+    /// Report `done` of `total` units of `what` (throttled); `true` when the run should
+    /// stop.
+    pub fn poll(&mut self, what: &str, done: usize, total: usize) -> bool {
+        let now = Instant::now();
+        if self
+            .last
+            .is_none_or(|t| now.duration_since(t) >= Duration::from_millis(200))
+        {
+            self.last = Some(now);
+            let what = if self.phase.is_empty() {
+                what.to_string()
+            } else {
+                format!("{}: {what}", self.phase)
+            };
+            self.observer.setup(&SetupReport {
+                what: &what,
+                done,
+                total,
+            });
+        }
+        self.observer.stop_requested()
+    }
+
+    /// The poll as the callback of the particle crates.
+    pub fn callback(&mut self) -> impl FnMut(porofrac_particles::Progress) -> bool + '_ {
+        |p| self.poll(p.what, p.done, p.total)
+    }
+
+    /// `Err(RunError::Interrupted)` when the run should stop (between two phases).
+    pub fn check(&mut self) -> Result<(), RunError> {
+        if self.observer.stop_requested() {
+            Err(RunError::Interrupted)
+        } else {
+            Ok(())
+        }
+    }
+
+    /// The observer's handle for the steps of the model.
+    pub fn stop_handle(&self) -> Stop {
+        self.observer.stop_handle()
+    }
+}
+
+/// The summary of a run stopped while its model was being built: no step,
+/// `"status": "interrupted at t = 0"`.
+pub(crate) fn interrupted_in_setup(ls: &LoadedScene, start: Instant, dim: usize) -> Summary {
+    let wall = WallSeconds {
+        total: start.elapsed().as_secs_f64(),
+        ..WallSeconds::default()
+    };
+    Summary {
+        scene: ls.scene.scene.name.clone(),
+        model: ls.model().to_string(),
+        dim,
+        cells: 0,
+        nodes: 0,
+        dofs: 0,
+        steps: 0,
+        status: "interrupted at t = 0".into(),
+        interrupted_at: Some(0.0),
+        fractured_cells: 0,
+        wall_seconds: wall,
+        peak_memory_bytes: peak_memory_bytes(),
+        solver: Default::default(),
+        field_extrema: BTreeMap::new(),
+        errors: BTreeMap::new(),
+        version: env!("CARGO_PKG_VERSION").into(),
+        extra: serde_json::Map::new(),
+    }
+}
+
+/// `Err` naming the probe (or field) when a value about to be written is not finite.
+fn check_finite(
+    ls: &LoadedScene,
+    t: f64,
+    probes: &[f64],
+    extrema: &BTreeMap<String, [f64; 2]>,
+    may_be_undefined: &dyn Fn(usize) -> bool,
+) -> Result<(), RunError> {
+    let s = &ls.scene;
+    if let Some((i, v)) = probes
+        .iter()
+        .enumerate()
+        .find(|(i, v)| v.is_infinite() || (v.is_nan() && !may_be_undefined(*i)))
+    {
+        let key = ki("output.probe", i, &["field"]);
+        return Err(ls
+            .error(
+                &key,
+                format!(
+                    "= \"{}\" is {v} at t = {t:e} s: the run diverged or the value is \
+                     undefined there; nothing of this step was written",
+                    s.output.probe[i].field
+                ),
+            )
+            .into());
+    }
+    if let Some((name, [lo, hi])) = extrema
+        .iter()
+        .find(|(_, [lo, hi])| !(lo.is_finite() && hi.is_finite()))
+    {
+        return Err(ls
+            .error(
+                &k(&["schedule"]),
+                format!(
+                    ": field {name} reaches [{lo}, {hi}] at t = {t:e} s: the run diverged \
+                     (lower the time step); nothing of this step was written"
+                ),
+            )
+            .into());
+    }
+    Ok(())
 }
 
 /// An observer that reports nothing and never stops a run.
@@ -103,9 +342,16 @@ pub(crate) fn drive(
     let mut steps = 0;
     let mut interrupted = None;
     let mut row = Vec::new();
-    let mut rows = Vec::new();
     for (step, &t) in times.iter().enumerate() {
-        let stats = model.step(step)?;
+        let stats = match model.step(step) {
+            Err(RunError::Interrupted) => {
+                // Stopped inside the step: its state is partial, the files end at the
+                // last written step.
+                interrupted = Some(written.last().copied().unwrap_or(0.0));
+                break;
+            }
+            r => r?,
+        };
         model.after_step(out)?;
         let stop = step + 1 < times.len() && observer.stop_requested();
         let write =
@@ -116,13 +362,34 @@ pub(crate) fn drive(
             row.push(t);
             let first = row.len();
             model.probes(&mut row);
+            let step_extrema = model.field_extrema();
+            check_finite(ls, t, &row[first..], &step_extrema, &|i| {
+                model.probe_may_be_undefined(i)
+            })?;
+            // Every line of the step, checked before anything of the step is written.
+            let mut line_rows: Vec<Vec<Vec<f64>>> = Vec::with_capacity(lines.len());
+            for i in 0..lines.len() {
+                let mut rows = Vec::new();
+                model.line(i, &mut rows);
+                if let Some(v) = rows.iter().flatten().find(|v| !v.is_finite()) {
+                    return Err(ls
+                        .error(
+                            &ki("output.line", i, &["field"]),
+                            format!(
+                                "= \"{}\" is {v} at a point of the line at t = {t:e} s: the \
+                                 run diverged or the value is undefined there",
+                                s.output.line[i].field
+                            ),
+                        )
+                        .into());
+                }
+                line_rows.push(rows);
+            }
             for (j, v) in row[first..].iter().enumerate() {
                 series[j].push(*v);
             }
             probes.push(&row)?;
-            for (i, table) in lines.iter_mut().enumerate() {
-                rows.clear();
-                model.line(i, &mut rows);
+            for (table, mut rows) in lines.iter_mut().zip(line_rows) {
                 for r in &mut rows {
                     r.insert(0, t);
                 }
@@ -132,7 +399,7 @@ pub(crate) fn drive(
                 let name = model.write_vtk(&vtk_dir, written.len())?;
                 pvd.add(t, format!("vtk/{name}"))?;
             }
-            extrema = model.field_extrema();
+            extrema = step_extrema;
             written.push(t);
             output_seconds += t_out.elapsed().as_secs_f64();
         }
@@ -188,4 +455,44 @@ pub(crate) fn drive(
         version: env!("CARGO_PKG_VERSION").into(),
         extra: model.summary_extras(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A value that is not finite names its probe (and its line in the file) or the
+    /// field; finite values pass.
+    #[test]
+    fn values_that_are_not_finite_name_their_probe_or_field() {
+        let text = std::fs::read_to_string(
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/nscd/column.toml"),
+        )
+        .unwrap();
+        let ls = crate::common::loaded::parse(&text, Path::new("c.toml"), crate::MODELS).unwrap();
+        let mut ext = BTreeMap::new();
+        ext.insert("vx".to_string(), [-1.0, 1.0]);
+        assert!(check_finite(&ls, 0.1, &[1.0, 2.0, 3.0], &ext, &|_| false).is_ok());
+        let e = check_finite(&ls, 0.1, &[1.0, f64::INFINITY, 3.0], &ext, &|_| true)
+            .unwrap_err()
+            .to_string();
+        let line = text
+            .lines()
+            .position(|l| l.contains("field = \"y\""))
+            .unwrap()
+            + 1;
+        assert!(e.contains(&format!("c.toml:{line}:")), "{e}");
+        assert!(
+            e.contains("output.probe[1]") && e.contains("is inf at t = 1e-1 s"),
+            "{e}"
+        );
+        // NaN passes where the model says the value may be undefined, not elsewhere.
+        assert!(check_finite(&ls, 0.1, &[f64::NAN, 2.0, 3.0], &ext, &|i| i == 0).is_ok());
+        assert!(check_finite(&ls, 0.1, &[1.0, 2.0, f64::NAN], &ext, &|i| i == 0).is_err());
+        ext.insert("speed".to_string(), [0.0, f64::NAN]);
+        let e = check_finite(&ls, 0.1, &[1.0, 2.0, 3.0], &ext, &|_| false)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("field speed reaches [0, NaN]"), "{e}");
+    }
 }

@@ -49,6 +49,10 @@ pub enum RunError {
     /// The coupled fracturing step failed.
     #[error("{0}")]
     Coupled(#[from] porofrac_sim::FractureError),
+    /// A stop was requested inside a long phase (the build of a model, or a step); the
+    /// run ends as interrupted ([`crate::common::driver`]), not as an error.
+    #[error("interrupted")]
+    Interrupted,
 }
 
 /// What a step did, for progress and statistics.
@@ -103,6 +107,14 @@ pub trait Model {
     fn errors(&self) -> Result<BTreeMap<String, f64>, RunError>;
     /// Wall time of the model's phases so far (assembly, solve, flow, its own output).
     fn wall_seconds(&self) -> WallSeconds;
+    /// Whether probe number `probe` may be NaN in a valid state: a value undefined at
+    /// the probe's place (a fluid probe inside a solid disk). No by default: a probe that
+    /// is NaN or infinite ends the run ([`crate::common::driver`]); an infinite value
+    /// always does.
+    fn probe_may_be_undefined(&self, probe: usize) -> bool {
+        let _ = probe;
+        false
+    }
     /// Keys of the model's own in `summary.json`, besides the shared ones (none by
     /// default).
     fn summary_extras(&self) -> serde_json::Map<String, serde_json::Value> {
@@ -212,7 +224,14 @@ fn run_model(
             )
             .into());
     };
-    let summary = kind.run(ls, laws, out, observer)?;
+    let start = std::time::Instant::now();
+    let summary = match kind.run(ls, laws, out, observer) {
+        // Stopped while the model was built: nothing was stepped.
+        Err(RunError::Interrupted) => {
+            crate::common::driver::interrupted_in_setup(ls, start, ls.scene.scene.dim as usize)
+        }
+        r => r?,
+    };
     summary.write(out)?;
     Ok(summary)
 }

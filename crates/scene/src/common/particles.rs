@@ -6,7 +6,10 @@
 use serde::Deserialize;
 
 use porofrac_particles::packing::{Hole, RadiusDistribution, Region, hexagonal_in};
-use porofrac_particles::{Disks, RandomPacking};
+use porofrac_particles::{Disks, ParticleError, RandomPacking};
+
+use crate::common::driver::SetupPoll;
+use crate::common::model::RunError;
 
 use crate::common::loaded::{LoadedScene, SceneError, k, ki, step_count_f64};
 use crate::common::particle_output::PARTICLE_FIELDS;
@@ -104,6 +107,50 @@ pub enum Distribution {
 /// Most disks a scene may generate.
 pub const MAX_PARTICLES: f64 = 2.0e7;
 
+/// Farthest a listed centre may lie from the median centre, in largest diameters. The
+/// neighbour search cuts the bounding box of the centres into at most `4 n + 16` cells:
+/// one disk far away makes the cells huge and the search quadratic, and nothing a
+/// particle model simulates spans a million grain diameters (a 2e7-disk packing is
+/// about 5000 diameters across).
+pub const MAX_SPREAD: f64 = 1e6;
+
+/// The listed centre farthest from the component-wise median centre, with its distance
+/// and the allowed one, when it lies beyond [`MAX_SPREAD`] largest diameters.
+fn farthest_beyond(c: &[[f64; 2]], r: &[f64]) -> Option<(usize, f64, f64)> {
+    let median = |a: usize| {
+        let mut v: Vec<f64> = c.iter().map(|p| p[a]).collect();
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    if c.is_empty() {
+        return None;
+    }
+    let m = [median(0), median(1)];
+    let reach = MAX_SPREAD * 2.0 * r.iter().copied().fold(0.0, f64::max);
+    let (i, d) = c
+        .iter()
+        .map(|p| (p[0] - m[0]).hypot(p[1] - m[1]))
+        .enumerate()
+        .max_by(|a, b| a.1.total_cmp(&b.1))?;
+    (d > reach).then_some((i, d, reach))
+}
+
+/// Smallest and largest radius a checked `[particles]` section gives (m).
+pub fn radius_range(p: &ParticlesSection) -> [f64; 2] {
+    let fold = |v: &[f64]| {
+        [
+            v.iter().copied().fold(f64::INFINITY, f64::min),
+            v.iter().copied().fold(0.0, f64::max),
+        ]
+    };
+    match (p.kind, &p.radius_list, p.radius, &p.radii) {
+        (ParticleKind::List, _, _, Some(radii)) => fold(radii),
+        (_, Some(list), _, _) => fold(list),
+        (_, None, Some(r), _) => r.range(),
+        _ => [0.0, 0.0],
+    }
+}
+
 fn positive(ls: &LoadedScene, f: &str, v: f64) -> Result<(), SceneError> {
     if v.is_finite() && v > 0.0 {
         Ok(())
@@ -150,6 +197,35 @@ pub fn check(ls: &LoadedScene, model: &str) -> Result<(), SceneError> {
     };
     let key = |f: &str| k(&["particles", f]);
     positive(ls, "density", p.density)?;
+    let kind_name = match p.kind {
+        ParticleKind::Random => "random",
+        ParticleKind::Hexagonal => "hexagonal",
+        ParticleKind::List => "list",
+    };
+    for (f, set, applies) in [
+        (
+            "packing_fraction",
+            p.packing_fraction.is_some(),
+            p.kind == ParticleKind::Random,
+        ),
+        ("seed", p.seed.is_some(), p.kind == ParticleKind::Random),
+        (
+            "distribution",
+            p.distribution != Distribution::Uniform,
+            p.kind == ParticleKind::Random,
+        ),
+        ("radius", p.radius.is_some(), p.kind != ParticleKind::List),
+        ("region", p.region.is_some(), p.kind != ParticleKind::List),
+        ("centres", p.centres.is_some(), p.kind == ParticleKind::List),
+        ("radii", p.radii.is_some(), p.kind == ParticleKind::List),
+    ] {
+        if set && !applies {
+            return Err(ls.error(
+                &key(f),
+                format!("has no effect with kind = \"{kind_name}\""),
+            ));
+        }
+    }
     match p.kind {
         ParticleKind::Random | ParticleKind::Hexagonal => {
             let given = [p.region.is_some(), p.disk.is_some(), p.polygon.is_some()];
@@ -298,13 +374,25 @@ pub fn check(ls: &LoadedScene, model: &str) -> Result<(), SceneError> {
                     return Err(ls.error(&key("centres"), format!("[{i}] is not finite")));
                 }
             }
+            if let Some((i, d, reach)) = farthest_beyond(c, r) {
+                return Err(ls.error(
+                    &key("centres"),
+                    format!(
+                        "[{i}] = [{}, {}] lies {d:.3e} m from the median centre of the \
+                         particles, more than {MAX_SPREAD:.0e} largest diameters \
+                         ({reach:.3e} m): a particle so far away is a typing error",
+                        c[i][0], c[i][1]
+                    ),
+                ));
+            }
         }
     }
     Ok(())
 }
 
-/// The disks of a checked `[particles]` section.
-pub fn generate(ls: &LoadedScene) -> Result<Disks, SceneError> {
+/// The disks of a checked `[particles]` section, reporting the packing's progress to
+/// `setup` (phase `"packing"`); a stop request ends it with [`RunError::Interrupted`].
+pub fn generate(ls: &LoadedScene, setup: &mut SetupPoll<'_>) -> Result<Disks, RunError> {
     let p = ls
         .scene
         .particles
@@ -339,21 +427,34 @@ pub fn generate(ls: &LoadedScene) -> Result<Disks, SceneError> {
                 if !matches!(spec.distribution, RadiusDistribution::List(_)) {
                     spec.distribution = RadiusDistribution::Uniform;
                 }
-                spec.generate_in(&region, &holes)
-                    .map_err(|e| ls.error(&key("packing_fraction"), format!(": {e}")))?
+                setup.phase("packing");
+                match spec.generate_in_polled(&region, &holes, &mut setup.callback()) {
+                    Ok(p) => p,
+                    Err(ParticleError::Interrupted) => return Err(RunError::Interrupted),
+                    Err(e) => {
+                        return Err(ls.error(&key("packing_fraction"), format!(": {e}")).into());
+                    }
+                }
             };
             (packing.centres, packing.radii)
         }
     };
     if centres.is_empty() {
-        return Err(ls.error(&key("kind"), "generates no particle"));
+        return Err(ls.error(&key("kind"), "generates no particle").into());
     }
-    Disks::new(&centres, &radii, p.density)
-        .map_err(|e| ls.error(&k(&["particles"]), format!(": {e}")))
+    setup.check()?;
+    Ok(Disks::new(&centres, &radii, p.density)
+        .map_err(|e| ls.error(&k(&["particles"]), format!(": {e}")))?)
 }
 
-/// The `[schedule]` of a particle model: present, `end_time > 0`, `dt > 0` or `steps ≥ 1`,
-/// and no more output steps than a run may take.
+/// Shortest schedule step of a particle model (s): forces are impulses divided by the
+/// step, velocities displacements divided by it; below this the quotients overflow for
+/// ordinary masses and speeds (1e-300 s gives `inf`).
+pub const MIN_STEP: f64 = 1e-200;
+
+/// The `[schedule]` of a particle model: present, `end_time > 0`, exactly one of
+/// `dt > 0` (with `end_time ≥ dt`) and `steps ≥ 1`, a step of at least [`MIN_STEP`], and
+/// no more output steps than a run may take.
 pub fn check_particle_schedule(ls: &LoadedScene, model: &str) -> Result<(), SceneError> {
     let Some(sch) = &ls.scene.schedule else {
         return Err(ls.error(
@@ -363,16 +464,43 @@ pub fn check_particle_schedule(ls: &LoadedScene, model: &str) -> Result<(), Scen
     };
     positive_at(ls, &k(&["schedule", "end_time"]), sch.end_time)?;
     match (sch.dt, sch.steps) {
-        (Some(dt), _) => positive_at(ls, &k(&["schedule", "dt"]), dt)?,
+        (Some(dt), None) => {
+            positive_at(ls, &k(&["schedule", "dt"]), dt)?;
+            if sch.end_time < dt * (1.0 - 1e-9) {
+                return Err(ls.error(
+                    &k(&["schedule", "end_time"]),
+                    format!(
+                        "= {:e} s is shorter than one step dt = {dt:e} s",
+                        sch.end_time
+                    ),
+                ));
+            }
+        }
         (None, Some(n)) if n >= 1 => {}
         (None, Some(n)) => {
             return Err(ls.error(&k(&["schedule", "steps"]), format!("= {n} must be ≥ 1")));
+        }
+        (Some(_), Some(_)) => {
+            return Err(ls.error(&k(&["schedule"]), "needs exactly one of dt and steps"));
         }
         (None, None) => {
             return Err(ls.error(&k(&["schedule", "dt"]), "is missing: give dt or steps"));
         }
     }
+    // The step each output time is reached with, and what the models divide by it
+    // (velocities, forces = impulse / h): both must be normal numbers.
     let n = step_count_f64(sch);
+    let h = sch.dt.unwrap_or(sch.end_time / n);
+    if !(h.is_normal() && (1.0 / h).is_finite() && h >= MIN_STEP) {
+        return Err(ls.error(
+            &k(&["schedule", if sch.dt.is_some() { "dt" } else { "end_time" }]),
+            format!(
+                "gives a step of {h:e} s, below the {MIN_STEP:e} s a particle model can \
+                 divide by (end_time = {:e} s)",
+                sch.end_time
+            ),
+        ));
+    }
     if n > crate::common::limits::MAX_STEPS as f64 {
         return Err(ls.error(
             &k(&["schedule", if sch.dt.is_some() { "dt" } else { "steps" }]),

@@ -130,6 +130,36 @@ fn check_schedule(ls: &LoadedScene, units: &Units) -> Result<(), SceneError> {
             ),
         ));
     }
+    // Output times are whole numbers of lattice steps (as lbmpy and Palabos write every
+    // N iterations): an interval or end time between two lattice steps is refused with
+    // the nearest valid values, rather than rounded silently.
+    let n = crate::common::loaded::step_count_f64(sch);
+    let (what, interval) = match sch.dt {
+        Some(dt) => ("dt", dt),
+        None => ("steps", sch.end_time / n),
+    };
+    for (key, v) in [("end_time", sch.end_time), (what, interval)] {
+        let m = v / units.dt;
+        if (m - m.round()).abs() > 1e-9 * m.max(1.0) || m.round() < 1.0 {
+            let below = short(m.floor().max(1.0) * units.dt);
+            let above = short(m.ceil().max(1.0) * units.dt);
+            let (interval, lattice_dt) = (short(interval), short(units.dt));
+            let hint = if key == "steps" {
+                format!(
+                    "gives output every {interval} s, not a whole number of lattice steps \
+                     of {lattice_dt} s ({m:.4} steps): choose end_time and steps so that \
+                     end_time / steps is {below} s or {above} s"
+                )
+            } else {
+                format!(
+                    "= {} s is not a whole number of lattice steps of {lattice_dt} s ({m:.4} \
+                     steps): use {below} s or {above} s",
+                    short(v)
+                )
+            };
+            return Err(ls.error(&k(&["schedule", key]), hint));
+        }
+    }
     Ok(())
 }
 
@@ -194,6 +224,12 @@ fn check_output(
                 if p.at.len() != 2 || !p.at.iter().all(|v| v.is_finite()) {
                     return Err(ls.error(&pk("at"), "must be two finite numbers (m)"));
                 }
+                if !inside_lattice(ls, &p.at) {
+                    return Err(ls.error(
+                        &pk("at"),
+                        format!("= {:?} is outside the lattice (lbm.extent)", p.at),
+                    ));
+                }
             }
         }
     }
@@ -204,10 +240,30 @@ fn check_output(
             if v.len() != 2 || !v.iter().all(|x| x.is_finite()) {
                 return Err(ls.error(&lk(f), "must be two finite numbers (m)"));
             }
+            if !inside_lattice(ls, v) {
+                return Err(ls.error(
+                    &lk(f),
+                    format!("= {v:?}: the line leaves the lattice (lbm.extent)"),
+                ));
+            }
         }
         crate::common::loaded::line_points_and_name(ls, i, l)?;
     }
     Ok(())
+}
+
+/// `v` to 12 significant digits, printed as short as that allows (`0.065`, not
+/// `6.500000000000001e-2`): precise enough for the 1e-9 check it is a hint for.
+fn short(v: f64) -> String {
+    format!("{v:.11e}")
+        .parse::<f64>()
+        .map_or_else(|_| v.to_string(), |x| x.to_string())
+}
+
+/// Whether the point `x` lies in `lbm.extent` (boundary included).
+fn inside_lattice(ls: &LoadedScene, x: &[f64]) -> bool {
+    let l = ls.scene.lbm.as_ref().expect("checked by check_section");
+    (0..2).all(|a| x[a] >= l.extent[0][a] && x[a] <= l.extent[1][a])
 }
 
 fn field(ls: &LoadedScene, key: &[KeyPart], f: &str) -> Result<(), SceneError> {

@@ -5,8 +5,11 @@
 //!   from spacing, viscosity and tau), the sides of `[[lbm.boundary]]` and the
 //!   `[[obstacle]]`s are placed on the lattice. Nodes sit at the centres of the `Δx` cells
 //!   covering `extent`, so walls on the sides lie halfway between nodes;
-//! - *step*: from one output time to the next, `round(t/Δt)` lattice steps in total;
-//!   velocities given as expressions are evaluated at every lattice step;
+//! - *step*: from one output time to the next, `t/Δt` lattice steps in total (output
+//!   times are whole numbers of lattice steps, checked by [`check`](mod@check): an interval between
+//!   two lattice steps is refused with the nearest valid values, as lbmpy and Palabos
+//!   users expect outputs every N iterations); velocities given as expressions are
+//!   evaluated at every lattice step; the stop request is polled between lattice steps;
 //! - *fields*: `vx vy pressure density` (bilinear between nodes), obstacle forces and
 //!   torques (momentum exchange, per metre of depth), `.vti` image data.
 //!
@@ -30,7 +33,7 @@ use porofrac_lbm::{Lattice, MAX_MACH, Obstacle, Shape, Side, Thermal, Units};
 
 pub use check::check;
 
-use crate::common::driver::{Observer, drive};
+use crate::common::driver::{Observer, SetupPoll, Stop, drive};
 use crate::common::expr::Expr;
 use crate::common::lattice::images;
 use crate::common::lattice::sections::{CollisionChoice, ShapeChoice};
@@ -86,6 +89,8 @@ struct LbmModel<'a> {
     fluid_updates: f64,
     max_mach: f64,
     name: String,
+    /// Polled between the lattice steps of an output step.
+    stop: Stop,
 }
 
 /// Run a checked lattice Boltzmann scene and write its `summary.json`.
@@ -95,12 +100,12 @@ pub(crate) fn run(
     observer: &mut dyn Observer,
 ) -> Result<Summary, RunError> {
     let start = Instant::now();
-    let mut model = build(ls)?;
+    let mut model = build(ls, &mut SetupPoll::new(observer))?;
     let build_seconds = start.elapsed().as_secs_f64();
     drive(ls, &mut model, out, observer, start, build_seconds, 2)
 }
 
-fn build(ls: &LoadedScene) -> Result<LbmModel<'_>, RunError> {
+fn build<'a>(ls: &'a LoadedScene, setup: &mut SetupPoll<'_>) -> Result<LbmModel<'a>, RunError> {
     let s = &ls.scene;
     let l = s.lbm.as_ref().expect("checked");
     let LatticeParts {
@@ -173,6 +178,7 @@ fn build(ls: &LoadedScene) -> Result<LbmModel<'_>, RunError> {
         fluid_updates: 0.0,
         max_mach: 0.0,
         name: s.scene.name.clone(),
+        stop: setup.stop_handle(),
     };
     for p in &s.output.probe {
         model.probes.push(match &p.obstacle {
@@ -195,6 +201,45 @@ fn build(ls: &LoadedScene) -> Result<LbmModel<'_>, RunError> {
     if let Some(v) = &l.initial_velocity {
         let v = VelocityExpr::new(v);
         let (dx, o, u) = (units.dx, origin, units);
+        // Every node's value must be finite (and below the Mach limit) before the
+        // lattice takes it: name the key and the first bad point.
+        let (nx, ny) = model.lat.size();
+        let key = k(&["lbm", "initial_velocity"]);
+        for j in 0..ny {
+            for i in 0..nx {
+                let x = [o[0] + (i as f64 + 0.5) * dx, o[1] + (j as f64 + 0.5) * dx];
+                let w = v.at(x, 0.0);
+                let speed = (w[0] * w[0] + w[1] * w[1]).sqrt();
+                if !speed.is_finite() {
+                    return Err(ls
+                        .error(
+                            &key,
+                            format!(
+                                "is [{}, {}] at x = [{:e}, {:e}] m: not a finite velocity",
+                                w[0], w[1], x[0], x[1]
+                            ),
+                        )
+                        .into());
+                }
+                let ma = u.mach(speed);
+                if ma > MAX_MACH {
+                    return Err(ls
+                        .error(
+                            &key,
+                            format!(
+                                "is {speed:e} m/s at x = [{:e}, {:e}] m, Mach {ma:.3} on this \
+                                 lattice (limit {MAX_MACH}): refine the spacing, lower tau or \
+                                 the velocity",
+                                x[0], x[1]
+                            ),
+                        )
+                        .into());
+                }
+            }
+            if setup.poll("initial velocity, row", j, ny) {
+                return Err(RunError::Interrupted);
+            }
+        }
         model.lat.init(|p| {
             let x = [o[0] + p[0] * dx, o[1] + p[1] * dx];
             let w = v.at(x, 0.0);
@@ -262,10 +307,15 @@ impl LbmModel<'_> {
 
     /// The largest Mach number so far; an error when the flow diverged or exceeds the limit.
     fn check_state(&mut self) -> Result<(), RunError> {
-        let speed = self
-            .lat
-            .max_speed()
-            .map_err(|e| RunError::Flow(format!("lbm: {e}")))?;
+        let speed = self.lat.max_speed().map_err(|e| {
+            RunError::Flow(format!(
+                "lbm: {e} (at t = {:.6e} s). The usual causes: lbm.tau too close to 0.5, a \
+                 velocity (lbm.initial_velocity, a boundary or obstacle velocity) or \
+                 lbm.body_force too large for the lattice (Mach), or too coarse an \
+                 lbm.spacing",
+                self.lat.steps() as f64 * self.units.dt
+            ))
+        })?;
         let ma = speed / (1.0f64 / 3.0).sqrt();
         self.max_mach = self.max_mach.max(ma);
         if ma > MAX_MACH {
@@ -441,6 +491,9 @@ impl Model for LbmModel<'_> {
         let t0 = Instant::now();
         let mut n = 0;
         while self.lat.steps() < target {
+            if self.stop.requested() {
+                return Err(RunError::Interrupted);
+            }
             if varies {
                 self.apply_motion(self.lat.steps() as f64 * self.units.dt)?;
             }

@@ -111,6 +111,7 @@ pub fn lsm_error(ls: &LoadedScene, e: &LsmError) -> SceneError {
         LsmError::Overlap { .. } | LsmError::NotFinite { .. } => k(&["particles"]),
         LsmError::External { .. } => k(&["loading"]),
         LsmError::Calibration(_) => k(&["bonds", "calibrate"]),
+        LsmError::Interrupted => k(&["lsm"]),
     };
     ls.error(&key, format!(": {e}"))
 }
@@ -255,6 +256,27 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
         let key = |f: &str| k(&["lsm", f]);
         if let Some(dt) = l.dt {
             positive(ls, &key("dt"), dt)?;
+            if let Some(sch) = &s.schedule {
+                let n = sch.end_time / dt;
+                if n > crate::common::limits::MAX_STEPS as f64 {
+                    return Err(ls.error(
+                        &key("dt"),
+                        format!(
+                            "= {dt:e} s gives {n:.3e} time steps up to end_time = {} s, more \
+                             than the {} a run may take (leave dt out for a fraction of the \
+                             stable step)",
+                            sch.end_time,
+                            crate::common::limits::MAX_STEPS
+                        ),
+                    ));
+                }
+            }
+        }
+        if l.dt.is_some() && l.dt_fraction.is_some() {
+            return Err(ls.error(
+                &key("dt_fraction"),
+                "has no effect when dt is given: give one of them",
+            ));
         }
         if let Some(f) = l.dt_fraction
             && !(f > 0.0 && f <= 1.0)

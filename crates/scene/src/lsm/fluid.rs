@@ -300,11 +300,15 @@ impl Fluid {
         solid: &mut LatticeSolid,
         t: f64,
         mut crack: Option<&mut super::crack::CrackLog>,
+        stop: &crate::common::driver::Stop,
     ) -> Result<usize, RunError> {
         let dt = self.pf.dt();
         let target = (t / dt).round() as u64;
         let before = self.pf.stats().substeps;
         while self.pf.stats().steps < target {
+            if stop.requested() {
+                return Err(RunError::Interrupted);
+            }
             if self.time_dependent {
                 let (u, o) = (*self.pf.units(), self.pf.origin());
                 let time = self.pf.time();

@@ -41,16 +41,16 @@ use std::time::Instant;
 
 use plotters::style::RGBColor;
 use porofrac_grid::io::PvdWriter;
-use porofrac_lsm::calibrate::{QuasiStatic, brazilian, hexagonal_moduli, uniaxial};
+use porofrac_lsm::calibrate::{QuasiStatic, brazilian_polled, hexagonal_moduli, uniaxial_polled};
 use porofrac_lsm::{
-    BreakMode, ContactLaw, Damping, LatticeSolid, LsmSpec, Motion, NormalLaw, WallFaces,
+    BreakMode, ContactLaw, Damping, LatticeSolid, LsmError, LsmSpec, Motion, NormalLaw, WallFaces,
 };
 use porofrac_particles::packing::Region;
 use porofrac_particles::tracked::CellContact;
 use porofrac_particles::vtk::ContactLine;
 use porofrac_particles::{Disks, RandomPacking, TrackedCell};
 
-use crate::common::driver::{Observer, drive};
+use crate::common::driver::{Observer, SetupPoll, Stop, drive};
 use crate::common::loaded::{LoadedScene, k, ki, step_count};
 use crate::common::model::{Model, RunError, Sizes, StepStats};
 use crate::common::output::{SolverStats, Summary, WallSeconds};
@@ -65,7 +65,7 @@ pub(crate) fn run(
     observer: &mut dyn Observer,
 ) -> Result<Summary, RunError> {
     let start = Instant::now();
-    let mut model = build(ls)?;
+    let mut model = build(ls, &mut SetupPoll::new(observer))?;
     let build_seconds = start.elapsed().as_secs_f64();
     drive(ls, &mut model, out, observer, start, build_seconds, 2)
 }
@@ -112,7 +112,15 @@ pub struct LsmModel<'a> {
     history: Vec<[f64; 3]>,
     contacts_pvd: RefCell<Option<PvdWriter>>,
     fluid: Option<fluid::Fluid>,
+    /// Polled between the sub-steps of a step.
+    stop: Stop,
 }
+
+/// Smallest `[lsm] dt` as a fraction of the stable step: below it the run takes a
+/// million times more steps than a stable one for no gain in accuracy (the explicit
+/// scheme's error is already far below the bond-breakage resolution at half the stable
+/// step).
+const MIN_DT_FRACTION: f64 = 1e-6;
 
 fn spec_of(ls: &LoadedScene) -> Result<LsmSpec, SceneError> {
     let law = check::bond_law(ls)?;
@@ -151,7 +159,11 @@ fn spec_of(ls: &LoadedScene) -> Result<LsmSpec, SceneError> {
 
 /// Calibration samples with the packing recipe of `[particles]` (random kind): a box of
 /// 20 × 20 largest radii for E and ν, a disk of radius 10 largest radii for σ_t.
-fn calibrate(ls: &LoadedScene, spec: &LsmSpec) -> Result<Calibration, SceneError> {
+fn calibrate(
+    ls: &LoadedScene,
+    spec: &LsmSpec,
+    setup: &mut SetupPoll<'_>,
+) -> Result<Calibration, RunError> {
     let p = ls.scene.particles.as_ref().expect("checked");
     let key = k(&["bonds", "calibrate"]);
     let (r0, r1) = match (&p.radius_list, p.radius) {
@@ -160,9 +172,22 @@ fn calibrate(ls: &LoadedScene, spec: &LsmSpec) -> Result<Calibration, SceneError
             l.iter().copied().fold(0.0, f64::max),
         ),
         (None, Some(r)) => (r.range()[0], r.range()[1]),
-        _ => return Err(ls.error(&key, "needs a random or hexagonal [particles] kind")),
+        _ => {
+            return Err(ls
+                .error(&key, "needs a random or hexagonal [particles] kind")
+                .into());
+        }
     };
-    let packing = |lo: [f64; 2], hi: [f64; 2], region: &Region| -> Result<Disks, SceneError> {
+    let error = |e: LsmError| match e {
+        LsmError::Interrupted => RunError::Interrupted,
+        e => check::lsm_error(ls, &e).into(),
+    };
+    setup.phase("calibration");
+    let packing = |lo: [f64; 2],
+                   hi: [f64; 2],
+                   region: &Region,
+                   setup: &mut SetupPoll<'_>|
+     -> Result<Disks, RunError> {
         let mut rp = RandomPacking::new(
             lo,
             hi,
@@ -174,10 +199,15 @@ fn calibrate(ls: &LoadedScene, spec: &LsmSpec) -> Result<Calibration, SceneError
         if let Some(l) = &p.radius_list {
             rp = rp.with_radii(l);
         }
-        let pk = rp
-            .generate_in(region, &[])
-            .map_err(|e| ls.error(&key, format!(": {e}")))?;
-        Disks::new(&pk.centres, &pk.radii, p.density).map_err(|e| ls.error(&key, format!(": {e}")))
+        let pk = match rp.generate_in_polled(region, &[], &mut setup.callback()) {
+            Ok(pk) => pk,
+            Err(porofrac_particles::ParticleError::Interrupted) => {
+                return Err(RunError::Interrupted);
+            }
+            Err(e) => return Err(ls.error(&key, format!(": {e}")).into()),
+        };
+        Ok(Disks::new(&pk.centres, &pk.radii, p.density)
+            .map_err(|e| ls.error(&key, format!(": {e}")))?)
     };
     let (e_lattice, _) = hexagonal_moduli(spec.bonds.kn, spec.bonds.ks);
     let c = (e_lattice / p.density).sqrt();
@@ -189,12 +219,13 @@ fn calibrate(ls: &LoadedScene, spec: &LsmSpec) -> Result<Calibration, SceneError
             lo: [0.0; 2],
             hi: [side; 2],
         },
+        setup,
     )?;
     let q = QuasiStatic {
         speed: 2e-4 * c,
         ..QuasiStatic::new(1.0)
     };
-    let u = uniaxial(boxed, *spec, 1e-3, &q).map_err(|e| check::lsm_error(ls, &e))?;
+    let u = uniaxial_polled(boxed, *spec, 1e-3, &q, &mut setup.callback()).map_err(error)?;
     let rad = 10.0 * r1;
     let disk = packing(
         [-rad; 2],
@@ -203,12 +234,13 @@ fn calibrate(ls: &LoadedScene, spec: &LsmSpec) -> Result<Calibration, SceneError
             centre: [0.0; 2],
             radius: rad,
         },
+        setup,
     )?;
     let q = QuasiStatic {
         speed: 2e-5 * c,
         ..QuasiStatic::new(1.0)
     };
-    let b = brazilian(disk, *spec, 2.0 * r1, &q).map_err(|e| check::lsm_error(ls, &e))?;
+    let b = brazilian_polled(disk, *spec, 2.0 * r1, &q, &mut setup.callback()).map_err(error)?;
     Ok(Calibration {
         e: u.e,
         nu: u.nu,
@@ -216,17 +248,20 @@ fn calibrate(ls: &LoadedScene, spec: &LsmSpec) -> Result<Calibration, SceneError
     })
 }
 
-/// Build the model of a checked lattice solid scene.
-pub fn build(ls: &LoadedScene) -> Result<LsmModel<'_>, RunError> {
+/// Build the model of a checked lattice solid scene, reporting the packing and the
+/// calibration to `setup`.
+pub fn build<'a>(ls: &'a LoadedScene, setup: &mut SetupPoll<'_>) -> Result<LsmModel<'a>, RunError> {
     let s = &ls.scene;
-    let disks = crate::common::particles::generate(ls)?;
+    let disks = crate::common::particles::generate(ls, setup)?;
     let spec = spec_of(ls)?;
     let calibration = if own(ls).bonds.as_ref().is_some_and(|b| b.calibrate) {
-        Some(calibrate(ls, &spec)?)
+        Some(calibrate(ls, &spec, setup)?)
     } else {
         None
     };
+    setup.check()?;
     let mut solid = LatticeSolid::new(disks, spec).map_err(|e| check::lsm_error(ls, &e))?;
+    setup.check()?;
     let l = own(ls).lsm.clone().unwrap_or_default();
     let stable = solid.stable_dt();
     let dt = match l.dt {
@@ -235,6 +270,18 @@ pub fn build(ls: &LoadedScene) -> Result<LsmModel<'_>, RunError> {
                 .error(
                     &k(&["lsm", "dt"]),
                     format!("= {dt:.4e} s is above the stable time step {stable:.4e} s"),
+                )
+                .into());
+        }
+        Some(dt) if dt < MIN_DT_FRACTION * stable => {
+            return Err(ls
+                .error(
+                    &k(&["lsm", "dt"]),
+                    format!(
+                        "= {dt:.4e} s is below {MIN_DT_FRACTION:e} of the stable time step \
+                         {stable:.4e} s: the run would take that many more steps for nothing \
+                         (leave dt out for half the stable step)"
+                    ),
                 )
                 .into());
         }
@@ -373,6 +420,7 @@ pub fn build(ls: &LoadedScene) -> Result<LsmModel<'_>, RunError> {
         history: vec![[0.0; 3]],
         contacts_pvd: RefCell::new(None),
         fluid,
+        stop: setup.stop_handle(),
     })
 }
 
@@ -541,6 +589,11 @@ impl Model for LsmModel<'_> {
         &self.times
     }
 
+    fn probe_may_be_undefined(&self, probe: usize) -> bool {
+        // A fluid probe inside a solid disk has no fluid value.
+        matches!(self.probes.get(probe), Some(ProbeKind::Fluid(..)))
+    }
+
     fn step(&mut self, step: usize) -> Result<StepStats, RunError> {
         if step == 0 {
             return Ok(StepStats::default());
@@ -552,6 +605,7 @@ impl Model for LsmModel<'_> {
                 &mut self.solid,
                 self.times[step],
                 self.crack.as_mut(),
+                &self.stop,
             )?;
             self.step_seconds += t0.elapsed().as_secs_f64();
             self.lsm_steps += n as u64;
@@ -568,6 +622,9 @@ impl Model for LsmModel<'_> {
         let dt = h / n as f64;
         let t0 = Instant::now();
         for _ in 0..n {
+            if self.stop.requested() {
+                return Err(RunError::Interrupted);
+            }
             if let Some(w) = self.wall {
                 self.pressure =
                     (self.pressure_rate * (self.solid.time() + dt)).min(self.pressure_max);

@@ -142,6 +142,43 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
         }
         if let Some(a) = n.alert {
             non_negative(ls, &key("alert"), a)?;
+            // At most the largest radius: a step moves a disk by much less than its
+            // radius (a larger move is refused), so contacts that can close within a
+            // step are all within that gap; a larger alert only adds candidates, as
+            // (alert / r)² per disk, up to all n² pairs.
+            if let Some(p) = &s.particles {
+                let [_, r_max] = crate::common::particles::radius_range(p);
+                if r_max > 0.0 && a > r_max {
+                    return Err(ls.error(
+                        &key("alert"),
+                        format!(
+                            "= {a} m is above the largest particle radius {r_max} m: contacts \
+                             that can close in a step lie within one radius, and a larger \
+                             alert distance makes the contact candidates grow as the square \
+                             of the particle count"
+                        ),
+                    ));
+                }
+            }
+        }
+        for (f, set) in [
+            ("settle_dt", n.settle_dt.is_some()),
+            ("settle_max_steps", n.settle_max_steps.is_some()),
+        ] {
+            if set && n.settle_ratio.is_none() {
+                return Err(ls.error(
+                    &key(f),
+                    "has no effect without settle_ratio (which turns the settling on)",
+                ));
+            }
+        }
+        if n.ordering_seed.is_some()
+            && !matches!(n.ordering, Some(super::file::OrderingChoice::Random))
+        {
+            return Err(ls.error(
+                &key("ordering_seed"),
+                "has no effect without ordering = \"random\"",
+            ));
         }
         if let Some(g) = n.gravity {
             for v in g {

@@ -33,9 +33,9 @@ use porofrac_grid::io::PvdWriter;
 
 use crate::common::particle_output;
 use porofrac_nscd::{Axis, ContactLaw, Nscd, NscdError, Ordering, RigidBody, SolverParams};
-use porofrac_particles::TrackedCell;
+use porofrac_particles::{ParticleError, TrackedCell};
 
-use crate::common::driver::{Observer, drive};
+use crate::common::driver::{Observer, SetupPoll, drive};
 use crate::common::loaded::{LoadedScene, k, ki, step_count};
 use crate::common::model::{Model, RunError, Sizes, StepStats};
 use crate::common::output::{SolverStats, Summary, WallSeconds};
@@ -49,7 +49,7 @@ pub(crate) fn run(
     observer: &mut dyn Observer,
 ) -> Result<Summary, RunError> {
     let start = Instant::now();
-    let mut model = build(ls)?;
+    let mut model = build(ls, &mut SetupPoll::new(observer))?;
     let build_seconds = start.elapsed().as_secs_f64();
     drive(ls, &mut model, out, observer, start, build_seconds, 2)
 }
@@ -90,6 +90,10 @@ pub struct NscdModel<'a> {
 
 fn scene_error(ls: &LoadedScene, e: &NscdError) -> RunError {
     let key = match e {
+        NscdError::Interrupted | NscdError::Particles(ParticleError::Interrupted) => {
+            return RunError::Interrupted;
+        }
+        NscdError::TooManyCandidates { .. } => k(&["nscd", "alert"]),
         NscdError::BadParameter { name, .. } => match *name {
             "mu_static" | "mu_dynamic" => k(&["contact", "mu"]),
             "cohesion" => k(&["contact", "cohesion"]),
@@ -137,10 +141,14 @@ fn walls(ls: &LoadedScene) -> Vec<RigidBody> {
         .collect()
 }
 
-/// Build the model of a checked NSCD scene.
-pub fn build(ls: &LoadedScene) -> Result<NscdModel<'_>, RunError> {
+/// Build the model of a checked NSCD scene, reporting the packing and the settling to
+/// `setup`.
+pub fn build<'a>(
+    ls: &'a LoadedScene,
+    setup: &mut SetupPoll<'_>,
+) -> Result<NscdModel<'a>, RunError> {
     let s = &ls.scene;
-    let disks = crate::common::particles::generate(ls)?;
+    let disks = crate::common::particles::generate(ls, setup)?;
     let c = own(ls).contact.clone().unwrap_or_default();
     let mu = c.mu.unwrap_or(0.0);
     let law = ContactLaw {
@@ -167,20 +175,27 @@ pub fn build(ls: &LoadedScene) -> Result<NscdModel<'_>, RunError> {
         },
     };
     let gravity = n.gravity.unwrap_or([0.0, -9.81]);
+    setup.check()?;
     let mut sys =
         Nscd::new(disks, walls(ls), law, params, gravity).map_err(|e| scene_error(ls, &e))?;
+    // Ctrl-C stops the NLGS sweeps of the settling and of every step.
+    sys.set_interrupt(setup.stop_handle().flag());
     let sch = s.schedule.as_ref().expect("checked: [schedule] present");
     let steps = step_count(sch) as usize;
     let dt = sch.dt.unwrap_or(sch.end_time / steps as f64);
     let settling = match n.settle_ratio {
         Some(ratio) => {
             let t0 = Instant::now();
+            setup.phase("settling");
             let st = sys
-                .settle(porofrac_nscd::SettleParams {
-                    dt: n.settle_dt.unwrap_or(dt),
-                    ratio,
-                    max_steps: n.settle_max_steps.map_or(20_000, |m| m as usize),
-                })
+                .settle_polled(
+                    porofrac_nscd::SettleParams {
+                        dt: n.settle_dt.unwrap_or(dt),
+                        ratio,
+                        max_steps: n.settle_max_steps.map_or(20_000, |m| m as usize),
+                    },
+                    &mut setup.callback(),
+                )
                 .map_err(|e| scene_error(ls, &e))?;
             Some((st, t0.elapsed().as_secs_f64()))
         }

@@ -135,6 +135,23 @@ pub(crate) fn check_section(ls: &LoadedScene) -> Result<(Units, [bool; 2]), Scen
     {
         return Err(ls.error(&key("body_force"), "must be two finite numbers (m/s²)"));
     }
+    if let Some(b) = &l.body_force {
+        // One lattice step of the body force alone must not carry the fluid past the
+        // Mach limit: the lattice acceleration is a velocity gained per step.
+        let g = b[0].hypot(b[1]);
+        let per_step = units.acceleration(g);
+        let limit = MAX_MACH * (1.0f64 / 3.0).sqrt();
+        if !per_step.is_finite() || per_step >= limit {
+            return Err(ls.error(
+                &key("body_force"),
+                format!(
+                    "= {g:e} m/s² adds {per_step:.3e} lattice velocity units per step, more \
+                     than the Mach limit {MAX_MACH} allows in one step ({limit:.3e}): lower \
+                     the body force, or refine the spacing or lower tau"
+                ),
+            ));
+        }
+    }
     if let Some(v) = &l.initial_velocity {
         vector(ls, &key("initial_velocity"), v)?;
     }
