@@ -389,10 +389,49 @@ fn signed_volume<const D: usize>(
     (vol, (hi - lo).amax())
 }
 
-/// Read a whole file, mapping failures to [`GridError::Io`] with the path.
+/// Largest mesh file read (bytes).
+pub const MAX_MESH_FILE_BYTES: u64 = 8 << 30;
+
+/// Read a whole mesh file, mapping failures to [`GridError::Io`] with the path. Only a
+/// regular file is read (not a directory, a device such as `/dev/zero` or a pipe), of at
+/// most [`MAX_MESH_FILE_BYTES`] bytes: no more than that plus one byte is ever read, and
+/// a buffer that cannot be allocated is an error, not an abort.
 pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>> {
-    fs::read(path).map_err(|source| GridError::Io {
+    use std::io::Read as _;
+    let io = |source| GridError::Io {
         path: path.to_path_buf(),
         source,
-    })
+    };
+    let refuse = |what: String| io(std::io::Error::new(std::io::ErrorKind::InvalidInput, what));
+    let meta = fs::metadata(path).map_err(io)?;
+    if !meta.is_file() {
+        return Err(refuse(
+            "not a regular file (a directory, device or pipe); a mesh must be one".into(),
+        ));
+    }
+    let too_big = |n: u64| {
+        refuse(format!(
+            "the file has {n} bytes or more, more than the {MAX_MESH_FILE_BYTES} a mesh file \
+             may have"
+        ))
+    };
+    if meta.len() > MAX_MESH_FILE_BYTES {
+        return Err(too_big(meta.len()));
+    }
+    let mut bytes = Vec::new();
+    bytes.try_reserve_exact(meta.len() as usize).map_err(|_| {
+        refuse(format!(
+            "cannot allocate {} bytes to read the file: not enough memory",
+            meta.len()
+        ))
+    })?;
+    fs::File::open(path)
+        .map_err(io)?
+        .take(MAX_MESH_FILE_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(io)?;
+    if bytes.len() as u64 > MAX_MESH_FILE_BYTES {
+        return Err(too_big(bytes.len() as u64));
+    }
+    Ok(bytes)
 }
