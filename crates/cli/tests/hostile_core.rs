@@ -239,7 +239,7 @@ fn a_failed_write_leaves_a_failed_summary_and_no_temporary_file() {
     assert!(err.contains("step_0000.vtu"), "{err}");
     let status = summary(&out)["status"].as_str().unwrap().to_string();
     assert!(
-        status.starts_with("failed: output: ") && status.contains("step_0000.vtu"),
+        status.starts_with("failed: ") && status.contains("step_0000.vtu: Is a directory"),
         "{status}"
     );
     let leftovers: Vec<PathBuf> = all_files(&out)
@@ -255,8 +255,13 @@ fn long_user_text_is_echoed_bounded() {
     let dir = tmp_dir("core_echo");
     // A syntax error at the end of a 200 kB expression (refused by the check).
     let long = format!("x{}", " + x".repeat(50_000));
-    let n = long.chars().count() + 2;
     let text = scene("patch_test.toml").replacen("3e-4*y\"]", &format!("{long} + )\"]"), 1);
+    // The whole expression as written, between its quotes.
+    let at = text.find(&long).unwrap();
+    let open = text[..at].rfind('"').unwrap();
+    let close = at + text[at..].find('"').unwrap();
+    let n = text[open + 1..close].chars().count();
+    assert!(n > 200_000);
     let (code, err) = run_in(&dir, "echo", &text, &dir.join("out"));
     assert_eq!(code, 1, "{err}");
     assert!(err.len() < 600, "{} bytes: {}", err.len(), &err[..600]);
