@@ -14,6 +14,12 @@
 //! * a 200 kB expression is echoed as its first 60 characters and its length, on stderr
 //!   and in `summary.json`;
 //! * a Cosserat body force that is not finite names `loads.body_force` and its line;
+//! * a 60³ corner-point deck with flow coupled to the mechanics (a direct solve whose
+//!   factor needs about 36 GB) is refused under a 4 GB address-space limit, naming
+//!   `grid`, the counts and the factor's share, before anything big is allocated;
+//! * a `.vtu` whose triangles overlap (a triangle standing on the bottom side inside the
+//!   square, so the run would be constrained and silent) is refused naming the first
+//!   cell next to the overlap;
 //! * `perturb = 0.3` (the maximum) on crossed Cosserat triangles of elongated squares
 //!   runs for several seeds, and 0.31 is refused naming `grid.perturb`.
 
@@ -321,6 +327,79 @@ fn perturbed_crossed_cosserat_triangles_stay_valid_at_the_maximum() {
     assert_eq!(code, 1, "{err}");
     assert!(
         err.contains(&format!("p.toml:{}: grid.perturb = 0.31 must be in [0, 0.3]", line_of(&text, "perturb"))),
+        "{err}"
+    );
+}
+
+#[test]
+fn a_deck_whose_direct_solve_does_not_fit_is_refused_before_allocating() {
+    use porofrac_grid::io::grdecl::Deck;
+    let dir = tmp_dir("core_deck_memory");
+    // The faulted deck of porofrac-grid/examples/grdecl_speed.rs, 60³ cells.
+    let n = 60;
+    let (dx, dz) = (10.0, 2.0);
+    let deck = Deck::on_vertical_pillars([n, n, n], [dx, dx], |[i, _], x, _, k| {
+        let throw = if i >= n / 2 { dz / 2.0 } else { 0.0 };
+        1000.0 + (k - k / 10) as f64 * dz + 0.02 * x + throw
+    });
+    let mut w = std::io::BufWriter::new(std::fs::File::create(dir.join("d60.grdecl")).unwrap());
+    deck.write_text(&mut w).unwrap();
+    drop(w);
+    let mut text = std::fs::read_to_string(root().join("scenes/corner_point/injection.toml"))
+        .unwrap()
+        .replace("faulted.grdecl", "d60.grdecl");
+    for m in ["[material.sandstone]", "[material.shaly]"] {
+        text = text.replace(m, &format!("{m}\nporosity = 0.2\npermeability = 1.0e-13"));
+    }
+    let path = dir.join("deck.toml");
+    std::fs::write(&path, &text).unwrap();
+    let cmd = format!(
+        "ulimit -v 4000000; exec '{}' run '{}' --out '{}'",
+        env!("CARGO_BIN_EXE_porofrac"),
+        path.display(),
+        dir.join("out").display()
+    );
+    let o = Command::new("sh").arg("-c").arg(cmd).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains(&format!("deck.toml:{}: grid holds ", line_of(&text, "[grid]")))
+            && err.contains("the factor of the direct solve alone")
+            && err.contains("this machine has 4.1 GB"),
+        "{err}"
+    );
+    // The estimate, not the allocator, stopped it: far below the limit at the refusal.
+    let summary = summary(&dir.join("out"));
+    let peak = summary["peak_memory_bytes"].as_f64().unwrap();
+    assert!(peak < 2.0e9, "{peak}");
+}
+
+#[test]
+fn overlapping_mesh_cells_are_refused() {
+    let dir = tmp_dir("core_overlap");
+    let pts = "0 0 0 1 0 0 1 1 0 0 1 0 0.2 0 0 0.6 0 0 0.2 0.5 0";
+    let vtu = format!(
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" \
+         byte_order=\"LittleEndian\">\n<UnstructuredGrid><Piece NumberOfPoints=\"7\" \
+         NumberOfCells=\"3\">\n<Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" \
+         format=\"ascii\">{pts}</DataArray></Points>\n<Cells><DataArray type=\"Int64\" \
+         Name=\"connectivity\" format=\"ascii\">0 1 2 0 2 3 4 5 6</DataArray>\n<DataArray \
+         type=\"Int64\" Name=\"offsets\" format=\"ascii\">3 6 9</DataArray>\n<DataArray \
+         type=\"UInt8\" Name=\"types\" format=\"ascii\">5 5 5</DataArray></Cells>\n</Piece>\
+         </UnstructuredGrid></VTKFile>\n"
+    );
+    std::fs::write(dir.join("over.vtu"), vtu).unwrap();
+    let text = "[scene]\nname = \"over\"\ndim = 2\n[grid]\nkind = \"file\"\npath = \"over.vtu\"\n\
+                [[region]]\nname = \"rock\"\nselect = { all = true }\nlaw = \"vem\"\n\
+                material = \"rock\"\n[material.rock]\nyoungs_modulus = 1.0e9\n\
+                poisson_ratio = 0.25\n[[bc]]\nboundary = \"ymin\"\ndisplacement = [0.0, 0.0]\n\
+                [[bc]]\nboundary = \"ymax\"\ntraction = [0.0, -1.0e6]\n";
+    let (code, err) = run_in(&dir, "over", text, &dir.join("out"));
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("over.toml:6: grid.path")
+            && err.contains("cell 0: overlaps other cells")
+            && err.contains("the 1st cell of the file"),
         "{err}"
     );
 }

@@ -468,6 +468,26 @@ mod tests {
         d
     }
 
+    /// A table whose file cannot be written (its target is a folder) returns the error
+    /// naming the file, keeps no temporary file, and its drop neither panics nor writes.
+    #[test]
+    fn a_failed_table_write_leaves_no_temporary_file() {
+        let d = dir("table");
+        std::fs::create_dir_all(d.join("probes.csv/inside")).unwrap();
+        let mut t = CsvTable::new(d.join("probes.csv"), &["time".to_string()]);
+        let _ = t.push_text(&["1".to_string()]);
+        let e = t.flush().unwrap_err();
+        assert_eq!(e.path, d.join("probes.csv"));
+        drop(t);
+        let names: Vec<String> = std::fs::read_dir(&d)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        assert_eq!(names, ["probes.csv"]);
+        assert!(d.join("probes.csv").is_dir());
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
     #[test]
     fn numbered_names() {
         assert!(numbered("step_0012.vtu", "step_", "vtu"));
