@@ -114,8 +114,10 @@ fn devices_pipes_and_huge_files_are_refused_before_reading() {
     let (code, err) = run_in(&dir, "mesh", &text, &dir.join("out"));
     assert_eq!(code, 1, "{err}");
     assert!(
-        err.contains(&format!("mesh.toml:{}: grid.path", line_of(&text, "path =")))
-            && err.contains("not a regular file"),
+        err.contains(&format!(
+            "mesh.toml:{}: grid.path",
+            line_of(&text, "path =")
+        )) && err.contains("not a regular file"),
         "{err}"
     );
 }
@@ -198,7 +200,12 @@ fn a_second_run_into_a_locked_folder_is_refused() {
 fn a_rerun_removes_the_earlier_steps_and_nothing_else() {
     let dir = tmp_dir("core_rerun");
     let out = dir.join("out");
-    let steps = |n: usize| format!("{}\n[schedule]\nend_time = 1.0\nsteps = {n}\n", scene("patch_test.toml"));
+    let steps = |n: usize| {
+        format!(
+            "{}\n[schedule]\nend_time = 1.0\nsteps = {n}\n",
+            scene("patch_test.toml")
+        )
+    };
     let (code, err) = run_in(&dir, "four", &steps(4), &out);
     assert_eq!(code, 0, "{err}");
     let names = |d: &Path| {
@@ -227,7 +234,10 @@ fn a_rerun_removes_the_earlier_steps_and_nothing_else() {
         names(&out.join("vtk")),
         ["mine.vtu", "step_0000.vtu", "step_0001.vtu"]
     );
-    assert_eq!(std::fs::read_to_string(out.join("notes.txt")).unwrap(), "mine");
+    assert_eq!(
+        std::fs::read_to_string(out.join("notes.txt")).unwrap(),
+        "mine"
+    );
     let pvd = std::fs::read_to_string(out.join("patch_test.pvd")).unwrap();
     assert_eq!(pvd.matches("<DataSet").count(), 2, "{pvd}");
     assert_eq!(summary(&out)["steps"], 1);
@@ -278,14 +288,20 @@ fn long_user_text_is_echoed_bounded() {
     // A run-time error echoing it: a Cosserat body force that is not finite.
     let text = scene("cosserat_shear_layer.toml").replace(
         "[solver]",
-        &format!("[loads]\nbody_force = [0.0, \"sqrt(x - 1){}\"]\n\n[solver]", " + x".repeat(50_000)),
+        &format!(
+            "[loads]\nbody_force = [0.0, \"sqrt(x - 1){}\"]\n\n[solver]",
+            " + x".repeat(50_000)
+        ),
     );
     let out = dir.join("out2");
     let (code, err) = run_in(&dir, "echo2", &text, &out);
     assert_eq!(code, 1, "{err}");
     assert!(err.len() < 600, "{} bytes", err.len());
     let status = summary(&out)["status"].as_str().unwrap().to_string();
-    assert!(status.len() < 600 && status.contains(" characters)"), "{status}");
+    assert!(
+        status.len() < 600 && status.contains(" characters)"),
+        "{status}"
+    );
 }
 
 #[test]
@@ -300,8 +316,9 @@ fn a_cosserat_body_force_that_is_not_finite_names_its_key() {
         assert_eq!(code, 1, "{err}");
         let line = line_of(&text, "body_force");
         assert!(
-            err.contains(&format!("bf.toml:{line}: loads.body_force [1] = \"{expr}\" is"))
-                && err.contains(value),
+            err.contains(&format!(
+                "bf.toml:{line}: loads.body_force [1] = \"{expr}\" is"
+            )) && err.contains(value),
             "{err}"
         );
         assert!(!err.contains("scene.model"), "{err}");
@@ -326,7 +343,10 @@ fn perturbed_crossed_cosserat_triangles_stay_valid_at_the_maximum() {
     let (code, err) = run_in(&dir, "p", &text, &dir.join("out"));
     assert_eq!(code, 1, "{err}");
     assert!(
-        err.contains(&format!("p.toml:{}: grid.perturb = 0.31 must be in [0, 0.3]", line_of(&text, "perturb"))),
+        err.contains(&format!(
+            "p.toml:{}: grid.perturb = 0.31 must be in [0, 0.3]",
+            line_of(&text, "perturb")
+        )),
         "{err}"
     );
 }
@@ -363,8 +383,10 @@ fn a_deck_whose_direct_solve_does_not_fit_is_refused_before_allocating() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(
-        err.contains(&format!("deck.toml:{}: grid holds ", line_of(&text, "[grid]")))
-            && err.contains("the factor of the direct solve alone")
+        err.contains(&format!(
+            "deck.toml:{}: grid holds ",
+            line_of(&text, "[grid]")
+        )) && err.contains("the factor of the direct solve alone")
             && err.contains("this machine has 4.1 GB"),
         "{err}"
     );

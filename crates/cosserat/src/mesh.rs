@@ -124,10 +124,8 @@ fn crossed_with(
     let centre0 = nodes.len();
     for j in 0..ny {
         for i in 0..nx {
-            let mut p = Point::<2>::new(
-                lo[0] + (i as f64 + 0.5) * dx,
-                lo[1] + (j as f64 + 0.5) * dy,
-            );
+            let mut p =
+                Point::<2>::new(lo[0] + (i as f64 + 0.5) * dx, lo[1] + (j as f64 + 0.5) * dy);
             place(&mut p, true);
             nodes.push(p);
         }
@@ -317,7 +315,11 @@ mod tests {
                     assert!(v >= 0.4 * 0.4 * v0, "seed {seed} cell {c}: {v} vs {v0}");
                     total += v;
                 }
-                assert!((total - w * h).abs() <= 1e-12 * w * h, "{total} vs {}", w * h);
+                assert!(
+                    (total - w * h).abs() <= 1e-12 * w * h,
+                    "{total} vs {}",
+                    w * h
+                );
                 for (p, q) in base.nodes().iter().zip(g.nodes()) {
                     let on_side = [0, 1].iter().any(|&k| p[k] == lo[k] || p[k] == hi[k]);
                     let moved = (q - p).norm();

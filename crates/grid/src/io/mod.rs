@@ -400,9 +400,11 @@ fn overlapping_cell<const D: usize>(grid: &Grid<D>) -> Option<(usize, i64)> {
     if sides.is_empty() {
         return None;
     }
-    let (lo, hi) = sides.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), s| {
-        (lo.min(s.0[1]).min(s.1[1]), hi.max(s.0[1]).max(s.1[1]))
-    });
+    let (lo, hi) = sides
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), s| {
+            (lo.min(s.0[1]).min(s.1[1]), hi.max(s.0[1]).max(s.1[1]))
+        });
     let strips = (sides.len() as f64).sqrt().ceil().max(1.0) as usize;
     let height = (hi - lo).max(f64::MIN_POSITIVE);
     let strip_of = |y: f64| (((y - lo) / height * strips as f64) as usize).min(strips - 1);
@@ -548,7 +550,11 @@ mod tests {
     /// Write an ASCII `.vtu` of triangles and quadrilaterals (by their node count).
     fn vtu(dir: &Path, name: &str, pts: &[[f64; 2]], cells: &[&[usize]]) -> std::path::PathBuf {
         let p: Vec<String> = pts.iter().map(|q| format!("{} {} 0", q[0], q[1])).collect();
-        let conn: Vec<String> = cells.iter().flat_map(|c| c.iter()).map(|n| n.to_string()).collect();
+        let conn: Vec<String> = cells
+            .iter()
+            .flat_map(|c| c.iter())
+            .map(|n| n.to_string())
+            .collect();
         let mut off = 0;
         let offsets: Vec<String> = cells
             .iter()
@@ -557,7 +563,10 @@ mod tests {
                 off.to_string()
             })
             .collect();
-        let types: Vec<&str> = cells.iter().map(|c| if c.len() == 3 { "5" } else { "9" }).collect();
+        let types: Vec<&str> = cells
+            .iter()
+            .map(|c| if c.len() == 3 { "5" } else { "9" })
+            .collect();
         let text = format!(
             "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" \
              byte_order=\"LittleEndian\">\n<UnstructuredGrid><Piece NumberOfPoints=\"{}\" \
@@ -650,10 +659,15 @@ mod tests {
 
     #[test]
     fn ordinals() {
-        let v: Vec<String> = [1, 2, 3, 4, 11, 12, 13, 21, 22, 101, 111].map(ordinal).to_vec();
+        let v: Vec<String> = [1, 2, 3, 4, 11, 12, 13, 21, 22, 101, 111]
+            .map(ordinal)
+            .to_vec();
         assert_eq!(
             v,
-            ["1st", "2nd", "3rd", "4th", "11th", "12th", "13th", "21st", "22nd", "101st", "111th"]
+            [
+                "1st", "2nd", "3rd", "4th", "11th", "12th", "13th", "21st", "22nd", "101st",
+                "111th"
+            ]
         );
     }
 

@@ -19,12 +19,12 @@
 //!     [`FACTOR_ENTRIES_PER_N43`] `c` = 45 and [`BYTES_PER_FACTOR_ENTRY`] `e` = 10
 //!     (measured on the same decks with flow and the monolithic coupling, LDLᵀ of
 //!     mechanics and pressure: 20³, n = 30 558, 31.7 M entries, peak 434 MB; 40³,
-//!     n = 237 518, 609 M entries, peak 6.17 GB; the estimates are 452 MB and
-//!     6.8 GB). A 3D run factors when the flow is coupled to the mechanics (every
+//!     n = 237 518, 609 M entries, peak 6.17 GB; the estimates are 494 MB and
+//!     7.1 GB). A 3D run factors when the flow is coupled to the mechanics (every
 //!     coupling counts: a conservative choice), or when the mechanics uses the sparse
 //!     Cholesky (`linear = "cholesky"`, or `"auto"` below
 //!     [`porofrac_sim::linear::AUTO_MIN_EQUATIONS_3D`] equations). The faulted 100³
-//!     deck with coupled flow (0.9 M cells, 3.9 M unknowns) needs about 280 GB this
+//!     deck with coupled flow (0.9 M cells, 3.9 M unknowns) needs about 290 GB this
 //!     way, and mechanics alone with CG-AMG about 6.7 GB: both are refused under a
 //!     4 GB address-space limit before anything big is allocated.
 //! - **Memory of the machine**: the smaller of the physical memory (`MemTotal` of
@@ -122,7 +122,10 @@ pub fn run_bytes_of(dim: usize, cells: f64, unknowns: f64, direct: bool) -> (f64
     } else {
         0.0
     };
-    (BYTES_PER_ITEM_3D as f64 * (cells + unknowns) + factor, factor)
+    (
+        BYTES_PER_ITEM_3D as f64 * (cells + unknowns) + factor,
+        factor,
+    )
 }
 
 /// What needs the memory, for the error of [`fits_in_memory`]: the counts.
@@ -170,7 +173,10 @@ mod tests {
         ];
         for (cells, unknowns, direct, peak) in cases {
             let (b, factor) = run_bytes_of(3, cells, unknowns, direct);
-            assert!(b >= peak && b <= 1.25 * peak, "{cells} {unknowns}: {b} vs {peak}");
+            assert!(
+                b >= peak && b <= 1.25 * peak,
+                "{cells} {unknowns}: {b} vs {peak}"
+            );
             assert_eq!(factor > 0.0, direct);
         }
         assert_eq!(run_bytes_of(2, 1e6, 2e6, true), (run_bytes(1e6, 2e6), 0.0));
@@ -180,6 +186,11 @@ mod tests {
         assert!((f8 / f1 - 16.0).abs() < 1e-9);
         assert_eq!(factor_note(0.0), "");
         let t = factor_note(2.8e11);
-        assert!(t.contains("direct solve alone, which grows as unknowns^(4/3) in 3D, needs about 280.0 GB"), "{t}");
+        assert!(
+            t.contains(
+                "direct solve alone, which grows as unknowns^(4/3) in 3D, needs about 280.0 GB"
+            ),
+            "{t}"
+        );
     }
 }

@@ -623,7 +623,9 @@ fn check_wells(ls: &LoadedScene, d: usize) -> Result<(), SceneError> {
 /// Bound steps, output series and generated grids before anything is allocated
 /// ([`crate::common::limits`]).
 fn check_sizes(ls: &LoadedScene, d: usize) -> Result<(), SceneError> {
-    use crate::common::limits::{MAX_CELLS, MAX_STEPS, factor_note, fits_in_memory, run_bytes_of, run_text};
+    use crate::common::limits::{
+        MAX_CELLS, MAX_STEPS, factor_note, fits_in_memory, run_bytes_of, run_text,
+    };
     let s = &ls.scene;
     if let Some(sch) = &s.schedule {
         let n = step_count_f64(sch);

@@ -82,12 +82,8 @@ fn run_dim<const D: usize>(
     let flow_on = ls.scene.physics.flow == Some(true);
     let unknowns = (D * grid.num_nodes() + if flow_on { grid.num_cells() } else { 0 }) as f64;
     let cells = grid.num_cells() as f64;
-    let (bytes, factor) = crate::common::limits::run_bytes_of(
-        D,
-        cells,
-        unknowns,
-        check::factors(ls, D, unknowns),
-    );
+    let (bytes, factor) =
+        crate::common::limits::run_bytes_of(D, cells, unknowns, check::factors(ls, D, unknowns));
     crate::common::limits::fits_in_memory(
         bytes,
         &format!("holds {}", crate::common::limits::run_text(cells, unknowns)),

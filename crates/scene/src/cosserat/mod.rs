@@ -114,7 +114,12 @@ fn load_not_finite<const D: usize>(
         values.extend(f.iter().enumerate().map(|(a, v)| ("body_force", a, v)));
     }
     if let Some(c) = &l.body_couple {
-        values.extend(c.values().into_iter().enumerate().map(|(a, v)| ("body_couple", a, v)));
+        values.extend(
+            c.values()
+                .into_iter()
+                .enumerate()
+                .map(|(a, v)| ("body_couple", a, v)),
+        );
     }
     let cells = grid.num_cells().max(1);
     let stride = (cells * times.len() * values.len().max(1) / 10_000_000).max(1);
