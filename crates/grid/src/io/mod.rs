@@ -298,7 +298,7 @@ impl<const D: usize> RawMesh<D> {
                     cell: c,
                     what: format!(
                         "overlaps other cells: next to its boundary side the mesh covers the \
-                         plane {times} times, not once ({}, the {} cell of the file); the \
+                         plane {times} times, not once ({}), the {} cell of the file; the \
                          connectivity folds the mesh over itself",
                         self.describe(c),
                         ordinal(c + 1)
@@ -318,8 +318,8 @@ impl<const D: usize> RawMesh<D> {
                         return Err(in_file(GridError::Cell {
                             cell: c,
                             what: format!(
-                                "inverted element: signed volume {vol:e} < 0 ({}, the {} cell of \
-                                 the file); elements are not reoriented, fix the node order in \
+                                "inverted element: signed volume {vol:e} < 0 ({}), the {} cell \
+                                 of the file; elements are not reoriented, fix the node order in \
                                  the mesh",
                                 self.describe(c),
                                 ordinal(c + 1)
