@@ -2,6 +2,8 @@
 //!
 //! * [`crossed`]: each square of an `nx × ny` lattice cut into 4 triangles by its centre
 //!   (the "crossed" meshes of the seed's verification plan §4 E1 and E3).
+//! * [`crossed_perturbed`]: the same mesh with its interior nodes jittered by a bounded,
+//!   seeded amount that keeps every triangle valid (the bound is derived there).
 //! * [`plate_with_hole`]: the quarter plate `[0, L]²` minus the disc of radius `r` at the
 //!   origin (E2), an O-grid graded towards the hole, each quad cut by its shorter diagonal.
 //! * [`locate`]: the simplex containing a point.
@@ -14,6 +16,93 @@ use crate::error::Result;
 ///
 /// Errors: a zero count or an empty box (from the grid builder, or named here).
 pub fn crossed(lo: Point<2>, hi: Point<2>, n: [usize; 2]) -> Result<Grid<2>> {
+    crossed_with(lo, hi, n, |_, _| {})
+}
+
+/// Largest jitter amplitude of [`crossed_perturbed`] (the documented maximum of the
+/// scene key `perturb`, the same as the grid crate's).
+pub const MAX_PERTURB: f64 = porofrac_grid::generate::MAX_PERTURB;
+
+/// A crossed mesh ([`crossed`]) whose interior nodes (corners not on the box boundary,
+/// and every square centre) move by `amplitude · m · ξ`, with `ξ` uniform in the unit disc
+/// (a SplitMix64 stream seeded with `seed`, node by node in node order) and
+/// `m = min(dx/2, dy/2, dx·dy/√(dx²+dy²))` the smallest altitude of the mesh's triangles.
+///
+/// Why every triangle stays valid for `amplitude < 1/2`: a triangle degenerates only when
+/// a vertex reaches the line of the opposite side. Each point of that side is a convex
+/// combination of its two ends, so it moves by at most `amplitude · m`, and the vertex by
+/// at most `amplitude · m` too: the distance, initially the altitude `h ≥ m`, stays at
+/// least `h − 2 · amplitude · m ≥ (1 − 2 · amplitude) h > 0` along the whole straight
+/// motion, so the orientation never flips. At the maximum 0.3 every altitude keeps at
+/// least 40 % of its length, whatever the aspect ratio of the squares (the grid crate's
+/// bound, a fraction of the shortest incident edge, is not enough for crossed triangles
+/// of elongated squares, whose apex lies only `dy/2` from the base).
+///
+/// Errors: those of [`crossed`], and `amplitude` outside `[0, MAX_PERTURB]`.
+pub fn crossed_perturbed(
+    lo: Point<2>,
+    hi: Point<2>,
+    n: [usize; 2],
+    amplitude: f64,
+    seed: u64,
+) -> Result<Grid<2>> {
+    if !(0.0..=MAX_PERTURB).contains(&amplitude) {
+        return Err(GridError::Input(format!(
+            "perturbation amplitude must be in [0, {MAX_PERTURB}] (fraction of the smallest \
+             altitude of the triangles), got {amplitude}"
+        ))
+        .into());
+    }
+    if n[0] == 0 || n[1] == 0 {
+        return crossed(lo, hi, n);
+    }
+    let dx = (hi[0] - lo[0]) / n[0] as f64;
+    let dy = (hi[1] - lo[1]) / n[1] as f64;
+    let m = (0.5 * dx).min(0.5 * dy).min(dx * dy / dx.hypot(dy));
+    let mut rng = SplitMix64(seed);
+    crossed_with(lo, hi, n, |p, interior| {
+        if interior {
+            let xi = rng.unit_disc();
+            *p += xi * (amplitude * m);
+        }
+    })
+}
+
+/// The SplitMix64 generator (Steele, Lea, Flood 2014): a 64-bit state stepped by a
+/// constant and mixed; enough for a reproducible jitter.
+struct SplitMix64(u64);
+
+impl SplitMix64 {
+    fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    /// Uniform in `[0, 1)` (53 bits).
+    fn unit(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+    /// Uniform in the unit disc, by rejection.
+    fn unit_disc(&mut self) -> Point<2> {
+        loop {
+            let p = Point::<2>::new(2.0 * self.unit() - 1.0, 2.0 * self.unit() - 1.0);
+            if p.norm_squared() <= 1.0 {
+                return p;
+            }
+        }
+    }
+}
+
+/// [`crossed`] with `place(node, interior)` called on every node in node order before the
+/// cells are built (`interior`: not on the box boundary).
+fn crossed_with(
+    lo: Point<2>,
+    hi: Point<2>,
+    n: [usize; 2],
+    mut place: impl FnMut(&mut Point<2>, bool),
+) -> Result<Grid<2>> {
     if n[0] == 0 || n[1] == 0 || !(hi[0] > lo[0] && hi[1] > lo[1]) {
         return Err(GridError::Input(format!(
             "crossed mesh: need n > 0 and hi > lo, got n = {n:?}, lo = {lo:?}, hi = {hi:?}"
@@ -26,20 +115,19 @@ pub fn crossed(lo: Point<2>, hi: Point<2>, n: [usize; 2]) -> Result<Grid<2>> {
     let mut nodes = Vec::with_capacity((nx + 1) * (ny + 1) + nx * ny);
     for j in 0..=ny {
         for i in 0..=nx {
-            nodes.push(Point::<2>::new(
-                lo[0] + i as f64 * dx,
-                lo[1] + j as f64 * dy,
-            ));
+            let mut p = Point::<2>::new(lo[0] + i as f64 * dx, lo[1] + j as f64 * dy);
+            place(&mut p, i > 0 && i < nx && j > 0 && j < ny);
+            nodes.push(p);
         }
     }
     let corner = |i: usize, j: usize| j * (nx + 1) + i;
     let centre0 = nodes.len();
     for j in 0..ny {
         for i in 0..nx {
-            nodes.push(Point::<2>::new(
-                lo[0] + (i as f64 + 0.5) * dx,
-                lo[1] + (j as f64 + 0.5) * dy,
-            ));
+            let mut p =
+                Point::<2>::new(lo[0] + (i as f64 + 0.5) * dx, lo[1] + (j as f64 + 0.5) * dy);
+            place(&mut p, true);
+            nodes.push(p);
         }
     }
     let mut loops = CellFaceLoops::new();
@@ -200,6 +288,54 @@ pub fn locate<const D: usize>(grid: &Grid<D>, x: &Point<D>) -> Option<usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// At the maximum amplitude, for squares of aspect ratio 1:8 to 8:1 and 300 seeds,
+    /// every triangle keeps an area of at least 0.4² of its own (a side `b ≥ m` and its
+    /// altitude `h ≥ m` each shrink by at most 2·a·m, so keep 40 %), no node moves more than
+    /// a·m, boundary nodes stay, and the total area is the box's.
+    #[test]
+    fn perturbed_crossed_meshes_stay_valid_at_the_maximum() {
+        let a = MAX_PERTURB;
+        for (w, h, n) in [
+            (1.0, 1.0, [4, 4]),
+            (8.0, 1.0, [4, 4]),
+            (1.0, 8.0, [4, 4]),
+            (2000.0, 1000.0, [10, 50]),
+            (1e-3, 1e-3, [10, 50]),
+        ] {
+            let (lo, hi) = (Point::<2>::new(-0.5 * w, 0.0), Point::<2>::new(0.5 * w, h));
+            let base = crossed(lo, hi, n).unwrap();
+            let (dx, dy) = (w / n[0] as f64, h / n[1] as f64);
+            let m = (0.5 * dx).min(0.5 * dy).min(dx * dy / dx.hypot(dy));
+            for seed in 0..300 {
+                let g = crossed_perturbed(lo, hi, n, a, seed).unwrap();
+                let mut total = 0.0;
+                for c in 0..g.num_cells() {
+                    let (v0, v) = (base.cell_volume(c), g.cell_volume(c));
+                    assert!(v >= 0.4 * 0.4 * v0, "seed {seed} cell {c}: {v} vs {v0}");
+                    total += v;
+                }
+                assert!(
+                    (total - w * h).abs() <= 1e-12 * w * h,
+                    "{total} vs {}",
+                    w * h
+                );
+                for (p, q) in base.nodes().iter().zip(g.nodes()) {
+                    let on_side = [0, 1].iter().any(|&k| p[k] == lo[k] || p[k] == hi[k]);
+                    let moved = (q - p).norm();
+                    assert!(moved <= a * m * (1.0 + 1e-12), "{moved} > {}", a * m);
+                    assert!(!on_side || moved == 0.0);
+                }
+            }
+        }
+        // Reproducible, and refused above the maximum.
+        let (lo, hi) = (Point::<2>::new(0.0, 0.0), Point::<2>::new(1.0, 1.0));
+        let g1 = crossed_perturbed(lo, hi, [3, 3], 0.2, 7).unwrap();
+        let g2 = crossed_perturbed(lo, hi, [3, 3], 0.2, 7).unwrap();
+        assert_eq!(g1.nodes(), g2.nodes());
+        assert!(crossed_perturbed(lo, hi, [3, 3], 0.31, 7).is_err());
+        assert!(crossed_perturbed(lo, hi, [3, 3], f64::NAN, 7).is_err());
+    }
 
     #[test]
     fn crossed_mesh_counts_and_area() {

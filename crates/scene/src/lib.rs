@@ -115,15 +115,27 @@ impl Scene {
 
     /// Run the scene and write its outputs into `out`.
     ///
-    /// A run that fails still writes `summary.json` with the error as its `status`; an
-    /// interrupted run ([`Observer::stop_requested`]) ends after the current step with
+    /// A run that fails still writes `summary.json` with `"status": "failed: <error>"`;
+    /// an interrupted run ([`Observer::stop_requested`]) ends after the current step with
     /// complete files and `"status": "interrupted at t = …"` ([`Summary::interrupted`]).
+    /// The run locks `out` while it writes (a second run into it is refused) and first
+    /// removes what an earlier run wrote there under porofrac's names
+    /// ([`output::OutputLock`], [`output::remove_earlier_outputs`]).
     pub fn run(&self, out: &Path, observer: &mut dyn Observer) -> Result<Summary, RunError> {
         let start = std::time::Instant::now();
+        let lock = output::OutputLock::acquire(out)?;
+        if let Some(pid) = lock.taken_over() {
+            eprintln!(
+                "note: {}: took over the lock of process {pid}, which no longer runs",
+                out.join(output::LOCK_FILE).display()
+            );
+        }
+        output::remove_earlier_outputs(out, self.name())?;
         let result = common::model::run(&self.loaded, &self.laws, out, observer);
         if let Err(e) = &result {
             output::write_failed_summary(&self.loaded, out, &e.to_string(), start);
         }
+        drop(lock);
         result
     }
 }

@@ -293,7 +293,19 @@ impl<const D: usize> RawMesh<D> {
             *n = node_map[*n];
         }
         match Grid::from_cell_faces(kept, &self.loops) {
-            Ok(grid) => Ok(Built { grid, node_map }),
+            Ok(grid) => match overlapping_cell(&grid) {
+                Some((c, times)) => Err(in_file(GridError::Cell {
+                    cell: c,
+                    what: format!(
+                        "overlaps other cells: next to its boundary side the mesh covers the \
+                         plane {times} times, not once ({}), the {} cell of the file; the \
+                         connectivity folds the mesh over itself",
+                        self.describe(c),
+                        ordinal(c + 1)
+                    ),
+                })),
+                None => Ok(Built { grid, node_map }),
+            },
             Err(e) => {
                 // Prefer the precise diagnosis of an inverted standard element.
                 let nodes: Vec<Point<D>> = compact_nodes(&self.nodes, &node_map, labels.len());
@@ -306,9 +318,11 @@ impl<const D: usize> RawMesh<D> {
                         return Err(in_file(GridError::Cell {
                             cell: c,
                             what: format!(
-                                "inverted element: signed volume {vol:e} < 0 ({}); elements are \
-                                 not reoriented, fix the node order in the mesh",
-                                self.describe(c)
+                                "inverted element: signed volume {vol:e} < 0 ({}), the {} cell \
+                                 of the file; elements are not reoriented, fix the node order in \
+                                 the mesh",
+                                self.describe(c),
+                                ordinal(c + 1)
                             ),
                         }));
                     }
@@ -337,6 +351,99 @@ impl<const D: usize> RawMesh<D> {
         let o = self.origin[c];
         format!("{} {}{}", self.what_cell, o.tag, at_line(o.line))
     }
+}
+
+/// `1st`, `2nd`, `3rd`, `4th`, … (`11th`, `12th`, `13th`).
+fn ordinal(n: usize) -> String {
+    let suffix = match (n % 10, n % 100) {
+        (_, 11..=13) => "th",
+        (1, _) => "st",
+        (2, _) => "nd",
+        (3, _) => "rd",
+        _ => "th",
+    };
+    format!("{n}{suffix}")
+}
+
+/// In 2D, a cell of a mesh that overlaps itself, and how many times the plane is covered
+/// next to one of its boundary sides; `None` in 3D or when the cells do not overlap.
+///
+/// Every cell is positively oriented and every interior side is shared by two cells that
+/// traverse it in opposite directions (the grid checks both), so the number of cells
+/// covering a point equals the winding number about it of the boundary sides, each
+/// traversed as its cell traverses it. Crossing a boundary side inwards raises that number
+/// by one; where cells overlap it is 2 or more, and such a region is bounded by boundary
+/// sides. So the mesh overlaps itself if and only if, just inside some boundary side (at
+/// its midpoint moved into its cell by a thousandth of its length), the winding number
+/// is not 1. The winding number is counted along a ray in +x through the boundary sides
+/// that share its horizontal strip (`√B` strips for `B` boundary sides). The cell
+/// reported is the first (lowest index) whose boundary side fails.
+fn overlapping_cell<const D: usize>(grid: &Grid<D>) -> Option<(usize, i64)> {
+    if D != 2 {
+        return None;
+    }
+    // Boundary sides, each with its cell on the left.
+    let mut sides: Vec<([f64; 2], [f64; 2], usize)> = Vec::new();
+    for f in 0..grid.num_faces() {
+        if !grid.is_boundary_face(f) {
+            continue;
+        }
+        let l = grid.face_nodes(f);
+        let (c, _) = grid.face_cells(f);
+        // The normal points out of the cell: the cell is on the left of a → b when the
+        // normal is on the right, (dy, −dx).
+        let (a, b, n) = (grid.node(l[0]), grid.node(l[1]), grid.face_normal(f));
+        let right = n[0] * (b[1] - a[1]) - n[1] * (b[0] - a[0]);
+        let (a, b) = ([a[0], a[1]], [b[0], b[1]]);
+        sides.push(if right >= 0.0 { (a, b, c) } else { (b, a, c) });
+    }
+    if sides.is_empty() {
+        return None;
+    }
+    let (lo, hi) = sides
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), s| {
+            (lo.min(s.0[1]).min(s.1[1]), hi.max(s.0[1]).max(s.1[1]))
+        });
+    let strips = (sides.len() as f64).sqrt().ceil().max(1.0) as usize;
+    let height = (hi - lo).max(f64::MIN_POSITIVE);
+    let strip_of = |y: f64| (((y - lo) / height * strips as f64) as usize).min(strips - 1);
+    let mut in_strip: Vec<Vec<u32>> = vec![Vec::new(); strips];
+    for (i, s) in sides.iter().enumerate() {
+        let (y0, y1) = (s.0[1].min(s.1[1]), s.0[1].max(s.1[1]));
+        for strip in &mut in_strip[strip_of(y0)..=strip_of(y1)] {
+            strip.push(i as u32);
+        }
+    }
+    let winding = |q: [f64; 2]| -> i64 {
+        let mut w = 0;
+        for &i in &in_strip[strip_of(q[1])] {
+            let (a, b, _) = sides[i as usize];
+            let up = a[1] <= q[1] && q[1] < b[1];
+            let down = b[1] <= q[1] && q[1] < a[1];
+            if up || down {
+                let x = a[0] + (q[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]);
+                if x > q[0] {
+                    w += if up { 1 } else { -1 };
+                }
+            }
+        }
+        w
+    };
+    let mut worst: Option<(usize, i64)> = None;
+    for &(a, b, c) in &sides {
+        if worst.is_some_and(|(w, _)| w <= c) {
+            continue;
+        }
+        // A thousandth of the side's length to its left, into its cell.
+        let m = [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])];
+        let q = [m[0] - 1e-3 * (b[1] - a[1]), m[1] + 1e-3 * (b[0] - a[0])];
+        let w = winding(q);
+        if w != 1 {
+            worst = Some((c, w));
+        }
+    }
+    worst
 }
 
 /// `", line N"`, or nothing for line 0 (binary data has no lines).
@@ -389,10 +496,193 @@ fn signed_volume<const D: usize>(
     (vol, (hi - lo).amax())
 }
 
-/// Read a whole file, mapping failures to [`GridError::Io`] with the path.
+/// Largest mesh file read (bytes).
+pub const MAX_MESH_FILE_BYTES: u64 = 8 << 30;
+
+/// Read a whole mesh file, mapping failures to [`GridError::Io`] with the path. Only a
+/// regular file is read (not a directory, a device such as `/dev/zero` or a pipe), of at
+/// most [`MAX_MESH_FILE_BYTES`] bytes: no more than that plus one byte is ever read, and
+/// a buffer that cannot be allocated is an error, not an abort.
 pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>> {
-    fs::read(path).map_err(|source| GridError::Io {
+    use std::io::Read as _;
+    let io = |source| GridError::Io {
         path: path.to_path_buf(),
         source,
-    })
+    };
+    let refuse = |what: String| io(std::io::Error::new(std::io::ErrorKind::InvalidInput, what));
+    let meta = fs::metadata(path).map_err(io)?;
+    if !meta.is_file() {
+        return Err(refuse(
+            "not a regular file (a directory, device or pipe); a mesh must be one".into(),
+        ));
+    }
+    let too_big = |n: u64| {
+        refuse(format!(
+            "the file has {n} bytes or more, more than the {MAX_MESH_FILE_BYTES} a mesh file \
+             may have"
+        ))
+    };
+    if meta.len() > MAX_MESH_FILE_BYTES {
+        return Err(too_big(meta.len()));
+    }
+    let mut bytes = Vec::new();
+    bytes.try_reserve_exact(meta.len() as usize).map_err(|_| {
+        refuse(format!(
+            "cannot allocate {} bytes to read the file: not enough memory",
+            meta.len()
+        ))
+    })?;
+    fs::File::open(path)
+        .map_err(io)?
+        .take(MAX_MESH_FILE_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(io)?;
+    if bytes.len() as u64 > MAX_MESH_FILE_BYTES {
+        return Err(too_big(bytes.len() as u64));
+    }
+    Ok(bytes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Write an ASCII `.vtu` of triangles and quadrilaterals (by their node count).
+    fn vtu(dir: &Path, name: &str, pts: &[[f64; 2]], cells: &[&[usize]]) -> std::path::PathBuf {
+        let p: Vec<String> = pts.iter().map(|q| format!("{} {} 0", q[0], q[1])).collect();
+        let conn: Vec<String> = cells
+            .iter()
+            .flat_map(|c| c.iter())
+            .map(|n| n.to_string())
+            .collect();
+        let mut off = 0;
+        let offsets: Vec<String> = cells
+            .iter()
+            .map(|c| {
+                off += c.len();
+                off.to_string()
+            })
+            .collect();
+        let types: Vec<&str> = cells
+            .iter()
+            .map(|c| if c.len() == 3 { "5" } else { "9" })
+            .collect();
+        let text = format!(
+            "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" \
+             byte_order=\"LittleEndian\">\n<UnstructuredGrid><Piece NumberOfPoints=\"{}\" \
+             NumberOfCells=\"{}\">\n<Points><DataArray type=\"Float64\" \
+             NumberOfComponents=\"3\" format=\"ascii\">{}</DataArray></Points>\n<Cells>\
+             <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">{}</DataArray>\n\
+             <DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">{}</DataArray>\n\
+             <DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">{}</DataArray></Cells>\n\
+             </Piece></UnstructuredGrid></VTKFile>\n",
+            pts.len(),
+            cells.len(),
+            p.join(" "),
+            conn.join(" "),
+            offsets.join(" "),
+            types.join(" ")
+        );
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        path
+    }
+
+    fn dir(name: &str) -> std::path::PathBuf {
+        let d = std::env::temp_dir().join(format!("porofrac_io_{name}_{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    /// Overlapping cells whose orientations are all consistent are refused naming the
+    /// first cell next to the overlap (1-based in the message) and the covering count;
+    /// valid meshes, with a hole too, pass; an inverted cell is named 1-based.
+    #[test]
+    fn overlapping_and_inverted_cells_are_refused() {
+        let d = dir("overlap");
+        let sq = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+        // A triangle lying inside the square, with its own nodes (its base on y = 0.2).
+        let mut pts = sq.to_vec();
+        pts.extend([[0.2, 0.2], [0.6, 0.2], [0.2, 0.6]]);
+        let p = vtu(&d, "over.vtu", &pts, &[&[0, 1, 2], &[0, 2, 3], &[4, 5, 6]]);
+        let e = read_vtu::<2>(&p).unwrap_err().to_string();
+        assert!(
+            e.contains("cell 2: overlaps other cells")
+                && e.contains("covers the plane 2 times")
+                && e.contains("the 3rd cell of the file"),
+            "{e}"
+        );
+        // The same triangle listed first: it is the first bad cell.
+        let p = vtu(&d, "over2.vtu", &pts, &[&[4, 5, 6], &[0, 1, 2], &[0, 2, 3]]);
+        let e = read_vtu::<2>(&p).unwrap_err().to_string();
+        assert!(
+            e.contains("cell 0: overlaps other cells") && e.contains("the 1st cell"),
+            "{e}"
+        );
+        // Two squares overlapping in a corner, on nodes of their own: the first one's
+        // right side runs inside the second.
+        let mut pts = sq.to_vec();
+        pts.extend(sq.map(|[x, y]| [x + 0.3, y + 0.4]));
+        let p = vtu(&d, "two.vtu", &pts, &[&[0, 1, 2, 3], &[4, 5, 6, 7]]);
+        let e = read_vtu::<2>(&p).unwrap_err().to_string();
+        assert!(
+            e.contains("cell 0: overlaps") && e.contains("covers the plane 2 times"),
+            "{e}"
+        );
+        // Valid: the square in two triangles; a 3 × 3 block of squares without its centre.
+        let p = vtu(&d, "ok.vtu", &sq, &[&[0, 1, 2], &[0, 2, 3]]);
+        let g = read_vtu::<2>(&p).unwrap();
+        assert!((g.cell_volumes().iter().sum::<f64>() - 1.0).abs() < 1e-15);
+        let pts: Vec<[f64; 2]> = (0..16).map(|k| [(k % 4) as f64, (k / 4) as f64]).collect();
+        let quads: Vec<[usize; 4]> = (0..9)
+            .filter(|&k| k != 4)
+            .map(|k| {
+                let (i, j) = (k % 3, k / 3);
+                let n = j * 4 + i;
+                [n, n + 1, n + 5, n + 4]
+            })
+            .collect();
+        let refs: Vec<&[usize]> = quads.iter().map(|q| &q[..]).collect();
+        let p = vtu(&d, "hole.vtu", &pts, &refs);
+        let g = read_vtu::<2>(&p).unwrap();
+        assert!((g.cell_volumes().iter().sum::<f64>() - 8.0).abs() < 1e-12);
+        // Inverted: the second cell, named 1-based too.
+        let p = vtu(&d, "inv.vtu", &sq, &[&[0, 1, 2], &[0, 3, 2]]);
+        let e = read_vtu::<2>(&p).unwrap_err().to_string();
+        assert!(
+            e.contains("inverted element") && e.contains("the 2nd cell of the file"),
+            "{e}"
+        );
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn ordinals() {
+        let v: Vec<String> = [1, 2, 3, 4, 11, 12, 13, 21, 22, 101, 111]
+            .map(ordinal)
+            .to_vec();
+        assert_eq!(
+            v,
+            [
+                "1st", "2nd", "3rd", "4th", "11th", "12th", "13th", "21st", "22nd", "101st",
+                "111th"
+            ]
+        );
+    }
+
+    /// Devices and folders are not read; a regular file is read whole.
+    #[test]
+    fn only_regular_files_are_read() {
+        for p in ["/dev/zero", "/"] {
+            if Path::new(p).exists() {
+                let e = read_file(Path::new(p)).unwrap_err().to_string();
+                assert!(e.contains("not a regular file"), "{e}");
+            }
+        }
+        let d = dir("read");
+        std::fs::write(d.join("a.msh"), b"abc").unwrap();
+        assert_eq!(read_file(&d.join("a.msh")).unwrap(), b"abc");
+        std::fs::remove_dir_all(&d).unwrap();
+    }
 }

@@ -3,11 +3,30 @@
 //! - **Steps**: at most [`MAX_STEPS`] output times, and the in-memory series of the
 //!   written steps (probe columns, line points) must fit in memory.
 //! - **Cells and unknowns**: the grid a scene asks for is counted from its keys before
-//!   it is generated (after reading, for mesh files) and refused when the run would need
-//!   more memory than the machine has. The estimate is
-//!   `BYTES_PER_ITEM · (cells + unknowns)` with [`BYTES_PER_ITEM`] = 600, which is above
-//!   the measured peaks of the standard problems (E2 n = 1000: 2.0 M cells, 2.0 M
-//!   unknowns, 1.5 GB; E3 n = 40: 0.38 M cells, 0.21 M unknowns, 0.35 GB).
+//!   it is generated (after reading, for mesh files and decks) and refused when the run
+//!   would need more memory than the machine has ([`run_bytes_of`]). The estimate is
+//!   `b · (cells + unknowns)` plus, for a 3D run that factors its matrix, the factor:
+//!   - `b` = [`BYTES_PER_ITEM`] = 600 in 2D, above the measured peaks of the standard
+//!     problems (E2 n = 1000: 2.0 M cells, 2.0 M unknowns, 1.5 GB; E3 n = 40: 0.38 M
+//!     cells, 0.21 M unknowns, 0.35 GB);
+//!   - `b` = [`BYTES_PER_ITEM_3D`] = 1700 in 3D: hexahedra couple every node to 27
+//!     others (81 entries per matrix row, against 18 for 2D triangles), and the
+//!     multigrid keeps the matrix with both triangles and its coarse levels (measured:
+//!     the faulted 40³ deck of `porofrac-grid/examples/grdecl_speed.rs`, mechanics
+//!     only, CG-AMG: 57 600 cells, 179 918 unknowns, peak 369 MB = 1.55 kB per item);
+//!   - the factor of a direct solve in 3D: nested dissection gives about
+//!     `c · n^{4/3}` entries for `n` unknowns, at `e` bytes each at the peak, with
+//!     [`FACTOR_ENTRIES_PER_N43`] `c` = 45 and [`BYTES_PER_FACTOR_ENTRY`] `e` = 10
+//!     (measured on the same decks with flow and the monolithic coupling, LDLᵀ of
+//!     mechanics and pressure: 20³, n = 30 558, 31.7 M entries, peak 434 MB; 40³,
+//!     n = 237 518, 609 M entries, peak 6.17 GB; the estimates are 494 MB and
+//!     7.1 GB). A 3D run factors when the flow is coupled to the mechanics (every
+//!     coupling counts: a conservative choice), or when the mechanics uses the sparse
+//!     Cholesky (`linear = "cholesky"`, or `"auto"` below
+//!     [`porofrac_sim::linear::AUTO_MIN_EQUATIONS_3D`] equations). The faulted 100³
+//!     deck with coupled flow (0.9 M cells, 3.9 M unknowns) needs about 290 GB this
+//!     way, and mechanics alone with CG-AMG about 6.7 GB: both are refused under a
+//!     4 GB address-space limit before anything big is allocated.
 //! - **Memory of the machine**: the smaller of the physical memory (`MemTotal` of
 //!   `/proc/meminfo`) and the address-space limit of the process (`ulimit -v`, from
 //!   `/proc/self/limits`); where neither can be read, no memory bound applies.
@@ -30,8 +49,20 @@ pub const MAX_LINE_POINTS: u64 = 1_000_000;
 /// `porofrac-grid/examples/grdecl_speed.rs`), the run about as much again.
 pub const BYTES_PER_DECK_CELL: u64 = 3000;
 
-/// Estimated peak memory per cell and per unknown of a run (bytes).
+/// Estimated peak memory per cell and per unknown of a 2D run (bytes).
 pub const BYTES_PER_ITEM: u64 = 600;
+
+/// Estimated peak memory per cell and per unknown of a 3D run, the factor of a direct
+/// solve apart (bytes; see the module docs).
+pub const BYTES_PER_ITEM_3D: u64 = 1700;
+
+/// Entries of the factor of a 3D direct solve per `n^{4/3}` (`n` unknowns, nested
+/// dissection; see the module docs).
+pub const FACTOR_ENTRIES_PER_N43: f64 = 45.0;
+
+/// Peak bytes per entry of the factor of a direct solve (value, index, the workspace of
+/// the factorization).
+pub const BYTES_PER_FACTOR_ENTRY: f64 = 10.0;
 
 /// Memory a run may use (bytes), if it can be known.
 pub fn machine_memory() -> Option<u64> {
@@ -75,9 +106,45 @@ pub fn fits_in_memory(bytes: f64, what: &str) -> Result<(), String> {
     }
 }
 
-/// The memory estimate of a run with `cells` cells and `unknowns` unknowns.
+/// The memory estimate of a 2D run with `cells` cells and `unknowns` unknowns.
 pub fn run_bytes(cells: f64, unknowns: f64) -> f64 {
     BYTES_PER_ITEM as f64 * (cells + unknowns)
+}
+
+/// The memory estimate of a run (see the module docs): the whole, and the part of it for
+/// the factor of a direct solve (0 when there is none or in 2D).
+pub fn run_bytes_of(dim: usize, cells: f64, unknowns: f64, direct: bool) -> (f64, f64) {
+    if dim < 3 {
+        return (run_bytes(cells, unknowns), 0.0);
+    }
+    let factor = if direct {
+        FACTOR_ENTRIES_PER_N43 * unknowns.powf(4.0 / 3.0) * BYTES_PER_FACTOR_ENTRY
+    } else {
+        0.0
+    };
+    (
+        BYTES_PER_ITEM_3D as f64 * (cells + unknowns) + factor,
+        factor,
+    )
+}
+
+/// What needs the memory, for the error of [`fits_in_memory`]: the counts.
+pub fn run_text(cells: f64, unknowns: f64) -> String {
+    format!("{cells:.3e} cells and {unknowns:.3e} unknowns")
+}
+
+/// The end of a refusal when a direct solve's factor is part of the estimate (empty
+/// without one): its share and the way around it.
+pub fn factor_note(factor: f64) -> String {
+    if factor > 0.0 {
+        format!(
+            "; the factor of the direct solve alone, which grows as unknowns^(4/3) in 3D, \
+             needs about {} (the mechanics alone with linear = \"cg-amg\" has no factor)",
+            bytes_text(factor)
+        )
+    } else {
+        String::new()
+    }
 }
 
 #[cfg(test)]
@@ -92,5 +159,38 @@ mod tests {
         let e = fits_in_memory(run_bytes(1e16, 2e16), "1e16 cells").unwrap_err();
         assert!(e.contains("1e16 cells") && e.contains("GB"), "{e}");
         assert!(fits_in_memory(run_bytes(1e3, 2e3), "a small grid").is_ok());
+    }
+
+    /// The 3D model against the peaks it was fitted to (module docs): above each, by less
+    /// than 25 %; 2D unchanged.
+    #[test]
+    fn three_d_estimates_cover_the_measured_peaks() {
+        let cases = [
+            // cells, unknowns, direct, measured peak (bytes)
+            (7_200.0, 30_558.0, true, 434e6),
+            (57_600.0, 237_518.0, true, 6.17e9),
+            (57_600.0, 179_918.0, false, 369e6),
+        ];
+        for (cells, unknowns, direct, peak) in cases {
+            let (b, factor) = run_bytes_of(3, cells, unknowns, direct);
+            assert!(
+                b >= peak && b <= 1.25 * peak,
+                "{cells} {unknowns}: {b} vs {peak}"
+            );
+            assert_eq!(factor > 0.0, direct);
+        }
+        assert_eq!(run_bytes_of(2, 1e6, 2e6, true), (run_bytes(1e6, 2e6), 0.0));
+        // The factor grows as n^(4/3): 8 times the unknowns, 16 times the factor.
+        let (_, f1) = run_bytes_of(3, 0.0, 1e6, true);
+        let (_, f8) = run_bytes_of(3, 0.0, 8e6, true);
+        assert!((f8 / f1 - 16.0).abs() < 1e-9);
+        assert_eq!(factor_note(0.0), "");
+        let t = factor_note(2.8e11);
+        assert!(
+            t.contains(
+                "direct solve alone, which grows as unknowns^(4/3) in 3D, needs about 280.0 GB"
+            ),
+            "{t}"
+        );
     }
 }

@@ -35,7 +35,7 @@ impl fmt::Display for SceneError {
             || self.file.display().to_string(),
             |n| n.to_string_lossy().into_owned(),
         );
-        write!(f, "{name}:{}: {}", self.line, self.message)
+        write!(f, "{name}:{}: {}", self.line, bound_echoes(&self.message))
     }
 }
 
@@ -66,7 +66,7 @@ impl LoadedScene {
         SceneError {
             file: self.path.clone(),
             line: self.lines.line(path),
-            message: format!("{} {}", key_text(path), message),
+            message: bound_echoes(&format!("{} {}", key_text(path), message)),
         }
     }
     /// The model of the scene (`[scene] model`, default `"continuum"`).
@@ -191,16 +191,114 @@ pub fn load(path: &Path, models: &[&'static dyn ModelKind]) -> Result<LoadedScen
         line: 0,
         message: format!("cannot read the scene file: {e}"),
     };
-    let size = std::fs::metadata(path)
-        .map_err(|e| cannot(e.to_string()))?
-        .len();
-    if size > MAX_SCENE_BYTES {
-        return Err(cannot(format!(
-            "it has {size} bytes, more than the {MAX_SCENE_BYTES} a scene file may have"
-        )));
-    }
-    let text = std::fs::read_to_string(path).map_err(|e| cannot(e.to_string()))?;
+    let text = read_bounded(path, MAX_SCENE_BYTES, "a scene file").map_err(cannot)?;
     parse(&text, path, models)
+}
+
+/// Read the text of the regular file `path`, refusing more than `limit` bytes while
+/// reading (at most `limit + 1` bytes are read, so a device or a file that grows is never
+/// read whole) and anything that is not a regular file (a directory, `/dev/zero`, a FIFO):
+/// `Err` says why, in words for an error after "cannot read …: ". `what` names the kind of
+/// file (`"a scene file"`).
+pub fn read_bounded(path: &Path, limit: u64, what: &str) -> Result<String, String> {
+    use std::io::Read as _;
+    let meta = std::fs::metadata(path).map_err(|e| e.to_string())?;
+    if !meta.is_file() {
+        return Err(format!(
+            "it is not a regular file ({}); {what} must be one",
+            file_type_text(&meta.file_type())
+        ));
+    }
+    let too_big =
+        |n: u64| format!("it has {n} bytes or more, more than the {limit} {what} may have");
+    if meta.len() > limit {
+        return Err(too_big(meta.len()));
+    }
+    let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
+    let mut bytes = Vec::new();
+    file.take(limit.saturating_add(1))
+        .read_to_end(&mut bytes)
+        .map_err(|e| e.to_string())?;
+    if bytes.len() as u64 > limit {
+        return Err(too_big(bytes.len() as u64));
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        format!(
+            "it is not UTF-8 text (invalid byte at offset {})",
+            e.utf8_error().valid_up_to()
+        )
+    })
+}
+
+/// What kind of file system object a non-regular file is, in words.
+fn file_type_text(t: &std::fs::FileType) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt as _;
+        if t.is_char_device() {
+            return "a character device";
+        }
+        if t.is_block_device() {
+            return "a block device";
+        }
+        if t.is_fifo() {
+            return "a named pipe";
+        }
+        if t.is_socket() {
+            return "a socket";
+        }
+    }
+    if t.is_dir() {
+        "a directory"
+    } else {
+        "not a file"
+    }
+}
+
+/// Longest user text (characters) an error message repeats whole.
+pub const MAX_ECHO_CHARS: usize = 60;
+
+/// User text for an error message: whole if it has at most [`MAX_ECHO_CHARS`]
+/// characters, else its first ones followed by `… (N characters)`.
+pub fn echo(s: &str) -> String {
+    let n = s.chars().count();
+    // Short text, or text this function already shortened, stays as it is.
+    if n <= MAX_ECHO_CHARS
+        || (s.chars().nth(MAX_ECHO_CHARS) == Some('…') && s.ends_with(" characters)"))
+    {
+        return s.to_string();
+    }
+    let head: String = s.chars().take(MAX_ECHO_CHARS).collect();
+    format!("{head}… ({n} characters)")
+}
+
+/// `message` with every quoted part (between `"` or between backticks) longer than
+/// [`MAX_ECHO_CHARS`] shortened by [`echo`], so no error repeats a long text of the user
+/// whole (a 200 kB expression in a terminal or in `summary.json`).
+pub fn bound_echoes(message: &str) -> String {
+    if message.chars().count() <= MAX_ECHO_CHARS {
+        return message.to_string();
+    }
+    let mut out = String::with_capacity(message.len().min(4096));
+    let mut rest = message;
+    while let Some(open) = rest.find(['"', '`']) {
+        let q = rest[open..].chars().next().unwrap_or('"');
+        out.push_str(&rest[..=open]);
+        let after = &rest[open + 1..];
+        match after.find(q) {
+            Some(close) => {
+                out.push_str(&echo(&after[..close]));
+                out.push(q);
+                rest = &after[close + 1..];
+            }
+            None => {
+                out.push_str(&echo(after));
+                rest = "";
+            }
+        }
+    }
+    out.push_str(rest);
+    out
 }
 
 /// Deepest nesting of TOML arrays and tables in a scene file. The TOML parser recurses
@@ -229,7 +327,7 @@ pub fn parse(
     let toml_error = |e: toml::de::Error| SceneError {
         file: path.to_path_buf(),
         line: e.span().map_or(1, |s| line_of_offset(&text, s.start)),
-        message: e.message().trim().replace('\n', " "),
+        message: bound_echoes(&e.message().trim().replace('\n', " ")),
     };
     let doc = DeTable::parse(&text).map_err(toml_error)?;
     let lines = KeyLines::of(doc.get_ref(), &text);
@@ -250,7 +348,8 @@ pub fn parse(
                 file: path.to_path_buf(),
                 line: lines.line(&[KeyPart::Key(key.clone())]),
                 message: format!(
-                    "unknown field `{key}`, expected one of {}",
+                    "unknown field `{}`, expected one of {}",
+                    echo(key),
                     known.join(", ")
                 ),
             });

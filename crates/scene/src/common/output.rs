@@ -1,6 +1,15 @@
 //! Output files of a run (SCENE.md, "Outputs"): every file is written atomically
 //! (a temporary file in the same directory, then a rename), so an interrupted run never
 //! leaves a half-written file.
+//!
+//! One run at a time writes into an output folder: [`OutputLock`] holds the lock file
+//! `.porofrac.lock` (created with `create_new`, holding the process id) while the run
+//! writes; a second run into the same folder is refused naming the first one's process
+//! id, and a lock left by a process that no longer exists is taken over with a note.
+//! Before a run writes, [`remove_earlier_outputs`] removes the files an earlier run wrote
+//! into the folder under porofrac's own names (the VTK steps, `.pvd` series, tables,
+//! plots, `summary.json` and leftover temporary files), so ParaView never shows steps of
+//! an earlier run next to the new ones; nothing else in the folder is touched.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -216,8 +225,9 @@ pub fn peak_memory_bytes() -> u64 {
         .map_or(0, |kb| kb * 1024)
 }
 
-/// Write an error status into `summary.json` of a failed run (best effort: the run's own
-/// error is what the caller reports).
+/// Write `"status": "failed: <error>"` into `summary.json` of a failed run (best effort:
+/// the run's own error is what the caller reports; the write is atomic, so if it fails
+/// too nothing half-written stays).
 pub(crate) fn write_failed_summary(
     ls: &crate::common::loaded::LoadedScene,
     out: &Path,
@@ -232,7 +242,7 @@ pub(crate) fn write_failed_summary(
         nodes: 0,
         dofs: 0,
         steps: 0,
-        status: error.to_string(),
+        status: format!("failed: {error}"),
         interrupted_at: None,
         fractured_cells: 0,
         wall_seconds: WallSeconds {
@@ -247,4 +257,317 @@ pub(crate) fn write_failed_summary(
         extra: serde_json::Map::new(),
     };
     let _ = summary.write(out);
+}
+
+/// Name of the lock file of an output folder.
+pub const LOCK_FILE: &str = ".porofrac.lock";
+
+/// The lock of an output folder, held while a run writes into it (see the module docs);
+/// dropping it removes the lock file.
+#[derive(Debug)]
+pub struct OutputLock {
+    path: PathBuf,
+    /// The process id of a dead process whose lock was taken over.
+    taken_over: Option<u32>,
+}
+
+/// Whether process `pid` exists (`/proc/<pid>`); `None` where that cannot be known.
+fn process_alive(pid: u32) -> Option<bool> {
+    let proc = Path::new("/proc");
+    if !proc.join("self").exists() {
+        return None;
+    }
+    Some(proc.join(pid.to_string()).exists())
+}
+
+impl OutputLock {
+    /// Create `dir` if needed and lock it for this process. Errors (naming the lock file):
+    /// a live process holds the lock (its id is given), or the lock file cannot be
+    /// created or read.
+    pub fn acquire(dir: &Path) -> Result<Self, OutputError> {
+        let path = dir.join(LOCK_FILE);
+        let err = |source| OutputError {
+            path: path.clone(),
+            source,
+        };
+        std::fs::create_dir_all(dir).map_err(|source| OutputError {
+            path: dir.to_path_buf(),
+            source,
+        })?;
+        let mut taken_over = None;
+        // Two attempts: the second after removing a stale lock.
+        for _ in 0..2 {
+            match Self::create(&path) {
+                Ok(()) => return Ok(Self { path, taken_over }),
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {}
+                Err(e) => return Err(err(e)),
+            }
+            let text = match std::fs::read_to_string(&path) {
+                Ok(t) => t,
+                // Removed in between by its owner: try again.
+                Err(e) if e.kind() == std::io::ErrorKind::NotFound => continue,
+                Err(e) => return Err(err(e)),
+            };
+            let pid = text.trim().parse::<u32>().ok();
+            match pid.map(|p| (p, process_alive(p))) {
+                Some((p, Some(false))) if p != std::process::id() => {
+                    let _ = std::fs::remove_file(&path);
+                    taken_over = Some(p);
+                }
+                Some((p, _)) => {
+                    return Err(err(std::io::Error::other(format!(
+                        "another porofrac run (process {p}) is writing into this folder; wait \
+                         for it to end, or use another --out (if process {p} is not a \
+                         porofrac run, remove the lock file)"
+                    ))));
+                }
+                None => {
+                    return Err(err(std::io::Error::other(
+                        "the folder is locked by a lock file that holds no process id; \
+                         remove it if no run writes into this folder",
+                    )));
+                }
+            }
+        }
+        Err(err(std::io::Error::other(
+            "another porofrac run took the lock of this folder at the same moment",
+        )))
+    }
+
+    fn create(path: &Path) -> std::io::Result<()> {
+        use std::io::Write as _;
+        let mut f = std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(path)?;
+        let written = writeln!(f, "{}", std::process::id());
+        if let Err(e) = written {
+            drop(f);
+            let _ = std::fs::remove_file(path);
+            return Err(e);
+        }
+        Ok(())
+    }
+
+    /// The process id of a run that ended without removing its lock, when this lock took
+    /// it over.
+    pub fn taken_over(&self) -> Option<u32> {
+        self.taken_over
+    }
+}
+
+impl Drop for OutputLock {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.path);
+    }
+}
+
+/// Whether `name` is `<prefix>` followed by at least four digits and `.<ext>`.
+fn numbered(name: &str, prefix: &str, ext: &str) -> bool {
+    name.strip_prefix(prefix)
+        .and_then(|r| r.strip_suffix(ext))
+        .and_then(|r| r.strip_suffix('.'))
+        .is_some_and(|d| d.len() >= 4 && d.bytes().all(|b| b.is_ascii_digit()))
+}
+
+/// Whether `name` is a temporary file of an atomic write (`.tmp.<pid>.<n>.<name>`) of a
+/// process that no longer runs.
+fn stale_temporary(name: &str) -> bool {
+    let Some(rest) = name.strip_prefix(".tmp.") else {
+        return false;
+    };
+    let pid = rest.split('.').next().and_then(|p| p.parse::<u32>().ok());
+    match pid {
+        Some(p) if p == std::process::id() => false,
+        Some(p) => process_alive(p) != Some(true),
+        None => false,
+    }
+}
+
+/// Remove from `dir` the files an earlier run wrote there under porofrac's own names: in
+/// `vtk/` the numbered steps (`step_NNNN.vtu`, `step_NNNN.vti`, `particles_NNNN.vtp`,
+/// `contacts_NNNN.vtp`); the series `<name>.pvd` and `<name>_contacts.pvd` for the scene
+/// name `names` gives and the one the earlier `summary.json` records; the tables
+/// (`probes.csv`, `fracture.csv`, `heat.csv`, `broken.csv`, `crack.csv`, `lines/*.csv`);
+/// the pictures `plots/*.png` and `plots/fracture/*.png`; `summary.json`; and temporary
+/// files of atomic writes left by processes that no longer run. Folders left empty are
+/// removed. Nothing else is touched. Returns the number of files removed.
+pub fn remove_earlier_outputs(dir: &Path, name: &str) -> Result<usize, OutputError> {
+    let mut names = vec![name.to_string()];
+    if let Ok(text) = std::fs::read_to_string(dir.join("summary.json"))
+        && let Ok(v) = serde_json::from_str::<serde_json::Value>(&text)
+        && let Some(earlier) = v.get("scene").and_then(|s| s.as_str())
+        && !earlier.is_empty()
+        && !earlier.contains(['/', '\\'])
+        && earlier != name
+    {
+        names.push(earlier.to_string());
+    }
+    let top: Vec<String> = names
+        .iter()
+        .flat_map(|n| [format!("{n}.pvd"), format!("{n}_contacts.pvd")])
+        .chain(
+            [
+                "probes.csv",
+                "fracture.csv",
+                "heat.csv",
+                "broken.csv",
+                "crack.csv",
+                "summary.json",
+            ]
+            .map(String::from),
+        )
+        .collect();
+    let mut removed = 0;
+    let mut clean = |sub: &str, keep: &dyn Fn(&str) -> bool| -> Result<(), OutputError> {
+        let d = if sub.is_empty() {
+            dir.to_path_buf()
+        } else {
+            dir.join(sub)
+        };
+        let Ok(entries) = std::fs::read_dir(&d) else {
+            return Ok(());
+        };
+        for e in entries.flatten() {
+            let n = e.file_name();
+            let Some(n) = n.to_str() else { continue };
+            let is_file = e.file_type().is_ok_and(|t| t.is_file());
+            if is_file && (keep(n) || stale_temporary(n)) {
+                let p = e.path();
+                std::fs::remove_file(&p).map_err(|source| OutputError { path: p, source })?;
+                removed += 1;
+            }
+        }
+        if !sub.is_empty() {
+            // Only succeeds when empty: a folder holding the user's files stays.
+            let _ = std::fs::remove_dir(&d);
+        }
+        Ok(())
+    };
+    clean("vtk", &|n| {
+        numbered(n, "step_", "vtu")
+            || numbered(n, "step_", "vti")
+            || numbered(n, "particles_", "vtp")
+            || numbered(n, "contacts_", "vtp")
+    })?;
+    clean("lines", &|n| n.ends_with(".csv"))?;
+    clean("plots/fracture", &|n| n.ends_with(".png"))?;
+    clean("plots", &|n| n.ends_with(".png"))?;
+    clean("", &|n| top.iter().any(|t| t == n))?;
+    Ok(removed)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn dir(name: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("porofrac_output_{name}_{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    /// A table whose file cannot be written (its target is a folder) returns the error
+    /// naming the file, keeps no temporary file, and its drop neither panics nor writes.
+    #[test]
+    fn a_failed_table_write_leaves_no_temporary_file() {
+        let d = dir("table");
+        std::fs::create_dir_all(d.join("probes.csv/inside")).unwrap();
+        let mut t = CsvTable::new(d.join("probes.csv"), &["time".to_string()]);
+        let _ = t.push_text(&["1".to_string()]);
+        let e = t.flush().unwrap_err();
+        assert_eq!(e.path, d.join("probes.csv"));
+        drop(t);
+        let names: Vec<String> = std::fs::read_dir(&d)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        assert_eq!(names, ["probes.csv"]);
+        assert!(d.join("probes.csv").is_dir());
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn numbered_names() {
+        assert!(numbered("step_0012.vtu", "step_", "vtu"));
+        assert!(numbered("step_12345.vtu", "step_", "vtu"));
+        assert!(!numbered("step_012.vtu", "step_", "vtu"));
+        assert!(!numbered("step_0012x.vtu", "step_", "vtu"));
+        assert!(!numbered("mystep_0012.vtu", "step_", "vtu"));
+        assert!(!numbered("step_0012.vtu.bak", "step_", "vtu"));
+    }
+
+    /// The earlier run's files go, under both scene names; the user's files stay, and so
+    /// do folders that still hold them.
+    #[test]
+    fn earlier_outputs_are_removed_and_nothing_else() {
+        let d = dir("earlier");
+        for sub in ["vtk", "lines", "plots/fracture"] {
+            std::fs::create_dir_all(d.join(sub)).unwrap();
+        }
+        let ours = [
+            "vtk/step_0000.vtu",
+            "vtk/step_0001.vtu",
+            "vtk/particles_0003.vtp",
+            "old.pvd",
+            "old_contacts.pvd",
+            "new.pvd",
+            "probes.csv",
+            "lines/mid.csv",
+            "plots/probes.png",
+            "plots/fracture/open.png",
+            "summary.json",
+            ".tmp.4294967294.0.probes.csv",
+        ];
+        let theirs = [
+            "vtk/mine.vtu",
+            "other.pvd",
+            "notes.txt",
+            "plots/sketch.svg",
+            "lines/readme.txt",
+        ];
+        for f in ours.iter().chain(&theirs) {
+            std::fs::write(d.join(f), b"x").unwrap();
+        }
+        std::fs::write(d.join("summary.json"), br#"{"scene": "old"}"#).unwrap();
+        let live = format!(".tmp.{}.0.a.csv", std::process::id());
+        std::fs::write(d.join(&live), b"x").unwrap();
+        assert_eq!(remove_earlier_outputs(&d, "new").unwrap(), ours.len());
+        for f in ours {
+            assert!(!d.join(f).exists(), "{f}");
+        }
+        for f in theirs.iter().chain([&live.as_str()]) {
+            assert!(d.join(f).is_file(), "{f}");
+        }
+        assert!(!d.join("plots/fracture").exists());
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    /// A live lock (this process) is refused naming the pid; a stale one (a dead pid) is
+    /// taken over; the lock file goes with the lock.
+    #[test]
+    fn lock_refuses_a_live_owner_and_takes_over_a_dead_one() {
+        let d = dir("lock");
+        let lock = OutputLock::acquire(&d).unwrap();
+        assert_eq!(lock.taken_over(), None);
+        let text = std::fs::read_to_string(d.join(LOCK_FILE)).unwrap();
+        assert_eq!(text.trim(), std::process::id().to_string());
+        let e = OutputLock::acquire(&d).unwrap_err().to_string();
+        assert!(
+            e.contains(&format!("process {}", std::process::id())) && e.contains(LOCK_FILE),
+            "{e}"
+        );
+        drop(lock);
+        assert!(!d.join(LOCK_FILE).exists());
+        if process_alive(1) == Some(true) {
+            // A pid above the kernel's maximum (4194304) never runs.
+            std::fs::write(d.join(LOCK_FILE), "4294967294\n").unwrap();
+            let lock = OutputLock::acquire(&d).unwrap();
+            assert_eq!(lock.taken_over(), Some(4_294_967_294));
+        }
+        std::fs::write(d.join(LOCK_FILE), "garbage").unwrap();
+        assert!(OutputLock::acquire(&d).is_err());
+        std::fs::remove_dir_all(&d).unwrap();
+    }
 }

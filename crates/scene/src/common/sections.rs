@@ -697,7 +697,8 @@ pub fn key_text(path: &[KeyPart]) -> String {
                 if !s.is_empty() {
                     s.push('.');
                 }
-                s.push_str(k);
+                // A key is user text too: a long one is shortened like any echo.
+                s.push_str(&crate::common::loaded::echo(k));
             }
             KeyPart::Index(i) => s.push_str(&format!("[{i}]")),
         }

@@ -391,9 +391,15 @@ fn check_grid(ls: &LoadedScene, d: usize) -> Result<(), SceneError> {
         }
     }
     if let Some(p) = g.perturb
-        && !(0.0..0.5).contains(&p)
+        && !(0.0..=porofrac_grid::generate::MAX_PERTURB).contains(&p)
     {
-        return Err(ls.error(&key("perturb"), format!("= {p} must be in [0, 0.5)")));
+        return Err(ls.error(
+            &key("perturb"),
+            format!(
+                "= {p} must be in [0, {}] (a fraction of the local cell size)",
+                porofrac_grid::generate::MAX_PERTURB
+            ),
+        ));
     }
     if g.diagonals.is_some() && g.kind != GridKind::Composite {
         return Err(ls.error(&key("diagonals"), "applies to composite grids only"));
@@ -617,7 +623,9 @@ fn check_wells(ls: &LoadedScene, d: usize) -> Result<(), SceneError> {
 /// Bound steps, output series and generated grids before anything is allocated
 /// ([`crate::common::limits`]).
 fn check_sizes(ls: &LoadedScene, d: usize) -> Result<(), SceneError> {
-    use crate::common::limits::{MAX_CELLS, MAX_STEPS, fits_in_memory, run_bytes};
+    use crate::common::limits::{
+        MAX_CELLS, MAX_STEPS, factor_note, fits_in_memory, run_bytes_of, run_text,
+    };
     let s = &ls.scene;
     if let Some(sch) = &s.schedule {
         let n = step_count_f64(sch);
@@ -695,11 +703,36 @@ fn check_sizes(ls: &LoadedScene, d: usize) -> Result<(), SceneError> {
     }
     let flow = s.physics.flow == Some(true);
     let unknowns = d as f64 * nodes + if flow { cells } else { 0.0 };
-    fits_in_memory(
-        run_bytes(cells, unknowns),
-        &format!("asks for {cells:.3e} cells and {unknowns:.3e} unknowns"),
-    )
-    .map_err(|e| ls.error(&key, e))
+    let (bytes, factor) = run_bytes_of(d, cells, unknowns, factors(ls, d, unknowns));
+    fits_in_memory(bytes, &format!("asks for {}", run_text(cells, unknowns)))
+        .map_err(|e| ls.error(&key, format!("{e}{}", factor_note(factor))))
+}
+
+/// Whether a `d`-dimensional run of the scene with about `equations` unknowns factors a
+/// matrix (a direct solve): the flow coupled to the mechanics, or the mechanics solved
+/// by the sparse Cholesky (`linear = "cholesky"`, or `"auto"` on a small 3D system).
+pub(crate) fn factors(ls: &LoadedScene, d: usize, equations: f64) -> bool {
+    use crate::common::sections::{CouplingChoice, MechanicsSolver};
+    let s = &ls.scene;
+    let flow = s.physics.flow == Some(true);
+    if flow && s.physics.coupling.unwrap_or_default() != CouplingChoice::None {
+        return true;
+    }
+    if s.solver.mechanics.unwrap_or_default() == MechanicsSolver::Explicit {
+        return false;
+    }
+    match s.solver.linear.unwrap_or_default() {
+        LinearChoice::Cholesky => true,
+        LinearChoice::Auto => {
+            let min = if d >= 3 {
+                porofrac_sim::linear::AUTO_MIN_EQUATIONS_3D
+            } else {
+                porofrac_sim::linear::AUTO_MIN_EQUATIONS_2D
+            };
+            equations < min as f64
+        }
+        _ => false,
+    }
 }
 
 /// In a continuum scene: the Cosserat-only keys are errors naming key and model, and a

@@ -81,15 +81,19 @@ fn run_dim<const D: usize>(
     // Mesh files are counted only once read: bound the run before assembling it.
     let flow_on = ls.scene.physics.flow == Some(true);
     let unknowns = (D * grid.num_nodes() + if flow_on { grid.num_cells() } else { 0 }) as f64;
+    let cells = grid.num_cells() as f64;
+    let (bytes, factor) =
+        crate::common::limits::run_bytes_of(D, cells, unknowns, check::factors(ls, D, unknowns));
     crate::common::limits::fits_in_memory(
-        crate::common::limits::run_bytes(grid.num_cells() as f64, unknowns),
-        &format!(
-            "the grid has {} cells and {} unknowns",
-            grid.num_cells(),
-            unknowns
-        ),
+        bytes,
+        &format!("holds {}", crate::common::limits::run_text(cells, unknowns)),
     )
-    .map_err(|e| ls.error(&k(&["grid"]), e))?;
+    .map_err(|e| {
+        ls.error(
+            &k(&["grid"]),
+            format!("{e}{}", crate::common::limits::factor_note(factor)),
+        )
+    })?;
     let t_asm = Instant::now();
     let comp = compose(ls, registry, grid, deck)?;
     let cond = conditions(ls, grid, &comp)?;

@@ -404,9 +404,15 @@ fn check_grid(ls: &LoadedScene, d: usize) -> Result<(), SceneError> {
         _ => return Err(ls.error(&key("cells"), "is required: one count per axis")),
     }
     if let Some(p) = g.perturb
-        && !(0.0..0.5).contains(&p)
+        && !(0.0..=porofrac_grid::generate::MAX_PERTURB).contains(&p)
     {
-        return Err(ls.error(&key("perturb"), format!("= {p} must be in [0, 0.5)")));
+        return Err(ls.error(
+            &key("perturb"),
+            format!(
+                "= {p} must be in [0, {}] (a fraction of the local cell size)",
+                porofrac_grid::generate::MAX_PERTURB
+            ),
+        ));
     }
     Ok(())
 }

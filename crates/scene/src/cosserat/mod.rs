@@ -34,7 +34,6 @@ use porofrac_cosserat::{
     BodyLoads, Condition, Cosserat, CosseratError, GmresOptions, Integrator, Linear, LinearOptions,
     LinearSolver, Material, Options, components,
 };
-use porofrac_grid::generate::perturb;
 use porofrac_grid::{Grid, Point};
 
 use crate::common::driver::{Observer, drive};
@@ -62,14 +61,16 @@ pub(crate) fn run(
             Some(crate::common::sections::CellCount::PerAxis(v)) => [v[0] as usize, v[1] as usize],
             _ => unreachable!("checked"),
         };
-        let grid = porofrac_cosserat::mesh::crossed(point(&ext[0]), point(&ext[1]), n)
-            .map_err(|e| ls.error(&k(&["grid", "cells"]), e))?;
+        let (lo, hi) = (point(&ext[0]), point(&ext[1]));
         let amp = g.perturb.unwrap_or(0.0);
         AnyGrid::Two(if amp > 0.0 {
-            perturb(&grid, amp, g.seed.unwrap_or(0))
+            // The crossed mesh's own jitter: valid triangles up to the documented maximum
+            // whatever the aspect ratio of the squares.
+            porofrac_cosserat::mesh::crossed_perturbed(lo, hi, n, amp, g.seed.unwrap_or(0))
                 .map_err(|e| ls.error(&k(&["grid", "perturb"]), e))?
         } else {
-            grid
+            porofrac_cosserat::mesh::crossed(lo, hi, n)
+                .map_err(|e| ls.error(&k(&["grid", "cells"]), e))?
         })
     } else {
         build_grid(ls)?.0
@@ -96,6 +97,57 @@ fn scene_error(ls: &LoadedScene, e: CosseratError) -> RunError {
         CosseratError::Input { .. } | CosseratError::Solve(_) => k(&["scene", "model"]),
     };
     RunError::Scene(ls.error(&key, format!(": {e}")))
+}
+
+/// The first `[loads]` value (`body_force` or `body_couple` component) that is not a
+/// finite number at a cell centre at one of `times`, as an error at its key: a run error
+/// of the library (a non-finite right-hand side or state) is reported there rather than
+/// against the model. At most about 10⁷ evaluations (on an error path only).
+fn load_not_finite<const D: usize>(
+    ls: &LoadedScene,
+    grid: &Grid<D>,
+    times: &[f64],
+) -> Option<SceneError> {
+    let l = ls.scene.loads.as_ref()?;
+    let mut values: Vec<(&str, usize, &NumOrExpr)> = Vec::new();
+    if let Some(f) = &l.body_force {
+        values.extend(f.iter().enumerate().map(|(a, v)| ("body_force", a, v)));
+    }
+    if let Some(c) = &l.body_couple {
+        values.extend(
+            c.values()
+                .into_iter()
+                .enumerate()
+                .map(|(a, v)| ("body_couple", a, v)),
+        );
+    }
+    let cells = grid.num_cells().max(1);
+    let stride = (cells * times.len() * values.len().max(1) / 10_000_000).max(1);
+    for (key, a, v) in values {
+        let f = v.to_field();
+        for &t in times {
+            for c in (0..grid.num_cells()).step_by(stride) {
+                let x = grid.cell_centroid(c);
+                let y = f.eval(x.as_slice(), t);
+                if !y.is_finite() {
+                    let text = match v {
+                        NumOrExpr::Num(n) => n.to_string(),
+                        NumOrExpr::Expr(e) => format!("\"{}\"", crate::common::loaded::echo(e)),
+                    };
+                    return Some(ls.error(
+                        &k(&["loads", key]),
+                        format!(
+                            "[{a}] = {text} is {y} at x = {:?}, t = {t} (cell {}): a load must \
+                             be a finite number everywhere in the grid",
+                            x.as_slice(),
+                            c + 1
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    None
 }
 
 fn to_field<const D: usize>(v: &NumOrExpr) -> porofrac_cosserat::Field<D> {
@@ -409,16 +461,27 @@ impl<const D: usize> Model for Run<'_, D> {
         match &mut self.stepping {
             Stepping::Static(solver) => {
                 let mut x = vec![0.0; self.w.len()];
-                self.model.rhs(self.times[step], &mut x);
-                solver
-                    .solve(&mut x, Some(&self.w))
-                    .map_err(|e| scene_error(ls, e))?;
+                let t = self.times[step];
+                self.model.rhs(t, &mut x);
+                let grid = self.model.grid();
+                solver.solve(&mut x, Some(&self.w)).map_err(|e| {
+                    load_not_finite(ls, grid, &[t]).map_or_else(|| scene_error(ls, e), Into::into)
+                })?;
                 self.w = x;
             }
             Stepping::Dynamic { state, substeps } => {
                 if step > 0 {
-                    for _ in 0..*substeps {
-                        state.step(&self.model).map_err(|e| scene_error(ls, e))?;
+                    let (t0, t1) = (self.times[step - 1], self.times[step]);
+                    let n = *substeps;
+                    for _ in 0..n {
+                        state.step(&self.model).map_err(|e| {
+                            // The loads at the times the integrator evaluated them.
+                            let times: Vec<f64> = (0..=n.min(1000))
+                                .map(|i| t0 + (t1 - t0) * i as f64 / n.min(1000) as f64)
+                                .collect();
+                            load_not_finite(ls, self.model.grid(), &times)
+                                .map_or_else(|| scene_error(ls, e), Into::into)
+                        })?;
                     }
                 }
                 self.w.clone_from(&state.u);
