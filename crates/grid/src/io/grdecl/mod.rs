@@ -60,7 +60,8 @@
 //!   including faces towards inactive cells and across a fault's throw.
 //!
 //! Depths are kept as they are (`z` grows downwards, as in the deck). The tolerance is
-//! [`RELATIVE_TOLERANCE`] times the largest coordinate of the deck.
+//! [`RELATIVE_TOLERANCE`] times the largest depth of the deck (map coordinates, often in
+//! the millions, do not count).
 
 mod deck;
 mod process;

@@ -12,9 +12,11 @@ use crate::point::Point;
 
 use super::deck::Deck;
 
-/// Tolerance of the processing, relative to the size of the deck (the largest extent of
-/// its corner points): depths closer than this on a pillar are one node, and a cell
-/// thinner than this at all four pillars is pinched out.
+/// Tolerance of the processing, relative to the depths of the deck (the largest depth of
+/// its corners and pillar ends): depths closer than this on a pillar are one node, and a
+/// cell thinner than this at all four pillars is pinched out. Map coordinates do not
+/// count: with UTM coordinates (millions of metres) the tolerance would be millimetres,
+/// as large as real differences of depth.
 pub const RELATIVE_TOLERANCE: f64 = 1e-9;
 
 /// A corner-point grid as a polyhedral grid, with each cell's place in the deck.
@@ -166,10 +168,12 @@ pub fn corner_point_grid(deck: &Deck) -> Result<CornerPointGrid> {
             8 * n
         )));
     }
+    // Depths only: map coordinates (UTM, millions of metres) would make the tolerance
+    // millimetres, as large as real differences of depth.
     let scale = deck
         .coord
         .chunks(3)
-        .flat_map(|p| p.iter().copied())
+        .map(|p| p[2])
         .chain(deck.zcorn.iter().copied())
         .fold(0.0f64, |m, v| m.max(v.abs()))
         .max(f64::MIN_POSITIVE);
