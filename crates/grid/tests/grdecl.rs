@@ -324,3 +324,125 @@ fn bad_decks_are_errors_naming_file_line_and_keyword() {
     ));
     assert!(e.contains("ZCORN"), "{e}");
 }
+
+/// A repeat count that wraps when added to the values already read is refused before
+/// anything is pushed, naming the keyword, the file and the line.
+#[test]
+fn a_huge_repeat_count_is_an_error_not_an_allocation() {
+    let good = deck_text([1, 1, 1], 1.0, 1.0, |_, _, _, k| k as f64, "");
+    let at = good.find("ZCORN").unwrap();
+    let bad = format!("{}ZCORN\n 0 18446744073709551615*1 /\n", &good[..at]);
+    let line = bad.lines().count();
+    let e = error_of("repeat.grdecl", &bad);
+    assert!(
+        e.contains(&format!("repeat.grdecl:{line}:"))
+            && e.contains("ZCORN")
+            && e.contains("more than the 8 values")
+            && e.contains("(1 read before it)"),
+        "{e}"
+    );
+}
+
+/// Lines are read up to 1 MiB: a longer line (a file without newlines) is refused with
+/// its line, and what is not a regular file (a device, a directory, a FIFO) is refused
+/// before it is opened, also when an INCLUDE names it.
+#[test]
+fn long_lines_devices_directories_and_fifos_are_refused() {
+    let long = format!("SPECGRID\n 1 1 1 /\n{}", " ".repeat(2 << 20));
+    let e = error_of("long.grdecl", &long);
+    assert!(
+        e.contains("long.grdecl:3:") && e.contains("longer than 1048576 bytes"),
+        "{e}"
+    );
+    let e = read_deck("/dev/zero").unwrap_err().to_string();
+    assert!(e.contains("/dev/zero") && e.contains("not a regular file"), "{e}");
+    let e = error_of("zero.grdecl", "SPECGRID\n 1 1 1 /\nINCLUDE\n '/dev/zero' /\n");
+    assert!(
+        e.contains("zero.grdecl:4:") && e.contains("/dev/zero: is not a regular file"),
+        "{e}"
+    );
+    let dir = write("dir.grdecl", "").parent().unwrap().join("a-folder");
+    std::fs::create_dir_all(&dir).unwrap();
+    let e = read_deck(&dir).unwrap_err().to_string();
+    assert!(e.contains("a-folder") && e.contains("is a directory"), "{e}");
+    let e = error_of("incdir.grdecl", "INCLUDE\n 'a-folder' /\n");
+    assert!(
+        e.contains("incdir.grdecl:2:") && e.contains("is a directory"),
+        "{e}"
+    );
+    let fifo = dir.join("pipe.grdecl");
+    let _ = std::fs::remove_file(&fifo);
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    assert!(made.is_ok_and(|s| s.success()), "mkfifo {}", fifo.display());
+    let e = read_deck(&fifo).unwrap_err().to_string();
+    assert!(e.contains("pipe.grdecl") && e.contains("FIFO"), "{e}");
+}
+
+/// GRIDUNIT, when given, is the unit of COORD and ZCORN; without it the unit system
+/// is: a cube of 10 deck units is (10 u)³ for the one unit u that applies, never the
+/// product of two.
+#[test]
+fn grid_lengths_are_scaled_once_by_gridunit_or_else_the_unit_system() {
+    let body = deck_text([1, 1, 1], 10.0, 10.0, |_, _, _, k| 10.0 * k as f64, "");
+    let systems = [("", 1.0), ("METRIC\n", 1.0), ("FIELD\n", 0.3048), ("LAB\n", 0.01)];
+    let gridunits = [
+        ("", None),
+        ("GRIDUNIT\n 'METRES  ' /\n", Some(1.0)),
+        ("GRIDUNIT\n FEET /\n", Some(0.3048)),
+        ("GRIDUNIT\n 'CM' '    ' /\n", Some(0.01)),
+    ];
+    for (system, unit) in systems {
+        for (gridunit, grid_unit) in gridunits {
+            let text = format!("{system}{gridunit}{body}");
+            let (_, cp) = read_grdecl(write("units.grdecl", &text)).unwrap();
+            let u = grid_unit.unwrap_or(unit);
+            let want = (10.0f64 * u).powi(3);
+            let got = cp.grid.cell_volume(0);
+            assert!(
+                (got - want).abs() <= 1e-12 * want,
+                "{system:?} {gridunit:?}: {got} m³, expected {want}"
+            );
+        }
+    }
+}
+
+/// Every message names a file and a 1-based line: an INCLUDE cycle at the INCLUDE that
+/// closes it, a deck without SPECGRID at its end.
+#[test]
+fn include_cycles_and_a_missing_size_name_file_and_line() {
+    write("cycle-b.inc", "-- b\nINCLUDE\n 'cycle-a.inc' /\n");
+    write("cycle-a.inc", "-- a\n\nINCLUDE\n 'cycle-b.inc' /\n");
+    let e = error_of("cycle.grdecl", "INCLUDE\n 'cycle-a.inc' /\n");
+    assert!(
+        e.contains("cycle-b.inc:3:")
+            && e.contains("cycle of includes (cycle-a.inc → cycle-b.inc → cycle-a.inc)"),
+        "{e}"
+    );
+    let e = error_of("nosize.grdecl", "-- nothing\nPORO_X\n/\n\n");
+    assert!(
+        e.contains("nosize.grdecl:4:") && e.contains("no SPECGRID or DIMENS"),
+        "{e}"
+    );
+    let e = error_of("empty.grdecl", "");
+    assert!(e.contains("empty.grdecl:1:"), "{e}");
+}
+
+/// User text in a message is cut to 60 characters and its length.
+#[test]
+fn long_user_text_is_not_echoed_whole() {
+    let token = "X".repeat(500_000);
+    let e = error_of("token.grdecl", &format!("SPECGRID\n 1 1 1 /\n{token}\n"));
+    assert!(
+        e.len() < 300 && e.contains(&format!("{}… (500000 characters)", &token[..60])),
+        "{}",
+        &e[..e.len().min(400)]
+    );
+    let e = error_of("quoted.grdecl", &format!("'{token}'\n"));
+    assert!(e.len() < 300 && e.contains("(500000 characters)"), "{}", &e[..e.len().min(400)]);
+    let good = deck_text([1, 1, 1], 1.0, 1.0, |_, _, _, k| k as f64, "");
+    let e = error_of(
+        "number.grdecl",
+        &good.replacen(" 1.0 1.0 1.0 1.0\n/", &format!(" 1.0 1.0 1.0 {token}\n/"), 1),
+    );
+    assert!(e.len() < 300 && e.contains("(500000 characters)"), "{}", &e[..e.len().min(400)]);
+}
