@@ -446,3 +446,42 @@ fn long_user_text_is_not_echoed_whole() {
     );
     assert!(e.len() < 300 && e.contains("(500000 characters)"), "{}", &e[..e.len().min(400)]);
 }
+
+/// Bad cell properties of the grid's cells name the keyword, the file and line it was
+/// read at, and the cell's 1-based (i, j, k); inactive cells are not checked.
+#[test]
+fn bad_cell_properties_name_keyword_file_line_and_cell() {
+    use porofrac_grid::io::grdecl::check_cell_properties;
+    let body = deck_text([3, 1, 2], 1.0, 1.0, |_, _, _, k| k as f64, "");
+    let check = |name: &str, props: &str| {
+        let text = format!("{body}{props}");
+        let (deck, cp) = read_grdecl(write(name, &text)).unwrap();
+        check_cell_properties(&deck, &cp).map_err(|e| e.to_string())
+    };
+    // Cell (3, 1, 2) is the sixth of the deck; (1, 1, 1) inactive with PORO 0.
+    let props = "ACTNUM\n 0 5*1 /\nPORO\n 0 0.2 0.2 0.2 0.2 -0.45 /\n";
+    let line = body.lines().count() + 3;
+    let e = check("poro.grdecl", props).unwrap_err();
+    assert_eq!(
+        e,
+        format!(
+            "{}:{line}: PORO of cell (i, j, k) = (3, 1, 2) is -0.45; porosity must be in (0, 1]",
+            write("poro.grdecl", "").display()
+        )
+    );
+    assert!(check("ok.grdecl", "ACTNUM\n 0 5*1 /\nPORO\n 0 5*0.2 /\n").is_ok());
+    let e = check("permy.grdecl", "PORO\n 6*0.2 /\nPERMX\n 6*100 /\nPERMY\n 100 -5 4*100 /\n")
+        .unwrap_err();
+    assert!(
+        e.contains("PERMY of cell (i, j, k) = (2, 1, 1) is -5 mD")
+            && e.contains("permy.grdecl:"),
+        "{e}"
+    );
+    let e = check("ntg.grdecl", "PORO\n 6*0.2 /\nNTG\n 5*1 1.5 /\n").unwrap_err();
+    assert!(e.contains("NTG of cell (i, j, k) = (3, 1, 2) is 1.5"), "{e}");
+    let e = check("multpv.grdecl", "PORO\n 6*0.5 /\nMULTPV\n 1 3 4*1 /\n").unwrap_err();
+    assert!(
+        e.contains("MULTPV") && e.contains("(2, 1, 1) is 0.5 × 1 × 3 = 1.5"),
+        "{e}"
+    );
+}

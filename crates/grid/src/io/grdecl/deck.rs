@@ -116,6 +116,9 @@ pub struct Deck {
     pub fault_multipliers: Vec<(String, f64)>,
     /// Keywords read but not used (their data skipped), in order of appearance.
     pub skipped: Vec<String>,
+    /// Where each array keyword (`COORD`, `ZCORN`, `ACTNUM`, `PORO`, …) was read: the
+    /// keyword, its file and its 1-based line, in order (for messages about its values).
+    pub keyword_lines: Vec<(String, PathBuf, usize)>,
 }
 
 impl Deck {
@@ -751,6 +754,11 @@ impl DeckReader {
 
     fn finish(self) -> Result<Deck> {
         let mut deck = self.deck;
+        deck.keyword_lines = self
+            .arrays_at
+            .iter()
+            .map(|(word, file, line, _)| (word.clone(), file.clone(), *line))
+            .collect();
         let Some((dims_file, dims_line)) = self.dims_at else {
             return Err(GridError::Parse {
                 path: self.top,
