@@ -76,6 +76,61 @@ fn main() {
             total += v;
             worst = worst.max((v - g.cell_volume(c)).abs() / g.cell_volume(c).abs().max(1e-300));
         }
+        // Connected components of cells through shared faces.
+        let mut comp = vec![usize::MAX; g.num_cells()];
+        let mut sizes = Vec::new();
+        let mut cell_faces: Vec<Vec<usize>> = vec![Vec::new(); g.num_cells()];
+        for f in 0..g.num_faces() {
+            if let (a, Some(b)) = g.face_cells(f) {
+                cell_faces[a].push(b);
+                cell_faces[b].push(a);
+            }
+        }
+        for start in 0..g.num_cells() {
+            if comp[start] != usize::MAX {
+                continue;
+            }
+            let id = sizes.len();
+            let mut stack = vec![start];
+            comp[start] = id;
+            let mut n = 0;
+            while let Some(c) = stack.pop() {
+                n += 1;
+                for &d in &cell_faces[c] {
+                    if comp[d] == usize::MAX {
+                        comp[d] = id;
+                        stack.push(d);
+                    }
+                }
+            }
+            sizes.push(n);
+        }
+        sizes.sort_unstable_by(|a, b| b.cmp(a));
+        // Parts sharing a node with another part.
+        let mut node_part = vec![usize::MAX; g.num_nodes()];
+        let mut touching = 0;
+        for c in 0..g.num_cells() {
+            for &n in g.cell_nodes(c) {
+                if node_part[n] == usize::MAX {
+                    node_part[n] = comp[c];
+                } else if node_part[n] != comp[c] {
+                    touching += 1;
+                }
+            }
+        }
+        println!("{path}: {touching} node contacts between parts joined by no face");
+        for (name, faces) in g.face_tags() {
+            let mut per_part = std::collections::BTreeMap::new();
+            for &f in faces {
+                *per_part.entry(comp[g.face_cells(f).0]).or_insert(0usize) += 1;
+            }
+            println!("{path}: tag {name}: faces per part {per_part:?}");
+        }
+        println!(
+            "{path}: {} connected parts of cells, sizes {:?}",
+            sizes.len(),
+            &sizes[..sizes.len().min(8)]
+        );
         let [nx, ny, nz] = deck.dims;
         println!(
             "{path}: {nx} × {ny} × {nz}, {} cells ({} pinched, {} inactive), {} faces, {} nodes; \
