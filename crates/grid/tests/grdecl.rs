@@ -485,3 +485,22 @@ fn bad_cell_properties_name_keyword_file_line_and_cell() {
         "{e}"
     );
 }
+
+/// A whole simulation deck is read for its grid: reading stops at the first section
+/// after GRID (here SUMMARY, whose records this reader does not parse); a block-centred
+/// deck (DX, DY, DZ, TOPS) is refused as such.
+#[test]
+fn a_simulation_deck_is_read_up_to_its_grid_and_block_grids_are_named() {
+    let body = deck_text([1, 1, 1], 2.0, 2.0, |_, _, _, k| 100.0 + k as f64, "");
+    let text = format!("RUNSPEC\nDIMENS\n 1 1 1 /\nGRID\n{body}PROPS\nSUMMARY\nBPR\n1 1 1 /\n/\n");
+    let (_, cp) = read_grdecl(write("case.DATA", &text)).unwrap();
+    assert!((cp.grid.cell_volume(0) - 4.0).abs() < 1e-12);
+    let e = error_of(
+        "blocks.DATA",
+        "DIMENS\n 2 1 1 /\nGRID\nDX\n 2*10 /\nDY\n 2*10 /\nDZ\n 2*5 /\nTOPS\n 2*100 /\nPROPS\n",
+    );
+    assert!(
+        e.contains("blocks.DATA:1:") && e.contains("no COORD") && e.contains("DX DY DZ TOPS"),
+        "{e}"
+    );
+}

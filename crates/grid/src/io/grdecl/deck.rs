@@ -281,6 +281,8 @@ struct DeckReader {
     /// The file the deck starts with, and its number of lines.
     top: PathBuf,
     last_line: usize,
+    /// A section after the grid's was met (`PROPS`, …): reading stops.
+    done: bool,
     /// Where each `MULTFLT` record was read (file, line), in the order of
     /// [`Deck::fault_multipliers`].
     multflt_at: Vec<(PathBuf, usize)>,
@@ -449,6 +451,9 @@ impl DeckReader {
         depth: usize,
     ) -> Result<()> {
         while let Some(tok) = lx.next()? {
+            if self.done {
+                break;
+            }
             let word = match tok {
                 Token::Word(w) => w.to_ascii_uppercase(),
                 Token::Slash => continue,
@@ -580,6 +585,12 @@ impl DeckReader {
                     }
                     self.skip_record(lx)?;
                     self.read_file(&target, depth + 1)?;
+                }
+                // The sections after GRID and EDIT hold no grid data (and records this
+                // reader does not parse): the deck's grid is read.
+                "PROPS" | "REGIONS" | "SOLUTION" | "SUMMARY" | "SCHEDULE" => {
+                    self.done = true;
+                    break;
                 }
                 w if NO_DATA.contains(&w) => {}
                 w if is_keyword(w) => {
@@ -801,7 +812,12 @@ impl DeckReader {
                     line: dims_line,
                     what: format!(
                         "no {word} in the deck of this grid size: a corner-point grid needs \
-                         COORD and ZCORN"
+                         COORD and ZCORN{}",
+                        if deck.skipped.iter().any(|w| w == "DX" || w == "TOPS") {
+                            " (block-centred grids, DX DY DZ TOPS, are not read)"
+                        } else {
+                            ""
+                        }
                     ),
                 });
             }

@@ -13,7 +13,10 @@
 //! relative to the including one (the name as written, then in upper and in lower case),
 //! at most 16 deep, refusing cycles. Records end with `/`; `--` starts a comment; `n*v`
 //! repeats `v` `n` times. Other keywords are skipped (listed in [`Deck::skipped`]): their
-//! record up to `/`, or nothing when a known keyword follows first. Lengths are converted
+//! record up to `/`, or nothing when a known keyword follows first. Reading stops at the
+//! first of the sections after `GRID` and `EDIT` (`PROPS`, `REGIONS`, `SOLUTION`,
+//! `SUMMARY`, `SCHEDULE`), which hold no grid data, so that a whole simulation deck
+//! (`.DATA`) can be read for its grid. Lengths are converted
 //! to metres and permeabilities to m² ([`MILLIDARCY`]). [`check_cell_properties`]
 //! checks the properties of the grid's cells for flow, naming keyword, file, line and
 //! cell.
