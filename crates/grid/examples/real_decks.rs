@@ -24,7 +24,10 @@ fn enclosed_volume(grid: &Grid<3>, c: usize) -> f64 {
     let mut v = 0.0;
     for (&f, &out) in grid.cell_faces(c).iter().zip(grid.cell_face_outward(c)) {
         let nodes = grid.face_nodes(f);
-        let m = nodes.iter().map(|&n| grid.node(n) - o).sum::<porofrac_grid::Point<3>>()
+        let m = nodes
+            .iter()
+            .map(|&n| grid.node(n) - o)
+            .sum::<porofrac_grid::Point<3>>()
             / nodes.len() as f64;
         let mut s = 0.0;
         for k in 0..nodes.len() {

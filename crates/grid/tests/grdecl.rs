@@ -355,8 +355,14 @@ fn long_lines_devices_directories_and_fifos_are_refused() {
         "{e}"
     );
     let e = read_deck("/dev/zero").unwrap_err().to_string();
-    assert!(e.contains("/dev/zero") && e.contains("not a regular file"), "{e}");
-    let e = error_of("zero.grdecl", "SPECGRID\n 1 1 1 /\nINCLUDE\n '/dev/zero' /\n");
+    assert!(
+        e.contains("/dev/zero") && e.contains("not a regular file"),
+        "{e}"
+    );
+    let e = error_of(
+        "zero.grdecl",
+        "SPECGRID\n 1 1 1 /\nINCLUDE\n '/dev/zero' /\n",
+    );
     assert!(
         e.contains("zero.grdecl:4:") && e.contains("/dev/zero: is not a regular file"),
         "{e}"
@@ -364,7 +370,10 @@ fn long_lines_devices_directories_and_fifos_are_refused() {
     let dir = write("dir.grdecl", "").parent().unwrap().join("a-folder");
     std::fs::create_dir_all(&dir).unwrap();
     let e = read_deck(&dir).unwrap_err().to_string();
-    assert!(e.contains("a-folder") && e.contains("is a directory"), "{e}");
+    assert!(
+        e.contains("a-folder") && e.contains("is a directory"),
+        "{e}"
+    );
     let e = error_of("incdir.grdecl", "INCLUDE\n 'a-folder' /\n");
     assert!(
         e.contains("incdir.grdecl:2:") && e.contains("is a directory"),
@@ -384,7 +393,12 @@ fn long_lines_devices_directories_and_fifos_are_refused() {
 #[test]
 fn grid_lengths_are_scaled_once_by_gridunit_or_else_the_unit_system() {
     let body = deck_text([1, 1, 1], 10.0, 10.0, |_, _, _, k| 10.0 * k as f64, "");
-    let systems = [("", 1.0), ("METRIC\n", 1.0), ("FIELD\n", 0.3048), ("LAB\n", 0.01)];
+    let systems = [
+        ("", 1.0),
+        ("METRIC\n", 1.0),
+        ("FIELD\n", 0.3048),
+        ("LAB\n", 0.01),
+    ];
     let gridunits = [
         ("", None),
         ("GRIDUNIT\n 'METRES  ' /\n", Some(1.0)),
@@ -438,13 +452,25 @@ fn long_user_text_is_not_echoed_whole() {
         &e[..e.len().min(400)]
     );
     let e = error_of("quoted.grdecl", &format!("'{token}'\n"));
-    assert!(e.len() < 300 && e.contains("(500000 characters)"), "{}", &e[..e.len().min(400)]);
+    assert!(
+        e.len() < 300 && e.contains("(500000 characters)"),
+        "{}",
+        &e[..e.len().min(400)]
+    );
     let good = deck_text([1, 1, 1], 1.0, 1.0, |_, _, _, k| k as f64, "");
     let e = error_of(
         "number.grdecl",
-        &good.replacen(" 1.0 1.0 1.0 1.0\n/", &format!(" 1.0 1.0 1.0 {token}\n/"), 1),
+        &good.replacen(
+            " 1.0 1.0 1.0 1.0\n/",
+            &format!(" 1.0 1.0 1.0 {token}\n/"),
+            1,
+        ),
     );
-    assert!(e.len() < 300 && e.contains("(500000 characters)"), "{}", &e[..e.len().min(400)]);
+    assert!(
+        e.len() < 300 && e.contains("(500000 characters)"),
+        "{}",
+        &e[..e.len().min(400)]
+    );
 }
 
 /// Bad cell properties of the grid's cells name the keyword, the file and line it was
@@ -470,15 +496,20 @@ fn bad_cell_properties_name_keyword_file_line_and_cell() {
         )
     );
     assert!(check("ok.grdecl", "ACTNUM\n 0 5*1 /\nPORO\n 0 5*0.2 /\n").is_ok());
-    let e = check("permy.grdecl", "PORO\n 6*0.2 /\nPERMX\n 6*100 /\nPERMY\n 100 -5 4*100 /\n")
-        .unwrap_err();
+    let e = check(
+        "permy.grdecl",
+        "PORO\n 6*0.2 /\nPERMX\n 6*100 /\nPERMY\n 100 -5 4*100 /\n",
+    )
+    .unwrap_err();
     assert!(
-        e.contains("PERMY of cell (i, j, k) = (2, 1, 1) is -5 mD")
-            && e.contains("permy.grdecl:"),
+        e.contains("PERMY of cell (i, j, k) = (2, 1, 1) is -5 mD") && e.contains("permy.grdecl:"),
         "{e}"
     );
     let e = check("ntg.grdecl", "PORO\n 6*0.2 /\nNTG\n 5*1 1.5 /\n").unwrap_err();
-    assert!(e.contains("NTG of cell (i, j, k) = (3, 1, 2) is 1.5"), "{e}");
+    assert!(
+        e.contains("NTG of cell (i, j, k) = (3, 1, 2) is 1.5"),
+        "{e}"
+    );
     let e = check("multpv.grdecl", "PORO\n 6*0.5 /\nMULTPV\n 1 3 4*1 /\n").unwrap_err();
     assert!(
         e.contains("MULTPV") && e.contains("(2, 1, 1) is 0.5 × 1 × 3 = 1.5"),

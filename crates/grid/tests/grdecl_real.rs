@@ -22,7 +22,10 @@ fn corner_deck(dims: [usize; 3], spacing: f64, cells: &[[f64; 8]]) -> Deck {
     let mut coord = Vec::new();
     for j in 0..=ny {
         for i in 0..=nx {
-            let (x, y) = (ORIGIN[0] + i as f64 * spacing, ORIGIN[1] + j as f64 * spacing);
+            let (x, y) = (
+                ORIGIN[0] + i as f64 * spacing,
+                ORIGIN[1] + j as f64 * spacing,
+            );
             coord.extend([x, y, 1000.0, x, y, 2000.0]);
         }
     }
@@ -120,7 +123,14 @@ fn corners_millimetres_apart_at_map_coordinates() {
             1683.0, 1690.0, 1695.0, 1701.059, 1689.4, 1695.6, 1700.9, 1706.329,
         ],
         [
-            1695.0 + 8.5, 1701.0525, 1712.9, 1722.2, 1709.6, 1706.324, 1718.5, 1728.0,
+            1695.0 + 8.5,
+            1701.0525,
+            1712.9,
+            1722.2,
+            1709.6,
+            1706.324,
+            1718.5,
+            1728.0,
         ],
     ];
     let deck = corner_deck([1, 2, 1], 100.0, &cells);
@@ -140,7 +150,14 @@ fn a_column_of_cells_millimetres_thin_at_one_pillar() {
     let cells: Vec<[f64; 8]> = (0..3)
         .map(|k| {
             [
-                c0[k], c1[k], c2[k], c3[k], c0[k + 1], c1[k + 1], c2[k + 1], c3[k + 1],
+                c0[k],
+                c1[k],
+                c2[k],
+                c3[k],
+                c0[k + 1],
+                c1[k + 1],
+                c2[k + 1],
+                c3[k + 1],
             ]
         })
         .collect();
@@ -150,7 +167,10 @@ fn a_column_of_cells_millimetres_thin_at_one_pillar() {
     assert_exact_volumes(&cp.grid);
     for (c, cell) in cells.iter().enumerate() {
         let (got, want) = (cp.grid.cell_volume(c), column_volume(100.0, cell));
-        assert!((got - want).abs() < 1e-8 * want, "cell {c}: {got} m³, expected {want}");
+        assert!(
+            (got - want).abs() < 1e-8 * want,
+            "cell {c}: {got} m³, expected {want}"
+        );
     }
 }
 
@@ -161,13 +181,19 @@ fn a_column_of_cells_millimetres_thin_at_one_pillar() {
 fn a_partly_pinched_cell_beside_a_faulted_column() {
     let cells = [
         // Column (0, 0): a thick cell, then one pinched at corners 1 and 2.
-        [1600.0, 1600.0, 1600.0, 1600.0, 1635.406, 1640.623, 1640.449, 1646.635],
+        [
+            1600.0, 1600.0, 1600.0, 1600.0, 1635.406, 1640.623, 1640.449, 1646.635,
+        ],
         [
             1635.406, 1640.623, 1640.449, 1646.635, 1635.419, 1640.623, 1640.449, 1646.643,
         ],
         // Column (0, 1): two cells across the same depths, shifted.
-        [1640.0, 1646.0, 1600.0, 1600.0, 1645.355, 1646.64, 1650.0, 1650.0],
-        [1645.355, 1646.64, 1650.0, 1650.0, 1660.0, 1660.0, 1660.0, 1660.0],
+        [
+            1640.0, 1646.0, 1600.0, 1600.0, 1645.355, 1646.64, 1650.0, 1650.0,
+        ],
+        [
+            1645.355, 1646.64, 1650.0, 1650.0, 1660.0, 1660.0, 1660.0, 1660.0,
+        ],
     ];
     // Deck order: i fastest, then j, then k.
     let ordered = [cells[0], cells[2], cells[1], cells[3]];

@@ -445,7 +445,10 @@ impl<const D: usize> DofMap<D> {
                     return Err(SimError::FloatingPart {
                         cells: cells[p],
                         total: grid.num_cells(),
-                        cell: format!("cell {c} at {}", fmt_point(grid.cell_centroid(c).as_slice())),
+                        cell: format!(
+                            "cell {c} at {}",
+                            fmt_point(grid.cell_centroid(c).as_slice())
+                        ),
                         cell_index: c,
                         modes,
                     });

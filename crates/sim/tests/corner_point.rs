@@ -140,9 +140,8 @@ fn mdem_zone_in_a_faulted_corner_point_grid_passes_the_patch_test() {
 /// of leaving a singular system to the solver; fixed on `imax` too, both are held.
 #[test]
 fn an_island_of_cells_left_free_is_named() {
-    let mut deck = Deck::on_vertical_pillars([5, 1, 1], [10.0, 10.0], |_, _, _, k| {
-        100.0 + 5.0 * k as f64
-    });
+    let mut deck =
+        Deck::on_vertical_pillars([5, 1, 1], [10.0, 10.0], |_, _, _, k| 100.0 + 5.0 * k as f64);
     deck.actnum = Some(vec![true, false, false, true, true]);
     let cp = corner_point_grid(&deck).unwrap();
     let grid = &cp.grid;

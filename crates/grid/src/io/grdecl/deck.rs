@@ -345,12 +345,10 @@ impl<R: BufRead> Lexer<R> {
                 let n = (&mut self.input)
                     .take(MAX_LINE_BYTES as u64 + 1)
                     .read_until(b'\n', &mut self.buf)
-                    .map_err(|e| {
-                        GridError::Parse {
-                            path: self.path.clone(),
-                            line: self.line + 1,
-                            what: format!("cannot read: {e}"),
-                        }
+                    .map_err(|e| GridError::Parse {
+                        path: self.path.clone(),
+                        line: self.line + 1,
+                        what: format!("cannot read: {e}"),
                     })?;
                 if n == 0 {
                     return Ok(None);
@@ -561,15 +559,19 @@ impl DeckReader {
                         Some(Token::Word(w) | Token::Quoted(w)) => w,
                         _ => return Err(lx.error("INCLUDE: needs a file name")),
                     };
-                    let target = resolve_include(path, &name).map_err(|why| {
-                        lx.error(format!("INCLUDE '{}': {why}", shown(&name)))
-                    })?;
+                    let target = resolve_include(path, &name)
+                        .map_err(|why| lx.error(format!("INCLUDE '{}': {why}", shown(&name))))?;
                     let canonical = target.canonicalize().unwrap_or_else(|_| target.clone());
                     if let Some(at) = self.open.iter().position(|p| *p == canonical) {
                         let chain: Vec<String> = self.open[at..]
                             .iter()
                             .chain([&canonical])
-                            .map(|p| p.file_name().unwrap_or_default().to_string_lossy().into_owned())
+                            .map(|p| {
+                                p.file_name()
+                                    .unwrap_or_default()
+                                    .to_string_lossy()
+                                    .into_owned()
+                            })
                             .collect();
                         return Err(lx.error(format!(
                             "INCLUDE '{}': a cycle of includes ({})",

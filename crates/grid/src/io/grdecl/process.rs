@@ -423,7 +423,20 @@ pub fn corner_point_grid(deck: &Deck) -> Result<CornerPointGrid> {
     }
     drop(parts);
     let nodes = std::mem::take(&mut builder.nodes);
-    let mut grid = Grid::from_cell_faces(nodes, &loops)?;
+    // A cell the grid refuses (inverted, degenerate, not closed) is named by its deck
+    // (i, j, k).
+    let mut grid = Grid::from_cell_faces(nodes, &loops).map_err(|e| match e {
+        GridError::Cell { cell, what } if cell < ijk.len() => {
+            let [i, j, k] = ijk[cell];
+            GridError::Input(format!(
+                "cell (i, j, k) = ({}, {}, {}) (1-based): {what}",
+                i + 1,
+                j + 1,
+                k + 1
+            ))
+        }
+        e => e,
+    })?;
     let mut tags: BTreeMap<&str, Vec<usize>> = BTreeMap::new();
     for c in 0..num_cells {
         let faces = grid.cell_faces(c);
@@ -638,7 +651,10 @@ impl Builder<'_> {
             if kept <= 3 {
                 break;
             }
-            let prev = (1..n).map(|d| (k + n - d) % n).find(|&p| keep[p]).unwrap_or(k);
+            let prev = (1..n)
+                .map(|d| (k + n - d) % n)
+                .find(|&p| keep[p])
+                .unwrap_or(k);
             let next = (1..n).map(|d| (k + d) % n).find(|&q| keep[q]).unwrap_or(k);
             let (a, w) = (poly[prev], poly[next]);
             let mut between = (1..n).map(|d| (prev + d) % n).take_while(|&x| x != next);
@@ -836,4 +852,68 @@ fn simple_loops(face: &[usize], stack: &mut Vec<usize>, mut push: impl FnMut(&[u
         added += 1;
     }
     added
+}
+
+#[cfg(test)]
+mod tests {
+    use super::simple_loops;
+
+    fn split(face: &[usize]) -> Vec<Vec<usize>> {
+        let mut out = Vec::new();
+        let n = simple_loops(face, &mut Vec::new(), |l| out.push(l.to_vec()));
+        assert_eq!(n, out.len());
+        out
+    }
+
+    /// Directed edges of loops, sorted.
+    fn edges(loops: &[Vec<usize>]) -> Vec<(usize, usize)> {
+        let mut e: Vec<_> = loops
+            .iter()
+            .flat_map(|l| (0..l.len()).map(move |k| (l[k], l[(k + 1) % l.len()])))
+            .collect();
+        e.sort_unstable();
+        e
+    }
+
+    #[test]
+    fn a_loop_through_a_node_twice_splits_there_keeping_its_edges() {
+        // a b c a d: the loop a b c, and the edge a d walked there and back (dropped).
+        assert_eq!(split(&[1, 2, 3, 1, 4]), vec![vec![1, 2, 3]]);
+        // Two triangles joined at node 5, from any starting node and either way round:
+        // the same two loops, reversed when the loop is.
+        let face = [5, 7, 8, 5, 9, 6];
+        let loops = split(&face);
+        assert_eq!(loops, vec![vec![5, 7, 8], vec![5, 9, 6]]);
+        let mut kept_edges = edges(&loops);
+        let mut all_edges = edges(&[face.to_vec()]);
+        kept_edges.sort_unstable();
+        all_edges.sort_unstable();
+        assert_eq!(kept_edges, all_edges);
+        // Canonical loops: each rotated to start at its smallest node, sorted.
+        let canon = |mut ls: Vec<Vec<usize>>| {
+            for l in &mut ls {
+                let m = (0..l.len()).min_by_key(|&k| l[k]).unwrap();
+                l.rotate_left(m);
+            }
+            ls.sort();
+            ls
+        };
+        for shift in 0..face.len() {
+            let mut rotated = face.to_vec();
+            rotated.rotate_left(shift);
+            assert_eq!(
+                canon(split(&rotated)),
+                canon(loops.clone()),
+                "shift {shift}"
+            );
+            let reversed: Vec<usize> = rotated.iter().rev().copied().collect();
+            let back: Vec<Vec<usize>> = split(&reversed)
+                .into_iter()
+                .map(|l| l.into_iter().rev().collect())
+                .collect();
+            assert_eq!(canon(back), canon(loops.clone()), "reversed, shift {shift}");
+        }
+        // A simple loop is kept whole.
+        assert_eq!(split(&[3, 1, 2, 4]), vec![vec![1, 2, 4, 3]]);
+    }
 }
