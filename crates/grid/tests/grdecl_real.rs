@@ -263,17 +263,18 @@ fn random_faulted_decks_with_pinched_and_thin_layers_load_exactly() {
 }
 
 /// Real decks, paths in `POROFRAC_REAL_DECKS` (separated by `:`), converted to GRDECL
-/// (`xtgeo.grid_from_file(…).to_file(…, fformat="grdecl")`). Measured (release build,
-/// 2 cores shared with other builds):
+/// where needed (`xtgeo.grid_from_file(…).to_file(…, fformat="grdecl")`). Measured with
+/// `cargo run --release -p porofrac-grid --example real_decks` (median of 5; 2 cores,
+/// load average 5–7 from other builds):
 ///
-/// | deck (xtgeo-testdata)                          | size          | cells (pinched, inactive) | read + process |
-/// |------------------------------------------------|---------------|---------------------------|----------------|
-/// | drogon/4/simgrid_with_region_zone_attr.roff    | 46 × 73 × 32  | 73 419 (41, 33 996)       | 0.08 + 0.38 s  |
-/// | reek/reek_sim_grid.grdecl                      | 40 × 64 × 14  | 35 838 (0, 2)             | 0.02 + 0.19 s  |
-/// | reek3/reek_sim.grdecl                          | 40 × 64 × 14  | 35 812 (0, 28)            | 0.02 + 0.15 s  |
-/// | reek/REEK.EGRID                                | 40 × 64 × 14  | 35 838 (0, 2)             | 0.03 + 0.17 s  |
-/// | eme/2/emerald_hetero_grid.roff                 | 70 × 100 × 46 | 120 842 (0, 201 158)      | 0.20 + 0.75 s  |
-/// | eme/2/eme_small_w_hole_grid_params.grdecl      | 21 × 41 × 18  | 7 157 (0, 8 341)          | 0.01 + 0.04 s  |
+/// | deck (equinor/xtgeo-testdata)               | size          | cells (pinched, inactive) | read + process  |
+/// |---------------------------------------------|---------------|---------------------------|-----------------|
+/// | drogon/4/simgrid_with_region_zone_attr.roff | 46 × 73 × 32  | 73 419 (41, 33 996)       | 0.05 + 0.18 s   |
+/// | eme/2/emerald_hetero_grid.roff              | 70 × 100 × 46 | 120 842 (0, 201 158)      | 0.14 + 0.29 s   |
+/// | eme/2/eme_small_w_hole_grid_params.grdecl   | 21 × 41 × 18  | 7 157 (0, 8 341)          | 0.007 + 0.015 s |
+/// | reek/reek_sim_grid.grdecl                   | 40 × 64 × 14  | 35 838 (0, 2)             | 0.013 + 0.073 s |
+/// | reek/REEK.EGRID                             | 40 × 64 × 14  | 35 838 (0, 2)             | 0.018 + 0.089 s |
+/// | reek3/reek_sim.grdecl                       | 40 × 64 × 14  | 35 812 (0, 28)            | 0.013 + 0.077 s |
 #[test]
 #[ignore = "needs real decks: POROFRAC_REAL_DECKS=a.grdecl:b.grdecl"]
 fn real_decks_load() {
