@@ -175,7 +175,11 @@ fn unconstrained_island_fails_at_its_node() {
             else {
                 unreachable!()
             };
-            assert_eq!((cells, total, cell_index, modes.len()), (1, 3, 2, 3), "{msg}");
+            assert_eq!(
+                (cells, total, cell_index, modes.len()),
+                (1, 3, 2, 3),
+                "{msg}"
+            );
             assert!(msg.contains("cell 2 at (3.333"), "{msg}");
         }
         other => panic!("expected FloatingPart, got {:?}", other.map(|_| ())),
