@@ -72,7 +72,17 @@
 //!   surface on the top or bottom line of a cell. So every cell is a closed polyhedron and
 //!   every sub-face has its two cells. Faces are polygons of any number of nodes, split
 //!   into triangles about their vertex average like every grid face (non-planar faces as
-//!   in reservoir codes). The grid is validated as every grid is.
+//!   in reservoir codes). A face is oriented by how it was made (the corner order of a
+//!   top or bottom, the `(s, z)` order of a sub-face) and by whether the deck's `i`, `j`
+//!   and depth are right- or left-handed (`GDORIENT … RIGHT` or `LEFT`), never from its
+//!   normal against the cell's centre, which a thin or partly pinched cell makes
+//!   unreliable. A face whose loop passes twice through a node (corners of a pinched
+//!   cell meeting) is split there into simple loops, and loops of fewer than three nodes
+//!   are dropped. The grid is validated as every grid is; a cell it refuses is named by
+//!   its `(i, j, k)`. A known limit: a cell millimetres thin at some corners and metres
+//!   at others, with nodes of a fault on one face only, can have its triangulated top
+//!   cross its bottom (the vertex averages differ); it is refused as inverted, not
+//!   loaded with a wrong volume.
 //! * **Outer faces** are tagged by the ijk side they face: `imin`, `imax`, `jmin`, `jmax`,
 //!   `kmin` (top, Eclipse's convention of depth growing with `k`) and `kmax` (bottom),
 //!   including faces towards inactive cells and across a fault's throw.
