@@ -81,8 +81,8 @@
 //!   are dropped. The grid is validated as every grid is; a cell it refuses is named by
 //!   its `(i, j, k)`. A known limit: a cell millimetres thin at some corners and metres
 //!   at others, with nodes of a fault on one face only, can have its triangulated top
-//!   cross its bottom (the vertex averages differ); it is refused as inverted, not
-//!   loaded with a wrong volume.
+//!   cross its bottom (the vertex averages differ): its volume is still that of its
+//!   triangulated faces, and a cell whose crossing outweighs it is refused as inverted.
 //! * **Outer faces** are tagged by the ijk side they face: `imin`, `imax`, `jmin`, `jmax`,
 //!   `kmin` (top, Eclipse's convention of depth growing with `k`) and `kmax` (bottom),
 //!   including faces towards inactive cells and across a fault's throw.
