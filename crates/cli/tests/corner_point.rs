@@ -22,7 +22,9 @@
 //! * a deck declaring 1e9 cells and a ZCORN of 8e9 repeated values is refused at its
 //!   `DIMENS`, naming the memory, before anything is allocated;
 //! * the bounding-box side `zmin`, which touches no face of the dipping top, is an error
-//!   that points to the ijk sides; `select = { ijk = … }` on a generated grid is an error.
+//!   that points to the ijk sides; `select = { ijk = … }` on a generated grid is an error;
+//! * a negative `PORO` of an active cell in a flow scene is an error naming `PORO`, the
+//!   deck file and line, and the cell's 1-based `(i, j, k)`.
 
 mod common;
 
@@ -332,6 +334,25 @@ displacement = [0.0, 0.0, 0.0]
     assert_eq!(code, 1);
     assert!(
         err.contains("region[0].select") && err.contains("corner-point deck"),
+        "{err}"
+    );
+}
+
+#[test]
+fn a_bad_deck_porosity_names_keyword_file_line_and_cell() {
+    let dir = tmp_dir("cp_bad_poro_deck");
+    let path = dir.join("bad_poro.grdecl");
+    let mut text = std::fs::read_to_string(deck()).unwrap();
+    let line = text.lines().count() + 1;
+    text.push_str("PORO\n 5*0.2 -0.45 474*0.2 /\n");
+    std::fs::write(&path, text).unwrap();
+    let (code, err, _) = run(
+        "cp_bad_poro",
+        &balance_scene_on(path.to_str().unwrap(), "", "kmax"),
+    );
+    assert_eq!(code, 1);
+    assert!(
+        err.contains(&format!("bad_poro.grdecl:{line}: PORO of cell (i, j, k) = (6, 1, 1) is -0.45; porosity must be in (0, 1]")),
         "{err}"
     );
 }

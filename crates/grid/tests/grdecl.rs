@@ -324,3 +324,214 @@ fn bad_decks_are_errors_naming_file_line_and_keyword() {
     ));
     assert!(e.contains("ZCORN"), "{e}");
 }
+
+/// A repeat count that wraps when added to the values already read is refused before
+/// anything is pushed, naming the keyword, the file and the line.
+#[test]
+fn a_huge_repeat_count_is_an_error_not_an_allocation() {
+    let good = deck_text([1, 1, 1], 1.0, 1.0, |_, _, _, k| k as f64, "");
+    let at = good.find("ZCORN").unwrap();
+    let bad = format!("{}ZCORN\n 0 18446744073709551615*1 /\n", &good[..at]);
+    let line = bad.lines().count();
+    let e = error_of("repeat.grdecl", &bad);
+    assert!(
+        e.contains(&format!("repeat.grdecl:{line}:"))
+            && e.contains("ZCORN")
+            && e.contains("more than the 8 values")
+            && e.contains("(1 read before it)"),
+        "{e}"
+    );
+}
+
+/// Lines are read up to 1 MiB: a longer line (a file without newlines) is refused with
+/// its line, and what is not a regular file (a device, a directory, a FIFO) is refused
+/// before it is opened, also when an INCLUDE names it.
+#[test]
+fn long_lines_devices_directories_and_fifos_are_refused() {
+    let long = format!("SPECGRID\n 1 1 1 /\n{}", " ".repeat(2 << 20));
+    let e = error_of("long.grdecl", &long);
+    assert!(
+        e.contains("long.grdecl:3:") && e.contains("longer than 1048576 bytes"),
+        "{e}"
+    );
+    let e = read_deck("/dev/zero").unwrap_err().to_string();
+    assert!(
+        e.contains("/dev/zero") && e.contains("not a regular file"),
+        "{e}"
+    );
+    let e = error_of(
+        "zero.grdecl",
+        "SPECGRID\n 1 1 1 /\nINCLUDE\n '/dev/zero' /\n",
+    );
+    assert!(
+        e.contains("zero.grdecl:4:") && e.contains("/dev/zero: is not a regular file"),
+        "{e}"
+    );
+    let dir = write("dir.grdecl", "").parent().unwrap().join("a-folder");
+    std::fs::create_dir_all(&dir).unwrap();
+    let e = read_deck(&dir).unwrap_err().to_string();
+    assert!(
+        e.contains("a-folder") && e.contains("is a directory"),
+        "{e}"
+    );
+    let e = error_of("incdir.grdecl", "INCLUDE\n 'a-folder' /\n");
+    assert!(
+        e.contains("incdir.grdecl:2:") && e.contains("is a directory"),
+        "{e}"
+    );
+    let fifo = dir.join("pipe.grdecl");
+    let _ = std::fs::remove_file(&fifo);
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    assert!(made.is_ok_and(|s| s.success()), "mkfifo {}", fifo.display());
+    let e = read_deck(&fifo).unwrap_err().to_string();
+    assert!(e.contains("pipe.grdecl") && e.contains("FIFO"), "{e}");
+}
+
+/// GRIDUNIT, when given, is the unit of COORD and ZCORN; without it the unit system
+/// is: a cube of 10 deck units is (10 u)³ for the one unit u that applies, never the
+/// product of two.
+#[test]
+fn grid_lengths_are_scaled_once_by_gridunit_or_else_the_unit_system() {
+    let body = deck_text([1, 1, 1], 10.0, 10.0, |_, _, _, k| 10.0 * k as f64, "");
+    let systems = [
+        ("", 1.0),
+        ("METRIC\n", 1.0),
+        ("FIELD\n", 0.3048),
+        ("LAB\n", 0.01),
+    ];
+    let gridunits = [
+        ("", None),
+        ("GRIDUNIT\n 'METRES  ' /\n", Some(1.0)),
+        ("GRIDUNIT\n FEET /\n", Some(0.3048)),
+        ("GRIDUNIT\n 'CM' '    ' /\n", Some(0.01)),
+    ];
+    for (system, unit) in systems {
+        for (gridunit, grid_unit) in gridunits {
+            let text = format!("{system}{gridunit}{body}");
+            let (_, cp) = read_grdecl(write("units.grdecl", &text)).unwrap();
+            let u = grid_unit.unwrap_or(unit);
+            let want = (10.0f64 * u).powi(3);
+            let got = cp.grid.cell_volume(0);
+            assert!(
+                (got - want).abs() <= 1e-12 * want,
+                "{system:?} {gridunit:?}: {got} m³, expected {want}"
+            );
+        }
+    }
+}
+
+/// Every message names a file and a 1-based line: an INCLUDE cycle at the INCLUDE that
+/// closes it, a deck without SPECGRID at its end.
+#[test]
+fn include_cycles_and_a_missing_size_name_file_and_line() {
+    write("cycle-b.inc", "-- b\nINCLUDE\n 'cycle-a.inc' /\n");
+    write("cycle-a.inc", "-- a\n\nINCLUDE\n 'cycle-b.inc' /\n");
+    let e = error_of("cycle.grdecl", "INCLUDE\n 'cycle-a.inc' /\n");
+    assert!(
+        e.contains("cycle-b.inc:3:")
+            && e.contains("cycle of includes (cycle-a.inc → cycle-b.inc → cycle-a.inc)"),
+        "{e}"
+    );
+    let e = error_of("nosize.grdecl", "-- nothing\nPORO_X\n/\n\n");
+    assert!(
+        e.contains("nosize.grdecl:4:") && e.contains("no SPECGRID or DIMENS"),
+        "{e}"
+    );
+    let e = error_of("empty.grdecl", "");
+    assert!(e.contains("empty.grdecl:1:"), "{e}");
+}
+
+/// User text in a message is cut to 60 characters and its length.
+#[test]
+fn long_user_text_is_not_echoed_whole() {
+    let token = "X".repeat(500_000);
+    let e = error_of("token.grdecl", &format!("SPECGRID\n 1 1 1 /\n{token}\n"));
+    assert!(
+        e.len() < 300 && e.contains(&format!("{}… (500000 characters)", &token[..60])),
+        "{}",
+        &e[..e.len().min(400)]
+    );
+    let e = error_of("quoted.grdecl", &format!("'{token}'\n"));
+    assert!(
+        e.len() < 300 && e.contains("(500000 characters)"),
+        "{}",
+        &e[..e.len().min(400)]
+    );
+    let good = deck_text([1, 1, 1], 1.0, 1.0, |_, _, _, k| k as f64, "");
+    let e = error_of(
+        "number.grdecl",
+        &good.replacen(
+            " 1.0 1.0 1.0 1.0\n/",
+            &format!(" 1.0 1.0 1.0 {token}\n/"),
+            1,
+        ),
+    );
+    assert!(
+        e.len() < 300 && e.contains("(500000 characters)"),
+        "{}",
+        &e[..e.len().min(400)]
+    );
+}
+
+/// Bad cell properties of the grid's cells name the keyword, the file and line it was
+/// read at, and the cell's 1-based (i, j, k); inactive cells are not checked.
+#[test]
+fn bad_cell_properties_name_keyword_file_line_and_cell() {
+    use porofrac_grid::io::grdecl::check_cell_properties;
+    let body = deck_text([3, 1, 2], 1.0, 1.0, |_, _, _, k| k as f64, "");
+    let check = |name: &str, props: &str| {
+        let text = format!("{body}{props}");
+        let (deck, cp) = read_grdecl(write(name, &text)).unwrap();
+        check_cell_properties(&deck, &cp).map_err(|e| e.to_string())
+    };
+    // Cell (3, 1, 2) is the sixth of the deck; (1, 1, 1) inactive with PORO 0.
+    let props = "ACTNUM\n 0 5*1 /\nPORO\n 0 0.2 0.2 0.2 0.2 -0.45 /\n";
+    let line = body.lines().count() + 3;
+    let e = check("poro.grdecl", props).unwrap_err();
+    assert_eq!(
+        e,
+        format!(
+            "{}:{line}: PORO of cell (i, j, k) = (3, 1, 2) is -0.45; porosity must be in (0, 1]",
+            write("poro.grdecl", "").display()
+        )
+    );
+    assert!(check("ok.grdecl", "ACTNUM\n 0 5*1 /\nPORO\n 0 5*0.2 /\n").is_ok());
+    let e = check(
+        "permy.grdecl",
+        "PORO\n 6*0.2 /\nPERMX\n 6*100 /\nPERMY\n 100 -5 4*100 /\n",
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("PERMY of cell (i, j, k) = (2, 1, 1) is -5 mD") && e.contains("permy.grdecl:"),
+        "{e}"
+    );
+    let e = check("ntg.grdecl", "PORO\n 6*0.2 /\nNTG\n 5*1 1.5 /\n").unwrap_err();
+    assert!(
+        e.contains("NTG of cell (i, j, k) = (3, 1, 2) is 1.5"),
+        "{e}"
+    );
+    let e = check("multpv.grdecl", "PORO\n 6*0.5 /\nMULTPV\n 1 3 4*1 /\n").unwrap_err();
+    assert!(
+        e.contains("MULTPV") && e.contains("(2, 1, 1) is 0.5 × 1 × 3 = 1.5"),
+        "{e}"
+    );
+}
+
+/// A whole simulation deck is read for its grid: reading stops at the first section
+/// after GRID (here SUMMARY, whose records this reader does not parse); a block-centred
+/// deck (DX, DY, DZ, TOPS) is refused as such.
+#[test]
+fn a_simulation_deck_is_read_up_to_its_grid_and_block_grids_are_named() {
+    let body = deck_text([1, 1, 1], 2.0, 2.0, |_, _, _, k| 100.0 + k as f64, "");
+    let text = format!("RUNSPEC\nDIMENS\n 1 1 1 /\nGRID\n{body}PROPS\nSUMMARY\nBPR\n1 1 1 /\n/\n");
+    let (_, cp) = read_grdecl(write("case.DATA", &text)).unwrap();
+    assert!((cp.grid.cell_volume(0) - 4.0).abs() < 1e-12);
+    let e = error_of(
+        "blocks.DATA",
+        "DIMENS\n 2 1 1 /\nGRID\nDX\n 2*10 /\nDY\n 2*10 /\nDZ\n 2*5 /\nTOPS\n 2*100 /\nPROPS\n",
+    );
+    assert!(
+        e.contains("blocks.DATA:1:") && e.contains("no COORD") && e.contains("DX DY DZ TOPS"),
+        "{e}"
+    );
+}

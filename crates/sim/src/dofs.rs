@@ -289,6 +289,61 @@ impl<const D: usize> DofMap<D> {
     /// The rigid-body modes that the conditions leave free (empty when the stiffness of a
     /// connected grid is positive definite). See the module docs for the test.
     pub fn free_rigid_modes(&self, grid: &Grid<D>) -> Vec<String> {
+        self.free_modes_where(grid, |_| true)
+    }
+
+    /// The parts of the grid joined through shared nodes: the part of every node (the
+    /// nodes of a platen count as joined, as they share an equation; `usize::MAX` for a
+    /// node of no cell), and the number of parts.
+    fn node_parts(&self, grid: &Grid<D>) -> (Vec<usize>, usize) {
+        let n = grid.num_nodes();
+        let mut parent: Vec<usize> = (0..n).collect();
+        fn root(parent: &mut [usize], mut a: usize) -> usize {
+            while parent[a] != a {
+                parent[a] = parent[parent[a]];
+                a = parent[a];
+            }
+            a
+        }
+        let mut join = |nodes: &[usize]| {
+            if let Some(&first) = nodes.first() {
+                let r = root(&mut parent, first);
+                for &m in &nodes[1..] {
+                    let q = root(&mut parent, m);
+                    parent[q] = r;
+                }
+            }
+        };
+        for c in 0..grid.num_cells() {
+            join(grid.cell_nodes(c));
+        }
+        for p in &self.platens {
+            join(&p.nodes);
+        }
+        let mut used = vec![false; n];
+        for c in 0..grid.num_cells() {
+            for &m in grid.cell_nodes(c) {
+                used[m] = true;
+            }
+        }
+        let mut id = vec![usize::MAX; n];
+        let mut part = vec![usize::MAX; n];
+        let mut count = 0;
+        for m in 0..n {
+            if used[m] {
+                let r = root(&mut parent, m);
+                if id[r] == usize::MAX {
+                    id[r] = count;
+                    count += 1;
+                }
+                part[m] = id[r];
+            }
+        }
+        (part, count)
+    }
+
+    /// [`Self::free_rigid_modes`] counting only the conditions on nodes `keep` accepts.
+    fn free_modes_where(&self, grid: &Grid<D>, keep: impl Fn(usize) -> bool) -> Vec<String> {
         let names = rigid_mode_names::<D>();
         let m = names.len();
         let (lo, hi) = grid.bounding_box();
@@ -304,7 +359,7 @@ impl<const D: usize> DofMap<D> {
                 }
             }
         };
-        for &dof in &self.fixed_dofs {
+        for &dof in self.fixed_dofs.iter().filter(|&&dof| keep(dof / D)) {
             let x = grid.node(dof / D);
             for (k, ck) in c.iter_mut().enumerate() {
                 *ck = mode(k, x, dof % D);
@@ -312,7 +367,7 @@ impl<const D: usize> DofMap<D> {
             add(&c);
         }
         for p in &self.platens {
-            let Some(&first) = p.nodes.first() else {
+            let Some(&first) = p.nodes.first().filter(|&&n| keep(n)) else {
                 continue;
             };
             let x0 = grid.node(first);
@@ -366,8 +421,41 @@ impl<const D: usize> DofMap<D> {
         out
     }
 
-    /// Error [`SimError::Singular`] naming the free rigid-body modes, if there are any.
+    /// Error [`SimError::Singular`] naming the free rigid-body modes, if there are any;
+    /// for a grid in parts joined by no node (an island of cells), each part must have
+    /// none, else [`SimError::FloatingPart`] names the part's size and one of its cells.
     pub fn check_rigid_modes(&self, grid: &Grid<D>) -> Result<()> {
+        let (part, parts) = self.node_parts(grid);
+        if parts > 1 {
+            let mut cells = vec![0usize; parts];
+            let mut first = vec![usize::MAX; parts];
+            for c in 0..grid.num_cells() {
+                let p = part[grid.cell_nodes(c)[0]];
+                cells[p] += 1;
+                first[p] = first[p].min(c);
+            }
+            // Smallest parts first, so that an error names an island rather than the
+            // main part when both are free.
+            let mut order: Vec<usize> = (0..parts).collect();
+            order.sort_by_key(|&p| (std::cmp::Reverse(cells[p]), first[p]));
+            for &p in order.iter().rev() {
+                let modes = self.free_modes_where(grid, |n| part[n] == p);
+                if !modes.is_empty() {
+                    let c = first[p];
+                    return Err(SimError::FloatingPart {
+                        cells: cells[p],
+                        total: grid.num_cells(),
+                        cell: format!(
+                            "cell {c} at {}",
+                            fmt_point(grid.cell_centroid(c).as_slice())
+                        ),
+                        cell_index: c,
+                        modes,
+                    });
+                }
+            }
+            return Ok(());
+        }
         let modes = self.free_rigid_modes(grid);
         if modes.is_empty() {
             Ok(())

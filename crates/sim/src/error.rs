@@ -39,6 +39,26 @@ pub enum SimError {
         /// The free modes, e.g. `"translation x"`, `"rotation about z"`, or a combination.
         modes: Vec<String>,
     },
+    /// A part of the grid joined to the rest by no node (an island of cells, say between
+    /// inactive cells of a deck) is left free by the conditions: its stiffness is
+    /// singular, and an iterative solver would not converge.
+    #[error(
+        "{cells} of the grid's {total} cells ({cell} among them) form a part joined to the rest by no node, and the boundary conditions leave it free ({}): constrain that part, or leave its cells out of the grid",
+        modes.join(", ")
+    )]
+    FloatingPart {
+        /// Number of cells of the part.
+        cells: usize,
+        /// Number of cells of the grid.
+        total: usize,
+        /// One cell of the part, as the message names it (`cell 12 at (x, y, z)`; a caller
+        /// may name it in its own terms, e.g. by a deck's `(i, j, k)`).
+        cell: String,
+        /// Index of that cell in the grid.
+        cell_index: usize,
+        /// The free modes of the part.
+        modes: Vec<String>,
+    },
     /// The Cholesky factorization met a non-positive pivot.
     #[error(
         "the stiffness matrix is not positive definite at equation {equation} ({location}): \

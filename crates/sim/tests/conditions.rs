@@ -138,7 +138,8 @@ fn conflicting_conditions_name_the_node() {
 }
 
 /// A fixed square of two triangles and a separate, unconstrained triangle: the global
-/// rigid modes are removed, but the island is singular; the error names one of its nodes.
+/// rigid modes are removed, but the island is singular; the check names it (one cell of
+/// three, its three free modes) before any factorisation.
 #[test]
 fn unconstrained_island_fails_at_its_node() {
     let nodes = vec![
@@ -162,16 +163,26 @@ fn unconstrained_island_fails_at_its_node() {
         components: [Some(0.0.into()), Some(0.0.into())],
     };
     match setup(&grid, &[fix], &[]) {
-        Err(SimError::NotPositiveDefinite { location, .. }) => {
-            assert!(
-                ["node 4 ", "node 5 ", "node 6 "]
-                    .iter()
-                    .any(|s| location.contains(s)),
-                "{location}"
+        Err(e @ SimError::FloatingPart { .. }) => {
+            let msg = e.to_string();
+            let SimError::FloatingPart {
+                cells,
+                total,
+                cell_index,
+                modes,
+                ..
+            } = e
+            else {
+                unreachable!()
+            };
+            assert_eq!(
+                (cells, total, cell_index, modes.len()),
+                (1, 3, 2, 3),
+                "{msg}"
             );
-            eprintln!("island: {location}");
+            assert!(msg.contains("cell 2 at (3.333"), "{msg}");
         }
-        other => panic!("expected NotPositiveDefinite, got {:?}", other.map(|_| ())),
+        other => panic!("expected FloatingPart, got {:?}", other.map(|_| ())),
     }
 }
 

@@ -133,3 +133,62 @@ fn mdem_zone_in_a_faulted_corner_point_grid_passes_the_patch_test() {
         assert!(ds < 1e-9, "stress error {ds:.2e}");
     }
 }
+
+/// Two blocks of a deck cut apart by inactive cells (`ACTNUM 1 0 0 1 1`) share no node:
+/// with displacements fixed only on the `imin` side the east block of two cells floats,
+/// and the check names it (its size, one of its cells and its six free modes) instead
+/// of leaving a singular system to the solver; fixed on `imax` too, both are held.
+#[test]
+fn an_island_of_cells_left_free_is_named() {
+    let mut deck =
+        Deck::on_vertical_pillars([5, 1, 1], [10.0, 10.0], |_, _, _, k| 100.0 + 5.0 * k as f64);
+    deck.actnum = Some(vec![true, false, false, true, true]);
+    let cp = corner_point_grid(&deck).unwrap();
+    let grid = &cp.grid;
+    assert_eq!(grid.num_cells(), 3);
+    let fixed = |side: &str| Displacement {
+        name: side.into(),
+        faces: grid.boundary(side).unwrap(),
+        components: std::array::from_fn(|_| Some(ScalarField::Const(0.0))),
+    };
+    // `imin` holds the west cell only: the faces of the hole are imin/imax faces too, so
+    // take the faces of the west cell's own side.
+    let west: Vec<usize> = grid
+        .boundary("imin")
+        .unwrap()
+        .into_iter()
+        .filter(|&f| cp.ijk[grid.face_cells(f).0] == [0, 0, 0])
+        .collect();
+    let held_west = Displacement {
+        name: "west".into(),
+        faces: west,
+        components: std::array::from_fn(|_| Some(ScalarField::Const(0.0))),
+    };
+    let dofs = DofMap::new(grid, std::slice::from_ref(&held_west), &[]).unwrap();
+    match dofs.check_rigid_modes(grid) {
+        Err(SimError::FloatingPart {
+            cells,
+            total,
+            cell_index,
+            modes,
+            ..
+        }) => {
+            assert_eq!((cells, total, cp.ijk[cell_index]), (2, 3, [3, 0, 0]));
+            assert_eq!(modes.len(), 6, "{modes:?}");
+        }
+        other => panic!("expected a floating part, got {other:?}"),
+    }
+    let east: Vec<usize> = grid
+        .boundary("imax")
+        .unwrap()
+        .into_iter()
+        .filter(|&f| cp.ijk[grid.face_cells(f).0] == [4, 0, 0])
+        .collect();
+    let held_east = Displacement {
+        name: "east".into(),
+        faces: east,
+        ..fixed("imax")
+    };
+    let dofs = DofMap::new(grid, &[held_west, held_east], &[]).unwrap();
+    assert!(dofs.check_rigid_modes(grid).is_ok());
+}

@@ -6,7 +6,7 @@ use porofrac_grid::generate::{
     CompositeSpec, Diagonals, RoundWellSpec, cartesian, composite, extrude, perturb, round_well,
     simplices, voronoi,
 };
-use porofrac_grid::io::grdecl::{CornerPointGrid, DeckLimit, fault_faces};
+use porofrac_grid::io::grdecl::{CornerPointGrid, DeckLimit, check_cell_properties, fault_faces};
 use porofrac_grid::io::{read_grdecl_with, read_msh, read_vtu};
 use porofrac_grid::{Grid, GridError, Point};
 
@@ -107,6 +107,9 @@ pub fn build_grid(ls: &LoadedScene) -> Result<(AnyGrid, DeckCells), RunError> {
                     }
                 });
             let (deck, cp) = read_grdecl_with(&path, &limit).map_err(at_path)?;
+            if ls.scene.physics.flow == Some(true) {
+                check_cell_properties(&deck, &cp).map_err(at_path)?;
+            }
             let cells = DeckCells::from_deck(&deck, &cp);
             let (grid, mut cells) = with_mdem_zone(ls, cp.grid, cells)?;
             if let AnyGrid::Three(g3) = &grid {

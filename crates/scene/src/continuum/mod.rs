@@ -101,6 +101,27 @@ fn run_dim<const D: usize>(
     // Checks every cell against its law once (e.g. MDEM on a polygon is an error).
     LawMap::new(grid, law_refs.clone(), comp.law_of_cell.clone())?;
     let dofs = DofMap::new(grid, &cond.displacements, &cond.platens)?;
+    // An island of cells left free (a deck's active cells cut off by inactive ones) is
+    // named by its deck (i, j, k) where there is one.
+    dofs.check_rigid_modes(grid).map_err(|e| match e {
+        porofrac_sim::SimError::FloatingPart {
+            cells,
+            total,
+            cell_index,
+            modes,
+            ..
+        } if cell_index < deck.ijk.len() => {
+            let [i, j, k] = deck.ijk[cell_index];
+            porofrac_sim::SimError::FloatingPart {
+                cells,
+                total,
+                cell: format!("the cell (i, j, k) = ({}, {}, {})", i + 1, j + 1, k + 1),
+                cell_index,
+                modes,
+            }
+        }
+        e => e,
+    })?;
     let pattern = Pattern::new(grid, &dofs)?;
     let assembly = t_asm.elapsed().as_secs_f64();
     let body = Body {

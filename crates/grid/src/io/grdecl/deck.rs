@@ -116,6 +116,9 @@ pub struct Deck {
     pub fault_multipliers: Vec<(String, f64)>,
     /// Keywords read but not used (their data skipped), in order of appearance.
     pub skipped: Vec<String>,
+    /// Where each array keyword (`COORD`, `ZCORN`, `ACTNUM`, `PORO`, …) was read: the
+    /// keyword, its file and its 1-based line, in order (for messages about its values).
+    pub keyword_lines: Vec<(String, PathBuf, usize)>,
 }
 
 impl Deck {
@@ -209,6 +212,9 @@ impl Deck {
 pub const MAX_DECK_CELLS: usize = 1 << 31;
 /// Deepest chain of `INCLUDE`s.
 const MAX_INCLUDE_DEPTH: usize = 16;
+/// Longest line of a deck (1 MiB, newline included); a token lies on one line, so this
+/// bounds tokens too.
+pub const MAX_LINE_BYTES: usize = 1 << 20;
 
 /// Read a GRDECL deck (following `INCLUDE`s relative to the including file).
 pub fn read_deck(path: impl AsRef<Path>) -> Result<Deck> {
@@ -240,7 +246,15 @@ pub fn read_deck_with(path: impl AsRef<Path>, limit: &DeckLimit) -> Result<Deck>
         limit: limit.clone(),
         ..DeckReader::default()
     };
-    reader.read_file(path.as_ref(), 0)?;
+    let path = path.as_ref();
+    if let Some(what) = not_regular(path) {
+        return Err(GridError::Io {
+            path: path.to_path_buf(),
+            source: std::io::Error::new(std::io::ErrorKind::InvalidInput, what),
+        });
+    }
+    reader.top = path.to_path_buf();
+    reader.read_file(path, 0)?;
     reader.finish()
 }
 
@@ -264,6 +278,14 @@ struct DeckReader {
     open: Vec<PathBuf>,
     /// The largest deck accepted.
     limit: DeckLimit,
+    /// The file the deck starts with, and its number of lines.
+    top: PathBuf,
+    last_line: usize,
+    /// A section after the grid's was met (`PROPS`, …): reading stops.
+    done: bool,
+    /// Where each `MULTFLT` record was read (file, line), in the order of
+    /// [`Deck::fault_multipliers`].
+    multflt_at: Vec<(PathBuf, usize)>,
 }
 
 /// A token of the deck: a word or number, a quoted string, or the record end `/`.
@@ -318,14 +340,27 @@ impl<R: BufRead> Lexer<R> {
             if rest.is_empty() || rest.starts_with(b"--") {
                 self.buf.clear();
                 self.pos = 0;
-                let n = self
-                    .input
+                // At most one byte more than a line may have, so that a file without
+                // newlines (or a device) is refused after 1 MiB, not read whole.
+                let n = (&mut self.input)
+                    .take(MAX_LINE_BYTES as u64 + 1)
                     .read_until(b'\n', &mut self.buf)
-                    .map_err(|e| self.error(format!("cannot read: {e}")))?;
+                    .map_err(|e| GridError::Parse {
+                        path: self.path.clone(),
+                        line: self.line + 1,
+                        what: format!("cannot read: {e}"),
+                    })?;
                 if n == 0 {
                     return Ok(None);
                 }
                 self.line += 1;
+                if self.buf.len() > MAX_LINE_BYTES && self.buf.last() != Some(&b'\n') {
+                    self.buf.clear();
+                    return Err(self.error(format!(
+                        "the line is longer than {MAX_LINE_BYTES} bytes (1 MiB, the most a deck \
+                         line may have; is this a deck?)"
+                    )));
+                }
                 continue;
             }
             if rest[0] == b'/' {
@@ -358,10 +393,11 @@ fn push_values(word: &str, out: &mut Vec<f64>, limit: usize) -> std::result::Res
         Some((n, v)) => {
             let n: usize = n
                 .parse()
-                .map_err(|_| format!("`{word}` is not a repeat count `n*value`"))?;
+                .map_err(|_| format!("`{}` is not a repeat count `n*value`", shown(word)))?;
             if v.is_empty() {
                 return Err(format!(
-                    "`{word}`: a default (`n*` without a value) has no meaning in a grid array"
+                    "`{}`: a default (`n*` without a value) has no meaning in a grid array",
+                    shown(word)
                 ));
             }
             (n, v)
@@ -370,13 +406,17 @@ fn push_values(word: &str, out: &mut Vec<f64>, limit: usize) -> std::result::Res
     };
     let v: f64 = value
         .parse()
-        .map_err(|_| format!("`{word}` is not a number"))?;
+        .map_err(|_| format!("`{}` is not a number", shown(word)))?;
     if !v.is_finite() {
-        return Err(format!("`{word}` is not a finite number"));
+        return Err(format!("`{}` is not a finite number", shown(word)));
     }
-    if out.len() + count > limit {
+    // Checked before anything is pushed: a repeat count may be any number the deck
+    // writes (`18446744073709551615*1`), the values read so far never pass `limit`.
+    if count > limit.saturating_sub(out.len()) {
         return Err(format!(
-            "more than the {limit} values this keyword can have"
+            "`{}` makes more than the {limit} values this keyword can have ({} read before it)",
+            shown(word),
+            out.len()
         ));
     }
     out.extend(std::iter::repeat_n(v, count));
@@ -384,22 +424,10 @@ fn push_values(word: &str, out: &mut Vec<f64>, limit: usize) -> std::result::Res
 }
 
 impl DeckReader {
+    /// Read one file of the deck; `depth` is the number of `INCLUDE`s that led here (the
+    /// caller has checked the depth, cycles and that the file is a regular file).
     fn read_file(&mut self, path: &Path, depth: usize) -> Result<()> {
-        if depth > MAX_INCLUDE_DEPTH {
-            return Err(GridError::Parse {
-                path: path.to_path_buf(),
-                line: 0,
-                what: format!("INCLUDE nested deeper than {MAX_INCLUDE_DEPTH} files"),
-            });
-        }
         let canonical = path.canonicalize().unwrap_or_else(|_| path.to_path_buf());
-        if self.open.contains(&canonical) {
-            return Err(GridError::Parse {
-                path: path.to_path_buf(),
-                line: 0,
-                what: "INCLUDE cycle: the file includes itself".into(),
-            });
-        }
         let file = File::open(path).map_err(|source| GridError::Io {
             path: path.to_path_buf(),
             source,
@@ -408,6 +436,9 @@ impl DeckReader {
         let mut lexer = Lexer::new(BufReader::with_capacity(1 << 16, file), path);
         let result = self.read_tokens(&mut lexer, path, depth);
         self.open.pop();
+        if depth == 0 {
+            self.last_line = lexer.line;
+        }
         result
     }
 
@@ -418,12 +449,16 @@ impl DeckReader {
         depth: usize,
     ) -> Result<()> {
         while let Some(tok) = lx.next()? {
+            if self.done {
+                break;
+            }
             let word = match tok {
                 Token::Word(w) => w.to_ascii_uppercase(),
                 Token::Slash => continue,
                 Token::Quoted(q) => {
                     return Err(lx.error(format!(
-                        "'{q}': a quoted string where a keyword is expected"
+                        "'{}': a quoted string where a keyword is expected",
+                        shown(&q)
                     )));
                 }
             };
@@ -499,7 +534,7 @@ impl DeckReader {
                 }
                 "GRIDUNIT" => {
                     let unit = match lx.next()? {
-                        Some(Token::Word(w) | Token::Quoted(w)) => w.to_ascii_uppercase(),
+                        Some(Token::Word(w) | Token::Quoted(w)) => w.trim().to_ascii_uppercase(),
                         _ => return Err(lx.error("GRIDUNIT: needs a unit (METRES, FEET or CM)")),
                     };
                     self.gridunit_scale = Some(match unit.as_str() {
@@ -508,7 +543,8 @@ impl DeckReader {
                         "CM" => 0.01,
                         other => {
                             return Err(lx.error(format!(
-                                "GRIDUNIT: unit `{other}` is not METRES, FEET or CM"
+                                "GRIDUNIT: unit `{}` is not METRES, FEET or CM",
+                                shown(other)
                             )));
                         }
                     });
@@ -523,15 +559,40 @@ impl DeckReader {
                         Some(Token::Word(w) | Token::Quoted(w)) => w,
                         _ => return Err(lx.error("INCLUDE: needs a file name")),
                     };
+                    let target = resolve_include(path, &name)
+                        .map_err(|why| lx.error(format!("INCLUDE '{}': {why}", shown(&name))))?;
+                    let canonical = target.canonicalize().unwrap_or_else(|_| target.clone());
+                    if let Some(at) = self.open.iter().position(|p| *p == canonical) {
+                        let chain: Vec<String> = self.open[at..]
+                            .iter()
+                            .chain([&canonical])
+                            .map(|p| {
+                                p.file_name()
+                                    .unwrap_or_default()
+                                    .to_string_lossy()
+                                    .into_owned()
+                            })
+                            .collect();
+                        return Err(lx.error(format!(
+                            "INCLUDE '{}': a cycle of includes ({})",
+                            shown(&name),
+                            chain.join(" → ")
+                        )));
+                    }
+                    if depth + 1 > MAX_INCLUDE_DEPTH {
+                        return Err(lx.error(format!(
+                            "INCLUDE '{}': includes nested deeper than {MAX_INCLUDE_DEPTH} files",
+                            shown(&name)
+                        )));
+                    }
                     self.skip_record(lx)?;
-                    let target = resolve_include(path, &name).ok_or_else(|| {
-                        lx.error(format!(
-                            "INCLUDE '{name}': no such file next to {} (tried the name as given, \
-                             upper- and lower-case)",
-                            path.display()
-                        ))
-                    })?;
                     self.read_file(&target, depth + 1)?;
+                }
+                // The sections after GRID and EDIT hold no grid data (and records this
+                // reader does not parse): the deck's grid is read.
+                "PROPS" | "REGIONS" | "SOLUTION" | "SUMMARY" | "SCHEDULE" => {
+                    self.done = true;
+                    break;
                 }
                 w if NO_DATA.contains(&w) => {}
                 w if is_keyword(w) => {
@@ -542,7 +603,8 @@ impl DeckReader {
                 }
                 other => {
                     return Err(lx.error(format!(
-                        "`{other}` where a keyword is expected (is a record missing its `/`?)"
+                        "`{}` where a keyword is expected (is a record missing its `/`?)",
+                        shown(other)
                     )));
                 }
             }
@@ -578,18 +640,20 @@ impl DeckReader {
                     .filter(|m| m.is_finite() && *m >= 0.0);
                 let Some(m) = m else {
                     return Err(lx.error(format!(
-                        "MULTFLT: fault '{name}' needs a multiplier ≥ 0 (record: {})",
-                        items.join(" ")
+                        "MULTFLT: fault '{}' needs a multiplier ≥ 0 (record: {})",
+                        shown(&name),
+                        shown(&items.join(" "))
                     )));
                 };
                 self.deck.fault_multipliers.push((name, m));
+                self.multflt_at.push((lx.path.clone(), lx.line));
                 continue;
             }
             let bad = || {
                 lx.error(format!(
                     "FAULTS: record `{}` is not 'name' i1 i2 j1 j2 k1 k2 'face' with 1 ≤ i1 ≤ i2 ≤ nx \
                      (and so for j, k) and face X, X-, Y, Y-, Z or Z-",
-                    items.join(" ")
+                    shown(&items.join(" "))
                 ))
             };
             if items.len() < 8 {
@@ -662,7 +726,7 @@ impl DeckReader {
                     }
                 }
                 Some(Token::Quoted(q)) => {
-                    return Err(lx.error(format!("{word}: '{q}' is not a number")));
+                    return Err(lx.error(format!("{word}: '{}' is not a number", shown(&q))));
                 }
                 None => {
                     return Err(lx.error(format!(
@@ -703,11 +767,18 @@ impl DeckReader {
 
     fn finish(self) -> Result<Deck> {
         let mut deck = self.deck;
+        deck.keyword_lines = self
+            .arrays_at
+            .iter()
+            .map(|(word, file, line, _)| (word.clone(), file.clone(), *line))
+            .collect();
         let Some((dims_file, dims_line)) = self.dims_at else {
             return Err(GridError::Parse {
-                path: self.open.first().cloned().unwrap_or_default(),
-                line: 0,
-                what: "no SPECGRID or DIMENS: the grid size is missing".into(),
+                path: self.top,
+                line: self.last_line.max(1),
+                what: "no SPECGRID or DIMENS in the deck (read to its end): the grid size is \
+                       missing"
+                    .into(),
             });
         };
         let [nx, ny, nz] = deck.dims;
@@ -740,23 +811,34 @@ impl DeckReader {
             if !present {
                 return Err(GridError::Parse {
                     path: dims_file.clone(),
-                    line: 0,
-                    what: format!("no {word}: a corner-point grid needs COORD and ZCORN"),
+                    line: dims_line,
+                    what: format!(
+                        "no {word} in the deck of this grid size: a corner-point grid needs \
+                         COORD and ZCORN{}",
+                        if deck.skipped.iter().any(|w| w == "DX" || w == "TOPS") {
+                            " (block-centred grids, DX DY DZ TOPS, are not read)"
+                        } else {
+                            ""
+                        }
+                    ),
                 });
             }
         }
-        if let Some((name, _)) = deck
+        if let Some(((name, _), (file, line))) = deck
             .fault_multipliers
             .iter()
-            .find(|(n, _)| !deck.faults.iter().any(|s| &s.name == n))
+            .zip(&self.multflt_at)
+            .find(|((n, _), _)| !deck.faults.iter().any(|s| &s.name == n))
         {
             return Err(GridError::Parse {
-                path: dims_file.clone(),
-                line: 0,
-                what: format!("MULTFLT: no fault named '{name}' in FAULTS"),
+                path: file.clone(),
+                line: *line,
+                what: format!("MULTFLT: no fault named '{}' in FAULTS", shown(name)),
             });
         }
-        let scale = self.gridunit_scale.unwrap_or(1.0) * deck.units.metres();
+        // GRIDUNIT, when given, is the unit of COORD and ZCORN; without it the unit
+        // system (METRIC, FIELD, LAB) is. The two are never multiplied together.
+        let scale = self.gridunit_scale.unwrap_or(deck.units.metres());
         if scale != 1.0 {
             deck.coord.iter_mut().for_each(|v| *v *= scale);
             deck.zcorn.iter_mut().for_each(|v| *v *= scale);
@@ -804,7 +886,8 @@ fn is_keyword(w: &str) -> bool {
 
 /// The file an `INCLUDE` names, relative to the including file's folder: as written,
 /// then upper-case, then lower-case (decks written on Windows name files in any case).
-fn resolve_include(from: &Path, name: &str) -> Option<PathBuf> {
+/// The first that exists must be a regular file; the error says why not.
+fn resolve_include(from: &Path, name: &str) -> std::result::Result<PathBuf, String> {
     let dir = from.parent().unwrap_or(Path::new("."));
     let given = Path::new(name);
     let base = if given.is_absolute() {
@@ -812,13 +895,46 @@ fn resolve_include(from: &Path, name: &str) -> Option<PathBuf> {
     } else {
         dir.join(given)
     };
-    if base.is_file() {
-        return Some(base);
+    let mut candidates = vec![base.clone()];
+    if let (Some(file), Some(parent)) = (base.file_name(), base.parent()) {
+        let file = file.to_string_lossy();
+        candidates.push(parent.join(file.to_ascii_uppercase()));
+        candidates.push(parent.join(file.to_ascii_lowercase()));
     }
-    let file = base.file_name()?.to_string_lossy().into_owned();
-    let parent = base.parent()?.to_path_buf();
-    [file.to_ascii_uppercase(), file.to_ascii_lowercase()]
-        .into_iter()
-        .map(|f| parent.join(f))
-        .find(|p| p.is_file())
+    match candidates.into_iter().find(|p| p.exists()) {
+        None => Err(format!(
+            "no such file next to {} (tried the name as given, upper- and lower-case)",
+            from.display()
+        )),
+        Some(p) => match not_regular(&p) {
+            None => Ok(p),
+            Some(what) => Err(format!("{}: {what}", p.display())),
+        },
+    }
+}
+
+/// Why a path that exists cannot be a deck file (`None` if it is a regular file):
+/// directories, devices (`/dev/zero`), FIFOs and sockets are refused before they are
+/// opened (opening a FIFO would wait for a writer).
+fn not_regular(path: &Path) -> Option<String> {
+    match std::fs::metadata(path) {
+        Ok(m) if m.is_file() => None,
+        Ok(m) if m.is_dir() => Some("is a directory, not a deck file".into()),
+        Ok(_) => Some("is not a regular file (a device, FIFO or socket), not a deck file".into()),
+        Err(e) => Some(format!("cannot be read: {e}")),
+    }
+}
+
+/// Longest piece of user text a message repeats (in characters).
+const SHOWN_CHARS: usize = 60;
+
+/// User text as a message shows it: whole up to [`SHOWN_CHARS`] characters, else its
+/// start and its length (`COORDXXXX… (5242880 characters)`), so that a huge token does
+/// not flood the terminal.
+pub(crate) fn shown(text: &str) -> String {
+    let mut chars = text.char_indices();
+    match chars.nth(SHOWN_CHARS) {
+        None => text.to_string(),
+        Some((end, _)) => format!("{}… ({} characters)", &text[..end], text.chars().count()),
+    }
 }

@@ -12,9 +12,11 @@ use crate::point::Point;
 
 use super::deck::Deck;
 
-/// Tolerance of the processing, relative to the size of the deck (the largest extent of
-/// its corner points): depths closer than this on a pillar are one node, and a cell
-/// thinner than this at all four pillars is pinched out.
+/// Tolerance of the processing, relative to the depths of the deck (the largest depth of
+/// its corners and pillar ends): depths closer than this on a pillar are one node, and a
+/// cell thinner than this at all four pillars is pinched out. Map coordinates do not
+/// count: with UTM coordinates (millions of metres) the tolerance would be millimetres,
+/// as large as real differences of depth.
 pub const RELATIVE_TOLERANCE: f64 = 1e-9;
 
 /// A corner-point grid as a polyhedral grid, with each cell's place in the deck.
@@ -147,6 +149,9 @@ struct Builder<'a> {
     verts: Vec<Vertex>,
     /// Scratch: the polygon of an overlap in `(s, z)`.
     polygon: Vec<(f64, f64)>,
+    /// Whether `i`, `j` and the depth make a right-handed frame (see
+    /// [`right_handed`]).
+    right_handed: bool,
 }
 
 /// Process a deck into a polyhedral grid.
@@ -163,10 +168,12 @@ pub fn corner_point_grid(deck: &Deck) -> Result<CornerPointGrid> {
             8 * n
         )));
     }
+    // Depths only: map coordinates (UTM, millions of metres) would make the tolerance
+    // millimetres, as large as real differences of depth.
     let scale = deck
         .coord
         .chunks(3)
-        .flat_map(|p| p.iter().copied())
+        .map(|p| p[2])
         .chain(deck.zcorn.iter().copied())
         .fold(0.0f64, |m, v| m.max(v.abs()))
         .max(f64::MIN_POSITIVE);
@@ -184,6 +191,7 @@ pub fn corner_point_grid(deck: &Deck) -> Result<CornerPointGrid> {
         subfaces: Vec::new(),
         verts: Vec::new(),
         polygon: Vec::new(),
+        right_handed: right_handed(deck)?,
     };
     let b = &mut builder;
     // --- Active cells (ACTNUM, not pinched), numbered in deck order. ---
@@ -370,41 +378,37 @@ pub fn corner_point_grid(deck: &Deck) -> Result<CornerPointGrid> {
     // Chunks of cells in parallel, joined in order.
     const CHUNK: usize = 4096;
     let b = &b;
-    let centres: Vec<Point<3>> = ijk
-        .par_iter()
-        .map(|&[i, j, k]| b.cell_centre(i, j, k))
-        .collect::<Result<_>>()?;
     let parts: Vec<(CellFaceLoops, Vec<u8>)> = (0..num_cells.div_ceil(CHUNK))
         .into_par_iter()
         .map(|ch| {
             let mut loops = CellFaceLoops::new();
             let mut loop_side: Vec<u8> = Vec::new();
             let mut face = Vec::new();
+            let mut scratch = Vec::new();
             for c in ch * CHUNK..((ch + 1) * CHUNK).min(num_cells) {
                 let [i, j, k] = ijk[c];
-                let centre = centres[c];
                 for bottom in [0, 1] {
                     b.horizontal_loop(i, j, k, bottom, &mut face)?;
-                    if b.emit(&mut loops, &mut face, &centre, false) {
-                        loop_side.push(4 + bottom as u8);
-                    }
+                    // The loop's normal is `(P(i+1) − P(i)) × (P(j+1) − P(j))`: down (out of
+                    // the bottom) in a right-handed deck.
+                    let outward = (bottom == 1) == b.right_handed;
+                    let added = b.emit(&mut loops, &mut face, outward, &mut scratch);
+                    loop_side.extend(std::iter::repeat_n(4 + bottom as u8, added));
                 }
                 for &(f, side) in &sub_of_cell[sub_pos[c]..sub_pos[c + 1]] {
                     let sf = &b.subfaces[f];
                     b.sub_face_loop(sf, &mut face);
-                    // Orientation from the cell on the minus side (or the only one), so
-                    // that the two cells of a shared sub-face see it in opposite
-                    // orientations.
-                    let (ref_centre, flip) = match sf.cells {
-                        [Some(m), _] if side == 1 => (centres[m], true),
-                        _ => (centre, false),
-                    };
-                    if b.emit(&mut loops, &mut face, &ref_centre, flip) {
-                        // The side this face looks at: the pair's direction, + for the
-                        // minus cell.
-                        let dir = if sf.pair < (nx + 1) * ny { 0 } else { 2 };
-                        loop_side.push(dir + if side == 0 { 1 } else { 0 });
-                    }
+                    // The loop runs along the top from `s = 0` to `s = 1`, then back along the
+                    // bottom: its normal is (pillar to pillar) × down, towards `i + 1` on an
+                    // i-pair of a right-handed deck and towards `j − 1` on a j-pair. The two
+                    // cells of a sub-face see it in opposite orientations.
+                    let ipair = sf.pair < (nx + 1) * ny;
+                    let outward = (ipair == b.right_handed) == (side == 0);
+                    let added = b.emit(&mut loops, &mut face, outward, &mut scratch);
+                    // The side this face looks at: the pair's direction, + for the minus
+                    // cell.
+                    let dir = if sf.pair < (nx + 1) * ny { 0 } else { 2 };
+                    loop_side.extend(std::iter::repeat_n(dir + u8::from(side == 0), added));
                 }
                 loops.finish_cell();
             }
@@ -419,7 +423,20 @@ pub fn corner_point_grid(deck: &Deck) -> Result<CornerPointGrid> {
     }
     drop(parts);
     let nodes = std::mem::take(&mut builder.nodes);
-    let mut grid = Grid::from_cell_faces(nodes, &loops)?;
+    // A cell the grid refuses (inverted, degenerate, not closed) is named by its deck
+    // (i, j, k).
+    let mut grid = Grid::from_cell_faces(nodes, &loops).map_err(|e| match e {
+        GridError::Cell { cell, what } if cell < ijk.len() => {
+            let [i, j, k] = ijk[cell];
+            GridError::Input(format!(
+                "cell (i, j, k) = ({}, {}, {}) (1-based): {what}",
+                i + 1,
+                j + 1,
+                k + 1
+            ))
+        }
+        e => e,
+    })?;
     let mut tags: BTreeMap<&str, Vec<usize>> = BTreeMap::new();
     for c in 0..num_cells {
         let faces = grid.cell_faces(c);
@@ -440,6 +457,37 @@ pub fn corner_point_grid(deck: &Deck) -> Result<CornerPointGrid> {
         pinched,
         inactive,
     })
+}
+
+/// Whether the deck's `i`, `j` and depth axes make a right-handed frame (`GDORIENT …
+/// DOWN RIGHT`, say) or a left-handed one (`… DOWN LEFT`): the sign of `(a × b) · z`
+/// summed over the columns, `a` and `b` the columns' edges from pillar `(i, j)` to `(i +
+/// 1, j)` and to `(i, j + 1)` (tops and bottoms of the pillars, seen from above). Face loops are
+/// oriented from it, for every cell alike.
+fn right_handed(deck: &Deck) -> Result<bool> {
+    let [nx, ny, _] = deck.dims;
+    let point = |i: usize, j: usize, end: usize| {
+        let p = 6 * (i + (nx + 1) * j) + 3 * end;
+        [deck.coord[p], deck.coord[p + 1]]
+    };
+    let mut sum = 0.0;
+    for end in [0, 1] {
+        for j in 0..ny {
+            for i in 0..nx {
+                let o = point(i, j, end);
+                let (a, b) = (point(i + 1, j, end), point(i, j + 1, end));
+                sum += (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
+            }
+        }
+    }
+    if sum == 0.0 || !sum.is_finite() {
+        return Err(GridError::Input(
+            "corner-point grid: the columns have no area seen from above (COORD's pillars \
+             do not span the map)"
+                .into(),
+        ));
+    }
+    Ok(sum > 0.0)
 }
 
 /// Push the gap between `above` and `below` onto a stack unless it is thinner than `tol`.
@@ -587,18 +635,36 @@ impl Builder<'_> {
                 poly.push((s, lower(s)));
             }
         }
-        // Drop vertices inside an edge (not on a pillar, on the line of their neighbours).
-        let mut k = 0;
-        while poly.len() > 3 && k < poly.len() {
-            let n = poly.len();
-            let (a, v, w) = (poly[(k + n - 1) % n], poly[k], poly[(k + 1) % n]);
+        // Drop vertices inside an edge (not on a pillar, on the line of their neighbours),
+        // in order, each once. A vertex is dropped only if it and the vertices dropped
+        // next to it all lie on the new edge: dropping one after the other, each against
+        // its neighbours of the moment, could bend the edge away from a node that other
+        // faces have on it (found again on the edge by `nodes_on_segment`).
+        let n = poly.len();
+        let mut keep = [true; 16];
+        let mut kept = n;
+        let on_edge = |a: (f64, f64), v: (f64, f64), w: (f64, f64)| {
             let between = (a.0 < v.0 && v.0 < w.0) || (w.0 < v.0 && v.0 < a.0);
-            if between && (at([a.1, w.1], (v.0 - a.0) / (w.0 - a.0)) - v.1).abs() <= tol {
-                poly.remove(k);
-            } else {
-                k += 1;
+            between && (at([a.1, w.1], (v.0 - a.0) / (w.0 - a.0)) - v.1).abs() <= tol
+        };
+        for k in 0..n {
+            if kept <= 3 {
+                break;
+            }
+            let prev = (1..n)
+                .map(|d| (k + n - d) % n)
+                .find(|&p| keep[p])
+                .unwrap_or(k);
+            let next = (1..n).map(|d| (k + d) % n).find(|&q| keep[q]).unwrap_or(k);
+            let (a, w) = (poly[prev], poly[next]);
+            let mut between = (1..n).map(|d| (prev + d) % n).take_while(|&x| x != next);
+            if between.all(|x| on_edge(a, poly[x], w)) {
+                keep[k] = false;
+                kept -= 1;
             }
         }
+        let mut flags = keep.iter();
+        poly.retain(|_| flags.next().copied().unwrap_or(true));
         let start = self.verts.len();
         let poly = std::mem::take(&mut self.polygon);
         for &(s, z) in &poly {
@@ -730,45 +796,124 @@ impl Builder<'_> {
         Ok(())
     }
 
-    /// The mean of the eight corners of cell `(i, j, k)`.
-    fn cell_centre(&self, i: usize, j: usize, k: usize) -> Result<Point<3>> {
-        let mut c = Point::<3>::zeros();
-        for q in 0..4 {
-            let p = (i + q % 2) + (self.nx + 1) * (j + q / 2);
-            for dk in 0..2 {
-                c += self.pillar_point(p, self.z(i, j, k, q, dk))?;
-            }
-        }
-        Ok(c / 8.0)
-    }
-
-    /// Append a face loop, oriented outward from `centre` (reversed if `flip`), without
-    /// repeated nodes; a loop of fewer than three nodes is dropped (returns whether the
-    /// loop was added).
+    /// Append a face loop, reversed unless it is `outward` already, without repeated
+    /// nodes; returns the number of loops added (see [`simple_loops`]: a loop that passes
+    /// twice through a node, where the corners of a pinched cell meet, is split there, and
+    /// loops of fewer than three nodes are dropped). The orientation is known from how
+    /// the loop was made, never guessed from the geometry, which a thin or partly pinched
+    /// cell makes unreliable.
     fn emit(
         &self,
         loops: &mut CellFaceLoops,
         face: &mut Vec<usize>,
-        centre: &Point<3>,
-        flip: bool,
-    ) -> bool {
+        outward: bool,
+        scratch: &mut Vec<usize>,
+    ) -> usize {
         face.dedup();
         while face.len() > 1 && face.first() == face.last() {
             face.pop();
         }
         if face.len() < 3 {
-            return false;
+            return 0;
         }
-        let m = face.len();
-        let mid = face.iter().map(|&n| self.nodes[n]).sum::<Point<3>>() / m as f64;
-        let mut normal = Point::<3>::zeros();
-        for k in 0..m {
-            normal += (self.nodes[face[k]] - mid).cross(&(self.nodes[face[(k + 1) % m]] - mid));
-        }
-        if (normal.dot(&(mid - centre)) < 0.0) != flip {
+        if !outward {
             face.reverse();
         }
-        loops.push_face(face);
-        true
+        simple_loops(face, scratch, |l| loops.push_face(l))
+    }
+}
+
+/// Split a closed loop of nodes into loops that each visit a node once, and pass those
+/// of at least three nodes to `push` (returns how many). A loop through a node twice
+/// (`a b c a d`: the corners of a pinched cell meeting on a face) is two loops joined at
+/// that node (`a b c` and `a d`); the loops keep the edges of the original in their
+/// direction, so the cell stays closed, and a loop of two nodes (an edge walked there and
+/// back) has no area. The split starts at the smallest node, so the two cells of a face,
+/// which see the loop reversed, split it into the same loops.
+fn simple_loops(face: &[usize], stack: &mut Vec<usize>, mut push: impl FnMut(&[usize])) -> usize {
+    let m = face.len();
+    let first = (0..m).min_by_key(|&k| face[k]).unwrap_or(0);
+    let mut added = 0;
+    stack.clear();
+    for k in 0..m {
+        let n = face[(first + k) % m];
+        if let Some(p) = stack.iter().position(|&x| x == n) {
+            if stack.len() - p >= 3 {
+                push(&stack[p..]);
+                added += 1;
+            }
+            stack.truncate(p + 1);
+        } else {
+            stack.push(n);
+        }
+    }
+    if stack.len() >= 3 {
+        push(stack);
+        added += 1;
+    }
+    added
+}
+
+#[cfg(test)]
+mod tests {
+    use super::simple_loops;
+
+    fn split(face: &[usize]) -> Vec<Vec<usize>> {
+        let mut out = Vec::new();
+        let n = simple_loops(face, &mut Vec::new(), |l| out.push(l.to_vec()));
+        assert_eq!(n, out.len());
+        out
+    }
+
+    /// Directed edges of loops, sorted.
+    fn edges(loops: &[Vec<usize>]) -> Vec<(usize, usize)> {
+        let mut e: Vec<_> = loops
+            .iter()
+            .flat_map(|l| (0..l.len()).map(move |k| (l[k], l[(k + 1) % l.len()])))
+            .collect();
+        e.sort_unstable();
+        e
+    }
+
+    #[test]
+    fn a_loop_through_a_node_twice_splits_there_keeping_its_edges() {
+        // a b c a d: the loop a b c, and the edge a d walked there and back (dropped).
+        assert_eq!(split(&[1, 2, 3, 1, 4]), vec![vec![1, 2, 3]]);
+        // Two triangles joined at node 5, from any starting node and either way round:
+        // the same two loops, reversed when the loop is.
+        let face = [5, 7, 8, 5, 9, 6];
+        let loops = split(&face);
+        assert_eq!(loops, vec![vec![5, 7, 8], vec![5, 9, 6]]);
+        let mut kept_edges = edges(&loops);
+        let mut all_edges = edges(&[face.to_vec()]);
+        kept_edges.sort_unstable();
+        all_edges.sort_unstable();
+        assert_eq!(kept_edges, all_edges);
+        // Canonical loops: each rotated to start at its smallest node, sorted.
+        let canon = |mut ls: Vec<Vec<usize>>| {
+            for l in &mut ls {
+                let m = (0..l.len()).min_by_key(|&k| l[k]).unwrap();
+                l.rotate_left(m);
+            }
+            ls.sort();
+            ls
+        };
+        for shift in 0..face.len() {
+            let mut rotated = face.to_vec();
+            rotated.rotate_left(shift);
+            assert_eq!(
+                canon(split(&rotated)),
+                canon(loops.clone()),
+                "shift {shift}"
+            );
+            let reversed: Vec<usize> = rotated.iter().rev().copied().collect();
+            let back: Vec<Vec<usize>> = split(&reversed)
+                .into_iter()
+                .map(|l| l.into_iter().rev().collect())
+                .collect();
+            assert_eq!(canon(back), canon(loops.clone()), "reversed, shift {shift}");
+        }
+        // A simple loop is kept whole.
+        assert_eq!(split(&[3, 1, 2, 4]), vec![vec![1, 2, 4, 3]]);
     }
 }
