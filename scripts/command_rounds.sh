@@ -5,11 +5,12 @@
 #
 #   scripts/command_rounds.sh FENICS_PYTHON [ROUNDS]
 #
-# FENICS_PYTHON: a Python with dolfinx (../shared/peers/fem/README.md). Each round runs,
-# for E2 n = 1000 and E3 n = 40: `porofrac run scenes/bench/eK.toml` (time = assembly +
-# solve of summary.json, error = errors.l2_displacement), the `solvers` example on the
-# same problem (assembly + setup + solve), and the peer once (BEST_OF_CHEAP_S=1: one
-# pass; assembly + solve). One line per run: round, problem, tool, seconds, L2 error.
+# FENICS_PYTHON: a Python with dolfinx (and the FEniCSx driver `run_dolfinx.py`, kept
+# outside this repository). Each round runs, for E2 n = 1000 and E3 n = 40: `porofrac run
+# scenes/bench/eK.toml` (time = assembly + solve of summary.json, error =
+# errors.l2_displacement), the `solvers` example on the same problem (assembly + setup +
+# solve), and the peer once (BEST_OF_CHEAP_S=1: one pass; assembly + solve). One line per
+# run: round, problem, tool, seconds, L2 error.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 py=$1

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Cosserat DEM speed and accuracy against two peers, back to back on the same meshes: the
-# plate with a hole (seed 001 E2; r = 0.216 mm, r/l = 1.063, N = 0.5, reference SCF 2.5548).
+# plate with a hole (F. Marazzato (2021), arXiv:2101.08712, §3.9.1; r = 0.216 mm, r/l =
+# 1.063, N = 0.5, reference SCF 2.5548).
 #
 # usage: scripts/cosserat_rounds.sh [LEVEL ...]        (default: 3 5 8 12 18)
 #

@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
-# Refinement study of the seed's hydraulic fracture (scenes/hydrofrac_seed.toml): the
-# round-well zone at h, h/√2 and h/2 (refine = 12, 17, 24; the well polygon follows, its
-# default node spacing being half the zone's triangle size), the zone's extent, the far
-# field, the loads and the schedule unchanged. Prints, per grid: cells,
-# fractured cells at 40 min, the reach of each wing and of the crack (largest distance of
-# a fractured centroid from the well centre), the direction of the crack (axis through
-# the well centre of the fractured centroids, degrees from x; the largest compression is
-# along y, 90°), the wall time; then the changes between the two finest grids.
+# Refinement study of the hydraulic fracture of Nilsen et al. (2017) §3
+# (scenes/hydrofrac_seed.toml): the round-well zone at h, h/√2 and h/2 (refine = 12, 17, 24;
+# the well polygon follows, its default node spacing being half the zone's triangle size),
+# the zone's extent, the far field, the loads and the schedule unchanged. Prints, per grid:
+# cells, fractured cells at 40 min, the reach of each wing and of the crack (largest
+# distance of a fractured centroid from the well centre), the direction of the crack (axis
+# through the well centre of the fractured centroids, degrees from x; the largest
+# compression is along y, 90°), the wall time; then the changes between the two finest
+# grids.
 #
 # Usage (from the repository root, after `cargo build --release -p porofrac-cli`):
 #     scripts/hydrofrac_refinement.sh [OUTDIR] [REFINE...]

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""Grid sensitivity of the seed's hydraulic fracture on the composite (staircase) well
-(scenes/hydrofrac_composite.toml, the former scenes/hydrofrac_seed.toml).
+"""Grid sensitivity of the hydraulic fracture of Nilsen et al. (2017) §3 on the composite
+(staircase) well (scenes/hydrofrac_composite.toml, the former scenes/hydrofrac_seed.toml).
 
 Runs variants of the scene through the release binary and prints, for each, the number of
 fractured cells, the angle of the principal axis of their centroids (degrees from x; the

@@ -9,7 +9,7 @@
 #           (scenes/lsm/borehole_dry.toml, 10 MPa/s to 10 MPa)
 #   wetted  dry, pressure wall on the faces the fluid wets ([loading] wall = "wetted")
 #   fluid   fluid injected into the hole (scenes/lsm_hydrofrac.toml; about 4 min each here)
-# The packing of the calibration samples follows the seed as well, so p_b (the closed form
+# The packing of the calibration samples follows the packing seed as well, so p_b (the closed form
 # with the Brazilian-calibrated sigma_t) is per seed. PORFRAC_BIN overrides the binary
 # (default: build target/release/porofrac). Runs go to target/lsm_breakdown/MODE-SEED;
 # with LSM_BREAKDOWN_REUSE=1 a run whose summary.json is there is tabulated, not redone.

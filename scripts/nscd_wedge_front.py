@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Wedge-front position against wall displacement for a forced-fold run (seed 003, F1).
+"""Wedge-front position against wall displacement for a forced-fold run (Renouf et al.
+(2006) §5.2, Fig. 7).
 
     python3 scripts/nscd_wedge_front.py OUT_DIR [LAYER_TOP] [WALL_SPEED] [FRAME_DT]
 

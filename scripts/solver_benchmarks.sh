@@ -4,11 +4,11 @@
 #
 #   scripts/solver_benchmarks.sh [fenics-python]
 #
-# fenics-python: a Python with dolfinx (see ../shared/peers/fem/README.md); without it the
-# peer rows are skipped. Each case is its own process so that the peak RSS belongs to it.
-# Columns of the porofrac rows: problem, n, dofs, equations, solver, grid, assembly, setup,
-# solve, assembly + setup + solve [s], CG iterations, relative residual, L2 error, peak RSS
-# [MB], hierarchy or factor.
+# fenics-python: a Python with dolfinx (for the FEniCSx driver `run_dolfinx.py`, kept
+# outside this repository); without it the peer rows are skipped. Each case is its own
+# process so that the peak RSS belongs to it. Columns of the porofrac rows: problem, n,
+# dofs, equations, solver, grid, assembly, setup, solve, assembly + setup + solve [s], CG
+# iterations, relative residual, L2 error, peak RSS [MB], hierarchy or factor.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo build --release -p porofrac-sim --example solvers >&2

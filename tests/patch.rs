@@ -11,7 +11,7 @@
 //!   strain); perturbed Kuhn tetrahedra, perturbed hexahedra (non-planar faces), and a
 //!   mixed grid of hexahedra and tetrahedra whose hexahedra next to a split cube carry the
 //!   shared square as two triangles (polyhedra with 7 to 9 faces), perturbed (3D).
-//!   Reference: the VEM consistency (seed eq. 26) makes linear fields exact.
+//!   Reference: the VEM consistency (Nilsen et al. (2017) eq. 26) makes linear fields exact.
 //! * `uniaxial_traction_*`: rollers on `xmin` (u_x = 0) and `ymin` (u_y = 0), traction
 //!   `(s, 0)` on `xmax`, the rest free. Exact: `σ = s e_x ⊗ e_x`,
 //!   plane strain `u = (s (1 − ν²)/E x, −s ν (1 + ν)/E y)`, plane stress

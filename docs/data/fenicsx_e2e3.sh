@@ -7,7 +7,7 @@
 #
 # usage: docs/data/fenicsx_e2e3.sh [PYTHON] [PEERS_DIR]
 #   PYTHON     the venv interpreter with dolfinx (default /tmp/fenv/bin/python)
-#   PEERS_DIR  directory of run_dolfinx.py (default /work/shared/peers/fem)
+#   PEERS_DIR  directory of run_dolfinx.py (the FEniCSx driver, kept outside this repository)
 # QUICK=1 runs a tiny ladder.
 set -euo pipefail
 PY=${1:-/tmp/fenv/bin/python}

@@ -1,4 +1,5 @@
-//! The seed's hydraulic-fracture scene (`scenes/hydrofrac_seed.toml`, seed §3, Fig. 4,
+//! The hydraulic-fracture example of H. M. Nilsen, I. Larsen, X. Raynaud (2017), arXiv:1702.01552,
+//! §3, Fig. 4 (`scenes/hydrofrac_seed.toml`,
 //! without fluid lag) through the command, variants of it, and the same scene with fluid
 //! lag (`scenes/hydrofrac_seed_fluid_lag.toml`).
 //!
@@ -37,8 +38,8 @@
 //!   (Kirsch: `3σxx − σyy = +3e6 Pa` at the top and bottom), so cells may fail at t = 0,
 //!   but only in that band; the first failures touch the well. The bundled scene
 //!   (1/8 m, 40 minutes) passes the same plane test (ignored for its run time).
-//! * **Monolithic against explicit pressure** (seed §2.5), where both apply: on the
-//!   seed's soft well the staggered explicit update diverges (coupling strength
+//! * **Monolithic against explicit pressure** (Nilsen et al. (2017) §2.5), where both apply: on the
+//!   paper's soft well the staggered explicit update diverges (coupling strength
 //!   `α²/(φ c_f K)` ≈ 30, docs/BENCHMARKS.md). With a well as stiff as the rock, a fluid
 //!   compressibility of 1e-7 /Pa (coupling strength 0.03) and 4 pore volumes per hour,
 //!   on the scene with fluid lag, both fail the same cells, the explicit update at most
@@ -68,7 +69,7 @@ fn seed_scene() -> String {
     std::fs::read_to_string(root().join("scenes/hydrofrac_seed.toml")).unwrap()
 }
 
-/// The seed's scene with fluid lag and a fixed fracture permeability.
+/// The paper's scene with fluid lag and a fixed fracture permeability.
 fn fluid_lag_scene() -> String {
     std::fs::read_to_string(root().join("scenes/hydrofrac_seed_fluid_lag.toml")).unwrap()
 }
@@ -323,7 +324,7 @@ fn with_fluid_lag_refinement_changes_the_reach_and_direction_little() {
     assert_refinement_converges(&fluid_lag_scene(), "fluid-lag");
 }
 
-/// The well pressure at the first failure and the first failed cells, for the seed's
+/// The well pressure at the first failure and the first failed cells, for the paper's
 /// scene with `well_size` on the wall, steps of 10 s over 240 s.
 fn breakdown(well_size: f64) -> (f64, Vec<[f64; 3]>) {
     let dir = tmp_dir(&format!("hydrofrac-breakdown-{well_size}"));
@@ -384,7 +385,7 @@ fn breakdown_pressure_is_hubbert_willis_at_the_top_of_the_well() {
 #[test]
 fn no_injection_no_fracture() {
     let dir = tmp_dir("hydrofrac-shut-in");
-    // Ten minutes: the seed's scene fails its first cell at 3 minutes with injection.
+    // Ten minutes: the paper's scene fails its first cell at 3 minutes with injection.
     let scene = variant(
         &dir,
         &seed_scene(),

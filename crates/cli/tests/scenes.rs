@@ -649,7 +649,8 @@ fn every_bundled_scene_passes_check() {
 
 #[test]
 fn fracture_toughness_transmissivity_and_lag_keys_are_checked() {
-    // The seed's scene with fluid lag: a fixed fracture permeability, no toughness.
+    // The scene of Nilsen et al. (2017) §3 with fluid lag: a fixed fracture permeability,
+    // no toughness.
     let seed =
         std::fs::read_to_string(root().join("scenes/hydrofrac_seed_fluid_lag.toml")).unwrap();
     // A toughness needs a tensile strength.

@@ -153,7 +153,7 @@ impl<const D: usize> Grid<D> {
     /// On each face φ is linear on the facets of the shared triangulation, with the value
     /// at a face point `x̄` equal to the average of the face's vertex values, so
     /// `Σ_i N_i ⊗ x_i = |K| I` holds exactly (the discrete divergence theorem behind the
-    /// VEM consistency and the Biot `div_d`; seed eqs. 24–26).
+    /// VEM consistency and the Biot `div_d`; Nilsen et al. (2017) eqs. 24–26).
     /// In 2D this is `N_i = ½ R(x_{i+1} − x_{i−1})`, R the clockwise rotation.
     ///
     /// On a simplex the face integrals have the closed form `N_i = |K| ∇λ_i` (λ the

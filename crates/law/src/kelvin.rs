@@ -12,7 +12,7 @@
 //! matrices `B_k = e_a ⊗ e_a` (normal components) and `B_k = (e_a ⊗ e_b + e_b ⊗ e_a)/√2`
 //! (shear components, pairs `(a, b)` as listed by [`kelvin_pair`]). A fourth-order
 //! elasticity tensor with the minor and major symmetries becomes the symmetric `K × K`
-//! matrix `D_kl = B_k : C : B_l` (seed §2.3, after eq. 26), and `σ_K = D ε_K`.
+//! matrix `D_kl = B_k : C : B_l` (Nilsen et al. (2017) §2.3, after eq. 26), and `σ_K = D ε_K`.
 //!
 //! # Representation
 //!

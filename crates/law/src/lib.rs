@@ -1,8 +1,8 @@
 //! The [`CellLaw`] trait, Kelvin notation and elastic stiffness tensors.
 //!
 //! A *cell law* turns the nodal displacements of one cell into its elastic energy, the
-//! forces it exerts on its nodes, its stress, and its local stiffness (seed §2: VEM,
-//! MDEM and central-force DEM are all cell laws). Laws know nothing about sparse
+//! forces it exerts on its nodes, its stress, and its local stiffness (Nilsen et al. (2017)
+//! §2: VEM, MDEM and central-force DEM are all cell laws). Laws know nothing about sparse
 //! matrices or grids beyond the [`CellGeometry`] view of one cell; assembly lives in
 //! `porofrac-sim`.
 //!
@@ -22,7 +22,8 @@
 //! * [`stiffness`] — [`Stiffness`]: isotropic (3D, plane strain, plane stress) and
 //!   general anisotropic elastic stiffness in Kelvin form, validated.
 //! * [`testkit`] — the invariants every cell law must satisfy, as checks usable from any
-//!   crate's tests (the `user_law` example of `porofrac-scene` defines a law outside porofrac and uses it in a scene).
+//!   crate's tests (the `user_law` example of `porofrac-scene` defines a law outside
+//!   porofrac and uses it in a scene).
 
 pub mod error;
 pub mod kelvin;

@@ -16,7 +16,7 @@
 //! * **Pressure outlet**: anti-bounce-back (Ginzburg 2008; Izquierdo & Fueyo 2008),
 //!   `L(x_f, ᾱ) = −L(x_b, α) + 2 w_α ρ_w [1 + 9/2 (c_α·u)² − 3/2 u²]`, `ρ_w = 1 + p/c_s²`
 //!   and `u` the velocity of `x_f` at the previous time.
-//! * **Obstacle**: Yu et al. (2003) interpolated bounce-back (seed eq. 7) with
+//! * **Obstacle**: Yu et al. (2003) interpolated bounce-back (Mora et al. (2015) eq. 7) with
 //!   `δ = |x_f − x_w|/|x_f − x_b|`:
 //!   `L(x_f, ᾱ) = [(1−δ) L(x_f, α) + δ L(x_b, α) + δ L(x_f2, ᾱ) − 6 w_α ρ₀ c_α·u_w]/(1+δ)`
 //!   with `x_f2 = x_f − c_α`; where `x_f2` is not fluid, the plain moving bounce-back
@@ -25,11 +25,11 @@
 //!   [`ObstacleMass::Conserved`](crate::ObstacleMass) (default) each body's imbalance
 //!   `m = Σ [L(x_f, ᾱ) − L(x_b, α)]` over its cut links is removed again,
 //!   `L(x_f, ᾱ) −= m w_α / Σ w_α`, before the force is summed.
-//! * **Force** (seed eq. 8, momentum exchange per cut link):
+//! * **Force** (Mora et al. (2015) eq. 8, momentum exchange per cut link):
 //!   `ΔF = c_α [L(x_b, α) + L(x_f, ᾱ) − 2 w_α ρ₀]` (gauge: the reference density's share
-//!   cancels over a body wetted all round, see [`crate::lattice`]), or with the Galilean-invariant correction of
-//!   Wen et al. (2014) `ΔF = (c_α − u_w) L(x_b, α) − (c_ᾱ − u_w) L(x_f, ᾱ)`; torque
-//!   `(x_w − X) × ΔF`.
+//!   cancels over a body wetted all round, see [`crate::lattice`]), or with the
+//!   Galilean-invariant correction of Wen et al. (2014) `ΔF = (c_α − u_w) L(x_b, α) − (c_ᾱ
+//!   − u_w) L(x_f, ᾱ)`; torque `(x_w − X) × ΔF`.
 //!
 //! No unknown is read by another rule of the same step (a rule reads only what crossed
 //! into a solid or ghost node, or populations of fluid nodes that are not unknowns), except
@@ -114,7 +114,7 @@ pub(crate) struct PressureLink {
 pub(crate) struct ObstacleLink {
     pub node: u32,
     pub alpha: u8,
-    /// `δ` of seed eq. 6.
+    /// `δ` of Mora et al. (2015) eq. 6.
     pub delta: f64,
     /// `x_f2`, or `u32::MAX` where it is not fluid.
     pub f2: u32,
@@ -124,7 +124,7 @@ pub(crate) struct ObstacleLink {
     pub p: [f64; 2],
 }
 
-/// How the force on an obstacle is summed from its cut links (seed eq. 8).
+/// How the force on an obstacle is summed from its cut links (Mora et al. (2015) eq. 8).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum MomentumExchange {
     /// `ΔF = c_α [L(x_b, α) + L(x_f, ᾱ)]`.

@@ -1,5 +1,5 @@
-//! Collision operators: BGK (seed eqs. 1–2) and two-relaxation-time (TRT), with the Guo
-//! forcing term.
+//! Collision operators: BGK (Mora et al. (2015) eqs. 1–2) and two-relaxation-time (TRT),
+//! with the Guo forcing term.
 //!
 //! With `f^±_i = (f_i ± f_ī)/2` the symmetric and antisymmetric parts of a direction pair,
 //! TRT relaxes them with two rates,

@@ -1,4 +1,4 @@
-//! The D2Q9 velocity set, described once (seed eq. 3).
+//! The D2Q9 velocity set, described once (Mora et al. (2015) eq. 3).
 //!
 //! Directions: 0 rest; 1–4 the axes `(1,0) (0,1) (-1,0) (0,-1)`; 5–8 the diagonals
 //! `(1,1) (-1,1) (-1,-1) (1,-1)`. Weights `4/9`, `1/9`, `1/36`; sound speed

@@ -1,5 +1,5 @@
 //! Obstacle shapes in lattice units (node `(i, j)` sits at `(i + ½, j + ½)`): inside test
-//! and where a lattice link enters the shape (seed eq. 6).
+//! and where a lattice link enters the shape (Mora et al. (2015) eq. 6).
 
 /// A rigid shape.
 #[derive(Clone, Copy, Debug, PartialEq)]

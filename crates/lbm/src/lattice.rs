@@ -12,14 +12,14 @@
 //! * if nodes changed owner, the cut links of every obstacle with a solid node within two
 //!   nodes of a changed node are rebuilt (a link reads its fluid node `x_f` and `x_f2`).
 //!
-//! **Covered and uncovered nodes** (seed §002.3). A fluid node that an obstacle covers
-//! leaves the fluid with its momentum `ρu`; the body gains it. A node it uncovers is
-//! refilled with `f^eq(ρ̄, u_w)`, `ρ̄` the mean density of its fluid neighbours and `u_w`
-//! the body's velocity there; the body loses `ρ̄ u_w`. These transfers are reported by
-//! [`Lattice::node_exchange`] apart from the momentum exchange on cut links
-//! ([`Lattice::force`]); the sum of both is the momentum the fluid gave the body, so the
-//! momentum of fluid plus bodies is conserved to round-off with the standard momentum
-//! exchange (the Galilean-invariant variant is not conservative).
+//! **Covered and uncovered nodes** (Mora et al. (2015) eqs. 6–7 with moving particles). A
+//! fluid node that an obstacle covers leaves the fluid with its momentum `ρu`; the body
+//! gains it. A node it uncovers is refilled with `f^eq(ρ̄, u_w)`, `ρ̄` the mean density of
+//! its fluid neighbours and `u_w` the body's velocity there; the body loses `ρ̄ u_w`. These
+//! transfers are reported by [`Lattice::node_exchange`] apart from the momentum exchange on
+//! cut links ([`Lattice::force`]); the sum of both is the momentum the fluid gave the body,
+//! so the momentum of fluid plus bodies is conserved to round-off with the standard
+//! momentum exchange (the Galilean-invariant variant is not conservative).
 //!
 //! **Gauge forces.** The momentum exchange of each cut link is taken relative to the fluid
 //! at rest at the reference density, `ΔF = c_α [L(x_b, α) + L(x_f, ᾱ) − 2 w_α ρ₀]`: the
@@ -28,9 +28,10 @@
 //! covered by others (touching particles of a rock) is not pushed by the ambient pressure
 //! `c_s² ρ₀` on its wetted part only, which the solid contacts would carry.
 //!
-//! **Mass sources** (seed §002.6, injection): `f_α += w_α S` on the fluid nodes of a
-//! source after every step, `S` the mass per node and step ([`Lattice::set_source_rate`]);
-//! it adds mass and no momentum. [`Lattice::injected_mass`] counts what went in.
+//! **Mass sources** (the injection of Mora et al. (2015), Fig. 9): `f_α += w_α S` on the
+//! fluid nodes of a source after every step, `S` the mass per node and step
+//! ([`Lattice::set_source_rate`]); it adds mass and no momentum. [`Lattice::injected_mass`]
+//! counts what went in.
 //!
 //! **Periodic sides**: an obstacle may cross a periodic side; its nodes are taken modulo the
 //! period and its geometry is computed with the image nearest its centre, which is kept in
@@ -75,7 +76,7 @@ pub struct LatticeConfig {
 
 /// The mass balance of the obstacle rules.
 ///
-/// The interpolated bounce-back (seed eq. 7) does not conserve mass: what it returns
+/// The interpolated bounce-back (Mora et al. (2015) eq. 7) does not conserve mass: what it returns
 /// along the cut links of a body differs from what arrived, by an amount that depends on
 /// the flow next to the wall. Against a body at rest in a symmetric flow it cancels; at a
 /// turning wall it does not (a disk of radius 6 turning at 0.02 spacings per step in a
@@ -1253,7 +1254,7 @@ impl Lattice {
     }
 
     /// The cut links of obstacle `k`: fluid node `(i, j)`, direction `α` into the body and
-    /// `δ` (seed eq. 6).
+    /// `δ` (Mora et al. (2015) eq. 6).
     pub fn cut_links_of(&self, k: usize) -> impl Iterator<Item = (usize, usize, usize, f64)> + '_ {
         self.links[k].iter().map(|l| {
             let (i, j) = self.ij(l.node as usize);

@@ -1,8 +1,8 @@
 //! A lattice Boltzmann fluid: D2Q9 with BGK or TRT collision and Guo forcing, fused
 //! stream–collide with in-place AA streaming, periodic sides, halfway bounce-back walls
 //! (moving walls included), velocity inlets and pressure outlets, and rigid obstacles whose
-//! surfaces fall between nodes (Yu et al. interpolated bounce-back, seed eq. 7) with force
-//! and torque by momentum exchange (seed eq. 8).
+//! surfaces fall between nodes (Yu et al. interpolated bounce-back, eq. 7 of the paper
+//! below) with force and torque by momentum exchange (its eq. 8).
 //!
 //! Mora, Wang & Alonso-Marroquin (2015), eqs. 1–3 and 6–8. Everything here is in lattice
 //! units (`Δx = Δt = 1`, reference density 1); [`Units`] converts from SI. The crate knows
@@ -11,8 +11,9 @@
 //! ([`ObstacleMotion::External`], [`Lattice::place_obstacle`],
 //! [`Lattice::update_obstacles`]: how coupled particles are carried; only what moved is
 //! re-rasterised, and the momentum of covered and uncovered nodes is reported). Mass
-//! sources ([`Lattice::add_source`]) inject fluid (seed §002.6); the temperature lattice
-//! ([`Thermal`]) keeps the books of the heat through the sides and out of each obstacle.
+//! sources ([`Lattice::add_source`]) inject fluid (as in that paper's Fig. 9); the
+//! temperature lattice ([`Thermal`]) keeps the books of the heat through the sides and out
+//! of each obstacle.
 //!
 //! ```
 //! use porofrac_lbm::{Lattice, LatticeConfig, Obstacle, Shape};

@@ -3,10 +3,11 @@
 //!
 //! `g_i^eq = w_i T (1 + 3 c_i·u)` with `w = 1/3` (rest) and `1/6` (axes), `T = Σ g_i`,
 //! BGK relaxation with `τ_g` per node: `χ = c_s² (τ_g − ½)` in the fluid and `χ_s` in solid
-//! nodes (seed §002.2, the recommended passive-scalar form; the solid distribution `h` of
-//! the seed is the same lattice with the solid relaxation time, so heat crosses the
-//! interface without an extra rule: with equal `ρ c_p` on both sides the flux is continuous
-//! to first order). Solid nodes are advected with the body's velocity.
+//! nodes (a passive-scalar form in place of the internal-energy equilibrium of Mora et al. (2015)
+//! eqs. 4–5, which as printed carries no temperature; their solid distribution `h` is the
+//! same lattice with the solid relaxation time, so heat crosses the interface without an
+//! extra rule: with equal `ρ c_p` on both sides the flux is continuous to first order).
+//! Solid nodes are advected with the body's velocity.
 //!
 //! Sides, on the halfway link between the last node `x_f` and the ghost node:
 //! * periodic;

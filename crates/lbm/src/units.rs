@@ -1,7 +1,7 @@
 //! SI ↔ lattice units.
 //!
 //! With spacing `Δx`, kinematic viscosity `ν` and relaxation time `τ`, the lattice viscosity
-//! is `ν* = c_s² (τ − ½)` (seed §002.1), so `Δt = ν* Δx²/ν`. Velocities scale with
+//! is `ν* = c_s² (τ − ½)` (Mora et al. (2015) eqs. 1–2), so `Δt = ν* Δx²/ν`. Velocities scale with
 //! `Δx/Δt`, accelerations with `Δx/Δt²`, the gauge pressure is
 //! `p = c_s² (ρ* − 1) ρ (Δx/Δt)²`, forces per unit depth with `ρ Δx³/Δt²` and torques per
 //! unit depth with `ρ Δx⁴/Δt²`.

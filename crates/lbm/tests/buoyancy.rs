@@ -1,10 +1,10 @@
 //! Buoyancy of a fixed disk: fluid at rest under gravity in a closed box settles to the
 //! hydrostatic state `c_s² ∂ρ/∂y = −ρ g`, and the momentum exchange on the disk's cut
-//! links (seed eq. 8) then sums the pressure over its surface, `F = −∮ p n ds = ρ g π r²`
-//! upwards (Archimedes; ρ the density at the disk's centre). Checked within 2 % for BGK
-//! and TRT, at two radii and off-node centres (measured +1.74 % at r = 8.3 and +0.38 % at
-//! r = 12.6, for both); the horizontal force is below 1e-3 of it and
-//! the torque below 2 % of `F r` (link-wise forces are not normal to the surface).
+//! links (Mora et al. (2015) eq. 8) then sums the pressure over its surface, `F = −∮ p n ds
+//! = ρ g π r²` upwards (Archimedes; ρ the density at the disk's centre). Checked within 2 %
+//! for BGK and TRT, at two radii and off-node centres (measured +1.74 % at r = 8.3 and
+//! +0.38 % at r = 12.6, for both); the horizontal force is below 1e-3 of it and the torque
+//! below 2 % of `F r` (link-wise forces are not normal to the surface).
 
 use porofrac_lbm::{Collision, Lattice, LatticeConfig, Obstacle, Shape, SideKind};
 use std::f64::consts::PI;

@@ -1,10 +1,10 @@
-//! Circular Couette flow (seed eq. 7 on curved walls): fluid between an inner cylinder of
-//! radius R₁ turning at ω and a fixed enclosing cylinder of radius R₂ ([`Shape::Hollow`]),
-//! both surfaces between nodes, centre off the lattice. The steady Navier–Stokes solution
-//! is `u_θ(r) = A r + B/r`, `A = −ω R₁²/(R₂² − R₁²)`, `B = ω R₁² R₂²/(R₂² − R₁²)`. The
-//! relative L2 error of `u_θ` over the fluid nodes falls at second order under refinement
-//! (R₂ = 12, 24, 48 spacings, R₁ = R₂/2, diffusive scaling: wall speed ∝ 1/R₂, TRT with
-//! Λ = 3/16).
+//! Circular Couette flow (Mora et al. (2015) eq. 7 on curved walls): fluid between an inner
+//! cylinder of radius R₁ turning at ω and a fixed enclosing cylinder of radius R₂
+//! ([`Shape::Hollow`]), both surfaces between nodes, centre off the lattice. The steady
+//! Navier–Stokes solution is `u_θ(r) = A r + B/r`, `A = −ω R₁²/(R₂² − R₁²)`, `B = ω R₁²
+//! R₂²/(R₂² − R₁²)`. The relative L2 error of `u_θ` over the fluid nodes falls at second
+//! order under refinement (R₂ = 12, 24, 48 spacings, R₁ = R₂/2, diffusive scaling: wall
+//! speed ∝ 1/R₂, TRT with Λ = 3/16).
 //!
 //! The interpolated bounce-back alone gains mass at a turning wall (a disk of radius 6
 //! turning at 0.02 spacings per step in a closed 28² box: 669.0 → 671.2 in 5 000 steps),

@@ -4,8 +4,8 @@
 //! * Poiseuille between halfway walls (body force): TRT with `Λ = 3/16` and BGK at
 //!   `τ = ½ + √3/4` (also `Λ = 3/16`) give the exact parabola; BGK elsewhere is the exact
 //!   parabola plus a uniform slip that scales with `16Λ − 3` (Ginzburg & d'Humières 2003).
-//! * Plane Couette between walls that lie between nodes (box obstacles, seed eq. 7): the
-//!   linear profile to 1e-6.
+//! * Plane Couette between walls that lie between nodes (box obstacles, Mora et al. (2015)
+//!   eq. 7): the linear profile to 1e-6.
 //! * Taylor–Green decay: the kinematic viscosity within 1 %.
 //! * A disk and a box at rest in fluid at rest: force and torque zero to 1e-12.
 //! * Square array of cylinders (Stokes flow): `F/(μU)` against Sangani & Acrivos (1982),

@@ -1,4 +1,4 @@
-//! One bond: geometry, springs (seed 002.5) and the breakage test.
+//! One bond: geometry, springs (the ESyS-Particle bond model) and the breakage test.
 //!
 //! With `n = (x_j − x_i)/d`, `t = ẑ × n`, `d = |x_j − x_i|`:
 //!

@@ -4,18 +4,18 @@
 //! shear bond stiffnesses `k_n`, `k_s` in N/m² (force per metre per metre of stretch),
 //! bending stiffness `k_b` in N·m/m per radian.
 //!
-//! # Bond strength (seed 002.5, ESyS "direct Mohr–Coulomb" with a tension cut-off)
+//! # Bond strength (ESyS-Particle "direct Mohr–Coulomb" with a tension cut-off)
 //!
 //! A bond between disks of radii `R_i`, `R_j` has the width `w = 2 min(R_i, R_j)` and
 //! the strengths `F_t = σ_t w` (tension cut-off), `F_c = c w` (shear strength at zero
 //! normal force) and `M_max = σ_t w²/6` (bending, the elastic section modulus of a beam
 //! of width `w`). With `F_n` tension positive, it breaks
 //!
-//! * in **tension** if `F_n/F_t + |M_b|/M_max > 1` (β₁ = 1 of seed 002.5);
+//! * in **tension** if `F_n/F_t + |M_b|/M_max > 1` (β₁ = 1);
 //! * in **shear** if `|F_s| > F_c − F_n tan φ` (Mohr–Coulomb: compression raises the
 //!   shear strength, tension lowers it).
 //!
-//! With `σ_t = c / tan φ` this is the seed's `σ̂ > 1 or τ̂ > 1 − σ̂`; a cut-off above
+//! With `σ_t = c / tan φ` this is the ESyS `σ̂ > 1 or τ̂ > 1 − σ̂`; a cut-off above
 //! that apex of the Mohr–Coulomb line is refused (the shear test would fire first in
 //! pure tension).
 
@@ -115,7 +115,7 @@ pub struct ContactLaw {
     pub kn: f64,
     /// Tangential spring stiffness (N/m²), capped by Coulomb friction.
     pub ks: f64,
-    /// Coulomb friction coefficient μ (0.6 by default, seed 002.5).
+    /// Coulomb friction coefficient μ (0.6 by default, a common choice).
     pub friction: f64,
 }
 

@@ -1,6 +1,7 @@
-//! Lattice solid model (seed 002.5): 2D disks joined by breakable bonds with normal,
-//! shear and bending springs, frictional contacts between unbonded disks, explicit
-//! velocity Verlet in time.
+//! Lattice solid model (P. Mora, Y. Wang, F. Alonso-Marroquin (2015), J. Earth Sci.
+//! 26(1); that paper does not give the bond model, which follows Wang (2009) and
+//! ESyS-Particle): 2D disks joined by breakable bonds with normal, shear and bending
+//! springs, frictional contacts between unbonded disks, explicit velocity Verlet in time.
 //!
 //! * [`law`]: bond law (springs, Mohr–Coulomb strength with a tension cut-off), contact
 //!   law (linear or Hertz normal force, Coulomb friction), damping, prescribed motions;
@@ -16,7 +17,7 @@
 //! Everything is per metre of thickness: forces N/m, moments N·m/m, stiffnesses
 //! `k_n`, `k_s` in N/m² (Pa), `k_b` in N·m/m per radian, masses kg/m.
 //!
-//! # Hexagonal lattice: E and ν from k_n and k_s (seed 002.5, derived here)
+//! # Hexagonal lattice: E and ν from k_n and k_s (derived here)
 //!
 //! Equal disks of diameter d on a triangular lattice, every touching pair bonded. Under
 //! a homogeneous strain ε (and a rigid rotation w) the relative displacement of a bond

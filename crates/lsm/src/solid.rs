@@ -118,7 +118,7 @@ impl Adjacency {
     }
 }
 
-/// Bonded disks (seed 002.5). See the module docs for the scheme.
+/// Bonded disks (the ESyS-Particle bond model). See the module docs for the scheme.
 #[derive(Clone, Debug)]
 pub struct LatticeSolid {
     disks: Disks,

@@ -7,8 +7,8 @@
 //! `p a Δφ Σ_k e_k` over its rays. The forces sum to the pressure integral
 //! `∮ p n a dφ` over the wall (zero in total, the hoop load of the continuum on each
 //! side), so the tangential stress at the wall is `σ_θθ(a) = p (b² + a²)/(b² − a²)` for a
-//! disk of outer radius b (seed 002.8 item 7). The set is taken once, in the reference
-//! configuration (small strains).
+//! disk of outer radius b (the closed-form breakdown check). The set is taken once, in the
+//! reference configuration (small strains).
 //!
 //! **Wetted faces** ([`WallFaces::Wetted`]). A fluid filling the hole does not stop at the
 //! faces seen from the centre: it enters every notch between the lining disks and every

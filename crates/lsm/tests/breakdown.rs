@@ -1,11 +1,11 @@
 //! Random packings: the Brazilian test reports a tensile strength, and a pressurised
 //! borehole in a bonded disk (b = 10 m, a = 2 m, radii 0.2–0.5 m, dry: the pressure as
 //! wall forces, ramped over 40 wave crossings) initiates fracture near
-//! `p_b = σ_t (b² − a²)/(b² + a²)` (seed 002.8 item 7), with the first crack at the
-//! borehole wall. σ_t is the material's: the mean of the Brazilian tests of five
-//! packings of the same disk without its hole (caps one largest diameter thick).
-//! Initiation is the pressure of the first broken bond; the pressure at ten broken
-//! bonds (a crack a few grains long) is printed too.
+//! `p_b = σ_t (b² − a²)/(b² + a²)` (Lamé's thick cylinder with the tensile strength at the
+//! hole), with the first crack at the borehole wall. σ_t is the material's: the mean of the
+//! Brazilian tests of five packings of the same disk without its hole (caps one largest
+//! diameter thick). Initiation is the pressure of the first broken bond; the pressure at
+//! ten broken bonds (a crack a few grains long) is printed too.
 
 use porofrac_lsm::calibrate::{QuasiStatic, brazilian, hexagonal_springs};
 use porofrac_lsm::{BondLaw, Damping, LatticeSolid, LsmSpec};
@@ -117,7 +117,7 @@ fn borehole_breaks_down_near_the_thick_cylinder_estimate() {
             p_first / pb,
             p10 / pb
         );
-        // Initiation (seed 002.8 item 7: "fracture initiates near p_b"): the first break.
+        // Initiation (fracture should initiate near p_b): the first break.
         ratios.push(p_first / pb);
         // The first crack starts at the borehole wall (within two largest diameters).
         assert!(

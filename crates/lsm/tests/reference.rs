@@ -1,4 +1,4 @@
-//! Checks of the lattice solid against closed forms (seed 002.8 item 6):
+//! Checks of the lattice solid against closed forms:
 //!
 //! 1. a bonded pair oscillates with the period `2π√(μ/k_n)` (μ the reduced mass) and
 //!    velocity Verlet keeps the energy within 1e-6 (relative) over 10⁴ periods;

@@ -1,5 +1,5 @@
-//! Seed §3, Figure 3: the stiffness lost by the central-force DEM model of a triangle,
-//! `T = C − 𝒦(diag 𝒦⁻¹(C))`, as the apex of the triangle moves.
+//! Nilsen et al. (2017) §3, Figure 3: the stiffness lost by the central-force DEM model of
+//! a triangle, `T = C − 𝒦(diag 𝒦⁻¹(C))`, as the apex of the triangle moves.
 //!
 //! The triangle has its base from (−½, 0) to (½, 0) and its apex at (x, y); at
 //! (0, √3/2) it is equilateral and, for E = 1, ν = 1/4 in plane strain, `𝐊` is

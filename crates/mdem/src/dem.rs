@@ -1,4 +1,4 @@
-//! The central-force DEM law (seed §2.6, eqs. 32–33).
+//! The central-force DEM law (Nilsen et al. (2017) §2.6, eqs. 32–33).
 //!
 //! Each edge of the simplex is an independent spring with stiffness
 //! `k_i = 𝐊_ii`, the diagonal of the MDEM edge stiffness `𝐊 = |K| M⁻ᵀ D M⁻¹` of the
@@ -30,7 +30,7 @@ use crate::simplex::{Frame, tensor_from_kelvin, with_k};
 pub enum DemMode {
     /// All edges act, in tension and compression.
     Elastic,
-    /// Only shortening edges act (post-failure, seed eq. 33).
+    /// Only shortening edges act (post-failure, Nilsen et al. (2017) eq. 33).
     CompressionOnly,
 }
 
@@ -218,7 +218,7 @@ impl<const D: usize> DemLaw<D> {
         })
     }
 
-    /// Stress `σ = (1/|K|) Mᵀ F` (seed eq. 18), or an error.
+    /// Stress `σ = (1/|K|) Mᵀ F` (Nilsen et al. (2017) eq. 18), or an error.
     pub fn try_stress(
         &self,
         cell: &CellGeometry<'_, D>,

@@ -1,11 +1,11 @@
 //! DEM with normal and shear springs and micro-rotations on regular lattices
-//! (seed §2.1, eqs. 7–14).
+//! (Nilsen et al. (2017) §2.1, eqs. 7–14).
 //!
 //! # Why a lattice model and not a cell law
 //!
 //! A contact with a shear spring needs the particles' micro-rotations `θ` as degrees of
 //! freedom: without them a rigid rotation of the assembly stretches the shear springs
-//! and produces forces (the seed's remark after eq. 14, checked in the tests). The
+//! and produces forces (the paper's remark after eq. 14, checked in the tests). The
 //! [`porofrac_law::CellLaw`] trait has displacement-only degrees of freedom, so this
 //! DEM variant is not a cell law. It lives here as a small lattice model used to
 //! reproduce the effective-moduli relations (eqs. 12–14) that motivate MDEM.
@@ -40,16 +40,16 @@
 //!
 //! # Normalisation
 //!
-//! The seed takes `V = 1` (and `d = 1`) in this sum ("the effective volume"). Since
+//! The paper takes `V = 1` (and `d = 1`) in this sum ("the effective volume"). Since
 //! each contact is shared by two particles, the stress that is the derivative of the
 //! energy per unit volume, `W = (1/V_p) Σ_m ½·½ (k_n |ΔU_n|² + k_s |ΔU_s|²)`
 //! (`V_p` = volume per particle), is the sum with `V = 2 V_p`; both are available
-//! ([`Normalisation`]). With the seed's `V = 1`, `d = 1`:
+//! ([`Normalisation`]). With the paper's `V = 1`, `d = 1`:
 //!
 //! * square (2D) and simple cubic (3D) lattices: `C₁₁ = 2 k_n`, `C₁₂ = 0`, shear
-//!   modulus `μ = k_s`. These lattices are not isotropic; the seed's
+//!   modulus `μ = k_s`. These lattices are not isotropic; the paper's
 //!   `λ = 2(k_n − k_s)` is the coefficient of `Σ_i e_ii²` in its energy expression,
-//!   i.e. `C₁₁ − 2μ`, not `C₁₂` (the seed's `tr(e) I` should read `diag(e)`).
+//!   i.e. `C₁₁ − 2μ`, not `C₁₂` (the paper's `tr(e) I` should read `diag(e)`).
 //! * FCC lattice (the vertices of the regular tetrahedral–octahedral honeycomb, the 3D
 //!   "regular simplex" packing): `C₁₂ = k_n − k_s`, `C₄₄ = k_n + k_s`, which is eq. 12
 //!   exactly with `λ = C₁₂`, `μ = C₄₄`; `C₁₁ = 2(k_n + k_s)`, so the lattice is
@@ -71,7 +71,7 @@ use crate::simplex::{kelvin_pairs, kelvin_size};
 /// Which volume divides the Love–Weber stress sum.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Normalisation {
-    /// The seed's choice, `V = 1`.
+    /// The choice of Nilsen et al. (2017), `V = 1`.
     Seed,
     /// `V = 2 V_p`: the stress is the derivative of the energy per unit volume.
     Energy,

@@ -1,7 +1,9 @@
 //! MDEM and central-force DEM cell laws on simplices, and a DEM lattice with shear
 //! springs and micro-rotations.
 //!
-//! # Edge extensions (seed §2.2, eq. 15)
+//! # Edge extensions (Nilsen et al. 2017, §2.2, eq. 15)
+//!
+//! The paper: H. M. Nilsen, I. Larsen, X. Raynaud (2017), arXiv:1702.01552.
 //!
 //! On a simplex with `D + 1` nodes there are `K = D(D+1)/2` edges, exactly as many as
 //! independent strain components (3 in 2D, 6 in 3D). Edge `k` joins nodes `a_k → b_k`
@@ -18,31 +20,31 @@
 //! nodal displacements of a simplex span exactly the linear fields, `U = R u` with
 //! `R` the edge-projection operator (row `k`: `−t_k` at node `a_k`, `+t_k` at `b_k`).
 //!
-//! # MDEM (seed §2.2, eqs. 16–21)
+//! # MDEM (§2.2, eqs. 16–21)
 //!
 //! The energy `E = ½ Uᵀ 𝐊 U = ½ εᵀ Mᵀ 𝐊 M ε` equals the linear-elastic energy of the
 //! cell, `|K| · ½ ε · D ε`, iff `Mᵀ 𝐊 M = |K| D`, i.e.
 //!
 //! ```text
-//! 𝐊 = |K| (M⁻¹)ᵀ D M⁻¹          (seed eq. 21, with the volume factor |K|)
+//! 𝐊 = |K| (M⁻¹)ᵀ D M⁻¹          (eq. 21, with the volume factor |K|)
 //! ```
 //!
-//! (the seed's eq. 19 writes the energy without the ½ and eq. 21 without `|K|`; both are
+//! (the paper's eq. 19 writes the energy without the ½ and eq. 21 without `|K|`; both are
 //! absorbed here so that `E` is the physical energy of the cell). Edge forces are
 //! `F = 𝐊 U` (eq. 17, tension positive), nodal forces are the edge forces acting along
 //! the edges, `f = −Rᵀ F` (restoring), the stress is `σ = (1/|K|) Mᵀ F = D ε`
 //! (eq. 18) and the local stiffness is `Rᵀ 𝐊 R`, which equals the P1 finite-element
-//! stiffness `|K| Bᵀ D B` and the VEM stiffness on the same simplex (seed §2.4, eq. 27).
+//! stiffness `|K| Bᵀ D B` and the VEM stiffness on the same simplex (§2.4, eq. 27).
 //!
-//! # Central-force DEM (seed §2.6, eqs. 32–33)
+//! # Central-force DEM (§2.6, eqs. 32–33)
 //!
 //! [`DemLaw`] keeps only the diagonal `𝐊_d = diag(𝐊)`: each edge is an independent
 //! spring. Its effective Cauchy stiffness `Mᵀ 𝐊_d M / |K|` differs from `D` unless `𝐊`
 //! is diagonal; [`dem_stiffness_loss`] computes the difference
-//! `T = C − 𝒦(𝒦⁻¹(C)_d)` of the seed's Figure 3. The post-failure variant acts only
+//! `T = C − 𝒦(𝒦⁻¹(C)_d)` of the paper's Figure 3. The post-failure variant acts only
 //! on shortening edges (compression only).
 //!
-//! # DEM with shear springs and rotations (seed §2.1, eqs. 7–14)
+//! # DEM with shear springs and rotations (§2.1, eqs. 7–14)
 //!
 //! See [`lattice`].
 

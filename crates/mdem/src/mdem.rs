@@ -1,4 +1,4 @@
-//! The MDEM cell law (seed §2.2, eqs. 15–21).
+//! The MDEM cell law (Nilsen et al. (2017) §2.2, eqs. 15–21).
 
 use nalgebra::{DMatrix, SMatrix, SVector};
 use porofrac_grid::Point;
@@ -146,7 +146,7 @@ impl<const D: usize> MdemLaw<D> {
         })
     }
 
-    /// Edge forces `F = 𝐊 U` (seed eq. 17; tension positive), length `K`.
+    /// Edge forces `F = 𝐊 U` (Nilsen et al. (2017) eq. 17; tension positive), length `K`.
     pub fn edge_forces(
         &self,
         coords: &[Point<D>],
@@ -220,7 +220,7 @@ impl<const D: usize> MdemLaw<D> {
         })
     }
 
-    /// Stress `σ = (1/|K|) Mᵀ F = D ε` (seed eq. 18), or an error.
+    /// Stress `σ = (1/|K|) Mᵀ F = D ε` (Nilsen et al. (2017) eq. 18), or an error.
     pub fn try_stress(
         &self,
         cell: &CellGeometry<'_, D>,

@@ -1,5 +1,5 @@
-//! Simplex edge geometry: the edge map `M` (seed eq. 15) and the maps between the
-//! MDEM edge stiffness `𝐊` and the Cauchy stiffness `C` (seed eqs. 20–21).
+//! Simplex edge geometry: the edge map `M` (Nilsen et al. (2017) eq. 15) and the maps between the
+//! MDEM edge stiffness `𝐊` and the Cauchy stiffness `C` (eqs. 20–21).
 //!
 //! The hot-path core ([`Frame`]) is fixed-size and allocation-free: `K = D(D+1)/2` is a
 //! second const parameter chosen by a `match` on `D` in the laws, so no trait bounds on
@@ -313,14 +313,15 @@ pub fn simplex_volume<const D: usize>(coords: &[Point<D>]) -> Result<f64, MdemEr
     with_k!(D, |K| Frame::<D, K>::new(coords).map(|f| f.volume))
 }
 
-/// The edge map `M` (`K × K`, seed eq. 15): `U = M ε` for the edges in [`edges`] order.
+/// The edge map `M` (`K × K`, Nilsen et al. (2017) eq. 15): `U = M ε` for the edges in
+/// [`edges`] order.
 pub fn edge_matrix<const D: usize>(coords: &[Point<D>]) -> Result<DMatrix<f64>, MdemError> {
     check_dim::<D>()?;
     with_k!(D, |K| Frame::<D, K>::new(coords).map(|f| to_dyn(&f.m)))
 }
 
 /// `𝒦⁻¹(C)`: the MDEM edge stiffness `𝐊 = |K| M⁻ᵀ C M⁻¹` of a simplex for the Kelvin
-/// Cauchy stiffness `c` (seed eq. 21 with the volume factor).
+/// Cauchy stiffness `c` (Nilsen et al. (2017) eq. 21 with the volume factor).
 pub fn edge_stiffness_from_cauchy<const D: usize>(
     coords: &[Point<D>],
     c: &DMatrix<f64>,
@@ -334,7 +335,7 @@ pub fn edge_stiffness_from_cauchy<const D: usize>(
 }
 
 /// `𝒦(𝐊)`: the Cauchy stiffness `C = Mᵀ 𝐊 M / |K|` (Kelvin) that an edge stiffness
-/// `𝐊` represents on a simplex (seed eq. 20 with the volume factor).
+/// `𝐊` represents on a simplex (Nilsen et al. (2017) eq. 20 with the volume factor).
 pub fn cauchy_from_edge_stiffness<const D: usize>(
     coords: &[Point<D>],
     kmat: &DMatrix<f64>,

@@ -1,5 +1,5 @@
-//! Central-force DEM law (seed eqs. 32–33): springs = diag of the MDEM edge stiffness,
-//! effective stiffness `Mᵀ𝐊_d M/|K|`, and the compression-only post-failure law.
+//! Central-force DEM law (Nilsen et al. (2017) eqs. 32–33): springs = diag of the MDEM edge
+//! stiffness, effective stiffness `Mᵀ𝐊_d M/|K|`, and the compression-only post-failure law.
 
 mod common;
 

@@ -1,7 +1,8 @@
-//! Seed §3, first example / Figure 3: `T = C − 𝒦(diag 𝒦⁻¹(C))`, the stiffness lost when
-//! a triangle keeps only the diagonal of its MDEM edge stiffness. Material: E = 1,
-//! ν = 1/4, plane strain (for plane stress the equilateral triangle's 𝐊 is diagonal at
-//! ν = 1/3 instead, checked below, so the seed's statement fixes plane strain).
+//! Nilsen et al. (2017) §3, first example / Figure 3: `T = C − 𝒦(diag 𝒦⁻¹(C))`, the
+//! stiffness lost when a triangle keeps only the diagonal of its MDEM edge stiffness.
+//! Material: E = 1, ν = 1/4, plane strain (for plane stress the equilateral triangle's 𝐊 is
+//! diagonal at ν = 1/3 instead, checked below, so the paper's statement fixes plane
+//! strain).
 
 use nalgebra::DMatrix;
 use porofrac_grid::Point;

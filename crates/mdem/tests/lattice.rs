@@ -1,5 +1,5 @@
-//! DEM lattices with normal/shear springs and micro-rotations (seed §2.1, eqs. 7–14):
-//! effective moduli against closed forms, Poisson-ratio limits, torque balance,
+//! DEM lattices with normal/shear springs and micro-rotations (Nilsen et al. (2017) §2.1,
+//! eqs. 7–14): effective moduli against closed forms, Poisson-ratio limits, torque balance,
 //! energy consistency of the stress.
 
 use nalgebra::DMatrix;
@@ -66,7 +66,8 @@ fn square_and_cubic_lattices_match_the_seed_relations() {
                 expect[(i, i)] = if i < dim { 2.0 * kn } else { 2.0 * ks };
             }
             assert!((&c - &expect).amax() <= TOL, "{c} vs {expect}");
-            // The seed's λ = 2(k_n − k_s) is C₁₁ − 2μ (coefficient of Σ e_ii²), μ = k_s.
+            // The λ = 2(k_n − k_s) of Nilsen et al. (2017) is C₁₁ − 2μ (coefficient of Σ
+            // e_ii²), μ = k_s.
             let mu = 0.5 * c[(k - 1, k - 1)];
             close(mu, ks, "μ");
             close(c[(0, 0)] - 2.0 * mu, 2.0 * (kn - ks), "seed λ");

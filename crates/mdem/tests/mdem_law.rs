@@ -1,4 +1,4 @@
-//! MDEM law: the law test kit, the defining identities of seed eqs. 15–21, P1
+//! MDEM law: the law test kit, the defining identities of Nilsen et al. (2017) eqs. 15–21, P1
 //! equivalence on fixed cells, and error handling.
 
 mod common;

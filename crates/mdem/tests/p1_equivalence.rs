@@ -1,7 +1,7 @@
-//! Property test (seed §2.4): on every non-degenerate simplex the MDEM local stiffness
-//! equals the P1 FEM stiffness `|K| Bᵀ D B` and the VEM stiffness (`porofrac-vem`, whose
-//! stabilisation vanishes on simplices), for isotropic and random anisotropic `D`.
-//! Tolerance: 1e-12 relative to `max |K_FEM|`.
+//! Property test (Nilsen et al. (2017) §2.4): on every non-degenerate simplex the MDEM
+//! local stiffness equals the P1 FEM stiffness `|K| Bᵀ D B` and the VEM stiffness
+//! (`porofrac-vem`, whose stabilisation vanishes on simplices), for isotropic and random
+//! anisotropic `D`. Tolerance: 1e-12 relative to `max |K_FEM|`.
 
 mod common;
 

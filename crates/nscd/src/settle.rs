@@ -1,13 +1,16 @@
-//! Sample preparation: gravity settling before the loading (seed 003, §5.2 "the sample
-//! is stabilised under gravity"; criterion from SEEDS 003.6).
+//! Sample preparation: gravity settling before the loading (M. Renouf, F. Dubois, P. Alart
+//! (2006), Eur. J. Comput. Mech. 15(5), §5.1.1: "a state equilibrium is reached by a
+//! stabilisation phase under gravity"; the paper gives no stopping criterion, the one here
+//! is this project's choice).
 //!
 //! The bodies are held still (velocities zero along every axis) and the system is
 //! stepped with step `h` until the kinetic energy
 //! K = Σ ½ m|v|² + ½ I ω² falls below `ratio` × ΔE_p, where
 //! ΔE_p = Σ m_i g·(x_i − x_i⁰) is the potential energy released since the start of the
-//! settling (positive for a fall). After the settling the bodies get their motion back, velocities of the
-//! disks are zeroed, the reference positions `x0` are reset to the settled ones (so
-//! displacements count from the settled state) and the clock is reset to 0.
+//! settling (positive for a fall). After the settling the bodies get their motion back,
+//! velocities of the disks are zeroed, the reference positions `x0` are reset to the
+//! settled ones (so displacements count from the settled state) and the clock is reset to
+//! 0.
 
 use crate::{Axis, Nscd, NscdError};
 
@@ -16,7 +19,7 @@ use crate::{Axis, Nscd, NscdError};
 pub struct SettleParams {
     /// Step (s).
     pub dt: f64,
-    /// Stop once K < `ratio` × ΔE_p (SEEDS 003.6: 1e-6).
+    /// Stop once K < `ratio` × ΔE_p (this project's choice: 1e-6).
     pub ratio: f64,
     /// Most settling steps; reaching it is an error.
     pub max_steps: usize,

@@ -1,5 +1,6 @@
-//! Gravity settling (SEEDS 003.6): the criterion K < ratio × ΔE_p, the energy released by
-//! a dropped disk, held bodies, and the state handed to the loading.
+//! Gravity settling (Renouf et al. (2006) §5.1.1; the criterion is this project's): the
+//! criterion K < ratio × ΔE_p, the energy released by a dropped disk, held bodies, and the
+//! state handed to the loading.
 
 use porofrac_nscd::{ContactLaw, Nscd, NscdError, RigidBody, SettleParams, SolverParams};
 use porofrac_particles::{Disks, RandomPacking};

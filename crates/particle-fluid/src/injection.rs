@@ -1,5 +1,5 @@
-//! Injection at a borehole: a mass source on the fluid nodes of a disk (seed §002.6,
-//! `f_α += w_α S Δt`), ramped in time.
+//! Injection at a borehole: a mass source on the fluid nodes of a disk (Mora et al. (2015)
+//! Fig. 9: a source term in the LBM, `f_α += w_α S Δt`), ramped in time.
 //!
 //! * [`InjectionControl::Pressure`]: the gauge pressure of the source nodes is driven
 //!   towards `p(t) = p_max min(t/t_ramp, 1)`; each step every source node receives

@@ -12,9 +12,11 @@
 //! 2. **Sources**: the injection sets its mass source for the step ([`Injection`]).
 //! 3. **Heat**: the temperature lattice collides and streams with the velocities of the
 //!    fluid and the disks (solid nodes carry the solid diffusivity; §002.2).
-//! 4. **Fluid**: collide, stream, interpolated bounce-back on the cut links (seed eq. 7).
-//! 5. **Loads**: momentum exchange on the cut links (seed eq. 8) plus the node exchange of
-//!    step 1, in SI per metre of depth: `F = F* ρ Δx³/Δt²` (N/m), `T = T* ρ Δx⁴/Δt²` (N).
+//! 4. **Fluid**: collide, stream, interpolated bounce-back on the cut links (Mora et al.
+//!    (2015) eq. 7).
+//! 5. **Loads**: momentum exchange on the cut links (Mora et al. (2015) eq. 8) plus the
+//!    node exchange of step 1, in SI per metre of depth: `F = F* ρ Δx³/Δt²` (N/m), `T = T*
+//!    ρ Δx⁴/Δt²` (N).
 //! 6. **Particles**: `n_sub = ⌈Δt / Δt_p⌉` sub-steps of `Δt/n_sub`, `Δt_p` the
 //!    particles' stable step ([`ParticleSolver::stable_dt`]), with the loads of step 5
 //!    held constant (their time average over the lattice step is the step's momentum
@@ -48,10 +50,10 @@
 //! covered and uncovered nodes, and the heat through the sides of the box.
 //!
 //! **Resolution.** A disk of radius below `min_radius_nodes · Δx` is refused (default 2:
-//! the seed's smallest particle, read as a radius, is two lattice spacings). A gap between
-//! solids narrower than about `2Δx` holds no fluid node, or one without a second fluid
-//! node behind it (the interpolation then falls back to plain bounce-back), so fluid does
-//! not enter cracks narrower than the spacing.
+//! the smallest particle of Mora et al. (2015), read as a radius, is two lattice spacings).
+//! A gap between solids narrower than about `2Δx` holds no fluid node, or one without a
+//! second fluid node behind it (the interpolation then falls back to plain bounce-back), so
+//! fluid does not enter cracks narrower than the spacing.
 
 mod injection;
 mod lsm;

@@ -1,4 +1,4 @@
-//! Measures of a fault-propagation experiment (seed 003, experiment F2, §5.3) from the
+//! Measures of a fault-propagation experiment (Renouf et al. (2006) §5.3) from the
 //! particle positions x, displacements u and slip s of the basement fault:
 //!
 //! * **moved particles**: |u| ≥ s/2, i.e. on the hanging-wall side of the half-slip

@@ -1,5 +1,5 @@
 //! porofrac scenes as a library: read a scene file into a validated, typed [`Scene`],
-//! compose its model and run it, writing the outputs of `SCENE.md` (summary, probes,
+//! compose its model and run it, writing the outputs of docs/SCENE.md (summary, probes,
 //! lines, fracture log, VTK, plots). The `porofrac` command is a thin layer over this
 //! crate (arguments, progress, exit codes); a Rust program gets the same outputs with
 //!

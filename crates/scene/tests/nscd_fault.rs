@@ -1,10 +1,10 @@
-//! The fault-propagation experiment (seed 003, F2) through the library: the trends of
-//! the seed on the bundled reduced runs (`scenes/nscd/fault_gamma*.toml`, the
+//! The fault-propagation experiment (Renouf et al. (2006) §5.3) through the library: the trends
+//! reported there on the bundled reduced runs (`scenes/nscd/fault_gamma*.toml`, the
 //! 150 m × 15 m geometry scaled by 1/5, and `fault_thick.toml`, scaled by 2/5) — those
-//! that hold run, the others are kept ignored with the measured values — and the scene keys of the settling and of the
-//! fault measures on a smaller sample ([`scene_text`]: geometry × `SCALE` of the
-//! paper's, radii, density, μ and γ unchanged, the basement block at the paper's
-//! 0.325 m/s for the run that gives the paper's slip over thickness, 13 m / 15 m,
+//! that hold run, the others are kept ignored with the measured values — and the scene keys
+//! of the settling and of the fault measures on a smaller sample ([`scene_text`]: geometry
+//! × `SCALE` of the paper's, radii, density, μ and γ unchanged, the basement block at the
+//! paper's 0.325 m/s for the run that gives the paper's slip over thickness, 13 m / 15 m,
 //! gravity settling first).
 
 use std::path::Path;
@@ -134,12 +134,12 @@ fn mean_p(r: &Run, a: f64, b: f64) -> f64 {
     v.iter().sum::<f64>() / v.len() as f64
 }
 
-/// W1 (seed Fig. 14, phase 1 then phase 2) without cohesion, on the bundled reduced run
-/// (`fault_gamma0.toml`, 4 000 steps, under a minute on one core): the settling meets
-/// K < 1e-6 ΔE_p; p rises fast — its mean over [T/8, T/4] is at least 1.3 × its settled
-/// value — then stays on a plateau: the mean over [T/4, T] is within 25 % of the
-/// phase-1 level. (On the smaller samples of [`scene_text`] packing seed 3 rises by
-/// only 1.28×: the trend needs the reduced size.)
+/// W1 (Renouf et al. (2006) Fig. 14, phase 1 then phase 2) without cohesion, on the bundled
+/// reduced run (`fault_gamma0.toml`, 4 000 steps, under a minute on one core): the settling
+/// meets K < 1e-6 ΔE_p; p rises fast — its mean over [T/8, T/4] is at least 1.3 × its
+/// settled value — then stays on a plateau: the mean over [T/4, T] is within 25 % of the
+/// phase-1 level. (On the smaller samples of [`scene_text`] packing seed 3 rises by only
+/// 1.28×: the trend needs the reduced size.)
 #[test]
 fn w1_pressure_rises_fast_then_plateaus() {
     let r = &bundled_run("0");
@@ -179,13 +179,13 @@ fn thick_run(gamma: f64) -> Run {
     run_scene(scene, &format!("thick-{gamma:e}"))
 }
 
-/// SEEDS 003.5 item 7, on the sample twice as thick (`fault_thick.toml`, packing seed 1):
-/// in phase 2 ([T/4, T]) the W1 pressure at γ = 1e5 is 2 ± 0.5 times that at γ = 0
-/// (paper Fig. 14: "about 2×"; measured 1.59, and 1.63 and 1.67 with packing seeds 2
-/// and 3, docs/BENCHMARKS.md), and the run-out at γ = 1e5 is below that at γ = 0 (the
-/// paper's run-out shrinking with γ, between its ends only: the four values are not
-/// monotonic in any packing; 2.67 against 3.66 m here). Two runs of 4 000 steps, about
-/// a minute each on one core.
+/// The trend of Renouf et al. (2006) §5.3.3 (Fig. 14), on the sample twice as thick
+/// (`fault_thick.toml`, packing seed 1): in phase 2 ([T/4, T]) the W1 pressure at γ = 1e5
+/// is 2 ± 0.5 times that at γ = 0 (paper Fig. 14: "about 2×"; measured 1.59, and 1.63 and
+/// 1.67 with packing seeds 2 and 3, docs/BENCHMARKS.md), and the run-out at γ = 1e5 is
+/// below that at γ = 0 (the paper's run-out shrinking with γ, between its ends only: the
+/// four values are not monotonic in any packing; 2.67 against 3.66 m here). Two runs of 4
+/// 000 steps, about a minute each on one core.
 #[test]
 fn strong_cohesion_doubles_w1_pressure_and_shortens_the_run_out() {
     let (free, cohesive) = std::thread::scope(|s| {
@@ -218,9 +218,9 @@ fn values(key: &str) -> Vec<f64> {
     bundled().iter().map(|r| fault(r, key)).collect()
 }
 
-/// SEEDS 003.5 item 7: θ_l decreases monotonically with γ. Measured on the bundled runs
-/// (docs/BENCHMARKS.md): 37.2°, 36.4°, 36.4°, 47.8° — not monotonic, and another packing
-/// seed gives 31.3°, 47.5°, 25.7°, 39.2°.
+/// Renouf et al. (2006) §5.3.2 (Fig. 12a): θ_l decreases monotonically with γ. Measured on
+/// the bundled runs (docs/BENCHMARKS.md): 37.2°, 36.4°, 36.4°, 47.8° — not monotonic, and
+/// another packing seed gives 31.3°, 47.5°, 25.7°, 39.2°.
 #[test]
 #[ignore = "does not hold: θ_l is not monotonic in γ on the reduced runs (docs/BENCHMARKS.md)"]
 fn limit_angle_decreases_with_cohesion() {
@@ -228,9 +228,9 @@ fn limit_angle_decreases_with_cohesion() {
     assert!(a.windows(2).all(|w| w[1] < w[0]), "{a:?}");
 }
 
-/// The seed's run-out shrinks as γ grows. Monotonic on the bundled runs (1.05, 0.76,
-/// 0.63, 0.38 m) but not with packing seed 2 (1.35, 0.18, 0.71, 0.53 m), and not on
-/// the smaller samples of the fast tests: not robust.
+/// The run-out of Renouf et al. (2006) §5.3.2 shrinks as γ grows. Monotonic on the bundled
+/// runs (1.05, 0.76, 0.63, 0.38 m) but not with packing seed 2 (1.35, 0.18, 0.71, 0.53 m),
+/// and not on the smaller samples of the fast tests: not robust.
 #[test]
 #[ignore = "not robust: monotonic for packing seed 1 only (docs/BENCHMARKS.md)"]
 fn run_out_shrinks_with_cohesion() {
@@ -238,7 +238,8 @@ fn run_out_shrinks_with_cohesion() {
     assert!(r.windows(2).all(|w| w[1] < w[0]), "{r:?}");
 }
 
-/// SEEDS 003.5 item 7: the trishear L2 mismatch is smallest at γ = 0. Measured 0.275,
+/// After Renouf et al. (2006) §5.3.2 (the trishear zone matches best without
+/// cohesion): the trishear L2 mismatch is smallest at γ = 0. Measured 0.275,
 /// 0.263, 0.221, 0.145 (fitted half apical angles 26°, 27°, 24°, 19°): the largest at
 /// γ = 0 for packing seed 1; smallest at γ = 0 for seed 2 (0.165, 0.283, 0.225, 0.204).
 #[test]

@@ -2,7 +2,9 @@
 //! any polygon (2D) or polyhedron (3D): convex or not, with hanging nodes (extra
 //! collinear or coplanar vertices) and, in 3D, non-planar faces.
 //!
-//! # The method (seed §2.3, eqs. 22–26; Gain, Talischi & Paulino 2014)
+//! # The method (Nilsen et al. 2017, §2.3, eqs. 22–26; Gain, Talischi & Paulino 2014)
+//!
+//! The paper: H. M. Nilsen, I. Larsen, X. Raynaud (2017), arXiv:1702.01552.
 //!
 //! The degrees of freedom are the nodal displacements `u_i`. The only geometry needed is
 //! the cell volume `|K|`, the node coordinates `x_i`, their *vertex average*
@@ -14,7 +16,7 @@
 //! **Projection.** By the divergence theorem the cell average of the displacement
 //! gradient is computable from the degrees of freedom,
 //! `G(u) = (1/|K|) ∫_K ∇u = (1/|K|) Σ_j u_j ⊗ N_j`. The projection onto linear fields
-//! `P = P_R + P_C` (seed §2.3) is
+//! `P = P_R + P_C` (§2.3) is
 //!
 //! ```text
 //!   (P u)(x) = ū + G(u) (x − x̄),     ū = (1/n) Σ_j u_j,
@@ -33,7 +35,7 @@
 //! Nodal form: `(P u)_i = Σ_j p_ij u_j` with the scalar weights
 //! `p_ij = 1/n + d_i · N_j / |K|`, i.e. `P = p ⊗ I_D` ([`projection_matrix`]).
 //!
-//! **Local stiffness** (seed eq. 26):
+//! **Local stiffness** (eq. 26):
 //!
 //! ```text
 //!   A_K = |K| W_c D W_cᵀ + (I − P)ᵀ S (I − P)
@@ -64,8 +66,8 @@
 //!
 //! # Stabilization
 //!
-//! The default ([`Stabilization::Mrst`]) is the one the seed used (MRST's `vemmech`), so
-//! results compare node by node: `S = α_K I` with
+//! The default ([`Stabilization::Mrst`]) is the one Nilsen et al. (2017) used (MRST's
+//! `vemmech`), so results compare node by node: `S = α_K I` with
 //!
 //! ```text
 //!   2D:  α_K = |K| (D₁₁ + D₂₂ + 2 D₃₃) / (2 Σ_i |x_i − x̄|²)
@@ -80,7 +82,7 @@
 //!
 //! [`volumetric_strain`] is the trace of the projected strain,
 //! `tr ε(u) = (1/|K|) Σ_i N_i · u_i`, the exact relative volume change of the cell under
-//! the nodal displacements (the `div_d` of seed eqs. 29–30 per unit volume);
+//! the nodal displacements (the `div_d` of Nilsen et al. (2017) eqs. 29–30 per unit volume);
 //! [`volumetric_strain_weights`] gives its coefficient vector.
 
 use nalgebra::DMatrix;
@@ -102,7 +104,7 @@ pub enum VemError {
 /// Choice of the stabilization matrix `S` in `A_K = A_c + (I − P)ᵀ S (I − P)`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Stabilization {
-    /// MRST `vemmech` (the seed's choice): `S = α_K I`,
+    /// MRST `vemmech` (the choice of Nilsen et al. (2017)): `S = α_K I`,
     /// `α_K = |K| (Σ_normal D_kk + 2 Σ_shear D_kk) / (D · Σ_i |x_i − x̄|²)`.
     #[default]
     Mrst,

@@ -5,12 +5,12 @@
 //! Built in: `vem` ([`porofrac_vem::VemLaw`]), `mdem` ([`porofrac_mdem::MdemLaw`]) and
 //! `dem` (the elastic central-force law, [`porofrac_mdem::DemLaw`]). A user adds a law
 //! with [`LawRegistry::register`] and runs scenes with it through
-//! [`crate::Scene::load_with`] (the `user_law` example of this crate registers a P1 law of its own and runs a scene
-//! with it).
+//! [`crate::Scene::load_with`] (the `user_law` example of this crate registers a P1 law of
+//! its own and runs a scene with it).
 //!
 //! What a failed cell becomes is part of the registration ([`PostFailure`]): MDEM and
-//! DEM cells switch to the compression-only central-force law (seed eqs. 32–33), VEM
-//! cells keep their law.
+//! DEM cells switch to the compression-only central-force law (Nilsen et al. (2017) eqs.
+//! 32–33), VEM cells keep their law.
 
 use std::collections::BTreeMap;
 use std::fmt;
@@ -33,7 +33,8 @@ pub trait LawFamily: Send + Sync + 'static {
 pub enum PostFailure {
     /// It keeps its law (failure is recorded and marked only).
     Keep,
-    /// The compression-only central-force DEM law of its material (seed eqs. 32–33).
+    /// The compression-only central-force DEM law of its material (Nilsen et al. (2017)
+    /// eqs. 32–33).
     CompressionOnlyDem,
 }
 

@@ -1,4 +1,4 @@
-//! Output files of a run (SCENE.md, "Outputs"): every file is written atomically
+//! Output files of a run (docs/SCENE.md, "Outputs"): every file is written atomically
 //! (a temporary file in the same directory, then a rename), so an interrupted run never
 //! leaves a half-written file.
 //!

@@ -1,6 +1,6 @@
-//! End-of-run plots of an NSCD scene (`plots/`): the probe series grouped as the seed's
-//! figures group them (cell stresses p and q; dilatations; the rest), and a picture of
-//! the disks coloured by nine horizontal layers of their initial height, as the seed
+//! End-of-run plots of an NSCD scene (`plots/`): the probe series grouped as the figures of
+//! Renouf et al. (2006) group them (cell stresses p and q; dilatations; the rest), and a picture of
+//! the disks coloured by nine horizontal layers of their initial height, as that paper
 //! colours its layers (Figs. 5, 11).
 
 use std::path::Path;

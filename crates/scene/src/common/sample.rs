@@ -1,4 +1,4 @@
-//! Sampling fields at points (probes and lines of SCENE.md).
+//! Sampling fields at points (probes and lines of docs/SCENE.md).
 //!
 //! A point is located in the cell that contains it; nodal fields are interpolated with
 //! the same piecewise-linear hat functions the laws and loads use: each cell is split

@@ -1,4 +1,4 @@
-//! The scene file: typed TOML sections of `SCENE.md`, and the locations of keys for error
+//! The scene file: typed TOML sections of docs/SCENE.md, and the locations of keys for error
 //! messages.
 //!
 //! Parsing is strict: unknown keys, wrong types and choices that are not one of the
@@ -148,12 +148,12 @@ pub enum InitialMechanics {
 #[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum CouplingChoice {
-    /// Fully implicit (seed eq. 30).
+    /// Fully implicit (Nilsen et al. (2017) eq. 30).
     #[default]
     Monolithic,
     /// Fixed-stress split.
     FixedStress,
-    /// The seed's explicit-pressure update (§2.5).
+    /// The explicit-pressure update of Nilsen et al. (2017) §2.5.
     ExplicitPressure,
     /// Flow on a fixed skeleton.
     None,
@@ -282,7 +282,7 @@ pub struct SceneSection {
     pub dim: i64,
     /// 2D only: plane strain (default) or plane stress.
     pub plane: Option<Plane>,
-    /// The model: `"continuum"` (default); see ../SCENE-MODELS.md for the others.
+    /// The model: `"continuum"` (default); see docs/SCENE.md for the others.
     pub model: Option<String>,
 }
 

@@ -1,5 +1,6 @@
-//! The lattice Boltzmann model (seed 002, `[scene] model = "lbm"`): a D2Q9 fluid with
-//! obstacles whose surfaces fall between nodes ([`porofrac_lbm`]).
+//! The lattice Boltzmann model (P. Mora, Y. Wang, F. Alonso-Marroquin (2015), J. Earth Sci.
+//! 26(1); `[scene] model = "lbm"`): a D2Q9 fluid with obstacles whose surfaces fall between
+//! nodes ([`porofrac_lbm`]).
 //!
 //! - *build*: the SI inputs of `[lbm]` are converted to lattice units ([`Units`]: `Δt`
 //!   from spacing, viscosity and tau), the sides of `[[lbm.boundary]]` and the

@@ -1,7 +1,7 @@
-//! Fluid and heat in a lattice solid scene (seed 002, §002.6): with `[lbm]` the disks are
-//! carried by a lattice Boltzmann fluid ([`porofrac_particle_fluid`]); `[thermal]`
-//! adds temperature (conjugate: the disks' nodes carry `solid_diffusivity`), `[injection]`
-//! a ramped mass source at the borehole.
+//! Fluid and heat in a lattice solid scene (Mora et al. (2015), §3 and Fig. 9): with
+//! `[lbm]` the disks are carried by a lattice Boltzmann fluid
+//! ([`porofrac_particle_fluid`]); `[thermal]` adds temperature (conjugate: the disks' nodes
+//! carry `solid_diffusivity`), `[injection]` a ramped mass source at the borehole.
 //!
 //! - *build*: the lattice of `[lbm]` (as the `lbm` model builds it), one moving obstacle per
 //!   disk; a disk of radius below two spacings is an error naming `lbm.spacing`;

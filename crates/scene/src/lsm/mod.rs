@@ -1,12 +1,12 @@
-//! The lattice solid model (seed 002.5, `[scene] model = "lsm"`): bonded disks
-//! ([`porofrac_lsm`]).
+//! The lattice solid model (P. Mora, Y. Wang, F. Alonso-Marroquin (2015), J. Earth Sci.
+//! 26(1); `[scene] model = "lsm"`): bonded disks ([`porofrac_lsm`]).
 //!
 //! - *build*: the disks of `[particles]` ([`crate::common::particles`]), the bond law of
 //!   `[bonds]` (E and ν through the hexagonal closed form, or k_n, k_s), `[contacts]`,
 //!   `[lsm]` (time step, damping, gravity) and `[loading]` (platens, a pressure ramp on
 //!   the hole, on the faces seen from its centre or on the faces a fluid would wet,
-//!   [`porofrac_lsm::WallFaces`]); with `[bonds] calibrate = true` a uniaxial compression and a Brazilian
-//!   test of the same packing recipe first ([`porofrac_lsm::calibrate`]);
+//!   [`porofrac_lsm::WallFaces`]); with `[bonds] calibrate = true` a uniaxial compression
+//!   and a Brazilian test of the same packing recipe first ([`porofrac_lsm::calibrate`]);
 //! - *step*: as many LSM steps as fit between two output times;
 //! - *fields*: particle probes (`x y vx vy omega fx fy radius`), tracked cells (`p q
 //!   anisotropy anisotropy_volume dilation_x dilation_y contacts broken_bonds`), scene

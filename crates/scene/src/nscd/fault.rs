@@ -1,5 +1,6 @@
-//! `[nscd.fault]`: the measures of a fault-propagation experiment (seed 003, F2) written
-//! to `summary.json` under `fault` at the end of a run ([`porofrac_particles::fault`]).
+//! `[nscd.fault]`: the measures of a fault-propagation experiment (Renouf et al. (2006)
+//! §5.3) written to `summary.json` under `fault` at the end of a run
+//! ([`porofrac_particles::fault`]).
 //!
 //! With the tip x_T(t) = x_T⁰ + V₀ t e (the moving block's corner, e the fault direction)
 //! and the slip s = V₀ t, over the particles whose current centre is in `window`:

@@ -89,7 +89,8 @@ pub struct NscdSection {
     /// Gravity (m/s², default `[0, -9.81]`).
     pub gravity: Option<[f64; 2]>,
     /// Gravity settling before the loading: stop when the kinetic energy is below this
-    /// fraction of the potential energy released (SEEDS 003.6: 1e-6). No settling when
+    /// fraction of the potential energy released (1e-6 is a typical
+    /// value; the criterion is this project's choice). No settling when
     /// absent.
     pub settle_ratio: Option<f64>,
     /// Most settling steps (default 20 000); reaching it is an error.
@@ -100,10 +101,10 @@ pub struct NscdSection {
     pub fault: Option<FaultSection>,
 }
 
-/// `[nscd.fault]`: the basement fault of a fault-propagation experiment (seed 003, F2),
-/// for the measures written to `summary.json` at the end of the run
-/// ([`porofrac_particles::fault`]): the limit angle θ_l, the run-out, and the trishear
-/// L2 mismatch of the particle velocities.
+/// `[nscd.fault]`: the basement fault of a fault-propagation experiment (Renouf et al.
+/// (2006) §5.3), for the measures written to `summary.json` at the end of the run
+/// ([`porofrac_particles::fault`]): the limit angle θ_l, the run-out, and the trishear L2
+/// mismatch of the particle velocities.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FaultSection {

@@ -78,7 +78,7 @@ pub enum AxisChoice {
 #[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum ExchangeChoice {
-    /// `c_α [f̃_α + f_ᾱ]` (seed eq. 8).
+    /// `c_α [f̃_α + f_ᾱ]` (Mora et al. (2015) eq. 8).
     #[default]
     Standard,
     /// With relative velocities `c − u_w` (Wen et al. 2014).
