@@ -45,8 +45,8 @@
 //!
 //! FEniCSx points are read from `--peers` (`dim,n,solver,t_assemble,t_solve,l2_err,ndofs`;
 //! lines starting with `#` are comments), written by `docs/data/fenicsx_e2e3.sh`, which
-//! runs `peers/fem/run_dolfinx.py`. They are copied into the output CSV and plotted with
-//! time = `t_assemble + t_solve`.
+//! runs the FEniCSx driver `run_dolfinx.py` (kept outside this repository). They are
+//! copied into the output CSV and plotted with time = `t_assemble + t_solve`.
 //!
 //! # Output
 //!
