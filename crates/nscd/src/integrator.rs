@@ -1,4 +1,4 @@
-//! The one-step integrator: the Moreau–Jean θ-scheme on velocities (Renouf et al. (2006) eq. [3]).
+//! The one-step integrator: the Moreau–Jean θ-scheme on velocities (Renouf et al. (2006) eq. 3).
 //!
 //! On ]t_i, t_i + h], ½ ≤ θ ≤ 1, with M the masses, F the applied forces (constant over
 //! the step, so θF_{i+1} + (1 − θ)F_i = F) and H P the contact impulses:

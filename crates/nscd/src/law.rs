@@ -1,5 +1,5 @@
 //! The contact law and the exact solution of one local problem (Renouf et al. (2006) eq.
-//! [6] and the cohesive law of Fig. 3).
+//! 6 and the cohesive law of Fig. 3).
 //!
 //! Unknowns of a contact in its frame (n from the antagonist to the candidate,
 //! t = ẑ × n): the impulse P = (P_n, P_t) = h r over the step and the relative velocity

@@ -1,6 +1,6 @@
 //! The NSCD system and its time step, composed of the stages of the other modules.
 //!
-//! **Time step** (Renouf et al. (2006) eq. [3], Moreau–Jean) on ]t_i, t_i + h], ½ ≤ θ ≤ 1:
+//! **Time step** (Renouf et al. (2006) eq. 3, Moreau–Jean) on ]t_i, t_i + h], ½ ≤ θ ≤ 1:
 //!
 //! 1. predicted configuration q_m = q_i + h(1 − θ) q̇_i (bodies: their offset likewise),
 //!    [`crate::integrator::MoreauJean::predict`];
@@ -237,7 +237,7 @@ impl Nscd {
     }
 
     /// The contacts of the last step that carry a force, as tracked cells see them
-    /// (branch vector (r_i + r_j) n, Renouf et al. (2006) eq. [7]).
+    /// (branch vector (r_i + r_j) n, Renouf et al. (2006) eq. 7).
     pub fn cell_contacts(&self, out: &mut Vec<CellContact>) {
         out.clear();
         for c in self.contacts.as_slice() {

@@ -9,7 +9,7 @@
 //! - *fields*: particle probes (`x y vx vy omega fx fy radius`, `fx fy` the sum of the
 //!   contact forces on the particle), tracked-cell probes (`p q anisotropy
 //!   anisotropy_volume dilation_x dilation_y contacts broken_bonds`, Renouf et al. (2006)
-//!   eqs. [7]–[11], [`porofrac_particles::tracked`]), lines (the value of the particle
+//!   eqs. 7–11, [`porofrac_particles::tracked`]), lines (the value of the particle
 //!   nearest each point), `vtk/particles_NNNN.vtp` + `vtk/contacts_NNNN.vtp` with
 //!   `<name>.pvd` and `<name>_contacts.pvd`, field extrema, and `summary.json` with
 //!   `particles`, `contacts`, `sweeps` (mean, max), `final_residual`, `not_converged_steps`
