@@ -1,6 +1,6 @@
-//! Plate with a hole (the seed's verification plan §4 E2): the stress concentration factor of the DEM against
-//! the Mindlin / Kaloni–Ariman value, for several (N, r/ℓ) and mesh levels, with the wall
-//! time of assembly (reconstruction included) and solve.
+//! Plate with a hole (Marazzato (2021), arXiv:2101.08712, §3.9.1): the stress concentration
+//! factor of the DEM against the Mindlin / Kaloni–Ariman value, for several (N, r/ℓ) and mesh
+//! levels, with the wall time of assembly (reconstruction included) and solve.
 //!
 //! `cargo run --release -p porofrac-cosserat --example plate_hole [levels]`, or
 //! `… --example plate_hole mesh <level> <r> <path.vtu>` to write the O-grid mesh of a level

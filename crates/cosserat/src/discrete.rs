@@ -19,7 +19,8 @@
 //! `ū_D` the facet mean of the data).
 //!
 //! **Loads.** Volume loads are tested with the rotation/displacement of the same
-//! quadrature as the strain (the consistent pairing, the seed's verification plan §2 (derived): `Σ_q w_q f(x_q)·v_q`);
+//! quadrature as the strain (the consistent pairing, derived here so that the body-couple
+//! patch test is exact: `Σ_q w_q f(x_q)·v_q`);
 //! tractions with the facet values, `Σ_F |F| t̄·v_F`.
 //!
 //! The stiffness is kept in two value arrays on one pattern: the symmetric part (elastic +

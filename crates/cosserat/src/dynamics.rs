@@ -12,7 +12,7 @@
 //!   iteration and returns `0.8 · 2/ω_max` (the 0.8 covers the estimate from below).
 //!
 //! The velocity damping (30) on Dirichlet facets is not implemented: the clamped beam of
-//! the seed (tests/dynamics.rs) stays stable without it under Newmark.
+//! Marazzato (2021) §4.2.1 (tests/dynamics.rs) stays stable without it under Newmark.
 
 use crate::discrete::Cosserat;
 use crate::error::{CosseratError, Result};

@@ -273,7 +273,8 @@ mod tests {
         assert!((a[(s, s)] - 4.0 * g * 0.01).abs() < 1e-12);
     }
 
-    /// `(w⊗n):C:(w⊗n) = (λ+G−Gc)(w·n)² + (G+Gc)|w|²` (the seed's verification plan §2, eq. 17).
+    /// `(w⊗n):C:(w⊗n) = (λ+G−Gc)(w·n)² + (G+Gc)|w|²` (the law-weighted interior penalty of
+    /// Marazzato (2021) eq. 17).
     #[test]
     fn acoustic_tensor_closed_form() {
         let m = Material::with_couple_moduli(10.0, 0.3, 4.0, [1.0, 2.0, 0.5]).unwrap();

@@ -1,7 +1,8 @@
 //! Simplex meshes the Cosserat experiments use that the grid crate does not generate.
 //!
 //! * [`crossed`]: each square of an `nx × ny` lattice cut into 4 triangles by its centre
-//!   (the "crossed" meshes of the seed's verification plan §4 E1 and E3).
+//!   (the "crossed" meshes of the patch tests and the shear layer of Marazzato (2021),
+//!   arXiv:2101.08712, §3.8 and §3.9.2).
 //! * [`crossed_perturbed`]: the same mesh with its interior nodes jittered by a bounded,
 //!   seeded amount that keeps every triangle valid (the bound is derived there).
 //! * [`plate_with_hole`]: the quarter plate `[0, L]²` minus the disc of radius `r` at the

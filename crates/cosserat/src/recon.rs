@@ -4,7 +4,7 @@
 //! **Facet values.** For each facet `F` with centroid `x_F` we pick `D + 1` cells `S_F`
 //! whose barycentres span a non-degenerate simplex and solve
 //! `Σ λ_K = 1, Σ λ_K x_K = x_F` (10); then `w_F = Σ_{K∈S_F} λ_K w_K` (9) for every
-//! component. The cells are chosen from a *pool* (the seed's verification plan §2):
+//! component. The cells are chosen from a *pool* (Marazzato (2021) §3.1, eqs. 8–10):
 //!
 //! * interior facet: its two cells and their face neighbours (2D), every cell within graph
 //!   distance 2 of either (3D, where smaller pools can be all-degenerate, Remark 4);
@@ -28,7 +28,8 @@ use porofrac_grid::{Grid, Point};
 
 use crate::error::{CosseratError, Result};
 
-/// Largest admissible barycentric weight of a fallback stencil (the seed's verification plan §2 step 2).
+/// Largest admissible barycentric weight of a fallback stencil (Marazzato (2021) §3.1; the
+/// best subset with max|λ| < 10).
 pub const MAX_WEIGHT: f64 = 10.0;
 /// Pool cap per dimension index (`[2D, 3D]`): the nearest cells are kept.
 pub const MAX_POOL: [usize; 2] = [12, 16];

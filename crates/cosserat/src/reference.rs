@@ -1,4 +1,5 @@
-//! Closed-form references (the seed's verification plan §4, derived).
+//! Closed-form references for the verification problems of Marazzato (2021),
+//! arXiv:2101.08712, §3.8–§4.2 (derived here).
 //!
 //! * [`ShearLayer`]: the 1D Cosserat shear layer (E3). With `σ12 = τ` constant and
 //!   `δ² = 4 G Gc / ((G + Gc) M)` (`M` the 2D couple modulus, `m = M φ'`):
@@ -163,7 +164,8 @@ pub fn hole_scf(nu: f64, n: f64, r: f64, length: f64) -> f64 {
 mod tests {
     use super::*;
 
-    /// the seed's verification plan §4 E3, instance A: τ = 108.891 MPa and the sample points.
+    /// The shear layer of Marazzato (2021) §3.9.2 with u1 = 1e-5 m on top and no end
+    /// rotations: τ = 108.891 MPa and the sample points.
     #[test]
     fn shear_layer_instance_a() {
         let s = ShearLayer::new(1e-3, 1e10, 2e10, 100.0, [0.0, 0.0, 1e-5, 0.0]);
@@ -183,7 +185,8 @@ mod tests {
         assert!((b.phi(0.9e-3) / -2.03383e-2 - 1.0).abs() < 2e-4);
     }
 
-    /// The SCF table of the seed's verification plan §4 E2 (ν = 0.3).
+    /// The SCF of the plate with a hole of Marazzato (2021) §3.9.1, Mindlin's closed form
+    /// (ν = 0.3).
     #[test]
     fn scf_table() {
         for (n, rl, want) in [

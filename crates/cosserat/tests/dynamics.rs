@@ -1,4 +1,5 @@
-//! Dynamics (the seed's verification plan §3 and §5 test 4):
+//! Dynamics (Marazzato (2021) eqs. 30–31, and energy conservation of average-acceleration
+//! Newmark):
 //!
 //! * a free body (no Dirichlet condition, no load) under Newmark average acceleration
 //!   conserves `½VᵀMV + ½UᵀKU` to 1e-10 relative over 200 steps (2D and 3D);
@@ -6,10 +7,10 @@
 //!   initial value over 400 steps), and 1.1 × the estimated limit `2/ω_max` blows up,
 //!   which shows the estimate is close to the true limit;
 //! * a zero micro-inertia is refused for dynamics;
-//! * the seed's 3D beam in dynamic flexion (E4): the first period of the tip deflection
-//!   after a one-step tip impulse lies between the Euler–Bernoulli periods of the Cosserat
-//!   bound (`D = EI + (M + Mc)a²`, 31.0 µs) and of the Cauchy beam (`D = EI`, 48.9 µs), and
-//!   a coarser mesh is stiffer (shorter period).
+//! * the beam of Marazzato (2021) §4.2.1 in dynamic flexion: the first period of the tip
+//!   deflection after a one-step tip impulse lies between the Euler–Bernoulli periods of the
+//!   Cosserat bound (`D = EI + (M + Mc)a²`, 31.0 µs) and of the Cauchy beam (`D = EI`,
+//!   48.9 µs), and a coarser mesh is stiffer (shorter period).
 
 mod common;
 
@@ -149,8 +150,8 @@ fn zero_micro_inertia_is_refused() {
     assert!(e.to_string().contains("micro_inertia"));
 }
 
-/// The tip deflection history of the seed's beam (1 mm × 40 µm × 40 µm, `nx × 2 × 2`
-/// cubes of 6 tetrahedra, clamped at x = 0, a y-traction `p0 = E·1e-6` on the tip face
+/// The tip deflection history of the beam of Marazzato (2021) §4.2.1 (1 mm × 40 µm × 40 µm,
+/// `nx × 2 × 2` cubes of 6 tetrahedra, clamped at x = 0, a y-traction `p0 = E·1e-6` on the tip face
 /// during the first step, Newmark over `T = 200 L √(ρ/E)`), and the times at which it
 /// changes sign (linear interpolation between steps).
 fn beam_sign_changes(nx: usize, steps: usize) -> Vec<f64> {

@@ -1,6 +1,6 @@
-//! Lamb's problem (the seed's E5): a vertical Ricker body force (f0 = 14.5 Hz, t0 = 0.1 s,
-//! uniform in a disk of radius 50 m) 100 m below the free surface of a 3 km × 1 km
-//! half-plane, E = 18.8 GPa, ν = 0.25, ρ = 2200 kg/m³, crossed triangles of 20 m,
+//! Lamb's problem (Marazzato (2021) §4.2.2): a vertical Ricker body force (f0 = 14.5 Hz,
+//! t0 = 0.1 s, uniform in a disk of radius 50 m) 100 m below the free surface of a
+//! 3 km × 1 km half-plane, E = 18.8 GPa, ν = 0.25, ρ = 2200 kg/m³, crossed triangles of 20 m,
 //! explicit leapfrog at the computed stable step, every side free.
 //!
 //! Wave speeds from the moveout of the waveforms (cross-correlation of the vertical
@@ -12,11 +12,11 @@
 //!
 //! The closed forms are those of the classical medium: `Vp = √((λ+2G)/ρ)` = 3202.3 m/s,
 //! `Vs = √(G/ρ)` = 1848.8 m/s, `V_R = 0.91940 Vs` = 1699.8 m/s (ν = 0.25). With `Gc = 0`
-//! the Cosserat medium is classical and all three speeds are within 5 %. With the seed's
-//! `Gc = G` and a numerical length `ℓ = h/4` (the seed's code passes `ℓ/2` with
+//! the Cosserat medium is classical and all three speeds are within 5 %. With the paper's
+//! `Gc = G` and a numerical length `ℓ = h/4` (the author's published code passes `ℓ/2` with
 //! `ℓ = h/2`), P and S stay within 5 % and the Rayleigh wave is faster than the classical
 //! one: at wavelengths of about 23 ℓ the couple stresses stiffen the surface wave
-//! (measured 1850 m/s, +8.8 %). The arrival at the seed's receiver (−300 m, surface) follows
+//! (measured 1850 m/s, +8.8 %). The arrival at the paper's receiver (−300 m, surface) follows
 //! from these speeds.
 
 use porofrac_cosserat::mesh::{crossed, locate};

@@ -1,5 +1,6 @@
-//! Reconstruction exactness (the seed's verification plan §5 test 1): for affine fields the facet values (9),
-//! the Stokes gradients (11) and the P1 reconstruction (14) are exact to 1e-12 relative,
+//! Reconstruction exactness (this project's check of Marazzato (2021) §3.1): for affine
+//! fields the facet values (9), the Stokes gradients (11) and the P1 reconstruction (14) are
+//! exact to 1e-12 relative,
 //! on structured, perturbed and crossed triangles and on (perturbed) tetrahedra, including
 //! boundary facets. Also: a grid with a non-simplex cell is an error naming the cell.
 

@@ -1,4 +1,5 @@
-//! Static verification against closed forms (the seed's verification plan §4–§5):
+//! Static verification against closed forms (the patch tests, shear layer and plate with a
+//! hole of Marazzato (2021) §3.8–§3.9):
 //!
 //! * patch tests 1 and 2 (E1): affine `u`, constant `φ`, Dirichlet (Nitsche) on the whole
 //!   boundary; every cell stress equals the exact constant stress to 1e-9 relative, on the
@@ -255,8 +256,9 @@ fn rigid_modes_in_the_kernel() {
     assert!(kernel_defect(&model, &[stretch]) > 1e-3);
 }
 
-/// E3, instance A (the seed's verification plan §4): strip of width h = 1 mm, 10 × 50 crossed squares,
-/// ν = 0, G = 10 GPa, Gc = 20 GPa, couple modulus 4Gℓ² = 100 N.
+/// The shear layer of Marazzato (2021) §3.9.2, u1 = 1e-5 m on top, no end rotations: strip
+/// of width h = 1 mm, 10 × 50 crossed squares, ν = 0, G = 10 GPa, Gc = 20 GPa, couple modulus
+/// 4Gℓ² = 100 N.
 pub fn shear_layer(variant: StrainVariant, ends: [f64; 4]) -> (f64, f64, f64) {
     let h = 1e-3;
     let grid = mesh::crossed(
