@@ -1,10 +1,9 @@
 //! Plate with a hole (Marazzato (2021), arXiv:2101.08712, §3.9.1): the DEM stress
 //! concentration factor (largest cell σ22 over the applied traction) against the Mindlin /
-//! Kaloni–Ariman value for six
-//! (N, r/ℓ) pairs and the Cauchy limit (N = 0, SCF 3). Gate: within 4 % on the level-5
-//! O-grid (8,000 triangles) and the error falling from level 3 (2,880 triangles) to
-//! level 5. The cell-constant maximum sits inside the first cell and underestimates the
-//! peak, so the error is one-sided and first order.
+//! Kaloni–Ariman value for six (N, r/ℓ) pairs and the Cauchy limit (N = 0, SCF 3). Gate:
+//! within 4 % on the level-5 O-grid (8,000 triangles) and the error falling from level 3
+//! (2,880 triangles) to level 5. The cell-constant maximum sits inside the first cell and
+//! underestimates the peak, so the error is one-sided and first order.
 
 use porofrac_cosserat::reference::hole_scf;
 use porofrac_cosserat::{

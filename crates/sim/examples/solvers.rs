@@ -245,8 +245,8 @@ fn main() {
         best = (best.0.min(asm), best.1.min(solve));
     }
     if repeat > 1 {
-        // The FEniCSx peer's rule (`best_of` in peers/fem/common.py): every timed key is
-        // the minimum over the repetitions.
+        // The FEniCSx driver's rule (`best_of` in the FEniCSx driver's common.py, kept
+        // outside this repository): every timed key is the minimum over the repetitions.
         println!(
             "best of {repeat}, per-key minima: assembly {:.2} s, setup + solve {:.2} s, total {:.2} s",
             best.0,

@@ -8,8 +8,8 @@
 //!   Σ_K a_K(u, v) = ∫_Ω (b + ρ g) · v dx + ∫_Γt t · v ds  (+ platen forces)
 //! ```
 //!
-//! where `a_K` is the bilinear form of the cell law of cell `K` (seed §2.2–2.3: VEM, MDEM
-//! or P1), represented by its local stiffness `K_K` and its nodal forces
+//! where `a_K` is the bilinear form of the cell law of cell `K` (Nilsen et al. (2017) §2.2–2.3:
+//! VEM, MDEM or P1), represented by its local stiffness `K_K` and its nodal forces
 //! `F_K(u) = −∂E_K/∂u`. [`assemble`] evaluates, at a given nodal displacement `u`
 //! (prescribed values filled in), the reduced tangent `Tᵀ K_ff T` (see [`crate::dofs`])
 //! into the values of a [`Pattern`] and the reduced internal forces `Tᵀ F(u)`. For a

@@ -1,10 +1,10 @@
-//! Explicit damped dynamics (dynamic relaxation), seed §2.7.
+//! Explicit damped dynamics (dynamic relaxation), Nilsen et al. (2017) §2.7.
 //!
-//! The seed solves the mechanics of MDEM, DEM and VEM cells as in DEM codes: by explicit
+//! Nilsen et al. (2017) solve the mechanics of MDEM, DEM and VEM cells as in DEM codes: by explicit
 //! time integration of Newton's law with Cundall's local, non-viscous damping, letting
 //! the system relax to its static state. Only the nodal forces of the cell laws
 //! ([`porofrac_law::CellLaw::forces`]) are needed, so any mix of laws — including the
-//! nonlinear compression-only DEM of seed eq. 33 — runs unchanged.
+//! nonlinear compression-only DEM of Nilsen et al. (2017) eq. 33 — runs unchanged.
 //!
 //! # Equations
 //!
@@ -39,7 +39,7 @@
 //! started with `v^{−½} = v⁰ − (Δt/2) f⁰/M`, the total energy oscillates boundedly. The
 //! damping force always opposes the motion (its power `−α |f| |v̂|` is never positive);
 //! it does not depend on the size of the velocity, so slow and fast parts of the grid are
-//! damped alike (seed §2.7). Prescribed dofs follow their values at `t^{n+1}`.
+//! damped alike (Nilsen et al. (2017) §2.7). Prescribed dofs follow their values at `t^{n+1}`.
 //!
 //! # Stable time step
 //!

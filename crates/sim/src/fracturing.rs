@@ -1,14 +1,15 @@
 //! Fracturing of a poroelastic body: failure criteria, law switching, fracture
-//! permeability and the coupled step (seed §2.5–2.7).
+//! permeability and the coupled step (Nilsen et al. (2017) §2.5–2.7).
 //!
 //! # The model
 //!
 //! Every cell has an intact law (VEM, MDEM, ...) and a failure criterion on its
 //! effective (skeleton) stress, tension positive ([`porofrac_frac::Combined`]: tensile,
-//! seed eq. 31, Mohr–Coulomb, and at crack tips the toughness of
+//! Nilsen et al. (2017) eq. 31, Mohr–Coulomb, and at crack tips the toughness of
 //! [`porofrac_frac::toughness`]). A cell that fails stays failed: its law switches to the
 //! post-failure law of its instance (a failed MDEM cell becomes the compression-only
-//! central-force DEM of seed eqs. 32–33; a law without a post-failure law keeps its own)
+//! central-force DEM of eqs. 32–33 of Nilsen et al. (2017); a law without a post-failure law
+//! keeps its own)
 //! and, when a fracture permeability is set ([`FracturePermeability`]: one value, or a
 //! crack transmissivity shared over the cell's width), its permeability becomes that
 //! value so the fluid enters the fracture.
@@ -129,7 +130,8 @@ pub enum StressMeasure {
     /// The cell stress of the law (constant per cell).
     #[default]
     Cell,
-    /// The cell average of the Zienkiewicz–Zhu recovered nodal stress (seed Fig. 5).
+    /// The cell average of the Zienkiewicz–Zhu recovered nodal stress (Nilsen et al.
+    /// (2017) Fig. 5).
     Recovered,
 }
 
@@ -319,12 +321,12 @@ impl<const D: usize> FailureResolution<D> {
 
 /// The coupling scheme of a [`Fracturing`] run.
 pub enum Scheme {
-    /// Fully implicit monolithic (seed eq. 30).
+    /// Fully implicit monolithic (Nilsen et al. (2017) eq. 30).
     Monolithic(Monolithic),
     /// Fixed-stress split; needs the drained bulk modulus of every cell.
     FixedStress(FixedStress, Vec<f64>),
-    /// The seed's explicit-pressure update (§2.5): the volumetric term in the failed cells
-    /// and in the cells flagged here (e.g. the injection cells).
+    /// The explicit-pressure update of Nilsen et al. (2017) §2.5: the volumetric term in the
+    /// failed cells and in the cells flagged here (e.g. the injection cells).
     ExplicitPressure(ExplicitPressure, Vec<bool>),
 }
 

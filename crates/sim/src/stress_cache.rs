@@ -2,7 +2,7 @@
 //!
 //! For a law whose stiffness does not depend on the displacement
 //! ([`CellLaw::is_linear`](porofrac_law::CellLaw::is_linear)) the cell stress is linear in the cell's nodal displacements
-//! (seed eq. 18 for MDEM, the projected strain for VEM):
+//! (Nilsen et al. (2017) eq. 18 for MDEM, the projected strain for VEM):
 //!
 //! ```text
 //!   σ(u_K) = Σ_j u_j σ(e_j) = B_K u_K,   B_K = [σ(e_1) … σ(e_m)]   (D² × m)

@@ -12,8 +12,8 @@
 //!   exact critical step `2/ω_max` (dense eigenvalues of `M⁻¹A`) and within a factor 2 of it;
 //!   1.05 × the exact critical step diverges, 0.95 × stays bounded.
 //! * (d) a too-large time step gives an error naming a cell, not NaN.
-//! * (e) the seed's 1e5 stiffness contrast on the composite well grid, with and without
-//!   density scaling.
+//! * (e) the 1e5 well/rock stiffness contrast of Nilsen et al. (2017) §3 on the composite well
+//!   grid, with and without density scaling.
 
 mod common;
 
@@ -155,8 +155,8 @@ fn mixed_vem_mdem_dem_grid_reaches_the_direct_solution() {
 
 #[test]
 fn compression_only_dem_reaches_equilibrium() {
-    // DEM in compression-only mode (seed eq. 33) in the right half, MDEM in the left, a
-    // top and a lateral pressure: all springs start open at u = 0 (a Newton solve from
+    // DEM in compression-only mode (Nilsen et al. (2017) eq. 33) in the right half, MDEM in the
+    // left, a top and a lateral pressure: all springs start open at u = 0 (a Newton solve from
     // u = 0 meets a singular tangent), so only the explicit solver applies. Check: the
     // equilibrium residual recomputed independently with `assemble` and `nodal_loads` is
     // below 1e-8 of the load, and the solution differs from the all-closed (elastic DEM)

@@ -1,13 +1,13 @@
-//! The seed's explicit-pressure update (§2.5): the volumetric coupling only in fractured
-//! cells, the flow implicit in the fluxes.
+//! The explicit-pressure update of Nilsen et al. (2017) §2.5: the volumetric coupling only
+//! in fractured cells, the flow implicit in the fluxes.
 
 use super::{
     BiotCoupling, BiotResult, BiotState, BiotStep, BiotSystem, CouplingStats, FlowSolver,
     MechSolver, check_len, check_state, check_step,
 };
 
-/// The seed's explicit-pressure coupling (§2.5): the volumetric term only in fractured
-/// cells, no feedback iteration (see the module docs).
+/// The explicit-pressure coupling of Nilsen et al. (2017) §2.5: the volumetric term only in
+/// fractured cells, no feedback iteration (see the module docs).
 pub struct ExplicitPressure {
     /// `fractured[K]`: whether cell `K` carries the volumetric coupling term.
     pub fractured: Vec<bool>,

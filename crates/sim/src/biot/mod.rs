@@ -1,12 +1,13 @@
 //! Biot poroelasticity: the coupling of the mechanics of this crate with the TPFA flow of
-//! `porofrac-flow` (seed §2.5, eqs. 28–30).
+//! `porofrac-flow` (H. M. Nilsen, I. Larsen, X. Raynaud (2017), arXiv:1702.01552, §2.5,
+//! eqs. 28–30).
 //!
 //! # Continuous model and sign convention
 //!
 //! Tension is positive. With `u` the displacement, `p` the pore pressure, `p₀` the initial
 //! pore pressure (in equilibrium, it does not deform the rock: the coupling acts on
 //! `p − p₀`), `σ'` the effective stress of the cell laws and α the Biot–Willis
-//! coefficient, the total stress is `σ = σ' − α (p − p₀) I` and (seed eq. 28)
+//! coefficient, the total stress is `σ = σ' − α (p − p₀) I` and (eq. 28 there)
 //!
 //! ```text
 //!   ∇·σ + f = 0,      ∂/∂t (S p + α ∇·u) − ∇·(k/μ ∇p) = q .
@@ -14,8 +15,9 @@
 //!
 //! # Discrete operators
 //!
-//! The discrete divergence of seed eq. 30 is the exact volume change of the first-order
-//! VEM projection: with `N_i = ∫_∂K φ_i n dS` ([`porofrac_grid::Grid::cell_node_normals`]),
+//! The discrete divergence of Nilsen et al. (2017) eq. 30 is the exact volume change of the
+//! first-order VEM projection: with `N_i = ∫_∂K φ_i n dS`
+//! ([`porofrac_grid::Grid::cell_node_normals`]),
 //!
 //! ```text
 //!   ΔV_K(u) = Σ_{i ∈ K} N_i · u_i = |K| tr ε(Π u) = ∫_K ∇·(Π u) dx ,
@@ -33,7 +35,7 @@
 //! ([`BiotSystem::pore_pressure_forces`]): the same `N_i` as the volume change, so the
 //! mechanics sees exactly the transpose of the flow's coupling block.
 //!
-//! # Time discretization (seed eqs. 29–30)
+//! # Time discretization (Nilsen et al. 2017, eqs. 29–30)
 //!
 //! Implicit Euler from `(uⁿ, pⁿ)` at `t` to `t + Δt`, with `K` the reduced stiffness,
 //! `M = diag(|K| S_K)` the accumulation, `A` the TPFA flux matrix and `b` the flow forcing
@@ -117,10 +119,10 @@
 //! which is that value for isotropic materials and the Reuss-like mean-normal stiffness
 //! for anisotropic ones.
 //!
-//! # Explicit pressure update (seed §2.5)
+//! # Explicit pressure update (Nilsen et al. 2017, §2.5)
 //!
-//! For explicit mechanics the seed keeps the volumetric term only in fractured cells and
-//! updates the pressure otherwise without feedback. [`ExplicitPressure::update_pressure`]
+//! For explicit mechanics Nilsen et al. (2017) keep the volumetric term only in fractured
+//! cells and update the pressure otherwise without feedback. [`ExplicitPressure::update_pressure`]
 //! takes `u^{n+1}`, `uⁿ`, `pⁿ` and the set `F` of fractured cells and solves
 //!
 //! ```text
@@ -146,7 +148,7 @@
 //! * `system.rs` — [`BiotSystem`]: the mechanics, the flow and the coupling operators.
 //! * `monolithic.rs` — [`Monolithic`]: the fully implicit block system and its `LDLᵀ`.
 //! * `fixed_stress.rs` — [`FixedStress`]: the fixed-stress split.
-//! * `explicit.rs` — [`ExplicitPressure`]: the seed's explicit-pressure update.
+//! * `explicit.rs` — [`ExplicitPressure`]: the explicit-pressure update of Nilsen et al. (2017).
 //! * `flow_solve.rs`, `mech_solve.rs` — the flow and mechanics solves of the split schemes.
 
 mod explicit;

@@ -1,5 +1,5 @@
-//! The fully implicit monolithic scheme (seed eq. 30): the symmetric quasi-definite
-//! block system, its `LDLᵀ` factorization and low-rank updates.
+//! The fully implicit monolithic scheme (Nilsen et al. (2017) eq. 30): the symmetric
+//! quasi-definite block system, its `LDLᵀ` factorization and low-rank updates.
 
 use std::ops::Range;
 use std::sync::Arc;
@@ -14,9 +14,9 @@ use super::{
     check_state, check_step, snap_step,
 };
 
-/// The fully implicit monolithic scheme (seed eq. 30): one symmetric quasi-definite
-/// system per step, solved by a sparse `LDLᵀ` factorization (see the module docs for the
-/// block form and the scaling).
+/// The fully implicit monolithic scheme (Nilsen et al. (2017) eq. 30): one symmetric
+/// quasi-definite system per step, solved by a sparse `LDLᵀ` factorization (see the module docs for
+/// the block form and the scaling).
 ///
 /// The block matrix depends on the stiffness, α and the node normals, the TPFA matrix,
 /// the storage, `s` and `Δt`, not on the state: a step whose inputs are those of the last
