@@ -3,7 +3,7 @@
 //!
 //! # Model
 //!
-//! Mass conservation with Darcy's law (the flow part of seed eq. 28b, without the
+//! Mass conservation with Darcy's law (the flow part of Nilsen et al. (2017) eq. 28b, without the
 //! volumetric coupling term that a Biot model adds):
 //!
 //! ```text
@@ -19,7 +19,7 @@
 //! Cell-centred finite volumes with two-point fluxes ([`trans`]): the flux from cell `K` to
 //! its neighbour `L` across face `f` is `T_f (p_K − p_L)/μ` with `T_f` the harmonic average
 //! of the half-transmissibilities `t_{K,f} = A_f (K n_f)·(c_f − x_K)/|c_f − x_K|²`.
-//! Time is discretized by implicit Euler (seed eq. 29):
+//! Time is discretized by implicit Euler (Nilsen et al. (2017) eq. 29):
 //!
 //! ```text
 //!   |K| S_K (p_K^{n+1} − p_K^n)/Δt + Σ_f F_{K,f}(p^{n+1}) = Q_K ,
@@ -27,8 +27,8 @@
 //!
 //! assembled as `(M/Δt + A) p^{n+1} = M/Δt p^n + b(t^{n+1})` ([`model`]), with `M` the
 //! accumulation diagonal, `A` the symmetric flux matrix (with Dirichlet and well terms)
-//! and `b` the forcing; all three are public so that a Biot coupling (seed eq. 30) can add
-//! its blocks. The system is symmetric positive definite and solved by sparse Cholesky
+//! and `b` the forcing; all three are public so that a Biot coupling (Nilsen et al. (2017) eq. 30)
+//! can add its blocks. The system is symmetric positive definite and solved by sparse Cholesky
 //! (`porofrac_sparse::Cholesky`) with the symbolic factorization reused across steps.
 //!
 //! Sources ([`problem::Source`]) are total rates or pore volumes per hour spread over a set

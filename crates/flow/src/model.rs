@@ -1,7 +1,7 @@
 //! The assembled TPFA flow model and its time stepping.
 //!
 //! With cell pressures `p`, implicit Euler from `t^n` to `t^{n+1} = t^n + Δt` solves, for
-//! every cell `K` (seed eq. 29 with `S_c = S_K`),
+//! every cell `K` (Nilsen et al. (2017) eq. 29 with `S_c = S_K`),
 //!
 //! ```text
 //!   |K| S_K (p_K − p_K^n)/Δt + Σ_{f interior} T_f/μ (p_K − p_L) + Σ_{f Dirichlet} T_f/μ (p_K − p_b)
@@ -17,9 +17,9 @@
 //!   storage or a pressure anchor, so a sparse Cholesky factorization is used;
 //! * `b(t)` — [`FlowModel::forcing`]: sources, Dirichlet and well pressures, Neumann fluxes.
 //!
-//! A Biot coupling (seed eq. 30) adds `α div_d (u^{n+1} − u^n)` to the left-hand side of each
-//! cell equation (times `1/Δt` in this scaling) and the block `−α div_dᵀ` to the mechanics; it
-//! can be assembled from these public pieces without touching this crate.
+//! A Biot coupling (Nilsen et al. (2017) eq. 30) adds `α div_d (u^{n+1} − u^n)` to the left-hand
+//! side of each cell equation (times `1/Δt` in this scaling) and the block `−α div_dᵀ` to the
+//! mechanics; it can be assembled from these public pieces without touching this crate.
 //!
 //! The matrix pattern (cells and their face neighbours) is built once; the symbolic
 //! Cholesky factorization is computed on the first solve and reused for every later step;

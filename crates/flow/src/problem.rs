@@ -10,8 +10,8 @@ pub use porofrac_grid::field::{FieldFn, ScalarField};
 /// Rock properties per cell.
 ///
 /// Storage (specific storage coefficient, 1/Pa) of cell `K`:
-/// `S_K = φ_K c_f + (α_K − φ_K) / K_s` (seed eq. 28b's storativity `S_c`), with the
-/// solid grain bulk modulus `K_s = ∞` by default, so `S_K = φ_K c_f`.
+/// `S_K = φ_K c_f + (α_K − φ_K) / K_s` (the storativity `S_c` of Nilsen et al. (2017) eq. 28b),
+/// with the solid grain bulk modulus `K_s = ∞` by default, so `S_K = φ_K c_f`.
 #[derive(Clone, Debug)]
 pub struct Rock<const D: usize> {
     /// Porosity per cell, in (0, 1].

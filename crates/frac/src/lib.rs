@@ -1,22 +1,22 @@
 //! Failure criteria, the irreversible failure state of cells, and stress recovery.
 //!
 //! * [`FailureCriterion`]: a stress-based criterion on the effective (skeleton) stress
-//!   that the cell laws compute, tension positive. Built in: [`Tensile`] (seed eq. 31,
-//!   `max σ > σ_tens`) and [`MohrCoulomb`]; [`Combined`] checks several and reports the
-//!   first mode that fails.
+//!   that the cell laws compute, tension positive. Built in: [`Tensile`] (Nilsen et al.
+//!   (2017) eq. 31, `max σ > σ_tens`) and [`MohrCoulomb`]; [`Combined`] checks several and reports
+//!   the first mode that fails.
 //! * [`FailureState`]: which cells have failed, when and how. Failure is irreversible.
 //! * [`mod@resolve`]: the loop that solves, checks, fails and re-solves within a time step
 //!   until the state is consistent.
 //! * [`recovery`]: superconvergent patch recovery (Zienkiewicz–Zhu) of nodal stresses
-//!   from cell stresses on any grid (seed Fig. 5), and cell values from the recovered
-//!   nodal field, so a criterion can be evaluated on a smoother stress near a tip.
+//!   from cell stresses on any grid (Nilsen et al. (2017) Fig. 5), and cell values from the
+//!   recovered nodal field, so a criterion can be evaluated on a smoother stress near a tip.
 //! * [`tracking`]: crack tracking, so a crack grows perpendicular to the largest principal
 //!   stress rather than along mesh diagonals.
 //! * [`toughness`]: fracture toughness at crack tips ([`Toughness`], [`CrackTips`]), so a
 //!   crack grows at the same stress intensity on every grid.
 //!
 //! What a failed cell becomes is the caller's choice: in porofrac's scenes a failed MDEM
-//! cell switches to the compression-only central-force law (seed eqs. 32–33).
+//! cell switches to the compression-only central-force law (Nilsen et al. (2017) eqs. 32–33).
 
 pub mod recovery;
 pub mod resolve;
@@ -82,7 +82,7 @@ pub trait FailureCriterion<const D: usize>: Send + Sync {
     fn utilization(&self, s: &Tensor<D>) -> f64;
 }
 
-/// Tensile failure (seed eq. 31): `max σ > σ_tens`.
+/// Tensile failure (Nilsen et al. (2017) eq. 31): `max σ > σ_tens`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Tensile {
     strength: f64,

@@ -1,8 +1,8 @@
 //! Superconvergent patch recovery (Zienkiewicz & Zhu 1992) of nodal stresses.
 //!
 //! Cell stresses of first-order methods are constant per cell and oscillate near a
-//! fracture tip (seed §3, Fig. 5). For each node `n`, every stress component is fitted
-//! by least squares with a linear polynomial `a + b·(x − x_n)` to the cell values
+//! fracture tip (Nilsen et al. (2017) §3, Fig. 5). For each node `n`, every stress component is
+//! fitted by least squares with a linear polynomial `a + b·(x − x_n)` to the cell values
 //! sampled at the centroids of the cells around the node (its *patch*), and the recovered
 //! nodal value is `a`. Where the patch has fewer than `D + 1` cells or its centroids are
 //! degenerate (boundary and corner nodes), the patch grows by one ring of neighbouring

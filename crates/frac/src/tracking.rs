@@ -5,8 +5,8 @@
 //! largest principal stress `σ₁ ∝ cos(θ/2)(1 + sin(θ/2))`, which peaks at θ ≈ ±60°, not
 //! straight ahead (θ = 0, where the hoop stress peaks). A criterion on `σ₁` alone
 //! therefore lets cracks branch, widen and follow the mesh diagonals (the grid-orientation
-//! effect of the seed, §3). Crack-tracking schemes for smeared cracks (Cervera &
-//! Chiumenti 2006; Oliver's local tracking) restrict where a crack may grow to the cells
+//! effect reported by Nilsen et al. (2017) §3). Crack-tracking schemes for smeared cracks
+//! (Cervera & Chiumenti 2006; Oliver's local tracking) restrict where a crack may grow to the cells
 //! its path crosses; this module uses the local form:
 //!
 //! * when a cell fails, its *crack normal* `n_f` is recorded: the direction of its largest
@@ -41,8 +41,8 @@
 //! Why the exclusion radius: `σ₁` beside a crack tip peaks at θ ≈ ±60°, and the region of
 //! tension there is wider than the one ring of cells that rules (i) and (ii) block. With
 //! nucleation free outside that ring, cells one ring farther out fail as new cracks and
-//! grow into strands parallel to the first (on the seed's well, from the corners of the
-//! failed cluster). An exclusion radius of a few cells keeps the growth at the tip.
+//! grow into strands parallel to the first (on the well of Nilsen et al. (2017) §3, from the
+//! corners of the failed cluster). An exclusion radius of a few cells keeps the growth at the tip.
 //!
 //! Violating cells that are not admissible stay intact in this round (the criterion is
 //! checked again after every re-solve).
