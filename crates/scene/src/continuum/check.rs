@@ -1,4 +1,4 @@
-//! Checks of a continuum scene (SCENE.md): the grid, materials, regions, boundary
+//! Checks of a continuum scene (docs/SCENE.md): the grid, materials, regions, boundary
 //! conditions, loads, sources, wells, schedule, physics, solver and outputs, and the
 //! sizes a scene asks for. Every problem is a [`SceneError`] naming its key and line.
 

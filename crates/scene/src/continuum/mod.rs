@@ -1,5 +1,6 @@
-//! The continuum model (seed 000, `[scene] model = "continuum"`): VEM, MDEM and DEM cell
-//! laws, TPFA flow, Biot coupling and fracturing on a polyhedral grid.
+//! The continuum model (H. M. Nilsen, I. Larsen, X. Raynaud (2017), arXiv:1702.01552;
+//! `[scene] model = "continuum"`): VEM, MDEM and DEM cell laws, TPFA flow, Biot coupling and
+//! fracturing on a polyhedral grid.
 //!
 //! - *build*: the grid ([`crate::common::grid`]), the law and material of every cell and the conditions
 //!   ([`mod@compose`]), the flow model ([`mod@flow`]), the dof map, the stiffness pattern and the

@@ -1,6 +1,6 @@
 //! End-of-run plots of a continuum scene: the probe time series, the last state's fields
-//! (2D: the grid; 3D: the mid-height section) and, after fracturing in 2D, the seed's
-//! Figs. 4 and 5.
+//! (2D: the grid; 3D: the mid-height section) and, after fracturing in 2D, Figs. 4 and 5 of
+//! Nilsen et al. (2017).
 
 use std::path::Path;
 
@@ -30,7 +30,7 @@ pub(crate) struct PlotInputs<'a, const D: usize> {
 }
 
 /// `plots/`: the probe time series, the last state's fields (2D: the grid; 3D: the
-/// mid-height section) and, after fracturing in 2D, the seed's Figs. 4 and 5.
+/// mid-height section) and, after fracturing in 2D, Figs. 4 and 5 of Nilsen et al. (2017).
 pub(crate) fn write_plots<const D: usize>(
     ls: &LoadedScene,
     dir: &Path,
@@ -120,7 +120,7 @@ pub(crate) fn write_plots<const D: usize>(
             )?;
         }
         if let (Some(g2), true) = (as_2d(grid), failures.count() > 0) {
-            // The seed's Figs. 4 and 5.
+            // Figs. 4 and 5 of Nilsen et al. (2017).
             let stress2: Vec<Tensor<2>> = stress
                 .iter()
                 .map(|s| Tensor::<2>::from_fn(|i, j| s[(i, j)]))
@@ -142,7 +142,7 @@ pub(crate) fn write_plots<const D: usize>(
 
 /// Cell divergence of the displacement, `div u = Σ_i N_i · u_i / |K|`
 /// ([`porofrac_vem::volumetric_strain`]: the exact volume change of the VEM projection per
-/// unit volume; seed Fig. 4, upper right).
+/// unit volume; Nilsen et al. (2017) Fig. 4, upper right).
 fn cell_divergence<const D: usize>(grid: &Grid<D>, u: &[f64]) -> Vec<f64> {
     let mut geometry = porofrac_law::GeometryBuffer::<D>::default();
     let mut local = Vec::new();
@@ -184,10 +184,10 @@ fn window_around(grid: &Grid<2>, pts: &[Point<2>], pad: f64) -> ([f64; 2], [f64;
     w
 }
 
-/// Plots of a fractured 2D scene, like the seed's Figs. 4 and 5, in `plots/fracture/`:
-/// the fields of `plots` zoomed on the fractured cells (principal directions on `smax` and
-/// `smin`), and near the crack tip (the last cell to fail) the largest principal stress of
-/// the cells next to the Zienkiewicz–Zhu recovered one (Fig. 5).
+/// Plots of a fractured 2D scene, like Figs. 4 and 5 of Nilsen et al. (2017), in
+/// `plots/fracture/`: the fields of `plots` zoomed on the fractured cells (principal
+/// directions on `smax` and `smin`), and near the crack tip (the last cell to fail) the
+/// largest principal stress of the cells next to the Zienkiewicz–Zhu recovered one (Fig. 5).
 #[allow(clippy::too_many_arguments)]
 fn fracture_plots(
     dir: &Path,

@@ -1,4 +1,4 @@
-//! Checks of a `model = "cosserat"` scene (SCENE-MODELS.md, "Cosserat media"), and the
+//! Checks of a `model = "cosserat"` scene (docs/models/cosserat.md), and the
 //! refusal of the Cosserat keys in continuum scenes. Every problem names its key.
 
 use crate::common::loaded::{LoadedScene, SceneError, expr_ok, k, ki};

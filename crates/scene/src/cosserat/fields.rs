@@ -1,4 +1,4 @@
-//! Probe and line fields of the Cosserat model (SCENE-MODELS.md): `ux uy uz`, `phi` (2D)
+//! Probe and line fields of the Cosserat model (docs/models/cosserat.md): `ux uy uz`, `phi` (2D)
 //! or `phix phiy phiz` (3D), stresses `sxx sxy syx syy …` (`sxy` = σ_xy, the x-component
 //! of the traction on a face of normal y), couple stresses `mx my` (2D: `m_3x, m_3y`) or
 //! `mxx … mzz` (3D), and the totals `energy` (stored), `kinetic` and `work` (external).

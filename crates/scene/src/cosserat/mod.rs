@@ -1,5 +1,5 @@
 //! `model = "cosserat"`: the variational DEM for Cosserat media (crate
-//! `porofrac-cosserat`) driven by a scene (SCENE-MODELS.md, "Cosserat media").
+//! `porofrac-cosserat`) driven by a scene (docs/models/cosserat.md).
 //!
 //! * *build*: the simplex grid (`triangles` with `diagonals = "structured" | "crossed"`,
 //!   `tetrahedra`, or a file), the material of the one region, the `[[bc]]` conditions
