@@ -17,6 +17,7 @@ pub mod compose;
 pub mod fields;
 pub mod flow;
 pub mod plots;
+mod explain;
 
 use crate::common::loaded::SceneError;
 use crate::common::model::ModelKind;
@@ -36,7 +37,7 @@ use porofrac_sim::{
     StressMeasure, cell_stresses, drained_bulk_modulus, solve_explicit, solve_static,
 };
 
-use crate::common::driver::{Observer, drive};
+use crate::common::driver::{Observer, Stop, drive};
 use crate::common::laws::LawRegistry;
 use crate::common::loaded::{LoadedScene, k, ki};
 use crate::common::model::{Model, RunError, Sizes, StepStats};
@@ -109,7 +110,7 @@ fn run_dim<const D: usize>(
         pattern: &pattern,
         loads: &cond.loads,
     };
-    let mut stepper = Stepper::new(ls, body, deck, &comp, law_refs, out)?;
+    let mut stepper = Stepper::new(ls, body, deck, &comp, law_refs, out, observer.stop_handle())?;
     stepper.wall.assembly += assembly;
     drive(ls, &mut stepper, out, observer, start, grid_seconds, D)
 }
@@ -233,6 +234,8 @@ struct Stepper<'a, const D: usize> {
     done: usize,
     /// The static step left the stresses to be recovered after it (nothing could fail).
     stress_stale: bool,
+    /// The observer's stop request, polled before every solve of a step.
+    stop: Stop,
 }
 
 impl<'a, const D: usize> Stepper<'a, D> {
@@ -243,6 +246,7 @@ impl<'a, const D: usize> Stepper<'a, D> {
         comp: &'a Composition<D>,
         law_refs: Vec<&'a dyn CellLaw<D>>,
         out: &Path,
+        stop: Stop,
     ) -> Result<Self, RunError> {
         let s = &ls.scene;
         let grid = body.grid;
@@ -263,7 +267,8 @@ impl<'a, const D: usize> Stepper<'a, D> {
         let t_asm = Instant::now();
         let (driver, linear_name) = match flow.take_if(|_| coupling != CouplingChoice::None) {
             Some(f) => {
-                let frac = coupled(ls, body, comp, &law_refs, f, settings)?;
+                let mut frac = coupled(ls, body, comp, &law_refs, f, settings)?;
+                frac.set_interrupt(stop.flag());
                 (
                     Driver::Coupled {
                         frac: Box::new(frac),
@@ -368,6 +373,7 @@ impl<'a, const D: usize> Stepper<'a, D> {
             wall,
             done: 0,
             stress_stale: false,
+            stop,
         })
     }
 
@@ -388,7 +394,11 @@ impl<'a, const D: usize> Stepper<'a, D> {
         let mut iterations = 0;
         let mut worst = 0.0f64;
         let mut solve_seconds = 0.0;
+        let stop = &self.stop;
         let mut solve = |failed: &[bool]| -> Result<(Vec<f64>, Vec<Tensor<D>>), RunError> {
+            if stop.requested() {
+                return Err(RunError::Interrupted);
+            }
             let laws = LawMap::new(grid, law_refs.clone(), comp.law_of_cell_after(failed))?;
             let problem = StaticProblem {
                 grid,
@@ -491,26 +501,8 @@ impl<'a, const D: usize> Stepper<'a, D> {
         Ok(next.solves)
     }
 
-    /// The value of `field` at a located point.
-    fn sample(&self, field: Field, loc: &Location) -> f64 {
-        let c = loc.cell;
-        match field {
-            Field::Displacement(a) => loc.nodal(&self.u, D, a),
-            Field::Pressure => self.pressure.as_ref().map_or(f64::NAN, |p| p[c]),
-            Field::Fractured => f64::from(u8::from(self.failures.flags()[c])),
-            f => f
-                .of_stress(&self.stress[c], self.nu_of_cell[c], self.plane_strain)
-                .unwrap_or(f64::NAN),
-        }
-    }
-}
-
-impl<const D: usize> Model for Stepper<'_, D> {
-    fn times(&self) -> &[f64] {
-        &self.times
-    }
-
-    fn step(&mut self, step: usize) -> Result<StepStats, RunError> {
+    /// The step to `times[step]` (the [`Model::step`] before its errors are explained).
+    fn step_at(&mut self, step: usize) -> Result<StepStats, RunError> {
         let t = self.times[step];
         self.done = step;
         let iterations = if matches!(self.driver, Driver::Coupled { .. }) {
@@ -536,6 +528,31 @@ impl<const D: usize> Model for Stepper<'_, D> {
             iterations,
             failed: self.failures.count(),
         })
+    }
+
+    /// The value of `field` at a located point.
+    fn sample(&self, field: Field, loc: &Location) -> f64 {
+        let c = loc.cell;
+        match field {
+            Field::Displacement(a) => loc.nodal(&self.u, D, a),
+            Field::Pressure => self.pressure.as_ref().map_or(f64::NAN, |p| p[c]),
+            Field::Fractured => f64::from(u8::from(self.failures.flags()[c])),
+            f => f
+                .of_stress(&self.stress[c], self.nu_of_cell[c], self.plane_strain)
+                .unwrap_or(f64::NAN),
+        }
+    }
+}
+
+impl<const D: usize> Model for Stepper<'_, D> {
+    fn times(&self) -> &[f64] {
+        &self.times
+    }
+
+    fn step(&mut self, step: usize) -> Result<StepStats, RunError> {
+        let cells = self.body.grid.num_cells();
+        self.step_at(step)
+            .map_err(|e| explain::explain(self.ls, cells, e))
     }
 
     fn probes(&self, values: &mut Vec<f64>) {
