@@ -9,6 +9,12 @@ use crate::common::loaded::{LoadedScene, k, ki};
 use crate::common::model::RunError;
 use crate::common::sections::{KeyPart, key_text};
 
+/// Largest stress component a state may hold (Pa): the invariants of the output fields
+/// (von Mises, principal stresses) square the components, which overflows beyond about
+/// 1e154; no rock holds a stress within a hundred orders of magnitude of this, so a larger
+/// one is an overflowed load.
+pub(crate) const MAX_STRESS: f64 = 1e150;
+
 /// `key (line n)` for a key path of the scene.
 fn at(ls: &LoadedScene, path: &[KeyPart]) -> String {
     format!("{} (line {})", key_text(path), ls.error(path, "").line)
@@ -163,18 +169,7 @@ pub(crate) fn explain(ls: &LoadedScene, cells: usize, e: RunError) -> RunError {
                 ),
             )
             .into(),
-        Kind::NotFinite => ls
-            .error(
-                &k(&["bc"]),
-                format!(
-                    "— the solution overflowed ({e}): the loads are too large for the moduli of \
-                     the scene (or an expression of a load is not finite somewhere). Look at \
-                     the loads: {}; and at the moduli: {}",
-                    list(&load_keys(ls)),
-                    list(&material_keys(ls))
-                ),
-            )
-            .into(),
+        Kind::NotFinite => overflow(ls, &e.to_string()),
         Kind::NotSettled { failed } if 2 * failed > cells && cells > 0 => ls
             .error(
                 &k(&["bc"]),
@@ -188,4 +183,59 @@ pub(crate) fn explain(ls: &LoadedScene, cells: usize, e: RunError) -> RunError {
             .into(),
         _ => e,
     }
+}
+
+/// The error of a state that is not finite: `what` says which value (the solver's
+/// message, or the field and where); the loads and moduli of the scene are named.
+pub(crate) fn overflow(ls: &LoadedScene, what: &str) -> RunError {
+    ls.error(
+        &k(&["bc"]),
+        format!(
+            "— the solution overflowed ({what}): the loads are too large for the moduli of the \
+             scene (or an expression of a load is not finite somewhere). Look at the loads: \
+             {}; and at the moduli: {}",
+            list(&load_keys(ls)),
+            list(&material_keys(ls))
+        ),
+    )
+    .into()
+}
+
+/// `Err` naming the loads and moduli when a displacement or pressure of the state at `t`
+/// is not finite, or a stress component is beyond [`MAX_STRESS`].
+pub(crate) fn check_state<const D: usize>(
+    ls: &LoadedScene,
+    t: f64,
+    u: &[f64],
+    pressure: Option<&[f64]>,
+    stress: &[porofrac_law::Tensor<D>],
+) -> Result<(), RunError> {
+    let axes = ["x", "y", "z"];
+    if let Some(i) = u.iter().position(|v| !v.is_finite()) {
+        let what = format!(
+            "the displacement {} of node {} is {} at t = {t:e} s",
+            axes[i % D],
+            i / D,
+            u[i]
+        );
+        return Err(overflow(ls, &what));
+    }
+    if let Some(p) = pressure
+        && let Some(c) = p.iter().position(|v| !v.is_finite())
+    {
+        let what = format!("the pressure of cell {c} is {} at t = {t:e} s", p[c]);
+        return Err(overflow(ls, &what));
+    }
+    if let Some(c) = stress
+        .iter()
+        .position(|s| s.iter().any(|v| !(v.abs() <= MAX_STRESS)))
+    {
+        let v = stress[c].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let what = format!(
+            "a stress component of cell {c} is {v:e} Pa at t = {t:e} s, beyond {MAX_STRESS:e} Pa \
+             where its invariants overflow"
+        );
+        return Err(overflow(ls, &what));
+    }
+    Ok(())
 }

@@ -551,8 +551,18 @@ impl<const D: usize> Model for Stepper<'_, D> {
 
     fn step(&mut self, step: usize) -> Result<StepStats, RunError> {
         let cells = self.body.grid.num_cells();
-        self.step_at(step)
-            .map_err(|e| explain::explain(self.ls, cells, e))
+        let stats = self
+            .step_at(step)
+            .map_err(|e| explain::explain(self.ls, cells, e))?;
+        let stress: &[Tensor<D>] = if self.stress_stale { &[] } else { &self.stress };
+        explain::check_state(
+            self.ls,
+            self.times[step],
+            &self.u,
+            self.pressure.as_deref(),
+            stress,
+        )?;
+        Ok(stats)
     }
 
     fn probes(&self, values: &mut Vec<f64>) {
@@ -581,6 +591,7 @@ impl<const D: usize> Model for Stepper<'_, D> {
             )?;
             self.stress = cell_stresses(grid, &laws, &self.u)?;
             self.stress_stale = false;
+            explain::check_state::<D>(self.ls, self.times[self.done], &[], None, &self.stress)?;
             self.wall.output += t_out.elapsed().as_secs_f64();
         }
         for f in &self.failures.log()[self.logged..] {
