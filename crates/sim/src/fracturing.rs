@@ -644,7 +644,11 @@ impl<'a, const D: usize> Fracturing<'a, D> {
             stress_cache,
             interrupt,
         } = self;
-        let stop = || interrupt.as_ref().is_some_and(|f| f.load(Ordering::Relaxed));
+        let stop = || {
+            interrupt
+                .as_ref()
+                .is_some_and(|f| f.load(Ordering::Relaxed))
+        };
         let grid = body.grid;
         let t1 = t + dt;
         let limits = ActiveSetLimits {

@@ -12,9 +12,17 @@
 //!   about 1e-5 Pa s, bitumen 1e5 Pa s) and the compressibility is finite and ≥ 0.
 //! - **Output points** (`[[output.probe]] at`, `[[output.line]] from`/`to`) are finite
 //!   and, where the grid's box is known from its keys, inside that box.
+//! - **States**: a run whose stresses pass [`MAX_STRESS`] has overflowed; the models end
+//!   it with an error naming the loads and moduli of the scene.
 
 use crate::common::loaded::{LoadedScene, SceneError};
 use crate::common::sections::KeyPart;
+
+/// Largest stress component a state may hold (Pa): the invariants of the output fields
+/// (von Mises, principal stresses) square the components, which overflows beyond about
+/// 1e154; no rock holds a stress within a hundred orders of magnitude of this, so a larger
+/// one is an overflowed load.
+pub const MAX_STRESS: f64 = 1e150;
 
 /// Smallest modulus a scene may give (Pa).
 pub const MIN_MODULUS: f64 = 1e-3;
@@ -40,7 +48,7 @@ pub fn modulus(
     Err(ls.error(
         path,
         format!(
-            "= {v} must be {zero}in {MIN_MODULUS:e} … {MAX_MODULUS:e} Pa (a modulus outside \
+            "= {v:e} must be {zero}in {MIN_MODULUS:e} … {MAX_MODULUS:e} Pa (a modulus outside \
              this range makes the stiffness of the scene overflow or vanish)"
         ),
     ))
@@ -48,16 +56,13 @@ pub fn modulus(
 
 /// The `[fluid]` numbers: viscosity in [`MIN_VISCOSITY`] … [`MAX_VISCOSITY`] and a
 /// finite compressibility ≥ 0.
-pub fn fluid(
-    ls: &LoadedScene,
-    fluid: &crate::common::sections::Fluid,
-) -> Result<(), SceneError> {
+pub fn fluid(ls: &LoadedScene, fluid: &crate::common::sections::Fluid) -> Result<(), SceneError> {
     let key = |f: &str| crate::common::loaded::k(&["fluid", f]);
     let mu = fluid.viscosity;
     if !(MIN_VISCOSITY..=MAX_VISCOSITY).contains(&mu) {
         return Err(ls.error(
             &key("viscosity"),
-            format!("= {mu} must be in {MIN_VISCOSITY:e} … {MAX_VISCOSITY:e} Pa s"),
+            format!("= {mu:e} must be in {MIN_VISCOSITY:e} … {MAX_VISCOSITY:e} Pa s"),
         ));
     }
     let c = fluid.compressibility;

@@ -5,15 +5,10 @@
 
 use porofrac_sim::{BiotError, FractureError, SimError};
 
+use crate::common::bounds::MAX_STRESS;
 use crate::common::loaded::{LoadedScene, k, ki};
 use crate::common::model::RunError;
 use crate::common::sections::{KeyPart, key_text};
-
-/// Largest stress component a state may hold (Pa): the invariants of the output fields
-/// (von Mises, principal stresses) square the components, which overflows beyond about
-/// 1e154; no rock holds a stress within a hundred orders of magnitude of this, so a larger
-/// one is an overflowed load.
-pub(crate) const MAX_STRESS: f64 = 1e150;
 
 /// `key (line n)` for a key path of the scene.
 fn at(ls: &LoadedScene, path: &[KeyPart]) -> String {

@@ -14,10 +14,10 @@
 
 pub mod check;
 pub mod compose;
+mod explain;
 pub mod fields;
 pub mod flow;
 pub mod plots;
-mod explain;
 
 use crate::common::loaded::SceneError;
 use crate::common::model::ModelKind;
