@@ -93,6 +93,7 @@ enum Kind {
     Singular,
     NotFinite,
     NotSettled { failed: usize },
+    ActiveSet,
     Other,
 }
 
@@ -136,6 +137,7 @@ fn kind_of(e: &RunError) -> Kind {
             FractureError::Biot(b) => kind_of_biot(b),
             FractureError::Mechanics(s) => kind_of_sim(s),
             FractureError::NotSettled { failed, .. } => Kind::NotSettled { failed: *failed },
+            FractureError::ActiveSet { .. } => Kind::ActiveSet,
             _ => Kind::Other,
         },
         RunError::Fracture(m) if m.starts_with("failures did not settle") => {
@@ -172,6 +174,16 @@ pub(crate) fn explain(ls: &LoadedScene, cells: usize, e: RunError) -> RunError {
                     "— {e}: {failed} of {cells} cells failed, the loads exceed the strength of \
                      the rock almost everywhere. Look at the loads: {}; and at the strengths \
                      (tensile_strength, cohesion) of the materials",
+                    list(&load_keys(ls))
+                ),
+            )
+            .into(),
+        Kind::ActiveSet => ls
+            .error(
+                &k(&["bc"]),
+                format!(
+                    "— {e}: the fractured cells open and close without settling, most often \
+                     under loads far beyond the strength of the rock. Look at the loads: {}",
                     list(&load_keys(ls))
                 ),
             )
