@@ -90,7 +90,7 @@ fn probes_at_infinity_or_outside_the_grid_are_refused_by_check() {
     let (code, err) = check_text("cont_cosserat_probe_inf", &text);
     assert_eq!(code, 1, "{err}");
     assert!(
-        err.contains(&format!(":{line}:")) && err.contains("output.probe[1].at"),
+        err.contains(&format!(":{line}:")) && err.contains("output.probe[0].at"),
         "{err}"
     );
 }
