@@ -209,7 +209,6 @@ fn ctrl_c_while_the_first_failures_settle_ends_the_run_as_interrupted() {
     let status = child.wait().unwrap();
     assert_eq!(status.code(), Some(130));
     let summary: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
-            .unwrap();
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
     assert_eq!(summary["status"], "interrupted at t = 0");
 }

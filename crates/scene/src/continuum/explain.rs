@@ -235,7 +235,7 @@ pub(crate) fn check_state<const D: usize>(
     }
     if let Some(c) = stress
         .iter()
-        .position(|s| s.iter().any(|v| !(v.abs() <= MAX_STRESS)))
+        .position(|s| s.iter().any(|v| !v.is_finite() || v.abs() > MAX_STRESS))
     {
         let v = stress[c].iter().fold(0.0f64, |m, v| m.max(v.abs()));
         let what = format!(

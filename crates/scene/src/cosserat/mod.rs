@@ -492,7 +492,7 @@ impl<const D: usize> Run<'_, D> {
         } else if let Some(c) = self
             .stress
             .iter()
-            .position(|s| s.iter().any(|v| !(v.abs() <= max)))
+            .position(|s| s.iter().any(|v| !v.is_finite() || v.abs() > max))
         {
             format!("a stress of cell {c} is beyond {max:e} Pa at t = {t:e} s")
         } else {
