@@ -94,12 +94,14 @@ enum Kind {
     NotFinite,
     NotSettled { failed: usize },
     ActiveSet,
+    Conditions,
     Other,
 }
 
 fn kind_of_sim(e: &SimError) -> Kind {
     match e {
         SimError::NotPositiveDefinite { .. } => Kind::Singular,
+        SimError::Singular { .. } | SimError::Conflict { .. } => Kind::Conditions,
         SimError::NotFinite { .. } => Kind::NotFinite,
         SimError::LinearAlgebra(m) | SimError::Iterative(m) => kind_of_text(m),
         _ => Kind::Other,
@@ -111,7 +113,7 @@ fn kind_of_text(m: &str) -> Kind {
     let l = m.to_lowercase();
     if l.contains("pivot") || l.contains("positive definite") || l.contains("singular") {
         Kind::Singular
-    } else if l.contains("not finite") {
+    } else if l.contains("not finite") || l.contains("non-finite") {
         Kind::NotFinite
     } else {
         Kind::Other
@@ -178,6 +180,7 @@ pub(crate) fn explain(ls: &LoadedScene, cells: usize, e: RunError) -> RunError {
                 ),
             )
             .into(),
+        Kind::Conditions => ls.error(&k(&["bc"]), format!("— {e}")).into(),
         Kind::ActiveSet => ls
             .error(
                 &k(&["bc"]),
@@ -245,4 +248,16 @@ pub(crate) fn check_state<const D: usize>(
         return Err(overflow(ls, &what));
     }
     Ok(())
+}
+
+/// An error of the boundary conditions (two conditions that prescribe different values
+/// at a node, rigid-body motion left free) at the `[[bc]]` of the scene; others as they
+/// are.
+pub(crate) fn conditions(ls: &LoadedScene, e: SimError) -> RunError {
+    match e {
+        SimError::Conflict { .. } | SimError::Singular { .. } => {
+            ls.error(&k(&["bc"]), format!("— {e}")).into()
+        }
+        e => e.into(),
+    }
 }

@@ -101,7 +101,8 @@ fn run_dim<const D: usize>(
     let law_refs: Vec<&dyn CellLaw<D>> = comp.laws.iter().map(|l| l.as_ref()).collect();
     // Checks every cell against its law once (e.g. MDEM on a polygon is an error).
     LawMap::new(grid, law_refs.clone(), comp.law_of_cell.clone())?;
-    let dofs = DofMap::new(grid, &cond.displacements, &cond.platens)?;
+    let dofs = DofMap::new(grid, &cond.displacements, &cond.platens)
+        .map_err(|e| explain::conditions(ls, e))?;
     let pattern = Pattern::new(grid, &dofs)?;
     let assembly = t_asm.elapsed().as_secs_f64();
     let body = Body {
@@ -110,7 +111,8 @@ fn run_dim<const D: usize>(
         pattern: &pattern,
         loads: &cond.loads,
     };
-    let mut stepper = Stepper::new(ls, body, deck, &comp, law_refs, out, observer.stop_handle())?;
+    let mut stepper = Stepper::new(ls, body, deck, &comp, law_refs, out, observer.stop_handle())
+        .map_err(|e| explain::explain(ls, grid.num_cells(), e))?;
     stepper.wall.assembly += assembly;
     drive(ls, &mut stepper, out, observer, start, grid_seconds, D)
 }
