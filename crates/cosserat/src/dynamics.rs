@@ -168,6 +168,14 @@ impl Dynamics {
         self.solver.as_ref()
     }
 
+    /// Poll `flag` in the iterative Newmark solves ([`Linear::set_interrupt`]); the
+    /// explicit integrator solves nothing (its caller polls between steps).
+    pub fn set_interrupt(&mut self, flag: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>) {
+        if let Some(l) = self.solver.as_mut() {
+            l.set_interrupt(flag);
+        }
+    }
+
     /// Statistics of the Newmark solves (default for the explicit integrator).
     pub fn solver_stats(&self) -> LinearStats {
         self.solver.as_ref().map(Linear::stats).unwrap_or_default()

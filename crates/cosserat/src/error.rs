@@ -77,6 +77,10 @@ pub enum CosseratError {
     /// The grid could not be built.
     #[error("grid: {0}")]
     Grid(#[from] GridError),
+    /// A stop was requested (the flag of [`crate::linear::Linear::set_interrupt`]) during
+    /// an iterative solve.
+    #[error("interrupted")]
+    Interrupted,
 }
 
 /// Result with [`CosseratError`].

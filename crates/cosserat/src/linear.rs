@@ -96,6 +96,9 @@ use porofrac_sparse::{Ldlt, LdltError};
 use porofrac_sparse::{LdltSingle, TrailingFactor};
 use rayon::prelude::*;
 
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use crate::error::{CosseratError, Result};
 use crate::krylov::{FactorPrecision, GmresOptions, GmresStats, gmres};
 use crate::pattern::{BlockPattern, SparseLu};
@@ -914,6 +917,7 @@ pub struct Linear {
     kind: Kind,
     n: usize,
     stats: LinearStats,
+    interrupt: Option<Arc<AtomicBool>>,
 }
 
 impl std::fmt::Debug for Linear {
@@ -1082,7 +1086,19 @@ impl Linear {
                 Kind::Gmres(Box::new(g))
             }
         };
-        Ok(Self { kind, n, stats })
+        Ok(Self {
+            kind,
+            n,
+            stats,
+            interrupt: None,
+        })
+    }
+
+    /// Poll `flag` at every GMRES iteration: when it is set, [`Self::solve`] ends with
+    /// [`CosseratError::Interrupted`] (Ctrl-C during a long solve). A direct solve is not
+    /// iterative and does not poll.
+    pub fn set_interrupt(&mut self, flag: Option<Arc<AtomicBool>>) {
+        self.interrupt = flag;
     }
 
     /// The solver in use.
@@ -1121,7 +1137,7 @@ impl Linear {
         match &mut self.kind {
             Kind::Lu(lu) => lu.solve_in_place(rhs)?,
             Kind::Gmres(g) => {
-                let st = g.solve(rhs, guess)?;
+                let st = g.solve(rhs, guess, self.interrupt.as_deref())?;
                 self.stats.iterations += st.iterations;
                 self.stats.max_iterations = self.stats.max_iterations.max(st.iterations);
                 self.stats.max_residual = self.stats.max_residual.max(st.residual);
@@ -1340,7 +1356,12 @@ impl Gmres {
         })
     }
 
-    fn solve(&mut self, rhs: &mut [f64], guess: Option<&[f64]>) -> Result<GmresStats> {
+    fn solve(
+        &mut self,
+        rhs: &mut [f64],
+        guess: Option<&[f64]>,
+        interrupt: Option<&AtomicBool>,
+    ) -> Result<GmresStats> {
         let b = rhs.to_vec();
         match guess {
             Some(g) => rhs.copy_from_slice(g),
@@ -1373,6 +1394,9 @@ impl Gmres {
         let result = gmres(
             |x, y| me.apply(x, y),
             |r, z| match pre {
+                _ if interrupt.is_some_and(|f| f.load(Ordering::Relaxed)) => {
+                    Err(CosseratError::Interrupted)
+                }
                 Precond::Amg(amg) => amg
                     .apply(r, z)
                     .map_err(|e| CosseratError::Solve(format!("multigrid V-cycle: {e}"))),

@@ -64,6 +64,7 @@ use rayon::prelude::*;
 
 use crate::bc::Loads;
 use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::assembly::{ElementCache, law_error};
 use crate::biot::{
@@ -119,6 +120,10 @@ pub enum FractureError {
         /// Cells failed so far.
         failed: usize,
     },
+    /// A stop was requested (the flag of [`Fracturing::set_interrupt`]) between two
+    /// solves of a step.
+    #[error("interrupted")]
+    Interrupted,
 }
 
 /// Result alias of this module.
@@ -475,6 +480,8 @@ pub struct Fracturing<'a, const D: usize> {
     elements: Arc<ElementCache>,
     /// The stress operators of the cells with a linear law (built at the first solve).
     stress_cache: Option<StressCache>,
+    /// Polled before every solve of a step (failure rounds, active-set iterations).
+    interrupt: Option<Arc<AtomicBool>>,
 }
 
 /// A failure state's law map and stiffness (at zero displacement).
@@ -567,7 +574,18 @@ impl<'a, const D: usize> Fracturing<'a, D> {
             cached,
             elements,
             stress_cache: None,
+            interrupt: None,
         })
+    }
+
+    /// Poll `flag` before every solve of a step — failure rounds, active-set iterations
+    /// and the iterations of a fixed-stress scheme: when it is set, the step ends with
+    /// [`FractureError::Interrupted`] and the state stays at the start of the step.
+    pub fn set_interrupt(&mut self, flag: Option<Arc<AtomicBool>>) {
+        if let Scheme::FixedStress(f, _) = &mut self.scheme {
+            f.set_interrupt(flag.clone());
+        }
+        self.interrupt = flag;
     }
 
     /// The failure state (flags and the log of failures).
@@ -626,7 +644,13 @@ impl<'a, const D: usize> Fracturing<'a, D> {
             cached,
             elements,
             stress_cache,
+            interrupt,
         } = self;
+        let stop = || {
+            interrupt
+                .as_ref()
+                .is_some_and(|f| f.load(Ordering::Relaxed))
+        };
         let grid = body.grid;
         let t1 = t + dt;
         let limits = ActiveSetLimits {
@@ -639,6 +663,9 @@ impl<'a, const D: usize> Fracturing<'a, D> {
         // starts from its stiffness (see `active_set_solve`).
         let mut warm: Option<BiotState> = None;
         let solve = |fs: &FailureState| -> FractureResult<(BiotState, Vec<Tensor<D>>)> {
+            if stop() {
+                return Err(FractureError::Interrupted);
+            }
             if cached.as_ref().is_none_or(|c| c.flags != fs.flags()) {
                 *cached = Some(Cached {
                     flags: fs.flags().to_vec(),
@@ -671,8 +698,16 @@ impl<'a, const D: usize> Fracturing<'a, D> {
                     .map(|(a, b)| *a || *b)
                     .collect();
             }
-            let (new, residual, n) =
-                active_set_solve(&mut system, scheme, state, warm.as_ref(), t, dt, limits)?;
+            let (new, residual, n) = active_set_solve(
+                &mut system,
+                scheme,
+                state,
+                warm.as_ref(),
+                t,
+                dt,
+                limits,
+                &stop,
+            )?;
             solves += n;
             warm = Some(new.clone());
             worst = worst.max(residual);
@@ -832,6 +867,7 @@ fn active_set_solve<const D: usize>(
     t: f64,
     dt: f64,
     limits: ActiveSetLimits,
+    stop: &dyn Fn() -> bool,
 ) -> FractureResult<(BiotState, f64, usize)> {
     let t1 = t + dt;
     if system.mechanics().laws.all_linear() {
@@ -859,6 +895,9 @@ fn active_set_solve<const D: usize>(
     let mut best: Option<(BiotState, Vec<f64>, f64)> = None;
     let mut residual = f64::INFINITY;
     for it in 1..=limits.iterations.max(1) {
+        if it > 1 && stop() {
+            return Err(FractureError::Interrupted);
+        }
         let (new, p_used, solve_residual) = match state {
             None => {
                 let st = system.initial_state(t)?;

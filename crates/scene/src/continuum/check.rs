@@ -2,6 +2,7 @@
 //! conditions, loads, sources, wells, schedule, physics, solver and outputs, and the
 //! sizes a scene asks for. Every problem is a [`SceneError`] naming its key and line.
 
+use crate::common::bounds::{modulus, point_inside};
 use crate::common::laws::LawRegistry;
 use crate::common::loaded::{
     LoadedScene, SceneError, expr_ok, k, ki, len_is, line_points_and_name, positive, step_count_f64,
@@ -30,7 +31,7 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
     // Materials.
     for (name, m) in &s.material {
         let key = |f: &str| k(&["material", name, f]);
-        positive(ls, &key("youngs_modulus"), m.youngs_modulus)?;
+        modulus(ls, &key("youngs_modulus"), m.youngs_modulus, false)?;
         let nu = m.poisson_ratio;
         if !nu.is_finite() || nu >= 0.5 {
             return Err(ls.error(&key("poisson_ratio"), format!("= {nu} must be < 0.5")));
@@ -38,9 +39,11 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
         if nu <= -1.0 {
             return Err(ls.error(&key("poisson_ratio"), format!("= {nu} must be > -1")));
         }
+        if let Some(v) = m.solid_bulk_modulus {
+            modulus(ls, &key("solid_bulk_modulus"), v, false)?;
+        }
         for (f, v) in [
             ("density", m.density),
-            ("solid_bulk_modulus", m.solid_bulk_modulus),
             ("tensile_strength", m.tensile_strength),
             ("fracture_toughness", m.fracture_toughness),
         ] {
@@ -230,6 +233,9 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
     {
         expr_ok(ls, &k(&["initial", "pressure"]), p, false)?;
     }
+    if let Some(f) = &s.fluid {
+        crate::common::bounds::fluid(ls, f)?;
+    }
     if let Some(kf) = s.physics.fracture_permeability {
         positive(ls, &k(&["physics", "fracture_permeability"]), kf)?;
     }
@@ -322,9 +328,13 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
             .map_err(|e| ls.error(&key, e))
     };
     let mut names = std::collections::BTreeSet::new();
+    let extent = (s.grid.kind != GridKind::File)
+        .then_some(s.grid.extent.as_ref())
+        .flatten();
     for (i, p) in s.output.probe.iter().enumerate() {
         field_ok(&p.field, ki("output.probe", i, &["field"]))?;
         len_is(ls, &ki("output.probe", i, &["at"]), p.at.len(), d)?;
+        point_inside(ls, &ki("output.probe", i, &["at"]), &p.at, extent)?;
         if !names.insert(p.name.clone()) || p.name == "time" || p.name.contains(',') {
             return Err(ls.error(
                 &ki("output.probe", i, &["name"]),
@@ -336,6 +346,8 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
         field_ok(&l.field, ki("output.line", i, &["field"]))?;
         len_is(ls, &ki("output.line", i, &["from"]), l.from.len(), d)?;
         len_is(ls, &ki("output.line", i, &["to"]), l.to.len(), d)?;
+        point_inside(ls, &ki("output.line", i, &["from"]), &l.from, extent)?;
+        point_inside(ls, &ki("output.line", i, &["to"]), &l.to, extent)?;
         line_points_and_name(ls, i, l)?;
     }
     check_wells(ls, d)?;

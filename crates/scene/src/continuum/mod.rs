@@ -15,6 +15,7 @@
 
 pub mod check;
 pub mod compose;
+mod explain;
 pub mod fields;
 pub mod flow;
 pub mod plots;
@@ -37,7 +38,7 @@ use porofrac_sim::{
     StressMeasure, cell_stresses, drained_bulk_modulus, solve_explicit, solve_static,
 };
 
-use crate::common::driver::{Observer, drive};
+use crate::common::driver::{Observer, Stop, drive};
 use crate::common::laws::LawRegistry;
 use crate::common::loaded::{LoadedScene, k, ki};
 use crate::common::model::{Model, RunError, Sizes, StepStats};
@@ -101,7 +102,8 @@ fn run_dim<const D: usize>(
     let law_refs: Vec<&dyn CellLaw<D>> = comp.laws.iter().map(|l| l.as_ref()).collect();
     // Checks every cell against its law once (e.g. MDEM on a polygon is an error).
     LawMap::new(grid, law_refs.clone(), comp.law_of_cell.clone())?;
-    let dofs = DofMap::new(grid, &cond.displacements, &cond.platens)?;
+    let dofs = DofMap::new(grid, &cond.displacements, &cond.platens)
+        .map_err(|e| explain::conditions(ls, e))?;
     // An island of cells left free (a deck's active cells cut off by inactive ones) is
     // named by its deck (i, j, k) where there is one.
     dofs.check_rigid_modes(grid).map_err(|e| match e {
@@ -131,7 +133,8 @@ fn run_dim<const D: usize>(
         pattern: &pattern,
         loads: &cond.loads,
     };
-    let mut stepper = Stepper::new(ls, body, deck, &comp, law_refs, out)?;
+    let mut stepper = Stepper::new(ls, body, deck, &comp, law_refs, out, observer.stop_handle())
+        .map_err(|e| explain::explain(ls, grid.num_cells(), e))?;
     stepper.wall.assembly += assembly;
     drive(ls, &mut stepper, out, observer, start, grid_seconds, D)
 }
@@ -255,6 +258,8 @@ struct Stepper<'a, const D: usize> {
     done: usize,
     /// The static step left the stresses to be recovered after it (nothing could fail).
     stress_stale: bool,
+    /// The observer's stop request, polled before every solve of a step.
+    stop: Stop,
 }
 
 impl<'a, const D: usize> Stepper<'a, D> {
@@ -265,6 +270,7 @@ impl<'a, const D: usize> Stepper<'a, D> {
         comp: &'a Composition<D>,
         law_refs: Vec<&'a dyn CellLaw<D>>,
         out: &Path,
+        stop: Stop,
     ) -> Result<Self, RunError> {
         let s = &ls.scene;
         let grid = body.grid;
@@ -285,7 +291,8 @@ impl<'a, const D: usize> Stepper<'a, D> {
         let t_asm = Instant::now();
         let (driver, linear_name) = match flow.take_if(|_| coupling != CouplingChoice::None) {
             Some(f) => {
-                let frac = coupled(ls, body, comp, &law_refs, f, settings)?;
+                let mut frac = coupled(ls, body, comp, &law_refs, f, settings)?;
+                frac.set_interrupt(stop.flag());
                 (
                     Driver::Coupled {
                         frac: Box::new(frac),
@@ -390,6 +397,7 @@ impl<'a, const D: usize> Stepper<'a, D> {
             wall,
             done: 0,
             stress_stale: false,
+            stop,
         })
     }
 
@@ -410,7 +418,11 @@ impl<'a, const D: usize> Stepper<'a, D> {
         let mut iterations = 0;
         let mut worst = 0.0f64;
         let mut solve_seconds = 0.0;
+        let stop = &self.stop;
         let mut solve = |failed: &[bool]| -> Result<(Vec<f64>, Vec<Tensor<D>>), RunError> {
+            if stop.requested() {
+                return Err(RunError::Interrupted);
+            }
             let laws = LawMap::new(grid, law_refs.clone(), comp.law_of_cell_after(failed))?;
             let problem = StaticProblem {
                 grid,
@@ -513,26 +525,8 @@ impl<'a, const D: usize> Stepper<'a, D> {
         Ok(next.solves)
     }
 
-    /// The value of `field` at a located point.
-    fn sample(&self, field: Field, loc: &Location) -> f64 {
-        let c = loc.cell;
-        match field {
-            Field::Displacement(a) => loc.nodal(&self.u, D, a),
-            Field::Pressure => self.pressure.as_ref().map_or(f64::NAN, |p| p[c]),
-            Field::Fractured => f64::from(u8::from(self.failures.flags()[c])),
-            f => f
-                .of_stress(&self.stress[c], self.nu_of_cell[c], self.plane_strain)
-                .unwrap_or(f64::NAN),
-        }
-    }
-}
-
-impl<const D: usize> Model for Stepper<'_, D> {
-    fn times(&self) -> &[f64] {
-        &self.times
-    }
-
-    fn step(&mut self, step: usize) -> Result<StepStats, RunError> {
+    /// The step to `times[step]` (the [`Model::step`] before its errors are explained).
+    fn step_at(&mut self, step: usize) -> Result<StepStats, RunError> {
         let t = self.times[step];
         self.done = step;
         let iterations = if matches!(self.driver, Driver::Coupled { .. }) {
@@ -558,6 +552,41 @@ impl<const D: usize> Model for Stepper<'_, D> {
             iterations,
             failed: self.failures.count(),
         })
+    }
+
+    /// The value of `field` at a located point.
+    fn sample(&self, field: Field, loc: &Location) -> f64 {
+        let c = loc.cell;
+        match field {
+            Field::Displacement(a) => loc.nodal(&self.u, D, a),
+            Field::Pressure => self.pressure.as_ref().map_or(f64::NAN, |p| p[c]),
+            Field::Fractured => f64::from(u8::from(self.failures.flags()[c])),
+            f => f
+                .of_stress(&self.stress[c], self.nu_of_cell[c], self.plane_strain)
+                .unwrap_or(f64::NAN),
+        }
+    }
+}
+
+impl<const D: usize> Model for Stepper<'_, D> {
+    fn times(&self) -> &[f64] {
+        &self.times
+    }
+
+    fn step(&mut self, step: usize) -> Result<StepStats, RunError> {
+        let cells = self.body.grid.num_cells();
+        let stats = self
+            .step_at(step)
+            .map_err(|e| explain::explain(self.ls, cells, e))?;
+        let stress: &[Tensor<D>] = if self.stress_stale { &[] } else { &self.stress };
+        explain::check_state(
+            self.ls,
+            self.times[step],
+            &self.u,
+            self.pressure.as_deref(),
+            stress,
+        )?;
+        Ok(stats)
     }
 
     fn probes(&self, values: &mut Vec<f64>) {
@@ -586,6 +615,7 @@ impl<const D: usize> Model for Stepper<'_, D> {
             )?;
             self.stress = cell_stresses(grid, &laws, &self.u)?;
             self.stress_stale = false;
+            explain::check_state::<D>(self.ls, self.times[self.done], &[], None, &self.stress)?;
             self.wall.output += t_out.elapsed().as_secs_f64();
         }
         for f in &self.failures.log()[self.logged..] {

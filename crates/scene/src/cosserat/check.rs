@@ -1,6 +1,7 @@
 //! Checks of a `model = "cosserat"` scene (docs/models/cosserat.md), and the
 //! refusal of the Cosserat keys in continuum scenes. Every problem names its key.
 
+use crate::common::bounds::{modulus, point_inside};
 use crate::common::loaded::{LoadedScene, SceneError, expr_ok, k, ki};
 use crate::common::sections::{
     DiagonalsChoice, GridKind, KeyPart, LinearChoice, NumOrExpr, Select,
@@ -314,10 +315,14 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
     if s.output.every < 1 {
         return Err(ls.error(&k(&["output", "every"]), "must be ≥ 1"));
     }
+    let extent = (s.grid.kind != GridKind::File)
+        .then_some(s.grid.extent.as_ref())
+        .flatten();
     let mut names = std::collections::BTreeSet::new();
     for (i, p) in s.output.probe.iter().enumerate() {
         Field::parse(&p.field, d).map_err(|e| ls.error(&ki("output.probe", i, &["field"]), e))?;
         len_is(ls, &ki("output.probe", i, &["at"]), p.at.len(), d)?;
+        point_inside(ls, &ki("output.probe", i, &["at"]), &p.at, extent)?;
         if !names.insert(p.name.clone()) || p.name == "time" || p.name.contains(',') {
             return Err(ls.error(
                 &ki("output.probe", i, &["name"]),
@@ -329,6 +334,8 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
         Field::parse(&l.field, d).map_err(|e| ls.error(&ki("output.line", i, &["field"]), e))?;
         len_is(ls, &ki("output.line", i, &["from"]), l.from.len(), d)?;
         len_is(ls, &ki("output.line", i, &["to"]), l.to.len(), d)?;
+        point_inside(ls, &ki("output.line", i, &["from"]), &l.from, extent)?;
+        point_inside(ls, &ki("output.line", i, &["to"]), &l.to, extent)?;
         crate::common::loaded::line_points_and_name(ls, i, l)?;
     }
     Ok(())
@@ -442,8 +449,8 @@ fn check_material(ls: &LoadedScene, name: &str, d: usize) -> Result<(), SceneErr
         ));
     }
     match (m.shear_modulus, m.youngs_modulus.is_nan()) {
-        (Some(g), true) => positive(ls, &key("shear_modulus"), g)?,
-        (None, false) => positive(ls, &key("youngs_modulus"), m.youngs_modulus)?,
+        (Some(g), true) => modulus(ls, &key("shear_modulus"), g, false)?,
+        (None, false) => modulus(ls, &key("youngs_modulus"), m.youngs_modulus, false)?,
         (Some(_), false) => {
             return Err(ls.error(
                 &key("shear_modulus"),
@@ -455,7 +462,7 @@ fn check_material(ls: &LoadedScene, name: &str, d: usize) -> Result<(), SceneErr
         }
     }
     match m.cosserat_shear_modulus {
-        Some(gc) => non_negative(ls, &key("cosserat_shear_modulus"), gc)?,
+        Some(gc) => modulus(ls, &key("cosserat_shear_modulus"), gc, true)?,
         None => return Err(ls.error(&key("cosserat_shear_modulus"), "is missing")),
     }
     match (m.characteristic_length, &m.couple_moduli, d) {

@@ -36,13 +36,13 @@ use porofrac_cosserat::{
 };
 use porofrac_grid::{Grid, Point};
 
-use crate::common::driver::{Observer, drive};
+use crate::common::driver::{Observer, Stop, drive};
 use crate::common::grid::{AnyGrid, build_grid, point};
 use crate::common::loaded::{LoadedScene, k, ki};
 use crate::common::model::{Model, RunError, Sizes, StepStats};
 use crate::common::output::{SolverStats, Summary, WallSeconds};
 use crate::common::plots::{Canvas, FieldPlot, Values};
-use crate::common::sections::{DiagonalsChoice, GridKind, LinearChoice, NumOrExpr};
+use crate::common::sections::{DiagonalsChoice, GridKind, KeyPart, LinearChoice, NumOrExpr};
 
 use crate::common::rotation_keys::TimeIntegration;
 use fields::Field;
@@ -95,8 +95,63 @@ fn scene_error(ls: &LoadedScene, e: CosseratError) -> RunError {
         CosseratError::Grid(_) => k(&["grid"]),
         CosseratError::NotConverged { .. } => k(&["solver", "linear"]),
         CosseratError::Input { .. } | CosseratError::Solve(_) => k(&["scene", "model"]),
+        CosseratError::Interrupted => return RunError::Interrupted,
     };
     RunError::Scene(ls.error(&key, format!(": {e}")))
+}
+
+/// The error of a state that overflowed (`what`: which value), naming the loads and the
+/// moduli of the scene with their lines.
+fn overflow(ls: &LoadedScene, what: &str) -> RunError {
+    let s = &ls.scene;
+    let at = |path: &[KeyPart]| {
+        format!(
+            "{} (line {})",
+            crate::common::sections::key_text(path),
+            ls.error(path, "").line
+        )
+    };
+    let mut loads = Vec::new();
+    for (i, bc) in s.bc.iter().enumerate() {
+        for (f, set) in [
+            ("displacement", bc.displacement.is_some()),
+            ("traction", bc.traction.is_some()),
+            ("rotation", bc.rotation.is_some()),
+            ("couple_traction", bc.couple_traction.is_some()),
+        ] {
+            if set {
+                loads.push(at(&ki("bc", i, &[f])));
+            }
+        }
+    }
+    if let Some(l) = &s.loads {
+        if l.body_force.is_some() {
+            loads.push(at(&k(&["loads", "body_force"])));
+        }
+        if l.body_couple.is_some() {
+            loads.push(at(&k(&["loads", "body_couple"])));
+        }
+    }
+    let mut moduli = Vec::new();
+    for (name, m) in &s.material {
+        let f = if m.shear_modulus.is_some() {
+            "shear_modulus"
+        } else {
+            "youngs_modulus"
+        };
+        moduli.push(at(&k(&["material", name, f])));
+        moduli.push(at(&k(&["material", name, "cosserat_shear_modulus"])));
+    }
+    ls.error(
+        &k(&["loads"]),
+        format!(
+            "— the solution overflowed ({what}): the loads are too large for the moduli of the \
+             scene. Look at the loads: {}; and at the moduli: {}",
+            loads.join(", "),
+            moduli.join(", ")
+        ),
+    )
+    .into()
 }
 
 /// The first `[loads]` value (`body_force` or `body_couple` component) that is not a
@@ -285,6 +340,8 @@ struct Run<'a, const D: usize> {
     lines: Vec<(Field, LinePoints<D>)>,
     wall: WallSeconds,
     stats: SolverStats,
+    /// The observer's stop request, polled between the sub-steps of a step.
+    stop: Stop,
 }
 
 fn run_dim<const D: usize>(
@@ -306,6 +363,7 @@ fn run_dim<const D: usize>(
     let model = Cosserat::new(grid, mat, options, &cond, body).map_err(|e| scene_error(ls, e))?;
     let n_eq = model.equations();
     let linear_options = linear_options(ls);
+    let stop = observer.stop_handle();
     let mut times = vec![0.0];
     let stepping = match &ls.scene.schedule {
         None => {
@@ -316,6 +374,8 @@ fn run_dim<const D: usize>(
                     &linear_options,
                 )
                 .map_err(|e| scene_error(ls, e))?;
+            let mut solver = solver;
+            solver.set_interrupt(stop.flag());
             Stepping::Static(solver)
         }
         Some(sch) => {
@@ -344,6 +404,8 @@ fn run_dim<const D: usize>(
                 &linear_options,
             )
             .map_err(|e| scene_error(ls, e))?;
+            let mut state = state;
+            state.set_interrupt(stop.flag());
             Stepping::Dynamic { state, substeps }
         }
     };
@@ -403,6 +465,7 @@ fn run_dim<const D: usize>(
             ..SolverStats::default()
         },
         model,
+        stop,
     };
     drive(ls, &mut run, out, observer, start, grid_seconds, D)
 }
@@ -412,6 +475,35 @@ impl<const D: usize> Run<'_, D> {
         for c in 0..self.model.grid().num_cells() {
             self.stress[c] = self.model.cell_stress(c, &self.w);
         }
+    }
+
+    /// `Err` naming the loads and moduli of the scene when the state at `t` overflowed:
+    /// a generalised displacement that is not finite, a stress beyond
+    /// [`crate::common::bounds::MAX_STRESS`], or an energy that is not finite.
+    fn check_state(&self, t: f64) -> Result<(), RunError> {
+        let max = crate::common::bounds::MAX_STRESS;
+        let what = if let Some(i) = self.w.iter().position(|v| !v.is_finite()) {
+            format!(
+                "unknown {} of cell {} is {} at t = {t:e} s",
+                i % components(D),
+                i / components(D),
+                self.w[i]
+            )
+        } else if let Some(c) = self
+            .stress
+            .iter()
+            .position(|s| s.iter().any(|v| !v.is_finite() || v.abs() > max))
+        {
+            format!("a stress of cell {c} is beyond {max:e} Pa at t = {t:e} s")
+        } else {
+            let e = self.value(Field::Energy, self.model.grid().cell_centroid(0), 0);
+            let kin = self.value(Field::Kinetic, self.model.grid().cell_centroid(0), 0);
+            if e.is_finite() && kin.is_finite() {
+                return Ok(());
+            }
+            format!("the energy is {e} and the kinetic energy {kin} at t = {t:e} s")
+        };
+        Err(overflow(self.ls, &what))
     }
 
     fn value(&self, f: Field, x: &Point<D>, cell: usize) -> f64 {
@@ -474,6 +566,9 @@ impl<const D: usize> Model for Run<'_, D> {
                     let (t0, t1) = (self.times[step - 1], self.times[step]);
                     let n = *substeps;
                     for _ in 0..n {
+                        if self.stop.requested() {
+                            return Err(RunError::Interrupted);
+                        }
                         state.step(&self.model).map_err(|e| {
                             // The loads at the times the integrator evaluated them.
                             let times: Vec<f64> = (0..=n.min(1000))
@@ -489,6 +584,7 @@ impl<const D: usize> Model for Run<'_, D> {
         }
         self.wall.solve += t_solve.elapsed().as_secs_f64();
         self.refresh_stress();
+        self.check_state(self.times[step])?;
         Ok(StepStats {
             iterations: 0,
             failed: 0,

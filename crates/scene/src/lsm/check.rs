@@ -141,6 +141,7 @@ pub fn bond_law(ls: &LoadedScene) -> Result<BondLaw, SceneError> {
             if b.ks.is_some() {
                 return Err(ls.error(&key("ks"), "is set by youngs_modulus and poisson_ratio"));
             }
+            crate::common::bounds::modulus(ls, &key("youngs_modulus"), e, false)?;
             porofrac_lsm::calibrate::hexagonal_springs(e, nu).map_err(|e| lsm_error(ls, &e))?
         }
         (Some(_), None, None) => {
@@ -149,7 +150,11 @@ pub fn bond_law(ls: &LoadedScene) -> Result<BondLaw, SceneError> {
         (None, Some(_), None) => {
             return Err(ls.error(&key("youngs_modulus"), "is required with poisson_ratio"));
         }
-        (None, None, Some(kn)) => (kn, b.ks.unwrap_or(0.0)),
+        (None, None, Some(kn)) => {
+            // A 2D bond stiffness per unit thickness has the unit of a modulus.
+            crate::common::bounds::modulus(ls, &key("kn"), kn, false)?;
+            (kn, b.ks.unwrap_or(0.0))
+        }
         (None, None, None) => {
             return Err(ls.error(
                 &key("youngs_modulus"),

@@ -1,6 +1,9 @@
 //! The fixed-stress split: flow with the stabilisation `α²/K_dr`, then mechanics,
 //! iterated within each step.
 
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use super::{
     BiotCoupling, BiotError, BiotResult, BiotState, BiotStep, BiotSystem, CouplingStats,
     FlowSolver, MechSolver, check_state, check_step, inf_norm,
@@ -18,6 +21,7 @@ pub struct FixedStress {
     pub max_iterations: usize,
     flow: FlowSolver,
     mech: MechSolver,
+    interrupt: Option<Arc<AtomicBool>>,
 }
 
 impl FixedStress {
@@ -28,7 +32,14 @@ impl FixedStress {
             max_iterations,
             flow: FlowSolver::new(),
             mech: MechSolver::new(),
+            interrupt: None,
         }
+    }
+
+    /// Poll `flag` before every iteration after the first: when it is set, the step ends
+    /// with [`BiotError::Interrupted`] (Ctrl-C during a long step).
+    pub fn set_interrupt(&mut self, flag: Option<Arc<AtomicBool>>) {
+        self.interrupt = flag;
     }
 
     /// What the linear algebra did: the flow and mechanics factorizations and solves
@@ -92,6 +103,14 @@ impl<const D: usize> BiotCoupling<D> for FixedStress {
         let mut u_new = Vec::new();
         let mut change = f64::INFINITY;
         for it in 1..=self.max_iterations.max(1) {
+            if it > 1
+                && self
+                    .interrupt
+                    .as_ref()
+                    .is_some_and(|f| f.load(Ordering::Relaxed))
+            {
+                return Err(BiotError::Interrupted);
+            }
             sys.alpha_volume_change(&u_k, &mut cv)?;
             for c in 0..nc {
                 rhs[c] = r0[c] - (cv[c] - cvo[c]) + beta[c] * dp_k[c];

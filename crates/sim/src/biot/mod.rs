@@ -195,6 +195,10 @@ pub enum BiotError {
         /// The last relative change.
         change: f64,
     },
+    /// A stop was requested (the flag given to the scheme's `set_interrupt`) between two
+    /// iterations.
+    #[error("interrupted")]
+    Interrupted,
 }
 
 /// Result alias of the Biot module.
