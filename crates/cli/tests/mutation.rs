@@ -314,11 +314,7 @@ fn excerpt(stderr: &str) -> String {
 
 /// Judge one invocation; `None` when acceptable, else the failure class. `names` are
 /// the file names an error message may name; `out` is the output directory of a run.
-fn judge(
-    o: &Outcome,
-    names: &[&str],
-    out: Option<&Path>,
-) -> Result<String, String> {
+fn judge(o: &Outcome, names: &[&str], out: Option<&Path>) -> Result<String, String> {
     match o.end {
         _ if o.stderr.contains("panicked") => Err("panic".into()),
         End::Exit(101) => Err("exit 101 (panic)".into()),
