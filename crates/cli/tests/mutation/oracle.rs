@@ -160,12 +160,24 @@ pub fn non_finite_outputs(out: &Path) -> Vec<String> {
     found
 }
 
+/// Measures that are `null` by definition when undefined (docs/models/nscd.md): the
+/// fault-propagation measures when no disk of the window moved or no band holds points.
+const UNDEFINED_BY_DEFINITION: [&str; 4] = [
+    ".fault.limit_angle_deg",
+    ".fault.limit_angle_points",
+    ".fault.run_out",
+    ".fault.trishear",
+];
+
 /// Non-finite values of a summary: strings that spell one and `null` below the top
-/// level (serde writes NaN and ±inf as `null`; top-level `null` marks an absent section).
+/// level (serde writes NaN and ±inf as `null`; top-level `null` marks an absent section,
+/// and the measures of [`UNDEFINED_BY_DEFINITION`] are `null` when undefined).
 fn walk(v: &serde_json::Value, at: &str, depth: usize, found: &mut Vec<String>) {
     use serde_json::Value;
     match v {
-        Value::Null if depth > 1 => found.push(format!("summary.json {at} = null")),
+        Value::Null if depth > 1 && !UNDEFINED_BY_DEFINITION.contains(&at) => {
+            found.push(format!("summary.json {at} = null"))
+        }
         Value::String(s) => {
             let l = s.trim().to_ascii_lowercase();
             let l = l.trim_start_matches(['+', '-']);
