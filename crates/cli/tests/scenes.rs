@@ -165,7 +165,7 @@ fn invalid_values_name_file_line_and_key() {
     assert_eq!(code, 1);
     assert!(
         err.contains(&format!(
-            "e.toml:{}: material.rock.youngs_modulus = -1 must be > 0",
+            "e.toml:{}: material.rock.youngs_modulus = -1 must be in 1e-3 … 1e15 Pa",
             line_of(&text, "youngs")
         )),
         "{err}"

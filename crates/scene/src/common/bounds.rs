@@ -48,8 +48,9 @@ pub fn modulus(
     Err(ls.error(
         path,
         format!(
-            "= {v:e} must be {zero}in {MIN_MODULUS:e} … {MAX_MODULUS:e} Pa (a modulus outside \
-             this range makes the stiffness of the scene overflow or vanish)"
+            "= {} must be {zero}in {MIN_MODULUS:e} … {MAX_MODULUS:e} Pa (a modulus outside \
+             this range makes the stiffness of the scene overflow or vanish)",
+            number(v)
         ),
     ))
 }
@@ -62,7 +63,10 @@ pub fn fluid(ls: &LoadedScene, fluid: &crate::common::sections::Fluid) -> Result
     if !(MIN_VISCOSITY..=MAX_VISCOSITY).contains(&mu) {
         return Err(ls.error(
             &key("viscosity"),
-            format!("= {mu:e} must be in {MIN_VISCOSITY:e} … {MAX_VISCOSITY:e} Pa s"),
+            format!(
+                "= {} must be in {MIN_VISCOSITY:e} … {MAX_VISCOSITY:e} Pa s",
+                number(mu)
+            ),
         ));
     }
     let c = fluid.compressibility;
@@ -109,4 +113,14 @@ pub fn point_inside(
         }
     }
     Ok(())
+}
+
+/// A number as a user wrote it: plain between 10⁻³ and 10⁶ (`-1`, `0.5`), else in
+/// exponent form (`1e300`), so a message never spells out hundreds of digits.
+fn number(v: f64) -> String {
+    if v == 0.0 || (1e-3..1e6).contains(&v.abs()) || !v.is_finite() {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
 }
