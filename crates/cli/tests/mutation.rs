@@ -374,7 +374,6 @@ fn one(input: &Input, round: Option<u64>, seed: u64, root: &Path, tally: &Mutex<
         None => Mutant {
             bytes: input.text.clone().into_bytes(),
             what: "unmutated".into(),
-            key: None,
         },
     };
     // The scene to check and run, with the files it reads beside it.

@@ -83,8 +83,6 @@ pub struct Mutant {
     pub bytes: Vec<u8>,
     /// What the mutation did, in one line.
     pub what: String,
-    /// The key of the mutated `key = value` line of a scene, if any.
-    pub key: Option<String>,
 }
 
 /// Mutate `text` of the given kind once.
@@ -270,7 +268,6 @@ fn apply(op: Op, kind: Kind, text: &str, rng: &mut Rng) -> Option<Mutant> {
         out[i].replace_range(s..e, by);
         old
     };
-    let scene_key = |i: usize| (kind == Kind::Scene).then(|| key_of(lines[i])).flatten();
     match op {
         Op::Number => {
             let cands: Vec<(usize, (usize, usize))> = code
@@ -294,7 +291,6 @@ fn apply(op: Op, kind: Kind, text: &str, rng: &mut Rng) -> Option<Mutant> {
                     shorten(&out[i])
                 ),
                 bytes: join(&out, nl),
-                key: scene_key(i),
             })
         }
         Op::String => {
@@ -322,7 +318,6 @@ fn apply(op: Op, kind: Kind, text: &str, rng: &mut Rng) -> Option<Mutant> {
                     shorten(&old)
                 ),
                 bytes: join(&out, nl),
-                key: scene_key(i),
             })
         }
         Op::DeleteLine | Op::DuplicateLine => {
@@ -341,7 +336,6 @@ fn apply(op: Op, kind: Kind, text: &str, rng: &mut Rng) -> Option<Mutant> {
             Some(Mutant {
                 what: format!("line {} {verb}: `{}`", i + 1, shorten(&line)),
                 bytes: join(&out, nl),
-                key: scene_key(i),
             })
         }
         Op::DropHeader => {
@@ -358,7 +352,6 @@ fn apply(op: Op, kind: Kind, text: &str, rng: &mut Rng) -> Option<Mutant> {
             Some(Mutant {
                 what: format!("line {}: header `{}` dropped", i + 1, line.trim()),
                 bytes: join(&out, nl),
-                key: None,
             })
         }
         Op::Truncate => {
@@ -366,7 +359,6 @@ fn apply(op: Op, kind: Kind, text: &str, rng: &mut Rng) -> Option<Mutant> {
             Some(Mutant {
                 what: format!("truncated at byte {at} of {}", text.len()),
                 bytes: text.as_bytes()[..at].to_vec(),
-                key: None,
             })
         }
         Op::SwapValues => {
@@ -404,7 +396,6 @@ fn apply(op: Op, kind: Kind, text: &str, rng: &mut Rng) -> Option<Mutant> {
                     shorten(&out[b])
                 ),
                 bytes: join(&out, nl),
-                key: scene_key(a),
             })
         }
         Op::Repeat => {
@@ -430,7 +421,6 @@ fn apply(op: Op, kind: Kind, text: &str, rng: &mut Rng) -> Option<Mutant> {
             Some(Mutant {
                 what: format!("line {}: {old} -> {by} (repeat count)", i + 1),
                 bytes: join(&out, nl),
-                key: None,
             })
         }
         Op::DropSlash => {
@@ -448,7 +438,6 @@ fn apply(op: Op, kind: Kind, text: &str, rng: &mut Rng) -> Option<Mutant> {
             Some(Mutant {
                 what: format!("line {}: record terminator `/` dropped", i + 1),
                 bytes: join(&out, nl),
-                key: None,
             })
         }
         Op::KeywordNumbers => {
@@ -481,7 +470,6 @@ fn apply(op: Op, kind: Kind, text: &str, rng: &mut Rng) -> Option<Mutant> {
                     lines[k].trim()
                 ),
                 bytes: join(&out, nl),
-                key: None,
             })
         }
         Op::Base64 => {
@@ -513,7 +501,6 @@ fn apply(op: Op, kind: Kind, text: &str, rng: &mut Rng) -> Option<Mutant> {
                     i + 1
                 ),
                 bytes: join(&out, nl),
-                key: None,
             })
         }
     }
