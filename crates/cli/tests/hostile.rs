@@ -20,7 +20,7 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use common::{read_csv, root, tmp_dir};
+use common::{read_csv, root, send_ctrl_c, spawn_run, summary, tmp_dir};
 
 fn patch_text() -> String {
     std::fs::read_to_string(root().join("scenes/patch_test.toml")).unwrap()
@@ -247,30 +247,13 @@ fn ctrl_c_ends_with_status_130_and_complete_files() {
     let path = dir.join("long.toml");
     std::fs::write(&path, &text).unwrap();
     let out = dir.join("out");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_porofrac"))
-        .args([
-            "run",
-            path.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ])
-        .stderr(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
+    let mut child = spawn_run(&path, &out);
     wait_for(&out.join("probes.csv"));
     std::thread::sleep(std::time::Duration::from_millis(700));
-    let pid = child.id().to_string();
-    assert!(
-        Command::new("kill")
-            .args(["-INT", &pid])
-            .status()
-            .unwrap()
-            .success()
-    );
+    send_ctrl_c(&child);
     let status = child.wait().unwrap();
     assert_eq!(status.code(), Some(130));
-    let summary: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let summary = summary(&out);
     let status = summary["status"].as_str().unwrap();
     assert!(status.starts_with("interrupted at t = "), "{status}");
     let t: f64 = status["interrupted at t = ".len()..].parse().unwrap();

@@ -16,9 +16,8 @@
 mod common;
 
 use std::path::Path;
-use std::process::{Command, Stdio};
 
-use common::{porofrac, root, run_text, tmp_dir};
+use common::{porofrac, root, run_text, send_ctrl_c, spawn_run, summary, tmp_dir};
 
 fn scene(name: &str) -> String {
     std::fs::read_to_string(root().join("scenes").join(name)).unwrap()
@@ -186,29 +185,11 @@ fn ctrl_c_while_the_first_failures_settle_ends_the_run_as_interrupted() {
     let path = dir.join("settle.toml");
     std::fs::write(&path, text).unwrap();
     let out = dir.join("out");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_porofrac"))
-        .args([
-            "run",
-            path.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ])
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
+    let mut child = spawn_run(&path, &out);
     // The first state takes seconds to settle; the request lands inside it.
     std::thread::sleep(std::time::Duration::from_millis(1500));
-    let pid = child.id().to_string();
-    assert!(
-        Command::new("kill")
-            .args(["-INT", &pid])
-            .status()
-            .unwrap()
-            .success()
-    );
+    send_ctrl_c(&child);
     let status = child.wait().unwrap();
     assert_eq!(status.code(), Some(130));
-    let summary: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
-    assert_eq!(summary["status"], "interrupted at t = 0");
+    assert_eq!(summary(&out)["status"], "interrupted at t = 0");
 }

@@ -28,7 +28,7 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use common::{porofrac, root, tmp_dir};
+use common::{porofrac, root, send_ctrl_c, spawn_run, tmp_dir};
 
 fn scene(name: &str) -> String {
     std::fs::read_to_string(root().join("scenes").join(name)).unwrap()
@@ -143,16 +143,7 @@ fn a_second_run_into_a_locked_folder_is_refused() {
     let out = dir.join("out");
     let path = dir.join("long.toml");
     std::fs::write(&path, long_scene()).unwrap();
-    let mut first = Command::new(env!("CARGO_BIN_EXE_porofrac"))
-        .args([
-            "run",
-            path.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ])
-        .stderr(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
+    let mut first = spawn_run(&path, &out);
     let probes = out.join("probes.csv");
     for _ in 0..600 {
         if probes.is_file() {
@@ -162,9 +153,7 @@ fn a_second_run_into_a_locked_folder_is_refused() {
     }
     assert!(probes.is_file(), "the first run never wrote");
     let (code, err) = run_in(&dir, "second", &scene("patch_test.toml"), &out);
-    let _ = Command::new("kill")
-        .args(["-INT", &first.id().to_string()])
-        .status();
+    send_ctrl_c(&first);
     let status = first.wait().unwrap();
     assert_eq!(code, 1, "{err}");
     assert!(

@@ -24,7 +24,7 @@ use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
-use common::{porofrac, read_csv, root, tmp_dir};
+use common::{porofrac, read_csv, root, send_ctrl_c, summary, tmp_dir};
 
 fn scene(path: &str) -> String {
     std::fs::read_to_string(root().join("scenes").join(path)).unwrap()
@@ -227,20 +227,11 @@ fn interrupt_when(path: &Path, cue: &str) -> (i32, serde_json::Value, PathBuf) {
         }
         seen.push(l);
     }
-    let pid = child.id().to_string();
-    assert!(
-        Command::new("kill")
-            .args(["-INT", &pid])
-            .status()
-            .unwrap()
-            .success()
-    );
+    send_ctrl_c(&child);
     // Drain stderr so the child never blocks on a full pipe.
     for _ in lines {}
     let status = child.wait().unwrap();
-    let summary: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
-    (status.code().unwrap_or(-1), summary, out)
+    (status.code().unwrap_or(-1), summary(&out), out)
 }
 
 #[test]

@@ -3,7 +3,7 @@
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::process::{Child, Command, Stdio};
 
 /// The workspace root.
 pub fn root() -> PathBuf {
@@ -79,4 +79,30 @@ pub fn close(a: f64, b: f64, scale: f64, tol: f64) -> bool {
 /// The parsed `summary.json` of an output directory.
 pub fn summary(out: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
+}
+
+/// Starts `porofrac run SCENE --out OUT` in the background, its stderr discarded.
+pub fn spawn_run(scene: &Path, out: &Path) -> Child {
+    Command::new(env!("CARGO_BIN_EXE_porofrac"))
+        .args([
+            "run",
+            scene.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap()
+}
+
+/// Sends Ctrl-C (SIGINT) to a running child; asserts the signal was delivered.
+pub fn send_ctrl_c(child: &Child) {
+    let pid = child.id().to_string();
+    assert!(
+        Command::new("kill")
+            .args(["-INT", &pid])
+            .status()
+            .unwrap()
+            .success()
+    );
 }
