@@ -40,7 +40,9 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
-    /// Check a scene file without running it.
+    /// Check a scene without running it: everything a run does before its first step
+    /// (files read, grid built, conditions, probes, packings), nothing written; prints
+    /// what a run would do, with estimates of its memory and time.
     Check {
         /// The scene file (TOML).
         scene: PathBuf,
@@ -54,26 +56,47 @@ fn main() -> ExitCode {
     heap::retain_freed_memory();
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Check { scene } => Scene::load(&scene)
-            .map(|s| {
-                let what = match s.file().scene.model.as_deref().unwrap_or("continuum") {
-                    "continuum" => format!("grid {}", s.file().grid.kind.as_str()),
-                    model => format!("model {model}"),
-                };
-                println!(
-                    "{}: ok ({}D, {what})",
-                    s.path().display(),
-                    s.file().scene.dim
-                );
-                ExitCode::SUCCESS
-            })
-            .map_err(|e| e.to_string()),
+        Command::Check { scene } => check(&scene),
         Command::Run { scene, out } => run(&scene, out),
     };
     result.unwrap_or_else(|msg| {
         eprintln!("error: {msg}");
         ExitCode::from(1)
     })
+}
+
+/// `porofrac check`: the scene built as a run builds it (files read, grid, conditions,
+/// probes, packings; Ctrl-C stops a long build), nothing written; on success the `ok`
+/// line and what a run would do, with estimates of its memory and time.
+fn check(path: &Path) -> Result<ExitCode, String> {
+    let scene = Scene::load(path).map_err(|e| e.to_string())?;
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    let _ = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed));
+    let mut progress = Progress::new(stop);
+    let plan = match scene.check(&mut progress) {
+        Ok(plan) => plan,
+        Err(porofrac_scene::RunError::Interrupted) => {
+            progress.finish();
+            eprintln!("{}: check interrupted", path.display());
+            return Ok(ExitCode::from(INTERRUPTED));
+        }
+        Err(e) => return Err(e.to_string()),
+    };
+    progress.finish();
+    let what = match scene.file().scene.model.as_deref().unwrap_or("continuum") {
+        "continuum" => format!("grid {}", scene.file().grid.kind.as_str()),
+        model => format!("model {model}"),
+    };
+    println!(
+        "{}: ok ({}D, {what})",
+        scene.path().display(),
+        scene.file().scene.dim
+    );
+    for line in plan.lines_text() {
+        println!("  {line}");
+    }
+    Ok(ExitCode::SUCCESS)
 }
 
 fn run(path: &Path, out: Option<PathBuf>) -> Result<ExitCode, String> {

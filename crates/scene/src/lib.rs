@@ -48,6 +48,7 @@ pub use common::laws::{self, LawRegistry};
 pub use common::loaded::SceneError;
 pub use common::model::RunError;
 pub use common::output::Summary;
+pub use common::plan::Plan;
 pub use common::{driver, expr, limits, model, output};
 
 use common::loaded::{self as check, LoadedScene};
@@ -111,6 +112,19 @@ impl Scene {
     /// The default output directory, `out/<name>`.
     pub fn default_out(&self) -> PathBuf {
         PathBuf::from("out").join(self.name())
+    }
+
+    /// Everything a run does before its first step, and nothing written: the files the
+    /// scene names read (meshes, decks and their includes), the grid built, boundaries,
+    /// tags, selections, probes and lines located, the sections the model needs, rigid
+    /// body modes, the lattice's Mach number and relaxation time, packings and
+    /// calibrations. The same build as [`Scene::run`], so a scene `check` passes is one
+    /// `run` starts stepping, and one it refuses fails with the error `run` gives. The
+    /// [`Plan`] says what a run would compute and write, with estimates of its memory
+    /// and time. A long build (a packing) reports progress to `observer` and stops
+    /// with [`RunError::Interrupted`] when it asks.
+    pub fn check(&self, observer: &mut dyn Observer) -> Result<Plan, RunError> {
+        common::model::check(&self.loaded, &self.laws, observer)
     }
 
     /// Run the scene and write its outputs into `out`.

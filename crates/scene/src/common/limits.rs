@@ -147,6 +147,97 @@ pub fn factor_note(factor: f64) -> String {
     }
 }
 
+/// Seconds per unknown and output time of a continuum run (see [`throughput`]).
+pub const CONTINUUM_SECONDS_PER_UNKNOWN_STEP: f64 = 1e-6;
+
+/// Seconds per unknown and integrator step of a Cosserat run.
+pub const COSSERAT_SECONDS_PER_UNKNOWN_STEP: f64 = 1e-6;
+
+/// Seconds per lattice node and lattice step of a lattice Boltzmann run.
+pub const LBM_SECONDS_PER_NODE_STEP: f64 = 1e-8;
+
+/// Seconds per particle and lattice solid step.
+pub const LSM_SECONDS_PER_PARTICLE_STEP: f64 = 1e-7;
+
+/// Seconds per disk and contact dynamics step.
+pub const NSCD_SECONDS_PER_DISK_STEP: f64 = 1e-6;
+
+/// Peak bytes per unknown of a Cosserat run (the sparse LU factor included).
+pub const COSSERAT_BYTES_PER_UNKNOWN: f64 = 5000.0;
+
+/// Peak bytes per lattice node of a lattice Boltzmann run (9 populations and the
+/// node's flags and fields), without and with the temperature distribution.
+pub const LBM_BYTES_PER_NODE: [f64; 2] = [150.0, 250.0];
+
+/// Peak bytes per particle and per bond of a lattice solid run.
+pub const LSM_BYTES_PER_PARTICLE_AND_BOND: [f64; 2] = [500.0, 200.0];
+
+/// Peak bytes per disk of a contact dynamics run (its contacts included).
+pub const NSCD_BYTES_PER_DISK: f64 = 2000.0;
+
+/// The memory a run needs besides its model: the program itself (bytes).
+pub const BASE_BYTES: f64 = 20e6;
+
+/// The peak memory estimate of a Cosserat run with `unknowns` unknowns.
+pub fn cosserat_bytes(unknowns: f64) -> f64 {
+    BASE_BYTES + COSSERAT_BYTES_PER_UNKNOWN * unknowns
+}
+
+/// The peak memory estimate of a lattice Boltzmann run on `nodes` lattice nodes, with the
+/// temperature distribution or not (0 for no lattice).
+pub fn lbm_bytes(nodes: f64, thermal: bool) -> f64 {
+    if nodes == 0.0 {
+        return 0.0;
+    }
+    BASE_BYTES + LBM_BYTES_PER_NODE[usize::from(thermal)] * nodes
+}
+
+/// The peak memory estimate of a lattice solid run (its fluid apart).
+pub fn lsm_bytes(particles: f64, bonds: f64) -> f64 {
+    let [p, b] = LSM_BYTES_PER_PARTICLE_AND_BOND;
+    BASE_BYTES + p * particles + b * bonds
+}
+
+/// The peak memory estimate of a contact dynamics run with `disks` disks.
+pub fn nscd_bytes(disks: f64) -> f64 {
+    BASE_BYTES + NSCD_BYTES_PER_DISK * disks
+}
+
+/// What the run-time estimate of a check rests on: a model's measured seconds per unit of
+/// work ([`crate::common::model::Model::work`]) and how far a run may be from it.
+#[derive(Clone, Copy, Debug)]
+pub struct Throughput {
+    /// Seconds per unit of work on the machine of the measurement.
+    pub seconds_per_unit: f64,
+    /// The unit of work.
+    pub unit: &'static str,
+    /// The estimate is within this factor of the measured times of the bundled scenes.
+    pub factor: f64,
+    /// The machine and command of the measurement.
+    pub measured_on: &'static str,
+}
+
+/// The machine the throughput constants were measured on.
+pub const MEASURED_ON: &str = "2 shared cores, porofrac run of the bundled scenes";
+
+/// The throughput constant of model `model` (see [`Throughput`] and the module docs).
+pub fn throughput(model: &str) -> Throughput {
+    let (seconds_per_unit, unit, factor) = match model {
+        "continuum" => (CONTINUUM_SECONDS_PER_UNKNOWN_STEP, "unknown and step", 10.0),
+        "cosserat" => (COSSERAT_SECONDS_PER_UNKNOWN_STEP, "unknown and step", 10.0),
+        "lbm" => (LBM_SECONDS_PER_NODE_STEP, "lattice node and step", 3.0),
+        "lsm" => (LSM_SECONDS_PER_PARTICLE_STEP, "particle and step", 5.0),
+        "nscd" => (NSCD_SECONDS_PER_DISK_STEP, "disk and step", 10.0),
+        _ => (0.0, "", 1.0),
+    };
+    Throughput {
+        seconds_per_unit,
+        unit,
+        factor,
+        measured_on: MEASURED_ON,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

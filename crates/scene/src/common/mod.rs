@@ -23,6 +23,7 @@ pub mod output;
 pub mod particle_output;
 pub mod particle_plots;
 pub mod particles;
+pub mod plan;
 pub mod plots;
 pub mod rotation_keys;
 pub mod sample;

@@ -17,6 +17,7 @@ use crate::common::driver::Observer;
 use crate::common::laws::LawRegistry;
 use crate::common::loaded::{LoadedScene, SceneError, k};
 use crate::common::output::{OutputError, SolverStats, Summary, WallSeconds};
+use crate::common::plan::Plan;
 use crate::common::sections::KeyPart;
 
 /// Anything that ends a run.
@@ -120,6 +121,18 @@ pub trait Model {
     fn summary_extras(&self) -> serde_json::Map<String, serde_json::Value> {
         serde_json::Map::new()
     }
+    /// The sizes a check reports, in the model's own words (by default the cells, nodes
+    /// and unknowns of [`Model::sizes`]).
+    fn counts(&self) -> Vec<(&'static str, usize)> {
+        let s = self.sizes();
+        vec![("cells", s.cells), ("nodes", s.nodes), ("unknowns", s.dofs)]
+    }
+    /// The work of the whole schedule for the run-time estimate of a check, in the unit
+    /// of the model's throughput constant ([`crate::common::limits::Throughput`]).
+    fn work(&self) -> f64;
+    /// The estimated peak memory of a run of the model (bytes; the per-model estimates of
+    /// [`crate::common::limits`]).
+    fn peak_bytes(&self) -> f64;
 }
 
 /// A model's own sections, read from the parsed file by [`ModelKind::sections_of`] and
@@ -164,14 +177,72 @@ pub trait ModelKind: Sync {
     }
     /// Check every value the model reads (after the checks every model shares).
     fn check(&self, ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError>;
-    /// Build the model and drive it through the schedule, writing its outputs to `out`.
-    fn run(
+    /// Build the model — everything a run does before its first step: files read, grid
+    /// built, conditions, probes and lines located, packings and calibrations — and hand
+    /// it to `purpose` ([`Purpose::finish`]): a run drives it through the schedule
+    /// writing its outputs, a check describes it and writes nothing.
+    fn build(
         &self,
         ls: &LoadedScene,
         laws: &LawRegistry,
-        out: &Path,
+        purpose: &Purpose<'_>,
         observer: &mut dyn Observer,
-    ) -> Result<Summary, RunError>;
+    ) -> Result<Built, RunError>;
+}
+
+/// What a model is built for: the one difference between `run` and `check`.
+#[derive(Clone, Copy, Debug)]
+pub enum Purpose<'a> {
+    /// Drive the built model through its schedule and write the outputs into the folder.
+    Run(&'a Path),
+    /// Describe the built model ([`Plan`]); write nothing.
+    Check,
+}
+
+/// What a built model ended as.
+#[derive(Debug)]
+#[allow(clippy::large_enum_variant)]
+pub enum Built {
+    /// The summary of the run.
+    Ran(Summary),
+    /// What a run would do.
+    Checked(Plan),
+}
+
+impl Purpose<'_> {
+    /// The output folder of a run (`None` for a check: a build writes nothing then).
+    pub fn out(&self) -> Option<&Path> {
+        match self {
+            Purpose::Run(out) => Some(out),
+            Purpose::Check => None,
+        }
+    }
+
+    /// Hand a built model on: drive it ([`crate::common::driver::drive`]) for a run,
+    /// describe it ([`Plan::of`]) for a check. `start` is the start of the build and
+    /// `grid_seconds` the time spent on the grid (or the whole build).
+    pub(crate) fn finish(
+        &self,
+        ls: &LoadedScene,
+        model: &mut dyn Model,
+        observer: &mut dyn Observer,
+        start: std::time::Instant,
+        grid_seconds: f64,
+        dim: usize,
+    ) -> Result<Built, RunError> {
+        match self {
+            Purpose::Run(out) => {
+                crate::common::driver::drive(ls, model, out, observer, start, grid_seconds, dim)
+                    .map(Built::Ran)
+            }
+            Purpose::Check => Ok(Built::Checked(Plan::of(
+                ls,
+                model,
+                dim,
+                start.elapsed().as_secs_f64(),
+            ))),
+        }
+    }
 }
 
 /// Read a model's own sections from the non-shared part of a document.
@@ -193,6 +264,41 @@ pub(crate) fn run(
     out: &Path,
     observer: &mut dyn Observer,
 ) -> Result<Summary, RunError> {
+    let start = std::time::Instant::now();
+    let summary = match in_pool(ls, laws, &Purpose::Run(out), observer) {
+        Ok(Built::Ran(summary)) => summary,
+        Ok(Built::Checked(_)) => unreachable!("a run is driven"),
+        // Stopped while the model was built: nothing was stepped.
+        Err(RunError::Interrupted) => {
+            crate::common::driver::interrupted_in_setup(ls, start, ls.scene.scene.dim as usize)
+        }
+        Err(e) => return Err(e),
+    };
+    summary.write(out)?;
+    Ok(summary)
+}
+
+/// Build a validated scene's model as a run would, up to its first step, and describe
+/// it; nothing is written. A stop request of `observer` during the build ends it with
+/// [`RunError::Interrupted`].
+pub(crate) fn check(
+    ls: &LoadedScene,
+    laws: &LawRegistry,
+    observer: &mut dyn Observer,
+) -> Result<Plan, RunError> {
+    match in_pool(ls, laws, &Purpose::Check, observer)? {
+        Built::Checked(plan) => Ok(plan),
+        Built::Ran(_) => unreachable!("a check is not driven"),
+    }
+}
+
+/// Build the scene's model for `purpose` in the thread pool the scene asks for.
+fn in_pool(
+    ls: &LoadedScene,
+    laws: &LawRegistry,
+    purpose: &Purpose<'_>,
+    observer: &mut dyn Observer,
+) -> Result<Built, RunError> {
     // `[solver] threads`: 0 (default) keeps rayon's pool (one thread per core); n > 0 runs
     // the scene in a pool of n threads (the parallel assembly, AMG and flow kernels).
     match ls.scene.solver.threads {
@@ -201,18 +307,18 @@ pub(crate) fn run(
                 .num_threads(n as usize)
                 .build()
                 .map_err(|e| ls.error(&k(&["solver", "threads"]), format!("= {n}: {e}")))?;
-            pool.install(|| run_model(ls, laws, out, observer))
+            pool.install(|| build_model(ls, laws, purpose, observer))
         }
-        _ => run_model(ls, laws, out, observer),
+        _ => build_model(ls, laws, purpose, observer),
     }
 }
 
-fn run_model(
+fn build_model(
     ls: &LoadedScene,
     laws: &LawRegistry,
-    out: &Path,
+    purpose: &Purpose<'_>,
     observer: &mut dyn Observer,
-) -> Result<Summary, RunError> {
+) -> Result<Built, RunError> {
     let Some(kind) = ls.kind() else {
         return Err(ls
             .error(
@@ -224,14 +330,5 @@ fn run_model(
             )
             .into());
     };
-    let start = std::time::Instant::now();
-    let summary = match kind.run(ls, laws, out, observer) {
-        // Stopped while the model was built: nothing was stepped.
-        Err(RunError::Interrupted) => {
-            crate::common::driver::interrupted_in_setup(ls, start, ls.scene.scene.dim as usize)
-        }
-        r => r?,
-    };
-    summary.write(out)?;
-    Ok(summary)
+    kind.build(ls, laws, purpose, observer)
 }

@@ -38,11 +38,11 @@ use porofrac_sim::{
     StressMeasure, cell_stresses, drained_bulk_modulus, solve_explicit, solve_static,
 };
 
-use crate::common::driver::{Observer, Stop, drive};
+use crate::common::driver::{Observer, Stop};
 use crate::common::laws::LawRegistry;
 use crate::common::loaded::{LoadedScene, k, ki};
-use crate::common::model::{Model, RunError, Sizes, StepStats};
-use crate::common::output::{CsvTable, SolverStats, Summary, WallSeconds};
+use crate::common::model::{Built, Model, Purpose, RunError, Sizes, StepStats};
+use crate::common::output::{CsvTable, SolverStats, WallSeconds};
 use crate::common::sample::{Location, locate};
 use crate::common::sections::{
     CouplingChoice, FailureStress, InitialMechanics, LinearChoice, MechanicsSolver, Plane,
@@ -53,33 +53,52 @@ use compose::{Composition, compose, conditions, material_stiffness};
 use fields::Field;
 use flow::{FlowSetup, flow_setup};
 
-/// Run a checked continuum scene.
-pub(crate) fn run(
+/// Build a checked continuum scene's model and hand it to `purpose`.
+pub(crate) fn build(
     ls: &LoadedScene,
     registry: &LawRegistry,
-    out: &Path,
+    purpose: &Purpose<'_>,
     observer: &mut dyn Observer,
-) -> Result<Summary, RunError> {
+) -> Result<Built, RunError> {
     let start = Instant::now();
     check_supported(ls)?;
     let (grid, deck) = build_grid(ls)?;
     let grid_seconds = start.elapsed().as_secs_f64();
     match grid {
-        AnyGrid::Two(g) => run_dim(ls, registry, &g, &deck, out, observer, start, grid_seconds),
-        AnyGrid::Three(g) => run_dim(ls, registry, &g, &deck, out, observer, start, grid_seconds),
+        AnyGrid::Two(g) => build_dim(
+            ls,
+            registry,
+            &g,
+            &deck,
+            purpose,
+            observer,
+            start,
+            grid_seconds,
+        ),
+        AnyGrid::Three(g) => build_dim(
+            ls,
+            registry,
+            &g,
+            &deck,
+            purpose,
+            observer,
+            start,
+            grid_seconds,
+        ),
     }
 }
 
-fn run_dim<const D: usize>(
+#[allow(clippy::too_many_arguments)]
+fn build_dim<const D: usize>(
     ls: &LoadedScene,
     registry: &LawRegistry,
     grid: &Grid<D>,
     deck: &DeckCells,
-    out: &Path,
+    purpose: &Purpose<'_>,
     observer: &mut dyn Observer,
     start: Instant,
     grid_seconds: f64,
-) -> Result<Summary, RunError> {
+) -> Result<Built, RunError> {
     // Mesh files are counted only once read: bound the run before assembling it.
     let flow_on = ls.scene.physics.flow == Some(true);
     let unknowns = (D * grid.num_nodes() + if flow_on { grid.num_cells() } else { 0 }) as f64;
@@ -133,10 +152,19 @@ fn run_dim<const D: usize>(
         pattern: &pattern,
         loads: &cond.loads,
     };
-    let mut stepper = Stepper::new(ls, body, deck, &comp, law_refs, out, observer.stop_handle())
-        .map_err(|e| explain::explain(ls, grid.num_cells(), e))?;
+    let mut stepper = Stepper::new(
+        ls,
+        body,
+        deck,
+        &comp,
+        law_refs,
+        purpose.out(),
+        observer.stop_handle(),
+    )
+    .map_err(|e| explain::explain(ls, grid.num_cells(), e))?;
     stepper.wall.assembly += assembly;
-    drive(ls, &mut stepper, out, observer, start, grid_seconds, D)
+    stepper.peak_bytes = bytes;
+    purpose.finish(ls, &mut stepper, observer, start, grid_seconds, D)
 }
 
 /// Physics this version does not model yet is an error, not silently ignored.
@@ -260,6 +288,8 @@ struct Stepper<'a, const D: usize> {
     stress_stale: bool,
     /// The observer's stop request, polled before every solve of a step.
     stop: Stop,
+    /// The estimated peak memory of the run ([`crate::common::limits::run_bytes_of`]).
+    peak_bytes: f64,
 }
 
 impl<'a, const D: usize> Stepper<'a, D> {
@@ -269,7 +299,7 @@ impl<'a, const D: usize> Stepper<'a, D> {
         deck: &'a DeckCells,
         comp: &'a Composition<D>,
         law_refs: Vec<&'a dyn CellLaw<D>>,
-        out: &Path,
+        out: Option<&Path>,
         stop: Stop,
     ) -> Result<Self, RunError> {
         let s = &ls.scene;
@@ -357,8 +387,12 @@ impl<'a, const D: usize> Stepper<'a, D> {
         let mut header = vec!["cell".to_string()];
         header.extend(axes[..D].iter().map(|a| a.to_string()));
         header.extend(["time".to_string(), "mode".to_string()]);
-        let mut fracture_csv = CsvTable::new(out.join("fracture.csv"), &header);
-        fracture_csv.flush()?;
+        // A check (no `out`) writes nothing and never steps to the table.
+        let mut fracture_csv =
+            CsvTable::new(out.unwrap_or(Path::new("")).join("fracture.csv"), &header);
+        if out.is_some() {
+            fracture_csv.flush()?;
+        }
         let nu_of_cell = comp
             .material_of_cell()
             .into_iter()
@@ -398,6 +432,7 @@ impl<'a, const D: usize> Stepper<'a, D> {
             done: 0,
             stress_stale: false,
             stop,
+            peak_bytes: 0.0,
         })
     }
 
@@ -786,6 +821,15 @@ impl<const D: usize> Model for Stepper<'_, D> {
     fn wall_seconds(&self) -> WallSeconds {
         self.wall
     }
+
+    fn work(&self) -> f64 {
+        // One solve of the unknowns per output time, the initial one included.
+        self.body.dofs.num_equations() as f64 * self.times.len() as f64
+    }
+
+    fn peak_bytes(&self) -> f64 {
+        self.peak_bytes
+    }
 }
 
 /// Failure criteria, stress measure, tracking and limits of the scene: the same for the
@@ -941,13 +985,13 @@ impl ModelKind for ContinuumKind {
     fn check(&self, ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
         check::check(ls, laws)
     }
-    fn run(
+    fn build(
         &self,
         ls: &LoadedScene,
         laws: &LawRegistry,
-        out: &Path,
+        purpose: &Purpose<'_>,
         observer: &mut dyn Observer,
-    ) -> Result<Summary, RunError> {
-        run(ls, laws, out, observer)
+    ) -> Result<Built, RunError> {
+        build(ls, laws, purpose, observer)
     }
 }

@@ -36,23 +36,23 @@ use porofrac_cosserat::{
 };
 use porofrac_grid::{Grid, Point};
 
-use crate::common::driver::{Observer, Stop, drive};
+use crate::common::driver::{Observer, Stop};
 use crate::common::grid::{AnyGrid, build_grid, point};
 use crate::common::loaded::{LoadedScene, k, ki};
-use crate::common::model::{Model, RunError, Sizes, StepStats};
-use crate::common::output::{SolverStats, Summary, WallSeconds};
+use crate::common::model::{Built, Model, Purpose, RunError, Sizes, StepStats};
+use crate::common::output::{SolverStats, WallSeconds};
 use crate::common::plots::{Canvas, FieldPlot, Values};
 use crate::common::sections::{DiagonalsChoice, GridKind, KeyPart, LinearChoice, NumOrExpr};
 
 use crate::common::rotation_keys::TimeIntegration;
 use fields::Field;
 
-/// Run a checked cosserat scene.
-pub(crate) fn run(
+/// Build a checked cosserat scene's model and hand it to `purpose`.
+pub(crate) fn build(
     ls: &LoadedScene,
-    out: &Path,
+    purpose: &Purpose<'_>,
     observer: &mut dyn Observer,
-) -> Result<Summary, RunError> {
+) -> Result<Built, RunError> {
     let start = Instant::now();
     let g = &ls.scene.grid;
     let grid = if g.kind == GridKind::Triangles && g.diagonals == Some(DiagonalsChoice::Crossed) {
@@ -77,8 +77,8 @@ pub(crate) fn run(
     };
     let grid_seconds = start.elapsed().as_secs_f64();
     match grid {
-        AnyGrid::Two(g) => run_dim(ls, g, out, observer, start, grid_seconds),
-        AnyGrid::Three(g) => run_dim(ls, g, out, observer, start, grid_seconds),
+        AnyGrid::Two(g) => build_dim(ls, g, purpose, observer, start, grid_seconds),
+        AnyGrid::Three(g) => build_dim(ls, g, purpose, observer, start, grid_seconds),
     }
 }
 
@@ -344,14 +344,14 @@ struct Run<'a, const D: usize> {
     stop: Stop,
 }
 
-fn run_dim<const D: usize>(
+fn build_dim<const D: usize>(
     ls: &LoadedScene,
     grid: Grid<D>,
-    out: &Path,
+    purpose: &Purpose<'_>,
     observer: &mut dyn Observer,
     start: Instant,
     grid_seconds: f64,
-) -> Result<Summary, RunError> {
+) -> Result<Built, RunError> {
     let t_asm = Instant::now();
     let mat = material(ls, D)?;
     let cond = conditions(ls, &grid)?;
@@ -467,7 +467,7 @@ fn run_dim<const D: usize>(
         model,
         stop,
     };
-    drive(ls, &mut run, out, observer, start, grid_seconds, D)
+    purpose.finish(ls, &mut run, observer, start, grid_seconds, D)
 }
 
 impl<const D: usize> Run<'_, D> {
@@ -696,6 +696,19 @@ impl<const D: usize> Model for Run<'_, D> {
         }
     }
 
+    fn work(&self) -> f64 {
+        // One static solve, or every (sub-)step of the dynamics.
+        let steps = match &self.stepping {
+            Stepping::Static(_) => 1,
+            Stepping::Dynamic { substeps, .. } => substeps * self.times.len().saturating_sub(1),
+        };
+        self.model.equations() as f64 * steps as f64
+    }
+
+    fn peak_bytes(&self) -> f64 {
+        crate::common::limits::cosserat_bytes(self.model.equations() as f64)
+    }
+
     fn failed(&self) -> usize {
         0
     }
@@ -745,14 +758,14 @@ impl ModelKind for CosseratKind {
         let _ = laws;
         check::check(ls)
     }
-    fn run(
+    fn build(
         &self,
         ls: &LoadedScene,
         laws: &LawRegistry,
-        out: &Path,
+        purpose: &Purpose<'_>,
         observer: &mut dyn Observer,
-    ) -> Result<Summary, RunError> {
+    ) -> Result<Built, RunError> {
         let _ = laws;
-        run(ls, out, observer)
+        build(ls, purpose, observer)
     }
 }

@@ -34,7 +34,7 @@ use porofrac_lbm::{Lattice, MAX_MACH, Obstacle, Shape, Side, Thermal, Units};
 
 pub use check::check;
 
-use crate::common::driver::{Observer, SetupPoll, Stop, drive};
+use crate::common::driver::{Observer, SetupPoll, Stop};
 use crate::common::expr::Expr;
 use crate::common::lattice::images;
 use crate::common::lattice::sections::{CollisionChoice, ShapeChoice};
@@ -43,8 +43,8 @@ use crate::common::lattice::{
     thermal_tau,
 };
 use crate::common::loaded::{LoadedScene, k, ki};
-use crate::common::model::{Model, RunError, Sizes, StepStats};
-use crate::common::output::{OutputError, SolverStats, Summary, WallSeconds, write_atomic};
+use crate::common::model::{Built, Model, Purpose, RunError, Sizes, StepStats};
+use crate::common::output::{OutputError, SolverStats, WallSeconds, write_atomic};
 use crate::common::sections::NumOrExpr;
 use porofrac_vtk::{Attributes, DataArray, Encoding, ImageData};
 
@@ -94,16 +94,16 @@ struct LbmModel<'a> {
     stop: Stop,
 }
 
-/// Run a checked lattice Boltzmann scene and write its `summary.json`.
-pub(crate) fn run(
+/// Build a checked lattice Boltzmann scene's model and hand it to `purpose`.
+pub(crate) fn build_for(
     ls: &LoadedScene,
-    out: &Path,
+    purpose: &Purpose<'_>,
     observer: &mut dyn Observer,
-) -> Result<Summary, RunError> {
+) -> Result<Built, RunError> {
     let start = Instant::now();
     let mut model = build(ls, &mut SetupPoll::new(observer))?;
     let build_seconds = start.elapsed().as_secs_f64();
-    drive(ls, &mut model, out, observer, start, build_seconds, 2)
+    purpose.finish(ls, &mut model, observer, start, build_seconds, 2)
 }
 
 fn build<'a>(ls: &'a LoadedScene, setup: &mut SetupPoll<'_>) -> Result<LbmModel<'a>, RunError> {
@@ -687,6 +687,25 @@ impl Model for LbmModel<'_> {
         Ok(())
     }
 
+    fn counts(&self) -> Vec<(&'static str, usize)> {
+        let (nx, ny) = self.lat.size();
+        vec![
+            ("lattice nodes", nx * ny),
+            ("fluid nodes", self.lat.fluid_nodes()),
+        ]
+    }
+
+    fn work(&self) -> f64 {
+        let (nx, ny) = self.lat.size();
+        let end = self.times.last().copied().unwrap_or(0.0);
+        (nx * ny) as f64 * (end / self.units.dt).round()
+    }
+
+    fn peak_bytes(&self) -> f64 {
+        let (nx, ny) = self.lat.size();
+        crate::common::limits::lbm_bytes((nx * ny) as f64, self.thermal.is_some())
+    }
+
     fn sizes(&self) -> Sizes {
         let (nx, ny) = self.lat.size();
         Sizes {
@@ -757,15 +776,15 @@ impl ModelKind for LbmKind {
         let _ = laws;
         check::check(ls)
     }
-    fn run(
+    fn build(
         &self,
         ls: &LoadedScene,
         laws: &LawRegistry,
-        out: &Path,
+        purpose: &Purpose<'_>,
         observer: &mut dyn Observer,
-    ) -> Result<Summary, RunError> {
+    ) -> Result<Built, RunError> {
         let _ = laws;
-        run(ls, out, observer)
+        build_for(ls, purpose, observer)
     }
 }
 

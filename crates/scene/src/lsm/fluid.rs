@@ -370,6 +370,17 @@ impl Fluid {
         self.pf.fluid_loads().len()
     }
 
+    /// Nodes of the lattice.
+    pub fn lattice_nodes(&self) -> usize {
+        let (nx, ny) = self.pf.lattice().size();
+        nx * ny
+    }
+
+    /// Lattice steps of a run to `end` (s), for the run-time estimate of a check.
+    pub fn lattice_steps(&self, end: f64) -> f64 {
+        (end / self.pf.dt()).round()
+    }
+
     /// Whether fluid is injected (an `[injection]` source).
     pub fn injects(&self) -> bool {
         self.pf.injection().is_some()

@@ -50,24 +50,24 @@ use porofrac_particles::tracked::CellContact;
 use porofrac_particles::vtk::ContactLine;
 use porofrac_particles::{Disks, RandomPacking, TrackedCell};
 
-use crate::common::driver::{Observer, SetupPoll, Stop, drive};
+use crate::common::driver::{Observer, SetupPoll, Stop};
 use crate::common::loaded::{LoadedScene, k, ki, step_count};
-use crate::common::model::{Model, RunError, Sizes, StepStats};
-use crate::common::output::{SolverStats, Summary, WallSeconds};
+use crate::common::model::{Built, Model, Purpose, RunError, Sizes, StepStats};
+use crate::common::output::{SolverStats, WallSeconds};
 use crate::common::particle_output::{self, PARTICLE_FIELDS};
 
 use file::{DampingChoice, NormalChoice, WallChoice};
 
-/// Run a checked lattice solid scene and write its `summary.json`.
-pub(crate) fn run(
+/// Build a checked lattice solid scene's model and hand it to `purpose`.
+pub(crate) fn build_for(
     ls: &LoadedScene,
-    out: &Path,
+    purpose: &Purpose<'_>,
     observer: &mut dyn Observer,
-) -> Result<Summary, RunError> {
+) -> Result<Built, RunError> {
     let start = Instant::now();
     let mut model = build(ls, &mut SetupPoll::new(observer))?;
     let build_seconds = start.elapsed().as_secs_f64();
-    drive(ls, &mut model, out, observer, start, build_seconds, 2)
+    purpose.finish(ls, &mut model, observer, start, build_seconds, 2)
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -845,6 +845,41 @@ impl Model for LsmModel<'_> {
         Ok(())
     }
 
+    fn counts(&self) -> Vec<(&'static str, usize)> {
+        let mut c = vec![
+            ("particles", self.solid.disks().len()),
+            ("bonds", self.solid.bonds().len()),
+        ];
+        if let Some(f) = &self.fluid {
+            c.push(("lattice nodes", f.lattice_nodes()));
+        }
+        c
+    }
+
+    fn work(&self) -> f64 {
+        use crate::common::limits::{LBM_SECONDS_PER_NODE_STEP, LSM_SECONDS_PER_PARTICLE_STEP};
+        let end = self.times.last().copied().unwrap_or(0.0);
+        let particles = self.solid.disks().len() as f64;
+        match &self.fluid {
+            // The lattice's updates in particle steps of the same time.
+            Some(f) => {
+                let steps = f.lattice_steps(end);
+                particles * steps
+                    + f.lattice_nodes() as f64 * steps * LBM_SECONDS_PER_NODE_STEP
+                        / LSM_SECONDS_PER_PARTICLE_STEP
+            }
+            None => particles * (end / self.dt).ceil(),
+        }
+    }
+
+    fn peak_bytes(&self) -> f64 {
+        let nodes = self.fluid.as_ref().map_or(0, |f| f.lattice_nodes());
+        crate::common::limits::lsm_bytes(
+            self.solid.disks().len() as f64,
+            self.solid.bonds().len() as f64,
+        ) + crate::common::limits::lbm_bytes(nodes as f64, true)
+    }
+
     fn sizes(&self) -> Sizes {
         Sizes {
             cells: self.solid.disks().len(),
@@ -903,15 +938,15 @@ impl ModelKind for LsmKind {
         let _ = laws;
         check::check(ls)
     }
-    fn run(
+    fn build(
         &self,
         ls: &LoadedScene,
         laws: &LawRegistry,
-        out: &Path,
+        purpose: &Purpose<'_>,
         observer: &mut dyn Observer,
-    ) -> Result<Summary, RunError> {
+    ) -> Result<Built, RunError> {
         let _ = laws;
-        run(ls, out, observer)
+        build_for(ls, purpose, observer)
     }
 }
 

@@ -37,23 +37,23 @@ use crate::common::particle_output;
 use porofrac_nscd::{Axis, ContactLaw, Nscd, NscdError, Ordering, RigidBody, SolverParams};
 use porofrac_particles::{ParticleError, TrackedCell};
 
-use crate::common::driver::{Observer, SetupPoll, drive};
+use crate::common::driver::{Observer, SetupPoll};
 use crate::common::loaded::{LoadedScene, k, ki, step_count};
-use crate::common::model::{Model, RunError, Sizes, StepStats};
-use crate::common::output::{SolverStats, Summary, WallSeconds};
+use crate::common::model::{Built, Model, Purpose, RunError, Sizes, StepStats};
+use crate::common::output::{SolverStats, WallSeconds};
 
 use file::{OrderingChoice, WallComponent};
 
-/// Run a checked NSCD scene and write its `summary.json`.
-pub(crate) fn run(
+/// Build a checked NSCD scene's model and hand it to `purpose`.
+pub(crate) fn build_for(
     ls: &LoadedScene,
-    out: &Path,
+    purpose: &Purpose<'_>,
     observer: &mut dyn Observer,
-) -> Result<Summary, RunError> {
+) -> Result<Built, RunError> {
     let start = Instant::now();
     let mut model = build(ls, &mut SetupPoll::new(observer))?;
     let build_seconds = start.elapsed().as_secs_f64();
-    drive(ls, &mut model, out, observer, start, build_seconds, 2)
+    purpose.finish(ls, &mut model, observer, start, build_seconds, 2)
 }
 
 /// What a probe reads.
@@ -458,6 +458,18 @@ impl Model for NscdModel<'_> {
         Ok(())
     }
 
+    fn counts(&self) -> Vec<(&'static str, usize)> {
+        vec![("disks", self.sys.disks.len())]
+    }
+
+    fn work(&self) -> f64 {
+        self.sys.disks.len() as f64 * self.times.len().saturating_sub(1) as f64
+    }
+
+    fn peak_bytes(&self) -> f64 {
+        crate::common::limits::nscd_bytes(self.sys.disks.len() as f64)
+    }
+
     fn sizes(&self) -> Sizes {
         Sizes {
             cells: self.sys.disks.len(),
@@ -515,15 +527,15 @@ impl ModelKind for NscdKind {
         let _ = laws;
         check::check(ls)
     }
-    fn run(
+    fn build(
         &self,
         ls: &LoadedScene,
         laws: &LawRegistry,
-        out: &Path,
+        purpose: &Purpose<'_>,
         observer: &mut dyn Observer,
-    ) -> Result<Summary, RunError> {
+    ) -> Result<Built, RunError> {
         let _ = laws;
-        run(ls, out, observer)
+        build_for(ls, purpose, observer)
     }
 }
 

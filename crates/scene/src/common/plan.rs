@@ -1,0 +1,150 @@
+//! What `porofrac check` reports of a scene: the model built as a run builds it, up to
+//! its first step, described — its sizes, the steps and files a run would write, and
+//! estimates of the run's peak memory and time ([`crate::common::limits`] holds the
+//! per-model constants behind them and how good they are).
+
+use crate::common::limits::{self, Throughput};
+use crate::common::loaded::LoadedScene;
+use crate::common::model::Model;
+
+/// A built model, described: what a run of the scene computes and writes.
+#[derive(Clone, Debug)]
+pub struct Plan {
+    /// `[scene] model`.
+    pub model: String,
+    /// The dimension.
+    pub dim: usize,
+    /// The sizes in the model's own words (`cells`, `nodes`, `unknowns`; `particles`,
+    /// `bonds`; `lattice nodes`; `disks`, `contacts`), in the order they are printed.
+    pub counts: Vec<(&'static str, usize)>,
+    /// Output steps of the schedule (the initial state apart).
+    pub steps: usize,
+    /// Output times written (the initial state, every `[output] every`-th step, the
+    /// last): rows of `probes.csv` and of each line, VTK files when `[output] vtk`.
+    pub written: usize,
+    /// VTK files a run writes (0 without `[output] vtk`).
+    pub vtk_files: usize,
+    /// `[[output.probe]]` entries.
+    pub probes: usize,
+    /// `[[output.line]]` entries.
+    pub lines: usize,
+    /// Estimated peak memory of the run (bytes).
+    pub peak_bytes: f64,
+    /// Time the build took in this check (s): a run spends it again before its first
+    /// step.
+    pub build_seconds: f64,
+    /// Estimated time of the steps of a run (s), from the model's throughput constant.
+    pub step_seconds: f64,
+    /// The constant behind [`Plan::step_seconds`], with the factor it is good to.
+    pub throughput: Throughput,
+}
+
+impl Plan {
+    /// Describe a built `model` of `ls`, built in `build_seconds`.
+    pub fn of(ls: &LoadedScene, model: &dyn Model, dim: usize, build_seconds: f64) -> Self {
+        let s = &ls.scene;
+        let times = model.times().len();
+        let written = written_steps(times, s.output.every.max(1) as usize);
+        let throughput = limits::throughput(ls.model());
+        Self {
+            model: ls.model().to_string(),
+            dim,
+            counts: model.counts(),
+            steps: times.saturating_sub(1),
+            written,
+            vtk_files: if s.output.vtk { written } else { 0 },
+            probes: s.output.probe.len(),
+            lines: s.output.line.len(),
+            peak_bytes: model.peak_bytes(),
+            build_seconds,
+            step_seconds: model.work() * throughput.seconds_per_unit,
+            throughput,
+        }
+    }
+
+    /// The lines `porofrac check` prints below its `ok` line.
+    pub fn lines_text(&self) -> Vec<String> {
+        let counts: Vec<String> = self
+            .counts
+            .iter()
+            .map(|(what, n)| format!("{n} {what}"))
+            .collect();
+        let mut out = vec![
+            format!(
+                "model {} ({}D): {}",
+                self.model,
+                self.dim,
+                counts.join(", ")
+            ),
+            format!(
+                "steps: {}; written: {} ({} VTK files, {} probes, {} lines)",
+                self.steps, self.written, self.vtk_files, self.probes, self.lines
+            ),
+        ];
+        let f = self.throughput.factor;
+        out.push(format!(
+            "estimated peak memory: {} (within a factor of 2)",
+            limits::bytes_text(self.peak_bytes)
+        ));
+        out.push(format!(
+            "estimated run time: {} (build {} as measured here, steps {}; the steps' \
+             estimate is good to a factor of {f} on a machine like the one of the \
+             constants, {})",
+            seconds_text(self.build_seconds + self.step_seconds),
+            seconds_text(self.build_seconds),
+            seconds_text(self.step_seconds),
+            self.throughput.measured_on
+        ));
+        out
+    }
+}
+
+/// Output times a run writes out of `times` (the initial one included) with
+/// `[output] every = every`: step 0, every `every`-th step and the last.
+pub fn written_steps(times: usize, every: usize) -> usize {
+    if times == 0 {
+        return 0;
+    }
+    let last = times - 1;
+    let every = every.max(1);
+    last / every + 1 + usize::from(last % every != 0)
+}
+
+/// `0.12 s`, `42 s`, `1.5 min`, `3.2 h`.
+pub fn seconds_text(s: f64) -> String {
+    if s < 1.0 {
+        format!("{s:.2} s")
+    } else if s < 120.0 {
+        format!("{s:.0} s")
+    } else if s < 7200.0 {
+        format!("{:.1} min", s / 60.0)
+    } else {
+        format!("{:.1} h", s / 3600.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The written steps are those the driver writes: 0, every `every`-th, the last.
+    #[test]
+    fn written_steps_match_the_driver() {
+        for times in 0..30 {
+            for every in 1..7 {
+                let expected = (0..times)
+                    .filter(|&s| s == 0 || s % every == 0 || s + 1 == times)
+                    .count();
+                assert_eq!(written_steps(times, every), expected, "{times} {every}");
+            }
+        }
+    }
+
+    #[test]
+    fn seconds_are_in_readable_units() {
+        assert_eq!(seconds_text(0.123), "0.12 s");
+        assert_eq!(seconds_text(42.4), "42 s");
+        assert_eq!(seconds_text(150.0), "2.5 min");
+        assert_eq!(seconds_text(3.0 * 3600.0), "3.0 h");
+    }
+}
