@@ -622,31 +622,6 @@ fn flow_with_cg_amg_matches_cholesky() {
     }
 }
 
-/// Every bundled scene under `scenes/` passes `porofrac check` (parse, keys, materials,
-/// grids and decks it names), so a scene that drifts from the code is caught even when no
-/// test runs it.
-#[test]
-fn every_bundled_scene_passes_check() {
-    fn scenes_under(dir: &std::path::Path, out: &mut Vec<std::path::PathBuf>) {
-        for entry in std::fs::read_dir(dir).unwrap() {
-            let path = entry.unwrap().path();
-            if path.is_dir() {
-                scenes_under(&path, out);
-            } else if path.extension().is_some_and(|e| e == "toml") {
-                out.push(path);
-            }
-        }
-    }
-    let mut scenes = Vec::new();
-    scenes_under(&root().join("scenes"), &mut scenes);
-    assert!(scenes.len() >= 20, "{} scenes found", scenes.len());
-    for scene in scenes {
-        let (code, out, err) = porofrac(&["check", scene.to_str().unwrap()]);
-        assert_eq!(code, 0, "{}: {err}", scene.display());
-        assert!(out.contains("ok"), "{}: {out}", scene.display());
-    }
-}
-
 #[test]
 fn fracture_toughness_transmissivity_and_lag_keys_are_checked() {
     // The scene of Nilsen et al. (2017) §3 with fluid lag: a fixed fracture permeability,

@@ -147,96 +147,141 @@ pub fn factor_note(factor: f64) -> String {
     }
 }
 
-/// Seconds per unknown and output time of a continuum run (see [`throughput`]).
-pub const CONTINUUM_SECONDS_PER_UNKNOWN_STEP: f64 = 1e-6;
+/// Seconds per factor entry ([`factor_entries`]) and output time of a continuum run
+/// without failure criteria (measured: `mandel`, 2D, 4 840 unknowns, 201 times, 0.09 s
+/// = 7.6e-9; `corner_point/injection`, 3D, 1 949 unknowns, 21 times, 0.16 s = 7e-9).
+pub const CONTINUUM_SECONDS_PER_ENTRY: f64 = 1e-8;
 
-/// Seconds per unknown and integrator step of a Cosserat run.
-pub const COSSERAT_SECONDS_PER_UNKNOWN_STEP: f64 = 1e-6;
+/// Seconds per factor entry and output time of a 2D continuum run whose cells can fail:
+/// failures are resolved by repeated solves and factor updates within a step (measured:
+/// `hydrofrac_seed` 2.1e-7, `hydrofrac_seed_fluid_lag` 1.9e-7, `hydrofrac_composite`
+/// 9.8e-8).
+pub const CONTINUUM_SECONDS_PER_ENTRY_FAILING_2D: f64 = 1.5e-7;
 
-/// Seconds per lattice node and lattice step of a lattice Boltzmann run.
-pub const LBM_SECONDS_PER_NODE_STEP: f64 = 1e-8;
+/// Seconds per factor entry and output time of a 3D continuum run whose cells can fail
+/// (measured: `hydrofrac_3d` 1.1e-8, `corner_point/hydrofrac` 6.9e-9).
+pub const CONTINUUM_SECONDS_PER_ENTRY_FAILING_3D: f64 = 1e-8;
 
-/// Seconds per particle and lattice solid step.
-pub const LSM_SECONDS_PER_PARTICLE_STEP: f64 = 1e-7;
+/// Seconds per unknown and integrator step of a Cosserat run (measured:
+/// `cosserat_lamb`, 60 000 unknowns, 250 steps of 6 sub-steps, 36.8 s = 4.1e-7).
+pub const COSSERAT_SECONDS_PER_UNKNOWN_STEP: f64 = 4e-7;
 
-/// Seconds per disk and contact dynamics step.
-pub const NSCD_SECONDS_PER_DISK_STEP: f64 = 1e-6;
+/// Seconds per lattice node and lattice step of a lattice Boltzmann run (measured:
+/// `lbm/schaefer_turek_2d1`, 36 080 nodes, 40 000 steps, 8.5 s = 5.9e-9;
+/// `lbm/taylor_green` 5.3e-9).
+pub const LBM_SECONDS_PER_NODE_STEP: f64 = 6e-9;
 
-/// Peak bytes per unknown of a Cosserat run (the sparse LU factor included).
+/// Seconds per lattice node and lattice step of the fluid of a lattice solid run (the
+/// coupling's moving walls, refills and heat make it slower than a plain lattice;
+/// measured: `lsm_heat` 7.1e-8, `lsm_hydrofrac` 2.2e-8).
+pub const LSM_FLUID_SECONDS_PER_NODE_STEP: f64 = 4e-8;
+
+/// Seconds per particle and lattice solid step (measured: `lsm/borehole_dry` 1.6e-7,
+/// `lsm/brazilian` 1.1e-7, `lsm/borehole_flooded` 1.7e-7).
+pub const LSM_SECONDS_PER_PARTICLE_STEP: f64 = 1.5e-7;
+
+/// Seconds per disk and contact dynamics step (measured: `nscd/fault` 2.0e-5,
+/// `nscd/fault_gamma0` 7.3e-6: the sweeps of the contact solver vary with the scene).
+pub const NSCD_SECONDS_PER_DISK_STEP: f64 = 1.2e-5;
+
+/// Peak bytes per unknown of a Cosserat run, the sparse LU factor included (measured:
+/// 6.8 kB for `cosserat_plate_hole`, 2.2 kB for the explicit `cosserat_lamb`).
 pub const COSSERAT_BYTES_PER_UNKNOWN: f64 = 5000.0;
 
-/// Peak bytes per lattice node of a lattice Boltzmann run (9 populations and the
-/// node's flags and fields), without and with the temperature distribution.
-pub const LBM_BYTES_PER_NODE: [f64; 2] = [150.0, 250.0];
+/// Peak bytes per lattice node of a lattice Boltzmann fluid (9 populations, the node's
+/// flags and fields; measured: 140 B for `lbm/schaefer_turek_2d1`, 120 B for the fluid
+/// of `lsm_hydrofrac`), without and with the temperature distribution.
+pub const LBM_BYTES_PER_NODE: [f64; 2] = [150.0, 200.0];
 
 /// Peak bytes per particle and per bond of a lattice solid run.
-pub const LSM_BYTES_PER_PARTICLE_AND_BOND: [f64; 2] = [500.0, 200.0];
+pub const LSM_BYTES_PER_PARTICLE_AND_BOND: [f64; 2] = [2000.0, 1000.0];
 
 /// Peak bytes per disk of a contact dynamics run (its contacts included).
 pub const NSCD_BYTES_PER_DISK: f64 = 2000.0;
 
-/// The memory a run needs besides its model: the program itself (bytes).
-pub const BASE_BYTES: f64 = 20e6;
+/// Peak bytes per cell and unknown of a 2D continuum run whose flow is coupled to the
+/// mechanics: the factor of the Biot system and its updates (measured:
+/// `hydrofrac_seed` 3.5 kB, `hydrofrac_composite` 3.8 kB). A check's estimate only:
+/// the refusal of a scene too big for the machine keeps [`run_bytes_of`].
+pub const COUPLED_2D_BYTES_PER_ITEM: f64 = 4000.0;
 
-/// The peak memory estimate of a Cosserat run with `unknowns` unknowns.
-pub fn cosserat_bytes(unknowns: f64) -> f64 {
-    BASE_BYTES + COSSERAT_BYTES_PER_UNKNOWN * unknowns
-}
+/// The memory a run needs besides its model: the program itself (bytes; 11–17 MB
+/// measured for the smallest scenes).
+pub const BASE_BYTES: f64 = 15e6;
 
-/// The peak memory estimate of a lattice Boltzmann run on `nodes` lattice nodes, with the
-/// temperature distribution or not (0 for no lattice).
-pub fn lbm_bytes(nodes: f64, thermal: bool) -> f64 {
-    if nodes == 0.0 {
-        return 0.0;
+/// Entries of the factor of a direct solve of `n` unknowns, the unit of work of a
+/// continuum run's time estimate: `n log₂ n` in 2D, [`FACTOR_ENTRIES_PER_N43`]
+/// `· n^{4/3}` in 3D (nested dissection).
+pub fn factor_entries(dim: usize, n: f64) -> f64 {
+    if dim >= 3 {
+        FACTOR_ENTRIES_PER_N43 * n.powf(4.0 / 3.0)
+    } else {
+        n * n.max(2.0).log2()
     }
-    BASE_BYTES + LBM_BYTES_PER_NODE[usize::from(thermal)] * nodes
 }
 
-/// The peak memory estimate of a lattice solid run (its fluid apart).
+/// The peak memory estimate of a continuum run for a check (bytes, the program apart):
+/// [`run_bytes_of`], or [`COUPLED_2D_BYTES_PER_ITEM`] per cell and unknown for a 2D
+/// run with coupled flow.
+pub fn continuum_bytes(dim: usize, cells: f64, unknowns: f64, direct: bool, coupled: bool) -> f64 {
+    if dim < 3 && coupled {
+        COUPLED_2D_BYTES_PER_ITEM * (cells + unknowns)
+    } else {
+        run_bytes_of(dim, cells, unknowns, direct).0
+    }
+}
+
+/// The peak memory estimate of a Cosserat run with `unknowns` unknowns (bytes, the
+/// program apart).
+pub fn cosserat_bytes(unknowns: f64) -> f64 {
+    COSSERAT_BYTES_PER_UNKNOWN * unknowns
+}
+
+/// The peak memory estimate of a lattice Boltzmann fluid on `nodes` lattice nodes, with
+/// the temperature distribution or not (bytes).
+pub fn lbm_bytes(nodes: f64, thermal: bool) -> f64 {
+    LBM_BYTES_PER_NODE[usize::from(thermal)] * nodes
+}
+
+/// The peak memory estimate of a lattice solid (its fluid apart; bytes).
 pub fn lsm_bytes(particles: f64, bonds: f64) -> f64 {
     let [p, b] = LSM_BYTES_PER_PARTICLE_AND_BOND;
-    BASE_BYTES + p * particles + b * bonds
+    p * particles + b * bonds
 }
 
-/// The peak memory estimate of a contact dynamics run with `disks` disks.
+/// The peak memory estimate of a contact dynamics run with `disks` disks (bytes).
 pub fn nscd_bytes(disks: f64) -> f64 {
-    BASE_BYTES + NSCD_BYTES_PER_DISK * disks
+    NSCD_BYTES_PER_DISK * disks
 }
 
-/// What the run-time estimate of a check rests on: a model's measured seconds per unit of
-/// work ([`crate::common::model::Model::work`]) and how far a run may be from it.
+/// The work of a run for the time estimate of a check: units of work, and the seconds
+/// per unit with the factor the estimate is good to.
 #[derive(Clone, Copy, Debug)]
-pub struct Throughput {
-    /// Seconds per unit of work on the machine of the measurement.
+pub struct Work {
+    /// Units of work of the whole schedule.
+    pub units: f64,
+    /// Seconds per unit.
     pub seconds_per_unit: f64,
-    /// The unit of work.
+    /// The unit.
     pub unit: &'static str,
-    /// The estimate is within this factor of the measured times of the bundled scenes.
+    /// The measured times of the bundled scenes are within this factor of the estimate.
     pub factor: f64,
-    /// The machine and command of the measurement.
-    pub measured_on: &'static str,
 }
 
-/// The machine the throughput constants were measured on.
-pub const MEASURED_ON: &str = "2 shared cores, porofrac run of the bundled scenes";
-
-/// The throughput constant of model `model` (see [`Throughput`] and the module docs).
-pub fn throughput(model: &str) -> Throughput {
-    let (seconds_per_unit, unit, factor) = match model {
-        "continuum" => (CONTINUUM_SECONDS_PER_UNKNOWN_STEP, "unknown and step", 10.0),
-        "cosserat" => (COSSERAT_SECONDS_PER_UNKNOWN_STEP, "unknown and step", 10.0),
-        "lbm" => (LBM_SECONDS_PER_NODE_STEP, "lattice node and step", 3.0),
-        "lsm" => (LSM_SECONDS_PER_PARTICLE_STEP, "particle and step", 5.0),
-        "nscd" => (NSCD_SECONDS_PER_DISK_STEP, "disk and step", 10.0),
-        _ => (0.0, "", 1.0),
-    };
-    Throughput {
-        seconds_per_unit,
-        unit,
-        factor,
-        measured_on: MEASURED_ON,
+impl Work {
+    /// The estimated time of the steps (s).
+    pub fn seconds(&self) -> f64 {
+        self.units * self.seconds_per_unit
     }
 }
+
+/// Seconds of a run besides its build and steps: start-up, the output files and plots
+/// (0.04–0.2 s measured for the smallest bundled scenes).
+pub const RUN_OVERHEAD_SECONDS: f64 = 0.1;
+
+/// The measured peaks of the bundled scenes are within this factor of the estimates
+/// of a check ([`crate::common::plan`]).
+pub const MEMORY_FACTOR: f64 = 2.5;
 
 #[cfg(test)]
 mod tests {

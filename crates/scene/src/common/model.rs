@@ -127,11 +127,11 @@ pub trait Model {
         let s = self.sizes();
         vec![("cells", s.cells), ("nodes", s.nodes), ("unknowns", s.dofs)]
     }
-    /// The work of the whole schedule for the run-time estimate of a check, in the unit
-    /// of the model's throughput constant ([`crate::common::limits::Throughput`]).
-    fn work(&self) -> f64;
-    /// The estimated peak memory of a run of the model (bytes; the per-model estimates of
-    /// [`crate::common::limits`]).
+    /// The work of the whole schedule, for the run-time estimate of a check (the
+    /// per-model throughput constants of [`crate::common::limits`]).
+    fn work(&self) -> crate::common::limits::Work;
+    /// The estimated peak memory of a run of the model, the program itself apart (bytes;
+    /// the per-model estimates of [`crate::common::limits`]).
     fn peak_bytes(&self) -> f64;
 }
 

@@ -3,7 +3,7 @@
 //! estimates of the run's peak memory and time ([`crate::common::limits`] holds the
 //! per-model constants behind them and how good they are).
 
-use crate::common::limits::{self, Throughput};
+use crate::common::limits::{self, Work};
 use crate::common::loaded::LoadedScene;
 use crate::common::model::Model;
 
@@ -28,15 +28,15 @@ pub struct Plan {
     pub probes: usize,
     /// `[[output.line]]` entries.
     pub lines: usize,
-    /// Estimated peak memory of the run (bytes).
+    /// Estimated peak memory of the run (bytes), the program itself
+    /// ([`limits::BASE_BYTES`]) included.
     pub peak_bytes: f64,
     /// Time the build took in this check (s): a run spends it again before its first
     /// step.
     pub build_seconds: f64,
-    /// Estimated time of the steps of a run (s), from the model's throughput constant.
-    pub step_seconds: f64,
-    /// The constant behind [`Plan::step_seconds`], with the factor it is good to.
-    pub throughput: Throughput,
+    /// The work of the steps of a run, behind the estimate of their time
+    /// ([`Work::seconds`]).
+    pub work: Work,
 }
 
 impl Plan {
@@ -45,7 +45,6 @@ impl Plan {
         let s = &ls.scene;
         let times = model.times().len();
         let written = written_steps(times, s.output.every.max(1) as usize);
-        let throughput = limits::throughput(ls.model());
         Self {
             model: ls.model().to_string(),
             dim,
@@ -55,10 +54,9 @@ impl Plan {
             vtk_files: if s.output.vtk { written } else { 0 },
             probes: s.output.probe.len(),
             lines: s.output.line.len(),
-            peak_bytes: model.peak_bytes(),
+            peak_bytes: limits::BASE_BYTES + model.peak_bytes(),
             build_seconds,
-            step_seconds: model.work() * throughput.seconds_per_unit,
-            throughput,
+            work: model.work(),
         }
     }
 
@@ -81,19 +79,22 @@ impl Plan {
                 self.steps, self.written, self.vtk_files, self.probes, self.lines
             ),
         ];
-        let f = self.throughput.factor;
         out.push(format!(
-            "estimated peak memory: {} (within a factor of 2)",
-            limits::bytes_text(self.peak_bytes)
+            "estimated peak memory: {} (within a factor of {} of the measured peaks)",
+            limits::bytes_text(self.peak_bytes),
+            limits::MEMORY_FACTOR
         ));
+        let steps = self.work.seconds() + limits::RUN_OVERHEAD_SECONDS;
         out.push(format!(
-            "estimated run time: {} (build {} as measured here, steps {}; the steps' \
-             estimate is good to a factor of {f} on a machine like the one of the \
-             constants, {})",
-            seconds_text(self.build_seconds + self.step_seconds),
+            "estimated run time: {} = build {} (measured by this check) + steps and files {} \
+             (estimate within a factor of {} on a 2-core machine: {:.2e} {} at {:.1e} s each)",
+            seconds_text(self.build_seconds + steps),
             seconds_text(self.build_seconds),
-            seconds_text(self.step_seconds),
-            self.throughput.measured_on
+            seconds_text(steps),
+            self.work.factor,
+            self.work.units,
+            self.work.unit,
+            self.work.seconds_per_unit,
         ));
         out
     }

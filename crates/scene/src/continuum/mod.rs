@@ -163,7 +163,15 @@ fn build_dim<const D: usize>(
     )
     .map_err(|e| explain::explain(ls, grid.num_cells(), e))?;
     stepper.wall.assembly += assembly;
-    stepper.peak_bytes = bytes;
+    let coupled = flow_on && ls.scene.physics.coupling.unwrap_or_default() != CouplingChoice::None;
+    stepper.peak_bytes = crate::common::limits::continuum_bytes(
+        D,
+        cells,
+        unknowns,
+        check::factors(ls, D, unknowns),
+        coupled,
+    );
+    stepper.unknowns = unknowns;
     purpose.finish(ls, &mut stepper, observer, start, grid_seconds, D)
 }
 
@@ -288,8 +296,10 @@ struct Stepper<'a, const D: usize> {
     stress_stale: bool,
     /// The observer's stop request, polled before every solve of a step.
     stop: Stop,
-    /// The estimated peak memory of the run ([`crate::common::limits::run_bytes_of`]).
+    /// The estimated peak memory of the run ([`crate::common::limits::continuum_bytes`]).
     peak_bytes: f64,
+    /// Unknowns of the run: displacements and, with flow, pressures.
+    unknowns: f64,
 }
 
 impl<'a, const D: usize> Stepper<'a, D> {
@@ -433,6 +443,7 @@ impl<'a, const D: usize> Stepper<'a, D> {
             stress_stale: false,
             stop,
             peak_bytes: 0.0,
+            unknowns: 0.0,
         })
     }
 
@@ -822,9 +833,34 @@ impl<const D: usize> Model for Stepper<'_, D> {
         self.wall
     }
 
-    fn work(&self) -> f64 {
-        // One solve of the unknowns per output time, the initial one included.
-        self.body.dofs.num_equations() as f64 * self.times.len() as f64
+    fn counts(&self) -> Vec<(&'static str, usize)> {
+        let grid = self.body.grid;
+        let mut c = vec![
+            ("cells", grid.num_cells()),
+            ("nodes", grid.num_nodes()),
+            ("unknowns", self.body.dofs.num_equations()),
+        ];
+        if self.pressure.is_some() {
+            c.push(("pressure unknowns", grid.num_cells()));
+        }
+        c
+    }
+
+    fn work(&self) -> crate::common::limits::Work {
+        use crate::common::limits as l;
+        // A solve with the factor per output time, the initial one included; failures
+        // resolved within a step cost more.
+        let seconds_per_unit = match (self.comp.can_fail(), D) {
+            (false, _) => l::CONTINUUM_SECONDS_PER_ENTRY,
+            (true, 2) => l::CONTINUUM_SECONDS_PER_ENTRY_FAILING_2D,
+            (true, _) => l::CONTINUUM_SECONDS_PER_ENTRY_FAILING_3D,
+        };
+        l::Work {
+            units: l::factor_entries(D, self.unknowns) * self.times.len() as f64,
+            seconds_per_unit,
+            unit: "factor-entry steps",
+            factor: 5.0,
+        }
     }
 
     fn peak_bytes(&self) -> f64 {

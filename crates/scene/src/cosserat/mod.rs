@@ -696,13 +696,18 @@ impl<const D: usize> Model for Run<'_, D> {
         }
     }
 
-    fn work(&self) -> f64 {
+    fn work(&self) -> crate::common::limits::Work {
         // One static solve, or every (sub-)step of the dynamics.
         let steps = match &self.stepping {
             Stepping::Static(_) => 1,
             Stepping::Dynamic { substeps, .. } => substeps * self.times.len().saturating_sub(1),
         };
-        self.model.equations() as f64 * steps as f64
+        crate::common::limits::Work {
+            units: self.model.equations() as f64 * steps as f64,
+            seconds_per_unit: crate::common::limits::COSSERAT_SECONDS_PER_UNKNOWN_STEP,
+            unit: "unknown steps",
+            factor: 5.0,
+        }
     }
 
     fn peak_bytes(&self) -> f64 {

@@ -695,10 +695,15 @@ impl Model for LbmModel<'_> {
         ]
     }
 
-    fn work(&self) -> f64 {
+    fn work(&self) -> crate::common::limits::Work {
         let (nx, ny) = self.lat.size();
         let end = self.times.last().copied().unwrap_or(0.0);
-        (nx * ny) as f64 * (end / self.units.dt).round()
+        crate::common::limits::Work {
+            units: (nx * ny) as f64 * (end / self.units.dt).round(),
+            seconds_per_unit: crate::common::limits::LBM_SECONDS_PER_NODE_STEP,
+            unit: "node steps",
+            factor: 3.0,
+        }
     }
 
     fn peak_bytes(&self) -> f64 {

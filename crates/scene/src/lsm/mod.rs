@@ -856,19 +856,30 @@ impl Model for LsmModel<'_> {
         c
     }
 
-    fn work(&self) -> f64 {
-        use crate::common::limits::{LBM_SECONDS_PER_NODE_STEP, LSM_SECONDS_PER_PARTICLE_STEP};
+    fn work(&self) -> crate::common::limits::Work {
+        use crate::common::limits::{
+            LSM_FLUID_SECONDS_PER_NODE_STEP, LSM_SECONDS_PER_PARTICLE_STEP,
+        };
         let end = self.times.last().copied().unwrap_or(0.0);
         let particles = self.solid.disks().len() as f64;
-        match &self.fluid {
-            // The lattice's updates in particle steps of the same time.
-            Some(f) => {
-                let steps = f.lattice_steps(end);
-                particles * steps
-                    + f.lattice_nodes() as f64 * steps * LBM_SECONDS_PER_NODE_STEP
-                        / LSM_SECONDS_PER_PARTICLE_STEP
-            }
-            None => particles * (end / self.dt).ceil(),
+        let (units, seconds_per_unit, unit) = match &self.fluid {
+            // The lattice dominates: the particles' sub-steps are a few per cent.
+            Some(f) => (
+                f.lattice_nodes() as f64 * f.lattice_steps(end),
+                LSM_FLUID_SECONDS_PER_NODE_STEP,
+                "node steps",
+            ),
+            None => (
+                particles * (end / self.dt).ceil(),
+                LSM_SECONDS_PER_PARTICLE_STEP,
+                "particle steps",
+            ),
+        };
+        crate::common::limits::Work {
+            units,
+            seconds_per_unit,
+            unit,
+            factor: 3.0,
         }
     }
 
@@ -877,7 +888,7 @@ impl Model for LsmModel<'_> {
         crate::common::limits::lsm_bytes(
             self.solid.disks().len() as f64,
             self.solid.bonds().len() as f64,
-        ) + crate::common::limits::lbm_bytes(nodes as f64, true)
+        ) + crate::common::limits::lbm_bytes(nodes as f64, false)
     }
 
     fn sizes(&self) -> Sizes {

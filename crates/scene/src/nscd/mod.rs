@@ -462,8 +462,13 @@ impl Model for NscdModel<'_> {
         vec![("disks", self.sys.disks.len())]
     }
 
-    fn work(&self) -> f64 {
-        self.sys.disks.len() as f64 * self.times.len().saturating_sub(1) as f64
+    fn work(&self) -> crate::common::limits::Work {
+        crate::common::limits::Work {
+            units: self.sys.disks.len() as f64 * self.times.len().saturating_sub(1) as f64,
+            seconds_per_unit: crate::common::limits::NSCD_SECONDS_PER_DISK_STEP,
+            unit: "disk steps",
+            factor: 5.0,
+        }
     }
 
     fn peak_bytes(&self) -> f64 {
