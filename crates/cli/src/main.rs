@@ -88,14 +88,16 @@ fn check(path: &Path) -> Result<ExitCode, String> {
         "continuum" => format!("grid {}", scene.file().grid.kind.as_str()),
         model => format!("model {model}"),
     };
-    println!(
-        "{}: ok ({}D, {what})",
+    let mut text = format!(
+        "{}: ok ({}D, {what})\n",
         scene.path().display(),
         scene.file().scene.dim
     );
     for line in plan.lines_text() {
-        println!("  {line}");
+        text.push_str(&format!("  {line}\n"));
     }
+    // A reader that went away (`| head`) is not an error of the scene.
+    let _ = std::io::Write::write_all(&mut std::io::stdout().lock(), text.as_bytes());
     Ok(ExitCode::SUCCESS)
 }
 
