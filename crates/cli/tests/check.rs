@@ -94,9 +94,9 @@ fn refused_scenes() -> Vec<Refused> {
         no_bc.find("[[output.probe]]").unwrap(),
     );
     no_bc.replace_range(a..b, "");
-    let deck = std::fs::read_to_string(root().join("scenes/corner_point/faulted.grdecl"))
-        .unwrap()
-        .replacen("METRIC\n", "METRIC\nINCLUDE\n 'missing.inc' /\n", 1);
+    let faulted =
+        std::fs::read_to_string(root().join("scenes/corner_point/faulted.grdecl")).unwrap();
+    let deck = faulted.replacen("METRIC\n", "METRIC\nINCLUDE\n 'missing.inc' /\n", 1);
     assert!(deck.contains("INCLUDE"));
     let injection = "corner_point/injection.toml";
     let line = "\n[[output.line]]\nname = \"down\"\nfield = \"pressure\"\n\
@@ -116,7 +116,13 @@ fn refused_scenes() -> Vec<Refused> {
         },
         Refused {
             name: "missing_include",
-            scene: edited(injection, &[("faulted.grdecl", "with_include.grdecl")]),
+            scene: edited(
+                injection,
+                &[(
+                    "path = \"faulted.grdecl\"",
+                    "path = \"with_include.grdecl\"",
+                )],
+            ),
             files: vec![("with_include.grdecl", deck)],
             says: "INCLUDE 'missing.inc': no such file",
         },
@@ -153,13 +159,13 @@ fn refused_scenes() -> Vec<Refused> {
                 injection,
                 &[("at = [190.0, 150.0, 1030.0]", "at = [190.0, 150.0, 5030.0]")],
             ),
-            files: vec![],
+            files: vec![("faulted.grdecl", faulted.clone())],
             says: "output.probe[1].at = [190.0, 150.0, 5030.0] is outside the grid",
         },
         Refused {
             name: "line_outside_the_deck",
             scene: edited(injection, &[]) + line,
-            files: vec![],
+            files: vec![("faulted.grdecl", faulted.clone())],
             says: "of the line is outside the grid",
         },
         Refused {

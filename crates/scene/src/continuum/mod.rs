@@ -283,7 +283,8 @@ struct Stepper<'a, const D: usize> {
     // Outputs.
     probes: Vec<(Field, Location)>,
     lines: Vec<(Field, LinePoints<D>)>,
-    fracture_csv: CsvTable,
+    /// `fracture.csv` (none in a check, which writes nothing).
+    fracture_csv: Option<CsvTable>,
     logged: usize,
     nu_of_cell: Vec<f64>,
     plane_strain: bool,
@@ -397,12 +398,14 @@ impl<'a, const D: usize> Stepper<'a, D> {
         let mut header = vec!["cell".to_string()];
         header.extend(axes[..D].iter().map(|a| a.to_string()));
         header.extend(["time".to_string(), "mode".to_string()]);
-        // A check (no `out`) writes nothing and never steps to the table.
-        let mut fracture_csv =
-            CsvTable::new(out.unwrap_or(Path::new("")).join("fracture.csv"), &header);
-        if out.is_some() {
-            fracture_csv.flush()?;
-        }
+        let fracture_csv = match out {
+            Some(out) => {
+                let mut t = CsvTable::new(out.join("fracture.csv"), &header);
+                t.flush()?;
+                Some(t)
+            }
+            None => None,
+        };
         let nu_of_cell = comp
             .material_of_cell()
             .into_iter()
@@ -665,12 +668,15 @@ impl<const D: usize> Model for Stepper<'_, D> {
             self.wall.output += t_out.elapsed().as_secs_f64();
         }
         for f in &self.failures.log()[self.logged..] {
+            let Some(csv) = self.fracture_csv.as_mut() else {
+                break;
+            };
             let x = grid.cell_centroid(f.cell);
             let mut row = vec![f.cell.to_string()];
             row.extend(x.iter().map(|v| v.to_string()));
             row.push(f.time.to_string());
             row.push(f.mode.as_str().to_string());
-            self.fracture_csv.push_text(&row)?;
+            csv.push_text(&row)?;
         }
         self.logged = self.failures.count();
         Ok(())
