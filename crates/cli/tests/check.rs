@@ -406,3 +406,49 @@ fn the_report_states_the_sizes_steps_and_files() {
         "{out}"
     );
 }
+
+/// Ctrl-C while `check` builds a long packing (6.5 M disks, as in the run's own test)
+/// stops it at the next poll: exit status 130, and nothing written.
+#[test]
+fn ctrl_c_stops_a_long_build_of_check() {
+    use std::io::{BufRead, BufReader};
+    use std::process::Stdio;
+    let dir = fresh_dir("ctrlc");
+    let text = edited(
+        "nscd/pile.toml",
+        &[(
+            "region = [[0.0, 0.0], [100.0, 99.5]]",
+            "region = [[0.0, 0.0], [2530.0, 2530.0]]",
+        )],
+    );
+    std::fs::write(dir.join("big.toml"), text).unwrap();
+    let before = files_under(&dir);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_porofrac"))
+        .current_dir(&dir)
+        .args(["check", "big.toml"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut lines = BufReader::new(child.stderr.take().unwrap()).lines();
+    let mut seen = Vec::new();
+    loop {
+        let Some(Ok(l)) = lines.next() else {
+            panic!("the check ended before packing: {seen:?}");
+        };
+        if l.contains("packing: placing disks") {
+            break;
+        }
+        seen.push(l);
+    }
+    common::send_ctrl_c(&child);
+    let rest: Vec<String> = lines.map_while(Result::ok).collect();
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(130), "{rest:?}");
+    assert!(
+        rest.iter().any(|l| l == "big.toml: check interrupted"),
+        "{rest:?}"
+    );
+    assert!(!String::from_utf8_lossy(&out.stdout).contains(": ok"));
+    assert_eq!(files_under(&dir), before);
+}
