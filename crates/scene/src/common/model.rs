@@ -218,10 +218,10 @@ impl Purpose<'_> {
         }
     }
 
-    /// Hand a built model on: drive it ([`crate::common::driver::drive`]) for a run,
-    /// describe it ([`Plan::of`]) for a check. `start` is the start of the build and
-    /// `grid_seconds` the time spent on the grid (or the whole build).
-    pub(crate) fn finish(
+    /// Hand a built model on: drive it through the loop of [`crate::common::driver`] for
+    /// a run, describe it ([`Plan::of`]) for a check. `start` is the start of the build
+    /// and `grid_seconds` the time spent on the grid (or the whole build).
+    pub fn finish(
         &self,
         ls: &LoadedScene,
         model: &mut dyn Model,

@@ -108,7 +108,7 @@ pub fn written_steps(times: usize, every: usize) -> usize {
     }
     let last = times - 1;
     let every = every.max(1);
-    last / every + 1 + usize::from(last % every != 0)
+    last / every + 1 + usize::from(!last.is_multiple_of(every))
 }
 
 /// `0.12 s`, `42 s`, `1.5 min`, `3.2 h`.
