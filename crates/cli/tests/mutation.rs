@@ -4,7 +4,7 @@
 //! address-space limit and a wall-time bound: `check` on every scene mutant, `run` on the
 //! mutants of the scenes whose unmutated run is short (some of them with the schedule
 //! cut to two output times) and on every mesh and deck mutant (through the fast scene
-//! that reads it; `check` does not read grid files).
+//! that reads it).
 //!
 //! Mutations (see `mutation/mutator.rs`): a number replaced by a hostile value (0, −1,
 //! ±1e300, 1e-300, nan, inf, 2⁶⁴−1, 2³¹, 1e20), a string replaced by "", 10 kB, "1/0"
@@ -20,7 +20,8 @@
 //! within the grace period is listed as a long run, not a failure: the mutated scene
 //! asks for more work (a later end time, a stiffer rock and so a smaller stable step, a
 //! load that takes many failure rounds), and stopping it is what a user would do. A run
-//! that ignores Ctrl-C is a failure. `check` has no such grace: it must end in time.
+//! that ignores Ctrl-C is a failure. `check` builds the model as `run` does (packings,
+//! settling) and has the same grace.
 //!
 //! Environment: `POROFRAC_MUTATION_SEED` (default 20250611), `POROFRAC_MUTATION_BUDGET_S`
 //! (wall-time budget in seconds, default 100; mutants are drawn round after round over
@@ -320,7 +321,7 @@ fn judge(o: &Outcome, names: &[&str], out: Option<&Path>) -> Result<String, Stri
         End::Exit(101) => Err("exit 101 (panic)".into()),
         End::Signal(s) => Err(format!("killed by signal {s}")),
         End::Timeout(None) => Err("timeout, ignores Ctrl-C (killed)".into()),
-        End::Timeout(Some(130)) if out.is_some() => Ok(LONG.into()),
+        End::Timeout(Some(130)) => Ok(LONG.into()),
         End::Timeout(Some(c)) => Err(format!("timeout (stopped by Ctrl-C with status {c})")),
         End::Exit(1) => {
             let msg = o.stderr.trim();

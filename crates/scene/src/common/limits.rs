@@ -287,6 +287,70 @@ pub const MEMORY_FACTOR: f64 = 2.5;
 mod tests {
     use super::*;
 
+    /// The throughput constants against the runs they were measured on (the figures in
+    /// their docs): each estimate within the factor a check states (5 for the continuum,
+    /// Cosserat and contact dynamics, 3 for the lattices and the lattice solid).
+    #[test]
+    fn throughput_constants_cover_their_measured_runs() {
+        // (seconds per unit, units, measured seconds, stated factor)
+        let e2 = |n: f64, times: f64| factor_entries(2, n) * times;
+        let e3 = |n: f64, times: f64| factor_entries(3, n) * times;
+        let cases = [
+            // mandel: 3 240 + 1 600 unknowns, 201 times, 0.09 s
+            (CONTINUUM_SECONDS_PER_ENTRY, e2(4840.0, 201.0), 0.09, 5.0),
+            // corner_point/injection: 1 511 + 438 unknowns, 21 times, 0.16 s
+            (CONTINUUM_SECONDS_PER_ENTRY, e3(1949.0, 21.0), 0.16, 5.0),
+            // hydrofrac_seed: 20 657 + 19 500, 41 times, 5.38 s
+            (
+                CONTINUUM_SECONDS_PER_ENTRY_FAILING_2D,
+                e2(40157.0, 41.0),
+                5.38,
+                5.0,
+            ),
+            // hydrofrac_composite: 12 389 + 11 232, 41 times, 1.37 s
+            (
+                CONTINUUM_SECONDS_PER_ENTRY_FAILING_2D,
+                e2(23621.0, 41.0),
+                1.37,
+                5.0,
+            ),
+            // hydrofrac_3d: 19 981 + 24 328, 41 times, 31.2 s
+            (
+                CONTINUUM_SECONDS_PER_ENTRY_FAILING_3D,
+                e3(44309.0, 41.0),
+                31.2,
+                5.0,
+            ),
+            // cosserat_lamb: 60 000 unknowns, 1 500 steps, 36.8 s
+            (COSSERAT_SECONDS_PER_UNKNOWN_STEP, 6e4 * 1500.0, 36.8, 5.0),
+            // lbm/schaefer_turek_2d1: 36 080 nodes, 40 000 steps, 8.5 s
+            (LBM_SECONDS_PER_NODE_STEP, 36080.0 * 4e4, 8.5, 3.0),
+            // lsm_heat: 16 000 nodes, 4 000 steps, 4.6 s; lsm_hydrofrac: 810 000, 2 280, 40 s
+            (LSM_FLUID_SECONDS_PER_NODE_STEP, 16000.0 * 4000.0, 4.6, 3.0),
+            (
+                LSM_FLUID_SECONDS_PER_NODE_STEP,
+                810000.0 * 2280.0,
+                40.0,
+                3.0,
+            ),
+            // lsm/brazilian: 1 008 particles, 33 000 steps, 3.8 s
+            (LSM_SECONDS_PER_PARTICLE_STEP, 1008.0 * 33000.0, 3.8, 3.0),
+            // nscd/fault: 968 disks, 300 steps, 5.9 s; fault_gamma0: 597, 4 000, 17.5 s
+            (NSCD_SECONDS_PER_DISK_STEP, 968.0 * 300.0, 5.9, 5.0),
+            (NSCD_SECONDS_PER_DISK_STEP, 597.0 * 4000.0, 17.5, 5.0),
+        ];
+        for (k, (per_unit, units, measured, factor)) in cases.into_iter().enumerate() {
+            let est = per_unit * units;
+            assert!(
+                est <= factor * measured && measured <= factor * est,
+                "case {k}: estimate {est} s, measured {measured} s"
+            );
+        }
+        // 2D: n log2 n; 3D: 45 n^(4/3).
+        assert_eq!(factor_entries(2, 1024.0), 10240.0);
+        assert!((factor_entries(3, 1000.0) - 45.0 * 1e4).abs() < 1e-6);
+    }
+
     #[test]
     fn absurd_requests_do_not_fit_and_small_ones_do() {
         if machine_memory().is_none() {

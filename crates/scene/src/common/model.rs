@@ -5,6 +5,10 @@
 //! ask of it (*fields*): the value of each probe and of each line point, the VTK file of
 //! a written step, the extrema of its fields, its plots and its part of `summary.json`.
 //! The loop of [`crate::common::driver`] does the rest the same way for every model.
+//!
+//! `run` and `check` share the build ([`ModelKind::build`]): a run hands the built model
+//! to the loop, a check describes it ([`Purpose`], [`crate::common::plan`]) and writes
+//! nothing, so a scene that `check` passes is one that `run` starts stepping.
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -267,7 +271,18 @@ pub(crate) fn run(
     let start = std::time::Instant::now();
     let summary = match in_pool(ls, laws, &Purpose::Run(out), observer) {
         Ok(Built::Ran(summary)) => summary,
-        Ok(Built::Checked(_)) => unreachable!("a run is driven"),
+        // Only a model that ignored its purpose gets here.
+        Ok(Built::Checked(_)) => {
+            return Err(ls
+                .error(
+                    &k(&["scene", "model"]),
+                    format!(
+                        "= \"{}\" checked the scene instead of running it",
+                        ls.model()
+                    ),
+                )
+                .into());
+        }
         // Stopped while the model was built: nothing was stepped.
         Err(RunError::Interrupted) => {
             crate::common::driver::interrupted_in_setup(ls, start, ls.scene.scene.dim as usize)
@@ -288,7 +303,13 @@ pub(crate) fn check(
 ) -> Result<Plan, RunError> {
     match in_pool(ls, laws, &Purpose::Check, observer)? {
         Built::Checked(plan) => Ok(plan),
-        Built::Ran(_) => unreachable!("a check is not driven"),
+        // Only a model that ignored its purpose gets here.
+        Built::Ran(_) => Err(ls
+            .error(
+                &k(&["scene", "model"]),
+                format!("= \"{}\" ran the scene instead of checking it", ls.model()),
+            )
+            .into()),
     }
 }
 
