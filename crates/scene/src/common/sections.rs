@@ -11,8 +11,9 @@ use std::collections::BTreeMap;
 use serde::Deserialize;
 
 /// A number, or a string expression in x, y, z (m) and t (s).
-#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema, PartialEq)]
 #[serde(untagged)]
+#[schemars(extend("expected" = "a number or an expression in x, y, z, t, e.g. 1e6 or \"1e6*min(t/60, 1)\""))]
 pub enum NumOrExpr {
     /// A constant.
     Num(f64),
@@ -74,7 +75,7 @@ pub fn vector_field<const D: usize>(values: &[NumOrExpr]) -> porofrac_sim::Vecto
 pub type Component = NumOrExpr;
 
 /// `[scene] plane`: the 2D idealization.
-#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, schemars::JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum Plane {
     /// Plane strain (`ε_zz = 0`), the default.
@@ -85,7 +86,7 @@ pub enum Plane {
 }
 
 /// `[grid] kind`.
-#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, schemars::JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum GridKind {
     /// Axis-aligned boxes.
@@ -121,7 +122,7 @@ impl GridKind {
 }
 
 /// `[grid] diagonals` of composite grids.
-#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, schemars::JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum DiagonalsChoice {
     /// All fine squares split along the same diagonal.
@@ -134,7 +135,7 @@ pub enum DiagonalsChoice {
 }
 
 /// `[initial] mechanics`.
-#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, schemars::JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum InitialMechanics {
     /// Solve the mechanics at t = 0 before the schedule starts.
@@ -145,7 +146,7 @@ pub enum InitialMechanics {
 }
 
 /// `[physics] coupling`.
-#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, schemars::JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum CouplingChoice {
     /// Fully implicit (Nilsen et al. (2017) eq. 30).
@@ -160,7 +161,7 @@ pub enum CouplingChoice {
 }
 
 /// `[physics] failure_stress`.
-#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, schemars::JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum FailureStress {
     /// The cell law's stress.
@@ -171,7 +172,7 @@ pub enum FailureStress {
 }
 
 /// `[solver] mechanics`.
-#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, schemars::JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum MechanicsSolver {
     /// A static solve at every output time.
@@ -182,7 +183,7 @@ pub enum MechanicsSolver {
 }
 
 /// `[solver] linear`.
-#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, schemars::JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum LinearChoice {
     /// By dimension and size (measured in docs/BENCHMARKS.md).
@@ -223,7 +224,7 @@ pub const SHARED_SECTIONS: [&str; 17] = [
 
 /// The sections of a scene file that every model may read or two models share
 /// ([`SHARED_SECTIONS`]).
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SceneFile {
     /// `[scene]`.
@@ -273,7 +274,7 @@ pub struct SceneFile {
 }
 
 /// `[scene]`.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SceneSection {
     /// Output goes to `out/<name>/` unless `--out` is given.
@@ -287,12 +288,13 @@ pub struct SceneSection {
 }
 
 /// `[grid]`.
-#[derive(Clone, Debug, Default, Deserialize)]
+#[derive(Clone, Debug, Default, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct GridSection {
     /// The generator or reader.
     pub kind: GridKind,
     /// Min and max corner.
+    #[schemars(extend("unit" = "m"))]
     pub extent: Option<[Vec<f64>; 2]>,
     /// Cells per axis (one number for voronoi).
     pub cells: Option<CellCount>,
@@ -304,16 +306,20 @@ pub struct GridSection {
     /// ASCII, base64, appended, zlib) or else Gmsh 4.1 `.msh` (ASCII or binary).
     pub path: Option<String>,
     /// Composite: centre of the refined zone.
+    #[schemars(extend("unit" = "m"))]
     pub center: Option<Vec<f64>>,
     /// Composite: half-width of the refined zone (m).
+    #[schemars(extend("unit" = "m"))]
     pub zone_half_width: Option<f64>,
     /// Composite: subdivisions per coarse cell in the zone.
     pub refine: Option<i64>,
     /// Composite: radius of the tagged well cells (m).
+    #[schemars(extend("unit" = "m"))]
     pub well_radius: Option<f64>,
     /// Composite: name of the well tag (default `well`).
     pub well_tag: Option<String>,
     /// Round well: edge length on the well wall (m; default half the zone's spacing).
+    #[schemars(extend("unit" = "m"))]
     pub well_size: Option<f64>,
     /// Composite: split of the fine squares.
     pub diagonals: Option<DiagonalsChoice>,
@@ -324,12 +330,14 @@ pub struct GridSection {
     pub mdem_zone: Option<Select>,
     /// With `mdem_zone`: the well trajectory (points); zone cells whose centroid is
     /// within `well_radius` of it are tagged `well` (or `well_tag`).
+    #[schemars(extend("unit" = "m"))]
     pub well_path: Option<Vec<Vec<f64>>>,
 }
 
 /// `cells = [nx, ny(, nz)]` or, for Voronoi, one number.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema, PartialEq)]
 #[serde(untagged)]
+#[schemars(extend("expected" = "a number of cells per axis, e.g. [40, 20] (voronoi: one number)"))]
 pub enum CellCount {
     /// One number.
     One(i64),
@@ -338,7 +346,7 @@ pub enum CellCount {
 }
 
 /// `[[region]]`.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Region {
     /// Name (for `[[source]] region = ...`).
@@ -352,7 +360,7 @@ pub struct Region {
 }
 
 /// A cell selection.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema, PartialEq)]
 #[serde(rename_all = "lowercase", deny_unknown_fields)]
 pub enum Select {
     /// `{ all = true }`.
@@ -374,28 +382,33 @@ pub enum Select {
 }
 
 /// A polyline and a distance.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct PathBall {
     /// The polyline's points.
+    #[schemars(extend("unit" = "m"))]
     pub path: Vec<Vec<f64>>,
     /// Distance (m).
+    #[schemars(extend("unit" = "m"))]
     pub radius: f64,
 }
 
 /// Centre and radius.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Ball {
     /// Centre.
+    #[schemars(extend("unit" = "m"))]
     pub center: Vec<f64>,
     /// Radius (m).
+    #[schemars(extend("unit" = "m"))]
     pub radius: f64,
 }
 
 /// Scalar or per-axis permeability.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema, PartialEq)]
 #[serde(untagged)]
+#[schemars(extend("expected" = "a permeability or one per axis, e.g. 1e-15 or [1e-15, 1e-16]"))]
 pub enum Permeability {
     /// Isotropic (m²).
     Scalar(f64),
@@ -404,43 +417,56 @@ pub enum Permeability {
 }
 
 /// `[material.<name>]`.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Material {
     /// E (Pa). Required by the continuum model; `model = "cosserat"` accepts
     /// `shear_modulus` instead (absent: NaN, refused by the checks).
     #[serde(default = "missing")]
+    #[schemars(extend("unit" = "Pa"))]
     pub youngs_modulus: f64,
     /// ν.
     pub poisson_ratio: f64,
     /// ρ (kg/m³).
+    #[schemars(extend("unit" = "kg/m³"))]
     pub density: Option<f64>,
     /// Biot α.
     pub biot_alpha: Option<f64>,
     /// φ.
     pub porosity: Option<f64>,
     /// k (m²).
+    #[schemars(extend("unit" = "m²"))]
     pub permeability: Option<Permeability>,
     /// K_s (Pa).
+    #[schemars(extend("unit" = "Pa"))]
     pub solid_bulk_modulus: Option<f64>,
     /// Tensile strength (Pa).
+    #[schemars(extend("unit" = "Pa"))]
     pub tensile_strength: Option<f64>,
     /// Fracture toughness `K_Ic` (Pa·√m): a crack-tip cell fails in tension only when its
     /// stress intensity reaches it too.
+    #[schemars(extend("unit" = "Pa·√m"))]
     pub fracture_toughness: Option<f64>,
     /// Mohr–Coulomb cohesion (Pa).
+    #[schemars(extend("unit" = "Pa"))]
     pub cohesion: Option<f64>,
     /// Mohr–Coulomb friction angle (degrees).
+    #[schemars(extend("unit" = "degrees"))]
     pub friction_angle: Option<f64>,
     /// `model = "cosserat"`: G (Pa).
+    #[schemars(extend("unit" = "Pa", "models" = ["cosserat"]))]
     pub shear_modulus: Option<f64>,
     /// `model = "cosserat"`: Gc (Pa).
+    #[schemars(extend("unit" = "Pa", "models" = ["cosserat"]))]
     pub cosserat_shear_modulus: Option<f64>,
     /// `model = "cosserat"`: ℓ (m).
+    #[schemars(extend("unit" = "m", "models" = ["cosserat"]))]
     pub characteristic_length: Option<f64>,
     /// `model = "cosserat"`, 3D: `[L, M, Mc]` (N).
+    #[schemars(extend("unit" = "N", "models" = ["cosserat"]))]
     pub couple_moduli: Option<Vec<f64>>,
     /// `model = "cosserat"`: j (m²).
+    #[schemars(extend("unit" = "m²", "models" = ["cosserat"]))]
     pub micro_inertia: Option<f64>,
 }
 
@@ -449,113 +475,134 @@ fn missing() -> f64 {
 }
 
 /// `[fluid]`.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Fluid {
     /// μ (Pa s).
+    #[schemars(extend("unit" = "Pa·s"))]
     pub viscosity: f64,
     /// c_f (1/Pa).
+    #[schemars(extend("unit" = "1/Pa"))]
     pub compressibility: f64,
 }
 
 /// `[[bc]]`.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Bc {
     /// A side `xmin … zmax` or a face tag.
     pub boundary: String,
     /// Per component: number, expression or `"free"`.
+    #[schemars(extend("unit" = "m"))]
     pub displacement: Option<Vec<Component>>,
     /// Traction (Pa) per component.
+    #[schemars(extend("unit" = "Pa"))]
     pub traction: Option<Vec<NumOrExpr>>,
     /// Flow Dirichlet pressure (Pa).
+    #[schemars(extend("unit" = "Pa"))]
     pub pressure: Option<NumOrExpr>,
     /// Outward Darcy flux (m/s).
+    #[schemars(extend("unit" = "m/s"))]
     pub flux: Option<NumOrExpr>,
     /// Rigid platen.
     pub platen: Option<Platen>,
     /// `model = "cosserat"`: micro-rotation (2D one value, 3D three; or `"free"`).
+    #[schemars(extend("unit" = "rad", "models" = ["cosserat"]))]
     pub rotation: Option<crate::common::rotation_keys::PerRotation>,
     /// `model = "cosserat"`: couple traction (N/m).
+    #[schemars(extend("unit" = "N/m", "models" = ["cosserat"]))]
     pub couple_traction: Option<crate::common::rotation_keys::PerRotation>,
 }
 
 /// `platen = { force = [...] }`.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Platen {
     /// Total force per component (N; per metre in 2D), or `"free"`.
+    #[schemars(extend("unit" = "N"))]
     pub force: Vec<Component>,
 }
 
 /// `[loads]`.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Loads {
     /// Gravity (m/s²), uses the material density.
+    #[schemars(extend("unit" = "m/s²"))]
     pub gravity: Option<Vec<f64>>,
     /// Body force (N/m³) per component.
+    #[schemars(extend("unit" = "N/m³"))]
     pub body_force: Option<Vec<NumOrExpr>>,
     /// `model = "cosserat"`: body couple (N/m²).
+    #[schemars(extend("unit" = "N/m²", "models" = ["cosserat"]))]
     pub body_couple: Option<crate::common::rotation_keys::PerRotation>,
 }
 
 /// `[[source]]`.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Source {
     /// Name of a `[[region]]`.
     pub region: String,
     /// m³/s over the region.
+    #[schemars(extend("unit" = "m³/s"))]
     pub rate: Option<f64>,
     /// The region's pore volume per hour.
+    #[schemars(extend("unit" = "1/h"))]
     pub pore_volumes_per_hour: Option<f64>,
 }
 
 /// `[[well]]`: a Peaceman well in one cell, controlled by rate or bottom-hole pressure.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct WellSection {
     /// Name (for messages).
     pub name: String,
     /// The point the well passes through (its cell is the well's cell).
+    #[schemars(extend("unit" = "m"))]
     pub at: Option<Vec<f64>>,
     /// Or the index of the well's cell.
     pub cell: Option<i64>,
     /// Wellbore radius (m).
+    #[schemars(extend("unit" = "m"))]
     pub radius: f64,
     /// Skin factor (default 0).
     pub skin: Option<f64>,
     /// Volumetric rate (m³/s; 2D: per metre), positive for injection.
+    #[schemars(extend("unit" = "m³/s"))]
     pub rate: Option<f64>,
     /// Or the bottom-hole pressure (Pa).
+    #[schemars(extend("unit" = "Pa"))]
     pub bottom_hole_pressure: Option<f64>,
 }
 
 /// `[initial]`.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Initial {
     /// Initial pressure (Pa).
+    #[schemars(extend("unit" = "Pa"))]
     pub pressure: Option<NumOrExpr>,
     /// Equilibrium (default) or rest at t = 0.
     pub mechanics: Option<InitialMechanics>,
 }
 
 /// `[schedule]`.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Schedule {
     /// End time (s).
+    #[schemars(extend("unit" = "s"))]
     pub end_time: f64,
     /// Step (s).
+    #[schemars(extend("unit" = "s"))]
     pub dt: Option<f64>,
     /// Or a number of steps.
     pub steps: Option<i64>,
 }
 
 /// `[physics]`.
-#[derive(Clone, Debug, Default, Deserialize)]
+#[derive(Clone, Debug, Default, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Physics {
     /// Solve flow.
@@ -568,8 +615,10 @@ pub struct Physics {
     /// patch-recovered nodal stress averaged over the cell.
     pub failure_stress: Option<FailureStress>,
     /// Isotropic permeability (m²) of failed cells with flow (default 1e-12).
+    #[schemars(extend("unit" = "m²"))]
     pub fracture_permeability: Option<f64>,
     /// Or the crack transmissivity (m³): a failed cell takes `T / (2 r_c)`.
+    #[schemars(extend("unit" = "m³"))]
     pub fracture_transmissivity: Option<f64>,
     /// `false`: no fluid lag, the intact cells bordering a crack take its permeability
     /// (default `true`: they keep the rock's).
@@ -577,13 +626,15 @@ pub struct Physics {
     /// Residual stiffness ratio of open edges of failed cells (default 1e-6).
     pub open_edge_stiffness: Option<f64>,
     /// Crack tracking angle in degrees (absent: no tracking).
+    #[schemars(extend("unit" = "degrees"))]
     pub crack_tracking: Option<f64>,
     /// Crack tracking: no new crack within this distance (m) of a failed cell (default 0).
+    #[schemars(extend("unit" = "m"))]
     pub crack_exclusion: Option<f64>,
 }
 
 /// `[solver]`.
-#[derive(Clone, Debug, Default, Deserialize)]
+#[derive(Clone, Debug, Default, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Solver {
     /// Static solves or damped dynamic relaxation.
@@ -595,13 +646,15 @@ pub struct Solver {
     /// Threads (0: default).
     pub threads: Option<i64>,
     /// `model = "cosserat"`: η of the interior penalty.
+    #[schemars(extend("models" = ["cosserat"]))]
     pub penalty: Option<f64>,
     /// `model = "cosserat"`: time integrator with a `[schedule]`.
+    #[schemars(extend("models" = ["cosserat"]))]
     pub time_integration: Option<crate::common::rotation_keys::TimeIntegration>,
 }
 
 /// `[output]`.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Output {
     /// Write VTK files.
@@ -621,6 +674,7 @@ pub struct Output {
     pub line: Vec<Line>,
     /// An exact displacement (numbers or expressions in x, y, z, t): `summary.json` then
     /// reports the L2 error of the last written displacement against it.
+    #[schemars(extend("unit" = "m"))]
     pub exact_displacement: Option<Vec<NumOrExpr>>,
 }
 
@@ -645,7 +699,7 @@ fn one() -> i64 {
 }
 
 /// `[[output.probe]]`.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Probe {
     /// Column name.
@@ -654,6 +708,7 @@ pub struct Probe {
     pub field: String,
     /// Position (grid and lattice models).
     #[serde(default)]
+    #[schemars(extend("unit" = "m"))]
     pub at: Vec<f64>,
     /// Particle index (particle models).
     pub particle: Option<i64>,
@@ -664,7 +719,7 @@ pub struct Probe {
 }
 
 /// `[[output.line]]`.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Line {
     /// File name (`lines/<name>.csv`).
@@ -672,8 +727,10 @@ pub struct Line {
     /// Field name.
     pub field: String,
     /// Start point.
+    #[schemars(extend("unit" = "m"))]
     pub from: Vec<f64>,
     /// End point.
+    #[schemars(extend("unit" = "m"))]
     pub to: Vec<f64>,
     /// Number of sample points.
     pub points: i64,
