@@ -355,7 +355,7 @@ impl Walker<'_> {
             path: path.to_string(),
             array,
             meaning: if meaning.is_empty() {
-                description(v)
+                without_header(&description(v))
             } else {
                 meaning.to_string()
             },
@@ -489,7 +489,7 @@ impl Walker<'_> {
             return self.ty(r, allowed);
         }
         if let Some(c) = r.get("const") {
-            allowed.push((toml_text(c), description(r)));
+            allowed.push((toml_text(c), description(r).trim_end_matches('.').to_string()));
             return "word".into();
         }
         if let Some(e) = r.get("enum").and_then(Value::as_array) {
@@ -724,7 +724,9 @@ pub fn markdown(sections: &[Section]) -> String {
                     .allowed
                     .iter()
                     .map(|(w, m)| {
-                        if m.is_empty() {
+                        if w.contains('`') {
+                            w.trim_end_matches('.').to_string()
+                        } else if m.is_empty() {
                             format!("`{w}`")
                         } else {
                             format!("`{w}`: {m}")
@@ -736,7 +738,9 @@ pub fn markdown(sections: &[Section]) -> String {
             let default = if k.required {
                 "required".to_string()
             } else {
-                k.default.clone().map_or("—".into(), |d| format!("`{d}`"))
+                k.default.clone().map_or("—".into(), |d| {
+                    if d.contains('`') { d } else { format!("`{d}`") }
+                })
             };
             let _ = writeln!(
                 s,

@@ -283,7 +283,8 @@ pub struct SceneSection {
     pub dim: i64,
     /// 2D only: plane strain (default) or plane stress.
     pub plane: Option<Plane>,
-    /// The model: `"continuum"` (default); see docs/SCENE.md for the others.
+    /// The model (default `"continuum"`): `"continuum"`, `"cosserat"`, `"nscd"`, `"lsm"`
+    /// or `"lbm"` (docs/models/).
     pub model: Option<String>,
 }
 
