@@ -770,7 +770,12 @@ pub const SUMMARY_SCHEMA_COMMAND: &str =
 /// every model writes, each model's own keys allowed beside them. A number may be
 /// `null` (`serde_json` writes a NaN or an infinity so).
 pub fn summary_schema() -> String {
-    let mut v = schemars::schema_for!(crate::common::output::Summary).to_value();
+    // The schema of what serializing writes: keys skipped when empty are optional.
+    let mut v = schemars::generate::SchemaSettings::draft2020_12()
+        .for_serialize()
+        .into_generator()
+        .into_root_schema_for::<crate::common::output::Summary>()
+        .to_value();
     if let Some(o) = v.as_object_mut() {
         o.insert(
             "$comment".into(),
