@@ -41,20 +41,32 @@ fn the_summary_schema_is_generated() {
 fn keys_lists_a_model_and_a_section() {
     let (code, out, _) = porofrac(&["keys", "continuum", "grid"]);
     assert_eq!(code, 0);
-    assert!(out.starts_with("[grid]  (models: continuum, cosserat)\n"), "{out}");
+    assert!(
+        out.starts_with("[grid]  (models: continuum, cosserat)\n"),
+        "{out}"
+    );
     assert!(out.contains("\n  cells "), "{out}");
     assert!(!out.contains("[[bc]]"), "{out}");
     // A model sees its sections and the shared ones it reads, not the others'.
     let (_, nscd, _) = porofrac(&["keys", "nscd"]);
-    assert!(nscd.contains("[nscd]") && nscd.contains("[particles]"), "{nscd}");
-    assert!(!nscd.contains("[grid]") && !nscd.contains("[bonds]"), "{nscd}");
+    assert!(
+        nscd.contains("[nscd]") && nscd.contains("[particles]"),
+        "{nscd}"
+    );
+    assert!(
+        !nscd.contains("[grid]") && !nscd.contains("[bonds]"),
+        "{nscd}"
+    );
     // One word that is not a model is a section, of every model.
     let (_, bc, _) = porofrac(&["keys", "bc"]);
     assert!(bc.starts_with("[[bc]]"), "{bc}");
     assert!(bc.contains("(model cosserat)"), "{bc}");
     let (code, _, err) = porofrac(&["keys", "nscd", "grid"]);
     assert_eq!(code, 2);
-    assert!(err.starts_with("error: no section `grid` in model \"nscd\""), "{err}");
+    assert!(
+        err.starts_with("error: no section `grid` in model \"nscd\""),
+        "{err}"
+    );
 }
 
 #[test]
@@ -115,11 +127,19 @@ fn summaries_of_short_bundled_scenes_match_the_schema() {
         ("cosserat_shear_layer", vec![]),
         ("lbm/taylor_green", vec![]),
         ("nscd/column", vec![]),
-        ("lsm/brazilian", vec!["schedule.end_time=0.2", "schedule.steps=20"]),
+        (
+            "lsm/brazilian",
+            vec!["schedule.end_time=0.2", "schedule.steps=20"],
+        ),
     ] {
         let out = dir.join(scene.replace('/', "_"));
         let path = root().join(format!("scenes/{scene}.toml"));
-        let mut args = vec!["run", path.to_str().unwrap(), "--out", out.to_str().unwrap()];
+        let mut args = vec![
+            "run",
+            path.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ];
         for s in &set {
             args.extend(["--set", s]);
         }

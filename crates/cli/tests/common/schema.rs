@@ -18,7 +18,11 @@ pub fn validate(schema: &Value, v: &Value) -> Result<(), String> {
 
 fn check(root: &Value, s: &Value, v: &Value, at: &str) -> Result<(), String> {
     if let Some(b) = s.as_bool() {
-        return if b { Ok(()) } else { Err(format!("{at}: no value is allowed here")) };
+        return if b {
+            Ok(())
+        } else {
+            Err(format!("{at}: no value is allowed here"))
+        };
     }
     if let Some(r) = s.get("$ref").and_then(Value::as_str) {
         let name = r.trim_start_matches("#/$defs/");

@@ -429,8 +429,11 @@ impl Walker<'_> {
         let meaning = description(p);
         let mut allowed = Vec::new();
         let ty = self.ty(p, &mut allowed);
+        // A default serde computes as NaN (a required value refused by the checks when
+        // absent) serializes as null: no default.
         let default = p
             .get("default")
+            .filter(|d| !d.is_null())
             .map(toml_text)
             .or_else(|| default_in(&meaning));
         let text = |k: &str| {
@@ -489,7 +492,10 @@ impl Walker<'_> {
             return self.ty(r, allowed);
         }
         if let Some(c) = r.get("const") {
-            allowed.push((toml_text(c), description(r).trim_end_matches('.').to_string()));
+            allowed.push((
+                toml_text(c),
+                description(r).trim_end_matches('.').to_string(),
+            ));
             return "word".into();
         }
         if let Some(e) = r.get("enum").and_then(Value::as_array) {

@@ -657,20 +657,30 @@ pub fn check(
     // Keys of a shared section that other models read only (`[material.*]
     // shear_modulus` is the Cosserat model's), from the key reference.
     let all = crate::common::keys::sections(models, None);
-    for path in ls.lines.lines.keys() {
-        if let Some((_, key)) = crate::common::keys::find(&all, path)
+    let of_some_models: Vec<&str> = all
+        .iter()
+        .flat_map(|s| &s.keys)
+        .filter(|k| !k.models.is_empty())
+        .filter_map(|k| k.name.rsplit('.').next())
+        .collect();
+    // The first such key in the file's order.
+    let mut first: Option<(usize, &Vec<KeyPart>, String)> = None;
+    for (path, line) in &ls.lines.lines {
+        let named = matches!(path.last(), Some(KeyPart::Key(last)) if of_some_models.contains(&last.as_str()));
+        if named
+            && first.as_ref().is_none_or(|(l, _, _)| line < l)
+            && let Some((_, key)) = crate::common::keys::find(&all, path)
             && !key.models.is_empty()
             && !key.models.iter().any(|m| m == kind.name())
         {
-            return Err(ls.error(
-                path,
-                format!(
-                    "belongs to model \"{}\", not \"{}\"",
-                    key.models.join("\", \""),
-                    kind.name()
-                ),
-            ));
+            first = Some((*line, path, key.models.join("\", \"")));
         }
+    }
+    if let Some((_, path, owners)) = first {
+        return Err(ls.error(
+            path,
+            format!("belongs to model \"{owners}\", not \"{}\"", kind.name()),
+        ));
     }
     kind.check(ls, laws)
 }

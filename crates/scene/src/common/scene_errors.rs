@@ -160,7 +160,9 @@ pub fn explain(e: &toml::de::Error, place: &Place<'_>) -> SceneError {
     let Some(key) = key else {
         return place.at(span.as_ref(), &path, format!("{name}: {raw}"));
     };
-    if let Some(word) = between(&raw, "unknown variant `", "`") {
+    if let Some(word) = between(&raw, "unknown variant `", "`")
+        && !key.ty.starts_with("table")
+    {
         let words: Vec<String> = key
             .allowed
             .iter()

@@ -279,7 +279,7 @@ pub struct SceneFile {
 pub struct SceneSection {
     /// Output goes to `out/<name>/` unless `--out` is given.
     pub name: String,
-    /// 2 or 3.
+    /// 2 or 3 (the particle and lattice models: 2 only).
     pub dim: i64,
     /// 2D only: plane strain (default) or plane stress.
     pub plane: Option<Plane>,
@@ -292,45 +292,53 @@ pub struct SceneSection {
 #[derive(Clone, Debug, Default, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct GridSection {
-    /// The generator or reader.
+    /// The generator or reader (default `"cartesian"`).
     pub kind: GridKind,
-    /// Min and max corner.
+    /// Min and max corner (default the unit box).
     #[schemars(extend("unit" = "m"))]
     pub extent: Option<[Vec<f64>; 2]>,
-    /// Cells per axis (one number for voronoi).
+    /// Cells per axis; `voronoi`: one number (exactly that many cells). With `dim = 3`,
+    /// `composite` and `round-well` extrude the 2D grid over `cells[2]` layers.
     pub cells: Option<CellCount>,
-    /// Seed of random generators.
+    /// Seed of random generators: voronoi, perturb (default 0).
     pub seed: Option<u64>,
-    /// Interior node jitter, fraction of the local cell size.
+    /// Interior nodes move by up to this fraction of their shortest edge, < 0.5; boundary
+    /// nodes stay (default 0).
     pub perturb: Option<f64>,
-    /// Mesh file for `kind = "file"`, relative to the scene file: `.vtu` (any VTK encoding:
-    /// ASCII, base64, appended, zlib) or else Gmsh 4.1 `.msh` (ASCII or binary).
+    /// `file`: the mesh, relative to the scene file: `.vtu` (any VTK XML encoding: ASCII,
+    /// base64, appended, zlib), `.grdecl`/`.data` (an Eclipse corner-point deck, 3D), else
+    /// Gmsh 4.1 `.msh` (ASCII or binary).
     pub path: Option<String>,
-    /// Composite: centre of the refined zone.
+    /// Composite, round-well: centre of the refined zone (3D: x, y of the vertical well).
     #[schemars(extend("unit" = "m"))]
     pub center: Option<Vec<f64>>,
-    /// Composite: half-width of the refined zone (m).
+    /// Composite, round-well: half-width of the square zone, snapped to whole coarse cells.
     #[schemars(extend("unit" = "m"))]
     pub zone_half_width: Option<f64>,
-    /// Composite: subdivisions per coarse cell in the zone.
+    /// Composite: fine squares per coarse edge (each split in 2 triangles); round-well:
+    /// interface nodes per coarse edge (triangle size `h / refine`); file or deck with
+    /// `mdem_zone`: refinement levels 0–3.
     pub refine: Option<i64>,
-    /// Composite: radius of the tagged well cells (m).
+    /// Cells whose centroid is within it get the tag `well` (or `well_tag`); round-well:
+    /// radius of the circular well.
     #[schemars(extend("unit" = "m"))]
     pub well_radius: Option<f64>,
-    /// Composite: name of the well tag (default `well`).
+    /// Name of the tag of the well cells (default `"well"`).
     pub well_tag: Option<String>,
-    /// Round well: edge length on the well wall (m; default half the zone's spacing).
+    /// Round well: edge length on the well wall; the well has `n = max(32, 4⌈2πR / (4
+    /// well_size)⌉)` nodes (default half the zone's triangle size).
     #[schemars(extend("unit" = "m"))]
     pub well_size: Option<f64>,
-    /// Composite: split of the fine squares.
+    /// Composite: the split of the fine squares; Cosserat triangles: `"crossed"` (default
+    /// `"structured"`).
     pub diagonals: Option<DiagonalsChoice>,
-    /// Voronoi: Lloyd iterations.
+    /// Voronoi: Lloyd iterations (default 3).
     pub lloyd: Option<i64>,
-    /// 3D files and decks: cells replaced by conforming tetrahedra (an MDEM zone), refined
-    /// `refine` times; tagged `refined`.
+    /// 3D file or deck: cells replaced by conforming tetrahedra (an MDEM zone, tagged
+    /// `refined`), refined `refine` times.
     pub mdem_zone: Option<Select>,
-    /// With `mdem_zone`: the well trajectory (points); zone cells whose centroid is
-    /// within `well_radius` of it are tagged `well` (or `well_tag`).
+    /// With `mdem_zone`: the well trajectory (points); zone cells whose centroid is within
+    /// `well_radius` of it are tagged `well` (or `well_tag`).
     #[schemars(extend("unit" = "m"))]
     pub well_path: Option<Vec<Vec<f64>>>,
 }
@@ -350,11 +358,13 @@ pub enum CellCount {
 #[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Region {
-    /// Name (for `[[source]] region = ...`).
+    /// Name (for `[[source]] region`).
     pub name: String,
-    /// Which cells (by centroid).
+    /// Which cells, by centroid. Later regions override earlier ones for the cells they
+    /// select; the first region must give both `law` and `material`, later ones may give
+    /// one of them.
     pub select: Select,
-    /// `vem | mdem | dem`.
+    /// `"vem"`, `"mdem"`, `"dem"` or a registered law; model `cosserat`: `"cosserat-dem"`.
     pub law: Option<String>,
     /// Name of a `[material.<name>]`.
     pub material: Option<String>,
@@ -421,52 +431,54 @@ pub enum Permeability {
 #[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Material {
-    /// E (Pa). Required by the continuum model; `model = "cosserat"` accepts
-    /// `shear_modulus` instead (absent: NaN, refused by the checks).
+    /// E (required by the continuum model; `model = "cosserat"` accepts `shear_modulus`
+    /// instead).
     #[serde(default = "missing")]
     #[schemars(extend("unit" = "Pa"))]
     pub youngs_modulus: f64,
-    /// ν.
+    /// ν in (−1, 0.5).
     pub poisson_ratio: f64,
-    /// ρ (kg/m³).
+    /// ρ; needed by explicit mechanics and `[loads] gravity`.
     #[schemars(extend("unit" = "kg/m³"))]
     pub density: Option<f64>,
-    /// Biot α.
+    /// Biot α in [0, 1] (default 1).
     pub biot_alpha: Option<f64>,
-    /// φ.
+    /// φ in (0, 1]; required with flow (default on a corner-point deck: `PORO × NTG ×
+    /// MULTPV`).
     pub porosity: Option<f64>,
-    /// k (m²).
+    /// Isotropic k or `[kx, ky(, kz)]`; required with flow (default on a corner-point deck:
+    /// `[PERMX·NTG, PERMY·NTG, PERMZ]`).
     #[schemars(extend("unit" = "m²"))]
     pub permeability: Option<Permeability>,
-    /// K_s (Pa).
+    /// K_s of the grains, the same for all materials (default incompressible grains).
     #[schemars(extend("unit" = "Pa"))]
     pub solid_bulk_modulus: Option<f64>,
-    /// Tensile strength (Pa).
+    /// σ_t of the tensile criterion (Nilsen et al. eq. 31; default never fails in tension).
     #[schemars(extend("unit" = "Pa"))]
     pub tensile_strength: Option<f64>,
-    /// Fracture toughness `K_Ic` (Pa·√m): a crack-tip cell fails in tension only when its
-    /// stress intensity reaches it too.
+    /// K_Ic: a crack-tip cell fails in tension only when also `σ₁ √(2π r_c) ≥ K_Ic` (needs
+    /// `tensile_strength`).
     #[schemars(extend("unit" = "Pa·√m"))]
     pub fracture_toughness: Option<f64>,
-    /// Mohr–Coulomb cohesion (Pa).
+    /// Mohr–Coulomb cohesion (with `friction_angle`).
     #[schemars(extend("unit" = "Pa"))]
     pub cohesion: Option<f64>,
-    /// Mohr–Coulomb friction angle (degrees).
+    /// Mohr–Coulomb friction angle in [0, 90).
     #[schemars(extend("unit" = "degrees"))]
     pub friction_angle: Option<f64>,
-    /// `model = "cosserat"`: G (Pa).
+    /// Cosserat: G (instead of E).
     #[schemars(extend("unit" = "Pa", "models" = ["cosserat"]))]
     pub shear_modulus: Option<f64>,
-    /// `model = "cosserat"`: Gc (Pa).
+    /// Cosserat: Gc ≥ 0 (0 is classical elasticity).
     #[schemars(extend("unit" = "Pa", "models" = ["cosserat"]))]
     pub cosserat_shear_modulus: Option<f64>,
-    /// `model = "cosserat"`: ℓ (m).
+    /// Cosserat: ℓ (2D: `m_3j = 4Gℓ² ∂_jφ`; 3D: `L = 0, M = Mc = 2Gℓ²`).
     #[schemars(extend("unit" = "m", "models" = ["cosserat"]))]
     pub characteristic_length: Option<f64>,
-    /// `model = "cosserat"`, 3D: `[L, M, Mc]` (N).
+    /// Cosserat 3D: `[L, M, Mc]`, instead of `characteristic_length`.
     #[schemars(extend("unit" = "N", "models" = ["cosserat"]))]
     pub couple_moduli: Option<Vec<f64>>,
-    /// `model = "cosserat"`: j (m²).
+    /// Cosserat dynamics: j.
     #[schemars(extend("unit" = "m²", "models" = ["cosserat"]))]
     pub micro_inertia: Option<f64>,
 }
@@ -479,10 +491,10 @@ fn missing() -> f64 {
 #[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Fluid {
-    /// μ (Pa s).
+    /// μ (`[fluid]` is required with flow).
     #[schemars(extend("unit" = "Pa·s"))]
     pub viscosity: f64,
-    /// c_f (1/Pa).
+    /// c_f.
     #[schemars(extend("unit" = "1/Pa"))]
     pub compressibility: f64,
 }
@@ -491,26 +503,30 @@ pub struct Fluid {
 #[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Bc {
-    /// A side `xmin … zmax` or a face tag.
+    /// A side `xmin xmax ymin ymax zmin zmax` (of the bounding box; `zmin zmax` in 3D only)
+    /// or a face tag.
     pub boundary: String,
-    /// Per component: number, expression or `"free"`.
+    /// Prescribed displacement per component; `"free"` leaves a component (which may then
+    /// carry `traction`).
     #[schemars(extend("unit" = "m"))]
     pub displacement: Option<Vec<Component>>,
-    /// Traction (Pa) per component.
+    /// Traction on the boundary faces, per component.
     #[schemars(extend("unit" = "Pa"))]
     pub traction: Option<Vec<NumOrExpr>>,
-    /// Flow Dirichlet pressure (Pa).
+    /// Flow: Dirichlet pressure. A boundary with neither `pressure` nor `flux` is no-flow.
     #[schemars(extend("unit" = "Pa"))]
     pub pressure: Option<NumOrExpr>,
-    /// Outward Darcy flux (m/s).
+    /// Flow: outward Darcy flux (Neumann); not with `pressure`.
     #[schemars(extend("unit" = "m/s"))]
     pub flux: Option<NumOrExpr>,
-    /// Rigid platen.
+    /// A rigid platen: the boundary's nodes share one displacement per loaded component,
+    /// the total force applied to it; not with `displacement` or `traction`.
     pub platen: Option<Platen>,
-    /// `model = "cosserat"`: micro-rotation (2D one value, 3D three; or `"free"`).
+    /// Cosserat: micro-rotation (2D one value, 3D three; or `"free"`), imposed by Nitsche
+    /// terms; a component may not be both prescribed and loaded.
     #[schemars(extend("unit" = "rad", "models" = ["cosserat"]))]
     pub rotation: Option<crate::common::rotation_keys::PerRotation>,
-    /// `model = "cosserat"`: couple traction (N/m).
+    /// Cosserat: couple traction (2D one value, 3D three).
     #[schemars(extend("unit" = "N/m", "models" = ["cosserat"]))]
     pub couple_traction: Option<crate::common::rotation_keys::PerRotation>,
 }
@@ -519,7 +535,7 @@ pub struct Bc {
 #[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Platen {
-    /// Total force per component (N; per metre in 2D), or `"free"`.
+    /// Total force per component (2D: per metre), or `"free"`.
     #[schemars(extend("unit" = "N"))]
     pub force: Vec<Component>,
 }
@@ -528,13 +544,13 @@ pub struct Platen {
 #[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Loads {
-    /// Gravity (m/s²), uses the material density.
+    /// Body force ρ g with the material density.
     #[schemars(extend("unit" = "m/s²"))]
     pub gravity: Option<Vec<f64>>,
-    /// Body force (N/m³) per component.
+    /// Body force per component (manufactured solutions use it).
     #[schemars(extend("unit" = "N/m³"))]
     pub body_force: Option<Vec<NumOrExpr>>,
-    /// `model = "cosserat"`: body couple (N/m²).
+    /// Cosserat: body couple (2D one value, 3D three).
     #[schemars(extend("unit" = "N/m²", "models" = ["cosserat"]))]
     pub body_couple: Option<crate::common::rotation_keys::PerRotation>,
 }
@@ -543,12 +559,13 @@ pub struct Loads {
 #[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Source {
-    /// Name of a `[[region]]`.
+    /// Name of a `[[region]]`: fluid is injected (positive) or produced in its cells.
     pub region: String,
-    /// m³/s over the region.
+    /// Total rate over the region (2D: per metre).
     #[schemars(extend("unit" = "m³/s"))]
     pub rate: Option<f64>,
-    /// The region's pore volume per hour.
+    /// Or the region's pore volume per hour; exactly one of `rate` and
+    /// `pore_volumes_per_hour`.
     #[schemars(extend("unit" = "1/h"))]
     pub pore_volumes_per_hour: Option<f64>,
 }
@@ -559,20 +576,20 @@ pub struct Source {
 pub struct WellSection {
     /// Name (for messages).
     pub name: String,
-    /// The point the well passes through (its cell is the well's cell).
+    /// The well's cell is the one containing this point; or
     #[schemars(extend("unit" = "m"))]
     pub at: Option<Vec<f64>>,
-    /// Or the index of the well's cell.
+    /// the cell index; exactly one of `at` and `cell`.
     pub cell: Option<i64>,
     /// Wellbore radius (m).
     #[schemars(extend("unit" = "m"))]
     pub radius: f64,
     /// Skin factor (default 0).
     pub skin: Option<f64>,
-    /// Volumetric rate (m³/s; 2D: per metre), positive for injection.
+    /// Injection (positive) rate (2D: per metre); or
     #[schemars(extend("unit" = "m³/s"))]
     pub rate: Option<f64>,
-    /// Or the bottom-hole pressure (Pa).
+    /// the bottom-hole pressure; exactly one of `rate` and `bottom_hole_pressure`.
     #[schemars(extend("unit" = "Pa"))]
     pub bottom_hole_pressure: Option<f64>,
 }
@@ -581,10 +598,11 @@ pub struct WellSection {
 #[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Initial {
-    /// Initial pressure (Pa).
+    /// Initial pore pressure p₀; the coupling acts on `p − p₀` (default 0).
     #[schemars(extend("unit" = "Pa"))]
     pub pressure: Option<NumOrExpr>,
-    /// Equilibrium (default) or rest at t = 0.
+    /// `"equilibrium"`: the loads act on the skeleton at t = 0 with p = p₀; `"zero"`: start
+    /// from rest, loads on at t = 0+ (default `"equilibrium"`).
     pub mechanics: Option<InitialMechanics>,
 }
 
@@ -592,13 +610,14 @@ pub struct Initial {
 #[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Schedule {
-    /// End time (s).
+    /// End of the run. Without `[schedule]` a continuum or Cosserat scene is one static
+    /// solve at t = 0; a schedule has at most 1e7 steps.
     #[schemars(extend("unit" = "s"))]
     pub end_time: f64,
-    /// Step (s).
+    /// Step; exactly one of `dt` and `steps`.
     #[schemars(extend("unit" = "s"))]
     pub dt: Option<f64>,
-    /// Or a number of steps.
+    /// Number of steps, instead of `dt`.
     pub steps: Option<i64>,
 }
 
@@ -606,30 +625,33 @@ pub struct Schedule {
 #[derive(Clone, Debug, Default, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Physics {
-    /// Solve flow.
+    /// Solve TPFA flow (default `false`).
     pub flow: Option<bool>,
-    /// The poroelastic coupling.
+    /// The poroelastic coupling (default `"monolithic"`).
     pub coupling: Option<CouplingChoice>,
-    /// Check failure criteria.
+    /// Check failure criteria after every solve (default `false`). Within a step the most
+    /// critical violating cells (within 1 % of the largest utilization) fail and the step
+    /// is solved again until none fails.
     pub fracture: Option<bool>,
-    /// Stress the failure criteria see: the cell law's stress (default) or the
-    /// patch-recovered nodal stress averaged over the cell.
+    /// Stress the failure criteria see (default `"cell"`).
     pub failure_stress: Option<FailureStress>,
-    /// Isotropic permeability (m²) of failed cells with flow (default 1e-12).
+    /// Isotropic permeability of failed cells with flow (default 1e-12).
     #[schemars(extend("unit" = "m²"))]
     pub fracture_permeability: Option<f64>,
-    /// Or the crack transmissivity (m³): a failed cell takes `T / (2 r_c)`.
+    /// Instead: a failed cell takes `T / (2 r_c)` (`r_c`: radius of the disk or ball of the
+    /// cell's size).
     #[schemars(extend("unit" = "m³"))]
     pub fracture_transmissivity: Option<f64>,
     /// `false`: no fluid lag, the intact cells bordering a crack take its permeability
     /// (default `true`: they keep the rock's).
     pub fluid_lag: Option<bool>,
-    /// Residual stiffness ratio of open edges of failed cells (default 1e-6).
+    /// Residual stiffness ratio of open edges of failed cells, in [0, 1) (default 1e-6).
     pub open_edge_stiffness: Option<f64>,
-    /// Crack tracking angle in degrees (absent: no tracking).
+    /// A crack continues along its line, kinking at most this angle, in (0, 90] (default no
+    /// tracking).
     #[schemars(extend("unit" = "degrees"))]
     pub crack_tracking: Option<f64>,
-    /// Crack tracking: no new crack within this distance (m) of a failed cell (default 0).
+    /// With tracking: no new crack within this distance of a failed cell (default 0).
     #[schemars(extend("unit" = "m"))]
     pub crack_exclusion: Option<f64>,
 }
@@ -638,18 +660,21 @@ pub struct Physics {
 #[derive(Clone, Debug, Default, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Solver {
-    /// Static solves or damped dynamic relaxation.
+    /// Continuum: a static solve at every step time, or damped dynamic relaxation (needs
+    /// `density`) (default `"direct"`).
     pub mechanics: Option<MechanicsSolver>,
-    /// The linear solver.
+    /// The linear solver (default `"auto"`; docs/SCENE-GUIDE.md, `[solver]`, says what
+    /// `"auto"` picks per model and size).
     pub linear: Option<LinearChoice>,
-    /// Relative residual / unbalanced-force ratio.
+    /// Relative residual of iterative solves; unbalanced-force ratio of explicit relaxation
+    /// (default 1e-8 for CG, 1e-10 for GMRES).
     pub tolerance: Option<f64>,
-    /// Threads (0: default).
+    /// 0: one thread per core; n in 1..=1024: a pool of n threads (default 0).
     pub threads: Option<i64>,
-    /// `model = "cosserat"`: η of the interior penalty.
+    /// Cosserat: η of the interior penalty (default 1).
     #[schemars(extend("models" = ["cosserat"]))]
     pub penalty: Option<f64>,
-    /// `model = "cosserat"`: time integrator with a `[schedule]`.
+    /// Cosserat with a `[schedule]` (default `"newmark"`).
     #[schemars(extend("models" = ["cosserat"]))]
     pub time_integration: Option<crate::common::rotation_keys::TimeIntegration>,
 }
@@ -658,23 +683,26 @@ pub struct Solver {
 #[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Output {
-    /// Write VTK files.
+    /// Write VTK files under `vtk/` and `<name>.pvd`.
     #[serde(default = "yes")]
     pub vtk: bool,
-    /// Write PNG plots.
+    /// Write PNG plots under `plots/`.
     #[serde(default = "yes")]
     pub plots: bool,
-    /// Write every n-th step.
+    /// Write every n-th step (probes, lines, VTK).
     #[serde(default = "one")]
     pub every: i64,
-    /// `[[output.probe]]`.
+    /// `[[output.probe]]`: one column of `probes.csv` (`time,<names…>`, one row per written
+    /// step, the first at t = 0).
     #[serde(default)]
     pub probe: Vec<Probe>,
-    /// `[[output.line]]`.
+    /// `[[output.line]]`: a field sampled along a segment at every written step:
+    /// `lines/<name>.csv` with `time,s,x,y[,z],value`.
     #[serde(default)]
     pub line: Vec<Line>,
-    /// An exact displacement (numbers or expressions in x, y, z, t): `summary.json` then
-    /// reports the L2 error of the last written displacement against it.
+    /// Continuum: `summary.json` `errors.l2_displacement`, the L2 error of the last
+    /// displacement (its P1 interpolant, degree-5 quadrature per cell; triangles or
+    /// tetrahedra) against this displacement (numbers or expressions in x, y, z, t).
     #[schemars(extend("unit" = "m"))]
     pub exact_displacement: Option<Vec<NumOrExpr>>,
 }
@@ -705,15 +733,15 @@ fn one() -> i64 {
 pub struct Probe {
     /// Column name.
     pub name: String,
-    /// Field name.
+    /// A field of the model (docs/SCENE-GUIDE.md lists them per model).
     pub field: String,
-    /// Position (grid and lattice models).
+    /// Grid and lattice models: the point; fluid probes of `lsm` with `[lbm]`.
     #[serde(default)]
     #[schemars(extend("unit" = "m"))]
     pub at: Vec<f64>,
-    /// Particle index (particle models).
+    /// Particle models: the particle's index.
     pub particle: Option<i64>,
-    /// Tracked cell (particle models).
+    /// Particle models: a tracked cell (the particles whose centre is inside at t = 0).
     pub cell: Option<Ball>,
     /// Lattice Boltzmann: the obstacle whose force or torque is probed (instead of `at`).
     pub obstacle: Option<String>,
@@ -725,7 +753,7 @@ pub struct Probe {
 pub struct Line {
     /// File name (`lines/<name>.csv`).
     pub name: String,
-    /// Field name.
+    /// A field of the model.
     pub field: String,
     /// Start point.
     #[schemars(extend("unit" = "m"))]
@@ -733,7 +761,7 @@ pub struct Line {
     /// End point.
     #[schemars(extend("unit" = "m"))]
     pub to: Vec<f64>,
-    /// Number of sample points.
+    /// Number of sample points (at most 1e6).
     pub points: i64,
 }
 
