@@ -156,6 +156,24 @@ fn errors_in_overrides_name_the_option() {
         e.ends_with(": --set bc.3.traction: the scene has 2 `bc` entries, not 3"),
         "{e}"
     );
+    let e = error_with(BASE, &["shedule.end_time=1.0"]);
+    assert!(
+        e.ends_with(
+            ": --set shedule.end_time: unknown section `shedule`; did you mean `schedule`?"
+        ),
+        "{e}"
+    );
+    // A table made by an override, checked after the typed read.
+    let e = error_with(BASE, &["schedule.end_time=1.0", "schedule.dt=-1"]);
+    assert!(
+        e.ends_with(": --set schedule.dt: schedule.dt = -1 must be > 0"),
+        "{e}"
+    );
+    let e = error_with(BASE, &["schedule.end_time=1.0"]);
+    assert!(
+        e.ends_with(": --set schedule.end_time: schedule needs exactly one of dt and steps"),
+        "{e}"
+    );
     let e = error_with(BASE, &["grid.celss=[4, 4]"]);
     assert!(
         e.ends_with(": --set grid.celss: unknown key `celss` in [grid]; did you mean `cells`?"),

@@ -70,7 +70,12 @@ impl LoadedScene {
     /// An error at a key path: the line is that of the deepest part of the path written
     /// in the file (1 if none is).
     pub fn error(&self, path: &[KeyPart], message: impl fmt::Display) -> SceneError {
-        if let Some(o) = self.overrides.iter().find(|o| path.starts_with(&o.path)) {
+        if let Some(o) = self.overrides.iter().find(|o| {
+            path.starts_with(&o.path)
+                || (!path.is_empty()
+                    && o.path.starts_with(path)
+                    && !self.lines.in_file(path, self.text.len()))
+        }) {
             return SceneError {
                 file: self.path.clone(),
                 line: 0,
@@ -186,6 +191,14 @@ impl KeyLines {
             }
             path.pop();
         }
+    }
+
+    /// Whether the file writes `path` (a key or a table that only a `--set` made is not
+    /// written in it: its spans lie past the file's `text_len` bytes).
+    pub(crate) fn in_file(&self, path: &[KeyPart], text_len: usize) -> bool {
+        self.spans
+            .iter()
+            .any(|(r, p)| p.as_slice() == path && r.start < text_len)
     }
 
     /// The line of the longest prefix of `path` written in the file; 1 if none is.

@@ -66,9 +66,12 @@ impl Place<'_> {
                     .find(|o| o.span.start <= s.start && s.start <= o.span.end)
             })
             .or_else(|| {
-                self.overrides
-                    .iter()
-                    .find(|o| path.starts_with(&o.path) && !path.is_empty())
+                self.overrides.iter().find(|o| {
+                    !path.is_empty()
+                        && (path.starts_with(&o.path)
+                            || (o.path.starts_with(path)
+                                && !self.lines.in_file(path, self.text.len())))
+                })
             })
         {
             return SceneError {

@@ -292,7 +292,7 @@ pub struct SceneSection {
 #[derive(Clone, Debug, Default, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct GridSection {
-    /// The generator or reader (default `"cartesian"`).
+    /// The generator or reader.
     pub kind: GridKind,
     /// Min and max corner (default the unit box).
     #[schemars(extend("unit" = "m"))]
