@@ -15,7 +15,9 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use clap::{Parser, Subcommand};
-use porofrac_scene::{Observer, Scene, SetupReport, StepReport, Stop};
+use porofrac_scene::common::keys;
+use porofrac_scene::common::overrides::Override;
+use porofrac_scene::{LawRegistry, MODELS, Observer, Scene, SetupReport, StepReport, Stop};
 
 /// Simulate fracturing of porous rock: run scene files, write ParaView files, CSV and plots.
 #[derive(Parser, Debug)]
@@ -23,7 +25,7 @@ use porofrac_scene::{Observer, Scene, SetupReport, StepReport, Stop};
     name = "porofrac",
     version,
     about,
-    after_help = "Examples:\n  porofrac run scenes/patch_test.toml\n  porofrac run scenes/patch_test.toml --out /tmp/patch\n  porofrac check scenes/patch_test.toml"
+    after_help = "Examples:\n  porofrac run scenes/patch_test.toml\n  porofrac run scenes/patch_test.toml --out /tmp/patch\n  porofrac run scenes/patch_test.toml --set material.rock.youngs_modulus=2e10\n  porofrac check scenes/patch_test.toml\n  porofrac keys continuum grid"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -39,6 +41,10 @@ enum Command {
         /// Output directory.
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Set a key of the scene (repeatable): a dotted key, 1-based numbers for arrays
+        /// of tables (`bc.2.value=1e6`), a TOML value or a bare word.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
     },
     /// Check a scene without running it: everything a run does before its first step
     /// (files read, grid built, conditions, probes, packings), nothing written; prints
@@ -46,6 +52,23 @@ enum Command {
     Check {
         /// The scene file (TOML).
         scene: PathBuf,
+        /// Set a key of the scene (repeatable), as for `run`.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+    },
+    /// List the keys of scene files: type, unit, default, allowed values and meaning.
+    Keys {
+        /// A model (continuum, cosserat, nscd, lsm, lbm): its sections and the shared ones
+        /// it reads; or a section when no model is given.
+        model: Option<String>,
+        /// A section (`grid`, `bc`, `output.probe`): that section only.
+        section: Option<String>,
+        /// Markdown tables (docs/SCENE.md is this output for all models).
+        #[arg(long)]
+        markdown: bool,
+        /// Print the JSON Schema of summary.json instead (docs/summary.schema.json).
+        #[arg(long, conflicts_with_all = ["model", "section", "markdown"])]
+        summary_schema: bool,
     },
 }
 
@@ -56,8 +79,21 @@ fn main() -> ExitCode {
     heap::retain_freed_memory();
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Check { scene } => check(&scene),
-        Command::Run { scene, out } => run(&scene, out),
+        Command::Keys {
+            summary_schema: true,
+            ..
+        } => {
+            print!("{}", keys::summary_schema());
+            return ExitCode::SUCCESS;
+        }
+        Command::Keys {
+            model,
+            section,
+            markdown,
+            ..
+        } => return keys(model.as_deref(), section.as_deref(), markdown),
+        Command::Check { scene, set } => check(&scene, &set),
+        Command::Run { scene, out, set } => run(&scene, out, &set),
     };
     result.unwrap_or_else(|msg| {
         eprintln!("error: {msg}");
@@ -68,8 +104,10 @@ fn main() -> ExitCode {
 /// `porofrac check`: the scene built as a run builds it (files read, grid, conditions,
 /// probes, packings; Ctrl-C stops a long build), nothing written; on success the `ok`
 /// line and what a run would do, with estimates of its memory and time.
-fn check(path: &Path) -> Result<ExitCode, String> {
-    let scene = Scene::load(path).map_err(|e| e.to_string())?;
+fn check(path: &Path, set: &[String]) -> Result<ExitCode, String> {
+    let set = overrides(set)?;
+    let scene = Scene::load_with_overrides(path, LawRegistry::default(), &set)
+        .map_err(|e| e.to_string())?;
     let stop = Arc::new(AtomicBool::new(false));
     let flag = Arc::clone(&stop);
     let _ = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed));
@@ -101,8 +139,58 @@ fn check(path: &Path) -> Result<ExitCode, String> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn run(path: &Path, out: Option<PathBuf>) -> Result<ExitCode, String> {
-    let scene = Scene::load(path).map_err(|e| e.to_string())?;
+/// The `--set` arguments, each `KEY=VALUE`.
+fn overrides(set: &[String]) -> Result<Vec<Override>, String> {
+    set.iter().map(|s| Override::parse(s)).collect()
+}
+
+/// `porofrac keys [MODEL] [SECTION]`: the key reference, from the parser's types.
+fn keys(model: Option<&str>, section: Option<&str>, markdown: bool) -> ExitCode {
+    let names: Vec<&str> = MODELS.iter().map(|m| m.name()).collect();
+    // One word that is not a model is a section.
+    let (model, section) = match (model, section) {
+        (Some(m), None) if !names.contains(&m) => (None, Some(m)),
+        other => other,
+    };
+    if let Some(m) = model
+        && !names.contains(&m)
+    {
+        eprintln!(
+            "error: no model \"{m}\"; the models are {}",
+            names.join(", ")
+        );
+        return ExitCode::from(2);
+    }
+    let mut sections = keys::sections(MODELS, model);
+    if let Some(s) = section {
+        let all: Vec<String> = sections.iter().map(|s| s.path.clone()).collect();
+        sections = keys::select(sections, s);
+        if sections.is_empty() {
+            let near = keys::nearest(s, &all)
+                .map(|n| format!("; did you mean `{n}`?"))
+                .unwrap_or_default();
+            eprintln!(
+                "error: no section `{s}`{}{near} (sections: {})",
+                model
+                    .map(|m| format!(" in model \"{m}\""))
+                    .unwrap_or_default(),
+                all.join(", ")
+            );
+            return ExitCode::from(2);
+        }
+    }
+    if markdown {
+        print!("{}", keys::markdown(&sections));
+    } else {
+        print!("{}", keys::text(&sections));
+    }
+    ExitCode::SUCCESS
+}
+
+fn run(path: &Path, out: Option<PathBuf>, set: &[String]) -> Result<ExitCode, String> {
+    let set = overrides(set)?;
+    let scene = Scene::load_with_overrides(path, LawRegistry::default(), &set)
+        .map_err(|e| e.to_string())?;
     let out = out.unwrap_or_else(|| scene.default_out());
     // Ctrl-C: finish the current step, keep what was written, exit with 130.
     let stop = Arc::new(AtomicBool::new(false));

@@ -181,7 +181,10 @@ fn unknown_keys_and_types_are_errors() {
         err.contains(&format!("unknown.toml:{}:", line_of(&text, "poisson = "))),
         "{err}"
     );
-    assert!(err.contains("unknown field `poisson`"), "{err}");
+    assert!(
+        err.contains("unknown key `poisson` in [material.rock]; did you mean `poisson_ratio`?"),
+        "{err}"
+    );
     let text = patch_text().replace("cells = [8, 8]", "cells = \"many\"");
     let (code, err) = check_text("types", &text);
     assert_eq!(code, 1);

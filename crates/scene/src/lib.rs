@@ -86,6 +86,20 @@ impl Scene {
         Ok(Self { loaded, laws })
     }
 
+    /// Read, parse and validate a scene file with `--set KEY=VALUE` overrides applied to
+    /// the parsed document before the typed read ([`common::overrides`]): every check
+    /// applies to them, an error in one names `--set KEY`, and `summary.json` records
+    /// them under `overrides`.
+    pub fn load_with_overrides(
+        path: &Path,
+        laws: LawRegistry,
+        overrides: &[common::overrides::Override],
+    ) -> Result<Self, SceneError> {
+        let loaded = check::load_with(path, MODELS, overrides)?;
+        check::check(&loaded, &laws, MODELS)?;
+        Ok(Self { loaded, laws })
+    }
+
     /// Parse and validate scene text; `path` names it in errors and anchors relative
     /// paths (mesh files).
     pub fn parse(text: &str, path: &Path, laws: LawRegistry) -> Result<Self, SceneError> {

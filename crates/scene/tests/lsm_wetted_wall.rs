@@ -96,10 +96,10 @@ fn wall_keys_are_checked() {
             "[[output.probe]]\nname = \"e\"\nfield = \"crack_extent\"\n",
             "field = \"crack_extent\" needs a pressurised hole",
         ),
-        // serde names the line of the key and the variants
+        // the line of the key, the key and the words it accepts
         (
             "[loading]\npressure_rate = 1.0e7\nwall = \"wet\"\n",
-            "expected `rays` or `wetted`",
+            "loading.wall = \"wet\": expected one of \"rays\", \"wetted\"",
         ),
     ];
     for (loading, key) in cases {

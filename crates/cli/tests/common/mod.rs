@@ -2,6 +2,8 @@
 
 #![allow(dead_code)]
 
+pub mod schema;
+
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 
@@ -78,7 +80,16 @@ pub fn close(a: f64, b: f64, scale: f64, tol: f64) -> bool {
 
 /// The parsed `summary.json` of an output directory.
 pub fn summary(out: &Path) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
+    let v =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    // Every summary a test reads matches the published schema.
+    if let Err(e) = schema::validate(&schema::summary_schema(), &v) {
+        panic!(
+            "{}: not valid against docs/summary.schema.json: {e}",
+            out.display()
+        );
+    }
+    v
 }
 
 /// Starts `porofrac run SCENE --out OUT` in the background, its stderr discarded.

@@ -237,6 +237,7 @@ pub(crate) fn interrupted_in_setup(ls: &LoadedScene, start: Instant, dim: usize)
         field_extrema: BTreeMap::new(),
         errors: BTreeMap::new(),
         version: env!("CARGO_PKG_VERSION").into(),
+        overrides: ls.overrides(),
         extra: serde_json::Map::new(),
     }
 }
@@ -453,6 +454,7 @@ pub(crate) fn drive(
         field_extrema: extrema,
         errors,
         version: env!("CARGO_PKG_VERSION").into(),
+        overrides: ls.overrides(),
         extra: model.summary_extras(),
     })
 }

@@ -35,7 +35,12 @@ impl fmt::Display for SceneError {
             || self.file.display().to_string(),
             |n| n.to_string_lossy().into_owned(),
         );
-        write!(f, "{name}:{}: {}", self.line, bound_echoes(&self.message))
+        if self.line == 0 {
+            // Not at a line of the file: it cannot be read, or the error is in a `--set`.
+            write!(f, "{name}: {}", bound_echoes(&self.message))
+        } else {
+            write!(f, "{name}:{}: {}", self.line, bound_echoes(&self.message))
+        }
     }
 }
 
@@ -57,12 +62,26 @@ pub struct LoadedScene {
     own: Option<Arc<dyn OwnSections>>,
     /// Line of every key path of the file.
     lines: KeyLines,
+    /// The `--set` overrides applied to the file, in command-line order.
+    overrides: Vec<crate::common::overrides::Applied>,
 }
 
 impl LoadedScene {
     /// An error at a key path: the line is that of the deepest part of the path written
     /// in the file (1 if none is).
     pub fn error(&self, path: &[KeyPart], message: impl fmt::Display) -> SceneError {
+        if let Some(o) = self.overrides.iter().find(|o| {
+            path.starts_with(&o.path)
+                || (!path.is_empty()
+                    && o.path.starts_with(path)
+                    && !self.lines.in_file(path, self.text.len()))
+        }) {
+            return SceneError {
+                file: self.path.clone(),
+                line: 0,
+                message: bound_echoes(&format!("--set {}: {} {}", o.key, key_text(path), message)),
+            };
+        }
         SceneError {
             file: self.path.clone(),
             line: self.lines.line(path),
@@ -83,6 +102,14 @@ impl LoadedScene {
         let own: &dyn std::any::Any = self.own.as_deref().expect("the model's sections are read");
         own.downcast_ref::<T>()
             .expect("a model reads its own sections")
+    }
+    /// The `--set` overrides of the scene: each key as written on the command line and its
+    /// value (for `summary.json`).
+    pub fn overrides(&self) -> BTreeMap<String, serde_json::Value> {
+        self.overrides
+            .iter()
+            .map(|o| (o.key.clone(), o.json.clone()))
+            .collect()
     }
     /// The top-level keys of the file, in the parser's order.
     pub fn top_level(&self) -> &[String] {
@@ -117,18 +144,22 @@ impl fmt::Debug for Kind {
 /// table key's line is where the key is written (for `[a.b]`, the header), an element of
 /// an array of tables is at its `[[...]]` header.
 #[derive(Clone, Debug, Default)]
-struct KeyLines {
+pub(crate) struct KeyLines {
     lines: BTreeMap<Vec<KeyPart>, usize>,
     top: Vec<String>,
+    /// The byte range of every key and of every value, with its key path (for the errors
+    /// of the parser, which carry a byte range).
+    pub(crate) spans: Vec<(std::ops::Range<usize>, Vec<KeyPart>)>,
 }
 
 impl KeyLines {
     fn of(doc: &DeTable<'_>, text: &str) -> Self {
         let mut lines = BTreeMap::new();
         let mut path = Vec::new();
-        Self::walk(doc, text, &mut path, &mut lines);
+        let mut spans = Vec::new();
+        Self::walk(doc, text, &mut path, &mut lines, &mut spans);
         let top = doc.keys().map(|k| k.get_ref().to_string()).collect();
-        Self { lines, top }
+        Self { lines, top, spans }
     }
 
     fn walk(
@@ -136,18 +167,22 @@ impl KeyLines {
         text: &str,
         path: &mut Vec<KeyPart>,
         lines: &mut BTreeMap<Vec<KeyPart>, usize>,
+        spans: &mut Vec<(std::ops::Range<usize>, Vec<KeyPart>)>,
     ) {
         for (key, value) in table {
             path.push(KeyPart::Key(key.get_ref().to_string()));
             lines.insert(path.clone(), line_of_offset(text, key.span().start));
+            spans.push((key.span(), path.clone()));
+            spans.push((value.span(), path.clone()));
             match value.get_ref() {
-                DeValue::Table(t) => Self::walk(t, text, path, lines),
+                DeValue::Table(t) => Self::walk(t, text, path, lines, spans),
                 DeValue::Array(items) => {
                     for (i, item) in items.into_iter().enumerate() {
                         if let DeValue::Table(t) = item.get_ref() {
                             path.push(KeyPart::Index(i));
                             lines.insert(path.clone(), line_of_offset(text, item.span().start));
-                            Self::walk(t, text, path, lines);
+                            spans.push((item.span(), path.clone()));
+                            Self::walk(t, text, path, lines, spans);
                             path.pop();
                         }
                     }
@@ -158,8 +193,16 @@ impl KeyLines {
         }
     }
 
+    /// Whether the file writes `path` (a key or a table that only a `--set` made is not
+    /// written in it: its spans lie past the file's `text_len` bytes).
+    pub(crate) fn in_file(&self, path: &[KeyPart], text_len: usize) -> bool {
+        self.spans
+            .iter()
+            .any(|(r, p)| p.as_slice() == path && r.start < text_len)
+    }
+
     /// The line of the longest prefix of `path` written in the file; 1 if none is.
-    fn line(&self, path: &[KeyPart]) -> usize {
+    pub(crate) fn line(&self, path: &[KeyPart]) -> usize {
         (1..=path.len())
             .rev()
             .find_map(|n| self.lines.get(&path[..n]).copied())
@@ -186,13 +229,7 @@ pub const MAX_SCENE_BYTES: u64 = 16 << 20;
 /// Read and parse a scene file (syntax, types, unknown keys).
 /// Models are those of `models`, as for [`parse`].
 pub fn load(path: &Path, models: &[&'static dyn ModelKind]) -> Result<LoadedScene, SceneError> {
-    let cannot = |e: String| SceneError {
-        file: path.to_path_buf(),
-        line: 0,
-        message: format!("cannot read the scene file: {e}"),
-    };
-    let text = read_bounded(path, MAX_SCENE_BYTES, "a scene file").map_err(cannot)?;
-    parse(&text, path, models)
+    load_with(path, models, &[])
 }
 
 /// Read the text of the regular file `path`, refusing more than `limit` bytes while
@@ -313,6 +350,35 @@ pub fn parse(
     path: &Path,
     models: &[&'static dyn ModelKind],
 ) -> Result<LoadedScene, SceneError> {
+    parse_with(text, path, models, &[])
+}
+
+/// Read and parse a scene file as [`load`] does, with the `--set` overrides applied to
+/// the parsed document before the typed read ([`crate::common::overrides`]).
+pub fn load_with(
+    path: &Path,
+    models: &[&'static dyn ModelKind],
+    overrides: &[crate::common::overrides::Override],
+) -> Result<LoadedScene, SceneError> {
+    let cannot = |e: String| SceneError {
+        file: path.to_path_buf(),
+        line: 0,
+        message: format!("cannot read the scene file: {e}"),
+    };
+    let text = read_bounded(path, MAX_SCENE_BYTES, "a scene file").map_err(cannot)?;
+    parse_with(&text, path, models, overrides)
+}
+
+/// Parse scene text as [`parse`] does, with the `--set` overrides applied to the parsed
+/// document before the typed read, so every check applies to them; an error in an
+/// override names `--set KEY`.
+pub fn parse_with(
+    text: &str,
+    path: &Path,
+    models: &[&'static dyn ModelKind],
+    overrides: &[crate::common::overrides::Override],
+) -> Result<LoadedScene, SceneError> {
+    use crate::common::overrides;
     if let Some((offset, depth)) = too_deep(text) {
         return Err(SceneError {
             file: path.to_path_buf(),
@@ -329,8 +395,34 @@ pub fn parse(
         line: e.span().map_or(1, |s| line_of_offset(&text, s.start)),
         message: bound_echoes(&e.message().trim().replace('\n', " ")),
     };
-    let doc = DeTable::parse(&text).map_err(toml_error)?;
+    // The file and then the override values: the document is parsed from the file's part,
+    // so its spans are the file's offsets; a span past the file is in an override.
+    let source = overrides::source(&text, overrides);
+    let mut doc = DeTable::parse(&source[..text.len()]).map_err(toml_error)?;
+    let applied =
+        overrides::apply(doc.get_mut(), &source, text.len(), overrides).map_err(|message| {
+            SceneError {
+                file: path.to_path_buf(),
+                line: 0,
+                message: bound_echoes(&message),
+            }
+        })?;
     let lines = KeyLines::of(doc.get_ref(), &text);
+    let model_name = overrides::model_of(doc.get_ref());
+    let explain = |e: toml::de::Error| {
+        crate::common::scene_errors::explain(
+            &e,
+            &crate::common::scene_errors::Place {
+                file: path,
+                text: &text,
+                source: &source,
+                lines: &lines,
+                overrides: &applied,
+                models,
+                model: &model_name,
+            },
+        )
+    };
     // Top-level keys: the shared sections, or a section some model declares.
     let owned = |key: &str| models.iter().any(|m| m.sections().contains(&key));
     for key in &lines.top {
@@ -343,24 +435,27 @@ pub fn parse(
                     }
                 }
             }
-            let known: Vec<String> = known.iter().map(|s| format!("`{s}`")).collect();
-            return Err(SceneError {
-                file: path.to_path_buf(),
-                line: lines.line(&[KeyPart::Key(key.clone())]),
-                message: format!(
-                    "unknown field `{}`, expected one of {}",
-                    echo(key),
-                    known.join(", ")
-                ),
-            });
+            return Err(crate::common::scene_errors::unknown_section(
+                key,
+                &crate::common::scene_errors::Place {
+                    file: path,
+                    text: &text,
+                    source: &source,
+                    lines: &lines,
+                    overrides: &applied,
+                    models,
+                    model: &model_name,
+                },
+                &known,
+            ));
         }
     }
     let (shared, own) = split_document(doc);
-    let scene = SceneFile::deserialize(toml::de::Deserializer::from(shared)).map_err(toml_error)?;
+    let scene = SceneFile::deserialize(toml::de::Deserializer::from(shared)).map_err(explain)?;
     let name = scene.scene.model.as_deref().unwrap_or("continuum");
     let kind = models.iter().copied().find(|m| m.name() == name);
     let own = match kind {
-        Some(m) => Some(m.sections_of(own).map_err(toml_error)?),
+        Some(m) => Some(m.sections_of(own).map_err(explain)?),
         None => None,
     };
     Ok(LoadedScene {
@@ -370,6 +465,7 @@ pub fn parse(
         kind: kind.map(Kind),
         own,
         lines,
+        overrides: applied,
     })
 }
 
@@ -521,7 +617,7 @@ pub fn step_count(sch: &crate::common::sections::Schedule) -> u64 {
 
 /// The top-level keys every model may have: `[scene]`, `[schedule]`, `[output]`,
 /// `[solver]`.
-const ALWAYS: [&str; 4] = ["scene", "schedule", "output", "solver"];
+use crate::common::keys::ALWAYS;
 
 /// Check a parsed scene: the keys of `[scene]`, the sections of other models (refused
 /// with the model they belong to, from the sections every model of `models` declares),
@@ -569,6 +665,34 @@ pub fn check(
         return Err(ls.error(
             &path,
             format!("belongs to model \"{owner}\", not \"{}\"", kind.name()),
+        ));
+    }
+    // Keys of a shared section that other models read only (`[material.*]
+    // shear_modulus` is the Cosserat model's), from the key reference.
+    let all = crate::common::keys::sections(models, None);
+    let of_some_models: Vec<&str> = all
+        .iter()
+        .flat_map(|s| &s.keys)
+        .filter(|k| !k.models.is_empty())
+        .filter_map(|k| k.name.rsplit('.').next())
+        .collect();
+    // The first such key in the file's order.
+    let mut first: Option<(usize, &Vec<KeyPart>, String)> = None;
+    for (path, line) in &ls.lines.lines {
+        let named = matches!(path.last(), Some(KeyPart::Key(last)) if of_some_models.contains(&last.as_str()));
+        if named
+            && first.as_ref().is_none_or(|(l, _, _)| line < l)
+            && let Some((_, key)) = crate::common::keys::find(&all, path)
+            && !key.models.is_empty()
+            && !key.models.iter().any(|m| m == kind.name())
+        {
+            first = Some((*line, path, key.models.join("\", \"")));
+        }
+    }
+    if let Some((_, path, owners)) = first {
+        return Err(ls.error(
+            path,
+            format!("belongs to model \"{owners}\", not \"{}\"", kind.name()),
         ));
     }
     kind.check(ls, laws)

@@ -179,6 +179,12 @@ pub trait ModelKind: Sync {
         let _ = doc;
         Ok(Arc::new(()))
     }
+    /// The JSON Schema of the model's own sections (the type [`ModelKind::sections_of`]
+    /// reads), for the key reference and the errors that name a key
+    /// ([`crate::common::keys`]); `None` for a model without sections of its own.
+    fn own_schema(&self) -> Option<schemars::Schema> {
+        None
+    }
     /// Check every value the model reads (after the checks every model shares).
     fn check(&self, ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError>;
     /// Build the model — everything a run does before its first step: files read, grid

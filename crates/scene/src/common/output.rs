@@ -119,7 +119,7 @@ impl Drop for CsvTable {
 }
 
 /// Wall time of the phases of a run (seconds; a phase that did not run is 0).
-#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+#[derive(Clone, Copy, Debug, Default, serde::Serialize, schemars::JsonSchema)]
 pub struct WallSeconds {
     /// Whole run.
     pub total: f64,
@@ -136,7 +136,7 @@ pub struct WallSeconds {
 }
 
 /// Linear-solver statistics.
-#[derive(Clone, Debug, Default, serde::Serialize)]
+#[derive(Clone, Debug, Default, serde::Serialize, schemars::JsonSchema)]
 pub struct SolverStats {
     /// Linear solver used.
     pub linear: String,
@@ -155,7 +155,7 @@ pub struct SolverStats {
 }
 
 /// `summary.json`.
-#[derive(Clone, Debug, serde::Serialize)]
+#[derive(Clone, Debug, serde::Serialize, schemars::JsonSchema)]
 pub struct Summary {
     /// Scene name.
     pub scene: String,
@@ -192,6 +192,10 @@ pub struct Summary {
     pub errors: std::collections::BTreeMap<String, f64>,
     /// porofrac version.
     pub version: String,
+    /// The `--set` overrides of the run: each key as written and its value (absent
+    /// without them).
+    #[serde(skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub overrides: std::collections::BTreeMap<String, serde_json::Value>,
     /// Keys a model adds ([`crate::common::model::Model::summary_extras`]: the `lattice` block
     /// and `mlups` of the lattice Boltzmann model, the particle statistics of contact
     /// dynamics).
@@ -254,6 +258,7 @@ pub(crate) fn write_failed_summary(
         field_extrema: Default::default(),
         errors: Default::default(),
         version: env!("CARGO_PKG_VERSION").into(),
+        overrides: ls.overrides(),
         extra: serde_json::Map::new(),
     };
     let _ = summary.write(out);

@@ -15,7 +15,7 @@ use crate::common::loaded::{LoadedScene, SceneError, k, ki, step_count_f64};
 use crate::common::particle_output::PARTICLE_FIELDS;
 
 /// `[particles] kind`: how the disks are generated.
-#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, schemars::JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum ParticleKind {
     /// A dense random polydisperse packing in `region` (random placement with overlap
@@ -29,8 +29,9 @@ pub enum ParticleKind {
 }
 
 /// A radius, or a `[min, max]` range drawn uniformly.
-#[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
+#[derive(Clone, Copy, Debug, Deserialize, schemars::JsonSchema, PartialEq)]
 #[serde(untagged)]
+#[schemars(extend("expected" = "a radius or a range [min, max], e.g. 0.5e-3 or [0.4e-3, 0.6e-3]"))]
 pub enum RadiusSpec {
     /// One radius (m).
     One(f64),
@@ -49,52 +50,63 @@ impl RadiusSpec {
 }
 
 /// `[particles]`.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ParticlesSection {
     /// Generator (default `"random"`).
     #[serde(default)]
     pub kind: ParticleKind,
     /// The box filled: `[[x0, y0], [x1, y1]]` (m); or `disk`, or `polygon`.
+    #[schemars(extend("unit" = "m"))]
     pub region: Option<[[f64; 2]; 2]>,
     /// Radius (hexagonal) or `[min, max]` (random), m.
+    #[schemars(extend("unit" = "m"))]
     pub radius: Option<RadiusSpec>,
     /// Random: disk area over box area (default 0.8).
     pub packing_fraction: Option<f64>,
     /// Random: seed (default 1).
     pub seed: Option<u64>,
     /// List: centres (m).
+    #[schemars(extend("unit" = "m"))]
     pub centres: Option<Vec<[f64; 2]>>,
     /// List: radii (m).
+    #[schemars(extend("unit" = "m"))]
     pub radii: Option<Vec<f64>>,
     /// Density (kg/m³; masses per metre of thickness).
+    #[schemars(extend("unit" = "kg/m³"))]
     pub density: f64,
     /// Instead of `region`: a disk region `{ center = [x, y], radius = R }`.
+    #[schemars(extend("unit" = "m"))]
     pub disk: Option<CircleSpec>,
     /// Instead of `region`: a polygon region, vertices in order (m).
+    #[schemars(extend("unit" = "m"))]
     pub polygon: Option<Vec<[f64; 2]>>,
     /// A circular hole left empty (a borehole): `{ center = [x, y], radius = a }`.
+    #[schemars(extend("unit" = "m"))]
     pub hole: Option<CircleSpec>,
     /// Random: how radii are drawn (default uniform in `radius`).
     #[serde(default)]
     pub distribution: Distribution,
     /// Random with `distribution = "list"`: the radii drawn from, with equal
     /// probability (m).
+    #[schemars(extend("unit" = "m"))]
     pub radius_list: Option<Vec<f64>>,
 }
 
 /// A circle `{ center = [x, y], radius = r }`.
-#[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
+#[derive(Clone, Copy, Debug, Deserialize, schemars::JsonSchema, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct CircleSpec {
     /// Centre (m).
+    #[schemars(extend("unit" = "m"))]
     pub center: [f64; 2],
     /// Radius (m).
+    #[schemars(extend("unit" = "m"))]
     pub radius: f64,
 }
 
 /// `[particles] distribution`.
-#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, schemars::JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum Distribution {
     /// Uniform in `radius = [min, max]`.

@@ -7,8 +7,9 @@ use serde::Deserialize;
 use crate::common::sections::NumOrExpr;
 
 /// One value per rotation component: a single value in 2D, three in 3D.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema, PartialEq)]
 #[serde(untagged)]
+#[schemars(extend("expected" = "one value in 2D or three in 3D, each a number, an expression or \"free\", e.g. 0 or [0, 0, \"free\"]"))]
 pub enum PerRotation {
     /// One value (2D).
     One(NumOrExpr),
@@ -27,7 +28,7 @@ impl PerRotation {
 }
 
 /// `[solver] time_integration` with a `[schedule]`.
-#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, schemars::JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum TimeIntegration {
     /// Newmark average acceleration (implicit).

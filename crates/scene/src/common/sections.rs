@@ -11,8 +11,9 @@ use std::collections::BTreeMap;
 use serde::Deserialize;
 
 /// A number, or a string expression in x, y, z (m) and t (s).
-#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema, PartialEq)]
 #[serde(untagged)]
+#[schemars(extend("expected" = "a number or an expression in x, y, z, t, e.g. 1e6 or \"1e6*min(t/60, 1)\""))]
 pub enum NumOrExpr {
     /// A constant.
     Num(f64),
@@ -74,7 +75,7 @@ pub fn vector_field<const D: usize>(values: &[NumOrExpr]) -> porofrac_sim::Vecto
 pub type Component = NumOrExpr;
 
 /// `[scene] plane`: the 2D idealization.
-#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, schemars::JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum Plane {
     /// Plane strain (`ε_zz = 0`), the default.
@@ -85,7 +86,7 @@ pub enum Plane {
 }
 
 /// `[grid] kind`.
-#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, schemars::JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum GridKind {
     /// Axis-aligned boxes.
@@ -121,7 +122,7 @@ impl GridKind {
 }
 
 /// `[grid] diagonals` of composite grids.
-#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, schemars::JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum DiagonalsChoice {
     /// All fine squares split along the same diagonal.
@@ -134,7 +135,7 @@ pub enum DiagonalsChoice {
 }
 
 /// `[initial] mechanics`.
-#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, schemars::JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum InitialMechanics {
     /// Solve the mechanics at t = 0 before the schedule starts.
@@ -145,7 +146,7 @@ pub enum InitialMechanics {
 }
 
 /// `[physics] coupling`.
-#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, schemars::JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum CouplingChoice {
     /// Fully implicit (Nilsen et al. (2017) eq. 30).
@@ -160,7 +161,7 @@ pub enum CouplingChoice {
 }
 
 /// `[physics] failure_stress`.
-#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, schemars::JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum FailureStress {
     /// The cell law's stress.
@@ -171,7 +172,7 @@ pub enum FailureStress {
 }
 
 /// `[solver] mechanics`.
-#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, schemars::JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum MechanicsSolver {
     /// A static solve at every output time.
@@ -182,7 +183,7 @@ pub enum MechanicsSolver {
 }
 
 /// `[solver] linear`.
-#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, schemars::JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum LinearChoice {
     /// By dimension and size (measured in docs/BENCHMARKS.md).
@@ -223,7 +224,7 @@ pub const SHARED_SECTIONS: [&str; 17] = [
 
 /// The sections of a scene file that every model may read or two models share
 /// ([`SHARED_SECTIONS`]).
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SceneFile {
     /// `[scene]`.
@@ -273,63 +274,79 @@ pub struct SceneFile {
 }
 
 /// `[scene]`.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SceneSection {
     /// Output goes to `out/<name>/` unless `--out` is given.
     pub name: String,
-    /// 2 or 3.
+    /// 2 or 3 (the particle and lattice models: 2 only).
     pub dim: i64,
     /// 2D only: plane strain (default) or plane stress.
     pub plane: Option<Plane>,
-    /// The model: `"continuum"` (default); see docs/SCENE.md for the others.
+    /// The model (default `"continuum"`): `"continuum"`, `"cosserat"`, `"nscd"`, `"lsm"`
+    /// or `"lbm"` (docs/models/).
     pub model: Option<String>,
 }
 
 /// `[grid]`.
-#[derive(Clone, Debug, Default, Deserialize)]
+#[derive(Clone, Debug, Default, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct GridSection {
     /// The generator or reader.
     pub kind: GridKind,
-    /// Min and max corner.
+    /// Min and max corner (default the unit box).
+    #[schemars(extend("unit" = "m"))]
     pub extent: Option<[Vec<f64>; 2]>,
-    /// Cells per axis (one number for voronoi).
+    /// Cells per axis; `voronoi`: one number (exactly that many cells). With `dim = 3`,
+    /// `composite` and `round-well` extrude the 2D grid over `cells[2]` layers.
     pub cells: Option<CellCount>,
-    /// Seed of random generators.
+    /// Seed of random generators: voronoi, perturb (default 0).
     pub seed: Option<u64>,
-    /// Interior node jitter, fraction of the local cell size.
+    /// Interior nodes move by up to this fraction of their shortest edge, < 0.5; boundary
+    /// nodes stay (default 0).
     pub perturb: Option<f64>,
-    /// Mesh file for `kind = "file"`, relative to the scene file: `.vtu` (any VTK encoding:
-    /// ASCII, base64, appended, zlib) or else Gmsh 4.1 `.msh` (ASCII or binary).
+    /// `file`: the mesh, relative to the scene file: `.vtu` (any VTK XML encoding: ASCII,
+    /// base64, appended, zlib), `.grdecl`/`.data` (an Eclipse corner-point deck, 3D), else
+    /// Gmsh 4.1 `.msh` (ASCII or binary).
     pub path: Option<String>,
-    /// Composite: centre of the refined zone.
+    /// Composite, round-well: centre of the refined zone (3D: x, y of the vertical well).
+    #[schemars(extend("unit" = "m"))]
     pub center: Option<Vec<f64>>,
-    /// Composite: half-width of the refined zone (m).
+    /// Composite, round-well: half-width of the square zone, snapped to whole coarse cells.
+    #[schemars(extend("unit" = "m"))]
     pub zone_half_width: Option<f64>,
-    /// Composite: subdivisions per coarse cell in the zone.
+    /// Composite: fine squares per coarse edge (each split in 2 triangles); round-well:
+    /// interface nodes per coarse edge (triangle size `h / refine`); file or deck with
+    /// `mdem_zone`: refinement levels 0–3.
     pub refine: Option<i64>,
-    /// Composite: radius of the tagged well cells (m).
+    /// Cells whose centroid is within it get the tag `well` (or `well_tag`); round-well:
+    /// radius of the circular well.
+    #[schemars(extend("unit" = "m"))]
     pub well_radius: Option<f64>,
-    /// Composite: name of the well tag (default `well`).
+    /// Name of the tag of the well cells (default `"well"`).
     pub well_tag: Option<String>,
-    /// Round well: edge length on the well wall (m; default half the zone's spacing).
+    /// Round well: edge length on the well wall; the well has `n = max(32, 4⌈2πR / (4
+    /// well_size)⌉)` nodes (default half the zone's triangle size).
+    #[schemars(extend("unit" = "m"))]
     pub well_size: Option<f64>,
-    /// Composite: split of the fine squares.
+    /// Composite: the split of the fine squares; Cosserat triangles: `"crossed"` (default
+    /// `"structured"`).
     pub diagonals: Option<DiagonalsChoice>,
-    /// Voronoi: Lloyd iterations.
+    /// Voronoi: Lloyd iterations (default 3).
     pub lloyd: Option<i64>,
-    /// 3D files and decks: cells replaced by conforming tetrahedra (an MDEM zone), refined
-    /// `refine` times; tagged `refined`.
+    /// 3D file or deck: cells replaced by conforming tetrahedra (an MDEM zone, tagged
+    /// `refined`), refined `refine` times.
     pub mdem_zone: Option<Select>,
-    /// With `mdem_zone`: the well trajectory (points); zone cells whose centroid is
-    /// within `well_radius` of it are tagged `well` (or `well_tag`).
+    /// With `mdem_zone`: the well trajectory (points); zone cells whose centroid is within
+    /// `well_radius` of it are tagged `well` (or `well_tag`).
+    #[schemars(extend("unit" = "m"))]
     pub well_path: Option<Vec<Vec<f64>>>,
 }
 
 /// `cells = [nx, ny(, nz)]` or, for Voronoi, one number.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema, PartialEq)]
 #[serde(untagged)]
+#[schemars(extend("expected" = "a number of cells per axis, e.g. [40, 20] (voronoi: one number)"))]
 pub enum CellCount {
     /// One number.
     One(i64),
@@ -338,21 +355,23 @@ pub enum CellCount {
 }
 
 /// `[[region]]`.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Region {
-    /// Name (for `[[source]] region = ...`).
+    /// Name (for `[[source]] region`).
     pub name: String,
-    /// Which cells (by centroid).
+    /// Which cells, by centroid. Later regions override earlier ones for the cells they
+    /// select; the first region must give both `law` and `material`, later ones may give
+    /// one of them.
     pub select: Select,
-    /// `vem | mdem | dem`.
+    /// `"vem"`, `"mdem"`, `"dem"` or a registered law; model `cosserat`: `"cosserat-dem"`.
     pub law: Option<String>,
     /// Name of a `[material.<name>]`.
     pub material: Option<String>,
 }
 
 /// A cell selection.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema, PartialEq)]
 #[serde(rename_all = "lowercase", deny_unknown_fields)]
 pub enum Select {
     /// `{ all = true }`.
@@ -374,28 +393,33 @@ pub enum Select {
 }
 
 /// A polyline and a distance.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct PathBall {
     /// The polyline's points.
+    #[schemars(extend("unit" = "m"))]
     pub path: Vec<Vec<f64>>,
     /// Distance (m).
+    #[schemars(extend("unit" = "m"))]
     pub radius: f64,
 }
 
 /// Centre and radius.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Ball {
     /// Centre.
+    #[schemars(extend("unit" = "m"))]
     pub center: Vec<f64>,
     /// Radius (m).
+    #[schemars(extend("unit" = "m"))]
     pub radius: f64,
 }
 
 /// Scalar or per-axis permeability.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema, PartialEq)]
 #[serde(untagged)]
+#[schemars(extend("expected" = "a permeability or one per axis, e.g. 1e-15 or [1e-15, 1e-16]"))]
 pub enum Permeability {
     /// Isotropic (m²).
     Scalar(f64),
@@ -404,43 +428,58 @@ pub enum Permeability {
 }
 
 /// `[material.<name>]`.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Material {
-    /// E (Pa). Required by the continuum model; `model = "cosserat"` accepts
-    /// `shear_modulus` instead (absent: NaN, refused by the checks).
+    /// E (required by the continuum model; `model = "cosserat"` accepts `shear_modulus`
+    /// instead).
     #[serde(default = "missing")]
+    #[schemars(extend("unit" = "Pa"))]
     pub youngs_modulus: f64,
-    /// ν.
+    /// ν in (−1, 0.5).
     pub poisson_ratio: f64,
-    /// ρ (kg/m³).
+    /// ρ; needed by explicit mechanics and `[loads] gravity`.
+    #[schemars(extend("unit" = "kg/m³"))]
     pub density: Option<f64>,
-    /// Biot α.
+    /// Biot α in [0, 1] (default 1).
     pub biot_alpha: Option<f64>,
-    /// φ.
+    /// φ in (0, 1]; required with flow (default on a corner-point deck: `PORO × NTG ×
+    /// MULTPV`).
     pub porosity: Option<f64>,
-    /// k (m²).
+    /// Isotropic k or `[kx, ky(, kz)]`; required with flow (default on a corner-point deck:
+    /// `[PERMX·NTG, PERMY·NTG, PERMZ]`).
+    #[schemars(extend("unit" = "m²"))]
     pub permeability: Option<Permeability>,
-    /// K_s (Pa).
+    /// K_s of the grains, the same for all materials (default incompressible grains).
+    #[schemars(extend("unit" = "Pa"))]
     pub solid_bulk_modulus: Option<f64>,
-    /// Tensile strength (Pa).
+    /// σ_t of the tensile criterion (Nilsen et al. eq. 31; default never fails in tension).
+    #[schemars(extend("unit" = "Pa"))]
     pub tensile_strength: Option<f64>,
-    /// Fracture toughness `K_Ic` (Pa·√m): a crack-tip cell fails in tension only when its
-    /// stress intensity reaches it too.
+    /// K_Ic: a crack-tip cell fails in tension only when also `σ₁ √(2π r_c) ≥ K_Ic` (needs
+    /// `tensile_strength`).
+    #[schemars(extend("unit" = "Pa·√m"))]
     pub fracture_toughness: Option<f64>,
-    /// Mohr–Coulomb cohesion (Pa).
+    /// Mohr–Coulomb cohesion (with `friction_angle`).
+    #[schemars(extend("unit" = "Pa"))]
     pub cohesion: Option<f64>,
-    /// Mohr–Coulomb friction angle (degrees).
+    /// Mohr–Coulomb friction angle in [0, 90).
+    #[schemars(extend("unit" = "degrees"))]
     pub friction_angle: Option<f64>,
-    /// `model = "cosserat"`: G (Pa).
+    /// Cosserat: G (instead of E).
+    #[schemars(extend("unit" = "Pa", "models" = ["cosserat"]))]
     pub shear_modulus: Option<f64>,
-    /// `model = "cosserat"`: Gc (Pa).
+    /// Cosserat: Gc ≥ 0 (0 is classical elasticity).
+    #[schemars(extend("unit" = "Pa", "models" = ["cosserat"]))]
     pub cosserat_shear_modulus: Option<f64>,
-    /// `model = "cosserat"`: ℓ (m).
+    /// Cosserat: ℓ (2D: `m_3j = 4Gℓ² ∂_jφ`; 3D: `L = 0, M = Mc = 2Gℓ²`).
+    #[schemars(extend("unit" = "m", "models" = ["cosserat"]))]
     pub characteristic_length: Option<f64>,
-    /// `model = "cosserat"`, 3D: `[L, M, Mc]` (N).
+    /// Cosserat 3D: `[L, M, Mc]`, instead of `characteristic_length`.
+    #[schemars(extend("unit" = "N", "models" = ["cosserat"]))]
     pub couple_moduli: Option<Vec<f64>>,
-    /// `model = "cosserat"`: j (m²).
+    /// Cosserat dynamics: j.
+    #[schemars(extend("unit" = "m²", "models" = ["cosserat"]))]
     pub micro_inertia: Option<f64>,
 }
 
@@ -449,178 +488,222 @@ fn missing() -> f64 {
 }
 
 /// `[fluid]`.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Fluid {
-    /// μ (Pa s).
+    /// μ (`[fluid]` is required with flow).
+    #[schemars(extend("unit" = "Pa·s"))]
     pub viscosity: f64,
-    /// c_f (1/Pa).
+    /// c_f.
+    #[schemars(extend("unit" = "1/Pa"))]
     pub compressibility: f64,
 }
 
 /// `[[bc]]`.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Bc {
-    /// A side `xmin … zmax` or a face tag.
+    /// A side `xmin xmax ymin ymax zmin zmax` (of the bounding box; `zmin zmax` in 3D only)
+    /// or a face tag.
     pub boundary: String,
-    /// Per component: number, expression or `"free"`.
+    /// Prescribed displacement per component; `"free"` leaves a component (which may then
+    /// carry `traction`).
+    #[schemars(extend("unit" = "m"))]
     pub displacement: Option<Vec<Component>>,
-    /// Traction (Pa) per component.
+    /// Traction on the boundary faces, per component.
+    #[schemars(extend("unit" = "Pa"))]
     pub traction: Option<Vec<NumOrExpr>>,
-    /// Flow Dirichlet pressure (Pa).
+    /// Flow: Dirichlet pressure. A boundary with neither `pressure` nor `flux` is no-flow.
+    #[schemars(extend("unit" = "Pa"))]
     pub pressure: Option<NumOrExpr>,
-    /// Outward Darcy flux (m/s).
+    /// Flow: outward Darcy flux (Neumann); not with `pressure`.
+    #[schemars(extend("unit" = "m/s"))]
     pub flux: Option<NumOrExpr>,
-    /// Rigid platen.
+    /// A rigid platen: the boundary's nodes share one displacement per loaded component,
+    /// the total force applied to it; not with `displacement` or `traction`.
     pub platen: Option<Platen>,
-    /// `model = "cosserat"`: micro-rotation (2D one value, 3D three; or `"free"`).
+    /// Cosserat: micro-rotation (2D one value, 3D three; or `"free"`), imposed by Nitsche
+    /// terms; a component may not be both prescribed and loaded.
+    #[schemars(extend("unit" = "rad", "models" = ["cosserat"]))]
     pub rotation: Option<crate::common::rotation_keys::PerRotation>,
-    /// `model = "cosserat"`: couple traction (N/m).
+    /// Cosserat: couple traction (2D one value, 3D three).
+    #[schemars(extend("unit" = "N/m", "models" = ["cosserat"]))]
     pub couple_traction: Option<crate::common::rotation_keys::PerRotation>,
 }
 
 /// `platen = { force = [...] }`.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Platen {
-    /// Total force per component (N; per metre in 2D), or `"free"`.
+    /// Total force per component (2D: per metre), or `"free"`.
+    #[schemars(extend("unit" = "N"))]
     pub force: Vec<Component>,
 }
 
 /// `[loads]`.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Loads {
-    /// Gravity (m/s²), uses the material density.
+    /// Body force ρ g with the material density.
+    #[schemars(extend("unit" = "m/s²"))]
     pub gravity: Option<Vec<f64>>,
-    /// Body force (N/m³) per component.
+    /// Body force per component (manufactured solutions use it).
+    #[schemars(extend("unit" = "N/m³"))]
     pub body_force: Option<Vec<NumOrExpr>>,
-    /// `model = "cosserat"`: body couple (N/m²).
+    /// Cosserat: body couple (2D one value, 3D three).
+    #[schemars(extend("unit" = "N/m²", "models" = ["cosserat"]))]
     pub body_couple: Option<crate::common::rotation_keys::PerRotation>,
 }
 
 /// `[[source]]`.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Source {
-    /// Name of a `[[region]]`.
+    /// Name of a `[[region]]`: fluid is injected (positive) or produced in its cells.
     pub region: String,
-    /// m³/s over the region.
+    /// Total rate over the region (2D: per metre).
+    #[schemars(extend("unit" = "m³/s"))]
     pub rate: Option<f64>,
-    /// The region's pore volume per hour.
+    /// Or the region's pore volume per hour; exactly one of `rate` and
+    /// `pore_volumes_per_hour`.
+    #[schemars(extend("unit" = "1/h"))]
     pub pore_volumes_per_hour: Option<f64>,
 }
 
 /// `[[well]]`: a Peaceman well in one cell, controlled by rate or bottom-hole pressure.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct WellSection {
     /// Name (for messages).
     pub name: String,
-    /// The point the well passes through (its cell is the well's cell).
+    /// The well's cell is the one containing this point; or
+    #[schemars(extend("unit" = "m"))]
     pub at: Option<Vec<f64>>,
-    /// Or the index of the well's cell.
+    /// the cell index; exactly one of `at` and `cell`.
     pub cell: Option<i64>,
     /// Wellbore radius (m).
+    #[schemars(extend("unit" = "m"))]
     pub radius: f64,
     /// Skin factor (default 0).
     pub skin: Option<f64>,
-    /// Volumetric rate (m³/s; 2D: per metre), positive for injection.
+    /// Injection (positive) rate (2D: per metre); or
+    #[schemars(extend("unit" = "m³/s"))]
     pub rate: Option<f64>,
-    /// Or the bottom-hole pressure (Pa).
+    /// the bottom-hole pressure; exactly one of `rate` and `bottom_hole_pressure`.
+    #[schemars(extend("unit" = "Pa"))]
     pub bottom_hole_pressure: Option<f64>,
 }
 
 /// `[initial]`.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Initial {
-    /// Initial pressure (Pa).
+    /// Initial pore pressure p₀; the coupling acts on `p − p₀` (default 0).
+    #[schemars(extend("unit" = "Pa"))]
     pub pressure: Option<NumOrExpr>,
-    /// Equilibrium (default) or rest at t = 0.
+    /// `"equilibrium"`: the loads act on the skeleton at t = 0 with p = p₀; `"zero"`: start
+    /// from rest, loads on at t = 0+ (default `"equilibrium"`).
     pub mechanics: Option<InitialMechanics>,
 }
 
 /// `[schedule]`.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Schedule {
-    /// End time (s).
+    /// End of the run. Without `[schedule]` a continuum or Cosserat scene is one static
+    /// solve at t = 0; a schedule has at most 1e7 steps.
+    #[schemars(extend("unit" = "s"))]
     pub end_time: f64,
-    /// Step (s).
+    /// Step; exactly one of `dt` and `steps`.
+    #[schemars(extend("unit" = "s"))]
     pub dt: Option<f64>,
-    /// Or a number of steps.
+    /// Number of steps, instead of `dt`.
     pub steps: Option<i64>,
 }
 
 /// `[physics]`.
-#[derive(Clone, Debug, Default, Deserialize)]
+#[derive(Clone, Debug, Default, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Physics {
-    /// Solve flow.
+    /// Solve TPFA flow (default `false`).
     pub flow: Option<bool>,
-    /// The poroelastic coupling.
+    /// The poroelastic coupling (default `"monolithic"`).
     pub coupling: Option<CouplingChoice>,
-    /// Check failure criteria.
+    /// Check failure criteria after every solve (default `false`). Within a step the most
+    /// critical violating cells (within 1 % of the largest utilization) fail and the step
+    /// is solved again until none fails.
     pub fracture: Option<bool>,
-    /// Stress the failure criteria see: the cell law's stress (default) or the
-    /// patch-recovered nodal stress averaged over the cell.
+    /// Stress the failure criteria see (default `"cell"`).
     pub failure_stress: Option<FailureStress>,
-    /// Isotropic permeability (m²) of failed cells with flow (default 1e-12).
+    /// Isotropic permeability of failed cells with flow (default 1e-12).
+    #[schemars(extend("unit" = "m²"))]
     pub fracture_permeability: Option<f64>,
-    /// Or the crack transmissivity (m³): a failed cell takes `T / (2 r_c)`.
+    /// Instead: a failed cell takes `T / (2 r_c)` (`r_c`: radius of the disk or ball of the
+    /// cell's size).
+    #[schemars(extend("unit" = "m³"))]
     pub fracture_transmissivity: Option<f64>,
     /// `false`: no fluid lag, the intact cells bordering a crack take its permeability
     /// (default `true`: they keep the rock's).
     pub fluid_lag: Option<bool>,
-    /// Residual stiffness ratio of open edges of failed cells (default 1e-6).
+    /// Residual stiffness ratio of open edges of failed cells, in [0, 1) (default 1e-6).
     pub open_edge_stiffness: Option<f64>,
-    /// Crack tracking angle in degrees (absent: no tracking).
+    /// A crack continues along its line, kinking at most this angle, in (0, 90] (default no
+    /// tracking).
+    #[schemars(extend("unit" = "degrees"))]
     pub crack_tracking: Option<f64>,
-    /// Crack tracking: no new crack within this distance (m) of a failed cell (default 0).
+    /// With tracking: no new crack within this distance of a failed cell (default 0).
+    #[schemars(extend("unit" = "m"))]
     pub crack_exclusion: Option<f64>,
 }
 
 /// `[solver]`.
-#[derive(Clone, Debug, Default, Deserialize)]
+#[derive(Clone, Debug, Default, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Solver {
-    /// Static solves or damped dynamic relaxation.
+    /// Continuum: a static solve at every step time, or damped dynamic relaxation (needs
+    /// `density`) (default `"direct"`).
     pub mechanics: Option<MechanicsSolver>,
-    /// The linear solver.
+    /// The linear solver (default `"auto"`; docs/SCENE-GUIDE.md, `[solver]`, says what
+    /// `"auto"` picks per model and size).
     pub linear: Option<LinearChoice>,
-    /// Relative residual / unbalanced-force ratio.
+    /// Relative residual of iterative solves; unbalanced-force ratio of explicit relaxation
+    /// (default 1e-8 for CG, 1e-10 for GMRES).
     pub tolerance: Option<f64>,
-    /// Threads (0: default).
+    /// 0: one thread per core; n in 1..=1024: a pool of n threads (default 0).
     pub threads: Option<i64>,
-    /// `model = "cosserat"`: η of the interior penalty.
+    /// Cosserat: η of the interior penalty (default 1).
+    #[schemars(extend("models" = ["cosserat"]))]
     pub penalty: Option<f64>,
-    /// `model = "cosserat"`: time integrator with a `[schedule]`.
+    /// Cosserat with a `[schedule]` (default `"newmark"`).
+    #[schemars(extend("models" = ["cosserat"]))]
     pub time_integration: Option<crate::common::rotation_keys::TimeIntegration>,
 }
 
 /// `[output]`.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Output {
-    /// Write VTK files.
+    /// Write VTK files under `vtk/` and `<name>.pvd`.
     #[serde(default = "yes")]
     pub vtk: bool,
-    /// Write PNG plots.
+    /// Write PNG plots under `plots/`.
     #[serde(default = "yes")]
     pub plots: bool,
-    /// Write every n-th step.
+    /// Write every n-th step (probes, lines, VTK).
     #[serde(default = "one")]
     pub every: i64,
-    /// `[[output.probe]]`.
+    /// `[[output.probe]]`: one column of `probes.csv` (`time,<names…>`, one row per written
+    /// step, the first at t = 0).
     #[serde(default)]
     pub probe: Vec<Probe>,
-    /// `[[output.line]]`.
+    /// `[[output.line]]`: a field sampled along a segment at every written step:
+    /// `lines/<name>.csv` with `time,s,x,y[,z],value`.
     #[serde(default)]
     pub line: Vec<Line>,
-    /// An exact displacement (numbers or expressions in x, y, z, t): `summary.json` then
-    /// reports the L2 error of the last written displacement against it.
+    /// Continuum: `summary.json` `errors.l2_displacement`, the L2 error of the last
+    /// displacement (its P1 interpolant, degree-5 quadrature per cell; triangles or
+    /// tetrahedra) against this displacement (numbers or expressions in x, y, z, t).
+    #[schemars(extend("unit" = "m"))]
     pub exact_displacement: Option<Vec<NumOrExpr>>,
 }
 
@@ -645,37 +728,40 @@ fn one() -> i64 {
 }
 
 /// `[[output.probe]]`.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Probe {
     /// Column name.
     pub name: String,
-    /// Field name.
+    /// A field of the model (docs/SCENE-GUIDE.md lists them per model).
     pub field: String,
-    /// Position (grid and lattice models).
+    /// Grid and lattice models: the point; fluid probes of `lsm` with `[lbm]`.
     #[serde(default)]
+    #[schemars(extend("unit" = "m"))]
     pub at: Vec<f64>,
-    /// Particle index (particle models).
+    /// Particle models: the particle's index.
     pub particle: Option<i64>,
-    /// Tracked cell (particle models).
+    /// Particle models: a tracked cell (the particles whose centre is inside at t = 0).
     pub cell: Option<Ball>,
     /// Lattice Boltzmann: the obstacle whose force or torque is probed (instead of `at`).
     pub obstacle: Option<String>,
 }
 
 /// `[[output.line]]`.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Line {
     /// File name (`lines/<name>.csv`).
     pub name: String,
-    /// Field name.
+    /// A field of the model.
     pub field: String,
     /// Start point.
+    #[schemars(extend("unit" = "m"))]
     pub from: Vec<f64>,
     /// End point.
+    #[schemars(extend("unit" = "m"))]
     pub to: Vec<f64>,
-    /// Number of sample points.
+    /// Number of sample points (at most 1e6).
     pub points: i64,
 }
 

@@ -777,6 +777,9 @@ impl ModelKind for LbmKind {
     ) -> Result<std::sync::Arc<dyn OwnSections>, toml::de::Error> {
         own_sections::<LbmSections>(doc)
     }
+    fn own_schema(&self) -> Option<schemars::Schema> {
+        Some(schemars::schema_for!(LbmSections))
+    }
     fn check(&self, ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
         let _ = laws;
         check::check(ls)
@@ -795,7 +798,7 @@ impl ModelKind for LbmKind {
 
 /// The sections of model `lbm` read by the model itself (`[lbm]` and `[thermal]` are
 /// shared with model `lsm`).
-#[derive(Clone, Debug, Default, serde::Deserialize)]
+#[derive(Clone, Debug, Default, serde::Deserialize, schemars::JsonSchema)]
 pub struct LbmSections {
     /// `[[obstacle]]`.
     #[serde(default)]

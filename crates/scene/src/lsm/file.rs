@@ -6,24 +6,31 @@ use serde::Deserialize;
 
 /// `[bonds]`: springs from `youngs_modulus` and `poisson_ratio` (hexagonal lattice
 /// closed form, [`porofrac_lsm`]) or `kn`, `ks` directly; strengths; calibration.
-#[derive(Clone, Debug, Default, Deserialize)]
+#[derive(Clone, Debug, Default, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct BondsSection {
     /// 2D Young's modulus E (Pa), with `poisson_ratio`.
+    #[schemars(extend("unit" = "Pa"))]
     pub youngs_modulus: Option<f64>,
     /// Poisson's ratio ν ≤ 1/3.
     pub poisson_ratio: Option<f64>,
     /// Normal stiffness k_n (N/m²), instead of E and ν.
+    #[schemars(extend("unit" = "N/m²"))]
     pub kn: Option<f64>,
     /// Shear stiffness k_s (N/m², default 0 with `kn`).
+    #[schemars(extend("unit" = "N/m²"))]
     pub ks: Option<f64>,
     /// Bending stiffness k_b (N·m/m per rad, default 0).
+    #[schemars(extend("unit" = "N·m/m per rad"))]
     pub kb: Option<f64>,
     /// Tensile strength σ_t (Pa): tension cut-off (default unbreakable).
+    #[schemars(extend("unit" = "Pa"))]
     pub tensile_strength: Option<f64>,
     /// Cohesion c (Pa, default σ_t tan φ).
+    #[schemars(extend("unit" = "Pa"))]
     pub cohesion: Option<f64>,
     /// Friction angle φ of the bond strength (degrees, default 30).
+    #[schemars(extend("unit" = "degrees"))]
     pub friction_angle: Option<f64>,
     /// Disks closer than (R_i + R_j)(1 + tolerance) are bonded (default 0.05).
     pub tolerance: Option<f64>,
@@ -34,7 +41,7 @@ pub struct BondsSection {
 }
 
 /// `[contacts] normal`.
-#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, schemars::JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum NormalChoice {
     /// `F = k_n δ`.
@@ -45,7 +52,7 @@ pub enum NormalChoice {
 }
 
 /// `[contacts]`: unbonded and broken-bond contacts.
-#[derive(Clone, Debug, Default, Deserialize)]
+#[derive(Clone, Debug, Default, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ContactsSection {
     /// Coulomb friction μ (default 0.6).
@@ -54,17 +61,20 @@ pub struct ContactsSection {
     #[serde(default)]
     pub normal: NormalChoice,
     /// Linear normal stiffness (N/m², default the bonds' k_n).
+    #[schemars(extend("unit" = "N/m²"))]
     pub kn: Option<f64>,
     /// Tangential stiffness (N/m², default the bonds' k_s).
+    #[schemars(extend("unit" = "N/m²"))]
     pub ks: Option<f64>,
     /// Hertz: grain Young's modulus (Pa).
+    #[schemars(extend("unit" = "Pa"))]
     pub modulus: Option<f64>,
     /// Hertz: grain Poisson's ratio.
     pub poisson_ratio: Option<f64>,
 }
 
 /// `[lsm] damping`.
-#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, schemars::JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum DampingChoice {
     /// None.
@@ -77,11 +87,12 @@ pub enum DampingChoice {
 }
 
 /// `[lsm]`: time stepping.
-#[derive(Clone, Debug, Default, Deserialize)]
+#[derive(Clone, Debug, Default, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct LsmSection {
     /// Time step (s); default `dt_fraction` × the stable one. Above the stable one is an
     /// error.
+    #[schemars(extend("unit" = "s"))]
     pub dt: Option<f64>,
     /// Time step as a fraction of the stable one (default 0.5).
     pub dt_fraction: Option<f64>,
@@ -91,6 +102,7 @@ pub struct LsmSection {
     /// α (local) or rate (viscous).
     pub damping_coefficient: Option<f64>,
     /// Gravity (m/s², default `[0, 0]`).
+    #[schemars(extend("unit" = "m/s²"))]
     pub gravity: Option<[f64; 2]>,
     /// With `[lbm]`: the fluid sees every disk enlarged by the bond tolerance, so the
     /// gap of a bonded pair holds no fluid (default false).
@@ -99,17 +111,19 @@ pub struct LsmSection {
 
 /// `[loading] platens`: the particles within `thickness` of the top and of the bottom
 /// of the sample move towards each other at `velocity`.
-#[derive(Clone, Copy, Debug, Deserialize)]
+#[derive(Clone, Copy, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct PlatensSpec {
     /// Speed of each platen (m/s).
+    #[schemars(extend("unit" = "m/s"))]
     pub velocity: f64,
     /// Thickness of the platen layers (m).
+    #[schemars(extend("unit" = "m"))]
     pub thickness: f64,
 }
 
 /// `[loading] wall`: which faces of the lining particles the hole pressure loads.
-#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, schemars::JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum WallChoice {
     /// The faces seen from the hole centre.
@@ -121,20 +135,23 @@ pub enum WallChoice {
 }
 
 /// `[loading]`.
-#[derive(Clone, Debug, Default, Deserialize)]
+#[derive(Clone, Debug, Default, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct LoadingSection {
     /// Platens (a Brazilian or compression test).
     pub platens: Option<PlatensSpec>,
     /// Pressure on the wall of `[particles] hole` rising at this rate (Pa/s).
+    #[schemars(extend("unit" = "Pa/s"))]
     pub pressure_rate: Option<f64>,
     /// Largest pressure, then held (Pa, default no limit).
+    #[schemars(extend("unit" = "Pa"))]
     pub pressure_max: Option<f64>,
     /// Faces the pressure loads (default `"rays"`).
     #[serde(default)]
     pub wall: WallChoice,
     /// `wall = "wetted"`: raster spacing (m, default half the smallest radius, the
     /// lattice spacing a fluid would need).
+    #[schemars(extend("unit" = "m"))]
     pub wall_spacing: Option<f64>,
     /// The hole pressure also acts in the broken bonds of the crack connected to the
     /// hole wall, `p · 2 min(R_i, R_j)` pushing their disks apart (a crack the fluid
@@ -145,7 +162,7 @@ pub struct LoadingSection {
 
 /// The sections of model `lsm` read by the model itself (`[particles]` is shared with
 /// model `nscd`, `[lbm]` and `[thermal]` with model `lbm`).
-#[derive(Clone, Debug, Default, Deserialize)]
+#[derive(Clone, Debug, Default, Deserialize, schemars::JsonSchema)]
 pub struct LsmSections {
     /// `[bonds]`.
     pub bonds: Option<BondsSection>,

@@ -32,18 +32,23 @@ use crate::common::output::write_atomic;
 pub const SECTIONS: [&str; 2] = ["lbm", "thermal"];
 
 /// `[injection]`: a mass source on the lattice nodes of a disk, ramped.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct InjectionSection {
     /// Centre of the source (m; default the `[particles]` hole).
+    #[schemars(extend("unit" = "m"))]
     pub center: Option<[f64; 2]>,
     /// Radius of the source (m; default half the hole radius).
+    #[schemars(extend("unit" = "m"))]
     pub radius: Option<f64>,
     /// Final target gauge pressure of the source nodes (Pa), or
+    #[schemars(extend("unit" = "Pa"))]
     pub pressure: Option<f64>,
     /// final mass rate per metre of depth (kg/(m·s)).
+    #[schemars(extend("unit" = "kg/(m·s)"))]
     pub rate: Option<f64>,
     /// Ramp from 0 to the final value (s).
+    #[schemars(extend("unit" = "s"))]
     pub ramp_time: f64,
     /// Pressure control: fraction of the density gap closed per step (default 0.5).
     pub gain: Option<f64>,

@@ -945,6 +945,9 @@ impl ModelKind for LsmKind {
     ) -> Result<std::sync::Arc<dyn OwnSections>, toml::de::Error> {
         own_sections::<file::LsmSections>(doc)
     }
+    fn own_schema(&self) -> Option<schemars::Schema> {
+        Some(schemars::schema_for!(file::LsmSections))
+    }
     fn check(&self, ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
         let _ = laws;
         check::check(ls)

@@ -6,8 +6,9 @@ use serde::Deserialize;
 pub use crate::common::particles::{ParticleKind, ParticlesSection, RadiusSpec};
 
 /// A velocity component of a wall: a number (m/s) or `"free"`.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema, PartialEq)]
 #[serde(untagged)]
+#[schemars(extend("expected" = "a velocity or \"free\""))]
 pub enum WallComponent {
     /// Prescribed velocity (m/s).
     Velocity(f64),
@@ -17,27 +18,33 @@ pub enum WallComponent {
 
 /// `[[wall]]`: a rigid segment or convex polygon translating at a prescribed velocity,
 /// or free along an axis under a force.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct WallSection {
     /// Name (for messages).
     pub name: Option<String>,
     /// Segment start (m).
+    #[schemars(extend("unit" = "m"))]
     pub from: Option<[f64; 2]>,
     /// Segment end (m).
+    #[schemars(extend("unit" = "m"))]
     pub to: Option<[f64; 2]>,
     /// Or a convex polygon, counter-clockwise (m).
+    #[schemars(extend("unit" = "m"))]
     pub polygon: Option<Vec<[f64; 2]>>,
     /// Velocity per component (m/s) or `"free"` (default `[0, 0]`).
+    #[schemars(extend("unit" = "m/s"))]
     pub velocity: Option<[WallComponent; 2]>,
     /// Force along the free components (N per metre of thickness).
+    #[schemars(extend("unit" = "N/m"))]
     pub force: Option<[f64; 2]>,
     /// Mass (kg per metre), needed with a free component.
+    #[schemars(extend("unit" = "kg/m"))]
     pub mass: Option<f64>,
 }
 
 /// `[contact]`: the law between disks, and between disks and walls.
-#[derive(Clone, Debug, Default, Deserialize)]
+#[derive(Clone, Debug, Default, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ContactSection {
     /// Coulomb friction coefficient (default 0).
@@ -46,13 +53,15 @@ pub struct ContactSection {
     /// end of the previous step; `mu` is then the dynamic one.
     pub mu_static: Option<f64>,
     /// Cohesion γ (N per metre of thickness, default 0).
+    #[schemars(extend("unit" = "N/m"))]
     pub cohesion: Option<f64>,
     /// Attraction distance d_w (m, default 0).
+    #[schemars(extend("unit" = "m"))]
     pub d_w: Option<f64>,
 }
 
 /// `[nscd] ordering`.
-#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, schemars::JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum OrderingChoice {
     /// Contacts sorted by candidate then antagonist, every sweep.
@@ -69,7 +78,7 @@ pub enum OrderingChoice {
 }
 
 /// `[nscd]`: time stepping and NLGS.
-#[derive(Clone, Debug, Default, Deserialize)]
+#[derive(Clone, Debug, Default, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct NscdSection {
     /// θ in [0.5, 1] (default 0.5).
@@ -81,12 +90,14 @@ pub struct NscdSection {
     /// Most sweeps per step (default 10 000).
     pub max_sweeps: Option<i64>,
     /// Alert distance of the detection (m, default half the smallest radius).
+    #[schemars(extend("unit" = "m"))]
     pub alert: Option<f64>,
     /// Order of the contacts in a sweep.
     pub ordering: Option<OrderingChoice>,
     /// Seed of the random ordering (default 1).
     pub ordering_seed: Option<u64>,
     /// Gravity (m/s², default `[0, -9.81]`).
+    #[schemars(extend("unit" = "m/s²"))]
     pub gravity: Option<[f64; 2]>,
     /// Gravity settling before the loading: stop when the kinetic energy is below this
     /// fraction of the potential energy released (1e-6 is a typical
@@ -96,6 +107,7 @@ pub struct NscdSection {
     /// Most settling steps (default 20 000); reaching it is an error.
     pub settle_max_steps: Option<i64>,
     /// Settling step (s, default the schedule's `dt`).
+    #[schemars(extend("unit" = "s"))]
     pub settle_dt: Option<f64>,
     /// `[nscd.fault]`: measures of a fault-propagation experiment in `summary.json`.
     pub fault: Option<FaultSection>,
@@ -105,28 +117,35 @@ pub struct NscdSection {
 /// (2006) §5.3), for the measures written to `summary.json` at the end of the run
 /// ([`porofrac_particles::fault`]): the limit angle θ_l, the run-out, and the trishear L2
 /// mismatch of the particle velocities.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct FaultSection {
     /// The fault tip at t = 0 (the moving block's upper corner, m).
+    #[schemars(extend("unit" = "m"))]
     pub tip: [f64; 2],
     /// Dip of the fault (degrees, in (0, 90)); the hanging wall moves up along it.
+    #[schemars(extend("unit" = "degrees"))]
     pub dip: f64,
     /// Slip rate of the hanging wall along the fault (m/s).
+    #[schemars(extend("unit" = "m/s"))]
     pub slip_rate: f64,
     /// The particles measured: current centres in `[[x0, y0], [x1, y1]]` (m).
+    #[schemars(extend("unit" = "m"))]
     pub window: [[f64; 2]; 2],
     /// Particle velocities are averaged over this last part of the run (s, default 1).
+    #[schemars(extend("unit" = "s"))]
     pub velocity_window: Option<f64>,
     /// Half apical angle of the analytic trishear zone (degrees); default: fitted.
+    #[schemars(extend("unit" = "degrees"))]
     pub half_apex: Option<f64>,
     /// Band height of the limit-angle measure (m, default 4 × the largest radius).
+    #[schemars(extend("unit" = "m"))]
     pub band: Option<f64>,
 }
 
 /// The sections of model `nscd` read by the model itself: `[[wall]]`, `[contact]`,
 /// `[nscd]` (`[particles]` is shared with model `lsm`).
-#[derive(Clone, Debug, Default, Deserialize)]
+#[derive(Clone, Debug, Default, Deserialize, schemars::JsonSchema)]
 pub struct NscdSections {
     /// `[[wall]]`: rigid bodies.
     #[serde(default)]

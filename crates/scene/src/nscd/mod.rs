@@ -528,6 +528,9 @@ impl ModelKind for NscdKind {
     ) -> Result<std::sync::Arc<dyn OwnSections>, toml::de::Error> {
         own_sections::<file::NscdSections>(doc)
     }
+    fn own_schema(&self) -> Option<schemars::Schema> {
+        Some(schemars::schema_for!(file::NscdSections))
+    }
     fn check(&self, ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
         let _ = laws;
         check::check(ls)

@@ -6,16 +6,20 @@ use serde::Deserialize;
 use crate::common::sections::NumOrExpr;
 
 /// `[lbm]`.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct LbmSection {
     /// Min and max corner (m).
+    #[schemars(extend("unit" = "m"))]
     pub extent: [Vec<f64>; 2],
     /// Lattice spacing Δx (m).
+    #[schemars(extend("unit" = "m"))]
     pub spacing: f64,
     /// Fluid density (kg/m³).
+    #[schemars(extend("unit" = "kg/m³"))]
     pub density: f64,
     /// Kinematic viscosity (m²/s).
+    #[schemars(extend("unit" = "m²/s"))]
     pub viscosity: f64,
     /// Relaxation time; with spacing and viscosity it fixes Δt.
     pub tau: f64,
@@ -31,8 +35,10 @@ pub struct LbmSection {
     #[serde(default)]
     pub periodic: Vec<AxisChoice>,
     /// Body acceleration on the fluid (m/s²).
+    #[schemars(extend("unit" = "m/s²"))]
     pub body_force: Option<Vec<f64>>,
     /// Initial velocity (m/s), numbers or expressions in x, y (default at rest).
+    #[schemars(extend("unit" = "m/s"))]
     pub initial_velocity: Option<Vec<NumOrExpr>>,
     /// How the force on obstacles is summed from the cut links.
     #[serde(default)]
@@ -43,7 +49,7 @@ pub struct LbmSection {
 }
 
 /// `[lbm] collision`.
-#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, schemars::JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum CollisionChoice {
     /// Single relaxation time.
@@ -54,7 +60,7 @@ pub enum CollisionChoice {
 }
 
 /// `[lbm] precision`.
-#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, schemars::JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum PrecisionChoice {
     /// `f64` populations.
@@ -65,7 +71,7 @@ pub enum PrecisionChoice {
 }
 
 /// An axis.
-#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Deserialize, schemars::JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum AxisChoice {
     /// x.
@@ -75,7 +81,7 @@ pub enum AxisChoice {
 }
 
 /// `[lbm] momentum_exchange`.
-#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, schemars::JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum ExchangeChoice {
     /// `c_α [f̃_α + f_ᾱ]` (Mora et al. (2015) eq. 8).
@@ -86,7 +92,7 @@ pub enum ExchangeChoice {
 }
 
 /// A side of the box.
-#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Deserialize, schemars::JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum SideChoice {
     /// x = min.
@@ -112,7 +118,7 @@ impl SideChoice {
 }
 
 /// `[[lbm.boundary]] kind`.
-#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, schemars::JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum BoundaryKindChoice {
     /// No-slip wall halfway between nodes (moving with `velocity`).
@@ -125,7 +131,7 @@ pub enum BoundaryKindChoice {
 }
 
 /// `[[lbm.boundary]]`.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct LbmBoundary {
     /// Which side.
@@ -134,13 +140,15 @@ pub struct LbmBoundary {
     #[serde(default)]
     pub kind: BoundaryKindChoice,
     /// Wall or inlet velocity (m/s), numbers or expressions in x, y, t.
+    #[schemars(extend("unit" = "m/s"))]
     pub velocity: Option<Vec<NumOrExpr>>,
     /// Outlet gauge pressure (Pa).
+    #[schemars(extend("unit" = "Pa"))]
     pub pressure: Option<f64>,
 }
 
 /// `[[obstacle]]`.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ObstacleSection {
     /// Name (for obstacle probes).
@@ -148,13 +156,15 @@ pub struct ObstacleSection {
     /// Shape and position.
     pub shape: ShapeChoice,
     /// Prescribed velocity of the centre (m/s), numbers or expressions in t.
+    #[schemars(extend("unit" = "m/s"))]
     pub velocity: Option<Vec<NumOrExpr>>,
     /// Prescribed angular velocity (rad/s), number or expression in t.
+    #[schemars(extend("unit" = "rad/s"))]
     pub angular_velocity: Option<NumOrExpr>,
 }
 
 /// `shape = { circle = {...} }` or `{ box = [[x0, y0], [x1, y1]] }`.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema, PartialEq)]
 #[serde(rename_all = "lowercase", deny_unknown_fields)]
 pub enum ShapeChoice {
     /// A disk.
@@ -164,45 +174,54 @@ pub enum ShapeChoice {
 }
 
 /// Centre and radius of a disk.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct CircleShape {
     /// Centre (m).
+    #[schemars(extend("unit" = "m"))]
     pub center: Vec<f64>,
     /// Radius (m).
+    #[schemars(extend("unit" = "m"))]
     pub radius: f64,
 }
 
 /// `[thermal]` (parsed so that its keys are known; not available in this version).
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ThermalSection {
     /// Diffusivity in the fluid (m²/s).
+    #[schemars(extend("unit" = "m²/s"))]
     pub diffusivity: f64,
     /// Diffusivity inside obstacles (m²/s).
+    #[schemars(extend("unit" = "m²/s"))]
     pub solid_diffusivity: Option<f64>,
     /// Initial temperature.
+    #[schemars(extend("unit" = "°C"))]
     pub initial: Option<NumOrExpr>,
     /// `[[thermal.boundary]]`.
     #[serde(default)]
     pub boundary: Vec<ThermalBoundary>,
     /// Initial temperature of the particles (model `lsm`; default `initial` at their
     /// centres).
+    #[schemars(extend("unit" = "°C", "models" = ["lsm"]))]
     pub particle_temperature: Option<f64>,
     /// Heat capacity per volume ρ c_p of fluid and particles, J/(m³·K), for the heat books
     /// (model `lsm`; default 4.18e6).
+    #[schemars(extend("unit" = "J/(m³·K)", "models" = ["lsm"]))]
     pub heat_capacity: Option<f64>,
 }
 
 /// `[[thermal.boundary]]`.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ThermalBoundary {
     /// Which side.
     pub side: SideChoice,
     /// Fixed temperature.
+    #[schemars(extend("unit" = "°C"))]
     pub temperature: Option<f64>,
     /// Fixed flux.
+    #[schemars(extend("unit" = "K·m/s"))]
     pub flux: Option<f64>,
     /// Zero-gradient outflow (advected heat leaves, nothing is reflected).
     #[serde(default)]
