@@ -23,7 +23,7 @@ use porofrac_scene::{Observer, Scene, SetupReport, StepReport, Stop};
     name = "porofrac",
     version,
     about,
-    after_help = "Examples:\n  porofrac run scenes/patch_test.toml\n  porofrac run scenes/patch_test.toml --out /tmp/patch\n  porofrac check scenes/patch_test.toml"
+    after_help = "Examples:\n  porofrac run scenes/patch_test.toml\n  porofrac run scenes/patch_test.toml --out /tmp/patch\n  porofrac run --resume /tmp/patch\n  porofrac check scenes/patch_test.toml"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -34,11 +34,16 @@ struct Cli {
 enum Command {
     /// Run a scene; output goes to out/NAME/ (NAME from the scene) unless --out is given.
     Run {
-        /// The scene file (TOML).
-        scene: PathBuf,
+        /// The scene file (TOML); with --resume it may be left out (the copy in the
+        /// checkpoint is used) or must have the content the checkpoint was written from.
+        #[arg(required_unless_present = "resume")]
+        scene: Option<PathBuf>,
         /// Output directory.
-        #[arg(long)]
+        #[arg(long, conflicts_with = "resume")]
         out: Option<PathBuf>,
+        /// Continue the run whose output directory (with its checkpoint/) is DIR.
+        #[arg(long, value_name = "DIR")]
+        resume: Option<PathBuf>,
     },
     /// Check a scene file without running it.
     Check {
@@ -68,7 +73,7 @@ fn main() -> ExitCode {
                 ExitCode::SUCCESS
             })
             .map_err(|e| e.to_string()),
-        Command::Run { scene, out } => run(&scene, out),
+        Command::Run { scene, out, resume } => run(scene.as_deref(), out, resume),
     };
     result.unwrap_or_else(|msg| {
         eprintln!("error: {msg}");
@@ -76,15 +81,31 @@ fn main() -> ExitCode {
     })
 }
 
-fn run(path: &Path, out: Option<PathBuf>) -> Result<ExitCode, String> {
-    let scene = Scene::load(path).map_err(|e| e.to_string())?;
-    let out = out.unwrap_or_else(|| scene.default_out());
+fn run(
+    path: Option<&Path>,
+    out: Option<PathBuf>,
+    resume: Option<PathBuf>,
+) -> Result<ExitCode, String> {
+    let scene = match (path, &resume) {
+        (Some(p), _) => Scene::load(p).map_err(|e| e.to_string())?,
+        (None, Some(dir)) => Scene::from_checkpoint(dir).map_err(|e| e.to_string())?,
+        (None, None) => return Err("no scene file given".into()),
+    };
+    let out = resume
+        .clone()
+        .or(out)
+        .unwrap_or_else(|| scene.default_out());
     // Ctrl-C: finish the current step, keep what was written, exit with 130.
     let stop = Arc::new(AtomicBool::new(false));
     let flag = Arc::clone(&stop);
     let _ = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed));
     let mut progress = Progress::new(stop);
-    let summary = scene.run(&out, &mut progress).map_err(|e| e.to_string())?;
+    let summary = if resume.is_some() {
+        scene.resume(&out, &mut progress)
+    } else {
+        scene.run(&out, &mut progress)
+    }
+    .map_err(|e| e.to_string())?;
     progress.finish();
     eprintln!(
         "{}: {} cells, {} dofs, {} steps in {:.2} s; output in {}{}",

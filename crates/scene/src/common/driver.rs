@@ -342,7 +342,38 @@ pub(crate) fn drive(
     let mut steps = 0;
     let mut interrupted = None;
     let mut row = Vec::new();
-    for (step, &t) in times.iter().enumerate() {
+    // Checkpoints and resuming (crate::common::checkpoint).
+    let checkpoint_every = s.output.checkpoint_every as usize;
+    if (checkpoint_every > 0 || ls.resume) && !model.checkpoints() {
+        return Err(ls
+            .error(
+                &k(&["output", "checkpoint_every"]),
+                format!(
+                    ": model \"{}\" cannot write or resume from checkpoints",
+                    ls.model()
+                ),
+            )
+            .into());
+    }
+    let mut first = 0;
+    if ls.resume {
+        let r = crate::common::checkpoint::resume(
+            ls,
+            out,
+            model,
+            &mut probes,
+            &mut lines,
+            &mut pvd,
+            series.len(),
+        )?;
+        first = r.step + 1;
+        written = r.written;
+        series = r.series;
+        extrema = r.extrema;
+        total_iterations = r.total_iterations;
+        steps = r.steps;
+    }
+    for (step, &t) in times.iter().enumerate().skip(first) {
         let stats = match model.step(step) {
             Err(RunError::Interrupted) => {
                 // Stopped inside the step: its state is partial, the files end at the
@@ -415,6 +446,27 @@ pub(crate) fn drive(
             total_iterations,
             failed: stats.failed,
         });
+        let periodic = checkpoint_every > 0 && step > 0 && step % checkpoint_every == 0;
+        if (periodic || (stop && model.checkpoints())) && step + 1 < times.len() {
+            let t_out = Instant::now();
+            crate::common::checkpoint::save(
+                ls,
+                out,
+                model,
+                &crate::common::checkpoint::Progress {
+                    step,
+                    written: &written,
+                    series: &series,
+                    extrema: &extrema,
+                    total_iterations,
+                    steps,
+                    probes: &probes,
+                    lines: &lines,
+                    pvd: pvd.as_ref(),
+                },
+            )?;
+            output_seconds += t_out.elapsed().as_secs_f64();
+        }
         if stop {
             interrupted = Some(t);
             break;

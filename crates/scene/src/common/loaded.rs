@@ -57,6 +57,9 @@ pub struct LoadedScene {
     own: Option<Arc<dyn OwnSections>>,
     /// Line of every key path of the file.
     lines: KeyLines,
+    /// Continue the run from the checkpoint of its output folder
+    /// ([`crate::common::checkpoint`]).
+    pub(crate) resume: bool,
 }
 
 impl LoadedScene {
@@ -370,6 +373,7 @@ pub fn parse(
         kind: kind.map(Kind),
         own,
         lines,
+        resume: false,
     })
 }
 

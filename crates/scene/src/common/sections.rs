@@ -613,6 +613,11 @@ pub struct Output {
     /// Write every n-th step.
     #[serde(default = "one")]
     pub every: i64,
+    /// Write a checkpoint (`checkpoint/state.bin`, the state of the run for
+    /// `porofrac run --resume`) every n-th step; 0 (default): none, but a run stopped by
+    /// Ctrl-C between steps still writes one.
+    #[serde(default)]
+    pub checkpoint_every: u64,
     /// `[[output.probe]]`.
     #[serde(default)]
     pub probe: Vec<Probe>,
@@ -630,6 +635,7 @@ impl Default for Output {
             vtk: true,
             plots: true,
             every: 1,
+            checkpoint_every: 0,
             probe: Vec::new(),
             line: Vec::new(),
             exact_displacement: None,

@@ -111,6 +111,8 @@ pub struct LsmModel<'a> {
     broken_written: usize,
     history: Vec<[f64; 3]>,
     contacts_pvd: RefCell<Option<PvdWriter>>,
+    /// Index of the output time of the current state (the time of its VTK files).
+    current: usize,
     fluid: Option<fluid::Fluid>,
     /// Polled between the sub-steps of a step.
     stop: Stop,
@@ -419,6 +421,7 @@ pub fn build<'a>(ls: &'a LoadedScene, setup: &mut SetupPoll<'_>) -> Result<LsmMo
         broken_written: 0,
         history: vec![[0.0; 3]],
         contacts_pvd: RefCell::new(None),
+        current: 0,
         fluid,
         stop: setup.stop_handle(),
     })
@@ -610,8 +613,9 @@ impl Model for LsmModel<'_> {
             self.step_seconds += t0.elapsed().as_secs_f64();
             self.lsm_steps += n as u64;
             self.pressure = f.pressure();
+            self.current = step;
             let (t, sh) = self.broken_by_mode();
-            self.history.push([self.solid.time(), t as f64, sh as f64]);
+            self.history.push([self.times[step], t as f64, sh as f64]);
             return Ok(StepStats {
                 iterations: n,
                 failed: self.solid.broken().len(),
@@ -651,8 +655,9 @@ impl Model for LsmModel<'_> {
         }
         self.step_seconds += t0.elapsed().as_secs_f64();
         self.lsm_steps += n as u64;
+        self.current = step;
         let (t, sh) = self.broken_by_mode();
-        self.history.push([self.solid.time(), t as f64, sh as f64]);
+        self.history.push([self.times[step], t as f64, sh as f64]);
         Ok(StepStats {
             iterations: n,
             failed: self.solid.broken().len(),
@@ -757,7 +762,7 @@ impl Model for LsmModel<'_> {
             self.ls,
             dir,
             index,
-            self.solid.time(),
+            self.times[self.current],
             d,
             &[("broken_bonds", &per)],
             &lines,
