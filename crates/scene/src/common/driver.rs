@@ -385,8 +385,42 @@ pub(crate) fn drive(
         };
         model.after_step(out)?;
         let stop = step + 1 < times.len() && observer.stop_requested();
-        let write =
-            step == 0 || step % s.output.every as usize == 0 || step + 1 == times.len() || stop;
+        let regular = step == 0 || step % s.output.every as usize == 0 || step + 1 == times.len();
+        let write = regular || stop;
+        // A checkpoint after this step: every `checkpoint_every` steps, and when stopped.
+        // It holds the files as a run that goes on has them: a step written only because
+        // the run stops is saved before that write, so a resumed run does not keep it.
+        let checkpoint = step + 1 < times.len()
+            && ((checkpoint_every > 0 && step > 0 && step % checkpoint_every == 0)
+                || (stop && model.checkpoints()));
+        macro_rules! save_checkpoint {
+            ($iterations:expr, $steps:expr) => {
+                let t_out = Instant::now();
+                crate::common::checkpoint::save(
+                    ls,
+                    out,
+                    model,
+                    &crate::common::checkpoint::Progress {
+                        step,
+                        written: &written,
+                        series: &series,
+                        extrema: &extrema,
+                        total_iterations: $iterations,
+                        steps: $steps,
+                        probes: &probes,
+                        lines: &lines,
+                        pvd: pvd.as_ref(),
+                    },
+                )?;
+                output_seconds += t_out.elapsed().as_secs_f64();
+            };
+        }
+        if checkpoint && !regular {
+            save_checkpoint!(
+                total_iterations + stats.iterations,
+                steps + usize::from(step > 0)
+            );
+        }
         if write {
             let t_out = Instant::now();
             row.clear();
@@ -446,26 +480,8 @@ pub(crate) fn drive(
             total_iterations,
             failed: stats.failed,
         });
-        let periodic = checkpoint_every > 0 && step > 0 && step % checkpoint_every == 0;
-        if (periodic || (stop && model.checkpoints())) && step + 1 < times.len() {
-            let t_out = Instant::now();
-            crate::common::checkpoint::save(
-                ls,
-                out,
-                model,
-                &crate::common::checkpoint::Progress {
-                    step,
-                    written: &written,
-                    series: &series,
-                    extrema: &extrema,
-                    total_iterations,
-                    steps,
-                    probes: &probes,
-                    lines: &lines,
-                    pvd: pvd.as_ref(),
-                },
-            )?;
-            output_seconds += t_out.elapsed().as_secs_f64();
+        if checkpoint && regular {
+            save_checkpoint!(total_iterations, steps);
         }
         if stop {
             interrupted = Some(t);
