@@ -300,3 +300,94 @@ fn nscd_series_share_their_times() {
     assert_eq!(parsed(&a)[1], 10.0 * 0.01);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A small Brazilian test of bonded disks (platens, breakage, tracked cell).
+const LSM: &str = r#"
+[scene]
+name = "ckpt_lsm"
+dim = 2
+model = "lsm"
+
+[particles]
+kind = "random"
+disk = { center = [0.0, 0.0], radius = 3.0 }
+radius = [0.2, 0.4]
+packing_fraction = 0.8
+seed = 1
+density = 2600.0
+
+[bonds]
+youngs_modulus = 10.0e9
+poisson_ratio = 0.2
+tensile_strength = 5.0e6
+cohesion = 10.0e6
+friction_angle = 30.0
+tolerance = 0.05
+
+[contacts]
+friction = 0.6
+
+[lsm]
+damping = "local"
+damping_coefficient = 0.7
+
+[loading]
+platens = { velocity = 4.0, thickness = 0.6 }
+
+[schedule]
+end_time = 0.012
+steps = 12
+
+[output]
+every = 2
+plots = false
+
+[[output.probe]]
+name = "platen_force"
+field = "platen_force"
+
+[[output.probe]]
+name = "broken"
+field = "broken"
+
+[[output.probe]]
+name = "p_centre"
+field = "p"
+cell = { center = [0.0, 0.0], radius = 1.5 }
+
+[[output.line]]
+name = "vy_mid"
+field = "vy"
+from = [-2.5, 0.0]
+to = [2.5, 0.0]
+points = 7
+"#;
+
+/// The particle and the contact series of an LSM run hold the very same times, which are
+/// the times of `probes.csv` (the particles advance by many sub-steps per output step).
+#[test]
+fn lsm_series_share_their_times() {
+    let dir = out_dir("lsm_times");
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = LSM
+        .replace("end_time = 0.012", "end_time = 0.3")
+        .replace("steps = 12", "steps = 30")
+        .replace("every = 2", "every = 10");
+    let path = dir.join("t.toml");
+    std::fs::write(&path, text).unwrap();
+    let out = dir.join("out");
+    Scene::load(&path).unwrap().run(&out, &mut Silent).unwrap();
+    let a = pvd_times(&out.join("ckpt_lsm.pvd"));
+    let b = pvd_times(&out.join("ckpt_lsm_contacts.pvd"));
+    assert_eq!(a.len(), 4);
+    assert_eq!(a, b);
+    let probes = std::fs::read_to_string(out.join("probes.csv")).unwrap();
+    let csv: Vec<f64> = probes
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').next().unwrap().parse().unwrap())
+        .collect();
+    let pvd: Vec<f64> = a.iter().map(|t| t.parse().unwrap()).collect();
+    assert_eq!(pvd, csv);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
