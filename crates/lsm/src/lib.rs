@@ -55,6 +55,7 @@ pub use bond::{Bond, BondForce, BreakMode, BrokenBond};
 pub use crack::CrackExtent;
 pub use law::{BondLaw, ContactLaw, Damping, Motion, NormalLaw};
 pub use solid::{LatticeSolid, LsmSpec, StepReport};
+pub use solid::state::SolidState;
 pub use wall::{PressureWall, WallFaces};
 
 /// A bad parameter or a failed step. Every variant names the argument or the particle.
@@ -114,6 +115,9 @@ pub enum LsmError {
     /// The progress callback asked to stop.
     #[error("interrupted")]
     Interrupted,
+    /// A saved state that does not fit the solid ([`LatticeSolid::restore_state`]).
+    #[error("saved state: {0}")]
+    State(String),
 }
 
 impl LsmError {

@@ -391,3 +391,8 @@ fn lsm_series_share_their_times() {
     assert_eq!(pvd, csv);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn lsm_resumes_bit_identical() {
+    check_resume("lsm", LSM, 5, 4);
+}
