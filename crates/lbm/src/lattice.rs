@@ -292,6 +292,60 @@ impl Lattice {
     pub fn rates(&self) -> Rates {
         self.rates
     }
+    /// The state a lattice with fixed obstacles carries from one step to the next, for a
+    /// checkpoint: the populations as stored, whether they are in the swapped layout of
+    /// the AA pattern, the step count, the mass injected by sources and the last step's
+    /// obstacle forces and exchanges.
+    pub fn raw_state(&self) -> (Vec<f64>, bool, u64, f64, Vec<[f64; 3]>, Vec<[f64; 3]>) {
+        (
+            self.pop.clone(),
+            self.layout == Layout::Swapped,
+            self.steps,
+            self.injected,
+            self.forces.clone(),
+            self.exchange.clone(),
+        )
+    }
+
+    /// Put back what [`Lattice::raw_state`] gave, into a lattice built the same way (same
+    /// size, sides and obstacles, which must not have moved); `Err` says which array does
+    /// not fit.
+    pub fn restore_raw_state(
+        &mut self,
+        pop: Vec<f64>,
+        swapped: bool,
+        steps: u64,
+        injected: f64,
+        forces: Vec<[f64; 3]>,
+        exchange: Vec<[f64; 3]>,
+    ) -> Result<(), String> {
+        if pop.len() != self.pop.len() {
+            return Err(format!(
+                "{} populations, the lattice has {}",
+                pop.len(),
+                self.pop.len()
+            ));
+        }
+        if forces.len() != self.forces.len() || exchange.len() != self.exchange.len() {
+            return Err(format!(
+                "{} obstacle forces, the lattice has {} obstacles",
+                forces.len(),
+                self.forces.len()
+            ));
+        }
+        self.pop = pop;
+        self.layout = if swapped {
+            Layout::Swapped
+        } else {
+            Layout::Natural
+        };
+        self.steps = steps;
+        self.injected = injected;
+        self.forces = forces;
+        self.exchange = exchange;
+        Ok(())
+    }
+
     /// Bytes of population storage.
     pub fn population_bytes(&self) -> usize {
         self.pop.len() * std::mem::size_of::<f64>()

@@ -129,6 +129,48 @@ impl Thermal {
         self.side_heat
     }
 
+    /// The state carried from one step to the next, for a checkpoint: the distributions,
+    /// the post-collision ones of the last step, the heat through the sides since the
+    /// start and the last step's heat out of each obstacle.
+    pub fn raw_state(&self) -> (Vec<[f64; 5]>, Vec<[f64; 5]>, [f64; 4], Vec<f64>) {
+        (
+            self.g.clone(),
+            self.post.clone(),
+            self.side_heat,
+            self.obstacle_heat.clone(),
+        )
+    }
+
+    /// Put back what [`Thermal::raw_state`] gave, into a field built the same way; `Err`
+    /// says which array does not fit.
+    pub fn restore_raw_state(
+        &mut self,
+        g: Vec<[f64; 5]>,
+        post: Vec<[f64; 5]>,
+        side_heat: [f64; 4],
+        obstacle_heat: Vec<f64>,
+    ) -> Result<(), String> {
+        if g.len() != self.g.len() || post.len() != self.post.len() {
+            return Err(format!(
+                "{} temperature nodes, the lattice has {}",
+                g.len(),
+                self.g.len()
+            ));
+        }
+        if obstacle_heat.len() != self.obstacle_heat.len() {
+            return Err(format!(
+                "{} obstacle heats, the lattice has {} obstacles",
+                obstacle_heat.len(),
+                self.obstacle_heat.len()
+            ));
+        }
+        self.g = g;
+        self.post = post;
+        self.side_heat = side_heat;
+        self.obstacle_heat = obstacle_heat;
+        Ok(())
+    }
+
     /// Heat that left obstacle `k`'s nodes in the last step (lattice units).
     pub fn obstacle_heat(&self, k: usize) -> f64 {
         self.obstacle_heat.get(k).copied().unwrap_or(0.0)
