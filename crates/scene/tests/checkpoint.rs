@@ -477,3 +477,72 @@ points = 9
 fn lbm_resumes_bit_identical() {
     check_resume("lbm", LBM, 5, 4);
 }
+
+/// A small Lamb problem (explicit Cosserat dynamics under a Ricker body force).
+const COSSERAT_EXPLICIT: &str = r#"
+[scene]
+name = "ckpt_cosserat"
+dim = 2
+model = "cosserat"
+
+[grid]
+kind = "triangles"
+diagonals = "crossed"
+extent = [[-100.0, 0.0], [100.0, 100.0]]
+cells = [10, 5]
+
+[[region]]
+name = "ground"
+select = { all = true }
+law = "cosserat-dem"
+material = "rock"
+
+[material.rock]
+youngs_modulus = 18.8e9
+poisson_ratio = 0.25
+cosserat_shear_modulus = 7.52e9
+characteristic_length = 5.0
+density = 2200.0
+micro_inertia = 4.1666667
+
+[loads]
+body_force = [0.0, "-1.0e6 * exp(-(x^2 + (y - 90)^2) / 625) * (1 - 2 * (pi * 145 * (t - 0.01))^2) * exp(-(pi * 145 * (t - 0.01))^2)"]
+
+[schedule]
+end_time = 0.012
+steps = 12
+
+[solver]
+time_integration = "explicit"
+
+[output]
+every = 2
+plots = false
+
+[[output.probe]]
+name = "receiver_uy"
+field = "uy"
+at = [-30.0, 99.0]
+
+[[output.probe]]
+name = "work"
+field = "work"
+at = [0.0, 50.0]
+
+[[output.line]]
+name = "uy_top"
+field = "uy"
+from = [-90.0, 99.0]
+to = [90.0, 99.0]
+points = 7
+"#;
+
+#[test]
+fn cosserat_resumes_bit_identical() {
+    check_resume("cosserat_explicit", COSSERAT_EXPLICIT, 5, 4);
+    let newmark = COSSERAT_EXPLICIT.replace(
+        "time_integration = \"explicit\"",
+        "time_integration = \"newmark\"\nlinear = \"gmres-amg\"",
+    );
+    check_resume("cosserat_newmark", &newmark, 5, 4);
+}
