@@ -54,8 +54,8 @@ pub mod wall;
 pub use bond::{Bond, BondForce, BreakMode, BrokenBond};
 pub use crack::CrackExtent;
 pub use law::{BondLaw, ContactLaw, Damping, Motion, NormalLaw};
-pub use solid::{LatticeSolid, LsmSpec, StepReport};
 pub use solid::state::SolidState;
+pub use solid::{LatticeSolid, LsmSpec, StepReport};
 pub use wall::{PressureWall, WallFaces};
 
 /// A bad parameter or a failed step. Every variant names the argument or the particle.

@@ -298,7 +298,11 @@ fn nscd_series_share_their_times() {
         .skip(1)
         .map(|l| l.split(',').next().unwrap().to_string())
         .collect();
-    let parsed = |v: &[String]| v.iter().map(|t| t.parse::<f64>().unwrap()).collect::<Vec<_>>();
+    let parsed = |v: &[String]| {
+        v.iter()
+            .map(|t| t.parse::<f64>().unwrap())
+            .collect::<Vec<_>>()
+    };
     assert_eq!(parsed(&a), parsed(&csv));
     assert_eq!(parsed(&a)[1], 10.0 * 0.01);
     std::fs::remove_dir_all(&dir).unwrap();

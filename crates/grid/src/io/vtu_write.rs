@@ -419,10 +419,7 @@ fn standard_3d<const D: usize>(
         // The outward loop of the first face, reversed, points inside: towards the node
         // that is not on it.
         let f = faces[0];
-        let apex = nodes
-            .iter()
-            .map(|&n| n as i64)
-            .find(|n| !f.contains(n))?;
+        let apex = nodes.iter().map(|&n| n as i64).find(|n| !f.contains(n))?;
         let order = vec![f[0], f[2], f[1], apex];
         let [a, b, cc, d] = [0, 1, 2, 3].map(|i| x(order[i]));
         let u = sub(b, a);

@@ -8,11 +8,11 @@
 //! What the scene fixes (radii, masses, bond stiffnesses and strengths) is not saved:
 //! the solid is rebuilt from the scene first.
 
+use super::LatticeSolid;
+use crate::LsmError;
 use crate::bond::{BreakMode, BrokenBond};
 use crate::contact::Pair;
 use crate::law::Motion;
-use super::LatticeSolid;
-use crate::LsmError;
 
 /// Named arrays of a solid's state (see the module docs).
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -199,7 +199,9 @@ impl LatticeSolid {
         for (k, &u) in ut.iter().enumerate() {
             let (i, j, b) = (ids[3 * k], ids[3 * k + 1], ids[3 * k + 2]);
             if i >= n as u64 || j >= n as u64 || (b >= nb as u64 && b != u64::from(u32::MAX)) {
-                return Err(LsmError::State(format!("pair {k} names a missing disk or bond")));
+                return Err(LsmError::State(format!(
+                    "pair {k} names a missing disk or bond"
+                )));
             }
             pairs.push(Pair {
                 i: i as u32,

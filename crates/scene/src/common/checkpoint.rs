@@ -366,7 +366,12 @@ pub fn read_header(out: &Path) -> Result<(String, u64), RunError> {
 
 /// Refuse the checkpoint of `out` for scene `ls` when it was written by another model or
 /// from another scene file content.
-pub(crate) fn check_matches(ls: &LoadedScene, out: &Path, model: &str, hash: u64) -> Result<(), RunError> {
+pub(crate) fn check_matches(
+    ls: &LoadedScene,
+    out: &Path,
+    model: &str,
+    hash: u64,
+) -> Result<(), RunError> {
     let p = path(out);
     if model != ls.model() {
         return Err(RunError::Checkpoint(format!(
@@ -463,7 +468,10 @@ pub fn save_pvd(state: &mut State, name: &str, pvd: &PvdWriter) {
     );
     state.put_str(
         &format!("{name}/files"),
-        &e.iter().map(|(_, f)| f.as_str()).collect::<Vec<_>>().join("\n"),
+        &e.iter()
+            .map(|(_, f)| f.as_str())
+            .collect::<Vec<_>>()
+            .join("\n"),
     );
 }
 
@@ -480,7 +488,11 @@ pub fn restore_pvd(state: &State, name: &str, path: &Path) -> Result<Option<PvdW
         files.split('\n').collect()
     };
     if files.len() != times.len() {
-        return Err(bad(format!("`{name}`: {} times, {} files", times.len(), files.len())));
+        return Err(bad(format!(
+            "`{name}`: {} times, {} files",
+            times.len(),
+            files.len()
+        )));
     }
     let entries = times
         .iter()
@@ -537,7 +549,11 @@ pub(crate) fn resume(
         let written = st.f64s("driver/written")?.to_vec();
         let flat = st.f64s_len("driver/series", written.len() * probe_count)?;
         let series = (0..probe_count)
-            .map(|j| (0..written.len()).map(|i| flat[j * written.len() + i]).collect())
+            .map(|j| {
+                (0..written.len())
+                    .map(|i| flat[j * written.len() + i])
+                    .collect()
+            })
             .collect();
         let names = st.str("driver/extrema_names")?;
         let names: Vec<&str> = if names.is_empty() {
@@ -677,9 +693,17 @@ mod tests {
         h[at..at + 8].copy_from_slice(&(1u64 << 60).to_le_bytes());
         assert!(e(&h).contains("array `n` runs past the end"), "{}", e(&h));
         let s = sample().state;
-        assert!(s.f64s("y").unwrap_err().to_string().contains("no array `y`"));
+        assert!(
+            s.f64s("y")
+                .unwrap_err()
+                .to_string()
+                .contains("no array `y`")
+        );
         let w = s.f64s_len("x", 5).unwrap_err().to_string();
-        assert!(w.contains("array `x` has 4 values") && w.contains("needs 5"), "{w}");
+        assert!(
+            w.contains("array `x` has 4 values") && w.contains("needs 5"),
+            "{w}"
+        );
         assert!(s.u64s("x").unwrap_err().to_string().contains("f64 values"));
     }
 }

@@ -631,7 +631,11 @@ impl<const D: usize> Model for Run<'_, D> {
         if let Some(l) = linear {
             state.put_u64(
                 "linear/counts",
-                vec![l.solves as u64, l.iterations as u64, l.max_iterations as u64],
+                vec![
+                    l.solves as u64,
+                    l.iterations as u64,
+                    l.max_iterations as u64,
+                ],
             );
             state.put_f64("linear/max_residual", vec![l.max_residual]);
         }

@@ -563,9 +563,17 @@ impl Model for LbmModel<'_> {
         state.put_u64("lattice/steps", vec![steps, u64::from(swapped)]);
         state.put_f64(
             "lattice/values",
-            vec![injected, self.stepping_seconds, self.fluid_updates, self.max_mach],
+            vec![
+                injected,
+                self.stepping_seconds,
+                self.fluid_updates,
+                self.max_mach,
+            ],
         );
-        state.put_f64("lattice/forces", forces.into_iter().flatten().collect::<Vec<_>>());
+        state.put_f64(
+            "lattice/forces",
+            forces.into_iter().flatten().collect::<Vec<_>>(),
+        );
         state.put_f64(
             "lattice/exchange",
             exchange.into_iter().flatten().collect::<Vec<_>>(),
@@ -573,7 +581,10 @@ impl Model for LbmModel<'_> {
         if let Some(th) = &self.thermal {
             let (g, post, sides, obstacles) = th.raw_state();
             state.put_f64("thermal/g", g.into_iter().flatten().collect::<Vec<_>>());
-            state.put_f64("thermal/post", post.into_iter().flatten().collect::<Vec<_>>());
+            state.put_f64(
+                "thermal/post",
+                post.into_iter().flatten().collect::<Vec<_>>(),
+            );
             state.put_f64("thermal/side_heat", sides.to_vec());
             state.put_f64("thermal/obstacle_heat", obstacles);
         }

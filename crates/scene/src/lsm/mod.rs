@@ -554,10 +554,17 @@ impl Model for LsmModel<'_> {
             state.put_u64(&format!("solid/{name}"), v);
         }
         state.put_f64("pressure", vec![self.pressure, self.step_seconds]);
-        state.put_f64("flood", self.flood.iter().flatten().copied().collect::<Vec<_>>());
+        state.put_f64(
+            "flood",
+            self.flood.iter().flatten().copied().collect::<Vec<_>>(),
+        );
         state.put_u64(
             "counts",
-            vec![self.lsm_steps, self.current as u64, self.broken_written as u64],
+            vec![
+                self.lsm_steps,
+                self.current as u64,
+                self.broken_written as u64,
+            ],
         );
         state.put_f64(
             "history",

@@ -39,10 +39,10 @@ use porofrac_particles::{ParticleError, TrackedCell};
 
 use crate::common::checkpoint::{self, State};
 use crate::common::driver::{Observer, SetupPoll, drive};
-use porofrac_nscd::detect::Antagonist;
 use crate::common::loaded::{LoadedScene, k, ki, step_count};
 use crate::common::model::{Model, RunError, Sizes, StepStats};
 use crate::common::output::{SolverStats, Summary, WallSeconds};
+use porofrac_nscd::detect::Antagonist;
 
 use file::{OrderingChoice, WallComponent};
 
@@ -391,7 +391,12 @@ impl Model for NscdModel<'_> {
         );
         state.put_f64(
             "stats/values",
-            vec![r.final_residual, r.max_residual, r.solve_seconds, self.step_seconds],
+            vec![
+                r.final_residual,
+                r.max_residual,
+                r.solve_seconds,
+                self.step_seconds,
+            ],
         );
         if let Some(pvd) = self.contacts_pvd.borrow().as_ref() {
             checkpoint::save_pvd(state, "contacts_pvd", pvd);
@@ -407,7 +412,12 @@ impl Model for NscdModel<'_> {
         let nb = self.sys.bodies.len();
         let offset = state.pairs("bodies/offset", nb)?;
         let velocity = state.pairs("bodies/velocity", nb)?;
-        for (b, (o, v)) in self.sys.bodies.iter_mut().zip(offset.into_iter().zip(velocity)) {
+        for (b, (o, v)) in self
+            .sys
+            .bodies
+            .iter_mut()
+            .zip(offset.into_iter().zip(velocity))
+        {
             b.offset = o;
             b.velocity = v;
         }
