@@ -72,6 +72,19 @@ pub struct Thermal {
     obstacle_heat: Vec<f64>,
 }
 
+/// What a temperature field carries from one step to the next ([`Thermal::raw_state`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ThermalState {
+    /// The distributions.
+    pub g: Vec<[f64; 5]>,
+    /// The post-collision distributions of the last step.
+    pub post: Vec<[f64; 5]>,
+    /// Heat through each side since the start.
+    pub side_heat: [f64; 4],
+    /// The last step's heat out of each obstacle.
+    pub obstacle_heat: Vec<f64>,
+}
+
 impl Thermal {
     /// A temperature lattice matching `lat`, with relaxation times `tau` (fluid) and
     /// `tau_solid` (obstacles), at temperature `t0(position)` (lattice coordinates).
@@ -129,45 +142,37 @@ impl Thermal {
         self.side_heat
     }
 
-    /// The state carried from one step to the next, for a checkpoint: the distributions,
-    /// the post-collision ones of the last step, the heat through the sides since the
-    /// start and the last step's heat out of each obstacle.
-    pub fn raw_state(&self) -> (Vec<[f64; 5]>, Vec<[f64; 5]>, [f64; 4], Vec<f64>) {
-        (
-            self.g.clone(),
-            self.post.clone(),
-            self.side_heat,
-            self.obstacle_heat.clone(),
-        )
+    /// The state carried from one step to the next ([`ThermalState`]), for a checkpoint.
+    pub fn raw_state(&self) -> ThermalState {
+        ThermalState {
+            g: self.g.clone(),
+            post: self.post.clone(),
+            side_heat: self.side_heat,
+            obstacle_heat: self.obstacle_heat.clone(),
+        }
     }
 
     /// Put back what [`Thermal::raw_state`] gave, into a field built the same way; `Err`
     /// says which array does not fit.
-    pub fn restore_raw_state(
-        &mut self,
-        g: Vec<[f64; 5]>,
-        post: Vec<[f64; 5]>,
-        side_heat: [f64; 4],
-        obstacle_heat: Vec<f64>,
-    ) -> Result<(), String> {
-        if g.len() != self.g.len() || post.len() != self.post.len() {
+    pub fn restore_raw_state(&mut self, s: ThermalState) -> Result<(), String> {
+        if s.g.len() != self.g.len() || s.post.len() != self.post.len() {
             return Err(format!(
                 "{} temperature nodes, the lattice has {}",
-                g.len(),
+                s.g.len(),
                 self.g.len()
             ));
         }
-        if obstacle_heat.len() != self.obstacle_heat.len() {
+        if s.obstacle_heat.len() != self.obstacle_heat.len() {
             return Err(format!(
                 "{} obstacle heats, the lattice has {} obstacles",
-                obstacle_heat.len(),
+                s.obstacle_heat.len(),
                 self.obstacle_heat.len()
             ));
         }
-        self.g = g;
-        self.post = post;
-        self.side_heat = side_heat;
-        self.obstacle_heat = obstacle_heat;
+        self.g = s.g;
+        self.post = s.post;
+        self.side_heat = s.side_heat;
+        self.obstacle_heat = s.obstacle_heat;
         Ok(())
     }
 

@@ -558,35 +558,26 @@ impl Model for LbmModel<'_> {
     }
 
     fn save_state(&self, state: &mut State) -> Result<(), RunError> {
-        let (pop, swapped, steps, injected, forces, exchange) = self.lat.raw_state();
-        state.put_f64("lattice/populations", pop);
-        state.put_u64("lattice/steps", vec![steps, u64::from(swapped)]);
+        let l = self.lat.raw_state();
+        state.put_f64("lattice/populations", l.populations);
+        state.put_u64("lattice/steps", vec![l.steps, u64::from(l.swapped)]);
         state.put_f64(
             "lattice/values",
             vec![
-                injected,
+                l.injected,
                 self.stepping_seconds,
                 self.fluid_updates,
                 self.max_mach,
             ],
         );
-        state.put_f64(
-            "lattice/forces",
-            forces.into_iter().flatten().collect::<Vec<_>>(),
-        );
-        state.put_f64(
-            "lattice/exchange",
-            exchange.into_iter().flatten().collect::<Vec<_>>(),
-        );
+        state.put_f64("lattice/forces", l.forces.concat());
+        state.put_f64("lattice/exchange", l.exchange.concat());
         if let Some(th) = &self.thermal {
-            let (g, post, sides, obstacles) = th.raw_state();
-            state.put_f64("thermal/g", g.into_iter().flatten().collect::<Vec<_>>());
-            state.put_f64(
-                "thermal/post",
-                post.into_iter().flatten().collect::<Vec<_>>(),
-            );
-            state.put_f64("thermal/side_heat", sides.to_vec());
-            state.put_f64("thermal/obstacle_heat", obstacles);
+            let t = th.raw_state();
+            state.put_f64("thermal/g", t.g.concat());
+            state.put_f64("thermal/post", t.post.concat());
+            state.put_f64("thermal/side_heat", t.side_heat.to_vec());
+            state.put_f64("thermal/obstacle_heat", t.obstacle_heat);
         }
         Ok(())
     }
@@ -602,25 +593,25 @@ impl Model for LbmModel<'_> {
         let values = state.f64s_len("lattice/values", 4)?;
         let no = self.lat.obstacles().len();
         self.lat
-            .restore_raw_state(
-                state.f64s("lattice/populations")?.to_vec(),
-                steps[1] != 0,
-                steps[0],
-                values[0],
-                rows(state.f64s_len("lattice/forces", 3 * no)?),
-                rows(state.f64s_len("lattice/exchange", 3 * no)?),
-            )
+            .restore_raw_state(porofrac_lbm::LatticeState {
+                populations: state.f64s("lattice/populations")?.to_vec(),
+                swapped: steps[1] != 0,
+                steps: steps[0],
+                injected: values[0],
+                forces: rows(state.f64s_len("lattice/forces", 3 * no)?),
+                exchange: rows(state.f64s_len("lattice/exchange", 3 * no)?),
+            })
             .map_err(bad)?;
         (self.stepping_seconds, self.fluid_updates, self.max_mach) =
             (values[1], values[2], values[3]);
         if let Some(th) = &mut self.thermal {
             let side = state.f64s_len("thermal/side_heat", 4)?;
-            th.restore_raw_state(
-                rows(state.f64s("thermal/g")?),
-                rows(state.f64s("thermal/post")?),
-                [side[0], side[1], side[2], side[3]],
-                state.f64s("thermal/obstacle_heat")?.to_vec(),
-            )
+            th.restore_raw_state(porofrac_lbm::ThermalState {
+                g: rows(state.f64s("thermal/g")?),
+                post: rows(state.f64s("thermal/post")?),
+                side_heat: [side[0], side[1], side[2], side[3]],
+                obstacle_heat: state.f64s("thermal/obstacle_heat")?.to_vec(),
+            })
             .map_err(bad)?;
         }
         Ok(())
