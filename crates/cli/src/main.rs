@@ -25,7 +25,7 @@ use porofrac_scene::{LawRegistry, MODELS, Observer, Scene, SetupReport, StepRepo
     name = "porofrac",
     version,
     about,
-    after_help = "Examples:\n  porofrac run scenes/patch_test.toml\n  porofrac run scenes/patch_test.toml --out /tmp/patch\n  porofrac run scenes/patch_test.toml --set material.rock.youngs_modulus=2e10\n  porofrac check scenes/patch_test.toml\n  porofrac keys continuum grid"
+    after_help = "Examples:\n  porofrac run scenes/patch_test.toml\n  porofrac run scenes/patch_test.toml --out /tmp/patch\n  porofrac run scenes/patch_test.toml --set material.rock.youngs_modulus=2e10\n  porofrac run --resume /tmp/patch\n  porofrac check scenes/patch_test.toml\n  porofrac keys continuum grid"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -36,15 +36,20 @@ struct Cli {
 enum Command {
     /// Run a scene; output goes to out/NAME/ (NAME from the scene) unless --out is given.
     Run {
-        /// The scene file (TOML).
-        scene: PathBuf,
+        /// The scene file (TOML); with --resume it may be left out (the copy in the
+        /// checkpoint is used) or must have the content the checkpoint was written from.
+        #[arg(required_unless_present = "resume")]
+        scene: Option<PathBuf>,
         /// Output directory.
-        #[arg(long)]
+        #[arg(long, conflicts_with = "resume")]
         out: Option<PathBuf>,
         /// Set a key of the scene (repeatable): a dotted key, 1-based numbers for arrays
         /// of tables (`bc.2.value=1e6`), a TOML value or a bare word.
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
+        /// Continue the run whose output directory (with its checkpoint/) is DIR.
+        #[arg(long, value_name = "DIR")]
+        resume: Option<PathBuf>,
     },
     /// Check a scene without running it: everything a run does before its first step
     /// (files read, grid built, conditions, probes, packings), nothing written; prints
@@ -93,7 +98,12 @@ fn main() -> ExitCode {
             ..
         } => return keys(model.as_deref(), section.as_deref(), markdown),
         Command::Check { scene, set } => check(&scene, &set),
-        Command::Run { scene, out, set } => run(&scene, out, &set),
+        Command::Run {
+            scene,
+            out,
+            set,
+            resume,
+        } => run(scene.as_deref(), out, resume, &set),
     };
     result.unwrap_or_else(|msg| {
         eprintln!("error: {msg}");
@@ -187,17 +197,41 @@ fn keys(model: Option<&str>, section: Option<&str>, markdown: bool) -> ExitCode 
     ExitCode::SUCCESS
 }
 
-fn run(path: &Path, out: Option<PathBuf>, set: &[String]) -> Result<ExitCode, String> {
+fn run(
+    path: Option<&Path>,
+    out: Option<PathBuf>,
+    resume: Option<PathBuf>,
+    set: &[String],
+) -> Result<ExitCode, String> {
     let set = overrides(set)?;
-    let scene = Scene::load_with_overrides(path, LawRegistry::default(), &set)
-        .map_err(|e| e.to_string())?;
-    let out = out.unwrap_or_else(|| scene.default_out());
+    let scene = match (path, &resume) {
+        (Some(p), _) => Scene::load_with_overrides(p, LawRegistry::default(), &set)
+            .map_err(|e| e.to_string())?,
+        (None, Some(_)) if !set.is_empty() => {
+            return Err(
+                "--set with --resume: a resumed run keeps the overrides its checkpoint holds \
+                 (name the scene file to give them again)"
+                    .into(),
+            );
+        }
+        (None, Some(dir)) => Scene::from_checkpoint(dir).map_err(|e| e.to_string())?,
+        (None, None) => return Err("no scene file given".into()),
+    };
+    let out = resume
+        .clone()
+        .or(out)
+        .unwrap_or_else(|| scene.default_out());
     // Ctrl-C: finish the current step, keep what was written, exit with 130.
     let stop = Arc::new(AtomicBool::new(false));
     let flag = Arc::clone(&stop);
     let _ = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed));
     let mut progress = Progress::new(stop);
-    let summary = scene.run(&out, &mut progress).map_err(|e| e.to_string())?;
+    let summary = if resume.is_some() {
+        scene.resume(&out, &mut progress)
+    } else {
+        scene.run(&out, &mut progress)
+    }
+    .map_err(|e| e.to_string())?;
     progress.finish();
     eprintln!(
         "{}: {} cells, {} dofs, {} steps in {:.2} s; output in {}{}",

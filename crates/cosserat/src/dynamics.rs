@@ -71,6 +71,23 @@ pub fn lumped_mass<const D: usize>(model: &Cosserat<D>) -> Vec<f64> {
 }
 
 impl Dynamics {
+    /// The load vector of the last step's end, which the next step's external work
+    /// uses (with `t`, `u`, `v`, `a` and `external_work`, the whole state a step carries
+    /// to the next: a checkpoint saves them).
+    pub fn previous_load(&self) -> &[f64] {
+        &self.f_prev
+    }
+
+    /// Put back the load vector [`Dynamics::previous_load`] gave (`Err` with the two
+    /// lengths when it does not fit).
+    pub fn set_previous_load(&mut self, f: Vec<f64>) -> std::result::Result<(), (usize, usize)> {
+        if f.len() != self.f_prev.len() {
+            return Err((f.len(), self.f_prev.len()));
+        }
+        self.f_prev = f;
+        Ok(())
+    }
+
     /// Start at `t0` from `u0`, `v0` (the initial acceleration solves `M A = F − K U`).
     ///
     /// Errors: `dt ≤ 0`, a zero micro-inertia (the rotation mass vanishes), wrong lengths,
@@ -174,6 +191,11 @@ impl Dynamics {
         if let Some(l) = self.solver.as_mut() {
             l.set_interrupt(flag);
         }
+    }
+
+    /// The Newmark solver, to put back its statistics ([`Linear::restore_counts`]).
+    pub fn solver_mut(&mut self) -> Option<&mut Linear> {
+        self.solver.as_mut()
     }
 
     /// Statistics of the Newmark solves (default for the explicit integrator).

@@ -1118,6 +1118,16 @@ impl Linear {
         self.stats
     }
 
+    /// Put back the solve counts of [`Linear::stats`] (`solves`, `iterations`,
+    /// `max_iterations`, `max_residual`) of a run that is continued; the factor's own
+    /// figures stay this solver's.
+    pub fn restore_counts(&mut self, s: &LinearStats) {
+        self.stats.solves = s.solves;
+        self.stats.iterations = s.iterations;
+        self.stats.max_iterations = s.max_iterations;
+        self.stats.max_residual = s.max_residual;
+    }
+
     /// Solve with `rhs` replaced by the solution. GMRES starts from `guess` when given
     /// (the previous step's solution in dynamics), else from zero.
     ///

@@ -218,6 +218,24 @@ pub struct Lattice {
     steps: u64,
 }
 
+/// What a lattice with fixed obstacles carries from one step to the next
+/// ([`Lattice::raw_state`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LatticeState {
+    /// The populations as stored.
+    pub populations: Vec<f64>,
+    /// Whether they are in the swapped layout of the AA pattern (after an even step).
+    pub swapped: bool,
+    /// Steps done.
+    pub steps: u64,
+    /// Mass injected by the sources so far.
+    pub injected: f64,
+    /// The last step's force and torque on each obstacle.
+    pub forces: Vec<[f64; 3]>,
+    /// The last step's momentum exchange of each obstacle.
+    pub exchange: Vec<[f64; 3]>,
+}
+
 impl Lattice {
     /// A lattice at rest with density 1.
     pub fn new(cfg: LatticeConfig) -> Result<Self, LbmError> {
@@ -292,6 +310,50 @@ impl Lattice {
     pub fn rates(&self) -> Rates {
         self.rates
     }
+    /// The state a lattice with fixed obstacles carries from one step to the next
+    /// ([`LatticeState`]), for a checkpoint.
+    pub fn raw_state(&self) -> LatticeState {
+        LatticeState {
+            populations: self.pop.clone(),
+            swapped: self.layout == Layout::Swapped,
+            steps: self.steps,
+            injected: self.injected,
+            forces: self.forces.clone(),
+            exchange: self.exchange.clone(),
+        }
+    }
+
+    /// Put back what [`Lattice::raw_state`] gave, into a lattice built the same way (same
+    /// size, sides and obstacles, which must not have moved); `Err` says which array does
+    /// not fit.
+    pub fn restore_raw_state(&mut self, s: LatticeState) -> Result<(), String> {
+        if s.populations.len() != self.pop.len() {
+            return Err(format!(
+                "{} populations, the lattice has {}",
+                s.populations.len(),
+                self.pop.len()
+            ));
+        }
+        if s.forces.len() != self.forces.len() || s.exchange.len() != self.exchange.len() {
+            return Err(format!(
+                "{} obstacle forces, the lattice has {} obstacles",
+                s.forces.len(),
+                self.forces.len()
+            ));
+        }
+        self.pop = s.populations;
+        self.layout = if s.swapped {
+            Layout::Swapped
+        } else {
+            Layout::Natural
+        };
+        self.steps = s.steps;
+        self.injected = s.injected;
+        self.forces = s.forces;
+        self.exchange = s.exchange;
+        Ok(())
+    }
+
     /// Bytes of population storage.
     pub fn population_bytes(&self) -> usize {
         self.pop.len() * std::mem::size_of::<f64>()

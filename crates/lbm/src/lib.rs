@@ -40,8 +40,10 @@ pub mod units;
 pub use boundary::{MomentumExchange, Side, SideKind};
 pub use collision::{Collision, Rates};
 pub use geometry::Shape;
-pub use lattice::{Lattice, LatticeConfig, MAX_MACH, Obstacle, ObstacleMass, ObstacleMotion};
-pub use thermal::{Thermal, ThermalSide};
+pub use lattice::{
+    Lattice, LatticeConfig, LatticeState, MAX_MACH, Obstacle, ObstacleMass, ObstacleMotion,
+};
+pub use thermal::{Thermal, ThermalSide, ThermalState};
 pub use units::Units;
 
 /// Smallest relaxation time accepted: `τ` must exceed `½ + 0.005` (at `τ → ½` the viscosity

@@ -72,6 +72,19 @@ pub struct Thermal {
     obstacle_heat: Vec<f64>,
 }
 
+/// What a temperature field carries from one step to the next ([`Thermal::raw_state`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ThermalState {
+    /// The distributions.
+    pub g: Vec<[f64; 5]>,
+    /// The post-collision distributions of the last step.
+    pub post: Vec<[f64; 5]>,
+    /// Heat through each side since the start.
+    pub side_heat: [f64; 4],
+    /// The last step's heat out of each obstacle.
+    pub obstacle_heat: Vec<f64>,
+}
+
 impl Thermal {
     /// A temperature lattice matching `lat`, with relaxation times `tau` (fluid) and
     /// `tau_solid` (obstacles), at temperature `t0(position)` (lattice coordinates).
@@ -127,6 +140,40 @@ impl Thermal {
     /// (lattice units: temperature × nodes).
     pub fn side_heat(&self) -> [f64; 4] {
         self.side_heat
+    }
+
+    /// The state carried from one step to the next ([`ThermalState`]), for a checkpoint.
+    pub fn raw_state(&self) -> ThermalState {
+        ThermalState {
+            g: self.g.clone(),
+            post: self.post.clone(),
+            side_heat: self.side_heat,
+            obstacle_heat: self.obstacle_heat.clone(),
+        }
+    }
+
+    /// Put back what [`Thermal::raw_state`] gave, into a field built the same way; `Err`
+    /// says which array does not fit.
+    pub fn restore_raw_state(&mut self, s: ThermalState) -> Result<(), String> {
+        if s.g.len() != self.g.len() || s.post.len() != self.post.len() {
+            return Err(format!(
+                "{} temperature nodes, the lattice has {}",
+                s.g.len(),
+                self.g.len()
+            ));
+        }
+        if s.obstacle_heat.len() != self.obstacle_heat.len() {
+            return Err(format!(
+                "{} obstacle heats, the lattice has {} obstacles",
+                s.obstacle_heat.len(),
+                self.obstacle_heat.len()
+            ));
+        }
+        self.g = s.g;
+        self.post = s.post;
+        self.side_heat = s.side_heat;
+        self.obstacle_heat = s.obstacle_heat;
+        Ok(())
     }
 
     /// Heat that left obstacle `k`'s nodes in the last step (lattice units).

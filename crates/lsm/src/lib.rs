@@ -54,6 +54,7 @@ pub mod wall;
 pub use bond::{Bond, BondForce, BreakMode, BrokenBond};
 pub use crack::CrackExtent;
 pub use law::{BondLaw, ContactLaw, Damping, Motion, NormalLaw};
+pub use solid::state::SolidState;
 pub use solid::{LatticeSolid, LsmSpec, StepReport};
 pub use wall::{PressureWall, WallFaces};
 
@@ -114,6 +115,9 @@ pub enum LsmError {
     /// The progress callback asked to stop.
     #[error("interrupted")]
     Interrupted,
+    /// A saved state that does not fit the solid ([`LatticeSolid::restore_state`]).
+    #[error("saved state: {0}")]
+    State(String),
 }
 
 impl LsmError {

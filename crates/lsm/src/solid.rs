@@ -33,6 +33,8 @@ use porofrac_particles::Disks;
 use porofrac_particles::cells::{CellList, max_radius};
 use rayon::prelude::*;
 
+pub mod state;
+
 /// Problems smaller than this run on the calling thread (no pool overhead).
 const PAR_MIN: usize = 4096;
 
@@ -504,6 +506,12 @@ impl LatticeSolid {
             d.angle[i] += s[2];
             self.dx[i] = s;
         }
+    }
+
+    /// The per-disk index of the candidate contacts (after the pairs were put back).
+    pub(crate) fn rebuild_pair_adjacency(&mut self) {
+        self.pair_adj
+            .build(self.disks.len(), self.pairs.iter().map(|p| (p.i, p.j)));
     }
 
     /// Rebuild the Verlet list of candidate contacts, keeping the tangential springs of

@@ -66,6 +66,27 @@ impl ContactSet {
         }
     }
 
+    /// The memory of the previous step, sorted by key: key, impulse and stick status of
+    /// each contact (for a checkpoint).
+    pub fn memory(&self) -> Vec<(ContactKey, [f64; 2], bool)> {
+        self.previous
+            .iter()
+            .map(|q| (q.key, q.p, q.stick))
+            .collect()
+    }
+
+    /// Replace the memory of the previous step by `memory` (as [`ContactSet::memory`]
+    /// gave it; sorted again by key).
+    pub fn set_memory(&mut self, memory: &[(ContactKey, [f64; 2], bool)]) {
+        self.previous.clear();
+        self.previous.extend(
+            memory
+                .iter()
+                .map(|&(key, p, stick)| Previous { key, p, stick }),
+        );
+        self.previous.sort_unstable_by_key(|q| q.key);
+    }
+
     /// Keep the impulses and the stick status of the step's contacts for the next step's
     /// warm start. A contact sticks when its normal impulse (with the cohesive shift) is
     /// positive and its tangential impulse strictly inside the friction cone

@@ -43,7 +43,7 @@ pub use body::{Axis, RigidBody};
 pub use law::ContactLaw;
 pub use nlgs::NlgsOptions;
 pub use settle::{SettleParams, SettleStats};
-pub use solver::{Nscd, Ordering, SolverParams, StepStats};
+pub use solver::{Nscd, Ordering, SolverParams, StepMemory, StepStats};
 
 /// Anything that stops an NSCD computation. Each variant names the parameter,
 /// particle or body at fault.

@@ -145,6 +145,21 @@ pub struct Nscd {
     nlgs: Nlgs,
 }
 
+/// What a system carries from one step to the next besides its public fields (disks,
+/// bodies, time): the step count (which seeds the random NLGS ordering), the last step
+/// length (contact forces are impulses over it) and the contact memory of the warm start.
+/// Saved and put back by a checkpoint, with [`Nscd::step_memory`] and
+/// [`Nscd::restore_step_memory`]; the other buffers are rebuilt by every step.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct StepMemory {
+    /// Steps taken.
+    pub steps: u64,
+    /// Length of the last step (s).
+    pub h_last: f64,
+    /// Per contact of the last step, sorted by key: key, impulse `[P_n, P_t]`, sticking.
+    pub contacts: Vec<(crate::contacts::ContactKey, [f64; 2], bool)>,
+}
+
 impl Nscd {
     /// A system; checks the law, the options, the bodies, and that no two bodies overlap
     /// by more than the alert distance.
@@ -277,6 +292,23 @@ impl Nscd {
                 bonded: false,
             });
         }
+    }
+
+    /// The memory a next step needs besides the public fields ([`StepMemory`]).
+    pub fn step_memory(&self) -> StepMemory {
+        StepMemory {
+            steps: self.steps,
+            h_last: self.h_last,
+            contacts: self.contacts.memory(),
+        }
+    }
+
+    /// Put back a [`StepMemory`] (into a system built the same way, whose public fields
+    /// are restored too).
+    pub fn restore_step_memory(&mut self, m: &StepMemory) {
+        self.steps = m.steps;
+        self.h_last = m.h_last;
+        self.contacts.set_memory(&m.contacts);
     }
 
     /// Advance by one step of length `h`: the stages of the module docs in order.

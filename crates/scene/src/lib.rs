@@ -166,4 +166,43 @@ impl Scene {
         drop(lock);
         result
     }
+
+    /// Continue the run whose checkpoint is in `out` (`<out>/checkpoint/state.bin`,
+    /// [`common::checkpoint`]): the model is built again, its state and the files written
+    /// so far are restored, and the run goes on from the step after the checkpoint, to
+    /// the same results as a run never stopped. The scene must be the one the checkpoint
+    /// was written from (same model, same file content), else the run is refused before
+    /// anything is built; nothing in `out` is removed first.
+    pub fn resume(&self, out: &Path, observer: &mut dyn Observer) -> Result<Summary, RunError> {
+        let start = std::time::Instant::now();
+        let (model, hash) = common::checkpoint::read_header(out)?;
+        common::checkpoint::check_matches(&self.loaded, out, &model, hash)?;
+        let lock = output::OutputLock::acquire(out)?;
+        let mut loaded = self.loaded.clone();
+        loaded.resume = true;
+        let result = common::model::run(&loaded, &self.laws, out, observer);
+        if let Err(e) = &result {
+            output::write_failed_summary(&self.loaded, out, &e.to_string(), start);
+        }
+        drop(lock);
+        result
+    }
+
+    /// The scene stored in the checkpoint of `out`, parsed as from its original path
+    /// (which anchors relative paths such as mesh files) with the `--set` overrides the
+    /// run was started with, and the built-in laws.
+    pub fn from_checkpoint(out: &Path) -> Result<Self, RunError> {
+        Self::from_checkpoint_with(out, LawRegistry::default())
+    }
+
+    /// [`Scene::from_checkpoint`] with the laws of `laws`.
+    pub fn from_checkpoint_with(out: &Path, laws: LawRegistry) -> Result<Self, RunError> {
+        let c = common::checkpoint::Checkpoint::read(out)?;
+        let text = c.state.str("scene/text")?;
+        let path = PathBuf::from(c.state.str("scene/path")?);
+        let overrides = common::checkpoint::stored_overrides(&c.state)?;
+        let loaded = check::parse_with(text, &path, MODELS, &overrides)?;
+        check::check(&loaded, &laws, MODELS)?;
+        Ok(Self { loaded, laws })
+    }
 }

@@ -37,6 +37,23 @@ impl PvdWriter {
         Ok(w)
     }
 
+    /// Create the collection file at `path` holding `entries` (time and relative data-set
+    /// path, as [`PvdWriter::entries`] gave them: the steps of a run that is continued).
+    pub fn with_entries(
+        path: impl AsRef<Path>,
+        entries: Vec<(f64, String)>,
+    ) -> Result<Self, VtkError> {
+        if let Some((t, _)) = entries.iter().find(|(t, _)| !t.is_finite()) {
+            return Err(VtkError::Input(format!("pvd: time {t} is not finite")));
+        }
+        let w = Self {
+            path: path.as_ref().to_path_buf(),
+            entries,
+        };
+        w.flush()?;
+        Ok(w)
+    }
+
     /// Append a step at `time` whose data set is `file` (a path relative to the `.pvd`
     /// file's directory, written with `/` separators), and rewrite the collection.
     pub fn add(&mut self, time: f64, file: impl AsRef<Path>) -> Result<(), VtkError> {

@@ -29,6 +29,14 @@ impl PvdWriter {
             .map_err(vtk_err)
     }
 
+    /// Create the collection file at `path` holding `entries` (time and relative data-set
+    /// path, as [`PvdWriter::entries`] gave them: the steps of a run that is continued).
+    pub fn with_entries(path: impl AsRef<Path>, entries: Vec<(f64, String)>) -> Result<Self> {
+        porofrac_vtk::PvdWriter::with_entries(path, entries)
+            .map(Self)
+            .map_err(vtk_err)
+    }
+
     /// Append a step at `time` whose data set is `file` (a path relative to the `.pvd`
     /// file's directory, written with `/` separators), and rewrite the collection.
     pub fn add(&mut self, time: f64, file: impl AsRef<Path>) -> Result<()> {

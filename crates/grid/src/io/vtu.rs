@@ -27,6 +27,11 @@ use crate::point::{Point, assert_dim};
 
 /// Name of the 2D field-data array that keeps the order of each cell's faces.
 pub(crate) const EDGE_ORDER: &str = "porofrac:edge_order";
+/// Name of the 3D field-data array holding every cell's face stream (when standard cell
+/// types are written, [`crate::io::write_vtu`]).
+pub(crate) const FACES: &str = "porofrac:faces";
+/// The end positions of each cell's part of [`FACES`].
+pub(crate) const FACE_OFFSETS: &str = "porofrac:faceoffsets";
 
 // ---------------------------------------------------------------------------- reading
 
@@ -710,7 +715,26 @@ fn parse_vtu<const D: usize>(
     let conn = cx.ints(conn_el, None)?;
     let offsets = cx.ints(offs_el, Some(nc))?;
     let types = cx.ints(types_el, Some(nc))?;
-    let poly = if types.contains(&42) {
+    // porofrac's own face stream of every cell (written beside tetrahedra and hexahedra)
+    // rebuilds the exact face numbering; else the `<Cells>` faces of the polyhedra.
+    let field_faces = if D == 3 {
+        let fds: Vec<_> = [ug.child("FieldData"), piece.child("FieldData")]
+            .into_iter()
+            .flatten()
+            .collect();
+        let fe = fds.iter().find_map(|fd| named(fd, FACES));
+        let fo = fds.iter().find_map(|fd| named(fd, FACE_OFFSETS));
+        match (fe, fo) {
+            (Some(fe), Some(fo)) => Some((cx.ints(fe, None)?, cx.ints(fo, Some(nc))?, fe.offset)),
+            _ => None,
+        }
+    } else {
+        None
+    };
+    let own_faces = field_faces.is_some();
+    let poly = if field_faces.is_some() {
+        field_faces
+    } else if types.contains(&42) {
         let fe = get("faces")?;
         let fo = get("faceoffsets")?;
         Some((cx.ints(fe, None)?, cx.ints(fo, Some(nc))?, fe.offset))
@@ -762,9 +786,23 @@ fn parse_vtu<const D: usize>(
         start = end;
         let t = types[c];
         let shape = match (D, t) {
-            (2, 5) => Some(Shape::Triangle),
-            (2, 9) => Some(Shape::Quad),
+            // Triangles and quadrilaterals go the polygon's way (with the edge order).
+            (2, 5 | 9) => {
+                let want = if t == 5 { 3 } else { 4 };
+                if v.len() != want {
+                    return Err(cx.err(
+                        conn_el.offset,
+                        format!(
+                            "cell {c}: a {} needs {want} points, got {}",
+                            if t == 5 { "triangle" } else { "quadrilateral" },
+                            v.len()
+                        ),
+                    ));
+                }
+                None
+            }
             (2, 7) => None,
+            (3, 10 | 12 | 13 | 14) if own_faces => None,
             (3, 10) => Some(Shape::Tetra),
             (3, 12) => Some(Shape::Hexa),
             (3, 13) => Some(Shape::Prism),
@@ -865,7 +903,11 @@ fn parse_vtu<const D: usize>(
             loops.finish_cell();
             face_start = fend;
         }
-        if poly.is_some() && shape.is_some() && poly.as_ref().is_some_and(|p| p.1[c] >= 0) {
+        if !own_faces
+            && poly.is_some()
+            && shape.is_some()
+            && poly.as_ref().is_some_and(|p| p.1[c] >= 0)
+        {
             return Err(cx.err(
                 cells_el.offset,
                 format!("cell {c}: faceoffset must be -1 for a non-polyhedral cell"),
@@ -959,6 +1001,91 @@ mod tests {
     use super::*;
     use crate::generate::cartesian;
     use crate::io::vtu_write::{Encoding, Field, vtu_bytes};
+
+    /// The VTK cell types of a written grid, and the grid read back.
+    fn written_types<const D: usize>(g: &Grid<D>) -> Vec<i64> {
+        let mut types = Vec::new();
+        for enc in [Encoding::Ascii, Encoding::Base64, Encoding::Appended] {
+            let bytes = vtu_bytes(g, &[], &[], enc).unwrap();
+            let text = String::from_utf8_lossy(&bytes).into_owned();
+            if enc != Encoding::Appended {
+                let cx = Ctx {
+                    path: Path::new("x.vtu"),
+                    lines: LineIndex::new(&text),
+                    big_endian: false,
+                    header64: true,
+                    zlib: false,
+                    appended: None,
+                };
+                let root = xml::parse(&text).ok().unwrap();
+                let cells = root
+                    .child("UnstructuredGrid")
+                    .and_then(|u| u.child("Piece"))
+                    .and_then(|p| p.child("Cells"))
+                    .unwrap();
+                let t = cx
+                    .ints(named(cells, "types").unwrap(), Some(g.num_cells()))
+                    .unwrap();
+                if !types.is_empty() {
+                    assert_eq!(t, types, "{enc:?}");
+                }
+                types = t;
+            }
+            let path = std::env::temp_dir().join(format!(
+                "porofrac_vtu_types_{}_{D}_{}_{enc:?}.vtu",
+                std::process::id(),
+                g.num_cells()
+            ));
+            std::fs::write(&path, &bytes).unwrap();
+            let back: Grid<D> = read_vtu(&path).unwrap();
+            std::fs::remove_file(&path).unwrap();
+            assert!(back == *g, "{enc:?}: read(write(g)) != g");
+        }
+        types
+    }
+
+    /// Triangles (5), quadrilaterals (9), tetrahedra (10) and hexahedra (12) are written
+    /// with their own VTK types, other cells as polygons (7) and polyhedra (42); every
+    /// grid reads back identical.
+    #[test]
+    fn standard_cell_types() {
+        use crate::generate::simplices;
+        let lo2 = Point::<2>::new(0.0, 0.0);
+        let hi2 = Point::<2>::new(2.0, 1.0);
+        let tri = simplices::<2>(lo2, hi2, [2, 1]).unwrap();
+        assert_eq!(written_types(&tri), vec![5; tri.num_cells()]);
+        let quads = cartesian::<2>(lo2, hi2, [2, 1]).unwrap();
+        assert_eq!(written_types(&quads), vec![9, 9]);
+        // A quadrilateral, a pentagon (hanging node 5 on its bottom edge) and a triangle.
+        let nodes = vec![
+            Point::<2>::new(0.0, 0.0),
+            Point::<2>::new(1.0, 0.0),
+            Point::<2>::new(2.0, 0.0),
+            Point::<2>::new(0.0, 1.0),
+            Point::<2>::new(1.0, 1.0),
+            Point::<2>::new(1.5, 0.0),
+            Point::<2>::new(2.0, 1.0),
+            Point::<2>::new(1.0, 2.0),
+        ];
+        let mut loops = CellFaceLoops::new();
+        loops.push_polygon(&[0, 1, 4, 3]);
+        loops.push_polygon(&[1, 5, 2, 6, 4]);
+        loops.push_polygon(&[4, 6, 7]);
+        let mixed = Grid::<2>::from_cell_faces(nodes, &loops).unwrap();
+        assert_eq!(written_types(&mixed), vec![9, 7, 5]);
+        let lo3 = Point::<3>::new(0.0, 0.0, 0.0);
+        let hi3 = Point::<3>::new(1.0, 2.0, 3.0);
+        let tets = simplices::<3>(lo3, hi3, [2, 1, 1]).unwrap();
+        assert_eq!(written_types(&tets), vec![10; tets.num_cells()]);
+        let hexes = cartesian::<3>(lo3, hi3, [2, 1, 1]).unwrap();
+        assert_eq!(written_types(&hexes), vec![12, 12]);
+        // Hexahedra and tetrahedra with prisms and a pyramid, which stay polyhedra.
+        let mixed3: Grid<3> = crate::io::read_msh(
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/mixed.msh"),
+        )
+        .unwrap();
+        assert_eq!(written_types(&mixed3), vec![12, 42, 42, 42, 10, 10]);
+    }
 
     /// Field arrays are written with the right layout in both encodings.
     #[test]

@@ -1,12 +1,21 @@
 //! VTK XML UnstructuredGrid (`.vtu`) writer: turns a grid into VTK points, cells and
 //! data arrays and writes them with [`porofrac_vtk`].
 //!
-//! * 2D cells are `VTK_POLYGON` (7) with the counter-clockwise [`Grid::cell_nodes`] and
-//!   points at `z = 0`. 3D cells are `VTK_POLYHEDRON` (42) with the `faces` / `faceoffsets`
-//!   arrays (the layout ParaView 5.x and meshio read): per cell the number of faces, then
-//!   for each face its node count and nodes, in the cell's outward order. A face seen from
-//!   its second cell is written reversed and rotated so that reading the file back gives
-//!   the same cell node order, hence the identical grid (`read(write(g)) == g`).
+//! * 2D cells with 3 nodes are `VTK_TRIANGLE` (5), with 4 nodes `VTK_QUAD` (9), the
+//!   others `VTK_POLYGON` (7); all with the counter-clockwise [`Grid::cell_nodes`] and
+//!   points at `z = 0`. In 3D, a cell of 4 triangular faces is a `VTK_TETRA` (10) and a
+//!   cell of 6 quadrilateral faces on 8 nodes, three faces at each node, a
+//!   `VTK_HEXAHEDRON` (12), both with their nodes in VTK's order; the other 3D cells are
+//!   `VTK_POLYHEDRON` (42) with the `faces` / `faceoffsets` arrays (the layout ParaView
+//!   5.x and meshio read; `faceoffsets` is −1 for a cell of a standard type): per cell the
+//!   number of faces, then for each face its node count and nodes, in the cell's outward
+//!   order. A face seen from its second cell is written reversed and rotated so that
+//!   reading the file back gives the same cell node order, hence the identical grid
+//!   (`read(write(g)) == g`). meshio thus reads one block per cell type.
+//! * In 3D, when a cell is written as a tetrahedron or hexahedron, the field-data arrays
+//!   `porofrac:faces` / `porofrac:faceoffsets` (`Int64`) hold the face stream of *every*
+//!   cell, so that reading the file back rebuilds the same face numbering and
+//!   orientation; other readers ignore them.
 //! * In 2D, when a cell does not list its faces in polygon order, the field-data array
 //!   `porofrac:edge_order` (`Int64`) gives, per cell, the position along the polygon of
 //!   each of its faces, so that the face numbering survives the round trip.
@@ -33,7 +42,7 @@ pub use porofrac_vtk::Encoding;
 
 use crate::error::{GridError, Result};
 use crate::grid::Grid;
-use crate::io::vtu::EDGE_ORDER;
+use crate::io::vtu::{EDGE_ORDER, FACE_OFFSETS, FACES};
 use crate::point::{Point, assert_dim};
 
 /// A data array to write, borrowed from the caller. Lengths must equal the number of
@@ -282,27 +291,18 @@ fn with_vtk<const D: usize, T>(
         .iter()
         .flat_map(|p| (0..3).map(move |a| if a < D { p[a] } else { 0.0 }))
         .collect();
-    let mut conn: Vec<i64> = Vec::with_capacity(grid.cell_nodes.len());
-    let mut offsets: Vec<i64> = Vec::with_capacity(nc);
-    for c in 0..nc {
-        conn.extend(grid.cell_nodes(c).iter().map(|&n| n as i64));
-        offsets.push(conn.len() as i64);
+    let cells_vtk = vtk_cells(grid);
+    if let Some((faces, offsets)) = &cells_vtk.all_faces {
+        field.push(DataArray::new(FACES, 1, &faces[..]));
+        field.push(DataArray::new(FACE_OFFSETS, 1, &offsets[..]));
     }
-    let types = vec![
-        if D == 2 {
-            CellType::Polygon
-        } else {
-            CellType::Polyhedron
-        };
-        nc
-    ];
-    let poly = (D == 3).then(|| polyhedron_faces(grid));
     let ug = UnstructuredGrid {
         points: &pts,
-        connectivity: &conn,
-        offsets: &offsets,
-        types: &types,
-        polyhedra: poly
+        connectivity: &cells_vtk.connectivity,
+        offsets: &cells_vtk.offsets,
+        types: &cells_vtk.types,
+        polyhedra: cells_vtk
+            .polyhedra
             .as_ref()
             .map(|(faces, faceoffsets)| Polyhedra { faces, faceoffsets }),
         field_data: &field,
@@ -310,6 +310,179 @@ fn with_vtk<const D: usize, T>(
         cell_data: Attributes::new(&cells),
     };
     f(&ug).map_err(vtk_err)
+}
+
+/// The cells of a grid in VTK terms (see the module docs).
+struct VtkCells {
+    types: Vec<CellType>,
+    connectivity: Vec<i64>,
+    offsets: Vec<i64>,
+    /// `faces` / `faceoffsets` of the `<Cells>` element (3D with a polyhedron).
+    polyhedra: Option<(Vec<i64>, Vec<i64>)>,
+    /// The face stream of every cell, for [`FACES`] / [`FACE_OFFSETS`] (3D with a
+    /// tetrahedron or hexahedron).
+    all_faces: Option<(Vec<i64>, Vec<i64>)>,
+}
+
+/// Types, connectivity and polyhedron faces of every cell: triangles and quadrilaterals
+/// in 2D (by node count; polygon order is a valid node order for both), tetrahedra and
+/// hexahedra in 3D (by face structure, nodes in VTK's order), polygons and polyhedra for
+/// the rest.
+fn vtk_cells<const D: usize>(grid: &Grid<D>) -> VtkCells {
+    let nc = grid.num_cells();
+    let mut types = Vec::with_capacity(nc);
+    let mut connectivity: Vec<i64> = Vec::with_capacity(grid.cell_nodes.len());
+    let mut offsets: Vec<i64> = Vec::with_capacity(nc);
+    if D == 2 {
+        for c in 0..nc {
+            let nodes = grid.cell_nodes(c);
+            types.push(match nodes.len() {
+                3 => CellType::Triangle,
+                4 => CellType::Quad,
+                _ => CellType::Polygon,
+            });
+            connectivity.extend(nodes.iter().map(|&n| n as i64));
+            offsets.push(connectivity.len() as i64);
+        }
+        return VtkCells {
+            types,
+            connectivity,
+            offsets,
+            polyhedra: None,
+            all_faces: None,
+        };
+    }
+    let (faces, face_ends) = polyhedron_faces(grid);
+    let mut poly_faces = Vec::new();
+    let mut poly_offsets = Vec::with_capacity(nc);
+    let mut any_poly = false;
+    let mut start = 0usize;
+    for c in 0..nc {
+        let end = face_ends[c] as usize;
+        let stream = &faces[start..end];
+        let standard = standard_3d(grid, c, stream);
+        match standard {
+            Some((ty, nodes)) => {
+                types.push(ty);
+                connectivity.extend(nodes);
+                poly_offsets.push(-1);
+            }
+            None => {
+                types.push(CellType::Polyhedron);
+                connectivity.extend(grid.cell_nodes(c).iter().map(|&n| n as i64));
+                poly_faces.extend_from_slice(stream);
+                poly_offsets.push(poly_faces.len() as i64);
+                any_poly = true;
+            }
+        }
+        offsets.push(connectivity.len() as i64);
+        start = end;
+    }
+    let any_standard = types.iter().any(|&t| t != CellType::Polyhedron);
+    VtkCells {
+        types,
+        connectivity,
+        offsets,
+        polyhedra: any_poly.then_some((poly_faces, poly_offsets)),
+        all_faces: any_standard.then_some((faces, face_ends)),
+    }
+}
+
+/// The face loops of a polyhedron's stream (`[n_faces, m, nodes…, m, nodes…]`).
+fn stream_faces(stream: &[i64]) -> Vec<&[i64]> {
+    let mut out = Vec::new();
+    let mut k = 1;
+    while k < stream.len() {
+        let m = stream[k] as usize;
+        out.push(&stream[k + 1..k + 1 + m]);
+        k += 1 + m;
+    }
+    out
+}
+
+/// Cell `c` as a VTK tetrahedron (4 triangles on 4 nodes, nodes ordered so that the
+/// first three, seen from the fourth, run counter-clockwise) or hexahedron (6
+/// quadrilaterals on 8 nodes, each node on three of them: the bottom loop with its
+/// normal pointing inside, then the node above each), given its outward face stream.
+fn standard_3d<const D: usize>(
+    grid: &Grid<D>,
+    c: usize,
+    stream: &[i64],
+) -> Option<(CellType, Vec<i64>)> {
+    let faces = stream_faces(stream);
+    let nodes = grid.cell_nodes(c);
+    let x = |n: i64| -> [f64; 3] {
+        let p = grid.node(n as usize);
+        std::array::from_fn(|a| if a < D { p[a] } else { 0.0 })
+    };
+    if nodes.len() == 4 && faces.len() == 4 && faces.iter().all(|f| f.len() == 3) {
+        // The outward loop of the first face, reversed, points inside: towards the node
+        // that is not on it.
+        let f = faces[0];
+        let apex = nodes.iter().map(|&n| n as i64).find(|n| !f.contains(n))?;
+        let order = vec![f[0], f[2], f[1], apex];
+        let [a, b, cc, d] = [0, 1, 2, 3].map(|i| x(order[i]));
+        let u = sub(b, a);
+        let v = sub(cc, a);
+        let w = sub(d, a);
+        let det = u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0])
+            + u[2] * (v[0] * w[1] - v[1] * w[0]);
+        return (det > 0.0).then_some((CellType::Tetra, order));
+    }
+    if nodes.len() != 8 || faces.len() != 6 || faces.iter().any(|f| f.len() != 4) {
+        return None;
+    }
+    let mut on = [0usize; 8];
+    for f in &faces {
+        for n in f.iter() {
+            let i = nodes.iter().position(|&m| m as i64 == *n)?;
+            on[i] += 1;
+        }
+    }
+    if on.iter().any(|&k| k != 3) {
+        return None;
+    }
+    let bottom: Vec<i64> = faces[0].iter().rev().copied().collect();
+    // The node above bottom node `b`: its neighbour along an edge of some face, off the
+    // bottom face.
+    let above = |b: i64| -> Option<i64> {
+        let mut found = None;
+        for f in &faces {
+            for k in 0..4 {
+                let (p, q) = (f[k], f[(k + 1) % 4]);
+                let other = if p == b {
+                    q
+                } else if q == b {
+                    p
+                } else {
+                    continue;
+                };
+                if !bottom.contains(&other) {
+                    match found {
+                        None => found = Some(other),
+                        Some(o) if o != other => return None,
+                        _ => {}
+                    }
+                }
+            }
+        }
+        found
+    };
+    let mut order = bottom.clone();
+    for k in 0..4 {
+        order.push(above(bottom[k])?);
+    }
+    let mut top = order[4..].to_vec();
+    top.sort_unstable();
+    top.dedup();
+    if top.len() != 4 {
+        return None;
+    }
+    Some((CellType::Hexahedron, order))
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
 /// In 2D, the position along the polygon ([`Grid::cell_nodes`]) of each of a cell's faces

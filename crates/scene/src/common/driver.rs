@@ -343,7 +343,38 @@ pub(crate) fn drive(
     let mut steps = 0;
     let mut interrupted = None;
     let mut row = Vec::new();
-    for (step, &t) in times.iter().enumerate() {
+    // Checkpoints and resuming (crate::common::checkpoint).
+    let checkpoint_every = s.output.checkpoint_every as usize;
+    if (checkpoint_every > 0 || ls.resume) && !model.checkpoints() {
+        return Err(ls
+            .error(
+                &k(&["output", "checkpoint_every"]),
+                format!(
+                    ": model \"{}\" cannot write or resume from checkpoints",
+                    ls.model()
+                ),
+            )
+            .into());
+    }
+    let mut first = 0;
+    if ls.resume {
+        let r = crate::common::checkpoint::resume(
+            ls,
+            out,
+            model,
+            &mut probes,
+            &mut lines,
+            &mut pvd,
+            series.len(),
+        )?;
+        first = r.step + 1;
+        written = r.written;
+        series = r.series;
+        extrema = r.extrema;
+        total_iterations = r.total_iterations;
+        steps = r.steps;
+    }
+    for (step, &t) in times.iter().enumerate().skip(first) {
         let stats = match model.step(step) {
             Err(RunError::Interrupted) => {
                 // Stopped inside the step: its state is partial, the files end at the
@@ -355,8 +386,42 @@ pub(crate) fn drive(
         };
         model.after_step(out)?;
         let stop = step + 1 < times.len() && observer.stop_requested();
-        let write =
-            step == 0 || step % s.output.every as usize == 0 || step + 1 == times.len() || stop;
+        let regular = step == 0 || step % s.output.every as usize == 0 || step + 1 == times.len();
+        let write = regular || stop;
+        // A checkpoint after this step: every `checkpoint_every` steps, and when stopped.
+        // It holds the files as a run that goes on has them: a step written only because
+        // the run stops is saved before that write, so a resumed run does not keep it.
+        let checkpoint = step + 1 < times.len()
+            && ((checkpoint_every > 0 && step > 0 && step % checkpoint_every == 0)
+                || (stop && model.checkpoints()));
+        macro_rules! save_checkpoint {
+            ($iterations:expr, $steps:expr) => {
+                let t_out = Instant::now();
+                crate::common::checkpoint::save(
+                    ls,
+                    out,
+                    model,
+                    &crate::common::checkpoint::Progress {
+                        step,
+                        written: &written,
+                        series: &series,
+                        extrema: &extrema,
+                        total_iterations: $iterations,
+                        steps: $steps,
+                        probes: &probes,
+                        lines: &lines,
+                        pvd: pvd.as_ref(),
+                    },
+                )?;
+                output_seconds += t_out.elapsed().as_secs_f64();
+            };
+        }
+        if checkpoint && !regular {
+            save_checkpoint!(
+                total_iterations + stats.iterations,
+                steps + usize::from(step > 0)
+            );
+        }
         if write {
             let t_out = Instant::now();
             row.clear();
@@ -416,6 +481,9 @@ pub(crate) fn drive(
             total_iterations,
             failed: stats.failed,
         });
+        if checkpoint && regular {
+            save_checkpoint!(total_iterations, steps);
+        }
         if stop {
             interrupted = Some(t);
             break;

@@ -64,6 +64,9 @@ pub struct LoadedScene {
     lines: KeyLines,
     /// The `--set` overrides applied to the file, in command-line order.
     overrides: Vec<crate::common::overrides::Applied>,
+    /// Continue the run from the checkpoint of its output folder
+    /// ([`crate::common::checkpoint`]).
+    pub(crate) resume: bool,
 }
 
 impl LoadedScene {
@@ -103,6 +106,11 @@ impl LoadedScene {
         own.downcast_ref::<T>()
             .expect("a model reads its own sections")
     }
+    /// The `--set` overrides applied to the scene, in command-line order.
+    pub(crate) fn applied_overrides(&self) -> &[crate::common::overrides::Applied] {
+        &self.overrides
+    }
+
     /// The `--set` overrides of the scene: each key as written on the command line and its
     /// value (for `summary.json`).
     pub fn overrides(&self) -> BTreeMap<String, serde_json::Value> {
@@ -466,6 +474,7 @@ pub fn parse_with(
         own,
         lines,
         overrides: applied,
+        resume: false,
     })
 }
 

@@ -11,6 +11,7 @@
 //! Nothing here imports a model folder.
 
 pub mod bounds;
+pub mod checkpoint;
 pub mod driver;
 pub mod expr;
 pub mod grid;

@@ -58,6 +58,9 @@ pub enum RunError {
     /// run ends as interrupted ([`crate::common::driver`]), not as an error.
     #[error("interrupted")]
     Interrupted,
+    /// A checkpoint could not be used or written ([`crate::common::checkpoint`]).
+    #[error("checkpoint {0}")]
+    Checkpoint(String),
 }
 
 /// What a step did, for progress and statistics.
@@ -137,6 +140,35 @@ pub trait Model {
     /// The estimated peak memory of a run of the model, the program itself apart (bytes;
     /// the per-model estimates of [`crate::common::limits`]).
     fn peak_bytes(&self) -> f64;
+    /// Whether the model writes checkpoints ([`Model::save_state`]); no by default, and
+    /// then `[output] checkpoint_every` and `--resume` are refused for it.
+    fn checkpoints(&self) -> bool {
+        false
+    }
+    /// Put into `state` everything of the current state (after step `step`) that a later
+    /// step, probe, line, field, file or the summary reads: positions, velocities,
+    /// histories, contact memories and warm starts, damage and fracture state, the model's
+    /// own output files' progress. Caches that change iterates are saved too, or reset so
+    /// that a straight run and a resumed one compute the same. Names must not start with
+    /// `driver/` or `scene/`.
+    fn save_state(&self, state: &mut crate::common::checkpoint::State) -> Result<(), RunError> {
+        let _ = state;
+        Err(RunError::Checkpoint(
+            "this model does not write checkpoints".into(),
+        ))
+    }
+    /// Put back the state [`Model::save_state`] saved, into a model just built from the
+    /// same scene whose outputs go to `out`; the next call is `step(step + 1)`.
+    fn restore_state(
+        &mut self,
+        state: &crate::common::checkpoint::State,
+        out: &Path,
+    ) -> Result<(), RunError> {
+        let _ = (state, out);
+        Err(RunError::Checkpoint(
+            "this model does not read checkpoints".into(),
+        ))
+    }
 }
 
 /// A model's own sections, read from the parsed file by [`ModelKind::sections_of`] and

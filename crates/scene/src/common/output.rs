@@ -66,6 +66,16 @@ impl CsvTable {
             dirty: true,
         }
     }
+    /// The text of the table so far (header and rows), for a checkpoint.
+    pub fn text(&self) -> &str {
+        &self.text
+    }
+    /// Replace the table's text by `text` (the header and rows of a checkpoint); the file
+    /// is rewritten at the next flush.
+    pub fn restore(&mut self, text: String) {
+        self.text = text;
+        self.dirty = true;
+    }
     /// Append a row of numbers (shortest round-trip form).
     pub fn push(&mut self, row: &[f64]) -> Result<(), OutputError> {
         self.append(row);
@@ -394,6 +404,7 @@ fn stale_temporary(name: &str) -> bool {
 /// `contacts_NNNN.vtp`); the series `<name>.pvd` and `<name>_contacts.pvd` for the scene
 /// name `names` gives and the one the earlier `summary.json` records; the tables
 /// (`probes.csv`, `fracture.csv`, `heat.csv`, `broken.csv`, `crack.csv`, `lines/*.csv`);
+/// the checkpoint `checkpoint/state.bin`;
 /// the pictures `plots/*.png` and `plots/fracture/*.png`; `summary.json`; and temporary
 /// files of atomic writes left by processes that no longer run. Folders left empty are
 /// removed. Nothing else is touched. Returns the number of files removed.
@@ -456,6 +467,7 @@ pub fn remove_earlier_outputs(dir: &Path, name: &str) -> Result<usize, OutputErr
             || numbered(n, "contacts_", "vtp")
     })?;
     clean("lines", &|n| n.ends_with(".csv"))?;
+    clean("checkpoint", &|n| n == "state.bin")?;
     clean("plots/fracture", &|n| n.ends_with(".png"))?;
     clean("plots", &|n| n.ends_with(".png"))?;
     clean("", &|n| top.iter().any(|t| t == n))?;

@@ -103,6 +103,11 @@ pub fn disk_extrema(d: &Disks) -> BTreeMap<String, [f64; 2]> {
     out
 }
 
+/// `<name>_contacts.pvd` in output folder `out`.
+pub fn contacts_pvd_path(ls: &LoadedScene, out: &Path) -> std::path::PathBuf {
+    out.join(format!("{}_contacts.pvd", ls.scene.scene.name))
+}
+
 /// Write `particles_NNNN.vtp` (with the `extra` point data) and `contacts_NNNN.vtp`
 /// into `dir`, and add the contacts file to `<name>_contacts.pvd` next to `dir`;
 /// returns the particles file name.
@@ -129,9 +134,7 @@ pub fn write_vtk(
     let mut pvd = contacts_pvd.borrow_mut();
     if pvd.is_none() {
         let parent = dir.parent().unwrap_or(Path::new("."));
-        *pvd = Some(PvdWriter::create(
-            parent.join(format!("{}_contacts.pvd", ls.scene.scene.name)),
-        )?);
+        *pvd = Some(PvdWriter::create(contacts_pvd_path(ls, parent))?);
     }
     if let Some(pvd) = pvd.as_mut() {
         pvd.add(time, format!("vtk/{contacts}"))?;

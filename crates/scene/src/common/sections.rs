@@ -692,6 +692,11 @@ pub struct Output {
     /// Write every n-th step (probes, lines, VTK).
     #[serde(default = "one")]
     pub every: i64,
+    /// Write a checkpoint (`checkpoint/state.bin`, the state of the run for
+    /// `porofrac run --resume`) every n-th step; 0 (default): none, but a run stopped by
+    /// Ctrl-C between steps still writes one.
+    #[serde(default)]
+    pub checkpoint_every: u64,
     /// `[[output.probe]]`: one column of `probes.csv` (`time,<names…>`, one row per written
     /// step, the first at t = 0).
     #[serde(default)]
@@ -713,6 +718,7 @@ impl Default for Output {
             vtk: true,
             plots: true,
             every: 1,
+            checkpoint_every: 0,
             probe: Vec::new(),
             line: Vec::new(),
             exact_displacement: None,

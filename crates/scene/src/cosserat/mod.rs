@@ -610,6 +610,86 @@ impl<const D: usize> Model for Run<'_, D> {
         Ok(())
     }
 
+    fn checkpoints(&self) -> bool {
+        true
+    }
+
+    fn save_state(&self, state: &mut crate::common::checkpoint::State) -> Result<(), RunError> {
+        state.put_f64("w", self.w.clone());
+        state.put_f64(
+            "stats",
+            vec![
+                self.stats.iterations as f64,
+                self.stats.max_relative_residual,
+                self.wall.solve,
+            ],
+        );
+        let linear = match &self.stepping {
+            Stepping::Static(l) => Some(l.stats()),
+            Stepping::Dynamic { state, .. } => state.solver().map(Linear::stats),
+        };
+        if let Some(l) = linear {
+            state.put_u64(
+                "linear/counts",
+                vec![
+                    l.solves as u64,
+                    l.iterations as u64,
+                    l.max_iterations as u64,
+                ],
+            );
+            state.put_f64("linear/max_residual", vec![l.max_residual]);
+        }
+        if let Stepping::Dynamic { state: d, .. } = &self.stepping {
+            state.put_f64("dynamics/t", vec![d.t, d.external_work]);
+            state.put_f64("dynamics/u", d.u.clone());
+            state.put_f64("dynamics/v", d.v.clone());
+            state.put_f64("dynamics/a", d.a.clone());
+            state.put_f64("dynamics/f_prev", d.previous_load().to_vec());
+        }
+        Ok(())
+    }
+
+    fn restore_state(
+        &mut self,
+        state: &crate::common::checkpoint::State,
+        _out: &Path,
+    ) -> Result<(), RunError> {
+        let n = self.w.len();
+        self.w = state.f64s_len("w", n)?.to_vec();
+        let s = state.f64s_len("stats", 3)?;
+        self.stats.iterations = s[0] as usize;
+        self.stats.max_relative_residual = s[1];
+        self.wall.solve = s[2];
+        if let Stepping::Dynamic { state: d, .. } = &mut self.stepping {
+            let t = state.f64s_len("dynamics/t", 2)?;
+            (d.t, d.external_work) = (t[0], t[1]);
+            d.u = state.f64s_len("dynamics/u", n)?.to_vec();
+            d.v = state.f64s_len("dynamics/v", n)?.to_vec();
+            d.a = state.f64s_len("dynamics/a", n)?.to_vec();
+            d.set_previous_load(state.f64s("dynamics/f_prev")?.to_vec())
+                .map_err(|(a, b)| {
+                    RunError::Checkpoint(format!(
+                        "array `dynamics/f_prev` has {a} values, the rebuilt model needs {b}"
+                    ))
+                })?;
+        }
+        let linear = match &mut self.stepping {
+            Stepping::Static(l) => Some(l),
+            Stepping::Dynamic { state, .. } => state.solver_mut(),
+        };
+        if let Some(l) = linear {
+            let c = state.u64s_len("linear/counts", 3)?;
+            let mut s = l.stats();
+            s.solves = c[0] as usize;
+            s.iterations = c[1] as usize;
+            s.max_iterations = c[2] as usize;
+            s.max_residual = state.f64("linear/max_residual")?;
+            l.restore_counts(&s);
+        }
+        self.refresh_stress();
+        Ok(())
+    }
+
     fn write_vtk(&self, dir: &Path, index: usize) -> Result<String, RunError> {
         let name = format!("step_{index:04}.vtu");
         vtk::write(&dir.join(&name), self.model.grid(), &self.w, &self.stress)?;

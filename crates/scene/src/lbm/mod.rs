@@ -20,6 +20,7 @@
 
 pub mod check;
 
+use crate::common::checkpoint::State;
 use crate::common::laws::LawRegistry;
 use crate::common::loaded::SceneError;
 use crate::common::model::ModelKind;
@@ -548,6 +549,71 @@ impl Model for LbmModel<'_> {
     }
 
     fn after_step(&mut self, _out: &Path) -> Result<(), RunError> {
+        Ok(())
+    }
+
+    fn checkpoints(&self) -> bool {
+        // Obstacles that move change the lattice's geometry, which is not saved.
+        self.motions.iter().all(|(v, w)| v.is_none() && w.is_none())
+    }
+
+    fn save_state(&self, state: &mut State) -> Result<(), RunError> {
+        let l = self.lat.raw_state();
+        state.put_f64("lattice/populations", l.populations);
+        state.put_u64("lattice/steps", vec![l.steps, u64::from(l.swapped)]);
+        state.put_f64(
+            "lattice/values",
+            vec![
+                l.injected,
+                self.stepping_seconds,
+                self.fluid_updates,
+                self.max_mach,
+            ],
+        );
+        state.put_f64("lattice/forces", l.forces.concat());
+        state.put_f64("lattice/exchange", l.exchange.concat());
+        if let Some(th) = &self.thermal {
+            let t = th.raw_state();
+            state.put_f64("thermal/g", t.g.concat());
+            state.put_f64("thermal/post", t.post.concat());
+            state.put_f64("thermal/side_heat", t.side_heat.to_vec());
+            state.put_f64("thermal/obstacle_heat", t.obstacle_heat);
+        }
+        Ok(())
+    }
+
+    fn restore_state(&mut self, state: &State, _out: &Path) -> Result<(), RunError> {
+        fn rows<const N: usize>(v: &[f64]) -> Vec<[f64; N]> {
+            v.chunks_exact(N)
+                .map(|c| std::array::from_fn(|k| c[k]))
+                .collect()
+        }
+        let bad = |e: String| RunError::Checkpoint(format!("lattice: {e}"));
+        let steps = state.u64s_len("lattice/steps", 2)?;
+        let values = state.f64s_len("lattice/values", 4)?;
+        let no = self.lat.obstacles().len();
+        self.lat
+            .restore_raw_state(porofrac_lbm::LatticeState {
+                populations: state.f64s("lattice/populations")?.to_vec(),
+                swapped: steps[1] != 0,
+                steps: steps[0],
+                injected: values[0],
+                forces: rows(state.f64s_len("lattice/forces", 3 * no)?),
+                exchange: rows(state.f64s_len("lattice/exchange", 3 * no)?),
+            })
+            .map_err(bad)?;
+        (self.stepping_seconds, self.fluid_updates, self.max_mach) =
+            (values[1], values[2], values[3]);
+        if let Some(th) = &mut self.thermal {
+            let side = state.f64s_len("thermal/side_heat", 4)?;
+            th.restore_raw_state(porofrac_lbm::ThermalState {
+                g: rows(state.f64s("thermal/g")?),
+                post: rows(state.f64s("thermal/post")?),
+                side_heat: [side[0], side[1], side[2], side[3]],
+                obstacle_heat: state.f64s("thermal/obstacle_heat")?.to_vec(),
+            })
+            .map_err(bad)?;
+        }
         Ok(())
     }
 

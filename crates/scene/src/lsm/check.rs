@@ -111,7 +111,7 @@ pub fn lsm_error(ls: &LoadedScene, e: &LsmError) -> SceneError {
         LsmError::Overlap { .. } | LsmError::NotFinite { .. } => k(&["particles"]),
         LsmError::External { .. } => k(&["loading"]),
         LsmError::Calibration(_) => k(&["bonds", "calibrate"]),
-        LsmError::Interrupted => k(&["lsm"]),
+        LsmError::Interrupted | LsmError::State(_) => k(&["lsm"]),
     };
     ls.error(&key, format!(": {e}"))
 }

@@ -81,6 +81,55 @@ impl CrackLog {
             .flood_loads(solid.disks(), solid.broken(), p, loads)
     }
 
+    /// Save the rows and pressures (the crack's connectivity follows from the broken
+    /// bonds, [`CrackLog::restore`]).
+    pub fn save(&self, state: &mut crate::common::checkpoint::State) {
+        state.put_f64(
+            "crack/rows",
+            self.rows
+                .iter()
+                .flat_map(|r| [r.0, r.3, r.4])
+                .collect::<Vec<_>>(),
+        );
+        let opt = |v: Option<f64>| v.map_or(Vec::new(), |p| vec![p]);
+        state.put_f64("crack/initiation", opt(self.initiation));
+        state.put_f64("crack/breakdown", opt(self.breakdown));
+    }
+
+    /// Put back what [`CrackLog::save`] saved, into a log just built, with `solid`
+    /// restored: the crack is rebuilt by taking in the same broken bonds in the same
+    /// order; `crack.csv` is rewritten at the next [`CrackLog::write_csv`].
+    pub fn restore(
+        &mut self,
+        state: &crate::common::checkpoint::State,
+        solid: &LatticeSolid,
+    ) -> Result<(), RunError> {
+        let rows = state.f64s("crack/rows")?;
+        let n = rows.len() / 3;
+        let broken = solid.broken();
+        if rows.len() != 3 * n || n > broken.len() {
+            return Err(RunError::Checkpoint(format!(
+                "the crack log has {n} rows, the solid {} broken bonds",
+                broken.len()
+            )));
+        }
+        self.rows.clear();
+        for (k, b) in broken[..n].iter().enumerate() {
+            self.extent
+                .add(b.i, b.j, [b.x, b.y])
+                .map_err(|e| RunError::Checkpoint(format!("crack log: {e}")))?;
+            self.rows
+                .push((rows[3 * k], b.i, b.j, rows[3 * k + 1], rows[3 * k + 2]));
+        }
+        let opt = |name: &str| -> Result<Option<f64>, RunError> {
+            Ok(state.f64s(name)?.first().copied())
+        };
+        self.initiation = opt("crack/initiation")?;
+        self.breakdown = opt("crack/breakdown")?;
+        self.written = usize::MAX;
+        Ok(())
+    }
+
     /// Extent of the crack connected to the wall (m from the hole centre).
     pub fn extent(&self) -> f64 {
         self.extent.extent()

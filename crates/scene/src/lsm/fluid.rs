@@ -293,7 +293,7 @@ impl Fluid {
             max_mach: 0.0,
             heat_rows: Vec::new(),
         };
-        f.record();
+        f.record(0.0);
         Ok(Some(f))
     }
 
@@ -341,11 +341,13 @@ impl Fluid {
                 porofrac_lbm::MAX_MACH
             )));
         }
-        self.record();
+        self.record(t);
         Ok((self.pf.stats().substeps - before) as usize)
     }
 
-    fn record(&mut self) {
+    /// Add the row of `heat.csv` of output time `t` (the driver's time of the step, the
+    /// same value as in `probes.csv` and the `.pvd` series).
+    fn record(&mut self, t: f64) {
         if self.pf.thermal().is_none() {
             return;
         }
@@ -360,7 +362,7 @@ impl Fluid {
                 / n as f64
         };
         self.heat_rows.push([
-            self.pf.time(),
+            t,
             h.particles,
             h.fluid,
             h.sides_in,

@@ -50,6 +50,7 @@ use porofrac_particles::tracked::CellContact;
 use porofrac_particles::vtk::ContactLine;
 use porofrac_particles::{Disks, RandomPacking, TrackedCell};
 
+use crate::common::checkpoint::{self, State};
 use crate::common::driver::{Observer, SetupPoll, Stop};
 use crate::common::loaded::{LoadedScene, k, ki, step_count};
 use crate::common::model::{Built, Model, Purpose, RunError, Sizes, StepStats};
@@ -111,6 +112,8 @@ pub struct LsmModel<'a> {
     broken_written: usize,
     history: Vec<[f64; 3]>,
     contacts_pvd: RefCell<Option<PvdWriter>>,
+    /// Index of the output time of the current state (the time of its VTK files).
+    current: usize,
     fluid: Option<fluid::Fluid>,
     /// Polled between the sub-steps of a step.
     stop: Stop,
@@ -419,6 +422,7 @@ pub fn build<'a>(ls: &'a LoadedScene, setup: &mut SetupPoll<'_>) -> Result<LsmMo
         broken_written: 0,
         history: vec![[0.0; 3]],
         contacts_pvd: RefCell::new(None),
+        current: 0,
         fluid,
         stop: setup.stop_handle(),
     })
@@ -536,6 +540,86 @@ fn ramp(t: f64) -> RGBColor {
 }
 
 impl Model for LsmModel<'_> {
+    fn checkpoints(&self) -> bool {
+        // With a lattice Boltzmann fluid ([lbm]) the coupled state is not saved.
+        self.fluid.is_none()
+    }
+
+    fn save_state(&self, state: &mut State) -> Result<(), RunError> {
+        let s = self.solid.save_state();
+        for (name, v) in s.reals {
+            state.put_f64(&format!("solid/{name}"), v);
+        }
+        for (name, v) in s.ints {
+            state.put_u64(&format!("solid/{name}"), v);
+        }
+        state.put_f64("pressure", vec![self.pressure, self.step_seconds]);
+        state.put_f64(
+            "flood",
+            self.flood.iter().flatten().copied().collect::<Vec<_>>(),
+        );
+        state.put_u64(
+            "counts",
+            vec![
+                self.lsm_steps,
+                self.current as u64,
+                self.broken_written as u64,
+            ],
+        );
+        state.put_f64(
+            "history",
+            self.history.iter().flatten().copied().collect::<Vec<_>>(),
+        );
+        if let Some(pvd) = self.contacts_pvd.borrow().as_ref() {
+            checkpoint::save_pvd(state, "contacts_pvd", pvd);
+        }
+        if let Some(c) = &self.crack {
+            c.save(state);
+        }
+        Ok(())
+    }
+
+    fn restore_state(&mut self, state: &State, out: &Path) -> Result<(), RunError> {
+        // The solid's own arrays, by the names a freshly built solid saves.
+        let template = self.solid.save_state();
+        let mut s = porofrac_lsm::SolidState::default();
+        for (name, _) in template.reals {
+            s.reals
+                .push((name, state.f64s(&format!("solid/{name}"))?.to_vec()));
+        }
+        for (name, _) in template.ints {
+            s.ints
+                .push((name, state.u64s(&format!("solid/{name}"))?.to_vec()));
+        }
+        self.solid
+            .restore_state(&s)
+            .map_err(|e| RunError::Checkpoint(e.to_string()))?;
+        let p = state.f64s_len("pressure", 2)?;
+        (self.pressure, self.step_seconds) = (p[0], p[1]);
+        let flood = state.f64s_len("flood", 3 * self.flood.len())?;
+        for (f, v) in self.flood.iter_mut().zip(flood.chunks_exact(3)) {
+            *f = [v[0], v[1], v[2]];
+        }
+        let c = state.u64s_len("counts", 3)?;
+        self.lsm_steps = c[0];
+        self.current = c[1] as usize;
+        // broken.csv is rewritten after the next step.
+        self.broken_written = usize::MAX;
+        let h = state.f64s("history")?;
+        self.history = h.chunks_exact(3).map(|v| [v[0], v[1], v[2]]).collect();
+        if let Some(pvd) = checkpoint::restore_pvd(
+            state,
+            "contacts_pvd",
+            &particle_output::contacts_pvd_path(self.ls, out),
+        )? {
+            *self.contacts_pvd.borrow_mut() = Some(pvd);
+        }
+        if let Some(c) = &mut self.crack {
+            c.restore(state, &self.solid)?;
+        }
+        Ok(())
+    }
+
     fn summary_extras(&self) -> serde_json::Map<String, serde_json::Value> {
         let (t, sh) = self.broken_by_mode();
         let (bu, cu) = self.solid.updates();
@@ -610,8 +694,9 @@ impl Model for LsmModel<'_> {
             self.step_seconds += t0.elapsed().as_secs_f64();
             self.lsm_steps += n as u64;
             self.pressure = f.pressure();
+            self.current = step;
             let (t, sh) = self.broken_by_mode();
-            self.history.push([self.solid.time(), t as f64, sh as f64]);
+            self.history.push([self.times[step], t as f64, sh as f64]);
             return Ok(StepStats {
                 iterations: n,
                 failed: self.solid.broken().len(),
@@ -651,8 +736,9 @@ impl Model for LsmModel<'_> {
         }
         self.step_seconds += t0.elapsed().as_secs_f64();
         self.lsm_steps += n as u64;
+        self.current = step;
         let (t, sh) = self.broken_by_mode();
-        self.history.push([self.solid.time(), t as f64, sh as f64]);
+        self.history.push([self.times[step], t as f64, sh as f64]);
         Ok(StepStats {
             iterations: n,
             failed: self.solid.broken().len(),
@@ -757,7 +843,7 @@ impl Model for LsmModel<'_> {
             self.ls,
             dir,
             index,
-            self.solid.time(),
+            self.times[self.current],
             d,
             &[("broken_bonds", &per)],
             &lines,

@@ -58,6 +58,29 @@ impl FaultProbe {
         }
     }
 
+    /// Save the positions kept at the start of the velocity window (if already taken).
+    pub fn save(&self, state: &mut crate::common::checkpoint::State) {
+        if let Some((t, x)) = &self.snapshot {
+            state.put_f64("fault/snapshot_time", vec![*t]);
+            state.put_pairs("fault/snapshot", x);
+        }
+    }
+
+    /// Put back what [`FaultProbe::save`] saved.
+    pub fn restore(
+        &mut self,
+        state: &crate::common::checkpoint::State,
+    ) -> Result<(), crate::common::model::RunError> {
+        self.snapshot = match state.f64("fault/snapshot_time") {
+            Ok(t) => {
+                let n = state.f64s("fault/snapshot")?.len() / 2;
+                Some((t, state.pairs("fault/snapshot", n)?))
+            }
+            Err(_) => None,
+        };
+        Ok(())
+    }
+
     fn tip(&self, t: f64) -> [f64; 2] {
         let s = self.section.slip_rate * t;
         [

@@ -37,10 +37,12 @@ use crate::common::particle_output;
 use porofrac_nscd::{Axis, ContactLaw, Nscd, NscdError, Ordering, RigidBody, SolverParams};
 use porofrac_particles::{ParticleError, TrackedCell};
 
+use crate::common::checkpoint::{self, State};
 use crate::common::driver::{Observer, SetupPoll};
 use crate::common::loaded::{LoadedScene, k, ki, step_count};
 use crate::common::model::{Built, Model, Purpose, RunError, Sizes, StepStats};
 use crate::common::output::{SolverStats, WallSeconds};
+use porofrac_nscd::detect::Antagonist;
 
 use file::{OrderingChoice, WallComponent};
 
@@ -63,7 +65,7 @@ enum ProbeKind {
     Cell(usize, usize),
 }
 
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 struct RunStats {
     steps: usize,
     sweeps: usize,
@@ -86,6 +88,8 @@ pub struct NscdModel<'a> {
     stats: RunStats,
     step_seconds: f64,
     contacts_pvd: RefCell<Option<PvdWriter>>,
+    /// Index of the output time of the current state (the time of its VTK files).
+    current: usize,
     settling: Option<(porofrac_nscd::SettleStats, f64)>,
     fault: Option<fault::FaultProbe>,
 }
@@ -256,6 +260,7 @@ pub fn build<'a>(
         stats: RunStats::default(),
         step_seconds: 0.0,
         contacts_pvd: RefCell::new(None),
+        current: 0,
         settling,
         fault,
     })
@@ -333,6 +338,145 @@ impl NscdModel<'_> {
 }
 
 impl Model for NscdModel<'_> {
+    fn checkpoints(&self) -> bool {
+        true
+    }
+
+    fn save_state(&self, state: &mut State) -> Result<(), RunError> {
+        checkpoint::save_disks(state, "disks", &self.sys.disks);
+        let b = &self.sys.bodies;
+        state.put_pairs(
+            "bodies/offset",
+            &b.iter().map(|b| b.offset).collect::<Vec<_>>(),
+        );
+        state.put_pairs(
+            "bodies/velocity",
+            &b.iter().map(|b| b.velocity).collect::<Vec<_>>(),
+        );
+        state.put_pairs("force", &self.sys.force);
+        state.put_f64("time", vec![self.sys.time]);
+        let m = self.sys.step_memory();
+        state.put_u64("steps", vec![m.steps, self.current as u64]);
+        state.put_f64("h_last", vec![m.h_last]);
+        let code = |a: &Antagonist| match *a {
+            Antagonist::Disk(j) => u64::from(j),
+            Antagonist::Body(j) => (1 << 32) | u64::from(j),
+        };
+        state.put_u64(
+            "memory/keys",
+            m.contacts
+                .iter()
+                .flat_map(|(k, _, _)| [u64::from(k.0), code(&k.1)])
+                .collect::<Vec<_>>(),
+        );
+        state.put_pairs(
+            "memory/impulse",
+            &m.contacts.iter().map(|c| c.1).collect::<Vec<_>>(),
+        );
+        state.put_u8(
+            "memory/stick",
+            m.contacts.iter().map(|c| u8::from(c.2)).collect::<Vec<_>>(),
+        );
+        let r = &self.stats;
+        state.put_u64(
+            "stats/counts",
+            vec![
+                r.steps as u64,
+                r.sweeps as u64,
+                r.max_sweeps as u64,
+                r.not_converged as u64,
+                r.updates,
+                r.max_contacts as u64,
+            ],
+        );
+        state.put_f64(
+            "stats/values",
+            vec![
+                r.final_residual,
+                r.max_residual,
+                r.solve_seconds,
+                self.step_seconds,
+            ],
+        );
+        if let Some(pvd) = self.contacts_pvd.borrow().as_ref() {
+            checkpoint::save_pvd(state, "contacts_pvd", pvd);
+        }
+        if let Some(f) = &self.fault {
+            f.save(state);
+        }
+        Ok(())
+    }
+
+    fn restore_state(&mut self, state: &State, out: &Path) -> Result<(), RunError> {
+        checkpoint::restore_disks(state, "disks", &mut self.sys.disks)?;
+        let nb = self.sys.bodies.len();
+        let offset = state.pairs("bodies/offset", nb)?;
+        let velocity = state.pairs("bodies/velocity", nb)?;
+        for (b, (o, v)) in self
+            .sys
+            .bodies
+            .iter_mut()
+            .zip(offset.into_iter().zip(velocity))
+        {
+            b.offset = o;
+            b.velocity = v;
+        }
+        self.sys.force = state.pairs("force", self.sys.disks.len())?;
+        self.sys.time = state.f64("time")?;
+        let steps = state.u64s_len("steps", 2)?;
+        let keys = state.u64s("memory/keys")?;
+        let n = keys.len() / 2;
+        let impulse = state.pairs("memory/impulse", n)?;
+        let stick = state.u8s("memory/stick")?;
+        if stick.len() != n || keys.len() != 2 * n {
+            return Err(RunError::Checkpoint(
+                "the contact memory's arrays differ in length".into(),
+            ));
+        }
+        let contacts = (0..n)
+            .map(|c| {
+                let (i, a) = (keys[2 * c] as u32, keys[2 * c + 1]);
+                let other = if a >> 32 == 1 {
+                    Antagonist::Body(a as u32)
+                } else {
+                    Antagonist::Disk(a as u32)
+                };
+                ((i, other), impulse[c], stick[c] != 0)
+            })
+            .collect();
+        self.sys.restore_step_memory(&porofrac_nscd::StepMemory {
+            steps: steps[0],
+            h_last: state.f64("h_last")?,
+            contacts,
+        });
+        self.current = steps[1] as usize;
+        let c = state.u64s_len("stats/counts", 6)?;
+        let v = state.f64s_len("stats/values", 4)?;
+        self.stats = RunStats {
+            steps: c[0] as usize,
+            sweeps: c[1] as usize,
+            max_sweeps: c[2] as usize,
+            final_residual: v[0],
+            max_residual: v[1],
+            not_converged: c[3] as usize,
+            updates: c[4],
+            solve_seconds: v[2],
+            max_contacts: c[5] as usize,
+        };
+        self.step_seconds = v[3];
+        if let Some(pvd) = checkpoint::restore_pvd(
+            state,
+            "contacts_pvd",
+            &particle_output::contacts_pvd_path(self.ls, out),
+        )? {
+            *self.contacts_pvd.borrow_mut() = Some(pvd);
+        }
+        if let Some(f) = &mut self.fault {
+            f.restore(state)?;
+        }
+        Ok(())
+    }
+
     fn summary_extras(&self) -> serde_json::Map<String, serde_json::Value> {
         self.particle_statistics()
             .into_iter()
@@ -351,6 +495,7 @@ impl Model for NscdModel<'_> {
         let h = self.times[step] - self.times[step - 1];
         let t0 = Instant::now();
         let st = self.sys.step(h).map_err(|e| scene_error(self.ls, &e))?;
+        self.current = step;
         self.step_seconds += t0.elapsed().as_secs_f64();
         let r = &mut self.stats;
         r.steps += 1;
@@ -417,7 +562,7 @@ impl Model for NscdModel<'_> {
             self.ls,
             dir,
             index,
-            self.sys.time,
+            self.times[self.current],
             &self.sys.disks,
             &[],
             &lines,
