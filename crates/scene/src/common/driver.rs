@@ -1,6 +1,10 @@
-//! The loop every model runs in: step through the output times, write `probes.csv`,
-//! `lines/<name>.csv`, the VTK series and `<name>.pvd` at the written steps, report
-//! progress, honour interruption, and put together `summary.json`.
+//! The loop every model runs in: step through the output times, sample the probes into
+//! `probes.csv` every `[output] probe_every` steps (default: every step), write
+//! `lines/<name>.csv`, the VTK series and `<name>.pvd` at the written steps (every
+//! `[output] every` steps, the first and the last), report progress, honour
+//! interruption, plot the probes and lines, and put together `summary.json`.
+//!
+//! CSV headers carry units: `time [s]`, `p_well [Pa]` ([`column`]).
 //!
 //! Every file is rewritten atomically after each written step, so whatever stops a run
 //! (an error, Ctrl-C, a killed process) leaves complete files of the finished steps.
@@ -47,8 +51,11 @@ pub struct StepReport {
     pub iterations: usize,
     /// Solver iterations so far.
     pub total_iterations: usize,
-    /// Failed cells (or broken bonds) so far.
+    /// What has failed so far, in the model's terms (`failed_name`).
     pub failed: usize,
+    /// What `failed` counts (`"fractured cells"`, `"broken bonds"`); `None` for a model
+    /// in which nothing fails (the progress line then leaves the count out).
+    pub failed_name: Option<&'static str>,
 }
 
 /// Where the build of a model is: `done` of `total` units of a phase (see
@@ -224,13 +231,14 @@ pub(crate) fn interrupted_in_setup(ls: &LoadedScene, start: Instant, dim: usize)
         scene: ls.scene.scene.name.clone(),
         model: ls.model().to_string(),
         dim,
-        cells: 0,
-        nodes: 0,
-        dofs: 0,
+        cells: None,
+        nodes: None,
+        dofs: None,
+        sizes_text: String::new(),
         steps: 0,
         status: "interrupted at t = 0".into(),
         interrupted_at: Some(0.0),
-        fractured_cells: 0,
+        fractured_cells: None,
         wall_seconds: wall,
         peak_memory_bytes: peak_memory_bytes(),
         solver: Default::default(),
@@ -284,6 +292,12 @@ fn check_finite(
     Ok(())
 }
 
+/// A CSV column header: the name and the unit in brackets, `p_well [Pa]`, `time [s]`
+/// (`[1]`: a number without unit). Readers split at the last ` [`.
+pub fn column(name: &str, unit: &str) -> String {
+    format!("{name} [{unit}]")
+}
+
 /// An observer that reports nothing and never stops a run.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Silent;
@@ -303,24 +317,32 @@ pub(crate) fn drive(
 ) -> Result<Summary, RunError> {
     let s = &ls.scene;
     let mut output_seconds = 0.0;
-    let mut header = vec!["time".to_string()];
-    header.extend(s.output.probe.iter().map(|p| p.name.clone()));
+    let mut header = vec![column("time", "s")];
+    header.extend(
+        s.output
+            .probe
+            .iter()
+            .map(|p| column(&p.name, model.unit(&p.field))),
+    );
     let mut probes = CsvTable::new(out.join("probes.csv"), &header);
     let axes = ["x", "y", "z"];
-    let mut line_header = vec!["time".to_string(), "s".to_string()];
-    line_header.extend(axes[..dim].iter().map(|a| a.to_string()));
-    line_header.push("value".into());
     let mut lines: Vec<CsvTable> = s
         .output
         .line
         .iter()
         .map(|l| {
+            let mut line_header = vec![column("time", "s"), column("s", "m")];
+            line_header.extend(axes[..dim].iter().map(|a| column(a, "m")));
+            line_header.push(column(&l.field, model.unit(&l.field)));
             CsvTable::new(
                 out.join("lines").join(format!("{}.csv", l.name)),
                 &line_header,
             )
         })
         .collect();
+    // Snapshots of every line for its end-of-run plot: the rows at (up to) six of the
+    // written times, spread over the run, and the last one.
+    let mut line_snapshots: Vec<Vec<(f64, Vec<Vec<f64>>)>> = vec![Vec::new(); lines.len()];
     let vtk_dir = out.join("vtk");
     let mut pvd = if s.output.vtk {
         std::fs::create_dir_all(&vtk_dir).map_err(|source| OutputError {
@@ -335,7 +357,14 @@ pub(crate) fn drive(
     };
 
     let times = model.times().to_vec();
+    let probe_every = s.output.probe_every.max(1) as usize;
+    let write_every = s.output.every.max(1) as usize;
+    // The written steps a complete run has, and the ones whose lines are plotted.
+    let planned_writes = (times.len().saturating_sub(1)).div_ceil(write_every) + 1;
+    let snapshot_stride = planned_writes.div_ceil(6).max(1);
+    let failed_name = model.sizes().failed;
     let mut series: Vec<Vec<f64>> = vec![Vec::new(); s.output.probe.len()];
+    let mut sampled: Vec<f64> = Vec::new();
     let mut written: Vec<f64> = Vec::new();
     let mut extrema = BTreeMap::new();
     let mut total_iterations = 0;
@@ -355,20 +384,28 @@ pub(crate) fn drive(
         model.after_step(out)?;
         let stop = step + 1 < times.len() && observer.stop_requested();
         let write =
-            step == 0 || step % s.output.every as usize == 0 || step + 1 == times.len() || stop;
-        if write {
+            step == 0 || step % write_every == 0 || step + 1 == times.len() || stop;
+        // Probes are sampled at their own interval and at every written step; sampling
+        // only reads the state.
+        let sample = write || step % probe_every == 0;
+        if sample {
             let t_out = Instant::now();
             row.clear();
             row.push(t);
             let first = row.len();
             model.probes(&mut row);
-            let step_extrema = model.field_extrema();
+            let step_extrema = if write {
+                model.field_extrema()
+            } else {
+                BTreeMap::new()
+            };
             check_finite(ls, t, &row[first..], &step_extrema, &|i| {
                 model.probe_may_be_undefined(i)
             })?;
-            // Every line of the step, checked before anything of the step is written.
+            // Every line of a written step, checked before anything of the step is
+            // written.
             let mut line_rows: Vec<Vec<Vec<f64>>> = Vec::with_capacity(lines.len());
-            for i in 0..lines.len() {
+            for i in (0..lines.len()).filter(|_| write) {
                 let mut rows = Vec::new();
                 model.line(i, &mut rows);
                 if let Some(v) = rows.iter().flatten().find(|v| !v.is_finite()) {
@@ -389,18 +426,28 @@ pub(crate) fn drive(
                 series[j].push(*v);
             }
             probes.push(&row)?;
-            for (table, mut rows) in lines.iter_mut().zip(line_rows) {
-                for r in &mut rows {
-                    r.insert(0, t);
+            sampled.push(t);
+            if write {
+                let last = step + 1 == times.len() || stop;
+                let snapshot = last || written.len() % snapshot_stride == 0;
+                for ((table, mut rows), snaps) in
+                    lines.iter_mut().zip(line_rows).zip(&mut line_snapshots)
+                {
+                    if snapshot && s.output.plots {
+                        snaps.push((t, rows.clone()));
+                    }
+                    for r in &mut rows {
+                        r.insert(0, t);
+                    }
+                    table.push_rows(&rows)?;
                 }
-                table.push_rows(&rows)?;
+                if let Some(pvd) = pvd.as_mut() {
+                    let name = model.write_vtk(&vtk_dir, written.len())?;
+                    pvd.add(t, format!("vtk/{name}"))?;
+                }
+                extrema = step_extrema;
+                written.push(t);
             }
-            if let Some(pvd) = pvd.as_mut() {
-                let name = model.write_vtk(&vtk_dir, written.len())?;
-                pvd.add(t, format!("vtk/{name}"))?;
-            }
-            extrema = step_extrema;
-            written.push(t);
             output_seconds += t_out.elapsed().as_secs_f64();
         }
         if step > 0 {
@@ -414,6 +461,7 @@ pub(crate) fn drive(
             iterations: stats.iterations,
             total_iterations,
             failed: stats.failed,
+            failed_name,
         });
         if stop {
             interrupted = Some(t);
@@ -425,7 +473,16 @@ pub(crate) fn drive(
     output_seconds += t_out.elapsed().as_secs_f64();
     if s.output.plots {
         let t_out = Instant::now();
-        model.plots(&out.join("plots"), &written, &series)?;
+        model.plots(&out.join("plots"), &sampled, &series)?;
+        for (l, snaps) in s.output.line.iter().zip(&line_snapshots) {
+            crate::common::plots::line_profiles(
+                &out.join("plots").join(format!("line_{}.png", l.name)),
+                &format!("{}: {} along line {}", s.scene.name, l.field, l.name),
+                &l.field,
+                model.unit(&l.field),
+                snaps,
+            )?;
+        }
         output_seconds += t_out.elapsed().as_secs_f64();
     }
     let sizes = model.sizes();
@@ -440,13 +497,14 @@ pub(crate) fn drive(
         cells: sizes.cells,
         nodes: sizes.nodes,
         dofs: sizes.dofs,
+        sizes_text: sizes.counts_text(),
         steps,
         status: match interrupted {
             Some(t) => format!("interrupted at t = {t}"),
             None => "ok".into(),
         },
         interrupted_at: interrupted,
-        fractured_cells: model.failed(),
+        fractured_cells: (sizes.failed == Some("fractured cells")).then(|| model.failed()),
         wall_seconds: wall,
         peak_memory_bytes: peak_memory_bytes(),
         solver: model.solver_stats(),

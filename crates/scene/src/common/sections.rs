@@ -610,9 +610,13 @@ pub struct Output {
     /// Write PNG plots.
     #[serde(default = "yes")]
     pub plots: bool,
-    /// Write every n-th step.
+    /// Write every n-th step (VTK, lines).
     #[serde(default = "one")]
     pub every: i64,
+    /// Sample the probes into `probes.csv` every n-th step (and at every written step),
+    /// independently of `every`; default 1: every step.
+    #[serde(default = "one")]
+    pub probe_every: i64,
     /// `[[output.probe]]`.
     #[serde(default)]
     pub probe: Vec<Probe>,
@@ -630,6 +634,7 @@ impl Default for Output {
             vtk: true,
             plots: true,
             every: 1,
+            probe_every: 1,
             probe: Vec::new(),
             line: Vec::new(),
             exact_displacement: None,

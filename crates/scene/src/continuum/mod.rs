@@ -749,11 +749,22 @@ impl<const D: usize> Model for Stepper<'_, D> {
     }
 
     fn sizes(&self) -> Sizes {
+        let (cells, nodes, dofs) = (
+            self.body.grid.num_cells(),
+            self.body.grid.num_nodes(),
+            self.body.dofs.num_equations(),
+        );
         Sizes {
-            cells: self.body.grid.num_cells(),
-            nodes: self.body.grid.num_nodes(),
-            dofs: self.body.dofs.num_equations(),
+            cells: Some(cells),
+            nodes: Some(nodes),
+            dofs: Some(dofs),
+            counts: vec![("cells", cells), ("nodes", nodes), ("unknowns", dofs)],
+            failed: Some("fractured cells"),
         }
+    }
+
+    fn unit(&self, field: &str) -> &'static str {
+        fields::unit(field)
     }
 
     fn failed(&self) -> usize {

@@ -39,7 +39,6 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::time::Instant;
 
-use plotters::style::RGBColor;
 use porofrac_grid::io::PvdWriter;
 use porofrac_lsm::calibrate::{QuasiStatic, brazilian_polled, hexagonal_moduli, uniaxial_polled};
 use porofrac_lsm::{
@@ -55,6 +54,7 @@ use crate::common::loaded::{LoadedScene, k, ki, step_count};
 use crate::common::model::{Model, RunError, Sizes, StepStats};
 use crate::common::output::{SolverStats, Summary, WallSeconds};
 use crate::common::particle_output::{self, PARTICLE_FIELDS};
+use crate::common::plots::Column;
 
 use file::{DampingChoice, NormalChoice, WallChoice};
 
@@ -514,27 +514,6 @@ fn push_link(
     });
 }
 
-/// A blue–green–yellow–red ramp for t in [0, 1].
-fn ramp(t: f64) -> RGBColor {
-    let stops = [
-        (49.0, 54.0, 149.0),
-        (69.0, 117.0, 180.0),
-        (116.0, 196.0, 118.0),
-        (254.0, 224.0, 71.0),
-        (215.0, 48.0, 39.0),
-    ];
-    let t = if t.is_finite() {
-        t.clamp(0.0, 1.0)
-    } else {
-        0.0
-    } * (stops.len() - 1) as f64;
-    let k = (t as usize).min(stops.len() - 2);
-    let f = t - k as f64;
-    let (a, b) = (stops[k], stops[k + 1]);
-    let mix = |x: f64, y: f64| (x + f * (y - x)).round() as u8;
-    RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
-}
-
 impl Model for LsmModel<'_> {
     fn summary_extras(&self) -> serde_json::Map<String, serde_json::Value> {
         let (t, sh) = self.broken_by_mode();
@@ -797,9 +776,15 @@ impl Model for LsmModel<'_> {
             &self.ls.scene.scene.name,
             written,
             &probes,
+            check::unit,
         )?;
         if let Some(f) = &self.fluid {
-            f.plots(dir, &self.solid)?;
+            f.plots(
+                dir,
+                &self.solid,
+                &self.ls.scene.scene.name,
+                written.last().copied().unwrap_or(0.0),
+            )?;
         }
         let d = self.solid.disks();
         let u: Vec<f64> = (0..d.len())
@@ -808,31 +793,36 @@ impl Model for LsmModel<'_> {
                 (u[0] * u[0] + u[1] * u[1]).sqrt()
             })
             .collect();
-        let umax = u.iter().copied().fold(0.0, f64::max).max(1e-300);
         let segments: Vec<([f64; 2], [f64; 2])> = self
             .solid
             .broken()
             .iter()
             .map(|b| (d.x[b.i], d.x[b.j]))
             .collect();
+        let t = written.last().copied().unwrap_or(0.0);
+        let title = format!(
+            "{}: displacement at t = {} s, broken bonds in black",
+            self.ls.scene.scene.name,
+            crate::common::plots::tick(t)
+        );
         particle_output::draw_disks(
             &dir.join("particles.png"),
             d,
-            |i| ramp(u[i] / umax),
-            &segments,
+            &particle_output::DiskPicture {
+                title: &title,
+                values: &u,
+                bar: "|u| [m]",
+                unit: "m",
+                segments: &segments,
+            },
         )?;
         let times: Vec<f64> = self.history.iter().map(|h| h[0]).collect();
         let columns = vec![
-            (
-                "tensile".to_string(),
-                self.history.iter().map(|h| h[1]).collect(),
-            ),
-            (
-                "shear".to_string(),
-                self.history.iter().map(|h| h[2]).collect(),
-            ),
-            (
-                "total".to_string(),
+            Column::new("tensile", "1", self.history.iter().map(|h| h[1]).collect()),
+            Column::new("shear", "1", self.history.iter().map(|h| h[2]).collect()),
+            Column::new(
+                "total",
+                "1",
                 self.history.iter().map(|h| h[1] + h[2]).collect(),
             ),
         ];
@@ -847,10 +837,17 @@ impl Model for LsmModel<'_> {
 
     fn sizes(&self) -> Sizes {
         Sizes {
-            cells: self.solid.disks().len(),
-            nodes: 0,
-            dofs: 3 * self.solid.disks().len(),
+            counts: vec![
+                ("particles", self.solid.disks().len()),
+                ("bonds", self.solid.bonds().len()),
+            ],
+            failed: Some("broken bonds"),
+            ..Sizes::default()
         }
+    }
+
+    fn unit(&self, field: &str) -> &'static str {
+        check::unit(field)
     }
 
     fn failed(&self) -> usize {
@@ -871,7 +868,7 @@ impl Model for LsmModel<'_> {
 
     fn wall_seconds(&self) -> WallSeconds {
         WallSeconds {
-            assembly: self.step_seconds,
+            stepping: self.step_seconds,
             ..WallSeconds::default()
         }
     }
