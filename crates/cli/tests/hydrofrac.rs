@@ -92,8 +92,8 @@ fn fractures(out: &Path) -> Vec<[f64; 3]> {
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
     assert!(
-        header == ["cell", "x", "y", "time", "mode"]
-            || header == ["cell", "x", "y", "z", "time", "mode"],
+        header == ["cell", "x [m]", "y [m]", "time [s]", "mode"]
+            || header == ["cell", "x [m]", "y [m]", "z [m]", "time [s]", "mode"],
         "{header:?}"
     );
     let time = header.len() - 2;
@@ -206,7 +206,7 @@ fn seed_scene_fracture_starts_at_the_well_and_grows_along_the_largest_compressio
     check_one_crack(&out, 90.0, 1.0 / 12.0);
     // Injection raised the well pressure above p0.
     let (header, rows) = read_csv(&out.join("probes.csv"));
-    assert_eq!(header[1], "p_well");
+    assert_eq!(header[1], "p_well [Pa]");
     assert_eq!(rows[0][1], 1e7);
     assert!(rows.last().unwrap()[1] > 1.1e7, "{:?}", rows.last());
     // Figs. 4 and 5.
@@ -415,7 +415,7 @@ fn no_injection_no_fracture() {
 fn fractures_3d(out: &Path) -> Vec<[f64; 4]> {
     let text = std::fs::read_to_string(out.join("fracture.csv")).unwrap();
     let mut lines = text.lines();
-    assert_eq!(lines.next(), Some("cell,x,y,z,time,mode"));
+    assert_eq!(lines.next(), Some("cell,x [m],y [m],z [m],time [s],mode"));
     lines
         .map(|l| {
             let f: Vec<&str> = l.split(',').collect();

@@ -189,9 +189,10 @@ fn mandel_scene_matches_the_closed_form() {
     let names: Vec<String> = xs
         .iter()
         .map(|x| format!("p_{:04}", (x * 1e4_f64).round() as i64))
-        .chain(["platen_uy".to_string()])
+        .map(|n| format!("{n} [Pa]"))
+        .chain(["platen_uy [m]".to_string()])
         .collect();
-    assert_eq!(header[0], "time");
+    assert_eq!(header[0], "time [s]");
     assert_eq!(&header[1..], names.as_slice());
     // t = 0 and every tenth step of 0.01 s up to 2 s.
     assert_eq!(rows.len(), 21);

@@ -292,10 +292,15 @@ fn check_finite(
     Ok(())
 }
 
-/// A CSV column header: the name and the unit in brackets, `p_well [Pa]`, `time [s]`
-/// (`[1]`: a number without unit). Readers split at the last ` [`.
+/// A CSV column header: the name and the unit in brackets, `p_well [Pa]`, `time [s]`;
+/// the name alone for numbers without a unit (`"1"`: ratios, counts, flags, indices).
+/// A reader takes the name as what comes before ` [`.
 pub fn column(name: &str, unit: &str) -> String {
-    format!("{name} [{unit}]")
+    if unit == "1" || unit.is_empty() {
+        name.to_string()
+    } else {
+        format!("{name} [{unit}]")
+    }
 }
 
 /// An observer that reports nothing and never stops a run.

@@ -233,8 +233,8 @@ pub fn draw_disks(path: &Path, d: &Disks, picture: &DiskPicture<'_>) -> Result<(
                 .disable_mesh()
                 .x_desc("x [m]")
                 .y_desc("y [m]")
-                .x_label_formatter(&|v| crate::common::plots::tick(*v))
-                .y_label_formatter(&|v| crate::common::plots::tick(*v))
+                .x_label_formatter(&crate::common::plots::axis_ticks(b[0], b[1]))
+                .y_label_formatter(&crate::common::plots::axis_ticks(b[2], b[3]))
                 .draw()
                 .map_err(perr(path))?;
             let (xr, yr) = chart.plotting_area().get_pixel_range();

@@ -338,6 +338,29 @@ pub fn tick(v: f64) -> String {
     }
 }
 
+/// Tick labels for an axis from `lo` to `hi`, all in one form: plain decimals when the
+/// largest magnitude is between 1e-3 and 1e5 (`0.0002`, `1500`), else a mantissa with
+/// the axis's common exponent (`1.5e6`, `2e6`); as many decimals as the ticks need.
+pub fn axis_ticks(lo: f64, hi: f64) -> impl Fn(&f64) -> String {
+    let m = lo.abs().max(hi.abs());
+    let plain = m == 0.0 || !m.is_finite() || (1e-3..1e5).contains(&m);
+    let e = if plain { 0 } else { m.log10().floor() as i32 };
+    let scale = 10f64.powi(e);
+    let step = ((hi - lo).abs() / 20.0 / scale).max(1e-12);
+    let decimals = (-step.log10()).ceil().clamp(0.0, 9.0) as usize;
+    move |v: &f64| {
+        let x = *v / scale;
+        let mut t = format!("{x:.decimals$}");
+        if t.contains('.') {
+            t = t.trim_end_matches('0').trim_end_matches('.').to_string();
+        }
+        if t == "-0" || t == "0" {
+            return "0".into();
+        }
+        if e == 0 { t } else { format!("{t}e{e}") }
+    }
+}
+
 /// The time unit that reads best for times up to `t_max` seconds: the factor to divide
 /// by and its name (`ms` below a second, `min`, `h`, `d` for long runs).
 pub fn time_unit(t_max: f64) -> (f64, &'static str) {
@@ -385,7 +408,7 @@ pub(crate) fn colour_bar<DB: DrawingBackend>(
         .disable_x_axis()
         .y_labels(if range.uniform { 1 } else { 8 })
         .y_label_style(("sans-serif", 13))
-        .y_label_formatter(&|v| tick(*v))
+        .y_label_formatter(&axis_ticks(lo, hi))
         .draw()
         .map_err(e)?;
     let steps = 100;
@@ -518,8 +541,8 @@ pub fn field(path: &Path, plot: &FieldPlot<'_>, values: Values<'_>) -> Result<()
                 .disable_mesh()
                 .x_desc("x [m]")
                 .y_desc("y [m]")
-                .x_label_formatter(&|v| tick(*v))
-                .y_label_formatter(&|v| tick(*v))
+                .x_label_formatter(&axis_ticks(lo[0], hi[0]))
+                .y_label_formatter(&axis_ticks(lo[1], hi[1]))
                 .draw()
                 .map_err(perr(path))?;
             let polys = pieces
@@ -584,13 +607,17 @@ impl Column {
 
 /// Plot time series against time, one panel per unit (stacked, sharing the time axis,
 /// each y axis named with its probes and unit); the time axis in s or the multiple that
-/// reads best ([`time_unit`]).
+/// reads best ([`time_unit`]). Nothing is drawn for fewer than two times (a static
+/// solve: the values are in the CSV).
 pub fn time_series(
     path: &Path,
     times: &[f64],
     columns: &[Column],
     title: &str,
 ) -> Result<(), PlotError> {
+    if times.len() < 2 || columns.is_empty() {
+        return Ok(());
+    }
     register_font();
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir).map_err(perr(path))?;
@@ -659,8 +686,8 @@ pub fn time_series(
                     .configure_mesh()
                     .x_desc(format!("time [{tu}]"))
                     .y_desc(y_desc)
-                    .x_label_formatter(&|v| tick(*v))
-                    .y_label_formatter(&|v| tick(*v))
+                    .x_label_formatter(&axis_ticks(t0, t1))
+                    .y_label_formatter(&axis_ticks(lo, hi))
                     .draw()
                     .map_err(perr(path))?;
                 for (k, c) in &cols {
@@ -757,8 +784,8 @@ pub fn line_profiles(
                 .configure_mesh()
                 .x_desc("distance along the line [m]")
                 .y_desc(label(field, unit))
-                .x_label_formatter(&|v| tick(*v))
-                .y_label_formatter(&|v| tick(*v))
+                .x_label_formatter(&axis_ticks(s0, s1))
+                .y_label_formatter(&axis_ticks(lo, hi))
                 .draw()
                 .map_err(perr(path))?;
             let n = snapshots.len();
@@ -832,6 +859,12 @@ mod tests {
         assert_eq!(tick(-1.5e6), "-1.5e6");
         assert_eq!(tick(3.25e-9), "3.25e-9");
         assert_eq!(tick(0.0), "0");
+        let f = axis_ticks(0.0, 1e-3);
+        assert_eq!([f(&0.0), f(&1e-4), f(&1e-3)], ["0", "0.0001", "0.001"]);
+        let f = axis_ticks(-2e6, 4e6);
+        assert_eq!([f(&-1.5e6), f(&4e6)], ["-1.5e6", "4e6"]);
+        let f = axis_ticks(0.0, 40.0);
+        assert_eq!([f(&5.0), f(&40.0)], ["5", "40"]);
         assert_eq!(time_unit(40.0), (1.0, "s"));
         assert_eq!(time_unit(0.02), (1e-3, "ms"));
         assert_eq!(time_unit(3e-5), (1e-6, "µs"));

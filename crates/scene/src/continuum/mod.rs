@@ -355,8 +355,8 @@ impl<'a, const D: usize> Stepper<'a, D> {
         let (probes, lines) = locate_outputs(ls, grid)?;
         let axes = ["x", "y", "z"];
         let mut header = vec!["cell".to_string()];
-        header.extend(axes[..D].iter().map(|a| a.to_string()));
-        header.extend(["time".to_string(), "mode".to_string()]);
+        header.extend(axes[..D].iter().map(|a| format!("{a} [m]")));
+        header.extend(["time [s]".to_string(), "mode".to_string()]);
         let mut fracture_csv = CsvTable::new(out.join("fracture.csv"), &header);
         fracture_csv.flush()?;
         let nu_of_cell = comp

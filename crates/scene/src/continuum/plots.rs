@@ -115,13 +115,13 @@ pub(crate) fn write_plots<const D: usize>(
         let t_last = written_times.last().copied().unwrap_or(0.0);
         let noise = noise_floors(&plots);
         for (name, vals) in &plots {
-            let (quantity, unit) = quantity(name);
+            let (long, short, unit) = quantity(name);
             let title = format!(
-                "{}: {quantity} at t = {} s{where_}",
+                "{}: {long} at t = {} s{where_}",
                 s.scene.name,
                 tick(t_last)
             );
-            let bar = label(quantity, unit);
+            let bar = label(short, unit);
             let mut plot = FieldPlot::new(&canvas, &title, &bar, unit, &marked);
             plot.noise = noise(name);
             crate::common::plots::field(
@@ -151,21 +151,22 @@ pub(crate) fn write_plots<const D: usize>(
     Ok(())
 }
 
-/// What a field plot is called and its unit: `("σ_xx", "Pa")`.
-fn quantity(name: &str) -> (&'static str, &'static str) {
+/// What a field plot is called in its title, in its colour bar, and its unit:
+/// `("σ_max (largest principal)", "σ_max", "Pa")`.
+fn quantity(name: &str) -> (&'static str, &'static str, &'static str) {
     match name {
-        "ux" => ("u_x", "m"),
-        "uy" => ("u_y", "m"),
-        "uz" => ("u_z", "m"),
-        "sxx" => ("σ_xx", "Pa"),
-        "syy" => ("σ_yy", "Pa"),
-        "szz" => ("σ_zz", "Pa"),
-        "sxy" => ("σ_xy", "Pa"),
-        "smax" => ("σ_max (largest principal)", "Pa"),
-        "smin" => ("σ_min (smallest principal)", "Pa"),
-        "divergence" => ("div u (volume strain)", "1"),
-        "pressure" => ("pore pressure p", "Pa"),
-        _ => ("value", "1"),
+        "ux" => ("u_x", "u_x", "m"),
+        "uy" => ("u_y", "u_y", "m"),
+        "uz" => ("u_z", "u_z", "m"),
+        "sxx" => ("σ_xx", "σ_xx", "Pa"),
+        "syy" => ("σ_yy", "σ_yy", "Pa"),
+        "szz" => ("σ_zz", "σ_zz", "Pa"),
+        "sxy" => ("σ_xy", "σ_xy", "Pa"),
+        "smax" => ("σ_max (largest principal stress)", "σ_max", "Pa"),
+        "smin" => ("σ_min (smallest principal stress)", "σ_min", "Pa"),
+        "divergence" => ("div u (volume strain)", "div u", "1"),
+        "pressure" => ("pore pressure", "p", "Pa"),
+        _ => ("value", "value", "1"),
     }
 }
 
@@ -261,9 +262,9 @@ fn fracture_plots(
         stress.iter().map(principal_directions).unzip();
     let noise = noise_floors(plots);
     for (name, vals) in plots {
-        let (quantity, unit) = quantity(name);
-        let title = format!("{quantity} at t = {} s, near the fracture", tick(t));
-        let bar = label(quantity, unit);
+        let (long, short, unit) = quantity(name);
+        let title = format!("{long} at t = {} s, near the fracture", tick(t));
+        let bar = label(short, unit);
         let mut plot = FieldPlot::new(canvas, &title, &bar, unit, marked);
         plot.noise = noise(name);
         plot.window = Some(window);

@@ -484,7 +484,9 @@ impl Fluid {
             return Ok(());
         }
         let mut text = String::from(
-            "time,particle_heat,fluid_heat,side_inflow,extracted_from_particles,carried,defect,mean_particle_temperature\n",
+            "time [s],particle_heat [J/m],fluid_heat [J/m],side_inflow [J/m],\
+             extracted_from_particles [J/m],carried [J/m],defect [J/m],\
+             mean_particle_temperature [°C]\n",
         );
         for r in &self.heat_rows {
             let row: Vec<String> = r.iter().map(|v| format!("{v:e}")).collect();

@@ -15,7 +15,7 @@
 //!   lines,
 //!   `vtk/particles_NNNN.vtp` (with `broken_bonds` per particle) and
 //!   `vtk/contacts_NNNN.vtp` (intact bonds `bonded = 1`, touching contacts `0`),
-//!   `broken.csv` (`time,i,j,x,y,mode`), with a pressurised hole `crack.csv`
+//!   `broken.csv` (`time [s],i,j,x [m],y [m],mode`), with a pressurised hole `crack.csv`
 //!   ([`crack::CrackLog`]), field extrema and `summary.json` keys
 //!   (`particles`, `bonds`, `broken_bonds`, `broken_tensile`, `broken_shear`,
 //!   `contacts`, `lsm_steps`, `dt`, `stable_dt`, `bond_updates_per_second`,
@@ -706,7 +706,7 @@ impl Model for LsmModel<'_> {
         if broken.len() == self.broken_written && self.broken_written > 0 {
             return Ok(());
         }
-        let mut text = String::from("time,i,j,x,y,mode\n");
+        let mut text = String::from("time [s],i,j,x [m],y [m],mode\n");
         for b in broken {
             text.push_str(&format!(
                 "{:e},{},{},{:e},{:e},{}\n",

@@ -9,7 +9,7 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use crate::common::plots::{ColourRange, PlotError, colour_bar, tick};
+use crate::common::plots::{ColourRange, PlotError, axis_ticks, colour_bar};
 
 /// What a lattice image shows besides the values.
 #[derive(Clone, Copy, Debug)]
@@ -87,8 +87,8 @@ pub(crate) fn field_png(
                 .disable_mesh()
                 .x_desc("x [m]")
                 .y_desc("y [m]")
-                .x_label_formatter(&|v| tick(*v))
-                .y_label_formatter(&|v| tick(*v))
+                .x_label_formatter(&axis_ticks(x0, x1))
+                .y_label_formatter(&axis_ticks(y0, y1))
                 .draw()
                 .map_err(e)?;
             let (xr, yr) = chart.plotting_area().get_pixel_range();
