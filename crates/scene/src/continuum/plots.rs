@@ -73,7 +73,7 @@ pub(crate) fn write_plots<const D: usize>(
                 let z = lo[2] + (0.5 + 1e-4) * (hi[2] - lo[2]);
                 (
                     crate::common::plots::Canvas::z_slice(g3, z),
-                    format!(" on z = {:.4}", 0.5 * (lo[2] + hi[2])),
+                    format!(" on z = {} m", tick(0.5 * (lo[2] + hi[2]))),
                 )
             }
             _ => unreachable!("grids are 2D or 3D"),
