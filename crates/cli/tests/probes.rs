@@ -70,7 +70,10 @@ fn flagship_probes_every_step_and_every_third_step_match_the_written_steps_bit_f
     assert!(err.contains("step 40/40: "), "{err}");
     assert!(!err.contains("step 41/"), "{err}");
     assert!(err.contains("fractured cells"), "{err}");
-    assert!(err.contains("19500 cells, 10375 nodes, 20657 unknowns, 40 steps"), "{err}");
+    assert!(
+        err.contains("19500 cells, 10375 nodes, 20657 unknowns, 40 steps"),
+        "{err}"
+    );
 
     // Sampling only at the VTK steps (every 10th), as before `probe_every`.
     let sub = dir.join("vtk-steps");
@@ -158,7 +161,10 @@ fn lattice_and_contact_runs_speak_their_own_words() {
     let out = dir.join("nscd");
     let err = run(&root().join("scenes/nscd/column.toml"), &out);
     assert!(!err.contains("fractured"), "{err}");
-    assert!(err.contains(" disks, ") && err.contains(" contacts, "), "{err}");
+    assert!(
+        err.contains(" disks, ") && err.contains(" contacts, "),
+        "{err}"
+    );
     let s = summary(&out);
     for key in ["cells", "nodes", "dofs", "fractured_cells"] {
         assert!(s.get(key).is_none(), "{key} in {s}");

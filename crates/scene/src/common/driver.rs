@@ -388,8 +388,7 @@ pub(crate) fn drive(
         };
         model.after_step(out)?;
         let stop = step + 1 < times.len() && observer.stop_requested();
-        let write =
-            step == 0 || step % write_every == 0 || step + 1 == times.len() || stop;
+        let write = step == 0 || step % write_every == 0 || step + 1 == times.len() || stop;
         // Probes are sampled at their own interval and at every written step; sampling
         // only reads the state.
         let sample = write || step % probe_every == 0;

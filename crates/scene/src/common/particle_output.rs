@@ -240,7 +240,8 @@ pub fn draw_disks(path: &Path, d: &Disks, picture: &DiskPicture<'_>) -> Result<(
             let (xr, yr) = chart.plotting_area().get_pixel_range();
             // Pixels per metre (the smaller of the two axes, so disks stay round).
             let scale = ((xr.end - xr.start) as f64 / w).min((yr.end - yr.start) as f64 / h);
-            let colour = |i: usize| range.colour(picture.values.get(i).copied().unwrap_or(f64::NAN));
+            let colour =
+                |i: usize| range.colour(picture.values.get(i).copied().unwrap_or(f64::NAN));
             chart
                 .draw_series((0..d.len()).map(|i| {
                     let r = ((d.r[i] * scale).round() as i32).max(1);

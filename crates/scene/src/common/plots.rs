@@ -636,11 +636,9 @@ pub fn time_series(
     atomic_png(
         path,
         |tmp| {
-            let root = BitMapBackend::new(tmp, (900, height)).into_drawing_area();
+            let root = BitMapBackend::new(tmp, (1000, height)).into_drawing_area();
             root.fill(&WHITE).map_err(perr(path))?;
-            let root = root
-                .titled(title, ("sans-serif", 22))
-                .map_err(perr(path))?;
+            let root = root.titled(title, ("sans-serif", 22)).map_err(perr(path))?;
             let panels = root.split_evenly((units.len().max(1), 1));
             let t0 = times.first().copied().unwrap_or(0.0) / scale;
             let t1 = times.last().copied().unwrap_or(1.0) / scale;
@@ -676,7 +674,8 @@ pub fn time_series(
                 } else {
                     format!("[{unit}]")
                 };
-                let mut chart = ChartBuilder::on(panel)
+                let (panel, key) = panel.split_horizontally(1000 - LEGEND_WIDTH);
+                let mut chart = ChartBuilder::on(&panel)
                     .margin(12)
                     .x_label_area_size(40)
                     .y_label_area_size(95)
@@ -690,8 +689,10 @@ pub fn time_series(
                     .y_label_formatter(&axis_ticks(lo, hi))
                     .draw()
                     .map_err(perr(path))?;
+                let mut entries = Vec::new();
                 for (k, c) in &cols {
                     let color = Palette99::pick(*k).to_rgba();
+                    entries.push((c.name.clone(), color));
                     let pts: Vec<(f64, f64)> = times
                         .iter()
                         .map(|t| t / scale)
@@ -707,26 +708,52 @@ pub fn time_series(
                             .draw_series(LineSeries::new(pts, color.stroke_width(2)))
                             .map_err(perr(path))?;
                     }
-                    let label_series = chart
-                        .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
-                        .map_err(perr(path))?;
-                    label_series.label(c.name.clone()).legend(move |(x, y)| {
-                        PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
-                    });
                 }
-                chart
-                    .configure_series_labels()
-                    .position(SeriesLabelPosition::UpperLeft)
-                    .background_style(WHITE.mix(0.8))
-                    .border_style(BLACK)
-                    .draw()
-                    .map_err(perr(path))?;
+                legend(&key, &entries).map_err(perr(path))?;
             }
             root.present().map_err(perr(path))?;
             Ok(())
         },
         perr::<String>(path),
     )
+}
+
+/// Width of the legend column beside a chart (pixels).
+const LEGEND_WIDTH: u32 = 180;
+
+/// A legend in its own column beside the chart (never over the curves): a short line of
+/// each colour and its name, as many as fit.
+fn legend<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    entries: &[(String, RGBAColor)],
+) -> Result<(), String> {
+    let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    let rows = ((area.dim_in_pixel().1 as i32 - 30) / 20).max(1) as usize;
+    for (k, (name, color)) in entries.iter().enumerate() {
+        let y = 30 + 20 * k as i32;
+        if k + 1 == rows && entries.len() > rows {
+            area.draw(&Text::new(
+                format!("… {} more", entries.len() - k),
+                (8, y - 7),
+                ("sans-serif", 14).into_font().color(&BLACK),
+            ))
+            .map_err(e)?;
+            break;
+        }
+        area.draw(&PathElement::new(
+            vec![(6, y), (30, y)],
+            color.stroke_width(3),
+        ))
+        .map_err(e)?;
+        let shown: String = name.chars().take(20).collect();
+        area.draw(&Text::new(
+            shown,
+            (36, y - 7),
+            ("sans-serif", 14).into_font().color(&BLACK),
+        ))
+        .map_err(e)?;
+    }
+    Ok(())
 }
 
 /// Plot a line's profiles: `field` (in `unit`) against arc length along the line, one
@@ -771,10 +798,11 @@ pub fn line_profiles(
     atomic_png(
         path,
         |tmp| {
-            let root = BitMapBackend::new(tmp, (900, 560)).into_drawing_area();
+            let root = BitMapBackend::new(tmp, (1000, 560)).into_drawing_area();
             root.fill(&WHITE).map_err(perr(path))?;
-            let mut chart = ChartBuilder::on(&root)
-                .caption(title, ("sans-serif", 22))
+            let root = root.titled(title, ("sans-serif", 22)).map_err(perr(path))?;
+            let (main, key) = root.split_horizontally(1000 - LEGEND_WIDTH);
+            let mut chart = ChartBuilder::on(&main)
                 .margin(15)
                 .x_label_area_size(40)
                 .y_label_area_size(95)
@@ -789,6 +817,7 @@ pub fn line_profiles(
                 .draw()
                 .map_err(perr(path))?;
             let n = snapshots.len();
+            let mut entries = Vec::new();
             for (k, (t, rows)) in snapshots.iter().enumerate() {
                 let color = if n == 1 {
                     BLUE.to_rgba()
@@ -801,18 +830,10 @@ pub fn line_profiles(
                     .collect();
                 chart
                     .draw_series(LineSeries::new(pts, color.stroke_width(2)))
-                    .map_err(perr(path))?
-                    .label(format!("t = {} {tu}", tick(t / scale)))
-                    .legend(move |(x, y)| {
-                        PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
-                    });
+                    .map_err(perr(path))?;
+                entries.push((format!("t = {} {tu}", tick(t / scale)), color));
             }
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.8))
-                .border_style(BLACK)
-                .draw()
-                .map_err(perr(path))?;
+            legend(&key, &entries).map_err(perr(path))?;
             root.present().map_err(perr(path))?;
             Ok(())
         },

@@ -141,7 +141,9 @@ mod tests {
         assert_eq!(Field::Stress(1, 2).of_stress(&s, nu, true), Some(0.0));
         assert_eq!(
             NAMES.map(unit),
-            ["Pa", "m", "m", "m", "Pa", "Pa", "Pa", "Pa", "Pa", "Pa", "Pa", "Pa", "1"]
+            [
+                "Pa", "m", "m", "m", "Pa", "Pa", "Pa", "Pa", "Pa", "Pa", "Pa", "Pa", "1"
+            ]
         );
         let smax = Field::Smax.of_stress(&s, nu, true).unwrap();
         assert!((smax - (lambda + 2.0 * mu) * eps).abs() <= 1e-15);

@@ -10,9 +10,9 @@ use porofrac_grid::{Grid, Point};
 use porofrac_law::{Tensor, principal};
 
 use crate::common::loaded::LoadedScene;
+use crate::common::model::RunError;
 use crate::common::plots::{Column, FieldPlot, label, tick};
 use crate::continuum::fields;
-use crate::common::model::RunError;
 
 /// What the end-of-run plots show: the probe series at the written times, the last
 /// displacement and cell stresses, the failures and the pressure.
@@ -116,11 +116,7 @@ pub(crate) fn write_plots<const D: usize>(
         let noise = noise_floors(&plots);
         for (name, vals) in &plots {
             let (long, short, unit) = quantity(name);
-            let title = format!(
-                "{}: {long} at t = {} s{where_}",
-                s.scene.name,
-                tick(t_last)
-            );
+            let title = format!("{}: {long} at t = {} s{where_}", s.scene.name, tick(t_last));
             let bar = label(short, unit);
             let mut plot = FieldPlot::new(&canvas, &title, &bar, unit, &marked);
             plot.noise = noise(name);

@@ -44,8 +44,8 @@ use crate::common::lattice::{
 };
 use crate::common::loaded::{LoadedScene, k, ki};
 use crate::common::model::{Model, RunError, Sizes, StepStats};
-use crate::common::plots::{Column, tick};
 use crate::common::output::{OutputError, SolverStats, Summary, WallSeconds, write_atomic};
+use crate::common::plots::{Column, tick};
 use crate::common::sections::NumOrExpr;
 use porofrac_vtk::{Attributes, DataArray, Encoding, ImageData};
 

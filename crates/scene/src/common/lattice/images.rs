@@ -57,7 +57,8 @@ pub(crate) fn field_png(
     );
     let (width, bar_w, footer) = (1000u32, 140u32, 26u32);
     let plot_w = (width - bar_w - 95) as f64;
-    let height = (plot_w * ny as f64 / nx as f64 + 110.0 + footer as f64).clamp(300.0, 1400.0) as u32;
+    let height =
+        (plot_w * ny as f64 / nx as f64 + 110.0 + footer as f64).clamp(300.0, 1400.0) as u32;
     let h = image.dx;
     let [x0, y0] = image.origin;
     let (x1, y1) = (x0 + nx as f64 * h, y0 + ny as f64 * h);
