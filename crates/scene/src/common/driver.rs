@@ -388,10 +388,11 @@ pub(crate) fn drive(
         };
         model.after_step(out)?;
         let stop = step + 1 < times.len() && observer.stop_requested();
-        let write = step == 0 || step % write_every == 0 || step + 1 == times.len() || stop;
+        let write =
+            step == 0 || step.is_multiple_of(write_every) || step + 1 == times.len() || stop;
         // Probes are sampled at their own interval and at every written step; sampling
         // only reads the state.
-        let sample = write || step % probe_every == 0;
+        let sample = write || step.is_multiple_of(probe_every);
         if sample {
             let t_out = Instant::now();
             row.clear();
@@ -433,7 +434,7 @@ pub(crate) fn drive(
             sampled.push(t);
             if write {
                 let last = step + 1 == times.len() || stop;
-                let snapshot = last || written.len() % snapshot_stride == 0;
+                let snapshot = last || written.len().is_multiple_of(snapshot_stride);
                 for ((table, mut rows), snaps) in
                     lines.iter_mut().zip(line_rows).zip(&mut line_snapshots)
                 {
