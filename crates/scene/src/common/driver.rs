@@ -4,7 +4,7 @@
 //! `[output] every` steps, the first and the last), report progress, honour
 //! interruption, plot the probes and lines, and put together `summary.json`.
 //!
-//! CSV headers carry units: `time [s]`, `p_well [Pa]` ([`column`]).
+//! CSV headers carry units: `time [s]`, `p_well [Pa]` ([`column()`]).
 //!
 //! Every file is rewritten atomically after each written step, so whatever stops a run
 //! (an error, Ctrl-C, a killed process) leaves complete files of the finished steps.
