@@ -234,10 +234,9 @@ fn run(
     .map_err(|e| e.to_string())?;
     progress.finish();
     eprintln!(
-        "{}: {} cells, {} dofs, {} steps in {:.2} s; output in {}{}",
+        "{}: {}, {} steps in {:.2} s; output in {}{}",
         summary.scene,
-        summary.cells,
-        summary.dofs,
+        summary.sizes_text,
         summary.steps,
         summary.wall_seconds.total,
         out.display(),
@@ -279,12 +278,18 @@ impl Observer for Progress {
         if r.total <= 1 {
             return;
         }
-        let msg = format!(
-            "t = {:.4e} s, solver iterations {} (total {}), fractured {}",
-            r.time, r.iterations, r.total_iterations, r.failed
+        // Steps are the output times after the initial state (step 0): `step 40/40`
+        // ends a run of 40 steps, as `summary.json` counts them.
+        let steps = r.total - 1;
+        let mut msg = format!(
+            "t = {:.4e} s, solver iterations {} (total {})",
+            r.time, r.iterations, r.total_iterations
         );
+        if let Some(what) = r.failed_name {
+            msg.push_str(&format!(", {} {what}", r.failed));
+        }
         if self.bar.is_none() && std::io::stderr().is_terminal() {
-            let bar = indicatif::ProgressBar::new(r.total as u64);
+            let bar = indicatif::ProgressBar::new(steps as u64);
             if let Ok(style) = indicatif::ProgressStyle::with_template(
                 "{bar:30} step {pos}/{len}  {msg}  ETA {eta}",
             ) {
@@ -294,10 +299,11 @@ impl Observer for Progress {
         }
         match &self.bar {
             Some(bar) => {
-                bar.set_position(r.step as u64 + 1);
+                bar.set_position(r.step as u64);
                 bar.set_message(msg);
             }
-            None => eprintln!("step {}/{}: {msg}", r.step + 1, r.total),
+            None if r.step == 0 => eprintln!("step 0/{steps} (initial state): {msg}"),
+            None => eprintln!("step {}/{steps}: {msg}", r.step),
         }
     }
 

@@ -389,14 +389,15 @@ fn the_report_states_the_sizes_steps_and_files() {
         "{out}"
     );
     assert!(
-        out.contains("steps: 0; written: 1 (1 VTK files, 2 probes, 1 lines)"),
+        out.contains("steps: 0; written: 1 (1 VTK files, 1 lines); probes.csv: 1 rows of 2 probes"),
         "{out}"
     );
-    // terzaghi: 400 steps written every 100th (0, 100, …, 400).
+    // terzaghi: 400 steps written every 100th (0, 100, …, 400), probes at every step.
     let scene = root().join("scenes/terzaghi.toml");
     let (code, out, err) = porofrac_in(&dir, &["check", scene.to_str().unwrap()]);
     assert_eq!(code, 0, "{err}");
     assert!(out.contains("steps: 400; written: 5 (5 VTK files"), "{out}");
+    assert!(out.contains("probes.csv: 401 rows of"), "{out}");
     // A lattice solid scene counts particles and bonds.
     let scene = root().join("scenes/lsm/brazilian.toml");
     let (code, out, err) = porofrac_in(&dir, &["check", scene.to_str().unwrap()]);

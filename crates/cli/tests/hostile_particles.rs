@@ -258,7 +258,7 @@ fn ctrl_c_inside_a_long_lsm_step_ends_the_run_as_interrupted() {
         .replace("every = 10", "every = 1");
     let path = write("ctrlc_lsm", &text);
     // The first progress line comes after step 0 (the initial state) is written.
-    let (code, summary, out) = interrupt_when(&path, "step 1/3");
+    let (code, summary, out) = interrupt_when(&path, "step 0/2 ");
     assert_eq!(code, 130, "{summary}");
     assert_eq!(summary["status"], "interrupted at t = 0");
     let (_, rows) = read_csv(&out.join("probes.csv"));
@@ -274,7 +274,7 @@ fn ctrl_c_inside_the_sweeps_of_an_nscd_step_ends_the_run_as_interrupted() {
         .replace("max_sweeps = 100", "max_sweeps = 100000000")
         .replace("every = 40", "every = 1");
     let path = write("ctrlc_nscd", &text);
-    let (code, summary, out) = interrupt_when(&path, "step 1/41");
+    let (code, summary, out) = interrupt_when(&path, "step 0/40 ");
     assert_eq!(code, 130, "{summary}");
     assert_eq!(summary["status"], "interrupted at t = 0");
     assert!(out.join("probes.csv").is_file());

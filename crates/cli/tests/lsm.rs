@@ -77,11 +77,13 @@ fn small_borehole_scene_runs_and_logs_broken_bonds() {
     assert!(pb > 0.0 && pb < 2.5e7 * 0.15, "first break at {pb}");
     let text = std::fs::read_to_string(out.join("broken.csv")).unwrap();
     let mut lines = text.lines();
-    assert_eq!(lines.next(), Some("time,i,j,x,y,mode"));
+    assert_eq!(lines.next(), Some("time [s],i,j,x [m],y [m],mode"));
     assert_eq!(lines.clone().count() as u64, broken);
     assert!(lines.all(|l| l.ends_with(",tensile") || l.ends_with(",shear")));
     let (header, rows) = read_csv(&out.join("probes.csv"));
-    assert_eq!(header, ["time", "pressure", "broken", "x0"]);
+    assert_eq!(header, ["time [s]", "pressure [Pa]", "broken", "x0 [m]"]);
+    // Probes at every step (16 output times), VTK every 5th.
+    assert_eq!(rows.len(), 16);
     assert_eq!(rows[0][1], 0.0);
     assert!((rows.last().unwrap()[1] - 2.5e7 * 0.15).abs() < 1.0);
     for f in [

@@ -87,8 +87,8 @@ fn hot_grains_cool_in_flowing_fluid_and_the_heat_books_balance() {
     );
     assert_eq!(s["fluid"]["fluid_steps"].as_u64(), Some(400));
     let (header, rows) = read_csv(&out.join("heat.csv"));
-    assert_eq!(header[0], "time");
-    assert_eq!(header[7], "mean_particle_temperature");
+    assert_eq!(header[0], "time [s]");
+    assert_eq!(header[7], "mean_particle_temperature [°C]");
     assert_eq!(rows.len(), 5);
     assert!((rows[0][7] - 80.0).abs() < 1e-9);
     assert!(rows[4][7] < rows[0][7]);

@@ -189,12 +189,17 @@ fn mandel_scene_matches_the_closed_form() {
     let names: Vec<String> = xs
         .iter()
         .map(|x| format!("p_{:04}", (x * 1e4_f64).round() as i64))
-        .chain(["platen_uy".to_string()])
+        .map(|n| format!("{n} [Pa]"))
+        .chain(["platen_uy [m]".to_string()])
         .collect();
-    assert_eq!(header[0], "time");
+    assert_eq!(header[0], "time [s]");
     assert_eq!(&header[1..], names.as_slice());
-    // t = 0 and every tenth step of 0.01 s up to 2 s.
+    // Probes at every step of 0.01 s up to 2 s; the checks below are at the written
+    // times, t = 0 and every tenth step.
+    assert_eq!(rows.len(), 201);
+    let rows: Vec<Vec<f64>> = rows.into_iter().step_by(10).collect();
     assert_eq!(rows.len(), 21);
+    assert!((rows[20][0] - 2.0).abs() < 1e-12);
     let m = Mandel::new(400);
     let mut worst_early: f64 = 0.0;
     let mut worst_late: f64 = 0.0;

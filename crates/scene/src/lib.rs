@@ -8,7 +8,7 @@
 //!
 //! let scene = Scene::load("scenes/patch_test.toml".as_ref())?;
 //! let summary = scene.run("out/patch_test".as_ref(), &mut Silent)?;
-//! println!("{} cells in {:.2} s", summary.cells, summary.wall_seconds.total);
+//! println!("{} in {:.2} s", summary.sizes_text, summary.wall_seconds.total);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!

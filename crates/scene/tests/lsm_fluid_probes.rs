@@ -119,7 +119,13 @@ fn fluid_probes_read_the_pressure_in_the_ring_and_none_outside() {
         .split(',')
         .map(|v| v.parse().unwrap())
         .collect();
-    let col = |n: &str| last[head.iter().position(|h| *h == n).unwrap()];
+    // Columns by name: the header is `name [unit]`.
+    let col = |n: &str| {
+        last[head
+            .iter()
+            .position(|h| h.split(" [").next() == Some(n))
+            .unwrap()]
+    };
     let p = col("injection");
     let s: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();

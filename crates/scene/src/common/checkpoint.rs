@@ -426,9 +426,11 @@ pub(crate) fn check_matches(
 pub(crate) struct Progress<'a> {
     /// The step just finished.
     pub step: usize,
-    /// The written times.
+    /// The times the probes were sampled at.
+    pub sampled: &'a [f64],
+    /// The written times (VTK, lines).
     pub written: &'a [f64],
-    /// The probe series at the written times.
+    /// The probe series at the sampled times.
     pub series: &'a [Vec<f64>],
     /// The field extrema of the last written step.
     pub extrema: &'a BTreeMap<String, [f64; 2]>,
@@ -458,6 +460,7 @@ pub(crate) fn save(
     state.put_str("scene/overrides", &override_lines(ls));
     state.put_str("scene/path", &ls.path.to_string_lossy());
     state.put_u64("driver/step", vec![p.step as u64]);
+    state.put_f64("driver/sampled", p.sampled);
     state.put_f64("driver/written", p.written);
     state.put_f64(
         "driver/series",
@@ -537,7 +540,9 @@ pub fn restore_pvd(state: &State, name: &str, path: &Path) -> Result<Option<PvdW
 pub(crate) struct Resumed {
     /// The step the checkpoint was written after.
     pub step: usize,
-    /// The written times.
+    /// The times the probes were sampled at.
+    pub sampled: Vec<f64>,
+    /// The written times (VTK, lines).
     pub written: Vec<f64>,
     /// The probe series.
     pub series: Vec<Vec<f64>>,
@@ -577,12 +582,13 @@ pub(crate) fn resume(
             )));
         }
         model.restore_state(st, out)?;
+        let sampled = st.f64s("driver/sampled")?.to_vec();
         let written = st.f64s("driver/written")?.to_vec();
-        let flat = st.f64s_len("driver/series", written.len() * probe_count)?;
+        let flat = st.f64s_len("driver/series", sampled.len() * probe_count)?;
         let series = (0..probe_count)
             .map(|j| {
-                (0..written.len())
-                    .map(|i| flat[j * written.len() + i])
+                (0..sampled.len())
+                    .map(|i| flat[j * sampled.len() + i])
                     .collect()
             })
             .collect();
@@ -612,6 +618,7 @@ pub(crate) fn resume(
         }
         Ok(Resumed {
             step,
+            sampled,
             written,
             series,
             extrema,

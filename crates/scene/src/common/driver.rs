@@ -1,6 +1,10 @@
-//! The loop every model runs in: step through the output times, write `probes.csv`,
-//! `lines/<name>.csv`, the VTK series and `<name>.pvd` at the written steps, report
-//! progress, honour interruption, and put together `summary.json`.
+//! The loop every model runs in: step through the output times, sample the probes into
+//! `probes.csv` every `[output] probe_every` steps (default: every step), write
+//! `lines/<name>.csv`, the VTK series and `<name>.pvd` at the written steps (every
+//! `[output] every` steps, the first and the last), report progress, honour
+//! interruption, plot the probes and lines, and put together `summary.json`.
+//!
+//! CSV headers carry units: `time [s]`, `p_well [Pa]` ([`column()`]).
 //!
 //! Every file is rewritten atomically after each written step, so whatever stops a run
 //! (an error, Ctrl-C, a killed process) leaves complete files of the finished steps.
@@ -47,8 +51,11 @@ pub struct StepReport {
     pub iterations: usize,
     /// Solver iterations so far.
     pub total_iterations: usize,
-    /// Failed cells (or broken bonds) so far.
+    /// What has failed so far, in the model's terms (`failed_name`).
     pub failed: usize,
+    /// What `failed` counts (`"fractured cells"`, `"broken bonds"`); `None` for a model
+    /// in which nothing fails (the progress line then leaves the count out).
+    pub failed_name: Option<&'static str>,
 }
 
 /// Where the build of a model is: `done` of `total` units of a phase (see
@@ -224,13 +231,14 @@ pub(crate) fn interrupted_in_setup(ls: &LoadedScene, start: Instant, dim: usize)
         scene: ls.scene.scene.name.clone(),
         model: ls.model().to_string(),
         dim,
-        cells: 0,
-        nodes: 0,
-        dofs: 0,
+        cells: None,
+        nodes: None,
+        dofs: None,
+        sizes_text: String::new(),
         steps: 0,
         status: "interrupted at t = 0".into(),
         interrupted_at: Some(0.0),
-        fractured_cells: 0,
+        fractured_cells: None,
         wall_seconds: wall,
         peak_memory_bytes: peak_memory_bytes(),
         solver: Default::default(),
@@ -285,6 +293,17 @@ fn check_finite(
     Ok(())
 }
 
+/// A CSV column header: the name and the unit in brackets, `p_well [Pa]`, `time [s]`;
+/// the name alone for numbers without a unit (`"1"`: ratios, counts, flags, indices).
+/// A reader takes the name as what comes before ` [`.
+pub fn column(name: &str, unit: &str) -> String {
+    if unit == "1" || unit.is_empty() {
+        name.to_string()
+    } else {
+        format!("{name} [{unit}]")
+    }
+}
+
 /// An observer that reports nothing and never stops a run.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Silent;
@@ -304,24 +323,32 @@ pub(crate) fn drive(
 ) -> Result<Summary, RunError> {
     let s = &ls.scene;
     let mut output_seconds = 0.0;
-    let mut header = vec!["time".to_string()];
-    header.extend(s.output.probe.iter().map(|p| p.name.clone()));
+    let mut header = vec![column("time", "s")];
+    header.extend(
+        s.output
+            .probe
+            .iter()
+            .map(|p| column(&p.name, model.unit(&p.field))),
+    );
     let mut probes = CsvTable::new(out.join("probes.csv"), &header);
     let axes = ["x", "y", "z"];
-    let mut line_header = vec!["time".to_string(), "s".to_string()];
-    line_header.extend(axes[..dim].iter().map(|a| a.to_string()));
-    line_header.push("value".into());
     let mut lines: Vec<CsvTable> = s
         .output
         .line
         .iter()
         .map(|l| {
+            let mut line_header = vec![column("time", "s"), column("s", "m")];
+            line_header.extend(axes[..dim].iter().map(|a| column(a, "m")));
+            line_header.push(column(&l.field, model.unit(&l.field)));
             CsvTable::new(
                 out.join("lines").join(format!("{}.csv", l.name)),
                 &line_header,
             )
         })
         .collect();
+    // Snapshots of every line for its end-of-run plot: the rows at (up to) six of the
+    // written times, spread over the run, and the last one.
+    let mut line_snapshots: Vec<Vec<(f64, Vec<Vec<f64>>)>> = vec![Vec::new(); lines.len()];
     let vtk_dir = out.join("vtk");
     let mut pvd = if s.output.vtk {
         std::fs::create_dir_all(&vtk_dir).map_err(|source| OutputError {
@@ -336,7 +363,14 @@ pub(crate) fn drive(
     };
 
     let times = model.times().to_vec();
+    let probe_every = s.output.probe_every.max(1) as usize;
+    let write_every = s.output.every.max(1) as usize;
+    // The written steps a complete run has, and the ones whose lines are plotted.
+    let planned_writes = (times.len().saturating_sub(1)).div_ceil(write_every) + 1;
+    let snapshot_stride = planned_writes.div_ceil(6).max(1);
+    let failed_name = model.sizes().failed;
     let mut series: Vec<Vec<f64>> = vec![Vec::new(); s.output.probe.len()];
+    let mut sampled: Vec<f64> = Vec::new();
     let mut written: Vec<f64> = Vec::new();
     let mut extrema = BTreeMap::new();
     let mut total_iterations = 0;
@@ -368,6 +402,7 @@ pub(crate) fn drive(
             series.len(),
         )?;
         first = r.step + 1;
+        sampled = r.sampled;
         written = r.written;
         series = r.series;
         extrema = r.extrema;
@@ -386,88 +421,79 @@ pub(crate) fn drive(
         };
         model.after_step(out)?;
         let stop = step + 1 < times.len() && observer.stop_requested();
-        let regular = step == 0 || step % s.output.every as usize == 0 || step + 1 == times.len();
-        let write = regular || stop;
-        // A checkpoint after this step: every `checkpoint_every` steps, and when stopped.
-        // It holds the files as a run that goes on has them: a step written only because
-        // the run stops is saved before that write, so a resumed run does not keep it.
-        let checkpoint = step + 1 < times.len()
-            && ((checkpoint_every > 0 && step > 0 && step % checkpoint_every == 0)
-                || (stop && model.checkpoints()));
-        macro_rules! save_checkpoint {
-            ($iterations:expr, $steps:expr) => {
+        let last = step + 1 == times.len();
+        // Written steps (VTK, lines) of a run that goes on, and its probe samples
+        // (sampling only reads the state).
+        let regular = step == 0 || step.is_multiple_of(write_every) || last;
+        let sampled_here = regular || step.is_multiple_of(probe_every);
+        // Sample the probes (`probe`) and write the lines and VTK file (`write`) of this
+        // step; every value is checked before anything of the step is written.
+        macro_rules! output_step {
+            ($probe:expr, $write:expr) => {{
+                let (probe, write): (bool, bool) = ($probe, $write);
                 let t_out = Instant::now();
-                crate::common::checkpoint::save(
-                    ls,
-                    out,
-                    model,
-                    &crate::common::checkpoint::Progress {
-                        step,
-                        written: &written,
-                        series: &series,
-                        extrema: &extrema,
-                        total_iterations: $iterations,
-                        steps: $steps,
-                        probes: &probes,
-                        lines: &lines,
-                        pvd: pvd.as_ref(),
-                    },
-                )?;
+                row.clear();
+                row.push(t);
+                let first = row.len();
+                model.probes(&mut row);
+                let step_extrema = if write {
+                    model.field_extrema()
+                } else {
+                    BTreeMap::new()
+                };
+                check_finite(ls, t, &row[first..], &step_extrema, &|i| {
+                    model.probe_may_be_undefined(i)
+                })?;
+                let mut line_rows: Vec<Vec<Vec<f64>>> = Vec::with_capacity(lines.len());
+                for i in (0..lines.len()).filter(|_| write) {
+                    let mut rows = Vec::new();
+                    model.line(i, &mut rows);
+                    if let Some(v) = rows.iter().flatten().find(|v| !v.is_finite()) {
+                        return Err(ls
+                            .error(
+                                &ki("output.line", i, &["field"]),
+                                format!(
+                                    "= \"{}\" is {v} at a point of the line at t = {t:e} s: \
+                                     the run diverged or the value is undefined there",
+                                    s.output.line[i].field
+                                ),
+                            )
+                            .into());
+                    }
+                    line_rows.push(rows);
+                }
+                if probe {
+                    for (j, v) in row[first..].iter().enumerate() {
+                        series[j].push(*v);
+                    }
+                    probes.push(&row)?;
+                    sampled.push(t);
+                }
+                if write {
+                    let snapshot = last || stop || written.len().is_multiple_of(snapshot_stride);
+                    for ((table, mut rows), snaps) in
+                        lines.iter_mut().zip(line_rows).zip(&mut line_snapshots)
+                    {
+                        if snapshot && s.output.plots {
+                            snaps.push((t, rows.clone()));
+                        }
+                        for r in &mut rows {
+                            r.insert(0, t);
+                        }
+                        table.push_rows(&rows)?;
+                    }
+                    if let Some(pvd) = pvd.as_mut() {
+                        let name = model.write_vtk(&vtk_dir, written.len())?;
+                        pvd.add(t, format!("vtk/{name}"))?;
+                    }
+                    extrema = step_extrema;
+                    written.push(t);
+                }
                 output_seconds += t_out.elapsed().as_secs_f64();
-            };
+            }};
         }
-        if checkpoint && !regular {
-            save_checkpoint!(
-                total_iterations + stats.iterations,
-                steps + usize::from(step > 0)
-            );
-        }
-        if write {
-            let t_out = Instant::now();
-            row.clear();
-            row.push(t);
-            let first = row.len();
-            model.probes(&mut row);
-            let step_extrema = model.field_extrema();
-            check_finite(ls, t, &row[first..], &step_extrema, &|i| {
-                model.probe_may_be_undefined(i)
-            })?;
-            // Every line of the step, checked before anything of the step is written.
-            let mut line_rows: Vec<Vec<Vec<f64>>> = Vec::with_capacity(lines.len());
-            for i in 0..lines.len() {
-                let mut rows = Vec::new();
-                model.line(i, &mut rows);
-                if let Some(v) = rows.iter().flatten().find(|v| !v.is_finite()) {
-                    return Err(ls
-                        .error(
-                            &ki("output.line", i, &["field"]),
-                            format!(
-                                "= \"{}\" is {v} at a point of the line at t = {t:e} s: the \
-                                 run diverged or the value is undefined there",
-                                s.output.line[i].field
-                            ),
-                        )
-                        .into());
-                }
-                line_rows.push(rows);
-            }
-            for (j, v) in row[first..].iter().enumerate() {
-                series[j].push(*v);
-            }
-            probes.push(&row)?;
-            for (table, mut rows) in lines.iter_mut().zip(line_rows) {
-                for r in &mut rows {
-                    r.insert(0, t);
-                }
-                table.push_rows(&rows)?;
-            }
-            if let Some(pvd) = pvd.as_mut() {
-                let name = model.write_vtk(&vtk_dir, written.len())?;
-                pvd.add(t, format!("vtk/{name}"))?;
-            }
-            extrema = step_extrema;
-            written.push(t);
-            output_seconds += t_out.elapsed().as_secs_f64();
+        if sampled_here {
+            output_step!(true, regular);
         }
         if step > 0 {
             steps += 1;
@@ -480,11 +506,40 @@ pub(crate) fn drive(
             iterations: stats.iterations,
             total_iterations,
             failed: stats.failed,
+            failed_name,
         });
-        if checkpoint && regular {
-            save_checkpoint!(total_iterations, steps);
+        // A checkpoint after this step: every `checkpoint_every` steps, and when stopped.
+        // It holds the files as a run that goes on has them: what is written only because
+        // the run stops comes after it, so a resumed run does not keep it.
+        if !last
+            && ((checkpoint_every > 0 && step > 0 && step.is_multiple_of(checkpoint_every))
+                || (stop && model.checkpoints()))
+        {
+            let t_out = Instant::now();
+            crate::common::checkpoint::save(
+                ls,
+                out,
+                model,
+                &crate::common::checkpoint::Progress {
+                    step,
+                    sampled: &sampled,
+                    written: &written,
+                    series: &series,
+                    extrema: &extrema,
+                    total_iterations,
+                    steps,
+                    probes: &probes,
+                    lines: &lines,
+                    pvd: pvd.as_ref(),
+                },
+            )?;
+            output_seconds += t_out.elapsed().as_secs_f64();
         }
         if stop {
+            // The state where the run stopped, written in full.
+            if !regular {
+                output_step!(!sampled_here, true);
+            }
             interrupted = Some(t);
             break;
         }
@@ -494,7 +549,16 @@ pub(crate) fn drive(
     output_seconds += t_out.elapsed().as_secs_f64();
     if s.output.plots {
         let t_out = Instant::now();
-        model.plots(&out.join("plots"), &written, &series)?;
+        model.plots(&out.join("plots"), &sampled, &series)?;
+        for (l, snaps) in s.output.line.iter().zip(&line_snapshots) {
+            crate::common::plots::line_profiles(
+                &out.join("plots").join(format!("line_{}.png", l.name)),
+                &format!("{}: {} along line {}", s.scene.name, l.field, l.name),
+                &l.field,
+                model.unit(&l.field),
+                snaps,
+            )?;
+        }
         output_seconds += t_out.elapsed().as_secs_f64();
     }
     let sizes = model.sizes();
@@ -509,13 +573,14 @@ pub(crate) fn drive(
         cells: sizes.cells,
         nodes: sizes.nodes,
         dofs: sizes.dofs,
+        sizes_text: sizes.counts_text(),
         steps,
         status: match interrupted {
             Some(t) => format!("interrupted at t = {t}"),
             None => "ok".into(),
         },
         interrupted_at: interrupted,
-        fractured_cells: model.failed(),
+        fractured_cells: (sizes.failed == Some("fractured cells")).then(|| model.failed()),
         wall_seconds: wall,
         peak_memory_bytes: peak_memory_bytes(),
         solver: model.solver_stats(),

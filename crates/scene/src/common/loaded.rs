@@ -704,5 +704,11 @@ pub fn check(
             format!("belongs to model \"{owners}\", not \"{}\"", kind.name()),
         ));
     }
+    if s.output.probe_every < 1 {
+        return Err(ls.error(
+            &k(&["output", "probe_every"]),
+            format!("= {} must be ≥ 1", s.output.probe_every),
+        ));
+    }
     kind.check(ls, laws)
 }

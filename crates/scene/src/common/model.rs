@@ -68,19 +68,43 @@ pub enum RunError {
 pub struct StepStats {
     /// Solver iterations of the step (linear iterations, coupled solves, relaxation steps).
     pub iterations: usize,
-    /// Cells (or bonds) failed so far.
+    /// What has failed so far, counted in the model's own terms ([`Sizes::failed`]:
+    /// fractured cells, broken bonds, broken cohesive contacts; 0 where nothing fails).
     pub failed: usize,
 }
 
-/// Sizes of a model for `summary.json`.
+/// Sizes of a model in its own terms, for the progress line and `summary.json`.
+///
+/// The grid models (continuum, Cosserat) fill `cells`, `nodes` and `dofs`, written to
+/// `summary.json` under those keys; the particle and lattice models leave them `None`
+/// (their counts are in their own `summary.json` keys: `particles`, `bonds`, `lattice`).
+/// `counts` is what the end-of-run line shows, in the model's words.
 #[derive(Clone, Debug, Default)]
 pub struct Sizes {
-    /// Cells (or particles, lattice nodes).
-    pub cells: usize,
-    /// Nodes.
-    pub nodes: usize,
-    /// Unknowns of the main system.
-    pub dofs: usize,
+    /// Grid cells (grid models).
+    pub cells: Option<usize>,
+    /// Grid nodes (models with nodal unknowns).
+    pub nodes: Option<usize>,
+    /// Unknowns of the main system (grid models).
+    pub dofs: Option<usize>,
+    /// The sizes the end-of-run line shows, in order, e.g. `[("cells", 64), ("nodes",
+    /// 81), ("unknowns", 98)]` or `[("particles", 400), ("bonds", 1100)]`.
+    pub counts: Vec<(&'static str, usize)>,
+    /// What [`StepStats::failed`] and [`Model::failed`] count (`"fractured cells"`,
+    /// `"broken bonds"`, `"broken cohesive contacts"`); `None` for a model in which
+    /// nothing fails (the count is then neither shown nor written).
+    pub failed: Option<&'static str>,
+}
+
+impl Sizes {
+    /// `cells 64, nodes 81, unknowns 98` as `64 cells, 81 nodes, 98 unknowns`.
+    pub fn counts_text(&self) -> String {
+        self.counts
+            .iter()
+            .map(|(what, n)| format!("{n} {what}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
 }
 
 /// A model built from a scene, stepping through its output times (see the module docs).
@@ -102,12 +126,17 @@ pub trait Model {
     fn write_vtk(&self, dir: &Path, index: usize) -> Result<String, RunError>;
     /// `[min, max]` of every field of the model at the current state.
     fn field_extrema(&self) -> BTreeMap<String, [f64; 2]>;
-    /// End-of-run plots into `dir` (`plots/`), given the probe series at the written times.
+    /// End-of-run plots into `dir` (`plots/`), given the probe series at the times they
+    /// were sampled (every `[output] probe_every` steps, the last time included).
     fn plots(&self, dir: &Path, written: &[f64], series: &[Vec<f64>]) -> Result<(), RunError>;
-    /// Sizes for `summary.json`.
+    /// Sizes for the progress line and `summary.json`, in the model's terms.
     fn sizes(&self) -> Sizes;
-    /// Failed cells (or broken bonds) so far.
+    /// What has failed so far, in the terms of [`Sizes::failed`] (0 where nothing fails).
     fn failed(&self) -> usize;
+    /// The unit of field `field` (a probe's or a line's `field`) for CSV headers and plot
+    /// axes: `"Pa"`, `"m"`, `"m/s"`; `"1"` for numbers without a unit (ratios, counts,
+    /// flags). Every field a model accepts has one.
+    fn unit(&self, field: &str) -> &'static str;
     /// Solver statistics of the run so far.
     fn solver_stats(&self) -> SolverStats;
     /// Error norms against the exact solution the scene gives, at the current state
@@ -127,12 +156,6 @@ pub trait Model {
     /// default).
     fn summary_extras(&self) -> serde_json::Map<String, serde_json::Value> {
         serde_json::Map::new()
-    }
-    /// The sizes a check reports, in the model's own words (by default the cells, nodes
-    /// and unknowns of [`Model::sizes`]).
-    fn counts(&self) -> Vec<(&'static str, usize)> {
-        let s = self.sizes();
-        vec![("cells", s.cells), ("nodes", s.nodes), ("unknowns", s.dofs)]
     }
     /// The work of the whole schedule, for the run-time estimate of a check (the
     /// per-model throughput constants of [`crate::common::limits`]).

@@ -137,6 +137,9 @@ pub struct WallSeconds {
     pub grid: f64,
     /// Assembly of matrices and loads.
     pub assembly: f64,
+    /// Time stepping of the particle and lattice models (contact detection, integration,
+    /// streaming and collision; the contact solver's sweeps are under `solve`).
+    pub stepping: f64,
     /// Linear solves of the mechanics.
     pub solve: f64,
     /// Flow solves.
@@ -173,21 +176,32 @@ pub struct Summary {
     pub model: String,
     /// 2 or 3.
     pub dim: usize,
-    /// Number of cells.
-    pub cells: usize,
-    /// Number of nodes.
-    pub nodes: usize,
-    /// Number of mechanical unknowns (equations after eliminating prescribed dofs).
-    pub dofs: usize,
-    /// Number of written steps after t = 0.
+    /// Number of grid cells (grid models only: continuum, Cosserat).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cells: Option<usize>,
+    /// Number of grid nodes (grid models only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub nodes: Option<usize>,
+    /// Number of unknowns of the main system (equations after eliminating prescribed
+    /// dofs; grid models only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub dofs: Option<usize>,
+    /// The model's sizes in its own words (`64 cells, 81 nodes, 98 unknowns`, `400
+    /// particles, 1100 bonds`) for the end-of-run line; not written.
+    #[serde(skip)]
+    pub sizes_text: String,
+    /// Number of steps computed after t = 0: the output times after the initial state
+    /// (the progress line's `step 40/40`).
     pub steps: usize,
     /// `"ok"`, `"interrupted at t = …"` or the error text.
     pub status: String,
     /// The last finished time of an interrupted run.
     #[serde(skip)]
     pub interrupted_at: Option<f64>,
-    /// Number of failed cells.
-    pub fractured_cells: usize,
+    /// Number of failed cells (continuum only; the particle models write their own
+    /// counts, e.g. `broken_bonds`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fractured_cells: Option<usize>,
     /// Wall time per phase.
     pub wall_seconds: WallSeconds,
     /// Peak resident memory of the process (bytes; 0 where unknown).
@@ -252,13 +266,14 @@ pub(crate) fn write_failed_summary(
         scene: ls.scene.scene.name.clone(),
         model: ls.model().to_string(),
         dim: ls.scene.scene.dim.clamp(0, 3) as usize,
-        cells: 0,
-        nodes: 0,
-        dofs: 0,
+        cells: None,
+        nodes: None,
+        dofs: None,
+        sizes_text: String::new(),
         steps: 0,
         status: format!("failed: {error}"),
         interrupted_at: None,
-        fractured_cells: 0,
+        fractured_cells: None,
         wall_seconds: WallSeconds {
             total: start.elapsed().as_secs_f64(),
             ..WallSeconds::default()

@@ -19,6 +19,22 @@ use crate::common::plots::PlotError;
 /// Fields of one particle (`particle = N` probes, lines).
 pub const PARTICLE_FIELDS: [&str; 8] = ["x", "y", "vx", "vy", "omega", "fx", "fy", "radius"];
 
+/// The unit of a particle field ([`PARTICLE_FIELDS`]) or a tracked-cell field (`p q`
+/// Pa, `anisotropy_volume` 1/m², the other ratios and counts `"1"`); `None` for other
+/// names. Forces are per metre of thickness (disks): N/m.
+pub fn particle_unit(field: &str) -> Option<&'static str> {
+    Some(match field {
+        "x" | "y" | "radius" => "m",
+        "vx" | "vy" => "m/s",
+        "omega" => "rad/s",
+        "fx" | "fy" => "N/m",
+        "p" | "q" => "Pa",
+        "anisotropy_volume" => "1/m²",
+        "anisotropy" | "dilation_x" | "dilation_y" | "contacts" | "broken_bonds" => "1",
+        _ => return None,
+    })
+}
+
 /// Value of `PARTICLE_FIELDS[field]` for particle i (`forces`: `[f_x, f_y]` per particle).
 pub fn particle_value(d: &Disks, i: usize, field: usize, forces: &[[f64; 2]]) -> f64 {
     match PARTICLE_FIELDS[field] {
@@ -149,17 +165,30 @@ fn perr<E: std::fmt::Display>(path: &Path) -> impl Fn(E) -> PlotError + '_ {
     }
 }
 
-/// A picture of the disks at their current position, disk i filled with `colour(i)`,
-/// and the `segments` drawn over them in black (written atomically).
-pub fn draw_disks(
-    path: &Path,
-    d: &Disks,
-    colour: impl Fn(usize) -> RGBColor,
-    segments: &[([f64; 2], [f64; 2])],
-) -> Result<(), PlotError> {
+/// What a picture of disks shows: a title, a value per disk (coloured by the 1st–99th
+/// percentile, [`crate::common::plots::ColourRange`]) and the colour bar's name (field
+/// and unit), segments drawn over the disks in black (broken bonds).
+#[derive(Clone, Copy, Debug)]
+pub struct DiskPicture<'a> {
+    /// The title.
+    pub title: &'a str,
+    /// One value per disk.
+    pub values: &'a [f64],
+    /// The colour bar's name (`displacement [m]`).
+    pub bar: &'a str,
+    /// The unit of the values (caption).
+    pub unit: &'a str,
+    /// Segments drawn over the disks.
+    pub segments: &'a [([f64; 2], [f64; 2])],
+}
+
+/// A picture of the disks at their current position (x and y axes in metres), disk i
+/// coloured by `picture.values[i]`, with a colour bar (written atomically).
+pub fn draw_disks(path: &Path, d: &Disks, picture: &DiskPicture<'_>) -> Result<(), PlotError> {
     if d.is_empty() {
         return Ok(());
     }
+    crate::common::plots::register_font();
     std::fs::create_dir_all(path.parent().unwrap_or(Path::new("."))).map_err(perr(path))?;
     let b = d.x.iter().zip(&d.r).fold(
         [
@@ -178,32 +207,56 @@ pub fn draw_disks(
         },
     );
     let (w, h) = ((b[1] - b[0]).max(1e-9), (b[3] - b[2]).max(1e-9));
-    let width = 1600u32;
-    let height = ((width as f64 * h / w).ceil() as u32).clamp(50, 4000);
-    let scale = (width as f64 / w).min(height as f64 / h);
-    let px = |p: [f64; 2]| {
-        (
-            ((p[0] - b[0]) * scale) as i32,
-            height as i32 - ((p[1] - b[2]) * scale) as i32,
-        )
-    };
+    let range = crate::common::plots::ColourRange::of(picture.values.iter().copied(), 0.0, false);
+    let (width, bar_w, footer) = (1200u32, 140u32, 26u32);
+    let plot_w = (width - bar_w - 95) as f64;
+    let height = (plot_w * h / w + 110.0 + footer as f64).clamp(300.0, 2400.0) as u32;
     crate::common::plots::atomic_png(
         path,
         |tmp| {
             let root = BitMapBackend::new(tmp, (width, height)).into_drawing_area();
             root.fill(&WHITE).map_err(perr(path))?;
-            for i in 0..d.len() {
-                let r = ((d.r[i] * scale).round() as i32).max(1);
-                root.draw(&Circle::new(px(d.x[i]), r, colour(i).filled()))
-                    .map_err(perr(path))?;
-            }
-            for (a, c) in segments {
-                root.draw(&PathElement::new(
-                    vec![px(*a), px(*c)],
-                    BLACK.stroke_width(3),
-                ))
+            let (top, foot) = root.split_vertically(height - footer);
+            foot.draw(&Text::new(
+                range.caption(picture.unit),
+                (12, 4),
+                ("sans-serif", 15).into_font().color(&BLACK),
+            ))
+            .map_err(perr(path))?;
+            let (main, bar) = top.split_horizontally(width - bar_w);
+            let mut chart = ChartBuilder::on(&main)
+                .caption(picture.title, ("sans-serif", 22))
+                .margin(10)
+                .x_label_area_size(35)
+                .y_label_area_size(60)
+                .build_cartesian_2d(b[0]..b[1], b[2]..b[3])
                 .map_err(perr(path))?;
-            }
+            chart
+                .configure_mesh()
+                .disable_mesh()
+                .x_desc("x [m]")
+                .y_desc("y [m]")
+                .x_label_formatter(&crate::common::plots::axis_ticks(b[0], b[1]))
+                .y_label_formatter(&crate::common::plots::axis_ticks(b[2], b[3]))
+                .draw()
+                .map_err(perr(path))?;
+            let (xr, yr) = chart.plotting_area().get_pixel_range();
+            // Pixels per metre (the smaller of the two axes, so disks stay round).
+            let scale = ((xr.end - xr.start) as f64 / w).min((yr.end - yr.start) as f64 / h);
+            let colour =
+                |i: usize| range.colour(picture.values.get(i).copied().unwrap_or(f64::NAN));
+            chart
+                .draw_series((0..d.len()).map(|i| {
+                    let r = ((d.r[i] * scale).round() as i32).max(1);
+                    Circle::new((d.x[i][0], d.x[i][1]), r, colour(i).filled())
+                }))
+                .map_err(perr(path))?;
+            chart
+                .draw_series(picture.segments.iter().map(|(a, c)| {
+                    PathElement::new(vec![(a[0], a[1]), (c[0], c[1])], BLACK.stroke_width(2))
+                }))
+                .map_err(perr(path))?;
+            crate::common::plots::colour_bar(&bar, &range, picture.bar).map_err(perr(path))?;
             root.present().map_err(perr(path))?;
             Ok(())
         },

@@ -5,23 +5,25 @@
 
 use std::path::Path;
 
-use plotters::prelude::*;
 use porofrac_particles::Disks;
 
-use crate::common::plots::{PlotError, time_series};
+use crate::common::particle_output::{DiskPicture, draw_disks};
+use crate::common::plots::{Column, PlotError, time_series};
 
-/// Probe series: `stress.png` (p, q), `dilation.png`, `probes.png` (the others).
+/// Probe series: `stress.png` (p, q), `dilation.png`, `probes.png` (the others); `unit`
+/// gives the unit of a field.
 pub fn probe_plots(
     dir: &Path,
     name: &str,
     times: &[f64],
     probes: &[(String, String, Vec<f64>)],
+    unit: impl Fn(&str) -> &'static str,
 ) -> Result<(), PlotError> {
     let groups: [(&str, &[&str], &str); 3] = [
         (
             "stress.png",
             &["p", "q"],
-            "cell stress p, q (Pa, compression positive)",
+            "cell stress p, q (compression positive)",
         ),
         (
             "dilation.png",
@@ -31,7 +33,7 @@ pub fn probe_plots(
         ("probes.png", &[], "probes"),
     ];
     for (file, fields, title) in groups {
-        let columns: Vec<(String, Vec<f64>)> = probes
+        let columns: Vec<Column> = probes
             .iter()
             .filter(|(_, f, _)| {
                 if fields.is_empty() {
@@ -40,7 +42,7 @@ pub fn probe_plots(
                     fields.contains(&f.as_str())
                 }
             })
-            .map(|(n, _, v)| (n.clone(), v.clone()))
+            .map(|(n, f, v)| Column::new(n.clone(), unit(f), v.clone()))
             .collect();
         if !columns.is_empty() {
             time_series(
@@ -55,33 +57,36 @@ pub fn probe_plots(
 }
 
 /// The disks at their current position, coloured by the layer (one of nine bands of
-/// equal height) their centre started in.
-pub fn layers(path: &Path, d: &Disks) -> Result<(), PlotError> {
+/// equal height, 1 at the bottom) their centre started in.
+pub fn layers(path: &Path, name: &str, t: f64, d: &Disks) -> Result<(), PlotError> {
     if d.is_empty() {
         return Ok(());
     }
-    let palette = [
-        RGBColor(68, 1, 84),
-        RGBColor(72, 40, 120),
-        RGBColor(62, 74, 137),
-        RGBColor(49, 104, 142),
-        RGBColor(38, 130, 142),
-        RGBColor(31, 158, 137),
-        RGBColor(53, 183, 121),
-        RGBColor(109, 205, 89),
-        RGBColor(180, 222, 44),
-    ];
+    let bands = 9.0;
     let (lo, hi) =
         d.x0.iter()
             .zip(&d.r)
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), (p, r)| {
                 (a.min(p[1] - r), b.max(p[1] + r))
             });
-    let band = (hi - lo).max(1e-9) / palette.len() as f64;
-    crate::common::particle_output::draw_disks(
+    let band = (hi - lo).max(1e-9) / bands;
+    let layer: Vec<f64> =
+        d.x0.iter()
+            .map(|p| (((p[1] - lo) / band).floor() + 1.0).min(bands))
+            .collect();
+    let title = format!(
+        "{name}: disks by initial layer at t = {} s",
+        crate::common::plots::tick(t)
+    );
+    draw_disks(
         path,
         d,
-        |i| palette[(((d.x0[i][1] - lo) / band) as usize).min(palette.len() - 1)],
-        &[],
+        &DiskPicture {
+            title: &title,
+            values: &layer,
+            bar: "layer (1: bottom)",
+            unit: "1",
+            segments: &[],
+        },
     )
 }

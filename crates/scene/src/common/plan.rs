@@ -20,8 +20,11 @@ pub struct Plan {
     /// Output steps of the schedule (the initial state apart).
     pub steps: usize,
     /// Output times written (the initial state, every `[output] every`-th step, the
-    /// last): rows of `probes.csv` and of each line, VTK files when `[output] vtk`.
+    /// last): rows of each line, VTK files when `[output] vtk`.
     pub written: usize,
+    /// Output times the probes are sampled at (the written ones and every
+    /// `[output] probe_every`-th step): rows of `probes.csv`.
+    pub sampled: usize,
     /// VTK files a run writes (0 without `[output] vtk`).
     pub vtk_files: usize,
     /// `[[output.probe]]` entries.
@@ -48,9 +51,14 @@ impl Plan {
         Self {
             model: ls.model().to_string(),
             dim,
-            counts: model.counts(),
+            counts: model.sizes().counts,
             steps: times.saturating_sub(1),
             written,
+            sampled: sampled_steps(
+                times,
+                s.output.every.max(1) as usize,
+                s.output.probe_every.max(1) as usize,
+            ),
             vtk_files: if s.output.vtk { written } else { 0 },
             probes: s.output.probe.len(),
             lines: s.output.line.len(),
@@ -75,8 +83,8 @@ impl Plan {
                 counts.join(", ")
             ),
             format!(
-                "steps: {}; written: {} ({} VTK files, {} probes, {} lines)",
-                self.steps, self.written, self.vtk_files, self.probes, self.lines
+                "steps: {}; written: {} ({} VTK files, {} lines); probes.csv: {} rows of {} probes",
+                self.steps, self.written, self.vtk_files, self.lines, self.sampled, self.probes
             ),
         ];
         out.push(format!(
@@ -111,6 +119,25 @@ pub fn written_steps(times: usize, every: usize) -> usize {
     last / every + 1 + usize::from(!last.is_multiple_of(every))
 }
 
+/// Output times at which a run samples its probes out of `times`: the written ones
+/// ([`written_steps`]) and every `probe_every`-th step.
+pub fn sampled_steps(times: usize, every: usize, probe_every: usize) -> usize {
+    let (every, probe_every) = (every.max(1), probe_every.max(1));
+    if times == 0 {
+        return 0;
+    }
+    let last = times - 1;
+    // Steps 1..last-1 that are a multiple of either interval, by inclusion–exclusion.
+    let lcm = every / gcd(every, probe_every) * probe_every;
+    let inner = last.saturating_sub(1);
+    let multiples = inner / every + inner / probe_every - inner / lcm;
+    multiples + 1 + usize::from(last > 0)
+}
+
+fn gcd(a: usize, b: usize) -> usize {
+    if b == 0 { a } else { gcd(b, a % b) }
+}
+
 /// `0.12 s`, `42 s`, `1.5 min`, `3.2 h`.
 pub fn seconds_text(s: f64) -> String {
     if s < 1.0 {
@@ -127,6 +154,28 @@ pub fn seconds_text(s: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The sampled steps are those the driver samples: 0, every `every`-th, every
+    /// `probe_every`-th, the last.
+    #[test]
+    fn sampled_steps_match_the_driver() {
+        for times in 0..40 {
+            for every in 1..7 {
+                for probe_every in 1..7 {
+                    let expected = (0..times)
+                        .filter(|&s| {
+                            s == 0 || s % every == 0 || s % probe_every == 0 || s + 1 == times
+                        })
+                        .count();
+                    assert_eq!(
+                        sampled_steps(times, every, probe_every),
+                        expected,
+                        "{times} {every} {probe_every}"
+                    );
+                }
+            }
+        }
+    }
 
     /// The written steps are those the driver writes: 0, every `every`-th, the last.
     #[test]

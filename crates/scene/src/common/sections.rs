@@ -689,20 +689,24 @@ pub struct Output {
     /// Write PNG plots under `plots/`.
     #[serde(default = "yes")]
     pub plots: bool,
-    /// Write every n-th step (probes, lines, VTK).
+    /// Write every n-th step (VTK, lines).
     #[serde(default = "one")]
     pub every: i64,
+    /// Sample the probes into `probes.csv` every n-th step (and at every written step),
+    /// independently of `every`; default 1: every step.
+    #[serde(default = "one")]
+    pub probe_every: i64,
     /// Write a checkpoint (`checkpoint/state.bin`, the state of the run for
     /// `porofrac run --resume`) every n-th step; 0 (default): none, but a run stopped by
     /// Ctrl-C between steps still writes one.
     #[serde(default)]
     pub checkpoint_every: u64,
-    /// `[[output.probe]]`: one column of `probes.csv` (`time,<names…>`, one row per written
-    /// step, the first at t = 0).
+    /// `[[output.probe]]`: one column of `probes.csv` (`time [s],<name [unit]>…`, one row
+    /// per sampled step, the first at t = 0).
     #[serde(default)]
     pub probe: Vec<Probe>,
     /// `[[output.line]]`: a field sampled along a segment at every written step:
-    /// `lines/<name>.csv` with `time,s,x,y[,z],value`.
+    /// `lines/<name>.csv` with `time [s],s [m],x [m],y [m][,z [m]],<field> [<unit>]`.
     #[serde(default)]
     pub line: Vec<Line>,
     /// Continuum: `summary.json` `errors.l2_displacement`, the L2 error of the last
@@ -719,6 +723,7 @@ impl Default for Output {
             plots: true,
             every: 1,
             checkpoint_every: 0,
+            probe_every: 1,
             probe: Vec::new(),
             line: Vec::new(),
             exact_displacement: None,

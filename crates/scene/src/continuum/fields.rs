@@ -50,6 +50,15 @@ pub const NAMES: [&str; 13] = [
     "fractured",
 ];
 
+/// The unit of a field of [`NAMES`] (`"m"`, `"Pa"`; `"1"` for `fractured`).
+pub fn unit(name: &str) -> &'static str {
+    match name {
+        "ux" | "uy" | "uz" => "m",
+        "fractured" => "1",
+        _ => "Pa",
+    }
+}
+
 impl Field {
     /// The field called `name` in a `dim`-D scene (`flow`: the scene solves flow), or why
     /// it is not available.
@@ -130,6 +139,12 @@ mod tests {
         assert!((szz - lambda * eps).abs() <= 1e-15, "{szz}");
         assert_eq!(Field::Stress(2, 2).of_stress(&s, nu, false), Some(0.0));
         assert_eq!(Field::Stress(1, 2).of_stress(&s, nu, true), Some(0.0));
+        assert_eq!(
+            NAMES.map(unit),
+            [
+                "Pa", "m", "m", "m", "Pa", "Pa", "Pa", "Pa", "Pa", "Pa", "Pa", "Pa", "1"
+            ]
+        );
         let smax = Field::Smax.of_stress(&s, nu, true).unwrap();
         assert!((smax - (lambda + 2.0 * mu) * eps).abs() <= 1e-15);
     }

@@ -396,8 +396,8 @@ impl<'a, const D: usize> Stepper<'a, D> {
         let (probes, lines) = locate_outputs(ls, grid)?;
         let axes = ["x", "y", "z"];
         let mut header = vec!["cell".to_string()];
-        header.extend(axes[..D].iter().map(|a| a.to_string()));
-        header.extend(["time".to_string(), "mode".to_string()]);
+        header.extend(axes[..D].iter().map(|a| format!("{a} [m]")));
+        header.extend(["time [s]".to_string(), "mode".to_string()]);
         let fracture_csv = match out {
             Some(out) => {
                 let mut t = CsvTable::new(out.join("fracture.csv"), &header);
@@ -801,11 +801,26 @@ impl<const D: usize> Model for Stepper<'_, D> {
     }
 
     fn sizes(&self) -> Sizes {
-        Sizes {
-            cells: self.body.grid.num_cells(),
-            nodes: self.body.grid.num_nodes(),
-            dofs: self.body.dofs.num_equations(),
+        let (cells, nodes, dofs) = (
+            self.body.grid.num_cells(),
+            self.body.grid.num_nodes(),
+            self.body.dofs.num_equations(),
+        );
+        let mut counts = vec![("cells", cells), ("nodes", nodes), ("unknowns", dofs)];
+        if self.pressure.is_some() {
+            counts.push(("pressure unknowns", cells));
         }
+        Sizes {
+            cells: Some(cells),
+            nodes: Some(nodes),
+            dofs: Some(dofs),
+            counts,
+            failed: Some("fractured cells"),
+        }
+    }
+
+    fn unit(&self, field: &str) -> &'static str {
+        fields::unit(field)
     }
 
     fn failed(&self) -> usize {
@@ -837,19 +852,6 @@ impl<const D: usize> Model for Stepper<'_, D> {
 
     fn wall_seconds(&self) -> WallSeconds {
         self.wall
-    }
-
-    fn counts(&self) -> Vec<(&'static str, usize)> {
-        let grid = self.body.grid;
-        let mut c = vec![
-            ("cells", grid.num_cells()),
-            ("nodes", grid.num_nodes()),
-            ("unknowns", self.body.dofs.num_equations()),
-        ];
-        if self.pressure.is_some() {
-            c.push(("pressure unknowns", grid.num_cells()));
-        }
-        c
     }
 
     fn work(&self) -> crate::common::limits::Work {

@@ -11,6 +11,8 @@ use porofrac_law::{Tensor, principal};
 
 use crate::common::loaded::LoadedScene;
 use crate::common::model::RunError;
+use crate::common::plots::{Column, FieldPlot, label, tick};
+use crate::continuum::fields;
 
 /// What the end-of-run plots show: the probe series at the written times, the last
 /// displacement and cell stresses, the failures and the pressure.
@@ -46,12 +48,12 @@ pub(crate) fn write_plots<const D: usize>(
         failures,
         pressure,
     } = inputs;
-    let columns: Vec<(String, Vec<f64>)> = s
+    let columns: Vec<Column> = s
         .output
         .probe
         .iter()
-        .map(|p| p.name.clone())
-        .zip(series.iter().cloned())
+        .zip(series)
+        .map(|(p, v)| Column::new(p.name.clone(), fields::unit(&p.field), v.clone()))
         .collect();
     if !columns.is_empty() {
         crate::common::plots::time_series(
@@ -71,7 +73,7 @@ pub(crate) fn write_plots<const D: usize>(
                 let z = lo[2] + (0.5 + 1e-4) * (hi[2] - lo[2]);
                 (
                     crate::common::plots::Canvas::z_slice(g3, z),
-                    format!(" on z = {:.4}", 0.5 * (lo[2] + hi[2])),
+                    format!(" on z = {} m", tick(0.5 * (lo[2] + hi[2]))),
                 )
             }
             _ => unreachable!("grids are 2D or 3D"),
@@ -111,11 +113,16 @@ pub(crate) fn write_plots<const D: usize>(
             plots.push(("pressure", p.to_vec()));
         }
         let t_last = written_times.last().copied().unwrap_or(0.0);
+        let noise = noise_floors(&plots);
         for (name, vals) in &plots {
-            let title = format!("{name} at t = {t_last} s{where_}");
+            let (long, short, unit) = quantity(name);
+            let title = format!("{}: {long} at t = {} s{where_}", s.scene.name, tick(t_last));
+            let bar = label(short, unit);
+            let mut plot = FieldPlot::new(&canvas, &title, &bar, unit, &marked);
+            plot.noise = noise(name);
             crate::common::plots::field(
                 &dir.join(format!("{name}.png")),
-                &crate::common::plots::FieldPlot::new(&canvas, &title, &marked),
+                &plot,
                 crate::common::plots::Values::Cell(vals),
             )?;
         }
@@ -138,6 +145,50 @@ pub(crate) fn write_plots<const D: usize>(
         }
     }
     Ok(())
+}
+
+/// What a field plot is called in its title, in its colour bar, and its unit:
+/// `("σ_max (largest principal)", "σ_max", "Pa")`.
+fn quantity(name: &str) -> (&'static str, &'static str, &'static str) {
+    match name {
+        "ux" => ("u_x", "u_x", "m"),
+        "uy" => ("u_y", "u_y", "m"),
+        "uz" => ("u_z", "u_z", "m"),
+        "sxx" => ("σ_xx", "σ_xx", "Pa"),
+        "syy" => ("σ_yy", "σ_yy", "Pa"),
+        "szz" => ("σ_zz", "σ_zz", "Pa"),
+        "sxy" => ("σ_xy", "σ_xy", "Pa"),
+        "smax" => ("σ_max (largest principal stress)", "σ_max", "Pa"),
+        "smin" => ("σ_min (smallest principal stress)", "σ_min", "Pa"),
+        "divergence" => ("div u (volume strain)", "div u", "1"),
+        "pressure" => ("pore pressure", "p", "Pa"),
+        _ => ("value", "value", "1"),
+    }
+}
+
+/// The round-off level of each plotted field: 1e-9 of the largest displacement for
+/// displacements, of the largest stress component for stresses (a shear stress that is
+/// zero up to round-off is then drawn uniform), of its own largest value otherwise.
+fn noise_floors<'a>(plots: &'a [(&str, Vec<f64>)]) -> impl Fn(&str) -> f64 + 'a {
+    let largest = |pred: &dyn Fn(&str) -> bool| {
+        plots
+            .iter()
+            .filter(|(n, _)| pred(n))
+            .flat_map(|(_, v)| v.iter())
+            .filter(|x| x.is_finite())
+            .fold(0.0f64, |m, x| m.max(x.abs()))
+    };
+    let u = largest(&|n| n.starts_with('u'));
+    let stress = largest(&|n| n.starts_with('s'));
+    move |name: &str| {
+        1e-9 * if name.starts_with('u') {
+            u
+        } else if name.starts_with('s') {
+            stress
+        } else {
+            0.0
+        }
+    }
 }
 
 /// Cell divergence of the displacement, `div u = Σ_i N_i · u_i / |K|`
@@ -205,9 +256,13 @@ fn fracture_plots(
     let window = window_around(grid, &centroids, 0.5);
     let (dmax, dmin): (Vec<[f64; 2]>, Vec<[f64; 2]>) =
         stress.iter().map(principal_directions).unzip();
+    let noise = noise_floors(plots);
     for (name, vals) in plots {
-        let title = format!("{name} at t = {t} s, near the fracture");
-        let mut plot = crate::common::plots::FieldPlot::new(canvas, &title, marked);
+        let (long, short, unit) = quantity(name);
+        let title = format!("{long} at t = {} s, near the fracture", tick(t));
+        let bar = label(short, unit);
+        let mut plot = FieldPlot::new(canvas, &title, &bar, unit, marked);
+        plot.noise = noise(name);
         plot.window = Some(window);
         plot.directions = match *name {
             "smax" => Some(&dmax),
@@ -232,16 +287,16 @@ fn fracture_plots(
     for (file, title, values) in [
         (
             "tip_smax_cell.png",
-            format!("smax of the cells near the tip, t = {t} s"),
+            format!("σ_max of the cells near the tip, t = {} s", tick(t)),
             crate::common::plots::Values::Cell(&smax_cell),
         ),
         (
             "tip_smax_recovered.png",
-            format!("smax recovered (ZZ patch) near the tip, t = {t} s"),
+            format!("σ_max recovered (ZZ patch) near the tip, t = {} s", tick(t)),
             crate::common::plots::Values::Nodal(&smax_nodal),
         ),
     ] {
-        let mut plot = crate::common::plots::FieldPlot::new(canvas, &title, marked);
+        let mut plot = FieldPlot::new(canvas, &title, "σ_max [Pa]", "Pa", marked);
         plot.window = Some(tip_window);
         crate::common::plots::field(&dir.join(file), &plot, values)?;
     }

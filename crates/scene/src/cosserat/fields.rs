@@ -49,6 +49,21 @@ impl Field {
         v
     }
 
+    /// The unit of field `name` in dimension `d`: displacements m, rotations rad,
+    /// stresses Pa, couple stresses N/m, energies and work J (per metre of thickness in
+    /// 2D: J/m); `"1"` for a name that is not a field.
+    pub fn unit(name: &str, d: usize) -> &'static str {
+        match Self::parse(name, d) {
+            Ok(Self::Dof(a)) if a < d => "m",
+            Ok(Self::Dof(_)) => "rad",
+            Ok(Self::Stress(_)) if name.starts_with('m') => "N/m",
+            Ok(Self::Stress(_)) => "Pa",
+            Ok(Self::Energy | Self::Kinetic | Self::Work) if d == 2 => "J/m",
+            Ok(Self::Energy | Self::Kinetic | Self::Work) => "J",
+            Err(_) => "1",
+        }
+    }
+
     /// Parse a field name, or an error listing the known ones.
     pub fn parse(name: &str, d: usize) -> Result<Self, String> {
         let ax = |c: u8| AXES[..d].iter().position(|a| a.as_bytes()[0] == c);
@@ -99,6 +114,14 @@ mod tests {
         assert_eq!(Field::parse("syx", 2), Ok(Field::Stress(2)));
         assert_eq!(Field::parse("my", 2), Ok(Field::Stress(5)));
         assert!(Field::parse("uz", 2).is_err());
+        let units: Vec<&str> = ["ux", "phi", "sxy", "my", "energy"]
+            .iter()
+            .map(|n| Field::unit(n, 2))
+            .collect();
+        assert_eq!(units, ["m", "rad", "Pa", "N/m", "J/m"]);
+        assert_eq!(Field::unit("phiz", 3), "rad");
+        assert_eq!(Field::unit("mzz", 3), "N/m");
+        assert_eq!(Field::unit("work", 3), "J");
         assert!(Field::parse("phi", 3).is_err());
         assert!(Field::parse("pressure", 2).unwrap_err().contains("known"));
     }

@@ -41,7 +41,7 @@ use crate::common::grid::{AnyGrid, build_grid, point};
 use crate::common::loaded::{LoadedScene, k, ki};
 use crate::common::model::{Built, Model, Purpose, RunError, Sizes, StepStats};
 use crate::common::output::{SolverStats, WallSeconds};
-use crate::common::plots::{Canvas, FieldPlot, Values};
+use crate::common::plots::{Canvas, Column, FieldPlot, Values, tick};
 use crate::common::sections::{DiagonalsChoice, GridKind, KeyPart, LinearChoice, NumOrExpr};
 
 use crate::common::rotation_keys::TimeIntegration;
@@ -725,15 +725,18 @@ impl<const D: usize> Model for Run<'_, D> {
         if let Some(g2) = (self.model.grid() as &dyn std::any::Any).downcast_ref::<Grid<2>>() {
             let canvas = Canvas::of_grid(g2);
             let nc = g2.num_cells();
-            for (name, title) in [
-                ("syy", "σ_yy (Pa), cell values"),
-                ("phi", "φ (rad), cell values"),
+            let scene = &self.ls.scene.scene.name;
+            let t = written.last().copied().unwrap_or(0.0);
+            for (name, what, bar, unit) in [
+                ("syy", "σ_yy, cell values", "σ_yy [Pa]", "Pa"),
+                ("phi", "rotation φ, cell values", "φ [rad]", "rad"),
             ] {
                 let f = Field::parse(name, 2).expect("2D field");
                 let v: Vec<f64> = (0..nc).map(|c| self.cell_value(f, c)).collect();
+                let title = format!("{scene}: {what} at t = {} s", tick(t));
                 crate::common::plots::field(
                     &dir.join(format!("{name}.png")),
-                    &FieldPlot::new(&canvas, title, &[]),
+                    &FieldPlot::new(&canvas, &title, bar, unit, &[]),
                     Values::Cell(&v),
                 )?;
             }
@@ -744,35 +747,41 @@ impl<const D: usize> Model for Run<'_, D> {
             let peak = (0..nc).max_by(|&a, &b| v[a].total_cmp(&v[b])).unwrap_or(0);
             let h = 20.0 * self.model.reconstruction().diameter[peak];
             let x = g2.cell_centroid(peak);
-            let mut plot = FieldPlot::new(&canvas, "σ_yy (Pa) near its peak", &[]);
+            let title = format!("{scene}: σ_yy near its peak at t = {} s", tick(t));
+            let mut plot = FieldPlot::new(&canvas, &title, "σ_yy [Pa]", "Pa", &[]);
             plot.window = Some(([x[0] - h, x[1] - h], [x[0] + h, x[1] + h]));
             crate::common::plots::field(&dir.join("syy_peak.png"), &plot, Values::Cell(&v))?;
         }
         if written.len() > 1 && !self.probes.is_empty() {
-            let columns: Vec<(String, Vec<f64>)> = self
+            let columns: Vec<Column> = self
                 .ls
                 .scene
                 .output
                 .probe
                 .iter()
                 .enumerate()
-                .map(|(i, p)| (p.name.clone(), series[i].clone()))
+                .map(|(i, p)| {
+                    Column::new(p.name.clone(), Field::unit(&p.field, D), series[i].clone())
+                })
                 .collect();
             crate::common::plots::time_series(
                 &dir.join("probes.png"),
                 written,
                 &columns,
-                "probes",
+                &format!("{}: probes", self.ls.scene.scene.name),
             )?;
         }
         Ok(())
     }
 
     fn sizes(&self) -> Sizes {
+        let (cells, dofs) = (self.model.grid().num_cells(), self.model.equations());
         Sizes {
-            cells: self.model.grid().num_cells(),
-            nodes: self.model.grid().num_nodes(),
-            dofs: self.model.equations(),
+            cells: Some(cells),
+            nodes: None,
+            dofs: Some(dofs),
+            counts: vec![("cells", cells), ("unknowns", dofs)],
+            failed: None,
         }
     }
 
@@ -792,6 +801,10 @@ impl<const D: usize> Model for Run<'_, D> {
 
     fn peak_bytes(&self) -> f64 {
         crate::common::limits::cosserat_bytes(self.model.equations() as f64)
+    }
+
+    fn unit(&self, field: &str) -> &'static str {
+        Field::unit(field, D)
     }
 
     fn failed(&self) -> usize {

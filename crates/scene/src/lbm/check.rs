@@ -15,6 +15,20 @@ pub const FIELDS: [&str; 5] = ["vx", "vy", "pressure", "density", "temperature"]
 /// Obstacle probe fields.
 pub const OBSTACLE_FIELDS: [&str; 3] = ["fx", "fy", "torque"];
 
+/// The unit of a field of [`FIELDS`] or [`OBSTACLE_FIELDS`] (forces and torques per
+/// metre of depth: N/m, N).
+pub fn unit(field: &str) -> &'static str {
+    match field {
+        "vx" | "vy" => "m/s",
+        "pressure" => "Pa",
+        "density" => "kg/m³",
+        "temperature" => "°C",
+        "fx" | "fy" => "N/m",
+        "torque" => "N",
+        _ => "1",
+    }
+}
+
 /// Check a scene with `[scene] model = "lbm"`.
 pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
     let s = &ls.scene;

@@ -46,6 +46,7 @@ use crate::common::lattice::{
 use crate::common::loaded::{LoadedScene, k, ki};
 use crate::common::model::{Built, Model, Purpose, RunError, Sizes, StepStats};
 use crate::common::output::{OutputError, SolverStats, WallSeconds, write_atomic};
+use crate::common::plots::{Column, tick};
 use crate::common::sections::NumOrExpr;
 use porofrac_vtk::{Attributes, DataArray, Encoding, ImageData};
 
@@ -392,18 +393,58 @@ impl LbmModel<'_> {
                     (vel[k + 1][1] - vel[k - 1][1]) / h - (vel[k + nx][0] - vel[k - nx][0]) / h;
             }
         }
-        images::field_png(&dir.join("speed.png"), [nx, ny], &speed, &solid, false)?;
-        images::field_png(&dir.join("vorticity.png"), [nx, ny], &vort, &solid, true)?;
+        let t = self.times.last().copied().unwrap_or(0.0);
+        let image = |title: &'static str, bar: &'static str, unit: &'static str| {
+            let title = format!("{}: {title} at t = {} s", self.name, tick(t));
+            (title, bar, unit)
+        };
+        for (file, (title, bar, unit), values, symmetric) in [
+            (
+                "speed.png",
+                image("fluid speed", "speed [m/s]", "m/s"),
+                &speed,
+                false,
+            ),
+            (
+                "vorticity.png",
+                image("vorticity", "vorticity [1/s]", "1/s"),
+                &vort,
+                true,
+            ),
+        ] {
+            images::field_png(
+                &dir.join(file),
+                [nx, ny],
+                values,
+                &solid,
+                &images::LatticeImage {
+                    title: &title,
+                    bar,
+                    unit,
+                    origin: self.origin,
+                    dx: self.units.dx,
+                    symmetric,
+                },
+            )?;
+        }
         if let Some(th) = &self.thermal {
-            let t: Vec<f64> = (0..ny)
+            let temps: Vec<f64> = (0..ny)
                 .flat_map(|j| (0..nx).map(move |i| th.temperature(i, j)))
                 .collect();
+            let (title, bar, unit) = image("temperature", "temperature [°C]", "°C");
             images::field_png(
                 &dir.join("temperature.png"),
                 [nx, ny],
-                &t,
+                &temps,
                 &vec![false; nx * ny],
-                false,
+                &images::LatticeImage {
+                    title: &title,
+                    bar,
+                    unit,
+                    origin: self.origin,
+                    dx: self.units.dx,
+                    symmetric: false,
+                },
             )?;
         }
         Ok(())
@@ -722,25 +763,31 @@ impl Model for LbmModel<'_> {
         if probes.is_empty() || written.is_empty() {
             return Ok(());
         }
-        let forces: Vec<(String, Vec<f64>)> = probes
+        let column = |(p, s): (&crate::common::sections::Probe, &Vec<f64>)| {
+            Column::new(p.name.clone(), check::unit(&p.field), s.clone())
+        };
+        let forces: Vec<Column> = probes
             .iter()
             .zip(series)
             .filter(|(p, _)| p.obstacle.is_some())
-            .map(|(p, s)| (p.name.clone(), s.clone()))
+            .map(column)
             .collect();
         if !forces.is_empty() {
             crate::common::plots::time_series(
                 &dir.join("obstacle_forces.png"),
                 written,
                 &forces,
-                &format!("{}: obstacle forces (N/m)", self.name),
+                &format!(
+                    "{}: obstacle forces and torques (per metre of depth)",
+                    self.name
+                ),
             )?;
         }
-        let fields: Vec<(String, Vec<f64>)> = probes
+        let fields: Vec<Column> = probes
             .iter()
             .zip(series)
             .filter(|(p, _)| p.obstacle.is_none())
-            .map(|(p, s)| (p.name.clone(), s.clone()))
+            .map(column)
             .collect();
         if !fields.is_empty() {
             crate::common::plots::time_series(
@@ -751,14 +798,6 @@ impl Model for LbmModel<'_> {
             )?;
         }
         Ok(())
-    }
-
-    fn counts(&self) -> Vec<(&'static str, usize)> {
-        let (nx, ny) = self.lat.size();
-        vec![
-            ("lattice nodes", nx * ny),
-            ("fluid nodes", self.lat.fluid_nodes()),
-        ]
     }
 
     fn work(&self) -> crate::common::limits::Work {
@@ -780,10 +819,16 @@ impl Model for LbmModel<'_> {
     fn sizes(&self) -> Sizes {
         let (nx, ny) = self.lat.size();
         Sizes {
-            cells: nx * ny,
-            nodes: self.lat.fluid_nodes(),
-            dofs: 9 * nx * ny,
+            counts: vec![
+                ("lattice nodes", nx * ny),
+                ("fluid nodes", self.lat.fluid_nodes()),
+            ],
+            ..Sizes::default()
         }
+    }
+
+    fn unit(&self, field: &str) -> &'static str {
+        check::unit(field)
     }
 
     fn failed(&self) -> usize {
@@ -804,7 +849,7 @@ impl Model for LbmModel<'_> {
 
     fn wall_seconds(&self) -> WallSeconds {
         WallSeconds {
-            solve: self.stepping_seconds,
+            stepping: self.stepping_seconds,
             ..WallSeconds::default()
         }
     }

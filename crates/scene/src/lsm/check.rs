@@ -35,6 +35,17 @@ pub const GLOBAL_FIELDS: [&str; 6] = [
 /// (Pa) and speed (m/s), bilinear between the fluid nodes around the point.
 pub const FLUID_FIELDS: [&str; 2] = ["fluid_pressure", "fluid_speed"];
 
+/// The unit of an LSM probe or line field (particle, cell, whole-scene or fluid field).
+pub fn unit(field: &str) -> &'static str {
+    crate::common::particle_output::particle_unit(field).unwrap_or(match field {
+        "pressure" | "fluid_pressure" => "Pa",
+        "platen_force" => "N/m",
+        "crack_extent" => "m",
+        "fluid_speed" => "m/s",
+        _ => "1",
+    })
+}
+
 /// Check the fluid point probes; returns the scene with each of them replaced by a
 /// scene-wide probe of the same name, for the checks shared with the other particle
 /// model (which refuse `at`).

@@ -8,7 +8,7 @@
 //! [`porofrac_lsm::WallFaces::Rays`]) in the reference configuration, whatever loads the
 //! wall (rays, wetted faces or fluid), so that every loading is measured alike.
 //!
-//! Output: `crack.csv` (`time,i,j,pressure,extent`, one row per broken bond in the order
+//! Output: `crack.csv` (`time [s],i,j,pressure [Pa],extent [m]`, one row per broken bond in the order
 //! of `broken.csv`), the scene-wide probe `crack_extent` (m) and the `summary.json` keys
 //! `initiation_pressure`, `breakdown_pressure`, `breakdown_extent` (`2a`, m) and
 //! `crack_extent` (m, at the end).
@@ -149,7 +149,7 @@ impl CrackLog {
         if self.rows.len() == self.written && self.written > 0 {
             return Ok(());
         }
-        let mut text = String::from("time,i,j,pressure,extent\n");
+        let mut text = String::from("time [s],i,j,pressure [Pa],extent [m]\n");
         for (t, i, j, p, e) in &self.rows {
             text.push_str(&format!("{t:e},{i},{j},{p:e},{e:e}\n"));
         }

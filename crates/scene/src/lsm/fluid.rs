@@ -14,6 +14,8 @@
 
 use std::path::Path;
 
+use crate::common::lattice::images::{LatticeImage, field_png};
+
 use serde::Deserialize;
 
 use porofrac_lbm::Lattice;
@@ -500,7 +502,9 @@ impl Fluid {
             return Ok(());
         }
         let mut text = String::from(
-            "time,particle_heat,fluid_heat,side_inflow,extracted_from_particles,carried,defect,mean_particle_temperature\n",
+            "time [s],particle_heat [J/m],fluid_heat [J/m],side_inflow [J/m],\
+             extracted_from_particles [J/m],carried [J/m],defect [J/m],\
+             mean_particle_temperature [°C]\n",
         );
         for r in &self.heat_rows {
             let row: Vec<String> = r.iter().map(|v| format!("{v:e}")).collect();
@@ -513,7 +517,13 @@ impl Fluid {
 
     /// Images of the fluid speed and pressure, of the temperature and of the disks coloured
     /// by temperature.
-    pub fn plots(&self, dir: &Path, solid: &LatticeSolid) -> Result<(), RunError> {
+    pub fn plots(
+        &self,
+        dir: &Path,
+        solid: &LatticeSolid,
+        name: &str,
+        t: f64,
+    ) -> Result<(), RunError> {
         let lat = self.pf.lattice();
         let u = self.pf.units();
         let (nx, ny) = lat.size();
@@ -528,49 +538,75 @@ impl Fluid {
                 solid_mask.push(lat.is_solid(i, j));
             }
         }
-        crate::common::lattice::images::field_png(
+        let stamp = format!("t = {} s", crate::common::plots::tick(t));
+        let base = LatticeImage {
+            title: "",
+            bar: "",
+            unit: "",
+            origin: self.pf.origin(),
+            dx: u.dx,
+            symmetric: false,
+        };
+        let title = format!("{name}: fluid speed at {stamp}");
+        field_png(
             &dir.join("fluid_speed.png"),
             [nx, ny],
             &speed,
             &solid_mask,
-            false,
+            &LatticeImage {
+                title: &title,
+                bar: "speed [m/s]",
+                unit: "m/s",
+                ..base
+            },
         )?;
-        crate::common::lattice::images::field_png(
+        let title = format!("{name}: fluid pressure (gauge) at {stamp}");
+        field_png(
             &dir.join("fluid_pressure.png"),
             [nx, ny],
             &pressure,
             &solid_mask,
-            false,
+            &LatticeImage {
+                title: &title,
+                bar: "pressure [Pa]",
+                unit: "Pa",
+                ..base
+            },
         )?;
         if let Some(th) = self.pf.thermal() {
-            let t: Vec<f64> = (0..ny)
+            let temps_fluid: Vec<f64> = (0..ny)
                 .flat_map(|j| (0..nx).map(move |i| (i, j)))
                 .map(|(i, j)| th.temperature(i, j))
                 .collect();
             let none = vec![false; nx * ny];
-            crate::common::lattice::images::field_png(
+            let title = format!("{name}: temperature at {stamp}");
+            field_png(
                 &dir.join("temperature.png"),
                 [nx, ny],
-                &t,
+                &temps_fluid,
                 &none,
-                false,
+                &LatticeImage {
+                    title: &title,
+                    bar: "temperature [°C]",
+                    unit: "°C",
+                    ..base
+                },
             )?;
             let d = solid.disks();
             let temps: Vec<f64> = (0..d.len())
                 .map(|i| self.pf.particle_temperature(i).unwrap_or(f64::NAN))
                 .collect();
-            let (lo, hi) = temps
-                .iter()
-                .filter(|v| v.is_finite())
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-                    (a.min(v), b.max(v))
-                });
-            let span = (hi - lo).max(1e-300);
+            let title = format!("{name}: disk temperature at {stamp}");
             crate::common::particle_output::draw_disks(
                 &dir.join("particles_temperature.png"),
                 d,
-                |i| super::ramp((temps[i] - lo) / span),
-                &[],
+                &crate::common::particle_output::DiskPicture {
+                    title: &title,
+                    values: &temps,
+                    bar: "temperature [°C]",
+                    unit: "°C",
+                    segments: &[],
+                },
             )?;
         }
         Ok(())

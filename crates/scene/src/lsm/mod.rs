@@ -15,7 +15,7 @@
 //!   lines,
 //!   `vtk/particles_NNNN.vtp` (with `broken_bonds` per particle) and
 //!   `vtk/contacts_NNNN.vtp` (intact bonds `bonded = 1`, touching contacts `0`),
-//!   `broken.csv` (`time,i,j,x,y,mode`), with a pressurised hole `crack.csv`
+//!   `broken.csv` (`time [s],i,j,x [m],y [m],mode`), with a pressurised hole `crack.csv`
 //!   ([`crack::CrackLog`]), field extrema and `summary.json` keys
 //!   (`particles`, `bonds`, `broken_bonds`, `broken_tensile`, `broken_shear`,
 //!   `contacts`, `lsm_steps`, `dt`, `stable_dt`, `bond_updates_per_second`,
@@ -39,7 +39,6 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::time::Instant;
 
-use plotters::style::RGBColor;
 use porofrac_grid::io::PvdWriter;
 use porofrac_lsm::calibrate::{QuasiStatic, brazilian_polled, hexagonal_moduli, uniaxial_polled};
 use porofrac_lsm::{
@@ -56,6 +55,7 @@ use crate::common::loaded::{LoadedScene, k, ki, step_count};
 use crate::common::model::{Built, Model, Purpose, RunError, Sizes, StepStats};
 use crate::common::output::{SolverStats, WallSeconds};
 use crate::common::particle_output::{self, PARTICLE_FIELDS};
+use crate::common::plots::Column;
 
 use file::{DampingChoice, NormalChoice, WallChoice};
 
@@ -518,27 +518,6 @@ fn push_link(
     });
 }
 
-/// A blue–green–yellow–red ramp for t in [0, 1].
-fn ramp(t: f64) -> RGBColor {
-    let stops = [
-        (49.0, 54.0, 149.0),
-        (69.0, 117.0, 180.0),
-        (116.0, 196.0, 118.0),
-        (254.0, 224.0, 71.0),
-        (215.0, 48.0, 39.0),
-    ];
-    let t = if t.is_finite() {
-        t.clamp(0.0, 1.0)
-    } else {
-        0.0
-    } * (stops.len() - 1) as f64;
-    let k = (t as usize).min(stops.len() - 2);
-    let f = t - k as f64;
-    let (a, b) = (stops[k], stops[k + 1]);
-    let mix = |x: f64, y: f64| (x + f * (y - x)).round() as u8;
-    RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
-}
-
 impl Model for LsmModel<'_> {
     fn checkpoints(&self) -> bool {
         // With a lattice Boltzmann fluid ([lbm]) the coupled state is not saved.
@@ -813,7 +792,7 @@ impl Model for LsmModel<'_> {
         if broken.len() == self.broken_written && self.broken_written > 0 {
             return Ok(());
         }
-        let mut text = String::from("time,i,j,x,y,mode\n");
+        let mut text = String::from("time [s],i,j,x [m],y [m],mode\n");
         for b in broken {
             text.push_str(&format!(
                 "{:e},{},{},{:e},{:e},{}\n",
@@ -883,9 +862,15 @@ impl Model for LsmModel<'_> {
             &self.ls.scene.scene.name,
             written,
             &probes,
+            check::unit,
         )?;
         if let Some(f) = &self.fluid {
-            f.plots(dir, &self.solid)?;
+            f.plots(
+                dir,
+                &self.solid,
+                &self.ls.scene.scene.name,
+                written.last().copied().unwrap_or(0.0),
+            )?;
         }
         let d = self.solid.disks();
         let u: Vec<f64> = (0..d.len())
@@ -894,31 +879,36 @@ impl Model for LsmModel<'_> {
                 (u[0] * u[0] + u[1] * u[1]).sqrt()
             })
             .collect();
-        let umax = u.iter().copied().fold(0.0, f64::max).max(1e-300);
         let segments: Vec<([f64; 2], [f64; 2])> = self
             .solid
             .broken()
             .iter()
             .map(|b| (d.x[b.i], d.x[b.j]))
             .collect();
+        let t = written.last().copied().unwrap_or(0.0);
+        let title = format!(
+            "{}: displacement at t = {} s, broken bonds in black",
+            self.ls.scene.scene.name,
+            crate::common::plots::tick(t)
+        );
         particle_output::draw_disks(
             &dir.join("particles.png"),
             d,
-            |i| ramp(u[i] / umax),
-            &segments,
+            &particle_output::DiskPicture {
+                title: &title,
+                values: &u,
+                bar: "|u| [m]",
+                unit: "m",
+                segments: &segments,
+            },
         )?;
         let times: Vec<f64> = self.history.iter().map(|h| h[0]).collect();
         let columns = vec![
-            (
-                "tensile".to_string(),
-                self.history.iter().map(|h| h[1]).collect(),
-            ),
-            (
-                "shear".to_string(),
-                self.history.iter().map(|h| h[2]).collect(),
-            ),
-            (
-                "total".to_string(),
+            Column::new("tensile", "1", self.history.iter().map(|h| h[1]).collect()),
+            Column::new("shear", "1", self.history.iter().map(|h| h[2]).collect()),
+            Column::new(
+                "total",
+                "1",
                 self.history.iter().map(|h| h[1] + h[2]).collect(),
             ),
         ];
@@ -929,17 +919,6 @@ impl Model for LsmModel<'_> {
             &format!("{}: broken bonds", self.ls.scene.scene.name),
         )?;
         Ok(())
-    }
-
-    fn counts(&self) -> Vec<(&'static str, usize)> {
-        let mut c = vec![
-            ("particles", self.solid.disks().len()),
-            ("bonds", self.solid.bonds().len()),
-        ];
-        if let Some(f) = &self.fluid {
-            c.push(("lattice nodes", f.lattice_nodes()));
-        }
-        c
     }
 
     fn work(&self) -> crate::common::limits::Work {
@@ -979,10 +958,23 @@ impl Model for LsmModel<'_> {
 
     fn sizes(&self) -> Sizes {
         Sizes {
-            cells: self.solid.disks().len(),
-            nodes: 0,
-            dofs: 3 * self.solid.disks().len(),
+            counts: {
+                let mut c = vec![
+                    ("particles", self.solid.disks().len()),
+                    ("bonds", self.solid.bonds().len()),
+                ];
+                if let Some(f) = &self.fluid {
+                    c.push(("lattice nodes", f.lattice_nodes()));
+                }
+                c
+            },
+            failed: Some("broken bonds"),
+            ..Sizes::default()
         }
+    }
+
+    fn unit(&self, field: &str) -> &'static str {
+        check::unit(field)
     }
 
     fn failed(&self) -> usize {
@@ -1003,7 +995,7 @@ impl Model for LsmModel<'_> {
 
     fn wall_seconds(&self) -> WallSeconds {
         WallSeconds {
-            assembly: self.step_seconds,
+            stepping: self.step_seconds,
             ..WallSeconds::default()
         }
     }

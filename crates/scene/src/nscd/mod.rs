@@ -598,13 +598,15 @@ impl Model for NscdModel<'_> {
             &self.ls.scene.scene.name,
             written,
             &probes,
+            |f| particle_output::particle_unit(f).unwrap_or("1"),
         )?;
-        crate::common::particle_plots::layers(&dir.join("layers.png"), &self.sys.disks)?;
+        crate::common::particle_plots::layers(
+            &dir.join("layers.png"),
+            &self.ls.scene.scene.name,
+            written.last().copied().unwrap_or(0.0),
+            &self.sys.disks,
+        )?;
         Ok(())
-    }
-
-    fn counts(&self) -> Vec<(&'static str, usize)> {
-        vec![("disks", self.sys.disks.len())]
     }
 
     fn work(&self) -> crate::common::limits::Work {
@@ -622,10 +624,16 @@ impl Model for NscdModel<'_> {
 
     fn sizes(&self) -> Sizes {
         Sizes {
-            cells: self.sys.disks.len(),
-            nodes: 0,
-            dofs: 3 * self.sys.disks.len(),
+            counts: vec![
+                ("disks", self.sys.disks.len()),
+                ("contacts", self.sys.contacts().len()),
+            ],
+            ..Sizes::default()
         }
+    }
+
+    fn unit(&self, field: &str) -> &'static str {
+        particle_output::particle_unit(field).unwrap_or("1")
     }
 
     fn failed(&self) -> usize {
@@ -647,7 +655,7 @@ impl Model for NscdModel<'_> {
 
     fn wall_seconds(&self) -> WallSeconds {
         WallSeconds {
-            assembly: self.step_seconds - self.stats.solve_seconds,
+            stepping: self.step_seconds - self.stats.solve_seconds,
             solve: self.stats.solve_seconds,
             ..WallSeconds::default()
         }
