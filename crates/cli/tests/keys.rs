@@ -96,7 +96,7 @@ fn set_overrides_keys_and_is_recorded() {
     // The patch test's stress is linear in E: twice E, twice σxx.
     let (head, rows_a) = read_csv(&a.join("probes.csv"));
     let (_, rows_b) = read_csv(&b.join("probes.csv"));
-    let col = head.iter().position(|h| h == "sxx_center").unwrap();
+    let col = head.iter().position(|h| h == "sxx_center [Pa]").unwrap();
     let (sa, sb) = (rows_a[0][col], rows_b[0][col]);
     assert!(sa.abs() > 0.0);
     assert!((sb / sa - 2.0).abs() < 1e-9, "{sa} {sb}");

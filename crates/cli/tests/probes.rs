@@ -71,7 +71,7 @@ fn flagship_probes_every_step_and_every_third_step_match_the_written_steps_bit_f
     assert!(!err.contains("step 41/"), "{err}");
     assert!(err.contains("fractured cells"), "{err}");
     assert!(
-        err.contains("19500 cells, 10375 nodes, 20657 unknowns, 40 steps"),
+        err.contains("19500 cells, 10375 nodes, 20657 unknowns, 19500 pressure unknowns, 40 steps"),
         "{err}"
     );
 
