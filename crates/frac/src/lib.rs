@@ -297,6 +297,20 @@ impl FailureState {
             log: Vec::new(),
         }
     }
+    /// The state of `num_cells` cells after the failures of `log` (in the order they
+    /// happened, as [`Self::log`] gives them: a saved state put back). Errors name a cell
+    /// out of range or recorded twice.
+    pub fn from_log(num_cells: usize, log: Vec<Failure>) -> Result<Self, String> {
+        let mut failed = vec![false; num_cells];
+        for f in &log {
+            match failed.get_mut(f.cell) {
+                None => return Err(format!("failed cell {} of {num_cells}", f.cell)),
+                Some(true) => return Err(format!("cell {} failed twice", f.cell)),
+                Some(x) => *x = true,
+            }
+        }
+        Ok(Self { failed, log })
+    }
     /// Whether cell `c` has failed.
     pub fn is_failed(&self, c: usize) -> bool {
         self.failed[c]

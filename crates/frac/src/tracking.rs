@@ -174,6 +174,45 @@ impl<const D: usize> CrackTracking<D> {
         self.points[c] = Some(point);
     }
 
+    /// The cells with a recorded crack, in the order recorded.
+    pub fn recorded(&self) -> &[usize] {
+        &self.recorded
+    }
+
+    /// Put back the cracks of an earlier run: the cells of [`Self::recorded`] with their
+    /// normals and points ([`Self::normal`], [`Self::point`]), replacing those recorded.
+    /// Errors name a cell out of range or recorded twice, or lengths that differ.
+    pub fn restore(
+        &mut self,
+        cells: &[usize],
+        normals: &[Point<D>],
+        points: &[Point<D>],
+    ) -> Result<(), String> {
+        let n = self.normals.len();
+        if normals.len() != cells.len() || points.len() != cells.len() {
+            return Err(format!(
+                "{} recorded cracks with {} normals and {} points",
+                cells.len(),
+                normals.len(),
+                points.len()
+            ));
+        }
+        let mut normal = vec![None; n];
+        let mut point = vec![None; n];
+        for ((&c, nc), pc) in cells.iter().zip(normals).zip(points) {
+            match normal.get_mut(c) {
+                None => return Err(format!("recorded cell {c} of {n}")),
+                Some(Some(_)) => return Err(format!("cell {c} recorded twice")),
+                Some(x) => *x = Some(*nc),
+            }
+            point[c] = Some(*pc);
+        }
+        self.normals = normal;
+        self.points = point;
+        self.recorded = cells.to_vec();
+        Ok(())
+    }
+
     /// The recorded crack normal of cell `c` (`None` while intact).
     pub fn normal(&self, c: usize) -> Option<Point<D>> {
         self.normals[c]

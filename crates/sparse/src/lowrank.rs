@@ -199,6 +199,35 @@ impl LowRank {
         self.lu.is_some()
     }
 
+    /// The unknowns whose columns of `A₀⁻¹` are cached, in the order they were computed.
+    pub fn cached_columns(&self) -> &[usize] {
+        &self.cached
+    }
+
+    /// Compute and cache the columns of `A₀⁻¹` of the unknowns `columns` (in this order;
+    /// those cached already and repeats are skipped) with the factors `ldlt`, and set up
+    /// no change: the cache of an earlier run with the same factors is the same, bit for
+    /// bit, and so are the updates [`LowRank::prepare`] builds on it.
+    pub fn cache_columns(&mut self, ldlt: &mut Ldlt, columns: &[usize]) -> Result<(), LdltError> {
+        let n = self.slot.len();
+        if let Some(&u) = columns.iter().find(|&&u| u >= n) {
+            return Err(LdltError(format!(
+                "cached column {u} of a matrix of {n} unknowns"
+            )));
+        }
+        self.clear_change();
+        let mut seen = vec![false; n];
+        let new: Vec<usize> = columns
+            .iter()
+            .copied()
+            .filter(|&u| self.slot[u] == NONE && !std::mem::replace(&mut seen[u], true))
+            .collect();
+        self.support = new;
+        let done = self.extend_cache(ldlt);
+        self.support.clear();
+        done
+    }
+
     /// Unknowns whose columns of `A₀⁻¹` are cached.
     #[cfg(test)]
     pub fn cached_len(&self) -> usize {

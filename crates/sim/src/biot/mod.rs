@@ -150,9 +150,12 @@
 //! * `fixed_stress.rs` — [`FixedStress`]: the fixed-stress split.
 //! * `explicit.rs` — [`ExplicitPressure`]: the explicit-pressure update of Nilsen et al. (2017).
 //! * `flow_solve.rs`, `mech_solve.rs` — the flow and mechanics solves of the split schemes.
+//! * `memory.rs` — [`SchemeMemory`]: what a scheme carries from one step to the next, for
+//!   checkpoints.
 
 mod explicit;
 mod fixed_stress;
+mod memory;
 mod flow_solve;
 mod mech_solve;
 mod monolithic;
@@ -160,6 +163,7 @@ mod system;
 
 pub use explicit::ExplicitPressure;
 pub use fixed_stress::FixedStress;
+pub use memory::SchemeMemory;
 use flow_solve::FlowSolver;
 use mech_solve::MechSolver;
 pub use monolithic::Monolithic;
