@@ -561,7 +561,10 @@ fn hydrofrac_small() -> String {
         ("cells = [30, 30]", "cells = [10, 10]"),
         ("refine = 12 ", "refine = 6 "),
         ("end_time = 2400.0", "end_time = 600.0"),
-        ("[output]\nevery = 10\n", "[output]\nevery = 1\nplots = false\n"),
+        (
+            "[output]\nevery = 10\n",
+            "[output]\nevery = 1\nplots = false\n",
+        ),
     ] {
         assert!(out.contains(from), "{from}");
         out = out.replace(from, to);
@@ -589,7 +592,11 @@ fn continuum_hydrofrac_resumes_bit_identical() {
         std::fs::write(&path, text.replace("end_time = 600.0", end)).unwrap();
         let out = dir.join(end);
         Scene::load(&path).unwrap().run(&out, &mut Silent).unwrap();
-        assert!(fracture_rows(&out) >= at_least, "{end}: {}", fracture_rows(&out));
+        assert!(
+            fracture_rows(&out) >= at_least,
+            "{end}: {}",
+            fracture_rows(&out)
+        );
         let summary = std::fs::read_to_string(out.join("summary.json")).unwrap();
         assert!(summary.contains("\"low_rank_updates\": "), "{summary}");
         assert!(!summary.contains("\"low_rank_updates\": 0,"), "{summary}");
@@ -616,7 +623,10 @@ fn continuum_terzaghi_resumes_bit_identical() {
     let mut text = include_str!("../../../scenes/terzaghi.toml").to_string();
     for (from, to) in [
         ("end_time = 86400.0\ndt = 216.0", "end_time = 2.1\ndt = 0.3"),
-        ("[output]\nevery = 100\n", "[output]\nevery = 2\nplots = false\n"),
+        (
+            "[output]\nevery = 100\n",
+            "[output]\nevery = 2\nplots = false\n",
+        ),
     ] {
         assert!(text.contains(from), "{from}");
         text = text.replace(from, to);
@@ -636,8 +646,48 @@ fn continuum_static_resumes_bit_identical() {
     );
     // The band fails at t = 5 s: stopped after it, and before it (periodic checkpoints).
     check_resume("continuum_tension_band", &text, 5, 2);
+    // Damped explicit relaxation from the previous step's displacements.
+    let explicit = text
+        .replace(
+            "poisson_ratio = 0.25\n",
+            "poisson_ratio = 0.25\ndensity = 2500.0\n",
+        )
+        .replace(
+            "[physics]\n",
+            "[solver]\nmechanics = \"explicit\"\n\n[physics]\n",
+        );
+    assert!(explicit.contains("mechanics = \"explicit\""));
+    check_resume("continuum_tension_band_explicit", &explicit, 5, 2);
+    let amg = text.replace(
+        "[physics]\n",
+        "[solver]\nlinear = \"cg-amg\"\n\n[physics]\n",
+    );
+    assert_ne!(amg, text);
+    // CG-AMG keeps its hierarchy from the first matrix: a rebuilt one would iterate
+    // otherwise, so such scenes are refused checkpoints.
+    let amg = amg.replace(
+        "[output]\nplots = false\n",
+        "[output]\nplots = false\ncheckpoint_every = 2\n",
+    );
+    let dir = out_dir("continuum_amg");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("amg.toml");
+    std::fs::write(&path, &amg).unwrap();
+    let e = Scene::load(&path)
+        .unwrap()
+        .run(&dir.join("out"), &mut Silent)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("output.checkpoint_every") && e.contains("cannot write or resume"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
     let text = include_str!("../../../scenes/flow_column.toml")
         .replace("end_time = 30.0", "end_time = 2.0")
-        .replace("[output]\nevery = 40\n", "[output]\nevery = 2\nplots = false\n");
+        .replace(
+            "[output]\nevery = 40\n",
+            "[output]\nevery = 2\nplots = false\n",
+        );
     check_resume("continuum_flow_column", &text, 3, 3);
 }

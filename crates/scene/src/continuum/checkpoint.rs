@@ -160,7 +160,10 @@ fn points<const D: usize>(values: &[f64]) -> Vec<Point<D>> {
 }
 
 /// Put back the state [`save`] saved into `s`, just built from the same scene.
-pub(super) fn restore<const D: usize>(s: &mut Stepper<'_, D>, state: &State) -> Result<(), RunError> {
+pub(super) fn restore<const D: usize>(
+    s: &mut Stepper<'_, D>,
+    state: &State,
+) -> Result<(), RunError> {
     let grid = s.body.grid;
     let (nc, nn) = (grid.num_cells(), grid.num_nodes());
     s.u = state.f64s_len("continuum/u", D * nn)?.to_vec();

@@ -2,8 +2,8 @@
 //! in fractured cells, the flow implicit in the fluxes.
 
 use super::{
-    BiotCoupling, BiotResult, BiotState, BiotStep, BiotSystem, CouplingStats, SchemeMemory, FlowSolver,
-    MechSolver, check_len, check_state, check_step,
+    BiotCoupling, BiotResult, BiotState, BiotStep, BiotSystem, CouplingStats, FlowSolver,
+    MechSolver, SchemeMemory, check_len, check_state, check_step,
 };
 
 /// The explicit-pressure coupling of Nilsen et al. (2017) §2.5: the volumetric term only in

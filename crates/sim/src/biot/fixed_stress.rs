@@ -5,8 +5,8 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use super::{
-    BiotCoupling, BiotError, BiotResult, BiotState, BiotStep, BiotSystem, CouplingStats, SchemeMemory,
-    FlowSolver, MechSolver, check_state, check_step, inf_norm,
+    BiotCoupling, BiotError, BiotResult, BiotState, BiotStep, BiotSystem, CouplingStats,
+    FlowSolver, MechSolver, SchemeMemory, check_state, check_step, inf_norm,
 };
 
 /// The fixed-stress split (see the module docs): flow with the stabilisation

@@ -155,17 +155,17 @@
 
 mod explicit;
 mod fixed_stress;
-mod memory;
 mod flow_solve;
 mod mech_solve;
+mod memory;
 mod monolithic;
 mod system;
 
 pub use explicit::ExplicitPressure;
 pub use fixed_stress::FixedStress;
-pub use memory::SchemeMemory;
 use flow_solve::FlowSolver;
 use mech_solve::MechSolver;
+pub use memory::SchemeMemory;
 pub use monolithic::Monolithic;
 pub(crate) use system::Operators;
 pub use system::{BiotSystem, drained_bulk_modulus};

@@ -11,8 +11,7 @@ use porofrac_sparse::{Ldlt, LdltError, LowRank, UpperRows};
 
 use super::{
     BiotCoupling, BiotError, BiotResult, BiotState, BiotStep, BiotSystem, CouplingStats, Operators,
-    SchemeMemory,
-    check_state, check_step, snap_step,
+    SchemeMemory, check_state, check_step, snap_step,
 };
 
 /// The fully implicit monolithic scheme (Nilsen et al. (2017) eq. 30): one symmetric
@@ -238,7 +237,8 @@ impl Monolithic {
             return Ok(());
         }
         let nnz = self.values.len();
-        if memory.factored.len() != nnz || !(memory.current.is_empty() || memory.current.len() == nnz)
+        if memory.factored.len() != nnz
+            || !(memory.current.is_empty() || memory.current.len() == nnz)
         {
             return Err(BiotError::Input(format!(
                 "resumed coupled matrix of {} entries, the pattern has {nnz}",
