@@ -366,6 +366,23 @@ mod tests {
         }
     }
 
+    /// A log put back gives the same state; a cell out of range or failed twice is
+    /// refused.
+    #[test]
+    fn failure_state_from_its_log() {
+        let mut f = FailureState::new(5);
+        f.fail(3, 1.0, FailureMode::Tensile);
+        f.fail(0, 2.5, FailureMode::Shear);
+        assert_eq!(FailureState::from_log(5, f.log().to_vec()).unwrap(), f);
+        let twice = vec![f.log()[0]; 2];
+        assert!(
+            FailureState::from_log(5, twice)
+                .unwrap_err()
+                .contains("twice")
+        );
+        assert!(FailureState::from_log(3, f.log().to_vec()).is_err());
+    }
+
     #[test]
     fn tensile_screen_passes_over_compression_and_keeps_tension() {
         let t = Tensile::new(2.0e5).unwrap();

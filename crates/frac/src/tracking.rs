@@ -347,6 +347,40 @@ mod tests {
         }
     }
 
+    /// Cracks put back from another tracking's record admit exactly the same cells; bad
+    /// records are refused.
+    #[test]
+    fn restored_cracks_admit_the_same_cells() {
+        let g = cartesian([0.0, 0.0].into(), [3.0, 3.0].into(), [3, 3]).unwrap();
+        let mut t = CrackTracking::new(&g, 20.0).unwrap();
+        let mut failed = vec![false; 9];
+        let sx = Tensor::<2>::new(1.0, 0.0, 0.0, -1.0);
+        let sy = Tensor::<2>::new(-1.0, 0.0, 0.0, 1.0);
+        t.record(4, &sx, &failed);
+        failed[4] = true;
+        t.record(7, &sx, &failed);
+        failed[7] = true;
+        let cells = t.recorded().to_vec();
+        assert_eq!(cells, [4, 7]);
+        let normals: Vec<_> = cells.iter().map(|&c| t.normal(c).unwrap()).collect();
+        let points: Vec<_> = cells.iter().map(|&c| t.point(c).unwrap()).collect();
+        let mut u = CrackTracking::new(&g, 20.0).unwrap();
+        u.restore(&cells, &normals, &points).unwrap();
+        for c in 0..9 {
+            assert_eq!(u.normal(c), t.normal(c));
+            assert_eq!(u.point(c), t.point(c));
+            for s in [&sx, &sy] {
+                assert_eq!(u.admits(c, s, &failed), t.admits(c, s, &failed), "cell {c}");
+            }
+        }
+        assert!(
+            u.restore(&[4, 4], &[normals[0]; 2], &[points[0]; 2])
+                .is_err()
+        );
+        assert!(u.restore(&[9], &normals[..1], &points[..1]).is_err());
+        assert!(u.restore(&[4], &normals, &points[..1]).is_err());
+    }
+
     /// A crack along y in a 7×7 grid of unit squares (cells of column 3, rows 2..=4,
     /// opened under σ₁ along x): its continuation above and below is admissible; a cell two
     /// columns beside it nucleates without an exclusion radius and not with one of 2.5.
