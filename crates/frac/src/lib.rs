@@ -297,6 +297,20 @@ impl FailureState {
             log: Vec::new(),
         }
     }
+    /// The state of `num_cells` cells after the failures of `log` (in the order they
+    /// happened, as [`Self::log`] gives them: a saved state put back). Errors name a cell
+    /// out of range or recorded twice.
+    pub fn from_log(num_cells: usize, log: Vec<Failure>) -> Result<Self, String> {
+        let mut failed = vec![false; num_cells];
+        for f in &log {
+            match failed.get_mut(f.cell) {
+                None => return Err(format!("failed cell {} of {num_cells}", f.cell)),
+                Some(true) => return Err(format!("cell {} failed twice", f.cell)),
+                Some(x) => *x = true,
+            }
+        }
+        Ok(Self { failed, log })
+    }
     /// Whether cell `c` has failed.
     pub fn is_failed(&self, c: usize) -> bool {
         self.failed[c]
@@ -350,6 +364,23 @@ mod tests {
                 proptest::prop_assert!(FailureCriterion::<2>::check(&t, &s2).is_none());
             }
         }
+    }
+
+    /// A log put back gives the same state; a cell out of range or failed twice is
+    /// refused.
+    #[test]
+    fn failure_state_from_its_log() {
+        let mut f = FailureState::new(5);
+        f.fail(3, 1.0, FailureMode::Tensile);
+        f.fail(0, 2.5, FailureMode::Shear);
+        assert_eq!(FailureState::from_log(5, f.log().to_vec()).unwrap(), f);
+        let twice = vec![f.log()[0]; 2];
+        assert!(
+            FailureState::from_log(5, twice)
+                .unwrap_err()
+                .contains("twice")
+        );
+        assert!(FailureState::from_log(3, f.log().to_vec()).is_err());
     }
 
     #[test]

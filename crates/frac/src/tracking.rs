@@ -174,6 +174,45 @@ impl<const D: usize> CrackTracking<D> {
         self.points[c] = Some(point);
     }
 
+    /// The cells with a recorded crack, in the order recorded.
+    pub fn recorded(&self) -> &[usize] {
+        &self.recorded
+    }
+
+    /// Put back the cracks of an earlier run: the cells of [`Self::recorded`] with their
+    /// normals and points ([`Self::normal`], [`Self::point`]), replacing those recorded.
+    /// Errors name a cell out of range or recorded twice, or lengths that differ.
+    pub fn restore(
+        &mut self,
+        cells: &[usize],
+        normals: &[Point<D>],
+        points: &[Point<D>],
+    ) -> Result<(), String> {
+        let n = self.normals.len();
+        if normals.len() != cells.len() || points.len() != cells.len() {
+            return Err(format!(
+                "{} recorded cracks with {} normals and {} points",
+                cells.len(),
+                normals.len(),
+                points.len()
+            ));
+        }
+        let mut normal = vec![None; n];
+        let mut point = vec![None; n];
+        for ((&c, nc), pc) in cells.iter().zip(normals).zip(points) {
+            match normal.get_mut(c) {
+                None => return Err(format!("recorded cell {c} of {n}")),
+                Some(Some(_)) => return Err(format!("cell {c} recorded twice")),
+                Some(x) => *x = Some(*nc),
+            }
+            point[c] = Some(*pc);
+        }
+        self.normals = normal;
+        self.points = point;
+        self.recorded = cells.to_vec();
+        Ok(())
+    }
+
     /// The recorded crack normal of cell `c` (`None` while intact).
     pub fn normal(&self, c: usize) -> Option<Point<D>> {
         self.normals[c]
@@ -306,6 +345,40 @@ mod tests {
             assert!(t.admits(7, s, &failed) && t.admits(1, s, &failed));
             assert!(!t.admits(3, s, &failed) && !t.admits(5, s, &failed));
         }
+    }
+
+    /// Cracks put back from another tracking's record admit exactly the same cells; bad
+    /// records are refused.
+    #[test]
+    fn restored_cracks_admit_the_same_cells() {
+        let g = cartesian([0.0, 0.0].into(), [3.0, 3.0].into(), [3, 3]).unwrap();
+        let mut t = CrackTracking::new(&g, 20.0).unwrap();
+        let mut failed = vec![false; 9];
+        let sx = Tensor::<2>::new(1.0, 0.0, 0.0, -1.0);
+        let sy = Tensor::<2>::new(-1.0, 0.0, 0.0, 1.0);
+        t.record(4, &sx, &failed);
+        failed[4] = true;
+        t.record(7, &sx, &failed);
+        failed[7] = true;
+        let cells = t.recorded().to_vec();
+        assert_eq!(cells, [4, 7]);
+        let normals: Vec<_> = cells.iter().map(|&c| t.normal(c).unwrap()).collect();
+        let points: Vec<_> = cells.iter().map(|&c| t.point(c).unwrap()).collect();
+        let mut u = CrackTracking::new(&g, 20.0).unwrap();
+        u.restore(&cells, &normals, &points).unwrap();
+        for c in 0..9 {
+            assert_eq!(u.normal(c), t.normal(c));
+            assert_eq!(u.point(c), t.point(c));
+            for s in [&sx, &sy] {
+                assert_eq!(u.admits(c, s, &failed), t.admits(c, s, &failed), "cell {c}");
+            }
+        }
+        assert!(
+            u.restore(&[4, 4], &[normals[0]; 2], &[points[0]; 2])
+                .is_err()
+        );
+        assert!(u.restore(&[9], &normals[..1], &points[..1]).is_err());
+        assert!(u.restore(&[4], &normals, &points[..1]).is_err());
     }
 
     /// A crack along y in a 7×7 grid of unit squares (cells of column 3, rows 2..=4,

@@ -554,3 +554,144 @@ fn cosserat_resumes_bit_identical() {
     );
     check_resume("cosserat_newmark", &newmark, 5, 4);
 }
+
+/// The hydraulic fracture of `scenes/hydrofrac_seed.toml` on a coarser grid for ten
+/// minutes, every step written: monolithic coupling with low-rank updates of its factors,
+/// recovered stresses, crack tracking and tip toughness, `fracture.csv`.
+fn hydrofrac_small() -> String {
+    let text = include_str!("../../../scenes/hydrofrac_seed.toml");
+    let mut out = text.to_string();
+    for (from, to) in [
+        ("cells = [30, 30]", "cells = [10, 10]"),
+        ("refine = 12 ", "refine = 6 "),
+        ("end_time = 2400.0", "end_time = 600.0"),
+        (
+            "[output]\nevery = 10\n",
+            "[output]\nevery = 1\nplots = false\n",
+        ),
+    ] {
+        assert!(out.contains(from), "{from}");
+        out = out.replace(from, to);
+    }
+    out
+}
+
+/// Rows of `fracture.csv` (failed cells) of an output folder.
+fn fracture_rows(dir: &Path) -> usize {
+    std::fs::read_to_string(dir.join("fracture.csv"))
+        .unwrap()
+        .lines()
+        .count()
+        - 1
+}
+
+#[test]
+fn continuum_hydrofrac_resumes_bit_identical() {
+    let text = hydrofrac_small();
+    // Cells fail before and after the step the run stops at.
+    let dir = out_dir("hydrofrac_rows");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("h.toml");
+    for (end, at_least) in [("end_time = 180.0", 1), ("end_time = 600.0", 2)] {
+        std::fs::write(&path, text.replace("end_time = 600.0", end)).unwrap();
+        let out = dir.join(end);
+        Scene::load(&path).unwrap().run(&out, &mut Silent).unwrap();
+        assert!(
+            fracture_rows(&out) >= at_least,
+            "{end}: {}",
+            fracture_rows(&out)
+        );
+        let summary = std::fs::read_to_string(out.join("summary.json")).unwrap();
+        assert!(summary.contains("\"low_rank_updates\": "), "{summary}");
+        assert!(!summary.contains("\"low_rank_updates\": 0,"), "{summary}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+    check_resume("continuum_hydrofrac", &text, 3, 4);
+    // The split schemes carry their flow and mechanics factors.
+    // (The explicit-pressure update opens cells without settling after four minutes on
+    // this grid: three minutes, a cell failed by then.)
+    let split = text
+        .replace(
+            "coupling = \"monolithic\"",
+            "coupling = \"explicit-pressure\"",
+        )
+        .replace("end_time = 600.0", "end_time = 180.0");
+    check_resume("continuum_hydrofrac_split", &split, 1, 2);
+}
+
+/// Terzaghi's consolidation (`scenes/terzaghi.toml`) for a few steps with a time step
+/// that is not a binary fraction: poroelasticity without fracture, the monolithic factors
+/// reused from step to step.
+#[test]
+fn continuum_terzaghi_resumes_bit_identical() {
+    let mut text = include_str!("../../../scenes/terzaghi.toml").to_string();
+    for (from, to) in [
+        ("end_time = 86400.0\ndt = 216.0", "end_time = 2.1\ndt = 0.3"),
+        (
+            "[output]\nevery = 100\n",
+            "[output]\nevery = 2\nplots = false\n",
+        ),
+    ] {
+        assert!(text.contains(from), "{from}");
+        text = text.replace(from, to);
+    }
+    check_resume("continuum_terzaghi", &text, 2, 3);
+    let fixed = text.replace("coupling = \"monolithic\"", "coupling = \"fixed-stress\"");
+    check_resume("continuum_terzaghi_fixed_stress", &fixed, 2, 3);
+}
+
+/// Static mechanics with failing cells and flow on the fixed skeleton
+/// (`coupling = "none"`), and static mechanics solved by damped explicit relaxation.
+#[test]
+fn continuum_static_resumes_bit_identical() {
+    let text = include_str!("../../../scenes/tension_band.toml").replace(
+        "[[output.probe]]\nname = \"syy_top\"",
+        "[output]\nplots = false\n\n[[output.probe]]\nname = \"syy_top\"",
+    );
+    // The band fails at t = 5 s: stopped after it, and before it (periodic checkpoints).
+    check_resume("continuum_tension_band", &text, 5, 2);
+    // Damped explicit relaxation from the previous step's displacements.
+    let explicit = text
+        .replace(
+            "poisson_ratio = 0.25\n",
+            "poisson_ratio = 0.25\ndensity = 2500.0\n",
+        )
+        .replace(
+            "[physics]\n",
+            "[solver]\nmechanics = \"explicit\"\n\n[physics]\n",
+        );
+    assert!(explicit.contains("mechanics = \"explicit\""));
+    check_resume("continuum_tension_band_explicit", &explicit, 5, 2);
+    let amg = text.replace(
+        "[physics]\n",
+        "[solver]\nlinear = \"cg-amg\"\n\n[physics]\n",
+    );
+    assert_ne!(amg, text);
+    // CG-AMG keeps its hierarchy from the first matrix: a rebuilt one would iterate
+    // otherwise, so such scenes are refused checkpoints.
+    let amg = amg.replace(
+        "[output]\nplots = false\n",
+        "[output]\nplots = false\ncheckpoint_every = 2\n",
+    );
+    let dir = out_dir("continuum_amg");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("amg.toml");
+    std::fs::write(&path, &amg).unwrap();
+    let e = Scene::load(&path)
+        .unwrap()
+        .run(&dir.join("out"), &mut Silent)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("output.checkpoint_every") && e.contains("cannot write or resume"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+    let text = include_str!("../../../scenes/flow_column.toml")
+        .replace("end_time = 30.0", "end_time = 2.0")
+        .replace(
+            "[output]\nevery = 40\n",
+            "[output]\nevery = 2\nplots = false\n",
+        );
+    check_resume("continuum_flow_column", &text, 3, 3);
+}

@@ -69,7 +69,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use crate::assembly::{ElementCache, law_error};
 use crate::biot::{
     BiotCoupling, BiotError, BiotState, BiotSystem, CouplingStats, ExplicitPressure, FixedStress,
-    Monolithic, Operators,
+    Monolithic, Operators, SchemeMemory,
 };
 use crate::dofs::DofMap;
 use crate::error::SimError;
@@ -264,6 +264,18 @@ impl<const D: usize> FailureResolution<D> {
         &self.settings
     }
 
+    /// The crack tracking, when the settings track cracks (its recorded cracks are the
+    /// state it carries between steps).
+    pub fn tracking(&self) -> Option<&CrackTracking<D>> {
+        self.tracking.as_ref()
+    }
+
+    /// The crack tracking, to put back the cracks of an earlier run
+    /// ([`CrackTracking::restore`]).
+    pub fn tracking_mut(&mut self) -> Option<&mut CrackTracking<D>> {
+        self.tracking.as_mut()
+    }
+
     /// Whether any cell has a failure criterion (else [`Self::resolve`] solves once and
     /// needs no stresses).
     pub fn can_fail(&self) -> bool {
@@ -350,6 +362,24 @@ impl Scheme {
             Scheme::Monolithic(m) => m.stats(),
             Scheme::FixedStress(f, _) => f.stats(),
             Scheme::ExplicitPressure(e, _) => e.stats(),
+        }
+    }
+
+    /// What the scheme carries from one step to the next (see [`SchemeMemory`]).
+    pub fn memory(&self) -> SchemeMemory {
+        match self {
+            Scheme::Monolithic(m) => m.memory(),
+            Scheme::FixedStress(f, _) => f.memory(),
+            Scheme::ExplicitPressure(e, _) => e.memory(),
+        }
+    }
+
+    /// Go on from `memory` (of a scheme of the same kind on the same system).
+    pub fn resume(&mut self, memory: SchemeMemory) {
+        match self {
+            Scheme::Monolithic(m) => m.resume(memory),
+            Scheme::FixedStress(f, _) => f.resume(memory),
+            Scheme::ExplicitPressure(e, _) => e.resume(memory),
         }
     }
 }
@@ -591,6 +621,47 @@ impl<'a, const D: usize> Fracturing<'a, D> {
     /// The failure state (flags and the log of failures).
     pub fn failures(&self) -> &FailureState {
         &self.failures
+    }
+    /// The failure resolution (its crack tracking carries state between steps).
+    pub fn resolution(&self) -> &FailureResolution<D> {
+        &self.resolution
+    }
+    /// The failure resolution, to put back its crack tracking ([`Self::resume`]).
+    pub fn resolution_mut(&mut self) -> &mut FailureResolution<D> {
+        &mut self.resolution
+    }
+    /// What the coupling scheme carries from one step to the next.
+    pub fn scheme_memory(&self) -> SchemeMemory {
+        self.scheme.memory()
+    }
+
+    /// Go on after a step of an earlier run of the same scene: its failure state and its
+    /// scheme's memory ([`Self::scheme_memory`]); the crack tracking is put back through
+    /// [`Self::resolution_mut`]. The permeability of the failed cells and the law map
+    /// follow from the failure state at the next solve, the stress operators are those of
+    /// the intact laws as at the first solve of a run: the next steps are those of the run
+    /// never stopped, bit for bit. Errors: a failure state of another grid.
+    pub fn resume(&mut self, failures: FailureState, scheme: SchemeMemory) -> FractureResult<()> {
+        let grid = self.body.grid;
+        let nc = grid.num_cells();
+        if failures.flags().len() != nc {
+            return Err(FractureError::Input(format!(
+                "failure state of {} cells, the grid has {nc}",
+                failures.flags().len()
+            )));
+        }
+        if self.stress_cache.is_none() {
+            let intact = self.laws.law_map(grid, &vec![false; nc])?;
+            self.stress_cache = Some(StressCache::new(
+                &intact,
+                &self.operators,
+                &self.coords,
+                grid.cell_volumes(),
+            ));
+        }
+        self.failures = failures;
+        self.scheme.resume(scheme);
+        Ok(())
     }
     /// The flow model with the current permeability.
     pub fn flow(&self) -> &FlowModel<D> {

@@ -81,7 +81,7 @@ pub use assembly::{assemble, nodal_loads};
 pub use bc::{Displacement, Gravity, Loads, Platen, Traction};
 pub use biot::{
     BiotCoupling, BiotError, BiotState, BiotStep, BiotSystem, CouplingStats, ExplicitPressure,
-    FixedStress, Linearization, Monolithic, drained_bulk_modulus,
+    FixedStress, Linearization, Monolithic, SchemeMemory, drained_bulk_modulus,
 };
 pub use dofs::DofMap;
 pub use error::{Result, SimError};

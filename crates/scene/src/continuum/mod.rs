@@ -14,6 +14,7 @@
 //!   ([`fields`]) for probes, lines, VTK and `field_extrema`, and the plots ([`plots`]).
 
 pub mod check;
+mod checkpoint;
 pub mod compose;
 mod explain;
 pub mod fields;
@@ -301,6 +302,8 @@ struct Stepper<'a, const D: usize> {
     peak_bytes: f64,
     /// Unknowns of the run: displacements and, with flow, pressures.
     unknowns: f64,
+    /// Numeric factorizations of the run before its solver was built (a resumed run).
+    count_base: usize,
 }
 
 impl<'a, const D: usize> Stepper<'a, D> {
@@ -447,6 +450,7 @@ impl<'a, const D: usize> Stepper<'a, D> {
             stop,
             peak_bytes: 0.0,
             unknowns: 0.0,
+            count_base: 0,
         })
     }
 
@@ -529,7 +533,7 @@ impl<'a, const D: usize> Stepper<'a, D> {
         }
         self.stats.iterations += iterations;
         self.stats.max_relative_residual = self.stats.max_relative_residual.max(worst);
-        self.stats.factorizations = solver.numeric_factorizations();
+        self.stats.factorizations = self.count_base + solver.numeric_factorizations();
         self.stats.symbolic_factorizations = solver.symbolic_factorizations();
         self.stats.factor_nnz = solver.factor_nnz();
         Ok(iterations)
@@ -562,7 +566,7 @@ impl<'a, const D: usize> Stepper<'a, D> {
         self.stats.max_relative_residual = self.stats.max_relative_residual.max(next.residual);
         let coupling = frac.stats();
         self.stats.linear = coupling.linear.into();
-        self.stats.factorizations = coupling.numeric_factorizations;
+        self.stats.factorizations = self.count_base + coupling.numeric_factorizations;
         self.stats.symbolic_factorizations = coupling.symbolic_factorizations;
         self.stats.factor_nnz = coupling.factor_nnz;
         self.stats.low_rank_updates = coupling.low_rank_updates;
@@ -873,6 +877,23 @@ impl<const D: usize> Model for Stepper<'_, D> {
 
     fn peak_bytes(&self) -> f64 {
         self.peak_bytes
+    }
+
+    fn checkpoints(&self) -> bool {
+        checkpoint::supported(self)
+    }
+
+    fn save_state(&self, state: &mut crate::common::checkpoint::State) -> Result<(), RunError> {
+        checkpoint::save(self, state);
+        Ok(())
+    }
+
+    fn restore_state(
+        &mut self,
+        state: &crate::common::checkpoint::State,
+        _out: &Path,
+    ) -> Result<(), RunError> {
+        checkpoint::restore(self, state)
     }
 }
 

@@ -3,7 +3,7 @@
 
 use super::{
     BiotCoupling, BiotResult, BiotState, BiotStep, BiotSystem, CouplingStats, FlowSolver,
-    MechSolver, check_len, check_state, check_step,
+    MechSolver, SchemeMemory, check_len, check_state, check_step,
 };
 
 /// The explicit-pressure coupling of Nilsen et al. (2017) §2.5: the volumetric term only in
@@ -29,6 +29,23 @@ impl ExplicitPressure {
     /// together (see [`CouplingStats`]).
     pub fn stats(&self) -> CouplingStats {
         self.flow.stats().add(self.mech.stats())
+    }
+
+    /// The flow and mechanics matrices of the current factors (see [`SchemeMemory`]).
+    pub fn memory(&self) -> SchemeMemory {
+        let (factored, dt) = self.flow.memory();
+        SchemeMemory {
+            factored,
+            dt,
+            stiffness: self.mech.memory(),
+            ..SchemeMemory::default()
+        }
+    }
+
+    /// Go on from `memory`: the factors are computed again before the next solve.
+    pub fn resume(&mut self, memory: SchemeMemory) {
+        self.flow.resume(memory.factored, memory.dt);
+        self.mech.resume(memory.stiffness);
     }
 
     /// The pressure at `t + dt` from the displacements `u_new = u^{n+1}`, `u_old = uⁿ`

@@ -6,7 +6,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use super::{
     BiotCoupling, BiotError, BiotResult, BiotState, BiotStep, BiotSystem, CouplingStats,
-    FlowSolver, MechSolver, check_state, check_step, inf_norm,
+    FlowSolver, MechSolver, SchemeMemory, check_state, check_step, inf_norm,
 };
 
 /// The fixed-stress split (see the module docs): flow with the stabilisation
@@ -46,6 +46,23 @@ impl FixedStress {
     /// together (see [`CouplingStats`]).
     pub fn stats(&self) -> CouplingStats {
         self.flow.stats().add(self.mech.stats())
+    }
+
+    /// The flow and mechanics matrices of the current factors (see [`SchemeMemory`]).
+    pub fn memory(&self) -> SchemeMemory {
+        let (factored, dt) = self.flow.memory();
+        SchemeMemory {
+            factored,
+            dt,
+            stiffness: self.mech.memory(),
+            ..SchemeMemory::default()
+        }
+    }
+
+    /// Go on from `memory`: the factors are computed again before the next solve.
+    pub fn resume(&mut self, memory: SchemeMemory) {
+        self.flow.resume(memory.factored, memory.dt);
+        self.mech.resume(memory.stiffness);
     }
 }
 

@@ -14,6 +14,10 @@ pub(super) struct MechSolver {
     solves: usize,
     rhs: Vec<f64>,
     full: Vec<f64>,
+    /// The stiffness to factorize again before the next solve (a resumed run).
+    resume: Option<Vec<f64>>,
+    /// Factorizations that only rebuilt the factors of a resumed run (not counted).
+    rebuilt: usize,
 }
 
 impl MechSolver {
@@ -24,7 +28,19 @@ impl MechSolver {
             solves: 0,
             rhs: Vec::new(),
             full: Vec::new(),
+            resume: None,
+            rebuilt: 0,
         }
+    }
+
+    /// The stiffness of the current factors (empty before the first).
+    pub(super) fn memory(&self) -> Vec<f64> {
+        self.factored.as_ref().map_or_else(Vec::new, |k| k.to_vec())
+    }
+
+    /// Factorize `stiffness` again before the next solve (see [`super::SchemeMemory`]).
+    pub(super) fn resume(&mut self, stiffness: Vec<f64>) {
+        self.resume = (!stiffness.is_empty()).then_some(stiffness);
     }
 
     /// Displacement in equilibrium with the loads at `t` and the pressure `p`.
@@ -43,6 +59,11 @@ impl MechSolver {
             .solver
             .as_mut()
             .ok_or_else(|| BiotError::Solver("mechanics solver missing".into()))?;
+        if let Some(k) = self.resume.take() {
+            solver.factorize(pat, &k)?;
+            self.rebuilt += 1;
+            self.factored = Some(Arc::from(k));
+        }
         let same = match &self.factored {
             Some(k) => Arc::ptr_eq(k, &sys.k_values) || **k == *sys.k_values,
             None => false,
@@ -67,7 +88,7 @@ impl MechSolver {
             numeric_factorizations: self
                 .solver
                 .as_ref()
-                .map_or(0, |s| s.numeric_factorizations()),
+                .map_or(0, |s| s.numeric_factorizations() - self.rebuilt),
             symbolic_factorizations: self
                 .solver
                 .as_ref()

@@ -150,11 +150,14 @@
 //! * `fixed_stress.rs` — [`FixedStress`]: the fixed-stress split.
 //! * `explicit.rs` — [`ExplicitPressure`]: the explicit-pressure update of Nilsen et al. (2017).
 //! * `flow_solve.rs`, `mech_solve.rs` — the flow and mechanics solves of the split schemes.
+//! * `memory.rs` — [`SchemeMemory`]: what a scheme carries from one step to the next, for
+//!   checkpoints.
 
 mod explicit;
 mod fixed_stress;
 mod flow_solve;
 mod mech_solve;
+mod memory;
 mod monolithic;
 mod system;
 
@@ -162,6 +165,7 @@ pub use explicit::ExplicitPressure;
 pub use fixed_stress::FixedStress;
 use flow_solve::FlowSolver;
 use mech_solve::MechSolver;
+pub use memory::SchemeMemory;
 pub use monolithic::Monolithic;
 pub(crate) use system::Operators;
 pub use system::{BiotSystem, drained_bulk_modulus};

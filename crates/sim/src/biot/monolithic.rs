@@ -11,7 +11,7 @@ use porofrac_sparse::{Ldlt, LdltError, LowRank, UpperRows};
 
 use super::{
     BiotCoupling, BiotError, BiotResult, BiotState, BiotStep, BiotSystem, CouplingStats, Operators,
-    check_state, check_step, snap_step,
+    SchemeMemory, check_state, check_step, snap_step,
 };
 
 /// The fully implicit monolithic scheme (Nilsen et al. (2017) eq. 30): one symmetric
@@ -60,6 +60,10 @@ pub struct Monolithic {
     /// The mechanical right-hand side of time-independent conditions and loads.
     base: Option<MechanicsBase>,
     work: MonolithicWork,
+    /// The state to go on from at the next step (a resumed run, [`SchemeMemory`]).
+    resume: Option<Box<SchemeMemory>>,
+    /// Factorizations that only rebuilt the factors of a resumed run (not counted).
+    rebuilt: usize,
 }
 
 /// `g`, the prescribed displacements and whether one is non-zero, for the conditions of
@@ -179,7 +183,126 @@ impl Monolithic {
             default_scale: None,
             base: None,
             work: MonolithicWork::default(),
+            resume: None,
+            rebuilt: 0,
         })
+    }
+
+    /// The matrices of the current factors and of the current step, the low-rank update
+    /// on them and the step they were built for (see [`SchemeMemory`]).
+    pub fn memory(&self) -> SchemeMemory {
+        let factored = self.ldlt.is_factored() && !self.factor_values.is_empty();
+        let count = self.ldlt.numeric_factorizations();
+        SchemeMemory {
+            factored: if factored {
+                self.factor_values.clone()
+            } else {
+                Vec::new()
+            },
+            current: match &self.factored {
+                Some(_) if factored => self.values.clone(),
+                _ => Vec::new(),
+            },
+            dt: self.factored.as_ref().map(|f| f.dt),
+            scale: self.s,
+            columns: self.low_rank.cached_columns().to_vec(),
+            forward: self
+                .forward
+                .as_ref()
+                .filter(|(k, ..)| *k == count)
+                .map(|(_, b, f)| (b.clone(), f.clone())),
+            residual: self.residual,
+            updates: self.updates,
+            ..SchemeMemory::default()
+        }
+    }
+
+    /// Go on from `memory` at the next step: the factors of its matrix are computed
+    /// again and its low-rank update is set up anew on them.
+    pub fn resume(&mut self, memory: SchemeMemory) {
+        self.residual = memory.residual;
+        self.updates = memory.updates;
+        self.resume = Some(Box::new(memory));
+    }
+
+    /// Rebuild the state of [`Self::memory`] for the step of `sys` at `t` by `dt`.
+    fn resume_with<const D: usize>(
+        &mut self,
+        sys: &BiotSystem<'_, D>,
+        memory: SchemeMemory,
+        t: f64,
+        dt: f64,
+    ) -> BiotResult<()> {
+        if memory.factored.is_empty() {
+            return Ok(());
+        }
+        let nnz = self.values.len();
+        if memory.factored.len() != nnz
+            || !(memory.current.is_empty() || memory.current.len() == nnz)
+        {
+            return Err(BiotError::Input(format!(
+                "resumed coupled matrix of {} entries, the pattern has {nnz}",
+                memory.factored.len()
+            )));
+        }
+        let n = self.num_unknowns();
+        if let Some((b, f)) = &memory.forward
+            && (b.len() != n || f.len() != n)
+        {
+            return Err(BiotError::Input(format!(
+                "resumed forward sweep of {} and {} values, the system has {n} unknowns",
+                b.len(),
+                f.len()
+            )));
+        }
+        self.values.clone_from(&memory.factored);
+        self.refactorize()?;
+        self.rebuilt += 1;
+        self.low_rank
+            .cache_columns(&mut self.ldlt, &memory.columns)
+            .map_err(|e| BiotError::Solver(e.0))?;
+        self.s = memory.scale;
+        let count = self.ldlt.numeric_factorizations();
+        self.forward = memory.forward.map(|(b, f)| (count, b, f));
+        let Some(fdt) = memory.dt else {
+            return Ok(());
+        };
+        // The step's matrix is the one of the checkpoint: the run never stopped holds it
+        // factorized (or updated) and does not build it again.
+        self.fill(sys, snap_step(dt, t, Some(fdt)));
+        if self.values != memory.current {
+            return Ok(());
+        }
+        if self.values != self.factor_values {
+            let updated = self
+                .low_rank
+                .prepare(
+                    &mut self.ldlt,
+                    &self.col_ptr,
+                    &self.row_idx,
+                    &self.factor_values,
+                    &self.values,
+                    self.max_rank,
+                )
+                .map_err(|e| BiotError::Solver(e.0))?;
+            if !updated {
+                return Err(BiotError::Input(
+                    "resumed low-rank update exceeds the largest rank".into(),
+                ));
+            }
+            self.low_rank
+                .prepare_correction(&self.ldlt, &self.col_ptr, &self.row_idx, &self.rows)
+                .map_err(|e| BiotError::Solver(e.0))?;
+        }
+        self.factored = Some(FactorInputs {
+            k: sys.k_values.clone(),
+            ops: sys.ops.clone(),
+            s: self.s,
+            dt: fdt,
+            flux: sys.flow.flux_matrix().val().to_vec(),
+            accumulation: sys.flow.accumulation().to_vec(),
+        });
+        Ok(())
     }
 
     /// Use `par` for factorizing (default sequential; a solve sweeps two independent
@@ -189,13 +312,13 @@ impl Monolithic {
     }
     /// Number of numeric factorizations done (a step with the same matrix reuses it).
     pub fn numeric_factorizations(&self) -> usize {
-        self.ldlt.numeric_factorizations()
+        self.ldlt.numeric_factorizations() - self.rebuilt
     }
     /// What the linear algebra did (see [`CouplingStats`]); one symbolic analysis.
     pub fn stats(&self) -> CouplingStats {
         CouplingStats {
             linear: "ldlt",
-            numeric_factorizations: self.ldlt.numeric_factorizations(),
+            numeric_factorizations: self.ldlt.numeric_factorizations() - self.rebuilt,
             symbolic_factorizations: 1,
             factor_nnz: self.ldlt.factor_nnz(),
             solves: self.ldlt.solves(),
@@ -534,6 +657,9 @@ impl<const D: usize> BiotCoupling<D> for Monolithic {
             return Err(BiotError::Input(
                 "monolithic solver built for another system".into(),
             ));
+        }
+        if let Some(memory) = self.resume.take() {
+            self.resume_with(sys, *memory, t, dt)?;
         }
         let dt = snap_step(dt, t, self.factored.as_ref().map(|f| f.dt));
         if dt == 0.0
