@@ -19,7 +19,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{porofrac, read_csv, root, summary, tmp_dir};
+use common::{porofrac, read_csv, root, run_ok as run, summary, tmp_dir};
 
 /// The flagship scene with `edits` applied, written into `dir`.
 fn flagship(dir: &Path, edits: &[(&str, &str)]) -> PathBuf {
@@ -31,18 +31,6 @@ fn flagship(dir: &Path, edits: &[(&str, &str)]) -> PathBuf {
     let path = dir.join("scene.toml");
     std::fs::write(&path, t).unwrap();
     path
-}
-
-/// Run and return stderr (exit status 0 required).
-fn run(scene: &Path, out: &Path) -> String {
-    let (code, _, err) = porofrac(&[
-        "run",
-        scene.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert_eq!(code, 0, "{}: {err}", scene.display());
-    err
 }
 
 /// The data lines of a CSV file, keyed by their time column's text.

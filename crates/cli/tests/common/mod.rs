@@ -24,7 +24,13 @@ pub fn tmp_dir(name: &str) -> PathBuf {
 
 /// Run the binary: exit status, stdout, stderr.
 pub fn porofrac(args: &[&str]) -> (i32, String, String) {
+    porofrac_in(Path::new("."), args)
+}
+
+/// Run the binary in `dir`: exit status, stdout, stderr.
+pub fn porofrac_in(dir: &Path, args: &[&str]) -> (i32, String, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_porofrac"))
+        .current_dir(dir)
         .args(args)
         .output()
         .unwrap();
@@ -35,8 +41,9 @@ pub fn porofrac(args: &[&str]) -> (i32, String, String) {
     )
 }
 
-/// Run `porofrac run <scene> --out <out>` and require success (exit status 0).
-pub fn run_ok(scene: &Path, out: &Path) {
+/// Run `porofrac run <scene> --out <out>`, require success (exit status 0) and return
+/// its stderr.
+pub fn run_ok(scene: &Path, out: &Path) -> String {
     let (code, _, err) = porofrac(&[
         "run",
         scene.to_str().unwrap(),
@@ -44,6 +51,7 @@ pub fn run_ok(scene: &Path, out: &Path) {
         out.to_str().unwrap(),
     ]);
     assert_eq!(code, 0, "{}: {err}", scene.display());
+    err
 }
 
 /// Write `text` as the scene `<name>.toml` in a fresh directory and run it into `out/`

@@ -279,17 +279,7 @@ impl Checkpoint {
     /// another format version, a truncated or damaged file).
     pub fn decode(bytes: &[u8]) -> Result<Self, RunError> {
         let mut r = Reader { b: bytes, at: 0 };
-        if r.take(8)? != MAGIC {
-            return Err(bad("not a porofrac checkpoint (wrong magic bytes)"));
-        }
-        let version = r.u32()?;
-        if version != FORMAT_VERSION {
-            return Err(bad(format!(
-                "format version {version}, this porofrac reads version {FORMAT_VERSION}"
-            )));
-        }
-        let model = r.text()?;
-        let scene_hash = r.u64()?;
+        let (model, scene_hash) = read_head(&mut r)?;
         let count = r.u64()?;
         let mut state = State::default();
         for _ in 0..count {
@@ -379,19 +369,23 @@ pub fn read_header(out: &Path) -> Result<(String, u64), RunError> {
         e => e,
     };
     let mut r = Reader { b: &head, at: 0 };
-    let parse = |r: &mut Reader<'_>| -> Result<(String, u64), RunError> {
-        if r.take(8)? != MAGIC {
-            return Err(bad("not a porofrac checkpoint (wrong magic bytes)"));
-        }
-        let version = r.u32()?;
-        if version != FORMAT_VERSION {
-            return Err(bad(format!(
-                "format version {version}, this porofrac reads version {FORMAT_VERSION}"
-            )));
-        }
-        Ok((r.text()?, r.u64()?))
-    };
+    let parse = |r: &mut Reader<'_>| -> Result<(String, u64), RunError> { read_head(r) };
     parse(&mut r).map_err(named)
+}
+
+/// The header of a checkpoint: magic bytes and format version checked; the model name
+/// and the scene hash.
+fn read_head(r: &mut Reader<'_>) -> Result<(String, u64), RunError> {
+    if r.take(8)? != MAGIC {
+        return Err(bad("not a porofrac checkpoint (wrong magic bytes)"));
+    }
+    let version = r.u32()?;
+    if version != FORMAT_VERSION {
+        return Err(bad(format!(
+            "format version {version}, this porofrac reads version {FORMAT_VERSION}"
+        )));
+    }
+    Ok((r.text()?, r.u64()?))
 }
 
 /// Refuse the checkpoint of `out` for scene `ls` when it was written by another model or

@@ -417,20 +417,16 @@ pub fn parse_with(
         })?;
     let lines = KeyLines::of(doc.get_ref(), &text);
     let model_name = overrides::model_of(doc.get_ref());
-    let explain = |e: toml::de::Error| {
-        crate::common::scene_errors::explain(
-            &e,
-            &crate::common::scene_errors::Place {
-                file: path,
-                text: &text,
-                source: &source,
-                lines: &lines,
-                overrides: &applied,
-                models,
-                model: &model_name,
-            },
-        )
+    let place = crate::common::scene_errors::Place {
+        file: path,
+        text: &text,
+        source: &source,
+        lines: &lines,
+        overrides: &applied,
+        models,
+        model: &model_name,
     };
+    let explain = |e: toml::de::Error| crate::common::scene_errors::explain(&e, &place);
     // Top-level keys: the shared sections, or a section some model declares.
     let owned = |key: &str| models.iter().any(|m| m.sections().contains(&key));
     for key in &lines.top {
@@ -444,17 +440,7 @@ pub fn parse_with(
                 }
             }
             return Err(crate::common::scene_errors::unknown_section(
-                key,
-                &crate::common::scene_errors::Place {
-                    file: path,
-                    text: &text,
-                    source: &source,
-                    lines: &lines,
-                    overrides: &applied,
-                    models,
-                    model: &model_name,
-                },
-                &known,
+                key, &place, &known,
             ));
         }
     }

@@ -50,19 +50,12 @@ impl FixedStress {
 
     /// The flow and mechanics matrices of the current factors (see [`SchemeMemory`]).
     pub fn memory(&self) -> SchemeMemory {
-        let (factored, dt) = self.flow.memory();
-        SchemeMemory {
-            factored,
-            dt,
-            stiffness: self.mech.memory(),
-            ..SchemeMemory::default()
-        }
+        SchemeMemory::of_split(&self.flow, &self.mech)
     }
 
     /// Go on from `memory`: the factors are computed again before the next solve.
     pub fn resume(&mut self, memory: SchemeMemory) {
-        self.flow.resume(memory.factored, memory.dt);
-        self.mech.resume(memory.stiffness);
+        memory.resume_split(&mut self.flow, &mut self.mech);
     }
 }
 

@@ -33,3 +33,31 @@ pub struct SchemeMemory {
     /// Matrices solved by a low-rank update so far.
     pub updates: usize,
 }
+
+impl SchemeMemory {
+    /// The memory of a split scheme (fixed-stress, explicit pressure): the flow matrix of
+    /// its factors with its `Δt`, and the mechanics stiffness.
+    pub(super) fn of_split(
+        flow: &super::flow_solve::FlowSolver,
+        mech: &super::mech_solve::MechSolver,
+    ) -> Self {
+        let (factored, dt) = flow.memory();
+        Self {
+            factored,
+            dt,
+            stiffness: mech.memory(),
+            ..Self::default()
+        }
+    }
+
+    /// Give a split scheme's solvers this memory: their factors are computed again
+    /// before the next solve.
+    pub(super) fn resume_split(
+        self,
+        flow: &mut super::flow_solve::FlowSolver,
+        mech: &mut super::mech_solve::MechSolver,
+    ) {
+        flow.resume(self.factored, self.dt);
+        mech.resume(self.stiffness);
+    }
+}
