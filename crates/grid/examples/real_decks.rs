@@ -12,33 +12,7 @@
 
 use std::time::Instant;
 
-use porofrac_grid::Grid;
 use porofrac_grid::io::grdecl::{corner_point_grid, read_deck};
-
-/// Volume enclosed by the faces of cell `c`, each face split into triangles about its
-/// vertex average: `V = Σ ((a − o) × (b − o)) · (m − o) / 6` over the outward triangles
-/// `(m, a, b)`, about a node `o` of the cell (map coordinates are large: about the origin
-/// the sum would cancel).
-fn enclosed_volume(grid: &Grid<3>, c: usize) -> f64 {
-    let o = *grid.node(grid.cell_nodes(c)[0]);
-    let mut v = 0.0;
-    for (&f, &out) in grid.cell_faces(c).iter().zip(grid.cell_face_outward(c)) {
-        let nodes = grid.face_nodes(f);
-        let m = nodes
-            .iter()
-            .map(|&n| grid.node(n) - o)
-            .sum::<porofrac_grid::Point<3>>()
-            / nodes.len() as f64;
-        let mut s = 0.0;
-        for k in 0..nodes.len() {
-            let a = grid.node(nodes[k]) - o;
-            let b = grid.node(nodes[(k + 1) % nodes.len()]) - o;
-            s += a.cross(&b).dot(&m);
-        }
-        v += if out { s } else { -s } / 6.0;
-    }
-    v
-}
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
@@ -75,7 +49,7 @@ fn main() {
         let g = &cp.grid;
         let (mut worst, mut total) = (0.0f64, 0.0);
         for c in 0..g.num_cells() {
-            let v = enclosed_volume(g, c);
+            let v = g.enclosed_volume(c);
             total += v;
             worst = worst.max((v - g.cell_volume(c)).abs() / g.cell_volume(c).abs().max(1e-300));
         }

@@ -340,6 +340,30 @@ impl<const D: usize> Grid<D> {
     }
 }
 
+impl Grid<3> {
+    /// Volume enclosed by the faces of cell `c`, each face split into triangles about its
+    /// vertex average: `V = Σ ((a − o) × (b − o)) · (m − o) / 6` over the outward
+    /// triangles `(m, a, b)`, about a node `o` of the cell (about the origin, map
+    /// coordinates in the millions would cancel the digits). Independent of how the
+    /// grid's own cell volumes are computed, it checks them and the faces' orientation.
+    pub fn enclosed_volume(&self, c: usize) -> f64 {
+        let o = *self.node(self.cell_nodes(c)[0]);
+        let mut v = 0.0;
+        for (&f, &out) in self.cell_faces(c).iter().zip(self.cell_face_outward(c)) {
+            let nodes = self.face_nodes(f);
+            let m = nodes.iter().map(|&n| self.node(n) - o).sum::<Point<3>>() / nodes.len() as f64;
+            let mut s = 0.0;
+            for k in 0..nodes.len() {
+                let a = self.node(nodes[k]) - o;
+                let b = self.node(nodes[(k + 1) % nodes.len()]) - o;
+                s += a.cross(&b).dot(&m);
+            }
+            v += if out { s } else { -s } / 6.0;
+        }
+        v
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use crate::Point;

@@ -52,38 +52,13 @@ fn corner_deck(dims: [usize; 3], spacing: f64, cells: &[[f64; 8]]) -> Deck {
     }
 }
 
-/// Volume enclosed by the faces of cell `c`, each face split into triangles about its
-/// vertex average: `Σ ((a − o) × (b − o)) · (m − o) / 6` over the outward triangles
-/// `(m, a, b)`, about a node `o` of the cell (about the origin, map coordinates in the
-/// millions would cancel the digits).
-fn enclosed_volume(grid: &Grid<3>, c: usize) -> f64 {
-    let o = *grid.node(grid.cell_nodes(c)[0]);
-    let mut v = 0.0;
-    for (&f, &out) in grid.cell_faces(c).iter().zip(grid.cell_face_outward(c)) {
-        let nodes = grid.face_nodes(f);
-        let m = nodes
-            .iter()
-            .map(|&n| grid.node(n) - o)
-            .sum::<porofrac_grid::Point<3>>()
-            / nodes.len() as f64;
-        let mut s = 0.0;
-        for k in 0..nodes.len() {
-            let a = grid.node(nodes[k]) - o;
-            let b = grid.node(nodes[(k + 1) % nodes.len()]) - o;
-            s += a.cross(&b).dot(&m);
-        }
-        v += if out { s } else { -s } / 6.0;
-    }
-    v
-}
-
 /// Every cell's volume is the volume its triangulated faces enclose, within rounding of
 /// coordinates of size `scale` (a cell millimetres thin in a map of millions of metres
 /// keeps about 10⁻¹⁰ m of its coordinates); every interior face has two cells seeing it
 /// in opposite orientations (their area vectors, summed over the cell, vanish).
 fn assert_exact_volumes(grid: &Grid<3>) {
     for c in 0..grid.num_cells() {
-        let (v, got) = (enclosed_volume(grid, c), grid.cell_volume(c));
+        let (v, got) = (grid.enclosed_volume(c), grid.cell_volume(c));
         let nodes = grid.cell_nodes(c);
         let size = nodes
             .iter()
