@@ -452,14 +452,23 @@ pub enum FracturePermeability {
     /// ball of its area or volume) takes `k = T / (2 r_c)`, so the band of failed cells,
     /// about `2 r_c` wide, conducts `T` on every grid.
     Transmissivity(f64),
+    /// The cubic law from the crack's own opening ([`crate::crack_flow`]): a wet cell of
+    /// aperture `w` and thickness `h_n` across the opening takes
+    /// `k = max(w³/12, T_min) / h_n`, with `T_min` (m³) the value given, the
+    /// transmissivity of a closed or just-failed crack. The aperture is measured at the
+    /// displacement of the start of each step (the initial equilibrium: none), so the
+    /// permeability lags the opening by one step.
+    CubicLaw(f64),
 }
 
 impl FracturePermeability {
     /// The permeability (m²) of a failed cell of area or volume `v`.
+    /// For [`Self::CubicLaw`] this is the floor `T_min / (2 r_c)` of a crack that has not
+    /// opened ([`crate::crack_flow::cubic_law_permeability`] gives the value of an opening).
     pub fn of_cell<const D: usize>(self, v: f64) -> f64 {
         match self {
             Self::Fixed(k) => k,
-            Self::Transmissivity(t) => {
+            Self::Transmissivity(t) | Self::CubicLaw(t) => {
                 t / (2.0 * porofrac_frac::toughness::equivalent_radius::<D>(v))
             }
         }
@@ -467,7 +476,7 @@ impl FracturePermeability {
 
     fn value(self) -> f64 {
         match self {
-            Self::Fixed(v) | Self::Transmissivity(v) => v,
+            Self::Fixed(v) | Self::Transmissivity(v) | Self::CubicLaw(v) => v,
         }
     }
 }
@@ -747,7 +756,14 @@ impl<'a, const D: usize> Fracturing<'a, D> {
             let Some(Cached { map, stiffness, .. }) = cached.as_mut() else {
                 return Err(FractureError::Input("law map missing".into()));
             };
-            update_permeability(grid, flow, fs.flags(), perm_of_failed)?;
+            update_permeability(
+                grid,
+                flow,
+                fs.flags(),
+                perm_of_failed,
+                operators,
+                state.map(|s| s.displacement.as_slice()),
+            )?;
             let mut system = BiotSystem::from_parts(
                 problem(body, map),
                 &flow.model,
@@ -886,25 +902,43 @@ fn stresses<const D: usize>(
     Ok(out)
 }
 
-/// Raise the permeability of newly failed cells (only when the flags changed).
+/// Raise the permeability of newly failed cells (only when the flags changed); with the
+/// cubic law ([`FracturePermeability::CubicLaw`]) the permeability of every wet cell from
+/// its opening at the displacement `u` (the start of the step; `None`: not opened), at
+/// every call (the flow model's matrix changes only where the values do).
 fn update_permeability<const D: usize>(
     grid: &Grid<D>,
     flow: &mut FractureFlow<D>,
     failed: &[bool],
     applied: &mut [bool],
+    ops: &Operators<D>,
+    u: Option<&[f64]>,
 ) -> FractureResult<()> {
     let Some(k) = flow.fracture_permeability else {
         return Ok(());
     };
-    if applied == failed {
+    let cubic = matches!(k, FracturePermeability::CubicLaw(_));
+    if applied == failed && !cubic {
         return Ok(());
     }
     let mut perm = flow.permeability.clone();
     let volumes = grid.cell_volumes();
+    let mut uc = Vec::new();
     for (c, wet) in flow.wet_cells(grid, failed).into_iter().enumerate() {
-        if wet {
-            perm.set(c, Tensor::<D>::identity() * k.of_cell::<D>(volumes[c]))?;
+        if !wet {
+            continue;
         }
+        let kc = match (k, u) {
+            (FracturePermeability::CubicLaw(t_min), Some(u)) => {
+                let nodes = ops.node_ptr[c]..ops.node_ptr[c + 1];
+                uc.clear();
+                uc.extend(ops.dofs[D * nodes.start..D * nodes.end].iter().map(|&d| u[d]));
+                let opening = crate::crack_flow::cell_opening(grid, c, &ops.normals[nodes], &uc);
+                crate::crack_flow::cubic_law_permeability(&opening, t_min)
+            }
+            _ => k.of_cell::<D>(volumes[c]),
+        };
+        perm.set(c, Tensor::<D>::identity() * kc)?;
     }
     flow.model.set_permeability(grid, &perm)?;
     applied.copy_from_slice(failed);

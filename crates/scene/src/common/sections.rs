@@ -171,6 +171,21 @@ pub enum FailureStress {
     Recovered,
 }
 
+/// `[physics] crack_flow`.
+#[derive(Clone, Copy, Debug, Default, Deserialize, schemars::JsonSchema, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum CrackFlow {
+    /// One permeability for every failed cell, whatever its opening
+    /// (`fracture_permeability` or `fracture_transmissivity`).
+    #[default]
+    Fixed,
+    /// The cubic law `w³/12μ` from the crack's own opening `w`, measured in every failed
+    /// cell from the displacements at the start of each step; `fracture_transmissivity`
+    /// is the floor of a closed crack.
+    #[serde(alias = "cubic_law")]
+    CubicLaw,
+}
+
 /// `[solver] mechanics`.
 #[derive(Clone, Copy, Debug, Default, Deserialize, schemars::JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
@@ -645,6 +660,12 @@ pub struct Physics {
     /// `false`: no fluid lag, the intact cells bordering a crack take its permeability
     /// (default `true`: they keep the rock's).
     pub fluid_lag: Option<bool>,
+    /// The crack's flow (default `"fixed"`): `"cubic-law"` gives a failed cell of aperture
+    /// `w` (the displacement jump across it, docs/models/continuum.md) and thickness
+    /// `h_n` across the opening the permeability `max(w³/12, T_min) / h_n`, so the crack
+    /// conducts `w³/12μ` per unit height; `T_min` is `fracture_transmissivity` (default
+    /// 1e-13 m³, a residual aperture of 0.11 mm). Needs fracture = true and flow = true.
+    pub crack_flow: Option<CrackFlow>,
     /// Residual stiffness ratio of open edges of failed cells, in [0, 1) (default 1e-6).
     pub open_edge_stiffness: Option<f64>,
     /// A crack continues along its line, kinking at most this angle, in (0, 90] (default no

@@ -8,7 +8,7 @@ use crate::common::loaded::{
     LoadedScene, SceneError, expr_ok, k, ki, len_is, line_points_and_name, positive, step_count_f64,
 };
 use crate::common::sections::{
-    Bc, CellCount, Component, DiagonalsChoice, GridKind, KeyPart, LinearChoice, Permeability,
+    Bc, CellCount, Component, CrackFlow, DiagonalsChoice, GridKind, KeyPart, LinearChoice, Permeability,
     Select,
 };
 use porofrac_grid::Point;
@@ -246,6 +246,21 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
             &k(&["physics", "fluid_lag"]),
             "needs fracture = true and flow = true",
         ));
+    }
+    if let Some(cf) = s.physics.crack_flow {
+        if s.physics.fracture != Some(true) || s.physics.flow != Some(true) {
+            return Err(ls.error(
+                &k(&["physics", "crack_flow"]),
+                "needs fracture = true and flow = true",
+            ));
+        }
+        if cf == CrackFlow::CubicLaw && s.physics.fracture_permeability.is_some() {
+            return Err(ls.error(
+                &k(&["physics", "fracture_permeability"]),
+                "does not apply with crack_flow = \"cubic-law\" (the permeability follows \
+                 the opening; fracture_transmissivity sets the floor of a closed crack)",
+            ));
+        }
     }
     if let Some(t) = s.physics.fracture_transmissivity {
         positive(ls, &k(&["physics", "fracture_transmissivity"]), t)?;

@@ -46,7 +46,7 @@ use crate::common::model::{Built, Model, Purpose, RunError, Sizes, StepStats};
 use crate::common::output::{CsvTable, SolverStats, WallSeconds};
 use crate::common::sample::{Location, locate};
 use crate::common::sections::{
-    CouplingChoice, FailureStress, InitialMechanics, LinearChoice, MechanicsSolver, Plane,
+    CouplingChoice, CrackFlow, FailureStress, InitialMechanics, LinearChoice, MechanicsSolver, Plane,
 };
 
 use crate::common::grid::{AnyGrid, DeckCells, build_grid, point};
@@ -957,6 +957,11 @@ fn coupled<'a, const D: usize>(
                 s.physics.fracture_transmissivity,
                 s.physics.fracture_permeability,
             ) {
+                _ if s.physics.crack_flow == Some(CrackFlow::CubicLaw) => {
+                    FracturePermeability::CubicLaw(
+                        s.physics.fracture_transmissivity.unwrap_or(1e-13),
+                    )
+                }
                 (Some(t), _) => FracturePermeability::Transmissivity(t),
                 (None, k) => FracturePermeability::Fixed(k.unwrap_or(1e-12)),
             }
