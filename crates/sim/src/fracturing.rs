@@ -932,7 +932,11 @@ fn update_permeability<const D: usize>(
             (FracturePermeability::CubicLaw(t_min), Some(u)) => {
                 let nodes = ops.node_ptr[c]..ops.node_ptr[c + 1];
                 uc.clear();
-                uc.extend(ops.dofs[D * nodes.start..D * nodes.end].iter().map(|&d| u[d]));
+                uc.extend(
+                    ops.dofs[D * nodes.start..D * nodes.end]
+                        .iter()
+                        .map(|&d| u[d]),
+                );
                 let opening = crate::crack_flow::cell_opening(grid, c, &ops.normals[nodes], &uc);
                 crate::crack_flow::cubic_law_permeability(&opening, t_min)
             }

@@ -1,0 +1,254 @@
+//! Sneddon's pressurized crack, plane strain, static, represented as the cell method
+//! represents a crack: a band of failed cells one cell thick.
+//!
+//! A crack of half-length `a` in an infinite plane under a uniform pressure `p` on its
+//! faces opens as `w(x) = 4 p (1 − ν²)/E · √(a² − x²)` (Sneddon 1946), with the volume
+//! `V = 2π p a² (1 − ν²)/E` per unit height. Here the plane is a graded grid of
+//! triangles (MDEM, i.e. P1, away from the crack; uniform cells of size `h = a/n` around
+//! it; 160 a across, fixed at its boundary: 0.02 % of the volume at n = 80 changed from 80 a to 160 a, 0.07 % from 40 a to 80 a); the crack is the row of triangles between
+//! `y = −h/2` and `y = h/2` with `|x| < a`, given the compression-only central-force law
+//! of a failed cell (Nilsen et al. (2017) eqs. 32–33, open edges at 1e-6 of their
+//! stiffness), and the pressure acts on the band as the pore pressure of a failed cell
+//! does in the Biot coupling with α = 1: the nodal forces `p N_i` of each band cell.
+//!
+//! Checks, at `n` = 10, 20, 40, 80 cells per half-length (1.8 s in all):
+//! - the opening measured as the jump of `u_y` across the band at its nodes, and as the
+//!   smeared cell opening of `porofrac_sim::crack_flow::cell_opening` (the aperture the
+//!   cubic law uses) at the band cells' centroids: relative L2 errors against Sneddon's;
+//! - the crack volume (the band's volume change `Σ N_i · u_i`) against `V`;
+//! - the observed orders between the resolutions.
+//!
+//! The tolerances are the measured errors rounded up by about 5 % (see
+//! docs/hydrofrac/validation.md for the table); the orders are asserted from below.
+
+use porofrac_grid::{Grid, Point};
+use porofrac_law::{CellLaw, Stiffness};
+use porofrac_mdem::{DemLaw, DemMode, MdemLaw};
+use porofrac_sim::crack_flow::cell_opening;
+use porofrac_sim::*;
+
+const A: f64 = 1.0;
+const E: f64 = 1.0e10;
+const NU: f64 = 0.25;
+const P: f64 = 1.0e6;
+
+/// Node coordinates on one axis: uniform spacing `h` from 0 to `inner` (a multiple of
+/// `h`, or from `h/2` when `half` is set), then growing by 1.2 per cell to beyond
+/// `outer`, mirrored about 0.
+fn axis(h: f64, inner: f64, outer: f64, half: bool) -> Vec<f64> {
+    let mut pos = Vec::new();
+    let mut x = if half { 0.5 * h } else { 0.0 };
+    while x < inner + 1e-9 * h {
+        pos.push(x);
+        x += h;
+    }
+    let mut step = h;
+    let mut last = *pos.last().unwrap();
+    while last < outer {
+        step *= 1.2;
+        last += step;
+        pos.push(last);
+    }
+    let mut all: Vec<f64> = pos.iter().rev().map(|v| -v).collect();
+    if !half {
+        all.pop();
+    }
+    all.extend_from_slice(&pos);
+    all
+}
+
+/// The grid of triangles on the lines `xs` × `ys`, every rectangle split along
+/// alternating diagonals (mirror-symmetric about both axes through a node line).
+fn triangles(xs: &[f64], ys: &[f64]) -> Grid<2> {
+    let (nx, ny) = (xs.len(), ys.len());
+    let nodes: Vec<Point<2>> = ys
+        .iter()
+        .flat_map(|&y| xs.iter().map(move |&x| Point::<2>::new(x, y)))
+        .collect();
+    let id = |i: usize, j: usize| j * nx + i;
+    let (mut pos, mut cn) = (vec![0], Vec::new());
+    let (ic, jc) = (nx / 2, ny / 2);
+    for j in 0..ny - 1 {
+        for i in 0..nx - 1 {
+            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            // The diagonal from the corner nearest the centre lines.
+            let flip = (i < ic) != (j < jc);
+            let tris = if flip {
+                [[a, b, d], [b, c, d]]
+            } else {
+                [[a, b, c], [a, c, d]]
+            };
+            for t in tris {
+                cn.extend_from_slice(&t);
+                pos.push(cn.len());
+            }
+        }
+    }
+    Grid::from_polygons(nodes, &pos, &cn).unwrap()
+}
+
+/// Sneddon's opening at `x`.
+fn sneddon(x: f64) -> f64 {
+    4.0 * P * (1.0 - NU * NU) / E * (A * A - x * x).max(0.0).sqrt()
+}
+
+/// Relative errors (L2 of the jump, L2 of the smeared cell opening, crack volume) with
+/// `n` cells per half-length.
+fn errors(n: usize) -> (f64, f64, f64) {
+    let h = A / n as f64;
+    let xs = axis(h, 1.5 * A, 80.0 * A, false);
+    let ys = axis(h, 0.5 * A, 80.0 * A, true);
+    let grid = triangles(&xs, &ys);
+    let stiffness = Stiffness::<2>::isotropic(E, NU).unwrap();
+    let mdem = MdemLaw::<2>::new(&stiffness).unwrap();
+    let dem = DemLaw::<2>::new(&stiffness, DemMode::CompressionOnly)
+        .unwrap()
+        .with_open_stiffness(1e-6)
+        .unwrap();
+    let band: Vec<bool> = grid
+        .cell_centroids()
+        .iter()
+        .map(|c| c[1].abs() < 0.5 * h && c[0].abs() < A)
+        .collect();
+    let law_of_cell = band.iter().map(|&b| usize::from(b)).collect();
+    let laws = LawMap::new(&grid, vec![&mdem as &dyn CellLaw<2>, &dem], law_of_cell).unwrap();
+    let fixed = Displacement {
+        name: "boundary".into(),
+        faces: grid.boundary_faces(),
+        components: [Some(0.0.into()), Some(0.0.into())],
+    };
+    let dofs = DofMap::new(&grid, &[fixed], &[]).unwrap();
+    let pattern = Pattern::new(&grid, &dofs).unwrap();
+    // The pressure's nodal forces p N_i on the band cells.
+    let mut full = vec![0.0; dofs.num_dofs()];
+    let mut nn = vec![Point::<2>::zeros(); 3];
+    for c in (0..grid.num_cells()).filter(|&c| band[c]) {
+        grid.cell_node_normals(c, &mut nn);
+        for (&i, ni) in grid.cell_nodes(c).iter().zip(&nn) {
+            full[2 * i] += P * ni[0];
+            full[2 * i + 1] += P * ni[1];
+        }
+    }
+    let neq = dofs.num_equations();
+    let mut fext = vec![0.0; neq];
+    dofs.reduce_add(&full, &mut fext);
+    let fnorm = fext.iter().map(|v| v * v).sum::<f64>().sqrt();
+    // Newton on the piecewise-linear laws: ends when the stiffness of the solution is
+    // the one solved with (the residual is then at rounding).
+    let mut u = vec![0.0; dofs.num_dofs()];
+    let mut values = vec![0.0; pattern.nnz()];
+    let mut forces = vec![0.0; neq];
+    let mut solver = DirectSolver::new(&pattern).unwrap();
+    let mut converged = false;
+    for _ in 0..40 {
+        assemble(&grid, &laws, &dofs, &pattern, &u, &mut values, &mut forces).unwrap();
+        let mut r: Vec<f64> = fext.iter().zip(&forces).map(|(a, b)| a + b).collect();
+        if r.iter().map(|v| v * v).sum::<f64>().sqrt() <= 1e-9 * fnorm {
+            converged = true;
+            break;
+        }
+        solver.factorize(&pattern, &values).unwrap();
+        solver.solve_in_place(&mut r).unwrap();
+        dofs.scatter_add(&r, &mut u);
+    }
+    assert!(converged, "n = {n}: the open/closed edges did not settle");
+
+    // The jump across the band at its nodes (x = −a + i h), trapezoid weights.
+    let node_at = |x: f64, y: f64| {
+        (0..grid.num_nodes())
+            .find(|&i| (grid.node(i) - Point::<2>::new(x, y)).norm() < 1e-9 * h)
+            .unwrap()
+    };
+    let (mut num, mut den) = (0.0, 0.0);
+    for i in 0..=2 * n {
+        let x = -A + i as f64 * h;
+        let jump = u[2 * node_at(x, 0.5 * h) + 1] - u[2 * node_at(x, -0.5 * h) + 1];
+        let wt = if i == 0 || i == 2 * n { 0.5 * h } else { h };
+        num += wt * (jump - sneddon(x)).powi(2);
+        den += wt * sneddon(x).powi(2);
+    }
+    let l2_jump = (num / den).sqrt();
+
+    // The smeared opening of each band cell at its centroid, weighted by its area.
+    let (mut num, mut den, mut volume) = (0.0, 0.0, 0.0);
+    for c in (0..grid.num_cells()).filter(|&c| band[c]) {
+        grid.cell_node_normals(c, &mut nn);
+        let uc: Vec<f64> = grid
+            .cell_nodes(c)
+            .iter()
+            .flat_map(|&i| [u[2 * i], u[2 * i + 1]])
+            .collect();
+        let w = cell_opening(&grid, c, &nn, &uc).aperture;
+        let exact = sneddon(grid.cell_centroid(c)[0]);
+        let vol = grid.cell_volume(c);
+        num += vol * (w - exact).powi(2);
+        den += vol * exact.powi(2);
+        volume += nn
+            .iter()
+            .zip(uc.chunks(2))
+            .map(|(ni, ui)| ni[0] * ui[0] + ni[1] * ui[1])
+            .sum::<f64>();
+    }
+    let l2_cell = (num / den).sqrt();
+    let exact_volume = 2.0 * std::f64::consts::PI * P * A * A * (1.0 - NU * NU) / E;
+    let vol_err = (volume - exact_volume) / exact_volume;
+    (l2_jump, l2_cell, vol_err)
+}
+
+/// The errors measured (2026-11-28) rounded up by about 5 %: a change of the method that
+/// costs accuracy fails here. Columns: L2 of the jump, L2 of the cell opening, crack
+/// volume (the band opens less than Sneddon's crack: the volume error is negative).
+const BOUNDS: [(usize, f64, f64, f64); 4] = [
+    (10, 5.9e-2, 4.8e-2, 6.5e-2),
+    (20, 3.2e-2, 2.65e-2, 3.65e-2),
+    (40, 1.78e-2, 1.5e-2, 2.05e-2),
+    (80, 1.04e-2, 9.0e-3, 1.21e-2),
+];
+
+#[test]
+fn sneddon_opening_and_volume_converge_at_10_20_40_80_cells_per_half_length() {
+    let e: Vec<(f64, f64, f64)> = BOUNDS.iter().map(|b| errors(b.0)).collect();
+    let order = |a: f64, b: f64| (a.abs() / b.abs()).log2();
+    for (b, (j, c, v)) in BOUNDS.iter().zip(&e) {
+        println!(
+            "n = {:>2}: L2 jump {j:.4e}, L2 cell opening {c:.4e}, volume {v:+.4e}",
+            b.0
+        );
+        assert!(
+            *j <= b.1,
+            "n = {}: L2 error of the jump {j:.4e} > {:.2e}",
+            b.0,
+            b.1
+        );
+        assert!(
+            *c <= b.2,
+            "n = {}: L2 error of the cell opening {c:.4e} > {:.2e}",
+            b.0,
+            b.2
+        );
+        assert!(
+            *v < 0.0 && -v <= b.3,
+            "n = {}: volume error {v:+.4e}, bound {:.2e}",
+            b.0,
+            b.3
+        );
+    }
+    for k in 1..BOUNDS.len() {
+        let (j, c, v) = (
+            order(e[k - 1].0, e[k].0),
+            order(e[k - 1].1, e[k].1),
+            order(e[k - 1].2, e[k].2),
+        );
+        println!(
+            "orders {}→{}: jump {j:.2}, cell {c:.2}, volume {v:.2}",
+            BOUNDS[k - 1].0,
+            BOUNDS[k].0
+        );
+        // Measured: 0.88, 0.86, 0.78 (jump); 0.85, 0.83, 0.73 (cell); 0.83, 0.83, 0.77
+        // (volume). The √r closure at the tips limits the order below 1.
+        assert!(
+            j >= 0.75 && c >= 0.7 && v >= 0.75,
+            "orders {j:.2} {c:.2} {v:.2}"
+        );
+    }
+}
