@@ -5,7 +5,9 @@
 //! faces opens as `w(x) = 4 p (1 − ν²)/E · √(a² − x²)` (Sneddon 1946), with the volume
 //! `V = 2π p a² (1 − ν²)/E` per unit height. Here the plane is a graded grid of
 //! triangles (MDEM, i.e. P1, away from the crack; uniform cells of size `h = a/n` around
-//! it; 160 a across, fixed at its boundary: 0.02 % of the volume at n = 80 changed from 80 a to 160 a, 0.07 % from 40 a to 80 a); the crack is the row of triangles between
+//! it; 160 a across, fixed at its boundary: the volume at n = 40 changed by 0.27 % of
+//! Sneddon's from 40 a to 80 a across and by 0.07 % from 80 a to 160 a); the crack is
+//! the row of triangles between
 //! `y = −h/2` and `y = h/2` with `|x| < a`, given the compression-only central-force law
 //! of a failed cell (Nilsen et al. (2017) eqs. 32–33, open edges at 1e-6 of their
 //! stiffness), and the pressure acts on the band as the pore pressure of a failed cell
