@@ -8,8 +8,8 @@ use crate::common::loaded::{
     LoadedScene, SceneError, expr_ok, k, ki, len_is, line_points_and_name, positive, step_count_f64,
 };
 use crate::common::sections::{
-    Bc, CellCount, Component, CrackFlow, DiagonalsChoice, GridKind, KeyPart, LinearChoice, Permeability,
-    Select,
+    Bc, CellCount, Component, CrackFlow, DiagonalsChoice, GridKind, KeyPart, LinearChoice,
+    Permeability, Select,
 };
 use porofrac_grid::Point;
 use porofrac_grid::generate::RoundWellSpec;

@@ -46,7 +46,8 @@ use crate::common::model::{Built, Model, Purpose, RunError, Sizes, StepStats};
 use crate::common::output::{CsvTable, SolverStats, WallSeconds};
 use crate::common::sample::{Location, locate};
 use crate::common::sections::{
-    CouplingChoice, CrackFlow, FailureStress, InitialMechanics, LinearChoice, MechanicsSolver, Plane,
+    CouplingChoice, CrackFlow, FailureStress, InitialMechanics, LinearChoice, MechanicsSolver,
+    Plane,
 };
 
 use crate::common::grid::{AnyGrid, DeckCells, build_grid, point};
