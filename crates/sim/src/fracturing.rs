@@ -457,7 +457,9 @@ pub enum FracturePermeability {
     /// `k = max(w³/12, T_min) / h_n`, with `T_min` (m³) the value given, the
     /// transmissivity of a closed or just-failed crack. The aperture is measured at the
     /// displacement of the start of each step (the initial equilibrium: none), so the
-    /// permeability lags the opening by one step.
+    /// permeability lags the opening by one step. A failed cell's Biot coefficient
+    /// becomes 1: the crack stores the volume it opens (the coupling data are rebuilt
+    /// when cells fail).
     CubicLaw(f64),
 }
 
@@ -756,6 +758,21 @@ impl<'a, const D: usize> Fracturing<'a, D> {
             let Some(Cached { map, stiffness, .. }) = cached.as_mut() else {
                 return Err(FractureError::Input("law map missing".into()));
             };
+            if matches!(
+                flow.fracture_permeability,
+                Some(FracturePermeability::CubicLaw(_))
+            ) {
+                // A failed cell is the crack's fluid: it stores the volume it opens.
+                let alpha: Vec<f64> = fs
+                    .flags()
+                    .iter()
+                    .zip(&flow.alpha)
+                    .map(|(&f, &a)| if f { 1.0 } else { a })
+                    .collect();
+                if alpha != operators.alpha {
+                    *operators = Arc::new(operators.with_alpha(grid, body.dofs, alpha));
+                }
+            }
             update_permeability(
                 grid,
                 flow,

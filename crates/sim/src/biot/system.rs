@@ -6,10 +6,11 @@ use std::sync::Arc;
 use rayon::prelude::*;
 
 use porofrac_flow::FlowModel;
-use porofrac_grid::Point;
+use porofrac_grid::{Grid, Point};
 use porofrac_law::Stiffness;
 
 use crate::assembly::{ElementCache, assemble, assemble_with, cell_tangents, nodal_loads};
+use crate::dofs::DofMap;
 use crate::solve::{DirectSolver, StaticProblem};
 
 use super::{BiotError, BiotResult, BiotState, Linearization, check_len};
@@ -72,6 +73,45 @@ pub(crate) struct Operators<const D: usize> {
     pub(crate) free_ptr: Vec<usize>,
     pub(crate) free_eq: Vec<usize>,
     pub(crate) free_w: Vec<f64>,
+}
+
+impl<const D: usize> Operators<D> {
+    /// The same coupling data with the Biot coefficient `alpha` (one per cell, in [0, 1]):
+    /// the weights `α_K N_i` of every cell recomputed from the kept node normals, the
+    /// free dofs those of `dofs` (the map the data was built with).
+    pub(crate) fn with_alpha(&self, grid: &Grid<D>, dofs: &DofMap<D>, alpha: Vec<f64>) -> Self {
+        let mut weights = Vec::with_capacity(self.weights.len());
+        let (mut free_eq, mut free_w) = (
+            Vec::with_capacity(self.free_eq.len()),
+            Vec::with_capacity(self.free_w.len()),
+        );
+        let mut free_ptr = Vec::with_capacity(self.free_ptr.len());
+        free_ptr.push(0);
+        for (c, &a_c) in alpha.iter().enumerate() {
+            let nn = &self.normals[self.node_ptr[c]..self.node_ptr[c + 1]];
+            for (&n, ni) in grid.cell_nodes(c).iter().zip(nn) {
+                for a in 0..D {
+                    weights.push(a_c * ni[a]);
+                    if let Some(e) = dofs.equation(n, a) {
+                        free_eq.push(e);
+                        free_w.push(a_c * ni[a]);
+                    }
+                }
+            }
+            free_ptr.push(free_eq.len());
+        }
+        Self {
+            alpha,
+            p0: self.p0.clone(),
+            node_ptr: self.node_ptr.clone(),
+            normals: self.normals.clone(),
+            weights,
+            dofs: self.dofs.clone(),
+            free_ptr,
+            free_eq,
+            free_w,
+        }
+    }
 }
 
 /// Stiffness values compared per rayon task when a linearization asks whether the
