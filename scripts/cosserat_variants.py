@@ -14,19 +14,25 @@ sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "peers", "cosse
 import dem  # noqa: E402
 from vtu import read_triangles  # noqa: E402
 
+# One change at a time from the seed's rule (`seed`: the first subset with max|lambda| < 1
+# on every facet); `default` is porofrac's default (boundary facets: the smallest
+# max|lambda|).
 VARIANTS = [
-    "base:",
-    "order-id:order=id",
-    "minmax:select=minmax",
-    "depth2:depth=2",
-    "cell-strain:strain=cell",
-    "eta0.5:eta=0.5",
-    "eta2:eta=2",
-    "hf-max:hf=max",
-    "hf-min:hf=min",
-    "hf-facet:hf=facet",
-    "hf-centres:hf=centres",
-    "traction-cell:traction=cell",
+    "seed:bselect=same",
+    "default:",
+    "smallest-weight:select=minmax,depth=2,bselect=same",
+    "minmax-pool1:select=minmax,bselect=same",
+    "interior-minmax-pool2:select=minmax,depth=2,bselect=first",
+    "order-id:order=id,bselect=same",
+    "quad:select=quad,bselect=same",
+    "cell-strain:strain=cell,bselect=same",
+    "eta0.5:eta=0.5,bselect=same",
+    "eta2:eta=2,bselect=same",
+    "hf-max:hf=max,bselect=same",
+    "hf-min:hf=min,bselect=same",
+    "hf-facet:hf=facet,bselect=same",
+    "hf-centres:hf=centres,bselect=same",
+    "traction-cell:traction=cell,bselect=same",
 ]
 
 
@@ -36,6 +42,8 @@ def parse(v):
     for kv in filter(None, rest.split(",")):
         k, val = kv.split("=")
         opt[k] = type(dem.DEFAULTS[k])(val)
+    if opt.get("bselect") == "same" and "select" not in opt:
+        opt["select"] = "first"
     return name, opt
 
 

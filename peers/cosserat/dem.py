@@ -1,7 +1,11 @@
 """The variational DEM for Cosserat media (seed 001.2) written plainly in numpy/scipy: the
 same method as porofrac-cosserat (crates/cosserat), for the plate with a hole (E2).
 
-usage: python dem.py MESH.vtu R R_OVER_L N [--check-stencils]
+usage: python dem.py MESH.vtu R R_OVER_L N [--order ..] [--select ..] [--bselect ..]
+       [--depth ..] [--strain ..] [--eta ..] [--hf ..] [--traction ..]
+
+The flags switch one choice of the method at a time (`python dem.py -h`); without them it
+is porofrac's default method.
 
 Reads a triangle mesh written by porofrac (`plate_hole mesh ...`), solves the quarter plate
 16.2 mm with a hole of radius R (mm), G = 1000 MPa, nu = 0.3, Gc = G N^2/(1 - N^2),
@@ -18,9 +22,10 @@ The method, as in crates/cosserat/src/{recon.rs, discrete.rs, material.rs}:
 * facet values (eqs. 8-10): for each facet, a pool of cells (interior facet: its two cells
   and their face neighbours; boundary facet: cells within graph distance 2), sorted by the
   distance of the barycentre to the facet centroid (ties by cell id), at most 12; the
-  3-subsets in lexicographic order, singular ones skipped (|det| <= 1e-10 |e1||e2|); the
-  first with max|lambda| < 1 is taken, otherwise the one with the smallest max|lambda| < 10;
-  if none, the pool grows by one graph level (twice at most);
+  3-subsets in lexicographic order, singular ones skipped (|det| <= 1e-10 |e1||e2|); on
+  an interior facet the first with max|lambda| < 1 is taken, otherwise the one with the
+  smallest max|lambda| < 10; on a boundary facet the one with the smallest max|lambda| (the
+  `smallest-boundary-weight` rule); if none, the pool grows by one graph level (twice at most);
 * Stokes gradients (11): G_K = (1/|K|) sum_F |F| w_F n_KF;
 * strain (12) with the Crouzeix-Raviart facet rotation at the three facet midpoints (weight
   |K|/3 each) and the elastic form (13) as sum_q B_q^T A B_q (the R^T A R form);
@@ -46,7 +51,7 @@ MAX_WEIGHT = 10.0
 # The choices of the method (command-line flags --order, --select, --depth, --strain, --eta,
 # --hf, --traction); these values are porofrac's.
 DEFAULTS = {"order": "distance", "select": "first", "depth": 1, "strain": "facet", "eta": 1.0,
-            "hf": "mean", "traction": "facet", "bselect": "same"}
+            "hf": "mean", "traction": "facet", "bselect": "minmax"}
 MAX_POOL = 12
 SIDE, G, NU = 16.2, 1e3, 0.3
 
