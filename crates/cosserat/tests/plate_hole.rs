@@ -1,8 +1,9 @@
 //! Plate with a hole (Marazzato (2021), arXiv:2101.08712, §3.9.1): the DEM stress
 //! concentration factor (largest cell σ22 over the applied traction) against the Mindlin /
 //! Kaloni–Ariman value for six (N, r/ℓ) pairs and the Cauchy limit (N = 0, SCF 3). Gate:
-//! within 4 % on the level-5 O-grid (8,000 triangles) and the error falling from level 3
-//! (2,880 triangles) to level 5. The cell-constant maximum sits inside the first cell and
+//! within 1.5 % on the level-5 O-grid (8,000 triangles; measured 0.05–1.07 % with the
+//! default stencil rule, 1.6–3.7 % with the seed's rule, which this gate of 4 % was set
+//! for) and the error falling from level 3 (2,880 triangles) to level 5. The cell-constant maximum sits inside the first cell and
 //! underestimates the peak, so the error is one-sided and first order.
 //!
 //! The stencil rules against the finite plate's converged SCF 2.5641 (N = 0.6, r/ℓ = 2,
@@ -64,7 +65,7 @@ fn scf_against_the_analytic_value() {
         let coarse = (scf(3, r, n, r / rl) - want) / want;
         let fine = (scf(5, r, n, r / rl) - want) / want;
         eprintln!("r = {r}, r/ℓ = {rl}, N = {n}: SCF {want:.4}, error {coarse:+.4} → {fine:+.4}");
-        assert!(fine.abs() < 0.04, "r/ℓ = {rl}, N = {n}: error {fine}");
+        assert!(fine.abs() < 0.015, "r/ℓ = {rl}, N = {n}: error {fine}");
         assert!(
             fine.abs() < coarse.abs(),
             "r/ℓ = {rl}, N = {n}: no improvement"

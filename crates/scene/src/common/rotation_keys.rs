@@ -33,8 +33,8 @@ impl PerRotation {
 #[serde(rename_all = "kebab-case")]
 pub enum Stencil {
     /// Interior facets: the first subset of the two cells and their neighbours, nearest
-    /// first, with all weights below 1; boundary facets: the subset with the smallest
-    /// largest weight.
+    /// first, with all weights below 1; boundary facets in 2D: the subset with the
+    /// smallest largest weight (3D: as `"first-interpolating"`).
     #[default]
     SmallestBoundaryWeight,
     /// The seed's rule: the first subset with all weights below 1 on every facet.
