@@ -42,7 +42,16 @@ peer_flags=()
 if [ "${PEER_RULE:-}" = smallest-weight ]; then
     peer_flags=(--select minmax --depth 2 --bselect same)
 fi
-csv() { echo "CSV $*"; }
+# One CSV line from a RESULT json: row JSON CODE LEVEL.
+row() {
+    python3 - "$@" "$ref" <<'PY'
+import json, sys
+d, code, level, ref = json.loads(sys.argv[1]), sys.argv[2], sys.argv[3], float(sys.argv[4])
+t = d["t_assemble"] + d["t_solve"]
+print(f"CSV {code},{level},{d['cells']},{d['dofs']},{d['t_assemble']:.6f},{d['t_solve']:.6f},"
+      f"{t:.6f},{d['scf']:.15e},{d['scf'] / ref - 1:.6e}")
+PY
+}
 echo "# $(date -u +%FT%TZ), load $(cut -d' ' -f1-3 /proc/loadavg), $(nproc) cores, cpus ${CPUS:-all}, peer ${PEER_RULE:-default}"
 for spec in "$@"; do
     IFS=: read -r L nc np <<<"$spec"
@@ -63,17 +72,11 @@ ref = float(sys.argv[3])
 print(f"CSV porofrac-command,{sys.argv[2]},{d['cells']},{d['dofs']},{w['assembly']:.6f},{w['solve']:.6f},"
       f"{w['assembly'] + w['solve']:.6f},{scf:.15e},{scf / ref - 1:.6e}  (total with output {w['total']:.4f})")
 PY
-        "${pin[@]}" "$ex" run "$mesh" "$r" "$rl" "$n" auto | sed -n 's/^RESULT //p' | python3 -c '
-import json, sys
-d = json.loads(sys.stdin.read()); ref = float(sys.argv[2])
-print(f"CSV porofrac,{sys.argv[1]},{d[\"cells\"]},{d[\"dofs\"]},{d[\"t_assemble\"]:.6f},{d[\"t_solve\"]:.6f},"
-      f"{d[\"t_assemble\"] + d[\"t_solve\"]:.6f},{d[\"scf\"]:.15e},{d[\"scf\"] / ref - 1:.6e}")' "$L" "$ref"
+        res=$("${pin[@]}" "$ex" run "$mesh" "$r" "$rl" "$n" auto | sed -n 's/^RESULT //p')
+        row "$res" porofrac "$L"
         if [ "$i" -le "$np" ]; then
-            (cd peers/cosserat && "${pin[@]}" "$python" dem.py "$mesh" "$r" "$rl" "$n" "${peer_flags[@]}") | sed -n 's/^RESULT //p' | python3 -c '
-import json, sys
-d = json.loads(sys.stdin.read()); ref = float(sys.argv[2]); code = sys.argv[3]
-print(f"CSV {code},{sys.argv[1]},{d[\"cells\"]},{d[\"dofs\"]},{d[\"t_assemble\"]:.6f},{d[\"t_solve\"]:.6f},"
-      f"{d[\"t_assemble\"] + d[\"t_solve\"]:.6f},{d[\"scf\"]:.15e},{d[\"scf\"] / ref - 1:.6e}")' "$L" "$ref" "python-dem${PEER_RULE:+-$PEER_RULE}"
+            res=$(cd peers/cosserat && "${pin[@]}" "$python" dem.py "$mesh" "$r" "$rl" "$n" "${peer_flags[@]}" | sed -n 's/^RESULT //p')
+            row "$res" "python-dem${PEER_RULE:+-$PEER_RULE}" "$L"
         fi
     done
 done

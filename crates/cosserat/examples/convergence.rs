@@ -19,8 +19,8 @@ use std::sync::Arc;
 
 use porofrac_cosserat::reference::ShearLayer;
 use porofrac_cosserat::{
-    BodyLoads, Condition, Cosserat, Material, Options, StencilRule, StrainVariant, constant,
-    mesh, strain_index,
+    BodyLoads, Condition, Cosserat, Material, Options, StencilRule, StrainVariant, constant, mesh,
+    strain_index,
 };
 use porofrac_grid::Point;
 
@@ -86,9 +86,15 @@ fn main() {
     let rules = [
         ("smallest-weight", StencilRule::SmallestWeight),
         ("first-interpolating", StencilRule::FirstInterpolating),
-        ("smallest-boundary-weight", StencilRule::SmallestBoundaryWeight),
+        (
+            "smallest-boundary-weight",
+            StencilRule::SmallestBoundaryWeight,
+        ),
     ];
-    let strains = [("facet", StrainVariant::Facet), ("cell", StrainVariant::Cell)];
+    let strains = [
+        ("facet", StrainVariant::Facet),
+        ("cell", StrainVariant::Cell),
+    ];
     println!(
         "rule                     strain  cells    h (mm)   L2(u1)     order  L2(φ)      order  \
          L2(σ12)    order"
@@ -105,8 +111,8 @@ fn main() {
                 let (cells, eu, ep, es) = errors(n, options);
                 let hh = 1.0 / (5 * n) as f64;
                 let order = |e: f64, e0: f64, h0: f64| (e0 / e).ln() / (h0 / hh).ln();
-                let (ou, op, os) =
-                    prev.map_or((f64::NAN, f64::NAN, f64::NAN), |(h0, u0, p0, s0)| {
+                let (ou, op, os) = prev
+                    .map_or((f64::NAN, f64::NAN, f64::NAN), |(h0, u0, p0, s0)| {
                         (order(eu, u0, h0), order(ep, p0, h0), order(es, s0, h0))
                     });
                 println!(

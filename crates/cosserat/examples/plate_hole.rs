@@ -170,9 +170,9 @@ fn main() {
             Some(_) => panic!("{usage}"),
         };
         let stencil = match args.get(8).map(String::as_str) {
-            None | Some("smallest-weight") => StencilRule::SmallestWeight,
+            None | Some("smallest-boundary-weight") => StencilRule::SmallestBoundaryWeight,
             Some("first-interpolating") => StencilRule::FirstInterpolating,
-            Some("smallest-boundary-weight") => StencilRule::SmallestBoundaryWeight,
+            Some("smallest-weight") => StencilRule::SmallestWeight,
             Some(_) => panic!("{usage}"),
         };
         let m = scf_on(grid, n, r / rl, solver, precision, stencil);

@@ -3,8 +3,9 @@
 //! Kaloni–Ariman value for six (N, r/ℓ) pairs and the Cauchy limit (N = 0, SCF 3). Gate:
 //! within 1.5 % on the level-5 O-grid (8,000 triangles; measured 0.05–1.07 % with the
 //! default stencil rule, 1.6–3.7 % with the seed's rule, which this gate of 4 % was set
-//! for) and the error falling from level 3 (2,880 triangles) to level 5. The cell-constant maximum sits inside the first cell and
-//! underestimates the peak, so the error is one-sided and first order.
+//! for) and the error falling from level 3 (2,880 triangles) to level 5. The cell-constant
+//! maximum sits inside the first cell and underestimates the peak, so the error is
+//! one-sided and first order.
 //!
 //! The stencil rules against the finite plate's converged SCF 2.5641 (N = 0.6, r/ℓ = 2,
 //! r = 0.216 mm; docs/models/cosserat.md, "Which stencil"): on the level-3 and level-5
@@ -87,7 +88,13 @@ fn default_stencil_rule_is_closer_to_the_converged_scf() {
             err(StencilRule::FirstInterpolating),
         );
         eprintln!("level {level}: default {default:+.4}, seed's rule {seed:+.4}");
-        assert!(default.abs() < gate, "level {level}: default error {default}");
-        assert!(seed.abs() > seed_above, "level {level}: seed's error {seed}");
+        assert!(
+            default.abs() < gate,
+            "level {level}: default error {default}"
+        );
+        assert!(
+            seed.abs() > seed_above,
+            "level {level}: seed's error {seed}"
+        );
     }
 }

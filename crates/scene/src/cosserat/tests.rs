@@ -237,6 +237,11 @@ fn stencil_key() {
         .replace("cosserat_shear_modulus = 500.0\n", "")
         .replace("characteristic_length = 0.1\n", "")
         .replace("rotation = 0.0\n", "");
-    let e = error_of(&format!("{cont}\n[solver]\nstencil = \"smallest-weight\"\n"));
-    assert!(e.contains("solver.stencil") && e.contains("cosserat"), "{e}");
+    let e = error_of(&format!(
+        "{cont}\n[solver]\nstencil = \"smallest-weight\"\n"
+    ));
+    assert!(
+        e.contains("solver.stencil") && e.contains("cosserat"),
+        "{e}"
+    );
 }
