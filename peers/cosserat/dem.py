@@ -150,8 +150,8 @@ def best_subset(pool, cc, xf, select="first"):
         ok = (a00 != 0.0) & (a11 != 0.0) & ~np.isnan(det) & ~(np.abs(det) <= 1e-10 * scale)
         l1 = a12 / a11
         l0 = (a02 - a01 * l1) / a00
-    w = np.stack([1.0 - (l0 + l1), l0, l1], axis=1)
-    m = np.abs(w).max(axis=1)
+        w = np.stack([1.0 - (l0 + l1), l0, l1], axis=1)
+        m = np.abs(w).max(axis=1)
     if select == "quad":  # the smallest bound of the error on quadratics
         d = cc[idx] - xf
         q = (np.abs(w) * (d[..., 0] * d[..., 0] + d[..., 1] * d[..., 1])).sum(axis=1)

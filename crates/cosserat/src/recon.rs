@@ -18,8 +18,9 @@
 //! `max|λ| <` [`MAX_WEIGHT`]. A boundary facet extrapolates (`x_F` lies outside the hull
 //! of the barycentres): by default ([`StencilRule::SmallestBoundaryWeight`]) it takes, in
 //! 2D, the subset with the smallest `max|λ|` of all, which bounds how much the
-//! extrapolation amplifies the cell values (in 3D the first with `max|λ| < 1`). If there is no admissible subset, the pool is widened by
-//! one graph level (twice at most) and then the facet is an error naming it.
+//! extrapolation amplifies the cell values (in 3D the first with `max|λ| < 1`). If there
+//! is no admissible subset, the pool is widened by one graph level (twice at most) and
+//! then the facet is an error naming it (the first such facet by id).
 //!
 //! Two other rules are kept ([`StencilRule`]): the seed's reading (the first subset with
 //! `max|λ| < 1` on boundary facets too) and the paper's wider pool with the smallest
@@ -113,7 +114,8 @@ impl<const D: usize> Reconstruction<D> {
             }
         }
         let neighbours = neighbours(grid);
-        // Facets are independent: in parallel, each thread with its own search scratch.
+        // Facets are independent: in parallel, each thread with its own search scratch;
+        // the error of the first failing facet by id, whatever the thread count.
         let facets = (0..grid.num_faces())
             .into_par_iter()
             .with_min_len(1024)
@@ -121,6 +123,8 @@ impl<const D: usize> Reconstruction<D> {
                 || Bfs::new(grid.num_cells()),
                 |bfs, f| facet_stencil(grid, &neighbours, bfs, f, rule),
             )
+            .collect::<Vec<_>>()
+            .into_iter()
             .collect::<Result<Vec<_>>>()?;
         let mut grad_pos = vec![0];
         let mut grad_cells = Vec::new();
