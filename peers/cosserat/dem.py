@@ -1,7 +1,11 @@
 """The variational DEM for Cosserat media (seed 001.2) written plainly in numpy/scipy: the
 same method as porofrac-cosserat (crates/cosserat), for the plate with a hole (E2).
 
-usage: python dem.py MESH.vtu R R_OVER_L N [--check-stencils]
+usage: python dem.py MESH.vtu R R_OVER_L N [--order ..] [--select ..] [--bselect ..]
+       [--depth ..] [--strain ..] [--eta ..] [--hf ..] [--traction ..]
+
+The flags switch one choice of the method at a time (`python dem.py -h`); without them it
+is porofrac's default method.
 
 Reads a triangle mesh written by porofrac (`plate_hole mesh ...`), solves the quarter plate
 16.2 mm with a hole of radius R (mm), G = 1000 MPa, nu = 0.3, Gc = G N^2/(1 - N^2),
@@ -18,9 +22,10 @@ The method, as in crates/cosserat/src/{recon.rs, discrete.rs, material.rs}:
 * facet values (eqs. 8-10): for each facet, a pool of cells (interior facet: its two cells
   and their face neighbours; boundary facet: cells within graph distance 2), sorted by the
   distance of the barycentre to the facet centroid (ties by cell id), at most 12; the
-  3-subsets in lexicographic order, singular ones skipped (|det| <= 1e-10 |e1||e2|); the
-  first with max|lambda| < 1 is taken, otherwise the one with the smallest max|lambda| < 10;
-  if none, the pool grows by one graph level (twice at most);
+  3-subsets in lexicographic order, singular ones skipped (|det| <= 1e-10 |e1||e2|); on
+  an interior facet the first with max|lambda| < 1 is taken, otherwise the one with the
+  smallest max|lambda| < 10; on a boundary facet the one with the smallest max|lambda| (the
+  `smallest-boundary-weight` rule); if none, the pool grows by one graph level (twice at most);
 * Stokes gradients (11): G_K = (1/|K|) sum_F |F| w_F n_KF;
 * strain (12) with the Crouzeix-Raviart facet rotation at the three facet midpoints (weight
   |K|/3 each) and the elastic form (13) as sum_q B_q^T A B_q (the R^T A R form);
@@ -43,6 +48,10 @@ from scipy.sparse.linalg import spsolve
 from vtu import read_triangles
 
 MAX_WEIGHT = 10.0
+# The choices of the method (command-line flags --order, --select, --depth, --strain, --eta,
+# --hf, --traction); these values are porofrac's.
+DEFAULTS = {"order": "distance", "select": "first", "depth": 1, "strain": "facet", "eta": 1.0,
+            "hf": "mean", "traction": "facet", "bselect": "minmax"}
 MAX_POOL = 12
 SIDE, G, NU = 16.2, 1e3, 0.3
 
@@ -109,9 +118,13 @@ def geometry(pts, tri, face_nodes, face_cells, cell_faces):
 _COMBOS = {p: np.array(list(combinations(range(p), 3)), dtype=np.int64) for p in range(3, MAX_POOL + 1)}
 
 
-def best_subset(pool, cc, xf):
+def best_subset(pool, cc, xf, select="first"):
     """Barycentric weights of xf in every 3-subset of the pool (lexicographic order, 2x2
-    Gaussian elimination with partial pivoting as in recon.rs), then the selection rule."""
+    Gaussian elimination with partial pivoting as in recon.rs), then the selection rule:
+    `first` takes the first subset with max|lambda| < 1 (else the smallest max|lambda| < 10),
+    `minmax` the subset with the smallest max|lambda| of all (the first of equals), `quad`
+    the subset with the smallest sum |lambda_c| |x_c - x_F|^2 (the bound of the facet value's
+    error on quadratic fields) among those with max|lambda| < 10."""
     p = len(pool)
     if p < 3:
         return None
@@ -137,9 +150,17 @@ def best_subset(pool, cc, xf):
         ok = (a00 != 0.0) & (a11 != 0.0) & ~np.isnan(det) & ~(np.abs(det) <= 1e-10 * scale)
         l1 = a12 / a11
         l0 = (a02 - a01 * l1) / a00
-    w = np.stack([1.0 - (l0 + l1), l0, l1], axis=1)
-    m = np.abs(w).max(axis=1)
-    good = np.flatnonzero(ok & (m < 1.0))
+        w = np.stack([1.0 - (l0 + l1), l0, l1], axis=1)
+        m = np.abs(w).max(axis=1)
+    if select == "quad":  # the smallest bound of the error on quadratics
+        d = cc[idx] - xf
+        q = (np.abs(w) * (d[..., 0] * d[..., 0] + d[..., 1] * d[..., 1])).sum(axis=1)
+        cand = np.flatnonzero(ok & (m < MAX_WEIGHT))
+        if len(cand) == 0:
+            return None
+        k = cand[np.argmin(q[cand])]
+        return idx[k], w[k]
+    good = np.flatnonzero(ok & (m < 1.0)) if select == "first" else []
     if len(good):
         k = good[0]
     else:
@@ -166,21 +187,28 @@ def bfs(nb, seeds, depth):
     return np.array(out, dtype=np.int64)
 
 
-def reconstruction(face_cells, fc, cc, nb):
-    """Facet stencils: (nf, 3) cells and weights."""
+def reconstruction(face_cells, fc, cc, nb, order="distance", select="first", depth_in=1,
+                   bselect="same"):
+    """Facet stencils: (nf, 3) cells and weights. `order`: the pool sorted by the distance
+    of the barycentres to the facet centroid (ties by id) and capped at MAX_POOL, or by
+    cell id (`id`, no cap); `depth_in`: graph distance of the interior pool."""
     nf = len(face_cells)
     st_cells = np.empty((nf, 3), dtype=np.int64)
     st_w = np.empty((nf, 3))
     for f in range(nf):
         a, b = face_cells[f]
-        seeds, depth = ([a, b], 1) if b >= 0 else ([a], 2)
+        seeds, depth = ([a, b], depth_in) if b >= 0 else ([a], 2)
         xf = fc[f]
         for extra in range(3):
             out = bfs(nb, seeds, depth + extra)
             d = cc[out] - xf
             d2 = d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1]
-            pool = out[np.lexsort((out, d2))][:MAX_POOL]
-            s = best_subset(pool, cc, xf)
+            if order == "id":
+                pool = np.sort(out)
+                pool = pool[:MAX_POOL] if len(pool) <= MAX_POOL else out[np.lexsort((out, d2))][:MAX_POOL]
+            else:
+                pool = out[np.lexsort((out, d2))][:MAX_POOL]
+            s = best_subset(pool, cc, xf, select if b >= 0 or bselect == "same" else bselect)
             if s is not None:
                 st_cells[f], st_w[f] = s
                 break
@@ -218,7 +246,8 @@ def block_diag_coo(blocks, size):
 
 
 # ----------------------------------------------------------------------------- solver
-def solve(pts, tri, r, rl, n_cos, check=False):
+def solve(pts, tri, r, rl, n_cos, opt=None):
+    opt = dict(DEFAULTS, **(opt or {}))
     timer = {}
     t0 = time.perf_counter()
     nc = len(tri)
@@ -241,7 +270,8 @@ def solve(pts, tri, r, rl, n_cos, check=False):
 
     # reconstruction (eqs. 8-10) and gradient operator (11)
     t_rec = time.perf_counter()
-    st_cells, st_w = reconstruction(face_cells, fc, cc, nb)
+    st_cells, st_w = reconstruction(face_cells, fc, cc, nb, opt["order"], opt["select"], opt["depth"],
+                                     opt["bselect"])
     Fint = sp.csr_matrix((st_w.ravel(), (np.repeat(np.arange(nf), 3), st_cells.ravel())), shape=(nf, nc))
     sign = np.where(face_cells[cell_faces, 0] == np.arange(nc)[:, None], 1.0, -1.0)  # (nc, 3)
     n_out = normal[cell_faces] * sign[..., None]                                       # (nc, 3, 2)
@@ -261,11 +291,16 @@ def solve(pts, tri, r, rl, n_cos, check=False):
 
     grad = sum(place(comp(Gd, a), 2 * a + j) for a in range(3) for j, Gd in enumerate((Gx, Gy)))
     Bs = []
-    for i in range(3):
-        Fi = Fint[cell_faces[:, i]]          # phi at the i-th facet midpoint of each cell
-        rot = place(comp(Fi, 2), 1) - place(comp(Fi, 2), 2)   # e12 += phi, e21 -= phi
-        Bs.append((grad + rot).tocsr())
-    Dq = block_diag_coo(np.broadcast_to(A, (nc, 6, 6)) * (vol / 3.0)[:, None, None], 6)
+    if opt["strain"] == "cell":  # the cell rotation, one point of weight |K|
+        cell = sp.identity(nc, format="csr")
+        Bs.append((grad + place(comp(cell, 2), 1) - place(comp(cell, 2), 2)).tocsr())
+        Dq = block_diag_coo(np.broadcast_to(A, (nc, 6, 6)) * vol[:, None, None], 6)
+    else:
+        for i in range(3):
+            Fi = Fint[cell_faces[:, i]]          # phi at the i-th facet midpoint of each cell
+            rot = place(comp(Fi, 2), 1) - place(comp(Fi, 2), 2)   # e12 += phi, e21 -= phi
+            Bs.append((grad + rot).tocsr())
+        Dq = block_diag_coo(np.broadcast_to(A, (nc, 6, 6)) * (vol / 3.0)[:, None, None], 6)
     K = sum(B.T @ Dq @ B for B in Bs)
 
     # interior penalty (17)
@@ -273,7 +308,9 @@ def solve(pts, tri, r, rl, n_cos, check=False):
     km, kp = face_cells[fi, 0], face_cells[fi, 1]
     nI = normal[fi]
     Q = np.einsum("fj,ajbl,fl->fab", nI, A.reshape(3, 2, 3, 2), nI)
-    h = 0.5 * (diam[km] + diam[kp])
+    h = {"mean": 0.5 * (diam[km] + diam[kp]), "max": np.maximum(diam[km], diam[kp]),
+         "min": np.minimum(diam[km], diam[kp]), "facet": area[fi],
+         "centres": _norm(cc[kp] - cc[km])}[opt["hf"]] / opt["eta"]
     half = tang[fi] * (0.5 / np.sqrt(3.0))
     ni = len(fi)
     Sm = sp.csr_matrix((np.ones(ni), (np.arange(ni), km)), shape=(ni, nc))
@@ -298,7 +335,7 @@ def solve(pts, tri, r, rl, n_cos, check=False):
     ff = np.array([f for f, _ in fixed])
     fk = np.array([k for _, k in fixed])
     nfix = len(ff)
-    Bbar = (Bs[0] + Bs[1] + Bs[2]) / 3.0
+    Bbar = sum(Bs) / len(Bs)
     AB = block_diag_coo(np.broadcast_to(A, (nc, 6, 6)), 6) @ Bbar
     c_of = face_cells[ff, 0]
     sel_rows = np.repeat(np.arange(nfix), 2)
@@ -310,7 +347,10 @@ def solve(pts, tri, r, rl, n_cos, check=False):
     K = (K - L.T @ T + T.T @ L).tocsc()
     top = on(1, hi[1])
     rhs = np.zeros(3 * nc)
-    np.add.at(rhs, st_cells[top] * 3 + 1, st_w[top] * area[top][:, None])
+    if opt["traction"] == "cell":
+        np.add.at(rhs, face_cells[top, 0] * 3 + 1, area[top])
+    else:
+        np.add.at(rhs, st_cells[top] * 3 + 1, st_w[top] * area[top][:, None])
     timer["t_assemble"] = time.perf_counter() - t0
 
     t1 = time.perf_counter()
@@ -337,18 +377,38 @@ def hole_scf(nu, n, r, length):
 
 
 def main():
-    if len(sys.argv) != 5:
-        sys.exit("usage: python dem.py MESH.vtu R R_OVER_L N")
-    path, r, rl, n_cos = sys.argv[1], float(sys.argv[2]), float(sys.argv[3]), float(sys.argv[4])
-    if not (r > 0 and rl > 0 and 0 <= n_cos < 1):
-        sys.exit(f"need R > 0, R_OVER_L > 0 and 0 <= N < 1, got {r}, {rl}, {n_cos}")
+    import argparse
+    p = argparse.ArgumentParser(description="variational Cosserat DEM, plate with a hole")
+    p.add_argument("mesh")
+    p.add_argument("r", type=float)
+    p.add_argument("r_over_l", type=float)
+    p.add_argument("n", type=float)
+    p.add_argument("--order", choices=["distance", "id"], default=DEFAULTS["order"],
+                   help="pool order: distance to the facet centroid, or cell id")
+    p.add_argument("--select", choices=["first", "minmax", "quad"], default=DEFAULTS["select"],
+                   help="first subset with max|lambda| < 1, or the smallest max|lambda|")
+    p.add_argument("--bselect", choices=["same", "first", "minmax", "quad"], default=DEFAULTS["bselect"],
+                   help="selection rule on boundary facets (same: as --select)")
+    p.add_argument("--depth", type=int, choices=[1, 2], default=DEFAULTS["depth"],
+                   help="graph distance of the interior-facet pool")
+    p.add_argument("--strain", choices=["facet", "cell"], default=DEFAULTS["strain"],
+                   help="rotation in the strain: facet (CR) values or the cell value")
+    p.add_argument("--eta", type=float, default=DEFAULTS["eta"], help="interior penalty weight")
+    p.add_argument("--hf", choices=["mean", "max", "min", "facet", "centres"], default=DEFAULTS["hf"],
+                   help="h_F of the penalty: mean/max/min cell diameter, facet length, centre distance")
+    p.add_argument("--traction", choices=["facet", "cell"], default=DEFAULTS["traction"],
+                   help="traction tested with the facet values or the cell value")
+    a = p.parse_args()
+    if not (a.r > 0 and a.r_over_l > 0 and 0 <= a.n < 1 and a.eta > 0):
+        sys.exit(f"need R > 0, R_OVER_L > 0, 0 <= N < 1 and eta > 0, got {a.r}, {a.r_over_l}, {a.n}, {a.eta}")
+    opt = {k: getattr(a, k) for k in DEFAULTS}
     t = time.perf_counter()
-    pts, tri = read_triangles(path)
+    pts, tri = read_triangles(a.mesh)
     t_read = time.perf_counter() - t
-    res = {"code": "python-dem", "mesh": path}
-    res.update(solve(pts, tri, r, rl, n_cos))
+    res = {"code": "python-dem", "mesh": a.mesh, "options": opt}
+    res.update(solve(pts, tri, a.r, a.r_over_l, a.n, opt))
     res["t_read"] = t_read
-    res["scf_ref"] = hole_scf(NU, n_cos, r, r / rl)
+    res["scf_ref"] = hole_scf(NU, a.n, a.r, a.r / a.r_over_l)
     res["peak_memory_bytes"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
     print("RESULT " + json.dumps(res), flush=True)
 

@@ -5,7 +5,8 @@
 //! `cargo run --release -p porofrac-cosserat --example plate_hole [levels]`, or
 //! `… --example plate_hole mesh <level> <r> <path.vtu>` to write the O-grid mesh of a level
 //! (the mesh of `scenes/cosserat_plate_hole.toml`), or
-//! `… --example plate_hole run <path.vtu> <r> <r/ℓ> <N> [auto|lu|gmres-amg|gmres-ldlt|ldlt-schur]`
+//! `… --example plate_hole run <path.vtu> <r> <r/ℓ> <N> [auto|lu|gmres-amg|gmres-ldlt|ldlt-schur]
+//! [single|double] [smallest-weight|first-interpolating]`
 //! to solve on a mesh file and print one `RESULT {json}` line (SCF, cells, dofs, nnz,
 //! assembly and solve wall time, and the split: reconstruction alone, solver setup,
 //! solve, iterations, entries of the factors) in the form of the peers
@@ -16,7 +17,7 @@ use std::time::Instant;
 use porofrac_cosserat::reference::hole_scf;
 use porofrac_cosserat::{
     BodyLoads, Condition, Cosserat, FactorPrecision, GmresOptions, LinearOptions, LinearSolver,
-    LinearStats, Material, Options, Reconstruction, constant, mesh, strain_index,
+    LinearStats, Material, Options, Reconstruction, StencilRule, constant, mesh, strain_index,
 };
 
 /// SCF of the DEM: the largest cell σ22 over the applied traction T = 1.
@@ -29,6 +30,7 @@ pub fn scf(level: usize, r: f64, n: f64, length: f64) -> (f64, usize, f64, f64) 
         length,
         LinearSolver::Lu,
         FactorPrecision::default(),
+        StencilRule::default(),
     );
     (m.scf, m.cells, m.t_asm, m.t_setup + m.t_iter)
 }
@@ -57,6 +59,7 @@ fn scf_on(
     length: f64,
     solver: LinearSolver,
     precision: FactorPrecision,
+    stencil: StencilRule,
 ) -> Measured {
     let (g, nu) = (1e3, 0.3);
     let a = n * n / (1.0 - n * n);
@@ -70,13 +73,16 @@ fn scf_on(
         .fix(2, constant(0.0));
     let top = Condition::new(grid.boundary("ymax").unwrap()).load(1, constant(1.0));
     let tr = Instant::now();
-    drop(Reconstruction::new(&grid).unwrap());
+    drop(Reconstruction::with_rule(&grid, stencil).unwrap());
     let t_recon = tr.elapsed().as_secs_f64();
     let t0 = Instant::now();
     let model = Cosserat::new(
         grid,
         m,
-        Options::default(),
+        Options {
+            stencil,
+            ..Options::default()
+        },
         &[left, bottom, top],
         BodyLoads::none(),
     )
@@ -145,7 +151,8 @@ fn main() {
     }
     if args.get(1).map(String::as_str) == Some("run") {
         let usage = "plate_hole run <path.vtu> <r> <r/l> <N> \
-                     [auto|lu|gmres-amg|gmres-ldlt|ldlt-schur] [single|double]";
+                     [auto|lu|gmres-amg|gmres-ldlt|ldlt-schur] [single|double] \
+                     [smallest-weight|first-interpolating]";
         let grid = porofrac_grid::io::read_vtu::<2>(&args[2]).expect("readable 2D .vtu mesh");
         let num = |i: usize| -> f64 { args.get(i).and_then(|s| s.parse().ok()).expect(usage) };
         let (r, rl, n) = (num(3), num(4), num(5));
@@ -162,7 +169,13 @@ fn main() {
             Some("double") => FactorPrecision::Double,
             Some(_) => panic!("{usage}"),
         };
-        let m = scf_on(grid, n, r / rl, solver, precision);
+        let stencil = match args.get(8).map(String::as_str) {
+            None | Some("smallest-boundary-weight") => StencilRule::SmallestBoundaryWeight,
+            Some("first-interpolating") => StencilRule::FirstInterpolating,
+            Some("smallest-weight") => StencilRule::SmallestWeight,
+            Some(_) => panic!("{usage}"),
+        };
+        let m = scf_on(grid, n, r / rl, solver, precision, stencil);
         println!(
             "RESULT {{\"code\": \"porofrac\", \"mesh\": \"{}\", \"cells\": {}, \"dofs\": {}, \
              \"nnz\": {}, \"scf\": {:.15e}, \"scf_ref\": {:.15e}, \"t_assemble\": {:.6}, \

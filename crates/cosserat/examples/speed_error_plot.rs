@@ -32,6 +32,18 @@ const SERIES: &[(&str, &str, RGBColor, bool)] = &[
         false,
     ),
     (
+        "porofrac-first-interpolating",
+        "porofrac DEM, the seed's stencil rule (earlier round)",
+        RGBColor(31, 119, 180),
+        true,
+    ),
+    (
+        "python-dem-smallest-weight",
+        "DEM in numpy/scipy, the paper's wider stencils",
+        RGBColor(214, 39, 40),
+        true,
+    ),
+    (
         "fenicsx-p2p1",
         "FEniCSx P2–P1 FEM (MUMPS)",
         RGBColor(127, 127, 127),

@@ -46,7 +46,7 @@ use crate::linear::{
 };
 use crate::material::{Material, components, levi_civita, rotations, strain_index, strain_len};
 use crate::pattern::{BlockPattern, SparseLu};
-use crate::recon::Reconstruction;
+use crate::recon::{Reconstruction, StencilRule};
 
 /// `γ` of the boundary penalty in [`Cosserat::preconditioner_values`]: of 1, 10, 30, 100
 /// and 1000, 30 gave the fewest GMRES iterations on the plate with a hole (8,000 and 20,480
@@ -71,6 +71,8 @@ pub struct Options {
     pub penalty: f64,
     /// Strain variant of eq. (12).
     pub strain: StrainVariant,
+    /// How the cells of each facet value are chosen (eqs. 8–10).
+    pub stencil: StencilRule,
 }
 
 impl Default for Options {
@@ -78,6 +80,7 @@ impl Default for Options {
         Self {
             penalty: 1.0,
             strain: StrainVariant::default(),
+            stencil: StencilRule::default(),
         }
     }
 }
@@ -262,7 +265,7 @@ impl<const D: usize> Cosserat<D> {
                 what: format!("body loads: {} components, want {n}", body.fields.len()),
             });
         }
-        let recon = Reconstruction::new(&grid)?;
+        let recon = Reconstruction::with_rule(&grid, options.stencil)?;
         let law = material.law_matrix(D);
         let nbr = neighbours(&grid, &recon);
         let pattern = BlockPattern::new(&nbr, n);

@@ -47,4 +47,4 @@ pub use krylov::{FactorPrecision, GmresOptions, GmresStats};
 pub use linear::{Linear, LinearOptions, LinearSolver, LinearStats, SystemRef};
 pub use material::{Material, components, rotations, strain_index, strain_len};
 pub use pattern::{BlockPattern, SparseLu};
-pub use recon::Reconstruction;
+pub use recon::{Reconstruction, StencilRule};

@@ -13,9 +13,19 @@
 //! The pool is sorted by distance of the barycentre to `x_F` (ties by cell id), so the
 //! choice is deterministic, and capped at [`MAX_POOL`] cells. The `(D+1)`-subsets are
 //! visited in lexicographic order; singular ones are skipped (`|det| < 1e-10 Π|edges|`).
-//! The first subset with `max|λ| < 1` is accepted; otherwise the subset minimising
-//! `max|λ|` among those with `max|λ| <` [`MAX_WEIGHT`]. If there is none, the pool is
-//! widened by one graph level (twice at most) and then the facet is an error naming it.
+//! On an interior facet the first subset with `max|λ| < 1` is accepted (the nearest cells
+//! that interpolate `x_F`); otherwise the subset minimising `max|λ|` among those with
+//! `max|λ| <` [`MAX_WEIGHT`]. A boundary facet extrapolates (`x_F` lies outside the hull
+//! of the barycentres): by default ([`StencilRule::SmallestBoundaryWeight`]) it takes, in
+//! 2D, the subset with the smallest `max|λ|` of all, which bounds how much the
+//! extrapolation amplifies the cell values (in 3D the first with `max|λ| < 1`). If there
+//! is no admissible subset, the pool is widened by one graph level (twice at most) and
+//! then the facet is an error naming it (the first such facet by id).
+//!
+//! Two other rules are kept ([`StencilRule`]): the seed's reading (the first subset with
+//! `max|λ| < 1` on boundary facets too) and the paper's wider pool with the smallest
+//! `max|λ|` everywhere. All are exact for affine fields; what each costs in accuracy is
+//! measured in docs/models/cosserat.md ("Which stencil").
 //!
 //! **Gradients.** `G_K(w) = (1/|K|) Σ_{F⊂∂K} |F| w_F ⊗ n_{K,F}` (11), exact for affine `w`
 //! because `Σ_F |F| x_F ⊗ n_{K,F} = |K| I`. Substituting (9) gives the *gradient stencil*
@@ -25,6 +35,7 @@
 //! is `δ_{cK} + g_{K,c}·(x − x_K)`, the same for every component.
 
 use porofrac_grid::{Grid, Point};
+use rayon::prelude::*;
 
 use crate::error::{CosseratError, Result};
 
@@ -33,6 +44,27 @@ use crate::error::{CosseratError, Result};
 pub const MAX_WEIGHT: f64 = 10.0;
 /// Pool cap per dimension index (`[2D, 3D]`): the nearest cells are kept.
 pub const MAX_POOL: [usize; 2] = [12, 16];
+
+/// How the `D + 1` cells of a facet value are chosen from the pool.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum StencilRule {
+    /// Interior facets: the first subset, nearest cells first, with `max|λ| < 1`;
+    /// boundary facets in 2D: the subset with the smallest `max|λ|` (the default: a
+    /// smaller stress concentration error than the seed's rule on every plate mesh
+    /// measured, and its shear-layer errors). In 3D the same as
+    /// [`Self::FirstInterpolating`]: on the clamped beam of the dynamics tests the smallest
+    /// boundary weight made the beam stiffer than the Cosserat bound of its period.
+    #[default]
+    SmallestBoundaryWeight,
+    /// The seed's reading: the first subset with `max|λ| < 1` on every facet (else the
+    /// smallest `max|λ|`).
+    FirstInterpolating,
+    /// The paper's pool for interior facets in 2D as well (graph distance 2 of the facet's
+    /// cells: "repeat the last operation once") and the subset with the smallest `max|λ|`
+    /// on every facet: wider stencils (about twice the matrix entries), a smaller
+    /// stress concentration error on coarse plates but larger L2 errors on the shear layer.
+    SmallestWeight,
+}
 
 /// One facet's reconstruction: `D + 1` cells and their barycentric weights.
 #[derive(Clone, Debug, PartialEq)]
@@ -59,11 +91,18 @@ pub struct Reconstruction<const D: usize> {
 }
 
 impl<const D: usize> Reconstruction<D> {
-    /// Build the stencils of every facet and cell of a simplex grid.
+    /// Build the stencils of every facet and cell of a simplex grid with the default
+    /// [`StencilRule`].
     ///
     /// Errors: a non-simplex cell ([`CosseratError::NotSimplex`]) or a facet without an
     /// admissible stencil ([`CosseratError::NoStencil`], naming the facet).
     pub fn new(grid: &Grid<D>) -> Result<Self> {
+        Self::with_rule(grid, StencilRule::default())
+    }
+
+    /// Build the stencils of every facet and cell with the stencil rule `rule` (errors as
+    /// [`Self::new`]).
+    pub fn with_rule(grid: &Grid<D>, rule: StencilRule) -> Result<Self> {
         for c in 0..grid.num_cells() {
             let (nf, nn) = (grid.cell_faces(c).len(), grid.cell_nodes(c).len());
             if nf != D + 1 || nn != D + 1 {
@@ -75,11 +114,18 @@ impl<const D: usize> Reconstruction<D> {
             }
         }
         let neighbours = neighbours(grid);
-        let mut facets = Vec::with_capacity(grid.num_faces());
-        let mut bfs = Bfs::new(grid.num_cells());
-        for f in 0..grid.num_faces() {
-            facets.push(facet_stencil(grid, &neighbours, &mut bfs, f)?);
-        }
+        // Facets are independent: in parallel, each thread with its own search scratch;
+        // the error of the first failing facet by id, whatever the thread count.
+        let facets = (0..grid.num_faces())
+            .into_par_iter()
+            .with_min_len(1024)
+            .map_init(
+                || Bfs::new(grid.num_cells()),
+                |bfs, f| facet_stencil(grid, &neighbours, bfs, f, rule),
+            )
+            .collect::<Vec<_>>()
+            .into_iter()
+            .collect::<Result<Vec<_>>>()?;
         let mut grad_pos = vec![0];
         let mut grad_cells = Vec::new();
         let mut grad_coef = Vec::new();
@@ -244,11 +290,24 @@ fn facet_stencil<const D: usize>(
     nb: &[Vec<usize>],
     bfs: &mut Bfs,
     f: usize,
+    rule: StencilRule,
 ) -> Result<FacetStencil> {
     let xf = *grid.face_centroid(f);
     let (a, b) = grid.face_cells(f);
+    let interior = match rule {
+        StencilRule::SmallestWeight => 2,
+        _ if D == 2 => 1,
+        _ => 2,
+    };
+    let first = match rule {
+        StencilRule::SmallestWeight => false,
+        StencilRule::FirstInterpolating => true,
+        // 3D: the seed's rule (measured on the beam of tests/dynamics.rs, the smallest
+        // weight on its boundary facets made it stiffer, below the Cosserat bound).
+        StencilRule::SmallestBoundaryWeight => b.is_some() || D == 3,
+    };
     let (seeds, depth): (Vec<usize>, usize) = match b {
-        Some(b) => (vec![a, b], if D == 2 { 1 } else { 2 }),
+        Some(b) => (vec![a, b], interior),
         None => (vec![a], D),
     };
     let cap = MAX_POOL[D - 2];
@@ -263,7 +322,7 @@ fn facet_stencil<const D: usize>(
             dp.total_cmp(&dq).then(p.cmp(&q))
         });
         pool.truncate(cap);
-        if let Some(s) = best_subset(grid, &pool, &xf) {
+        if let Some(s) = best_subset(grid, &pool, &xf, first) {
             return Ok(s);
         }
         if bfs.out.len() <= cap && extra > 0 && bfs.out.len() == pool.len() {
@@ -343,6 +402,7 @@ fn best_subset<const D: usize>(
     grid: &Grid<D>,
     pool: &[usize],
     xf: &Point<D>,
+    first: bool,
 ) -> Option<FacetStencil> {
     let k = D + 1;
     let p = pool.len();
@@ -358,7 +418,7 @@ fn best_subset<const D: usize>(
         }
         if let Some(w) = barycentric(grid, &cells[..k], xf) {
             let m = w[..k].iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            if m < 1.0 {
+            if first && m < 1.0 {
                 best = Some((m, cells, w));
                 break;
             }

@@ -1,6 +1,6 @@
 //! Types of the scene keys of `model = "cosserat"` that live in the shared sections
 //! (`[[bc]] rotation`, `couple_traction`, `[loads] body_couple`, `[solver]
-//! time_integration`).
+//! time_integration`, `stencil`).
 
 use serde::Deserialize;
 
@@ -25,6 +25,23 @@ impl PerRotation {
             Self::Many(v) => v.iter().collect(),
         }
     }
+}
+
+/// `[solver] stencil`: how the cells of each facet value are chosen (docs/models/cosserat.md,
+/// "Which stencil").
+#[derive(Clone, Copy, Debug, Default, Deserialize, schemars::JsonSchema, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum Stencil {
+    /// Interior facets: the first subset of the two cells and their neighbours, nearest
+    /// first, with all weights below 1; boundary facets in 2D: the subset with the
+    /// smallest largest weight (3D: as `"first-interpolating"`).
+    #[default]
+    SmallestBoundaryWeight,
+    /// The seed's rule: the first subset with all weights below 1 on every facet.
+    FirstInterpolating,
+    /// The paper's wider pool (graph distance 2) and the smallest largest weight on every
+    /// facet.
+    SmallestWeight,
 }
 
 /// `[solver] time_integration` with a `[schedule]`.

@@ -695,6 +695,10 @@ pub struct Solver {
     /// Cosserat: η of the interior penalty (default 1).
     #[schemars(extend("models" = ["cosserat"]))]
     pub penalty: Option<f64>,
+    /// Cosserat: how the cells of each facet value are chosen (default
+    /// `"smallest-boundary-weight"`).
+    #[schemars(extend("models" = ["cosserat"]))]
+    pub stencil: Option<crate::common::rotation_keys::Stencil>,
     /// Cosserat with a `[schedule]` (default `"newmark"`).
     #[schemars(extend("models" = ["cosserat"]))]
     pub time_integration: Option<crate::common::rotation_keys::TimeIntegration>,

@@ -805,6 +805,9 @@ fn refuse_cosserat_keys(ls: &LoadedScene) -> Result<(), SceneError> {
     if s.solver.penalty.is_some() {
         return Err(cos(k(&["solver", "penalty"])));
     }
+    if s.solver.stencil.is_some() {
+        return Err(cos(k(&["solver", "stencil"])));
+    }
     if s.solver.time_integration.is_some() {
         return Err(cos(k(&["solver", "time_integration"])));
     }

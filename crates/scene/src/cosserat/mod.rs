@@ -32,7 +32,7 @@ use std::time::Instant;
 use porofrac_cosserat::dynamics::Dynamics;
 use porofrac_cosserat::{
     BodyLoads, Condition, Cosserat, CosseratError, GmresOptions, Integrator, Linear, LinearOptions,
-    LinearSolver, Material, Options, components,
+    LinearSolver, Material, Options, StencilRule, components,
 };
 use porofrac_grid::{Grid, Point};
 
@@ -44,7 +44,7 @@ use crate::common::output::{SolverStats, WallSeconds};
 use crate::common::plots::{Canvas, Column, FieldPlot, Values, tick};
 use crate::common::sections::{DiagonalsChoice, GridKind, KeyPart, LinearChoice, NumOrExpr};
 
-use crate::common::rotation_keys::TimeIntegration;
+use crate::common::rotation_keys::{Stencil, TimeIntegration};
 use fields::Field;
 
 /// Build a checked cosserat scene's model and hand it to `purpose`.
@@ -358,6 +358,11 @@ fn build_dim<const D: usize>(
     let body = body_loads::<D>(ls);
     let options = Options {
         penalty: ls.scene.solver.penalty.unwrap_or(1.0),
+        stencil: match ls.scene.solver.stencil.unwrap_or_default() {
+            Stencil::SmallestBoundaryWeight => StencilRule::SmallestBoundaryWeight,
+            Stencil::FirstInterpolating => StencilRule::FirstInterpolating,
+            Stencil::SmallestWeight => StencilRule::SmallestWeight,
+        },
         ..Options::default()
     };
     let model = Cosserat::new(grid, mat, options, &cond, body).map_err(|e| scene_error(ls, e))?;
