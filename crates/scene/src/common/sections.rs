@@ -756,6 +756,9 @@ pub struct Probe {
     pub cell: Option<Ball>,
     /// Lattice Boltzmann: the obstacle whose force or torque is probed (instead of `at`).
     pub obstacle: Option<String>,
+    /// Model `nscd`: the `[[wall]]` (by `name`) whose reaction `fx fy torque` is probed.
+    #[schemars(extend("models" = ["nscd"]))]
+    pub wall: Option<String>,
 }
 
 /// `[[output.line]]`.

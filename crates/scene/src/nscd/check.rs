@@ -108,6 +108,20 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
                 non_negative(ls, &key(f), v)?;
             }
         }
+        if let Some(e) = c.restitution {
+            if !(0.0..=1.0).contains(&e) {
+                return Err(ls.error(&key("restitution"), format!("= {e} must be in [0, 1]")));
+            }
+            if e > 0.0 && c.cohesion.is_some_and(|g| g > 0.0) {
+                return Err(ls.error(
+                    &key("restitution"),
+                    format!(
+                        "= {e} with cohesion > 0: a cohesive contact does not rebound \
+                         (restitution applies to non-cohesive contacts)"
+                    ),
+                ));
+            }
+        }
     }
     if let Some(n) = &super::own(ls).nscd {
         let key = |f: &str| k(&["nscd", f]);
