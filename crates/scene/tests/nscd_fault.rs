@@ -283,6 +283,11 @@ fn settling_and_fault_keys_are_checked() {
         ),
         ("dip = 30.0", "dip = 95.0", "nscd.fault.dip"),
         (
+            "dip = 30.0",
+            "dip = 30.0\nlimit_fraction = 0.7",
+            "nscd.fault.limit_fraction",
+        ),
+        (
             "slip_rate = 0.325",
             "slip_rate = 0.0",
             "nscd.fault.slip_rate",

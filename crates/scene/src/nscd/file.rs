@@ -154,6 +154,10 @@ pub struct FaultSection {
     /// Band height of the limit-angle measure (m, default 4 × the largest radius).
     #[schemars(extend("unit" = "m"))]
     pub band: Option<f64>,
+    /// Fraction f of the slip that bounds the fault area (default 0.2): its left limit
+    /// is the contour |u| = (1 − f) s (rigid motion with the hanging wall on its left),
+    /// its right limit |u| = f s (undeformed on its right); in (0, 0.5).
+    pub limit_fraction: Option<f64>,
 }
 
 /// The sections of model `nscd` read by the model itself: `[[wall]]`, `[contact]`,
