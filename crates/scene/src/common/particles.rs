@@ -91,8 +91,8 @@ pub struct ParticlesSection {
     /// probability (m).
     #[schemars(extend("unit" = "m"))]
     pub radius_list: Option<Vec<f64>>,
-    /// Model `nscd`: `[[particles.velocity]]`, initial velocities and spins of selected
-    /// disks ([`crate::common::particle_velocity`]).
+    /// Initial velocities and spins of selected disks, one table per selection, applied
+    /// in the file's order (model nscd; after the settling when there is one).
     #[serde(default)]
     pub velocity: Vec<crate::common::particle_velocity::ParticleVelocity>,
 }

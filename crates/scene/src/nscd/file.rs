@@ -90,14 +90,14 @@ pub struct NscdSection {
     /// θ in [0.5, 1] (default 0.5). With θ < 1 a contact that closes at speed v_n
     /// keeps an overlap of at most h(1 − θ)v_n afterwards (h the step): contacts are
     /// detected at the predicted configuration q + h(1 − θ)q̇ and the step's positions
-    /// use (1 − θ) of the arrival velocity, so θ = ½ leaves up to h v_n / 2 (1.1 mm for
-    /// a head-on impact at 0.22 m/s with h = 0.01 s), θ = 1 none. Such overlaps are
+    /// use (1 − θ) of the arrival velocity, so θ = ½ leaves up to h v_n / 2 (1.5 mm for
+    /// a head-on impact closing at 3 m/s with h = 1 ms), θ = 1 none. Such overlaps are
     /// permanent (the law pushes nothing apart) but do not grow.
     pub theta: Option<f64>,
     /// W-weighted relative impulse change that ends the sweeps (default 1.666e-4).
     pub tolerance: Option<f64>,
-    /// Fewest NLGS sweeps of a step with contacts, always done (default 100, the
-    /// paper's "minimal number of iterations"); then the sweeps stop on `tolerance` or
+    /// Fewest NLGS sweeps of a step with contacts, always done (default 100): the
+    /// paper's "minimal number of iterations". Then the sweeps stop on `tolerance` or
     /// on a sweep that changes nothing.
     pub min_sweeps: Option<i64>,
     /// Most sweeps per step (default 10 000).
