@@ -83,12 +83,7 @@ pub fn build(
 /// the active ones (gap at the predicted configuration ≤ 0) with the bias
 /// `[e min(0, U_n⁻), 0]`, U_n⁻ the relative normal velocity at the start of the step
 /// from the disks' velocities `v_start` and the bodies' `body_v_start`; drop the others.
-pub fn newton(
-    contacts: &mut ContactSet,
-    e: f64,
-    v_start: &[[f64; 2]],
-    body_v_start: &[[f64; 2]],
-) {
+pub fn newton(contacts: &mut ContactSet, e: f64, v_start: &[[f64; 2]], body_v_start: &[[f64; 2]]) {
     contacts.list.retain(|c| c.gap <= 0.0);
     for ct in contacts.list.iter_mut() {
         let vi = v_start[ct.i as usize];

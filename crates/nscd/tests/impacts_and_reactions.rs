@@ -93,7 +93,10 @@ fn head_on_impact_reverses_the_relative_velocity_by_e() {
     }
     let (v1, v2) = (s.disks.v[0][0], s.disks.v[1][0]);
     assert!((v1 + v2 - 1.0).abs() < 1e-12, "momentum {}", v1 + v2);
-    assert!((v1 + 0.25).abs() < 1e-12 && (v2 - 1.25).abs() < 1e-12, "{v1} {v2}");
+    assert!(
+        (v1 + 0.25).abs() < 1e-12 && (v2 - 1.25).abs() < 1e-12,
+        "{v1} {v2}"
+    );
 }
 
 /// A disk moving at v = 1 m/s onto a floor, no gravity, e = 0, starting at gaps spread
@@ -128,7 +131,10 @@ fn inelastic_landing_overlap_is_at_most_h_one_minus_theta_v() {
             largest = largest.max(overlap);
         }
         if theta == 0.5 {
-            assert!(largest >= 0.95 * bound, "largest overlap {largest} of {bound}");
+            assert!(
+                largest >= 0.95 * bound,
+                "largest overlap {largest} of {bound}"
+            );
         } else {
             assert!(largest <= 1e-12 * h * v, "θ = 1: overlap {largest}");
         }
@@ -146,15 +152,27 @@ fn floor_carries_the_column() {
     let d = Disks::new(&centres, &vec![r; n], 2000.0).unwrap();
     let weight = d.mass.iter().sum::<f64>() * G;
     let floor = RigidBody::segment([-1.0, 0.0], [1.0, 0.0]);
-    let mut s = Nscd::new(d, vec![floor], ContactLaw::frictional(0.3), params(0.5), [0.0, -G])
-        .unwrap();
+    let mut s = Nscd::new(
+        d,
+        vec![floor],
+        ContactLaw::frictional(0.3),
+        params(0.5),
+        [0.0, -G],
+    )
+    .unwrap();
     for _ in 0..20 {
         s.step(1e-3).unwrap();
     }
     let [fx, fy, torque] = s.body_reaction(0);
     assert!(fx.abs() < 1e-9 * weight, "fx {fx}");
-    assert!((fy - weight).abs() < 1e-9 * weight, "fy {fy}, n m g {weight}");
-    assert!((torque - a * weight).abs() < 1e-9 * a * weight, "τ {torque}");
+    assert!(
+        (fy - weight).abs() < 1e-9 * weight,
+        "fy {fy}, n m g {weight}"
+    );
+    assert!(
+        (torque - a * weight).abs() < 1e-9 * a * weight,
+        "τ {torque}"
+    );
     assert_eq!(s.body_reaction(1), [0.0; 3], "no body 1");
 }
 
@@ -184,7 +202,11 @@ fn block_pushed_over_a_bed_needs_mu_n() {
         s.step(1e-3).unwrap();
     }
     let [fx, fy, _] = s.body_reaction(0);
-    assert!((fx - mu * load).abs() < 1e-9 * load, "fx {fx}, μN {}", mu * load);
+    assert!(
+        (fx - mu * load).abs() < 1e-9 * load,
+        "fx {fx}, μN {}",
+        mu * load
+    );
     assert!((fy + load).abs() < 1e-9 * load, "fy {fy}, −N {}", -load);
 }
 

@@ -239,7 +239,10 @@ mod tests {
         let (l, r) = fault_limits(&x, &u, 1.0, 0.2, 0.0, 0.5);
         let (l, r) = (l.unwrap().angle.to_degrees(), r.unwrap().angle.to_degrees());
         assert!((l - 64.0).abs() < 1.5 && (r - 46.0).abs() < 1.5, "{l} {r}");
-        let h = limit_angle(&x, &u, 1.0, 0.0, 0.5).unwrap().angle.to_degrees();
+        let h = limit_angle(&x, &u, 1.0, 0.0, 0.5)
+            .unwrap()
+            .angle
+            .to_degrees();
         assert!((h - 55.0).abs() < 1.5, "{h}");
     }
 

@@ -89,7 +89,12 @@ pub fn check(ls: &LoadedScene, model: &str, tables: &[ParticleVelocity]) -> Resu
         }
         if let Some(r) = t.region()
             && (r.check().is_err()
-                || !r.bounds().0.iter().chain(&r.bounds().1).all(|v| v.is_finite()))
+                || !r
+                    .bounds()
+                    .0
+                    .iter()
+                    .chain(&r.bounds().1)
+                    .all(|v| v.is_finite()))
         {
             return Err(ls.error(
                 &key(chosen[0]),

@@ -573,8 +573,7 @@ pub fn check_output_of(
         let f = p.field.as_str();
         if p.wall.is_some() {
             // Model nscd: the reaction of a wall (its name is checked by the model).
-            if !["fx", "fy", "torque"].contains(&f) || p.particle.is_some() || p.cell.is_some()
-            {
+            if !["fx", "fy", "torque"].contains(&f) || p.particle.is_some() || p.cell.is_some() {
                 return Err(ls.error(
                     &key("wall"),
                     format!(

@@ -249,10 +249,7 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
             if let Some(l) = f.limit_fraction
                 && !(l > 0.0 && l < 0.5)
             {
-                return Err(ls.error(
-                    &key("limit_fraction"),
-                    format!("= {l} must be in (0, 0.5)"),
-                ));
+                return Err(ls.error(&key("limit_fraction"), format!("= {l} must be in (0, 0.5)")));
             }
         }
     }
