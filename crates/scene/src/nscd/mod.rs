@@ -3,16 +3,18 @@
 //! ([`porofrac_nscd`]).
 //!
 //! - *build*: the disks of `[particles]` (a seeded random packing, a hexagonal lattice
-//!   or a list), the walls of `[[wall]]`, the law of `[contact]` and the solver options
+//!   or a list) with the initial velocities of `[[particles.velocity]]` (after the
+//!   settling), the walls of `[[wall]]`, the law of `[contact]` and the solver options
 //!   of `[nscd]` ([`build`]);
 //! - *step*: one θ-scheme step of [`porofrac_nscd::Nscd`] per schedule step;
 //! - *fields*: particle probes (`x y vx vy omega fx fy radius`, `fx fy` the sum of the
-//!   contact forces on the particle), tracked-cell probes (`p q anisotropy
+//!   contact forces on the particle), wall probes (`wall = NAME` with `fx fy torque`,
+//!   [`porofrac_nscd::Nscd::body_reaction`]), tracked-cell probes (`p q anisotropy
 //!   anisotropy_volume dilation_x dilation_y contacts broken_bonds`, Renouf et al. (2006)
 //!   eqs. 7–11, [`porofrac_particles::tracked`]), lines (the value of the particle
 //!   nearest each point), `vtk/particles_NNNN.vtp` + `vtk/contacts_NNNN.vtp` with
 //!   `<name>.pvd` and `<name>_contacts.pvd`, field extrema, and `summary.json` with
-//!   `particles`, `contacts`, `sweeps` (mean, max), `final_residual`, `not_converged_steps`
+//!   `particles`, `contacts` (last, mean, max), `sweeps` (mean, max), `final_residual`, `not_converged_steps`
 //!   and `contact_updates_per_second` (local solves per second of NLGS wall time);
 //! - *plots* ([`crate::common::particle_plots`]): probe series and the disks coloured by
 //!   initial layer.
