@@ -27,7 +27,8 @@ import csv, json, sys
 d, label, t0, t1 = sys.argv[1], sys.argv[2], float(sys.argv[3]), float(sys.argv[4])
 s = json.load(open(f"{d}/summary.json"))
 f = s.get("fault") or {}
-rows = list(csv.DictReader(open(f"{d}/probes.csv")))
+# Column names carry their unit ("time [s]", "p_W1 [Pa]"): key the rows by the name.
+rows = [{k.split(" [")[0]: v for k, v in r.items()} for r in csv.DictReader(open(f"{d}/probes.csv"))]
 t = [float(r["time"]) for r in rows]
 p = [float(r["p_W1"]) for r in rows]
 T = t[-1]

@@ -127,6 +127,35 @@ impl RigidBody {
         [f(self.axes[0]), f(self.axes[1])]
     }
 
+    /// Centroid of the body at zero offset: the midpoint of a segment, the area centroid
+    /// of a polygon (the vertex mean if its area is zero).
+    pub fn centroid(&self) -> [f64; 2] {
+        let n = self.vertices.len();
+        let mean = {
+            let s = self
+                .vertices
+                .iter()
+                .fold([0.0; 2], |a, v| [a[0] + v[0], a[1] + v[1]]);
+            [s[0] / n as f64, s[1] / n as f64]
+        };
+        if n < 3 {
+            return mean;
+        }
+        let (mut a2, mut cx, mut cy) = (0.0, 0.0, 0.0);
+        for k in 0..n {
+            let p = sub(self.vertices[k], mean);
+            let q = sub(self.vertices[(k + 1) % n], mean);
+            let w = cross(p, q);
+            a2 += w;
+            cx += (p[0] + q[0]) * w;
+            cy += (p[1] + q[1]) * w;
+        }
+        if a2 == 0.0 {
+            return mean;
+        }
+        [mean[0] + cx / (3.0 * a2), mean[1] + cy / (3.0 * a2)]
+    }
+
     /// Axis-aligned bounding box of the body displaced by `offset`.
     pub fn bounds(&self, offset: [f64; 2]) -> ([f64; 2], [f64; 2]) {
         let mut lo = [f64::INFINITY; 2];

@@ -88,6 +88,12 @@ impl MoreauJean {
         &self.offsets_m
     }
 
+    /// Velocities of the disks and of the bodies at the start of the step (after
+    /// [`MoreauJean::free_velocities`]).
+    pub fn start_velocities(&self) -> (&[[f64; 2]], &[[f64; 2]]) {
+        (&self.v_old, &self.body_v_old)
+    }
+
     /// Inverse masses and inverse moments of inertia of the disks.
     pub fn inverse_masses(&self) -> (&[f64], &[f64]) {
         (&self.inv_m, &self.inv_i)

@@ -9,6 +9,13 @@
 //! * **Signorini, gap-aware (IQS, zero restitution)**: the complementarity acts on
 //!   v̄_n = v_n + max(0, g)/(θh): P_n ≥ 0, v̄_n ≥ 0, P_n v̄_n = 0, so an open gap g is
 //!   closed exactly in the step and the contact never rebounds.
+//! * **Newton's impact law** (restitution e > 0, Moreau–Jean as in Siconos'
+//!   `NewtonImpactFrictionNSL` and LMGC90's `RST_CLB`): a contact whose gap at the
+//!   predicted configuration is ≤ 0 is active and the complementarity acts on
+//!   v̄_n = v_n + e min(0, v_n⁻), v_n⁻ the relative normal velocity at the start of the
+//!   step: an impact at v_n⁻ < 0 leaves at v_n = −e v_n⁻ unless friction or other
+//!   contacts hold it; a contact whose predicted gap is > 0 carries no impulse in that
+//!   step. With e = 0 the gap-aware law above is used unchanged.
 //! * **Cohesion** γ within d_w (status from the gap at the predicted configuration,
 //!   g ≤ d_w with γ > 0): the same law on P̄_n = P_n + hγ, so −hγ ≤ P_n; Coulomb acts on
 //!   P̄_n (|P_t| ≤ μ P̄_n, as LMGC90's IQS_WET_DS_CLB).
@@ -32,6 +39,9 @@ pub struct ContactLaw {
     pub cohesion: f64,
     /// Attraction distance d_w (m), ≥ 0.
     pub cohesion_distance: f64,
+    /// Normal restitution coefficient e of Newton's impact law, in [0, 1] (0: the
+    /// gap-aware inelastic law). Not with cohesion.
+    pub restitution: f64,
 }
 
 impl Default for ContactLaw {
@@ -48,7 +58,14 @@ impl ContactLaw {
             mu_dynamic: mu,
             cohesion: 0.0,
             cohesion_distance: 0.0,
+            restitution: 0.0,
         }
+    }
+
+    /// The same law with Newton's impact law of restitution `e`.
+    pub fn with_restitution(mut self, e: f64) -> Self {
+        self.restitution = e;
+        self
     }
 
     /// The same law with cohesion γ within d_w.
@@ -74,7 +91,22 @@ impl ContactLaw {
         non_negative("mu_static", self.mu_static)?;
         non_negative("mu_dynamic", self.mu_dynamic)?;
         non_negative("cohesion", self.cohesion)?;
-        non_negative("cohesion_distance", self.cohesion_distance)
+        non_negative("cohesion_distance", self.cohesion_distance)?;
+        if !(0.0..=1.0).contains(&self.restitution) {
+            return Err(crate::NscdError::BadParameter {
+                name: "restitution",
+                value: self.restitution,
+                message: "must be in [0, 1]",
+            });
+        }
+        if self.restitution > 0.0 && self.cohesion > 0.0 {
+            return Err(crate::NscdError::BadParameter {
+                name: "restitution",
+                value: self.restitution,
+                message: "must be 0 with cohesion (a cohesive contact does not rebound)",
+            });
+        }
+        Ok(())
     }
 }
 
@@ -106,15 +138,29 @@ pub fn solve_local(w: &Block, b: [f64; 2], mu: f64) -> [f64; 2] {
     }
     if w.nt == 0.0 {
         let pn = -b[0] / w.nn;
-        let pt = (-b[1] / w.tt).clamp(-mu * pn, mu * pn);
+        let pt = if w.tt > 0.0 {
+            (-b[1] / w.tt).clamp(-mu * pn, mu * pn)
+        } else {
+            // No tangential mobility (a fixed disk against a body prescribed along
+            // the tangent): the impulse cannot change v_t = b_t; slide against it.
+            if b[1] > 0.0 {
+                -mu * pn
+            } else if b[1] < 0.0 {
+                mu * pn
+            } else {
+                0.0
+            }
+        };
         return [pn, pt];
     }
     // Stick: W P = −b.
     let det = w.nn * w.tt - w.nt * w.nt;
-    let pn = (-b[0] * w.tt + b[1] * w.nt) / det;
-    let pt = (b[0] * w.nt - b[1] * w.nn) / det;
-    if pn >= 0.0 && pt.abs() <= mu * pn {
-        return [pn, pt];
+    if det > 0.0 {
+        let pn = (-b[0] * w.tt + b[1] * w.nt) / det;
+        let pt = (b[0] * w.nt - b[1] * w.nn) / det;
+        if pn >= 0.0 && pt.abs() <= mu * pn {
+            return [pn, pt];
+        }
     }
     // Slide with v_t of sign s: P_t = −s μ P_n, v_n = 0.
     for s in [1.0, -1.0] {
@@ -128,7 +174,10 @@ pub fn solve_local(w: &Block, b: [f64; 2], mu: f64) -> [f64; 2] {
             return [pn, -s * mu * pn];
         }
     }
-    // Not reached for a positive definite W; the projection keeps P admissible.
+    // Not reached for a positive definite W; the projection keeps P admissible (a W
+    // of rank one, a fixed disk against a body mobile along one axis, ends here when
+    // it neither slides nor opens: its tangential impulse is then left at 0).
     let pn = -b[0] / w.nn;
-    [pn, (-b[1] / w.tt).clamp(-mu * pn, mu * pn)]
+    let pt = if w.tt > 0.0 { -b[1] / w.tt } else { 0.0 };
+    [pn, pt.clamp(-mu * pn, mu * pn)]
 }

@@ -8,10 +8,10 @@
 //! ([`crate::problem`]).
 //!
 //! **Convergence test** after each sweep k: with ΔP_α the change of P_α during the
-//! sweep, e_k = √(Σ ΔP_αᵀ W_αα ΔP_α / Σ P_αᵀ W_αα P_α). The sweeps stop when
-//! k ≥ `min_sweeps` and e_k ≤ `tolerance`, when a sweep changed nothing at all (an exact
-//! fixed point: further sweeps would repeat it), or at `max_sweeps` (counted as not
-//! converged).
+//! sweep, e_k = √(Σ ΔP_αᵀ W_αα ΔP_α / Σ P_αᵀ W_αα P_α). `min_sweeps` is a floor: the
+//! sweeps stop once k ≥ `min_sweeps` and either e_k ≤ `tolerance` or the sweep changed
+//! nothing at all (an exact fixed point, also when Σ PᵀWP = 0), or at `max_sweeps`
+//! (counted as not converged). A step without contacts does no sweep.
 //!
 //! **Ordering** ([`Ordering`]): by default the contacts are swept in their sorted order
 //! (candidate, then antagonist), the same every sweep; [`Ordering::Random`] draws a new
@@ -55,7 +55,8 @@ pub struct NlgsOptions {
     /// Tolerance of the W-weighted relative impulse change (default 1.666e-4,
     /// LMGC90's).
     pub tolerance: f64,
-    /// Fewest sweeps (default 100, the paper's).
+    /// Fewest sweeps of a step with contacts, always done (default 100, the paper's
+    /// "minimal number of iterations").
     pub min_sweeps: usize,
     /// Most sweeps (default 10 000).
     pub max_sweeps: usize,
@@ -251,7 +252,7 @@ impl Nlgs {
                 } else {
                     0.0
                 };
-                if num == 0.0 || (k >= options.min_sweeps && stats.residual <= options.tolerance) {
+                if k >= options.min_sweeps && (num == 0.0 || stats.residual <= options.tolerance) {
                     stats.converged = true;
                     break;
                 }
@@ -370,5 +371,48 @@ mod tests {
         assert!((p[0] - 2.0 * d.mass[0]).abs() < 1e-9 * d.mass[0], "{p:?}");
         assert_eq!(p[1], 0.0);
         assert!(d.v[0][1].abs() < 1e-12);
+    }
+
+    /// `min_sweeps` is a floor: the same shock reaches its exact fixed point after two
+    /// sweeps, and with `min_sweeps = 7` seven sweeps are done, the impulse unchanged.
+    #[test]
+    fn min_sweeps_is_a_floor() {
+        let solve = |min_sweeps: usize| {
+            let mut d = Disks::new(&[[0.0, 0.5]], &[0.5], 1000.0).unwrap();
+            d.v[0] = [0.0, -2.0];
+            let floor = [RigidBody::segment([-2.0, 0.0], [2.0, 0.0])];
+            let mut set = ContactSet::default();
+            set.detect(&mut Detector::default(), &d.x, &d, &floor, &[[0.0; 2]], 0.1)
+                .unwrap();
+            let (inv_m, inv_i, body_inv) = ([1.0 / d.mass[0]], [1.0 / d.inertia[0]], [[0.0; 2]]);
+            let law = ContactLaw::frictional(0.3);
+            crate::problem::build(&mut set, &law, &inv_m, &inv_i, &body_inv, 1e-3, 0.5);
+            let options = NlgsOptions {
+                min_sweeps,
+                ..NlgsOptions::default()
+            };
+            let stats = Nlgs::default().solve(
+                &options,
+                0,
+                &mut set.list,
+                &d.x,
+                Velocities {
+                    v: &mut d.v,
+                    omega: &mut d.omega,
+                    body_v: &mut [[0.0; 2]],
+                },
+                InverseMasses {
+                    m: &inv_m,
+                    i: &inv_i,
+                    body: &body_inv,
+                },
+            );
+            (stats, set.as_slice()[0].p)
+        };
+        let (few, p_few) = solve(1);
+        let (floor, p_floor) = solve(7);
+        assert_eq!((few.sweeps, floor.sweeps), (2, 7));
+        assert!(floor.converged);
+        assert_eq!(p_few, p_floor);
     }
 }

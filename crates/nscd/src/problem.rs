@@ -21,6 +21,10 @@
 //! (gap ≤ `cohesion_distance`) shifts its normal impulse by hγ; the bias of the local
 //! problem is `[max(0, g)/(θh) − W_nn·shift, −W_nt·shift]`. Contacts between two
 //! immovable bodies (`W_nn = 0`) are dropped.
+//!
+//! With restitution e > 0 ([`newton`]), Newton's impact law replaces the gap-aware
+//! bias: the contacts whose predicted gap is > 0 are dropped for the step (no impulse),
+//! the others get the bias `e min(0, U_n⁻)`, U_n⁻ = (v_i − v_j)·n at the start of the step.
 
 use crate::contacts::ContactSet;
 use crate::detect::{Antagonist, Contact};
@@ -73,6 +77,23 @@ pub fn build(
     }
     list.retain(|c| c.w.nn > 0.0);
     contacts.list = list;
+}
+
+/// Newton's impact law of restitution `e` > 0 on the contacts set up by [`build`]: keep
+/// the active ones (gap at the predicted configuration ≤ 0) with the bias
+/// `[e min(0, U_n⁻), 0]`, U_n⁻ the relative normal velocity at the start of the step
+/// from the disks' velocities `v_start` and the bodies' `body_v_start`; drop the others.
+pub fn newton(contacts: &mut ContactSet, e: f64, v_start: &[[f64; 2]], body_v_start: &[[f64; 2]]) {
+    contacts.list.retain(|c| c.gap <= 0.0);
+    for ct in contacts.list.iter_mut() {
+        let vi = v_start[ct.i as usize];
+        let vj = match ct.other {
+            Antagonist::Disk(j) => v_start[j as usize],
+            Antagonist::Body(b) => body_v_start[b as usize],
+        };
+        let un = (vi[0] - vj[0]) * ct.n[0] + (vi[1] - vj[1]) * ct.n[1];
+        ct.bias = [e * un.min(0.0), 0.0];
+    }
 }
 
 /// Add the contacts' current impulses to the body velocities, `q̇ += M⁻¹ H P`: the warm

@@ -10,7 +10,8 @@
 //!    step, so θF_{i+1} + (1 − θ)F_i = F),
 //!    [`crate::integrator::MoreauJean::free_velocities`];
 //! 4. the contact problem: W blocks, law and warm start of each contact
-//!    ([`crate::problem`]);
+//!    ([`crate::problem`]; with restitution, Newton's impact law,
+//!    [`crate::problem::newton`]);
 //! 5. NLGS (eq. 5, Table 1) on the impulses P_α = h r_α ([`crate::nlgs`]);
 //! 6. q̇_{i+1} = q̇_free + M⁻¹ H P and q_{i+1} = q_i + h(θ q̇_{i+1} + (1 − θ) q̇_i)
 //!    ([`crate::integrator::MoreauJean::update`]), and the impulses kept for the next
@@ -251,6 +252,37 @@ impl Nscd {
         }
     }
 
+    /// The reaction of body `b` over the last step: `[f_x, f_y, τ]`, the sum of the
+    /// contact forces the body exerts on the disks (N per metre of thickness) and their
+    /// moment about the body's centroid (N·m per metre; counter-clockwise positive), both
+    /// at the step's predicted configuration. For a prescribed axis this is the force
+    /// the body's drive applies to hold its motion against the disks (a floor under a
+    /// column at rest: f_y = the column's weight). `[0, 0, 0]` before the first step or
+    /// for a body index out of range.
+    pub fn body_reaction(&self, b: usize) -> [f64; 3] {
+        let mut out = [0.0; 3];
+        let (Some(body), Some(offset)) = (
+            self.bodies.get(b),
+            self.integrator.predicted_offsets().get(b),
+        ) else {
+            return out;
+        };
+        let c0 = body.centroid();
+        let centre = [c0[0] + offset[0], c0[1] + offset[1]];
+        for c in self.contacts.as_slice() {
+            if c.other != Antagonist::Body(b as u32) {
+                continue;
+            }
+            let [rn, rt] = self.contact_force(c);
+            let f = [rn * c.n[0] + rt * c.t[0], rn * c.n[1] + rt * c.t[1]];
+            let arm = [c.point[0] - centre[0], c.point[1] - centre[1]];
+            out[0] += f[0];
+            out[1] += f[1];
+            out[2] += arm[0] * f[1] - arm[1] * f[0];
+        }
+        out
+    }
+
     /// The contacts of the last step that carry a force, as tracked cells see them
     /// (branch vector (r_i + r_j) n, Renouf et al. (2006) eq. 7).
     pub fn cell_contacts(&self, out: &mut Vec<CellContact>) {
@@ -341,6 +373,10 @@ impl Nscd {
             h,
             theta,
         );
+        if self.law.restitution > 0.0 {
+            let (v0, bv0) = ig.start_velocities();
+            crate::problem::newton(&mut self.contacts, self.law.restitution, v0, bv0);
+        }
         let d = &mut self.disks;
         crate::problem::apply_impulses(
             &self.contacts.list,

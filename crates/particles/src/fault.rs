@@ -11,6 +11,10 @@
 //!   particles; a least-squares line x_b = a + b·y through the band boundaries gives
 //!   θ_l = atan2(1, b) from the horizontal, measured on the footwall side (θ_l = θ for a
 //!   fault zone that continues the basement fault of dip θ, 90° for a vertical one);
+//! * **limits of the fault area** ([`fault_limits`]): the same construction on the
+//!   contours |u| = (1 − f)s (left: the hanging wall in rigid motion on its left) and
+//!   |u| = f s (right: the undeformed footwall on its right); their difference is the
+//!   opening of the fault area;
 //! * **run-out** ([`run_out`]): how far the moved material reaches beyond the point where
 //!   the basement fault, extended at its dip from its initial tip, meets the initial
 //!   free surface: max{x_i : |u_i| ≥ s/2} − (x_tip + (y_top − y_tip)/tan θ);
@@ -31,7 +35,12 @@ pub struct LimitAngle {
 
 /// Whether a particle with displacement `u` moved with the hanging wall (|u| ≥ s/2).
 pub fn moved(u: [f64; 2], slip: f64) -> bool {
-    (u[0] * u[0] + u[1] * u[1]).sqrt() >= 0.5 * slip
+    moved_by(u, slip, 0.5)
+}
+
+/// Whether a particle with displacement `u` moved by at least `fraction` of the slip.
+pub fn moved_by(u: [f64; 2], slip: f64, fraction: f64) -> bool {
+    (u[0] * u[0] + u[1] * u[1]).sqrt() >= fraction * slip
 }
 
 /// The limit angle θ_l (module docs) from bands of height `band` starting at `y0`
@@ -44,6 +53,38 @@ pub fn limit_angle(
     y0: f64,
     band: f64,
 ) -> Option<LimitAngle> {
+    contour_angle(x, u, slip, 0.5, y0, band)
+}
+
+/// The limits of the fault area (Renouf et al. (2006) Fig. 12: "the left limit
+/// separates the structure governed by a rigid motion from the other part; the right
+/// limit separates the undeformed structure from the other part") as `(left, right)`:
+/// the angles of the contours |u| = (1 − f) s and |u| = f s, each measured as
+/// [`limit_angle`] measures the half-slip one. Their difference is the opening of the
+/// fault area (2 φ_a for a trishear zone of half apical angle φ_a).
+pub fn fault_limits(
+    x: &[[f64; 2]],
+    u: &[[f64; 2]],
+    slip: f64,
+    f: f64,
+    y0: f64,
+    band: f64,
+) -> (Option<LimitAngle>, Option<LimitAngle>) {
+    (
+        contour_angle(x, u, slip, 1.0 - f, y0, band),
+        contour_angle(x, u, slip, f, y0, band),
+    )
+}
+
+/// The angle of the contour |u| = `fraction` × `slip`, measured as in [`limit_angle`].
+pub fn contour_angle(
+    x: &[[f64; 2]],
+    u: &[[f64; 2]],
+    slip: f64,
+    fraction: f64,
+    y0: f64,
+    band: f64,
+) -> Option<LimitAngle> {
     let top = x.iter().map(|p| p[1]).fold(f64::NEG_INFINITY, f64::max);
     if !(band > 0.0 && top > y0) {
         return None;
@@ -53,7 +94,7 @@ pub fn limit_angle(
     for (p, d) in x.iter().zip(u) {
         if p[1] >= y0 {
             let k = (((p[1] - y0) / band) as usize).min(bands - 1);
-            rows[k].push((p[0], moved(*d, slip)));
+            rows[k].push((p[0], moved_by(*d, slip, fraction)));
         }
     }
     let mut points = Vec::new();
@@ -176,6 +217,33 @@ mod tests {
             );
             assert_eq!(la.points.len(), 10);
         }
+    }
+
+    /// A fan of displacement between two lines from the origin at 70° (left limit) and
+    /// 40° (right limit), |u| falling linearly in angle from s to 0 across it: the
+    /// limits come back within 1.5° each for f = 0.2 (their contours are the lines at
+    /// 70 − 0.2·30 = 64° and 40 + 0.2·30 = 46°), and the half-slip angle is 55°.
+    #[test]
+    fn fan_gives_its_limits() {
+        let (mut x, mut u) = (Vec::new(), Vec::new());
+        for j in 0..60 {
+            let y = 0.05 + 0.1 * j as f64;
+            for i in -300..300 {
+                let xi = 0.02 * i as f64 + 0.01;
+                let a = y.atan2(xi).to_degrees();
+                let m = ((a - 40.0) / 30.0).clamp(0.0, 1.0);
+                x.push([xi, y]);
+                u.push([m, 0.0]);
+            }
+        }
+        let (l, r) = fault_limits(&x, &u, 1.0, 0.2, 0.0, 0.5);
+        let (l, r) = (l.unwrap().angle.to_degrees(), r.unwrap().angle.to_degrees());
+        assert!((l - 64.0).abs() < 1.5 && (r - 46.0).abs() < 1.5, "{l} {r}");
+        let h = limit_angle(&x, &u, 1.0, 0.0, 0.5)
+            .unwrap()
+            .angle
+            .to_degrees();
+        assert!((h - 55.0).abs() < 1.5, "{h}");
     }
 
     /// The analytic trishear velocities are fitted back with their own apical angle

@@ -16,7 +16,8 @@ fn out_dir(name: &str) -> PathBuf {
 }
 
 /// The column of ten disks: each disk feels a net contact force m g upwards (probe fy
-/// of the bottom disk), the floor carries 10 m g (largest normal force), nothing moves.
+/// of the bottom disk), the floor carries 10 m g (largest normal force, and its reaction
+/// probe), nothing moves; ten contacts at every step.
 #[test]
 fn column_scene_carries_its_weight() {
     let scene = Scene::load(&scene_dir().join("column.toml")).unwrap();
@@ -28,7 +29,9 @@ fn column_scene_carries_its_weight() {
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
     assert_eq!(json["particles"], 10);
-    assert_eq!(json["contacts"], 10);
+    assert_eq!(json["contacts"]["last"], 10);
+    assert_eq!(json["contacts"]["max"], 10);
+    assert_eq!(json["contacts"]["mean"], 10.0);
     assert_eq!(json["not_converged_steps"], 0);
     assert!(json["sweeps"]["max"].as_u64().unwrap() >= 1);
     assert!(json["contact_updates_per_second"].as_f64().unwrap() > 0.0);
@@ -55,6 +58,12 @@ fn column_scene_carries_its_weight() {
         last[1]
     );
     assert!((last[2] - 9.5).abs() < 1e-9, "top disk at {}", last[2]);
+    assert!(
+        (last[4] - 10.0 * w).abs() < 1e-8 * 10.0 * w,
+        "the floor's reaction {}, 10 m g = {}",
+        last[4],
+        10.0 * w
+    );
     for f in [
         "vtk/particles_0005.vtp",
         "vtk/contacts_0005.vtp",

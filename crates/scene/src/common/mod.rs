@@ -25,6 +25,7 @@ pub mod output;
 pub mod overrides;
 pub mod particle_output;
 pub mod particle_plots;
+pub mod particle_velocity;
 pub mod particles;
 pub mod plan;
 pub mod plots;

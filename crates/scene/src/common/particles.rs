@@ -91,6 +91,10 @@ pub struct ParticlesSection {
     /// probability (m).
     #[schemars(extend("unit" = "m"))]
     pub radius_list: Option<Vec<f64>>,
+    /// Initial velocities and spins of selected disks, one table per selection, applied
+    /// in the file's order (model nscd; after the settling when there is one).
+    #[serde(default)]
+    pub velocity: Vec<crate::common::particle_velocity::ParticleVelocity>,
 }
 
 /// A circle `{ center = [x, y], radius = r }`.
@@ -209,6 +213,7 @@ pub fn check(ls: &LoadedScene, model: &str) -> Result<(), SceneError> {
     };
     let key = |f: &str| k(&["particles", f]);
     positive(ls, "density", p.density)?;
+    crate::common::particle_velocity::check(ls, model, &p.velocity)?;
     let kind_name = match p.kind {
         ParticleKind::Random => "random",
         ParticleKind::Hexagonal => "hexagonal",
@@ -459,6 +464,15 @@ pub fn generate(ls: &LoadedScene, setup: &mut SetupPoll<'_>) -> Result<Disks, Ru
         .map_err(|e| ls.error(&k(&["particles"]), format!(": {e}")))?)
 }
 
+/// Set the initial velocities and spins of `disks` from `[[particles.velocity]]`
+/// ([`crate::common::particle_velocity`]).
+pub fn initial_velocities(ls: &LoadedScene, disks: &mut Disks) -> Result<(), RunError> {
+    match &ls.scene.particles {
+        Some(p) => crate::common::particle_velocity::apply(ls, &p.velocity, disks),
+        None => Ok(()),
+    }
+}
+
 /// Shortest schedule step of a particle model (s): forces are impulses divided by the
 /// step, velocities displacements divided by it; below this the quotients overflow for
 /// ordinary masses and speeds (1e-300 s gives `inf`).
@@ -557,7 +571,18 @@ pub fn check_output_of(
             ));
         }
         let f = p.field.as_str();
-        if PARTICLE_FIELDS.contains(&f) {
+        if p.wall.is_some() {
+            // Model nscd: the reaction of a wall (its name is checked by the model).
+            if !["fx", "fy", "torque"].contains(&f) || p.particle.is_some() || p.cell.is_some() {
+                return Err(ls.error(
+                    &key("wall"),
+                    format!(
+                        "probes a wall's reaction: field must be fx, fy or torque (not \"{f}\"), \
+                         without particle or cell"
+                    ),
+                ));
+            }
+        } else if PARTICLE_FIELDS.contains(&f) {
             match (p.particle, &p.cell) {
                 (Some(n), None) if n >= 0 => {}
                 (Some(n), None) => {

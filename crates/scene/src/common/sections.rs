@@ -781,6 +781,10 @@ pub struct Probe {
     pub cell: Option<Ball>,
     /// Lattice Boltzmann: the obstacle whose force or torque is probed (instead of `at`).
     pub obstacle: Option<String>,
+    /// The `[[wall]]` (by `name`) whose reaction `fx fy torque` is probed: the force
+    /// it exerts on the disks (N/m) and its moment about the wall's centroid (N·m/m).
+    #[schemars(extend("models" = ["nscd"]))]
+    pub wall: Option<String>,
 }
 
 /// `[[output.line]]`.

@@ -108,6 +108,20 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
                 non_negative(ls, &key(f), v)?;
             }
         }
+        if let Some(e) = c.restitution {
+            if !(0.0..=1.0).contains(&e) {
+                return Err(ls.error(&key("restitution"), format!("= {e} must be in [0, 1]")));
+            }
+            if e > 0.0 && c.cohesion.is_some_and(|g| g > 0.0) {
+                return Err(ls.error(
+                    &key("restitution"),
+                    format!(
+                        "= {e} with cohesion > 0: a cohesive contact does not rebound \
+                         (restitution applies to non-cohesive contacts)"
+                    ),
+                ));
+            }
+        }
     }
     if let Some(n) = &super::own(ls).nscd {
         let key = |f: &str| k(&["nscd", f]);
@@ -231,6 +245,11 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
             }
             if let Some(b) = f.band {
                 positive(ls, &key("band"), b)?;
+            }
+            if let Some(l) = f.limit_fraction
+                && !(l > 0.0 && l < 0.5)
+            {
+                return Err(ls.error(&key("limit_fraction"), format!("= {l} must be in (0, 0.5)")));
             }
         }
     }

@@ -8,6 +8,11 @@
 //! * `limit_angle_deg`: θ_l of the half-slip contour (the propagated fault), bands from
 //!   the current tip height (`band` high, default 4 r_max); `limit_angle_points` the
 //!   band boundaries;
+//! * `limits`: the left and right limits of the fault area of Renouf et al. (2006)
+//!   Fig. 12 (the hanging wall in rigid motion on the left of the contour
+//!   |u| = (1 − f)s, the undeformed footwall on the right of |u| = f s, f =
+//!   `limit_fraction`), each measured as θ_l: `left_deg`, `right_deg`, and their
+//!   difference `opening_deg`, the opening of the fault area;
 //! * `run_out`: the front of the moved material beyond the point where the basement
 //!   fault, extended at its dip from x_T⁰, meets the initial free surface (the highest
 //!   initial disk top);
@@ -17,7 +22,7 @@
 //!   relative L2 mismatch `l2`.
 
 use porofrac_nscd::Nscd;
-use porofrac_particles::fault::{fit_trishear, limit_angle, run_out};
+use porofrac_particles::fault::{fault_limits, fit_trishear, limit_angle, run_out};
 use porofrac_particles::trishear::Trishear;
 
 use super::file::FaultSection;
@@ -106,6 +111,12 @@ impl FaultProbe {
         let tip = self.tip(t);
         let band = self.section.band.unwrap_or(4.0 * d.radius_range()[1]);
         let la = limit_angle(&x, &u, slip, tip[1], band);
+        let f = self.section.limit_fraction.unwrap_or(0.2);
+        let (left, right) = fault_limits(&x, &u, slip, f, tip[1], band);
+        let deg = |l: &Option<porofrac_particles::fault::LimitAngle>| {
+            l.as_ref().map(|l| l.angle.to_degrees())
+        };
+        let opening = deg(&left).zip(deg(&right)).map(|(l, r)| l - r);
         let ro = run_out(&x, &u, slip, self.section.tip, self.dip, self.y_top);
         let trishear = self.snapshot.as_ref().and_then(|(t0, x0)| {
             let dt = t - t0;
@@ -139,6 +150,12 @@ impl FaultProbe {
             "particles": inside.len(),
             "limit_angle_deg": la.as_ref().map(|l| l.angle.to_degrees()),
             "limit_angle_points": la.map(|l| l.points),
+            "limits": {
+                "fraction": f,
+                "left_deg": deg(&left),
+                "right_deg": deg(&right),
+                "opening_deg": opening,
+            },
             "run_out": ro,
             "trishear": trishear,
         })

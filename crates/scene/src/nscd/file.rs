@@ -58,6 +58,12 @@ pub struct ContactSection {
     /// Attraction distance d_w (m, default 0).
     #[schemars(extend("unit" = "m"))]
     pub d_w: Option<f64>,
+    /// Normal restitution coefficient e in [0, 1] of Newton's impact law (default 0):
+    /// a contact that closes at relative normal velocity v_n⁻ < 0 leaves at −e v_n⁻
+    /// (Moreau–Jean with Newton's law as in Siconos and LMGC90's `RST_CLB`; a contact
+    /// is then active only once its predicted gap is ≤ 0). 0 keeps the gap-aware
+    /// inelastic law (LMGC90's `IQS_CLB`). Not with `cohesion`.
+    pub restitution: Option<f64>,
 }
 
 /// `[nscd] ordering`.
@@ -81,11 +87,18 @@ pub enum OrderingChoice {
 #[derive(Clone, Debug, Default, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct NscdSection {
-    /// θ in [0.5, 1] (default 0.5).
+    /// θ in [0.5, 1] (default 0.5). With θ < 1 a contact that closes at speed v_n
+    /// keeps an overlap of at most h(1 − θ)v_n afterwards (h the step): contacts are
+    /// detected at the predicted configuration q + h(1 − θ)q̇ and the step's positions
+    /// use (1 − θ) of the arrival velocity, so θ = ½ leaves up to h v_n / 2 (1.5 mm for
+    /// a head-on impact closing at 3 m/s with h = 1 ms), θ = 1 none. Such overlaps are
+    /// permanent (the law pushes nothing apart) but do not grow.
     pub theta: Option<f64>,
     /// W-weighted relative impulse change that ends the sweeps (default 1.666e-4).
     pub tolerance: Option<f64>,
-    /// Fewest sweeps per step (default 100).
+    /// Fewest NLGS sweeps of a step with contacts, always done (default 100): the
+    /// paper's "minimal number of iterations". Then the sweeps stop on `tolerance` or
+    /// on a sweep that changes nothing.
     pub min_sweeps: Option<i64>,
     /// Most sweeps per step (default 10 000).
     pub max_sweeps: Option<i64>,
@@ -141,6 +154,10 @@ pub struct FaultSection {
     /// Band height of the limit-angle measure (m, default 4 × the largest radius).
     #[schemars(extend("unit" = "m"))]
     pub band: Option<f64>,
+    /// Fraction f of the slip that bounds the fault area (default 0.2): its left limit
+    /// is the contour |u| = (1 − f) s (rigid motion with the hanging wall on its left),
+    /// its right limit |u| = f s (undeformed on its right); in (0, 0.5).
+    pub limit_fraction: Option<f64>,
 }
 
 /// The sections of model `nscd` read by the model itself: `[[wall]]`, `[contact]`,

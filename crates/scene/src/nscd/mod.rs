@@ -3,16 +3,18 @@
 //! ([`porofrac_nscd`]).
 //!
 //! - *build*: the disks of `[particles]` (a seeded random packing, a hexagonal lattice
-//!   or a list), the walls of `[[wall]]`, the law of `[contact]` and the solver options
+//!   or a list) with the initial velocities of `[[particles.velocity]]` (after the
+//!   settling), the walls of `[[wall]]`, the law of `[contact]` and the solver options
 //!   of `[nscd]` ([`build`]);
 //! - *step*: one θ-scheme step of [`porofrac_nscd::Nscd`] per schedule step;
 //! - *fields*: particle probes (`x y vx vy omega fx fy radius`, `fx fy` the sum of the
-//!   contact forces on the particle), tracked-cell probes (`p q anisotropy
+//!   contact forces on the particle), wall probes (`wall = NAME` with `fx fy torque`,
+//!   [`porofrac_nscd::Nscd::body_reaction`]), tracked-cell probes (`p q anisotropy
 //!   anisotropy_volume dilation_x dilation_y contacts broken_bonds`, Renouf et al. (2006)
 //!   eqs. 7–11, [`porofrac_particles::tracked`]), lines (the value of the particle
 //!   nearest each point), `vtk/particles_NNNN.vtp` + `vtk/contacts_NNNN.vtp` with
 //!   `<name>.pvd` and `<name>_contacts.pvd`, field extrema, and `summary.json` with
-//!   `particles`, `contacts`, `sweeps` (mean, max), `final_residual`, `not_converged_steps`
+//!   `particles`, `contacts` (last, mean, max), `sweeps` (mean, max), `final_residual`, `not_converged_steps`
 //!   and `contact_updates_per_second` (local solves per second of NLGS wall time);
 //! - *plots* ([`crate::common::particle_plots`]): probe series and the disks coloured by
 //!   initial layer.
@@ -63,6 +65,8 @@ pub(crate) fn build_for(
 enum ProbeKind {
     Particle(usize, usize),
     Cell(usize, usize),
+    /// A wall's reaction: body index, component (fx, fy, torque).
+    Wall(usize, usize),
 }
 
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -76,6 +80,8 @@ struct RunStats {
     updates: u64,
     solve_seconds: f64,
     max_contacts: usize,
+    /// Σ over the steps of their contact counts.
+    contact_steps: u64,
 }
 
 /// An NSCD scene being run.
@@ -104,6 +110,7 @@ fn scene_error(ls: &LoadedScene, e: &NscdError) -> RunError {
             "mu_static" | "mu_dynamic" => k(&["contact", "mu"]),
             "cohesion" => k(&["contact", "cohesion"]),
             "cohesion_distance" => k(&["contact", "d_w"]),
+            "restitution" => k(&["contact", "restitution"]),
             "dt" => k(&["schedule", "dt"]),
             other => k(&["nscd", other]),
         },
@@ -162,6 +169,7 @@ pub fn build<'a>(
         mu_dynamic: mu,
         cohesion: c.cohesion.unwrap_or(0.0),
         cohesion_distance: c.d_w.unwrap_or(0.0),
+        restitution: c.restitution.unwrap_or(0.0),
     };
     let n = own(ls).nscd.clone().unwrap_or_default();
     let defaults = SolverParams::default();
@@ -207,6 +215,8 @@ pub fn build<'a>(
         }
         None => None,
     };
+    // Initial velocities and spins, after the settling (which ends at rest).
+    crate::common::particles::initial_velocities(ls, &mut sys.disks)?;
     let fault = n
         .fault
         .as_ref()
@@ -224,7 +234,30 @@ pub fn build<'a>(
     let mut probes = Vec::new();
     let mut cells = Vec::new();
     for (i, p) in s.output.probe.iter().enumerate() {
-        if let Some(f) = check::PARTICLE_FIELDS.iter().position(|f| *f == p.field) {
+        if let Some(name) = &p.wall {
+            let walls = &own(ls).wall;
+            let Some(b) = walls.iter().position(|w| w.name.as_ref() == Some(name)) else {
+                let names: Vec<&str> = walls.iter().filter_map(|w| w.name.as_deref()).collect();
+                return Err(ls
+                    .error(
+                        &ki("output.probe", i, &["wall"]),
+                        format!(
+                            "= \"{name}\" names no [[wall]] (named walls: {})",
+                            if names.is_empty() {
+                                "none".to_string()
+                            } else {
+                                names.join(", ")
+                            }
+                        ),
+                    )
+                    .into());
+            };
+            let component = ["fx", "fy", "torque"]
+                .iter()
+                .position(|f| *f == p.field)
+                .expect("checked");
+            probes.push(ProbeKind::Wall(b, component));
+        } else if let Some(f) = check::PARTICLE_FIELDS.iter().position(|f| *f == p.field) {
             let idx = p.particle.expect("checked") as usize;
             if idx >= count {
                 return Err(ls
@@ -303,8 +336,14 @@ impl NscdModel<'_> {
         };
         vec![
             ("particles", self.sys.disks.len().into()),
-            ("contacts", self.sys.contacts().len().into()),
-            ("max_contacts", st.max_contacts.into()),
+            (
+                "contacts",
+                serde_json::json!({
+                    "last": self.sys.contacts().len(),
+                    "mean": if st.steps > 0 { st.contact_steps as f64 / st.steps as f64 } else { 0.0 },
+                    "max": st.max_contacts,
+                }),
+            ),
             (
                 "sweeps",
                 serde_json::json!({ "mean": mean, "max": st.max_sweeps, "total": st.sweeps }),
@@ -387,6 +426,7 @@ impl Model for NscdModel<'_> {
                 r.not_converged as u64,
                 r.updates,
                 r.max_contacts as u64,
+                r.contact_steps,
             ],
         );
         state.put_f64(
@@ -450,7 +490,7 @@ impl Model for NscdModel<'_> {
             contacts,
         });
         self.current = steps[1] as usize;
-        let c = state.u64s_len("stats/counts", 6)?;
+        let c = state.u64s_len("stats/counts", 7)?;
         let v = state.f64s_len("stats/values", 4)?;
         self.stats = RunStats {
             steps: c[0] as usize,
@@ -462,6 +502,7 @@ impl Model for NscdModel<'_> {
             updates: c[4],
             solve_seconds: v[2],
             max_contacts: c[5] as usize,
+            contact_steps: c[6],
         };
         self.step_seconds = v[3];
         if let Some(pvd) = checkpoint::restore_pvd(
@@ -507,6 +548,7 @@ impl Model for NscdModel<'_> {
         r.updates += st.updates;
         r.solve_seconds += st.solve_seconds;
         r.max_contacts = r.max_contacts.max(st.contacts);
+        r.contact_steps += st.contacts as u64;
         if let Some(f) = &mut self.fault {
             f.after_step(&self.sys);
         }
@@ -528,6 +570,7 @@ impl Model for NscdModel<'_> {
         for p in &self.probes {
             values.push(match *p {
                 ProbeKind::Particle(i, f) => self.particle_value(i, f, &forces),
+                ProbeKind::Wall(b, c) => self.sys.body_reaction(b)[c],
                 ProbeKind::Cell(c, f) => {
                     let s = &states[c];
                     match check::CELL_FIELDS[f] {
@@ -598,7 +641,7 @@ impl Model for NscdModel<'_> {
             &self.ls.scene.scene.name,
             written,
             &probes,
-            |f| particle_output::particle_unit(f).unwrap_or("1"),
+            probe_unit,
         )?;
         crate::common::particle_plots::layers(
             &dir.join("layers.png"),
@@ -633,7 +676,7 @@ impl Model for NscdModel<'_> {
     }
 
     fn unit(&self, field: &str) -> &'static str {
-        particle_output::particle_unit(field).unwrap_or("1")
+        probe_unit(field)
     }
 
     fn failed(&self) -> usize {
@@ -659,6 +702,14 @@ impl Model for NscdModel<'_> {
             solve: self.stats.solve_seconds,
             ..WallSeconds::default()
         }
+    }
+}
+
+/// Unit of a probe field (a wall's `torque`: N·m per metre of thickness).
+fn probe_unit(field: &str) -> &'static str {
+    match field {
+        "torque" => "N·m/m",
+        f => particle_output::particle_unit(f).unwrap_or("1"),
     }
 }
 
