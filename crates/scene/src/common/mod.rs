@@ -32,3 +32,4 @@ pub mod rotation_keys;
 pub mod sample;
 pub mod scene_errors;
 pub mod sections;
+pub mod snapshot;
