@@ -108,6 +108,20 @@ impl Scene {
         Ok(Self { loaded, laws })
     }
 
+    /// Parse and validate scene text with `--set` overrides applied to the parsed
+    /// document ([`Scene::load_with_overrides`] for text; `path` names it in errors and
+    /// anchors relative paths).
+    pub fn parse_with_overrides(
+        text: &str,
+        path: &Path,
+        laws: LawRegistry,
+        overrides: &[common::overrides::Override],
+    ) -> Result<Self, SceneError> {
+        let loaded = check::parse_with(text, path, MODELS, overrides)?;
+        check::check(&loaded, &laws, MODELS)?;
+        Ok(Self { loaded, laws })
+    }
+
     /// The typed content of the file.
     pub fn file(&self) -> &common::sections::SceneFile {
         &self.loaded.scene
