@@ -106,13 +106,18 @@ class Scene:
         """
         return self._inner.check()
 
-    def run(self, out: Optional[PathLike] = None, progress: Progress = True) -> "Result":
+    def run(
+        self, out: Optional[PathLike] = None, progress: Progress = True, fields: bool = True
+    ) -> "Result":
         """Run the scene.
 
         ``out=None`` keeps the results in memory and writes nothing; a folder writes the
         files of ``porofrac run`` there too. ``progress``: ``True`` shows a tqdm bar when
         tqdm is installed (nothing otherwise), ``False`` nothing, or a callable
         ``progress(step, total, time)`` called after every step (``time`` in s).
+        ``fields=False`` keeps the probes, lines and summary only, not the state of the
+        written steps (grid, fields, particles, lattice): less memory and time for big
+        grids.
 
         The GIL is released while the model steps, so other Python threads keep running.
         Ctrl-C stops the run after the step in progress and raises ``KeyboardInterrupt``
@@ -121,7 +126,7 @@ class Scene:
         """
         callback, close = _progress(progress, self._inner.path())
         try:
-            inner = self._inner.run(None if out is None else os.fspath(out), callback)
+            inner = self._inner.run(None if out is None else os.fspath(out), callback, fields)
         except KeyboardInterrupt as e:
             partial = getattr(e, "result", None)
             if partial is not None:

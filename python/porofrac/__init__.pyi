@@ -56,8 +56,11 @@ class Scene:
         """The scene's tables with the keys set applied."""
     def check(self) -> Dict[str, Any]:
         """Validate and build as a run would, writing nothing; what a run would do."""
-    def run(self, out: Optional[PathLike] = None, progress: Progress = True) -> "Result":
-        """Run the scene (in memory when ``out`` is None); GIL released while stepping."""
+    def run(
+        self, out: Optional[PathLike] = None, progress: Progress = True, fields: bool = True
+    ) -> "Result":
+        """Run the scene (in memory when ``out`` is None); GIL released while stepping;
+        ``fields=False`` keeps probes, lines and summary only."""
 
 class Grid:
     """The grid of a run in VTK terms."""

@@ -335,13 +335,15 @@ impl PyScene {
     /// when `out` is None. `progress(step, total, time)` is called after every step. The
     /// GIL is released while the model steps. Ctrl-C (a pending KeyboardInterrupt)
     /// stops the run after the step in progress and raises KeyboardInterrupt with the
-    /// partial result as its `result` attribute.
-    #[pyo3(signature = (out = None, progress = None))]
+    /// partial result as its `result` attribute. `fields=False` keeps probes and lines
+    /// only, not the state (grid, fields, particles, lattice) of the written steps.
+    #[pyo3(signature = (out = None, progress = None, fields = true))]
     fn run(
         &self,
         py: Python<'_>,
         out: Option<PathBuf>,
         progress: Option<Py<PyAny>>,
+        fields: bool,
     ) -> PyResult<PyResult_> {
         let scene = self.build(py)?;
         let line_names: Vec<String> = scene
@@ -352,6 +354,7 @@ impl PyScene {
             .map(|l| l.name.clone())
             .collect();
         let mut obs = PyObserver::new(progress, true);
+        obs.fields = fields;
         let summary = py.detach(|| match &out {
             Some(out) => scene.run(out, &mut obs),
             None => scene.run_in_memory(&mut obs),
@@ -388,6 +391,7 @@ struct PyObserver {
     stop: Arc<AtomicBool>,
     pending: Arc<Mutex<Option<PyErr>>>,
     records: bool,
+    fields: bool,
     probe_columns: Vec<String>,
     line_columns: Vec<Vec<String>>,
     sampled: Vec<f64>,
@@ -405,6 +409,7 @@ impl PyObserver {
             stop: Arc::new(AtomicBool::new(false)),
             pending: Arc::new(Mutex::new(None)),
             records,
+            fields: true,
             probe_columns: Vec::new(),
             line_columns: Vec::new(),
             sampled: Vec::new(),
@@ -473,6 +478,10 @@ impl Observer for PyObserver {
 
     fn records(&self) -> bool {
         self.records
+    }
+
+    fn snapshots(&self) -> bool {
+        self.records && self.fields
     }
 
     fn columns(&mut self, probes: &[String], lines: &[Vec<String>]) {

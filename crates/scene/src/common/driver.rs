@@ -124,6 +124,11 @@ pub trait Observer: Send {
     fn records(&self) -> bool {
         false
     }
+    /// Whether a recording observer wants the model's state at the written steps
+    /// ([`Observer::written`] gets `None` otherwise); as [`Observer::records`] by default.
+    fn snapshots(&self) -> bool {
+        self.records()
+    }
     /// Before the first step: the probe columns and, per line, its columns, with units
     /// (`p_well [Pa]`), as the CSV headers have them (`time [s]` first).
     fn columns(&mut self, probes: &[String], lines: &[Vec<String>]) {
@@ -520,10 +525,14 @@ pub(crate) fn drive(
                     sampled.push(t);
                 }
                 if write && records {
-                    let state = model.snapshot(written.is_empty()).map(|mut state| {
-                        state.time = t;
-                        state
-                    });
+                    let state = observer
+                        .snapshots()
+                        .then(|| model.snapshot(written.is_empty()))
+                        .flatten()
+                        .map(|mut state| {
+                            state.time = t;
+                            state
+                        });
                     observer.written(t, &line_rows, state);
                 }
                 if write {
