@@ -3,7 +3,9 @@
 
 Each round runs, back to back, for every scene: the command (`porofrac run SCENE --out
 DIR`), Python writing the same files (`Scene.load(SCENE).run(out=DIR, fields=False)`) and
-Python in memory (`Scene.load(SCENE).run(fields=...)`, POROFRAC_FIELDS=0 for `False`), each in a fresh process, timed from start to exit
+Python in memory (`Scene.load(SCENE).run(fields=...)`, POROFRAC_FIELDS=0 for `False`), each
+in a fresh process after `porofrac.retain_freed_memory()` (the command's heap policy),
+timed from start to exit
 (wall seconds, so interpreter start and `import porofrac` count; and the process's CPU
 seconds, user + system, less sensitive to other work on the machine). Prints a Markdown
 table of the rounds and medians. Usage, from the workspace root, with the package installed:
@@ -26,7 +28,7 @@ SCENES = ["scenes/hydrofrac_seed.toml", "scenes/bench/e2.toml"]
 # Whether the in-memory runs keep the state of the written steps (POROFRAC_FIELDS=0: no).
 FIELDS = os.environ.get("POROFRAC_FIELDS", "1") != "0"
 PY = (
-    "import porofrac, sys; "
+    "import porofrac, sys; porofrac.retain_freed_memory(); "
     "porofrac.Scene.load(sys.argv[1]).run(out={out}, progress=False, fields={fields})"
 )
 

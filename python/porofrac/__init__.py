@@ -27,9 +27,17 @@ from typing import Any, Callable, Dict, Optional, Union
 
 import numpy as np
 
-from ._porofrac import RunError, SceneError, _Result, _Scene, __version__
+from ._porofrac import RunError, SceneError, _Result, _Scene, __version__, retain_freed_memory
 
-__all__ = ["Scene", "Result", "Grid", "SceneError", "RunError", "__version__"]
+__all__ = [
+    "Scene",
+    "Result",
+    "Grid",
+    "SceneError",
+    "RunError",
+    "retain_freed_memory",
+    "__version__",
+]
 
 PathLike = Union[str, "os.PathLike[str]"]
 Progress = Union[bool, Callable[[int, int, float], Any], None]

@@ -11,6 +11,11 @@ __version__: str
 PathLike = Union[str, os.PathLike[str]]
 Progress = Union[bool, Callable[[int, int, float], Any], None]
 
+def retain_freed_memory() -> bool:
+    """Keep freed heap memory in this process for reuse, as the ``porofrac`` command
+    does (faster solves; the resident size stays at its peak). Process-wide, not undone;
+    whether it was applied (Linux with glibc)."""
+
 class SceneError(ValueError):
     """A problem in a scene, as the `porofrac` command reports it."""
 

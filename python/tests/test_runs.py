@@ -255,3 +255,13 @@ def test_tqdm_progress_runs(root, capsys):
     scene, _, _ = scene_with(root, "nscd")
     r = scene.run(progress=True)
     assert r.summary["status"] == "ok"
+
+
+def test_fields_false_keeps_probes_and_no_state(root):
+    scene = porofrac.Scene.load(root / "scenes/patch_test.toml")
+    full = scene.run(progress=False)
+    light = scene.run(progress=False, fields=False)
+    np.testing.assert_array_equal(light.probes["ux_center"], full.probes["ux_center"])
+    assert light.grid is None and full.grid is not None
+    with pytest.raises(ValueError):
+        light.field("displacement")

@@ -135,3 +135,10 @@ def test_help_and_version():
     assert porofrac.__version__
     assert issubclass(porofrac.SceneError, ValueError)
     assert issubclass(porofrac.RunError, RuntimeError)
+
+
+def test_the_heap_policy_of_the_command_applies_on_glibc():
+    import platform
+
+    applied = porofrac.retain_freed_memory()
+    assert applied == (platform.system() == "Linux" and platform.libc_ver()[0] == "glibc")
