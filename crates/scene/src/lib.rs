@@ -108,6 +108,20 @@ impl Scene {
         Ok(Self { loaded, laws })
     }
 
+    /// Parse and validate scene text with `--set` overrides applied to the parsed
+    /// document ([`Scene::load_with_overrides`] for text; `path` names it in errors and
+    /// anchors relative paths).
+    pub fn parse_with_overrides(
+        text: &str,
+        path: &Path,
+        laws: LawRegistry,
+        overrides: &[common::overrides::Override],
+    ) -> Result<Self, SceneError> {
+        let loaded = check::parse_with(text, path, MODELS, overrides)?;
+        check::check(&loaded, &laws, MODELS)?;
+        Ok(Self { loaded, laws })
+    }
+
     /// The typed content of the file.
     pub fn file(&self) -> &common::sections::SceneFile {
         &self.loaded.scene
@@ -159,12 +173,22 @@ impl Scene {
             );
         }
         output::remove_earlier_outputs(out, self.name())?;
-        let result = common::model::run(&self.loaded, &self.laws, out, observer);
+        let result = common::model::run(&self.loaded, &self.laws, Some(out), observer);
         if let Err(e) = &result {
             output::write_failed_summary(&self.loaded, out, &e.to_string(), start);
         }
         drop(lock);
         result
+    }
+
+    /// Run the scene and keep its results in memory, writing nothing: the observer gets
+    /// the probe values of every sampled step ([`Observer::sampled`]) and the lines and
+    /// the model's state ([`common::snapshot::Snapshot`]) of every written step
+    /// ([`Observer::written`]) when it [`Observer::records`]. The numbers are those of
+    /// [`Scene::run`]; `[output] checkpoint_every`, plots and VTK files are left out. An
+    /// interrupted run ends as [`Scene::run`] describes.
+    pub fn run_in_memory(&self, observer: &mut dyn Observer) -> Result<Summary, RunError> {
+        common::model::run(&self.loaded, &self.laws, None, observer)
     }
 
     /// Continue the run whose checkpoint is in `out` (`<out>/checkpoint/state.bin`,
@@ -180,7 +204,7 @@ impl Scene {
         let lock = output::OutputLock::acquire(out)?;
         let mut loaded = self.loaded.clone();
         loaded.resume = true;
-        let result = common::model::run(&loaded, &self.laws, out, observer);
+        let result = common::model::run(&loaded, &self.laws, Some(out), observer);
         if let Err(e) = &result {
             output::write_failed_summary(&self.loaded, out, &e.to_string(), start);
         }

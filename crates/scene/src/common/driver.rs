@@ -37,6 +37,7 @@ use porofrac_grid::io::PvdWriter;
 use crate::common::loaded::{LoadedScene, k, ki};
 use crate::common::model::{Model, RunError};
 use crate::common::output::{CsvTable, OutputError, Summary, WallSeconds, peak_memory_bytes};
+use crate::common::snapshot::Snapshot;
 
 /// Where a run is, after each step.
 #[derive(Clone, Copy, Debug)]
@@ -115,6 +116,32 @@ pub trait Observer: Send {
     /// should return a handle that reads the same flag, [`Stop::from_flag`]).
     fn stop_handle(&self) -> Stop {
         Stop::never()
+    }
+    /// Whether the observer keeps the results of a run kept in memory
+    /// ([`crate::Scene::run_in_memory`]): only then are [`Observer::columns`],
+    /// [`Observer::sampled`] and [`Observer::written`] called and snapshots made. No by
+    /// default.
+    fn records(&self) -> bool {
+        false
+    }
+    /// Whether a recording observer wants the model's state at the written steps
+    /// ([`Observer::written`] gets `None` otherwise); as [`Observer::records`] by default.
+    fn snapshots(&self) -> bool {
+        self.records()
+    }
+    /// Before the first step: the probe columns and, per line, its columns, with units
+    /// (`p_well [Pa]`), as the CSV headers have them (`time [s]` first).
+    fn columns(&mut self, probes: &[String], lines: &[Vec<String>]) {
+        let _ = (probes, lines);
+    }
+    /// The probe values at time `time` (s), in scene order, at every sampled step.
+    fn sampled(&mut self, time: f64, probes: &[f64]) {
+        let _ = (time, probes);
+    }
+    /// A written step: its time (s), the rows of every line (`s, x, y(, z), value`) and
+    /// the model's state.
+    fn written(&mut self, time: f64, lines: &[Vec<Vec<f64>>], snapshot: Option<Snapshot>) {
+        let _ = (time, lines, snapshot);
     }
 }
 
@@ -310,12 +337,13 @@ pub struct Silent;
 
 impl Observer for Silent {}
 
-/// Drive `model` through its times, writing the shared outputs into `out`. `wall` holds
-/// the time already spent (grid) and `start` the start of the run.
+/// Drive `model` through its times, writing the shared outputs into `out` (nothing
+/// without it: a run kept in memory for the observer, [`Observer::records`]). `wall`
+/// holds the time already spent (grid) and `start` the start of the run.
 pub(crate) fn drive(
     ls: &LoadedScene,
     model: &mut dyn Model,
-    out: &Path,
+    out: Option<&Path>,
     observer: &mut dyn Observer,
     start: Instant,
     grid_seconds: f64,
@@ -330,9 +358,8 @@ pub(crate) fn drive(
             .iter()
             .map(|p| column(&p.name, model.unit(&p.field))),
     );
-    let mut probes = CsvTable::new(out.join("probes.csv"), &header);
     let axes = ["x", "y", "z"];
-    let mut lines: Vec<CsvTable> = s
+    let line_headers: Vec<Vec<String>> = s
         .output
         .line
         .iter()
@@ -340,26 +367,44 @@ pub(crate) fn drive(
             let mut line_header = vec![column("time", "s"), column("s", "m")];
             line_header.extend(axes[..dim].iter().map(|a| column(a, "m")));
             line_header.push(column(&l.field, model.unit(&l.field)));
-            CsvTable::new(
+            line_header
+        })
+        .collect();
+    let records = observer.records();
+    if records {
+        observer.columns(&header, &line_headers);
+    }
+    // A run kept in memory (no `out`) writes nothing: no tables, VTK, plots or
+    // checkpoints.
+    let mut probes = out.map(|out| CsvTable::new(out.join("probes.csv"), &header));
+    let mut lines: Vec<CsvTable> = s
+        .output
+        .line
+        .iter()
+        .zip(line_headers)
+        .filter_map(|(l, line_header)| {
+            let out = out?;
+            Some(CsvTable::new(
                 out.join("lines").join(format!("{}.csv", l.name)),
                 &line_header,
-            )
+            ))
         })
         .collect();
     // Snapshots of every line for its end-of-run plot: the rows at (up to) six of the
     // written times, spread over the run, and the last one.
     let mut line_snapshots: Vec<Vec<(f64, Vec<Vec<f64>>)>> = vec![Vec::new(); lines.len()];
-    let vtk_dir = out.join("vtk");
-    let mut pvd = if s.output.vtk {
-        std::fs::create_dir_all(&vtk_dir).map_err(|source| OutputError {
-            path: vtk_dir.clone(),
-            source,
-        })?;
-        Some(PvdWriter::create(
-            out.join(format!("{}.pvd", s.scene.name)),
-        )?)
-    } else {
-        None
+    let vtk_dir = out.map(|out| out.join("vtk")).unwrap_or_default();
+    let mut pvd = match out {
+        Some(out) if s.output.vtk => {
+            std::fs::create_dir_all(&vtk_dir).map_err(|source| OutputError {
+                path: vtk_dir.clone(),
+                source,
+            })?;
+            Some(PvdWriter::create(
+                out.join(format!("{}.pvd", s.scene.name)),
+            )?)
+        }
+        _ => None,
     };
 
     let times = model.times().to_vec();
@@ -379,6 +424,7 @@ pub(crate) fn drive(
     let mut row = Vec::new();
     // Checkpoints and resuming (crate::common::checkpoint).
     let checkpoint_every = s.output.checkpoint_every as usize;
+    let checkpoint_every = if out.is_some() { checkpoint_every } else { 0 };
     if (checkpoint_every > 0 || ls.resume) && !model.checkpoints() {
         return Err(ls
             .error(
@@ -391,12 +437,12 @@ pub(crate) fn drive(
             .into());
     }
     let mut first = 0;
-    if ls.resume {
+    if let (true, Some(out), Some(probes)) = (ls.resume, out, probes.as_mut()) {
         let r = crate::common::checkpoint::resume(
             ls,
             out,
             model,
-            &mut probes,
+            probes,
             &mut lines,
             &mut pvd,
             series.len(),
@@ -419,7 +465,10 @@ pub(crate) fn drive(
             }
             r => r?,
         };
-        model.after_step(out)?;
+        match out {
+            Some(out) => model.after_step(out)?,
+            None => model.after_step_in_memory()?,
+        }
         let stop = step + 1 < times.len() && observer.stop_requested();
         let last = step + 1 == times.len();
         // Written steps (VTK, lines) of a run that goes on, and its probe samples
@@ -444,8 +493,9 @@ pub(crate) fn drive(
                 check_finite(ls, t, &row[first..], &step_extrema, &|i| {
                     model.probe_may_be_undefined(i)
                 })?;
-                let mut line_rows: Vec<Vec<Vec<f64>>> = Vec::with_capacity(lines.len());
-                for i in (0..lines.len()).filter(|_| write) {
+                let n_lines = s.output.line.len();
+                let mut line_rows: Vec<Vec<Vec<f64>>> = Vec::with_capacity(n_lines);
+                for i in (0..n_lines).filter(|_| write) {
                     let mut rows = Vec::new();
                     model.line(i, &mut rows);
                     if let Some(v) = rows.iter().flatten().find(|v| !v.is_finite()) {
@@ -466,8 +516,24 @@ pub(crate) fn drive(
                     for (j, v) in row[first..].iter().enumerate() {
                         series[j].push(*v);
                     }
-                    probes.push(&row)?;
+                    if let Some(probes) = probes.as_mut() {
+                        probes.push(&row)?;
+                    }
+                    if records {
+                        observer.sampled(t, &row[first..]);
+                    }
                     sampled.push(t);
+                }
+                if write && records {
+                    let state = observer
+                        .snapshots()
+                        .then(|| model.snapshot(written.is_empty()))
+                        .flatten()
+                        .map(|mut state| {
+                            state.time = t;
+                            state
+                        });
+                    observer.written(t, &line_rows, state);
                 }
                 if write {
                     let snapshot = last || stop || written.len().is_multiple_of(snapshot_stride);
@@ -511,7 +577,8 @@ pub(crate) fn drive(
         // A checkpoint after this step: every `checkpoint_every` steps, and when stopped.
         // It holds the files as a run that goes on has them: what is written only because
         // the run stops comes after it, so a resumed run does not keep it.
-        if !last
+        if let (Some(out), Some(probes)) = (out, probes.as_ref())
+            && !last
             && ((checkpoint_every > 0 && step > 0 && step.is_multiple_of(checkpoint_every))
                 || (stop && model.checkpoints()))
         {
@@ -528,7 +595,7 @@ pub(crate) fn drive(
                     extrema: &extrema,
                     total_iterations,
                     steps,
-                    probes: &probes,
+                    probes,
                     lines: &lines,
                     pvd: pvd.as_ref(),
                 },
@@ -547,7 +614,7 @@ pub(crate) fn drive(
     let t_out = Instant::now();
     let errors = model.errors()?;
     output_seconds += t_out.elapsed().as_secs_f64();
-    if s.output.plots {
+    if let Some(out) = out.filter(|_| s.output.plots) {
         let t_out = Instant::now();
         model.plots(&out.join("plots"), &sampled, &series)?;
         for (l, snaps) in s.output.line.iter().zip(&line_snapshots) {

@@ -33,3 +33,4 @@ pub mod rotation_keys;
 pub mod sample;
 pub mod scene_errors;
 pub mod sections;
+pub mod snapshot;

@@ -144,6 +144,19 @@ pub trait Model {
     fn errors(&self) -> Result<BTreeMap<String, f64>, RunError>;
     /// Wall time of the model's phases so far (assembly, solve, flow, its own output).
     fn wall_seconds(&self) -> WallSeconds;
+    /// What [`Model::after_step`] does to the state, without writing any file: the step
+    /// of a run kept in memory ([`crate::Scene::run_in_memory`]). Nothing by default (a
+    /// model whose `after_step` only writes files).
+    fn after_step_in_memory(&mut self) -> Result<(), RunError> {
+        Ok(())
+    }
+    /// The state at the current step for a run kept in memory
+    /// ([`crate::common::snapshot`]); `mesh`: include the grid (the first written step).
+    /// `None` by default (a model that keeps nothing but probes and lines).
+    fn snapshot(&self, mesh: bool) -> Option<crate::common::snapshot::Snapshot> {
+        let _ = mesh;
+        None
+    }
     /// Whether probe number `probe` may be NaN in a valid state: a value undefined at
     /// the probe's place (a fluid probe inside a solid disk). No by default: a probe that
     /// is NaN or infinite ends the run ([`crate::common::driver`]); an infinite value
@@ -262,6 +275,9 @@ pub enum Purpose<'a> {
     Run(&'a Path),
     /// Describe the built model ([`Plan`]); write nothing.
     Check,
+    /// Drive the built model through its schedule and keep the results in memory for the
+    /// observer ([`crate::Scene::run_in_memory`]); write nothing.
+    Memory,
 }
 
 /// What a built model ended as.
@@ -279,7 +295,7 @@ impl Purpose<'_> {
     pub fn out(&self) -> Option<&Path> {
         match self {
             Purpose::Run(out) => Some(out),
-            Purpose::Check => None,
+            Purpose::Check | Purpose::Memory => None,
         }
     }
 
@@ -296,8 +312,18 @@ impl Purpose<'_> {
         dim: usize,
     ) -> Result<Built, RunError> {
         match self {
-            Purpose::Run(out) => {
-                crate::common::driver::drive(ls, model, out, observer, start, grid_seconds, dim)
+            Purpose::Run(out) => crate::common::driver::drive(
+                ls,
+                model,
+                Some(out),
+                observer,
+                start,
+                grid_seconds,
+                dim,
+            )
+            .map(Built::Ran),
+            Purpose::Memory => {
+                crate::common::driver::drive(ls, model, None, observer, start, grid_seconds, dim)
                     .map(Built::Ran)
             }
             Purpose::Check => Ok(Built::Checked(Plan::of(
@@ -322,15 +348,19 @@ where
 }
 
 /// Run a validated scene with its model, in the thread pool the scene asks for, and
-/// write `summary.json`.
+/// write `summary.json` (nothing without `out`: a run kept in memory).
 pub(crate) fn run(
     ls: &LoadedScene,
     laws: &LawRegistry,
-    out: &Path,
+    out: Option<&Path>,
     observer: &mut dyn Observer,
 ) -> Result<Summary, RunError> {
     let start = std::time::Instant::now();
-    let summary = match in_pool(ls, laws, &Purpose::Run(out), observer) {
+    let purpose = match out {
+        Some(out) => Purpose::Run(out),
+        None => Purpose::Memory,
+    };
+    let summary = match in_pool(ls, laws, &purpose, observer) {
         Ok(Built::Ran(summary)) => summary,
         // Only a model that ignored its purpose gets here.
         Ok(Built::Checked(_)) => {
@@ -350,7 +380,9 @@ pub(crate) fn run(
         }
         Err(e) => return Err(e),
     };
-    summary.write(out)?;
+    if let Some(out) = out {
+        summary.write(out)?;
+    }
     Ok(summary)
 }
 

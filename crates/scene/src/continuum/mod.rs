@@ -308,6 +308,23 @@ struct Stepper<'a, const D: usize> {
 }
 
 impl<'a, const D: usize> Stepper<'a, D> {
+    /// Every cell's stress as `[xx, yy, zz, xy, yz, xz]` (Pa), for the VTK files and
+    /// the in-memory snapshots.
+    fn stress_xyz(&self) -> Vec<[f64; 6]> {
+        self.stress
+            .iter()
+            .zip(&self.nu_of_cell)
+            .map(|(s, &nu)| {
+                let c = |i, j| {
+                    Field::Stress(i, j)
+                        .of_stress(s, nu, self.plane_strain)
+                        .unwrap_or(0.0)
+                };
+                [c(0, 0), c(1, 1), c(2, 2), c(0, 1), c(1, 2), c(0, 2)]
+            })
+            .collect()
+    }
+
     fn new(
         ls: &'a LoadedScene,
         body: Body<'a, D>,
@@ -693,19 +710,7 @@ impl<const D: usize> Model for Stepper<'_, D> {
         let disp: Vec<Point<D>> = (0..grid.num_nodes())
             .map(|n| Point::<D>::from_column_slice(&self.u[D * n..D * n + D]))
             .collect();
-        let sym: Vec<[f64; 6]> = self
-            .stress
-            .iter()
-            .zip(&self.nu_of_cell)
-            .map(|(s, &nu)| {
-                let c = |i, j| {
-                    Field::Stress(i, j)
-                        .of_stress(s, nu, self.plane_strain)
-                        .unwrap_or(0.0)
-                };
-                [c(0, 0), c(1, 1), c(2, 2), c(0, 1), c(1, 2), c(0, 2)]
-            })
-            .collect();
+        let sym = self.stress_xyz();
         let fractured: Vec<i32> = self.failures.flags().iter().map(|&f| f as i32).collect();
         let mut cell_data = vec![
             ("stress", VtkField::SymTensors(&sym)),
@@ -733,6 +738,53 @@ impl<const D: usize> Model for Stepper<'_, D> {
             &cell_data,
         )?;
         Ok(name)
+    }
+
+    fn after_step_in_memory(&mut self) -> Result<(), RunError> {
+        // Without an output folder there is no fracture log: this only brings the
+        // stresses up to date.
+        self.after_step(Path::new(""))
+    }
+
+    fn snapshot(&self, mesh: bool) -> Option<crate::common::snapshot::Snapshot> {
+        use crate::common::snapshot::{Array, Mesh, Snapshot};
+        let grid = self.body.grid;
+        let mut cell_data = vec![
+            Array::new(
+                "stress",
+                6,
+                self.stress_xyz().into_iter().flatten().collect(),
+            ),
+            Array::new(
+                "law",
+                1,
+                self.law_ids.iter().map(|&l| f64::from(l)).collect(),
+            ),
+            Array::new(
+                "fractured",
+                1,
+                self.failures
+                    .flags()
+                    .iter()
+                    .map(|&f| f64::from(u8::from(f)))
+                    .collect(),
+            ),
+        ];
+        if let Some(p) = self.pressure.as_deref() {
+            cell_data.push(Array::new("pressure", 1, p.to_vec()));
+        }
+        Some(Snapshot {
+            time: 0.0,
+            mesh: mesh.then(|| std::sync::Arc::new(Mesh::of(grid))),
+            point_data: vec![Array::new(
+                "displacement",
+                D,
+                self.u[..D * grid.num_nodes()].to_vec(),
+            )],
+            cell_data,
+            particles: None,
+            lattice: None,
+        })
     }
 
     fn field_extrema(&self) -> BTreeMap<String, [f64; 2]> {

@@ -701,6 +701,23 @@ impl<const D: usize> Model for Run<'_, D> {
         Ok(name)
     }
 
+    fn snapshot(&self, mesh: bool) -> Option<crate::common::snapshot::Snapshot> {
+        use crate::common::snapshot::{Array, Mesh, Snapshot};
+        let grid = self.model.grid();
+        let [displacement, rotation, stress, couple_stress] =
+            vtk::cell_arrays(grid, &self.w, &self.stress);
+        Some(Snapshot {
+            mesh: mesh.then(|| std::sync::Arc::new(Mesh::of(grid))),
+            cell_data: vec![
+                Array::new("displacement", 3, displacement),
+                Array::new("rotation", 3, rotation),
+                Array::new("stress", 9, stress),
+                Array::new("couple_stress", 9, couple_stress),
+            ],
+            ..Default::default()
+        })
+    }
+
     fn field_extrema(&self) -> BTreeMap<String, [f64; 2]> {
         let mut out = BTreeMap::new();
         let nc = self.model.grid().num_cells();

@@ -16,6 +16,28 @@ pub fn write<const D: usize>(
     w: &[f64],
     stress: &[[f64; 18]],
 ) -> Result<(), GridError> {
+    let [displacement, rotation, force_stress, couple_stress] = cell_arrays(grid, w, stress);
+    let field = |components, values| Field::Components { components, values };
+    write_vtu(
+        path,
+        grid,
+        &[],
+        &[
+            ("displacement", field(3, &displacement)),
+            ("rotation", field(3, &rotation)),
+            ("stress", field(9, &force_stress)),
+            ("couple_stress", field(9, &couple_stress)),
+        ],
+    )
+}
+
+/// The cell arrays of the VTK files and the in-memory snapshots: displacement and
+/// rotation (3 per cell), force and couple stress (9 per cell, row-major).
+pub fn cell_arrays<const D: usize>(
+    grid: &Grid<D>,
+    w: &[f64],
+    stress: &[[f64; 18]],
+) -> [Vec<f64>; 4] {
     let n = components(D);
     let nc = grid.num_cells();
     let per_cell = |comps: usize, value: &dyn Fn(usize, usize) -> f64| -> Vec<f64> {
@@ -52,16 +74,5 @@ pub fn write<const D: usize>(
             stress[c][strain_index(3, 3 + i, j)]
         }
     });
-    let field = |components, values| Field::Components { components, values };
-    write_vtu(
-        path,
-        grid,
-        &[],
-        &[
-            ("displacement", field(3, &displacement)),
-            ("rotation", field(3, &rotation)),
-            ("stress", field(9, &force_stress)),
-            ("couple_stress", field(9, &couple_stress)),
-        ],
-    )
+    [displacement, rotation, force_stress, couple_stress]
 }

@@ -267,6 +267,37 @@ fn output_times(ls: &LoadedScene) -> Vec<f64> {
 }
 
 impl LbmModel<'_> {
+    /// The node arrays of the VTK files and the in-memory snapshots, row after row:
+    /// velocity (3 per node, m/s), pressure (Pa), density (kg/m³), solid (1 in a solid)
+    /// and temperature (K; empty without heat).
+    fn node_arrays(&self) -> [Vec<f64>; 5] {
+        let (nx, ny) = self.lat.size();
+        let mut velocity = Vec::with_capacity(3 * nx * ny);
+        let mut pressure = Vec::with_capacity(nx * ny);
+        let mut density = Vec::with_capacity(nx * ny);
+        let mut solid = Vec::with_capacity(nx * ny);
+        for j in 0..ny {
+            for i in 0..nx {
+                let (rho, u) = self.lat.moments(i, j);
+                velocity.extend([
+                    self.units.velocity_si(u[0]),
+                    self.units.velocity_si(u[1]),
+                    0.0,
+                ]);
+                pressure.push(self.units.pressure_si(rho));
+                density.push(rho * self.units.density);
+                solid.push(if self.lat.is_solid(i, j) { 1.0 } else { 0.0 });
+            }
+        }
+        let temperature: Vec<f64> = match &self.thermal {
+            Some(th) => (0..ny)
+                .flat_map(|j| (0..nx).map(move |i| th.temperature(i, j)))
+                .collect(),
+            None => Vec::new(),
+        };
+        [velocity, pressure, density, solid, temperature]
+    }
+
     /// Lattice position → SI position.
     fn si(&self, p: [f64; 2]) -> [f64; 2] {
         [
@@ -661,30 +692,8 @@ impl Model for LbmModel<'_> {
     fn write_vtk(&self, dir: &Path, index: usize) -> Result<String, RunError> {
         let name = format!("step_{index:04}.vti");
         let (nx, ny) = self.lat.size();
-        let mut velocity = Vec::with_capacity(3 * nx * ny);
-        let mut pressure = Vec::with_capacity(nx * ny);
-        let mut density = Vec::with_capacity(nx * ny);
-        let mut solid = Vec::with_capacity(nx * ny);
-        for j in 0..ny {
-            for i in 0..nx {
-                let (rho, u) = self.lat.moments(i, j);
-                velocity.extend([
-                    self.units.velocity_si(u[0]),
-                    self.units.velocity_si(u[1]),
-                    0.0,
-                ]);
-                pressure.push(self.units.pressure_si(rho));
-                density.push(rho * self.units.density);
-                solid.push(if self.lat.is_solid(i, j) { 1.0 } else { 0.0 });
-            }
-        }
+        let [velocity, pressure, density, solid, temperature] = self.node_arrays();
         let origin = self.si([0.5, 0.5]);
-        let temperature: Vec<f64> = match &self.thermal {
-            Some(th) => (0..ny)
-                .flat_map(|j| (0..nx).map(move |i| th.temperature(i, j)))
-                .collect(),
-            None => Vec::new(),
-        };
         let mut arrays = vec![
             DataArray::new("velocity", 3, &velocity[..]),
             DataArray::new("pressure", 1, &pressure[..]),
@@ -711,6 +720,34 @@ impl Model for LbmModel<'_> {
             })?;
         write_atomic(&path, &bytes)?;
         Ok(name)
+    }
+
+    fn snapshot(&self, _mesh: bool) -> Option<crate::common::snapshot::Snapshot> {
+        use crate::common::snapshot::{Array, Lattice, Snapshot};
+        let (nx, ny) = self.lat.size();
+        let [velocity, pressure, density, solid, temperature] = self.node_arrays();
+        let vx = velocity.iter().step_by(3).copied().collect();
+        let vy = velocity.iter().skip(1).step_by(3).copied().collect();
+        let mut fields = vec![
+            Array::new("vx", 1, vx),
+            Array::new("vy", 1, vy),
+            Array::new("pressure", 1, pressure),
+            Array::new("density", 1, density),
+            Array::new("solid", 1, solid),
+        ];
+        if self.thermal.is_some() {
+            fields.push(Array::new("temperature", 1, temperature));
+        }
+        Some(Snapshot {
+            lattice: Some(Lattice {
+                nx,
+                ny,
+                origin: self.si([0.5, 0.5]),
+                spacing: self.units.dx,
+                fields,
+            }),
+            ..Snapshot::default()
+        })
     }
 
     fn field_extrema(&self) -> BTreeMap<String, [f64; 2]> {

@@ -451,6 +451,20 @@ impl LsmModel<'_> {
 
     /// Intact bonds and touching contacts as the tracked cells and the VTK lines see
     /// them.
+    /// Broken bonds per disk and the links drawn, for the VTK files and the in-memory
+    /// snapshots.
+    fn disk_outputs(&self) -> (Vec<f64>, Vec<ContactLine>) {
+        let d = self.solid.disks();
+        let mut per = vec![0.0; d.len()];
+        for b in self.solid.broken() {
+            per[b.i] += 1.0;
+            per[b.j] += 1.0;
+        }
+        let (mut cc, mut lines) = (Vec::new(), Vec::new());
+        self.links(&mut cc, &mut lines);
+        (per, lines)
+    }
+
     fn links(&self, cell: &mut Vec<CellContact>, lines: &mut Vec<ContactLine>) {
         let d = self.solid.disks();
         for (b, f) in self.solid.bonds().iter().zip(self.solid.bond_forces()) {
@@ -809,15 +823,21 @@ impl Model for LsmModel<'_> {
         Ok(())
     }
 
+    fn snapshot(&self, _mesh: bool) -> Option<crate::common::snapshot::Snapshot> {
+        let (per, lines) = self.disk_outputs();
+        Some(crate::common::snapshot::Snapshot {
+            particles: Some(crate::common::snapshot::Particles::of(
+                self.solid.disks(),
+                &[("broken_bonds", &per)],
+                &lines,
+            )),
+            ..Default::default()
+        })
+    }
+
     fn write_vtk(&self, dir: &Path, index: usize) -> Result<String, RunError> {
         let d = self.solid.disks();
-        let mut per = vec![0.0; d.len()];
-        for b in self.solid.broken() {
-            per[b.i] += 1.0;
-            per[b.j] += 1.0;
-        }
-        let (mut cc, mut lines) = (Vec::new(), Vec::new());
-        self.links(&mut cc, &mut lines);
+        let (per, lines) = self.disk_outputs();
         particle_output::write_vtk(
             self.ls,
             dir,

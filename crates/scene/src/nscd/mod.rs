@@ -613,6 +613,19 @@ impl Model for NscdModel<'_> {
         )
     }
 
+    fn snapshot(&self, _mesh: bool) -> Option<crate::common::snapshot::Snapshot> {
+        let mut lines = Vec::new();
+        self.sys.contact_lines(&mut lines);
+        Some(crate::common::snapshot::Snapshot {
+            particles: Some(crate::common::snapshot::Particles::of(
+                &self.sys.disks,
+                &[],
+                &lines,
+            )),
+            ..Default::default()
+        })
+    }
+
     fn field_extrema(&self) -> BTreeMap<String, [f64; 2]> {
         let mut out = particle_output::disk_extrema(&self.sys.disks);
         let forces: Vec<[f64; 2]> = self
