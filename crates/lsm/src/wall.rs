@@ -1,14 +1,29 @@
-//! Pressure on the wall of a circular hole (a borehole), as forces on the particles
-//! that line it.
+//! Pressure on the wall of a circular hole (a borehole), as forces and moments on the
+//! particles that line it.
 //!
-//! The hole of centre `c` and radius `a` is swept by `N = 3600` rays from `c`; each ray
-//! of direction `e_k` hits a first disk (the nearest intersection). The pressure on the
-//! arc `a Δφ` of the ray, `Δφ = 2π/N`, pushes that disk outwards: the disk receives
-//! `p a Δφ Σ_k e_k` over its rays. The forces sum to the pressure integral
-//! `∮ p n a dφ` over the wall (zero in total, the hoop load of the continuum on each
-//! side), so the tangential stress at the wall is `σ_θθ(a) = p (b² + a²)/(b² − a²)` for a
-//! disk of outer radius b (the closed-form breakdown check). The set is taken once, in the
-//! reference configuration (small strains).
+//! **Faces seen from the centre** ([`WallFaces::Rays`], the default). The hole of centre
+//! `c` and radius `a` is swept by `N = 3600` rays from `c`; each ray of direction `e_k`
+//! meets a first disk among those whose near side lies within `a + 2 r_max` of `c`. The
+//! hole's boundary is the closed contour through these first hits in the order of their
+//! angle: along one disk, chords of its exposed arc; where the first disk changes between
+//! two rays, the ends of both faces are found by bisection of the angle (to round-off, so
+//! an arc ends where it is tangent to the ray or where the next disk hides it), and a
+//! straight gap segment joins them — also across rays that pass between the lining disks
+//! and meet none. The pressure on an edge `A → B` of the contour is `p (d_y, −d_x)`,
+//! `d = B − A` (the outward normal times the length). On a chord of one disk it acts at
+//! the chord's midpoint, whose normal passes through the disk's centre: it is the exact
+//! pressure integral over the arc between the two points (`p` times the chord, normal to
+//! it), with no moment. On a gap segment each of the two disks it joins takes half at its
+//! own end, with the moment `(x_end − x_i) × f/2` about its centre; the two halves have the
+//! moment of the whole about any point (`(A + B)/2 × f = A × f/2 + B × f/2`). The contour
+//! being closed, `Σ f = p rot(Σ d) = 0` and `Σ x × f = −p/2 Σ (|B|² − |A|²) = 0`: the loads
+//! have neither net force nor net torque, to round-off, on any packing and hole position
+//! and for any number of rays. A ring of N touching equal disks around the centre receives
+//! `p · 2 D cos(π/N) sin(π/N)` per disk outwards (D the radius of their centres: the chord
+//! between the contacts), so the thick-cylinder closed form of the tangential stress at the
+//! wall, `σ_θθ = p (b² + a²)/(b² − a²)` for a disk of outer radius b, holds with the hole's
+//! effective radius (the breakdown check). The loads are taken once, in the reference
+//! configuration (small strains).
 //!
 //! **Wetted faces** ([`WallFaces::Wetted`]). A fluid filling the hole does not stop at the
 //! faces seen from the centre: it enters every notch between the lining disks and every
@@ -33,12 +48,15 @@ use porofrac_particles::Disks;
 
 /// Rays per wall.
 const RAYS: usize = 3600;
+/// Most bisections of the angle between two rays that meet different disks (enough to
+/// reach round-off).
+const BISECTIONS: usize = 64;
 
 /// Which faces of the particles lining a hole the hole pressure loads (see the module
 /// docs).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub enum WallFaces {
-    /// The faces seen from the hole centre (3600 rays).
+    /// The faces seen from the hole centre (3600 rays), closed by gap segments.
     #[default]
     Rays,
     /// The faces a fluid filling the hole wets, notches and connected pockets included.
@@ -65,8 +83,9 @@ pub struct PressureWall {
     pub centre: [f64; 2],
     /// Radius of the hole (m).
     pub radius: f64,
-    /// Each lining particle and its load per unit pressure `a Δφ Σ e_k` (m).
-    pub members: Vec<(u32, [f64; 2])>,
+    /// Each lining particle and its load per unit pressure `[f_x, f_y, m]` (m, m²): the
+    /// force and the moment about the particle's centre.
+    pub members: Vec<(u32, [f64; 3])>,
     /// Pressure (Pa).
     pub pressure: f64,
 }
@@ -95,7 +114,7 @@ impl PressureWall {
         let members = load
             .iter()
             .enumerate()
-            .filter(|(_, l)| l[0] != 0.0 || l[1] != 0.0)
+            .filter(|(_, l)| l.iter().any(|&v| v != 0.0))
             .map(|(i, l)| (i as u32, *l))
             .collect();
         Ok(Self {
@@ -107,10 +126,10 @@ impl PressureWall {
     }
 }
 
-/// Load per unit pressure of every disk on the faces seen from the centre.
-fn ray_loads(disks: &Disks, centre: [f64; 2], radius: f64) -> Result<Vec<[f64; 2]>, LsmError> {
+/// Load per unit pressure `[f_x, f_y, m]` of every disk on the closed contour of the
+/// faces seen from the centre (see the module docs).
+fn ray_loads(disks: &Disks, centre: [f64; 2], radius: f64) -> Result<Vec<[f64; 3]>, LsmError> {
     let n = disks.len();
-    let mut load = vec![[0.0f64; 2]; n];
     let dphi = std::f64::consts::TAU / RAYS as f64;
     // Candidates: disks whose near side is within the largest diameter of the hole.
     let rmax = disks.radius_range()[1];
@@ -120,46 +139,119 @@ fn ray_loads(disks: &Disks, centre: [f64; 2], radius: f64) -> Result<Vec<[f64; 2
             d - disks.r[i] < radius + 2.0 * rmax
         })
         .collect();
-    let mut hit_any = false;
-    for k in 0..RAYS {
-        let phi = (k as f64 + 0.5) * dphi;
-        let e = [phi.cos(), phi.sin()];
-        let mut best: Option<(f64, usize)> = None;
-        for &i in &near {
-            let q = [disks.x[i][0] - centre[0], disks.x[i][1] - centre[1]];
-            let along = q[0] * e[0] + q[1] * e[1];
-            let perp2 = q[0] * q[0] + q[1] * q[1] - along * along;
-            let r2 = disks.r[i] * disks.r[i];
-            if along > 0.0 && perp2 < r2 {
-                let s = along - (r2 - perp2).sqrt();
-                if best.is_none_or(|(b, _)| s < b) {
-                    best = Some((s, i));
-                }
-            }
-        }
-        if let Some((_, i)) = best {
-            load[i][0] += radius * dphi * e[0];
-            load[i][1] += radius * dphi * e[1];
-            hit_any = true;
-        }
-    }
-    if !hit_any {
+    let ray = |phi: f64| -> Option<(usize, [f64; 2])> {
+        first_hit(disks, &near, centre, [phi.cos(), phi.sin()])
+    };
+    let disk = |h: &Option<(usize, [f64; 2])>| h.map(|(i, _)| i);
+    let hits: Vec<_> = (0..RAYS).map(|k| ray((k as f64 + 0.5) * dphi)).collect();
+    if hits.iter().all(Option::is_none) {
         return Err(LsmError::bad(
             "hole radius",
             radius,
             "no particle lines the hole",
         ));
     }
+    // The contour's vertices in the order of their angle: every hit, and where the first
+    // disk changes between two rays, the ends of the two faces found by bisection.
+    let mut verts: Vec<(usize, [f64; 2])> = Vec::with_capacity(RAYS + 64);
+    for k in 0..RAYS {
+        let (a, b) = (hits[k], hits[(k + 1) % RAYS]);
+        if let Some(v) = a {
+            verts.push(v);
+        }
+        if disk(&a) == disk(&b) {
+            continue;
+        }
+        // The last hit on a's face, then the first on b's (a ray between them may meet
+        // neither: a gap, a disk too small for the rays, or the tangent of two touching
+        // disks).
+        let phi = (k as f64 + 0.5) * dphi;
+        let (end_a, _) = bisect(phi, phi + dphi, &ray, |h| disk(h) == disk(&a));
+        let (_, start_b) = bisect(phi, phi + dphi, &ray, |h| disk(h) != disk(&b));
+        verts.extend(end_a);
+        verts.extend(start_b);
+    }
+    // The pressure on each edge A → B of the closed contour (outward normal (d_y, −d_x)
+    // times the length, d = B − A): on a disk's own face (a chord of its exposed arc)
+    // at the chord's midpoint, on a gap half at each end.
+    let mut load = vec![[0.0f64; 3]; n];
+    let mut push = |i: usize, at: [f64; 2], f: [f64; 2]| {
+        let q = [disks.x[i][0] - centre[0], disks.x[i][1] - centre[1]];
+        let arm = [at[0] - q[0], at[1] - q[1]];
+        let l = &mut load[i];
+        l[0] += f[0];
+        l[1] += f[1];
+        l[2] += arm[0] * f[1] - arm[1] * f[0];
+    };
+    for (k, &(i, a)) in verts.iter().enumerate() {
+        let (j, b) = verts[(k + 1) % verts.len()];
+        let f = [b[1] - a[1], a[0] - b[0]];
+        if i == j {
+            push(i, [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])], f);
+        } else {
+            let half = [0.5 * f[0], 0.5 * f[1]];
+            push(i, a, half);
+            push(j, b, half);
+        }
+    }
     Ok(load)
 }
 
-/// Load per unit pressure of every disk on its wetted faces (see the module docs).
+/// Bisection of the angles `[lo, hi]` for the change of `low_side` (true at `lo`, false
+/// at `hi`) along the first hits of `ray`: the hits on either side of it, to round-off.
+fn bisect<H: Copy>(
+    mut lo: f64,
+    mut hi: f64,
+    ray: &impl Fn(f64) -> H,
+    low_side: impl Fn(&H) -> bool,
+) -> (H, H) {
+    let (mut at_lo, mut at_hi) = (ray(lo), ray(hi));
+    for _ in 0..BISECTIONS {
+        let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi {
+            break;
+        }
+        let h = ray(mid);
+        if low_side(&h) {
+            (lo, at_lo) = (mid, h);
+        } else {
+            (hi, at_hi) = (mid, h);
+        }
+    }
+    (at_lo, at_hi)
+}
+
+/// The first of the disks `near` that the ray from `centre` in the unit direction `e`
+/// meets, and the point where it meets it (relative to `centre`).
+fn first_hit(
+    disks: &Disks,
+    near: &[usize],
+    centre: [f64; 2],
+    e: [f64; 2],
+) -> Option<(usize, [f64; 2])> {
+    let mut best: Option<(f64, usize)> = None;
+    for &i in near {
+        let q = [disks.x[i][0] - centre[0], disks.x[i][1] - centre[1]];
+        let along = q[0] * e[0] + q[1] * e[1];
+        let perp2 = q[0] * q[0] + q[1] * q[1] - along * along;
+        let r2 = disks.r[i] * disks.r[i];
+        if along > 0.0 && perp2 < r2 {
+            let s = along - (r2 - perp2).sqrt();
+            if best.is_none_or(|(b, _)| s < b) {
+                best = Some((s, i));
+            }
+        }
+    }
+    best.map(|(s, i)| (i, [s * e[0], s * e[1]]))
+}
+
+/// Load per unit pressure `[f_x, f_y, 0]` of every disk on its wetted faces (see the module docs).
 fn wetted_loads(
     disks: &Disks,
     centre: [f64; 2],
     h: f64,
     seal: f64,
-) -> Result<Vec<[f64; 2]>, LsmError> {
+) -> Result<Vec<[f64; 3]>, LsmError> {
     if !(h.is_finite() && h > 0.0) {
         return Err(LsmError::bad("wall spacing", h, "must be positive"));
     }
@@ -272,7 +364,7 @@ fn wetted_loads(
     let load = (0..n)
         .map(|i| {
             let (c, r) = (disks.x[i], seal * disks.r[i]);
-            let mut l = [0.0; 2];
+            let mut l = [0.0; 3];
             for m in 0..ARC_POINTS {
                 let th = (m as f64 + 0.5) * dth;
                 let e = [th.cos(), th.sin()];
