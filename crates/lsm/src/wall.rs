@@ -2,27 +2,21 @@
 //! particles that line it.
 //!
 //! **Faces seen from the centre** ([`WallFaces::Rays`], the default). The hole of centre
-//! `c` and radius `a` is swept by `N = 3600` rays from `c`; each ray of direction `e_k`
-//! meets a first disk among those whose near side lies within `a + 2 r_max` of `c`. The
-//! hole's boundary is the closed contour through these first hits in the order of their
-//! angle: along one disk, chords of its exposed arc; where the first disk changes between
-//! two rays, the ends of both faces are found by bisection of the angle (to round-off, so
-//! an arc ends where it is tangent to the ray or where the next disk hides it), and a
-//! straight gap segment joins them — also across rays that pass between the lining disks
-//! and meet none. The pressure on an edge `A → B` of the contour is `p (d_y, −d_x)`,
-//! `d = B − A` (the outward normal times the length). On a chord of one disk it acts at
-//! the chord's midpoint, whose normal passes through the disk's centre: it is the exact
-//! pressure integral over the arc between the two points (`p` times the chord, normal to
-//! it), with no moment. On a gap segment each of the two disks it joins takes half at its
-//! own end, with the moment `(x_end − x_i) × f/2` about its centre; the two halves have the
-//! moment of the whole about any point (`(A + B)/2 × f = A × f/2 + B × f/2`). The contour
-//! being closed, `Σ f = p rot(Σ d) = 0` and `Σ x × f = −p/2 Σ (|B|² − |A|²) = 0`: the loads
-//! have neither net force nor net torque, to round-off, on any packing and hole position
-//! and for any number of rays. A ring of N touching equal disks around the centre receives
-//! `p · 2 D cos(π/N) sin(π/N)` per disk outwards (D the radius of their centres: the chord
-//! between the contacts), so the thick-cylinder closed form of the tangential stress at the
-//! wall, `σ_θθ = p (b² + a²)/(b² − a²)` for a disk of outer radius b, holds with the hole's
-//! effective radius (the breakdown check). The loads are taken once, in the reference
+//! `c` and radius `a` is swept by `N = 3600` equally spaced rays from `c`; each ray of
+//! direction `e_k` meets a first disk among those whose near side lies within
+//! `a + 2 r_max` of `c`. The pressure on the arc `a Δφ` of the hole's circle, `Δφ = 2π/N`,
+//! pushes along the ray: the disk receives the force `p a Δφ e_k` and, the line of action
+//! passing through `c` and not through the disk's centre `x_i`, the moment
+//! `(c − x_i) × p a Δφ e_k` (the lsm solid integrates spins). A ray that meets no disk
+//! (it passes between the lining disks) gives half its arc to the disk met by the
+//! nearest ray before it and half to the one after it, along its own line of action.
+//! The arcs of all rays close the circle: the forces sum to `p a Δφ Σ_k e_k = 0` and
+//! every line of action passes through `c`, so the loads have neither net force nor net
+//! torque (about `c`, and so about any point), to round-off, on any packing and hole
+//! position. A disk seen over the angles `±β` about its own direction receives
+//! `p · 2a sin β` outwards (the hoop load of the smooth hole of radius `a`), so the
+//! tangential stress at the wall is `σ_θθ(a) = p (b² + a²)/(b² − a²)` for a disk of outer
+//! radius b (the closed-form breakdown check). The loads are taken once, in the reference
 //! configuration (small strains).
 //!
 //! **Wetted faces** ([`WallFaces::Wetted`]). A fluid filling the hole does not stop at the
@@ -48,15 +42,13 @@ use porofrac_particles::Disks;
 
 /// Rays per wall.
 const RAYS: usize = 3600;
-/// Most bisections of the angle between two rays that meet different disks (enough to
-/// reach round-off).
-const BISECTIONS: usize = 64;
 
 /// Which faces of the particles lining a hole the hole pressure loads (see the module
 /// docs).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub enum WallFaces {
-    /// The faces seen from the hole centre (3600 rays), closed by gap segments.
+    /// The faces seen from the hole centre (3600 rays; a ray passing between the disks
+    /// loads its two neighbours).
     #[default]
     Rays,
     /// The faces a fluid filling the hole wets, notches and connected pockets included.
@@ -126,8 +118,8 @@ impl PressureWall {
     }
 }
 
-/// Load per unit pressure `[f_x, f_y, m]` of every disk on the closed contour of the
-/// faces seen from the centre (see the module docs).
+/// Load per unit pressure `[f_x, f_y, m]` of every disk from the rays (see the module
+/// docs).
 fn ray_loads(disks: &Disks, centre: [f64; 2], radius: f64) -> Result<Vec<[f64; 3]>, LsmError> {
     let n = disks.len();
     let dphi = std::f64::consts::TAU / RAYS as f64;
@@ -139,96 +131,60 @@ fn ray_loads(disks: &Disks, centre: [f64; 2], radius: f64) -> Result<Vec<[f64; 3
             d - disks.r[i] < radius + 2.0 * rmax
         })
         .collect();
-    let ray = |phi: f64| -> Option<(usize, [f64; 2])> {
-        first_hit(disks, &near, centre, [phi.cos(), phi.sin()])
+    let dir = |k: usize| {
+        let phi = (k as f64 + 0.5) * dphi;
+        [phi.cos(), phi.sin()]
     };
-    let disk = |h: &Option<(usize, [f64; 2])>| h.map(|(i, _)| i);
-    let hits: Vec<_> = (0..RAYS).map(|k| ray((k as f64 + 0.5) * dphi)).collect();
-    if hits.iter().all(Option::is_none) {
+    let hits: Vec<Option<usize>> = (0..RAYS)
+        .map(|k| first_hit(disks, &near, centre, dir(k)))
+        .collect();
+    let Some(last) = hits.iter().rev().find_map(|h| *h) else {
         return Err(LsmError::bad(
             "hole radius",
             radius,
             "no particle lines the hole",
         ));
-    }
-    // The contour's vertices in the order of their angle: every hit, and where the first
-    // disk changes between two rays, the ends of the two faces found by bisection.
-    let mut verts: Vec<(usize, [f64; 2])> = Vec::with_capacity(RAYS + 64);
+    };
+    // The disks met before and after each ray (cyclically), for the rays that meet none.
+    let mut before = vec![last; RAYS];
+    let mut prev = last;
     for k in 0..RAYS {
-        let (a, b) = (hits[k], hits[(k + 1) % RAYS]);
-        if let Some(v) = a {
-            verts.push(v);
-        }
-        if disk(&a) == disk(&b) {
-            continue;
-        }
-        // The last hit on a's face, then the first on b's (a ray between them may meet
-        // neither: a gap, a disk too small for the rays, or the tangent of two touching
-        // disks).
-        let phi = (k as f64 + 0.5) * dphi;
-        let (end_a, _) = bisect(phi, phi + dphi, &ray, |h| disk(h) == disk(&a));
-        let (_, start_b) = bisect(phi, phi + dphi, &ray, |h| disk(h) != disk(&b));
-        verts.extend(end_a);
-        verts.extend(start_b);
+        prev = hits[k].unwrap_or(prev);
+        before[k] = prev;
     }
-    // The pressure on each edge A → B of the closed contour (outward normal (d_y, −d_x)
-    // times the length, d = B − A): on a disk's own face (a chord of its exposed arc)
-    // at the chord's midpoint, on a gap half at each end.
+    let first = hits.iter().find_map(|h| *h).unwrap_or(last);
+    let mut after = vec![first; RAYS];
+    let mut next = first;
+    for k in (0..RAYS).rev() {
+        next = hits[k].unwrap_or(next);
+        after[k] = next;
+    }
+    // The arc `a Δφ` of each ray pushes along the ray: the force `a Δφ e_k` and its
+    // moment about the disk's centre, the line of action passing through the hole centre.
     let mut load = vec![[0.0f64; 3]; n];
-    let mut push = |i: usize, at: [f64; 2], f: [f64; 2]| {
+    let mut push = |i: usize, share: f64, e: [f64; 2]| {
+        let f = [share * radius * dphi * e[0], share * radius * dphi * e[1]];
         let q = [disks.x[i][0] - centre[0], disks.x[i][1] - centre[1]];
-        let arm = [at[0] - q[0], at[1] - q[1]];
         let l = &mut load[i];
         l[0] += f[0];
         l[1] += f[1];
-        l[2] += arm[0] * f[1] - arm[1] * f[0];
+        l[2] -= q[0] * f[1] - q[1] * f[0];
     };
-    for (k, &(i, a)) in verts.iter().enumerate() {
-        let (j, b) = verts[(k + 1) % verts.len()];
-        let f = [b[1] - a[1], a[0] - b[0]];
-        if i == j {
-            push(i, [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])], f);
-        } else {
-            let half = [0.5 * f[0], 0.5 * f[1]];
-            push(i, a, half);
-            push(j, b, half);
+    for (k, hit) in hits.iter().enumerate() {
+        match hit {
+            Some(i) => push(*i, 1.0, dir(k)),
+            None => {
+                push(before[k], 0.5, dir(k));
+                push(after[k], 0.5, dir(k));
+            }
         }
     }
     Ok(load)
 }
 
-/// Bisection of the angles `[lo, hi]` for the change of `low_side` (true at `lo`, false
-/// at `hi`) along the first hits of `ray`: the hits on either side of it, to round-off.
-fn bisect<H: Copy>(
-    mut lo: f64,
-    mut hi: f64,
-    ray: &impl Fn(f64) -> H,
-    low_side: impl Fn(&H) -> bool,
-) -> (H, H) {
-    let (mut at_lo, mut at_hi) = (ray(lo), ray(hi));
-    for _ in 0..BISECTIONS {
-        let mid = 0.5 * (lo + hi);
-        if mid <= lo || mid >= hi {
-            break;
-        }
-        let h = ray(mid);
-        if low_side(&h) {
-            (lo, at_lo) = (mid, h);
-        } else {
-            (hi, at_hi) = (mid, h);
-        }
-    }
-    (at_lo, at_hi)
-}
-
 /// The first of the disks `near` that the ray from `centre` in the unit direction `e`
-/// meets, and the point where it meets it (relative to `centre`).
-fn first_hit(
-    disks: &Disks,
-    near: &[usize],
-    centre: [f64; 2],
-    e: [f64; 2],
-) -> Option<(usize, [f64; 2])> {
+/// meets.
+fn first_hit(disks: &Disks, near: &[usize], centre: [f64; 2], e: [f64; 2]) -> Option<usize> {
     let mut best: Option<(f64, usize)> = None;
     for &i in near {
         let q = [disks.x[i][0] - centre[0], disks.x[i][1] - centre[1]];
@@ -242,7 +198,7 @@ fn first_hit(
             }
         }
     }
-    best.map(|(s, i)| (i, [s * e[0], s * e[1]]))
+    best.map(|(_, i)| i)
 }
 
 /// Load per unit pressure `[f_x, f_y, 0]` of every disk on its wetted faces (see the module docs).

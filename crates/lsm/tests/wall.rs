@@ -1,10 +1,9 @@
 //! The pressure wall of a hole against closed forms, on a ring of N equal disks of radius
 //! R whose centres lie on the circle of radius D = R / sin(π/N) (neighbours touch).
 //!
-//! * Faces seen from the centre ([`WallFaces::Rays`]): each disk is seen between its two
-//!   contacts, at radius `D cos(π/N)` and angles ±π/N, so it receives the pressure on
-//!   the chord between them, `p · 2 D cos(π/N) sin(π/N)` outwards, no tangential part
-//!   and no moment (whatever the hole radius given).
+//! * Faces seen from the centre ([`WallFaces::Rays`]): each disk subtends ±π/N, so it
+//!   receives `p · 2a sin(π/N)` outwards (a the hole radius given), no tangential part
+//!   and no moment (the midpoint sum of the rays: within 1e-6).
 //! * Wetted faces ([`WallFaces::Wetted`], disks enlarged by s): neighbouring enlarged
 //!   circles cross at radius `r_c = D cos(π/N) − √((sR)² − R²)` on the bisector, so
 //!   the wetted arc of each disk runs between two points at radius `r_c` and angles
@@ -69,7 +68,7 @@ fn ring_loads_match_the_closed_forms() {
         },
     )
     .unwrap();
-    let (want_rays, want_wet) = (2.0 * d * half.cos() * half.sin(), 2.0 * rc * half.sin());
+    let (want_rays, want_wet) = (2.0 * a * half.sin(), 2.0 * rc * half.sin());
     let mut worst: [f64; 2] = [0.0; 2];
     for i in 0..N {
         let (rr, rt, rm) = parts(&disks, &rays, i);

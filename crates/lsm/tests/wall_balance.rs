@@ -1,8 +1,9 @@
-//! The hole pressure of the faces seen from the centre ([`WallFaces::Rays`]) is a closed
-//! contour's pressure integral: over any packing and any hole position its loads have no
-//! net force and no net torque (about the hole centre, and so about any point), to
-//! round-off — net force / (p · 2a) and net torque / (p a²) below 1e-12 — also when rays
-//! pass between the lining disks or most rays meet nothing.
+//! The hole pressure of the faces seen from the centre ([`WallFaces::Rays`]) is the
+//! pressure on the closed circle of the hole, each arc pushing along its ray: over any
+//! packing and any hole position its loads have no net force and no net torque (about
+//! the hole centre, and so about any point), to round-off — net force / (p · 2a) and net
+//! torque / (p a²) below 1e-12 — also when rays pass between the lining disks or most
+//! rays meet nothing.
 
 use porofrac_lsm::{PressureWall, WallFaces};
 use porofrac_particles::packing::{Hole, Region};
@@ -76,7 +77,7 @@ proptest! {
         }
     }
 
-    /// A few scattered disks: most rays meet nothing and the contour bridges the gaps.
+    /// A few scattered disks: most rays meet nothing and their neighbours take their load.
     #[test]
     fn a_sparse_lining_is_balanced_too(
         xs in proptest::collection::vec((-4.0f64..4.0, -4.0f64..4.0, 0.1f64..0.8), 1..12),
