@@ -201,7 +201,8 @@ fn first_hit(disks: &Disks, near: &[usize], centre: [f64; 2], e: [f64; 2]) -> Op
     best.map(|(_, i)| i)
 }
 
-/// Load per unit pressure `[f_x, f_y, 0]` of every disk on its wetted faces (see the module docs).
+/// Load per unit pressure `[f_x, f_y, 0]` of every disk on its wetted faces (see the
+/// module docs).
 fn wetted_loads(
     disks: &Disks,
     centre: [f64; 2],
