@@ -377,6 +377,7 @@ impl LatticeSolid {
                 let l = &mut self.loads[i as usize];
                 l[0] += w.pressure * a[0];
                 l[1] += w.pressure * a[1];
+                l[2] += w.pressure * a[2];
             }
         }
         // The force of the current configuration follows the new loads.

@@ -1,14 +1,23 @@
-//! Pressure on the wall of a circular hole (a borehole), as forces on the particles
-//! that line it.
+//! Pressure on the wall of a circular hole (a borehole), as forces and moments on the
+//! particles that line it.
 //!
-//! The hole of centre `c` and radius `a` is swept by `N = 3600` rays from `c`; each ray
-//! of direction `e_k` hits a first disk (the nearest intersection). The pressure on the
-//! arc `a Δφ` of the ray, `Δφ = 2π/N`, pushes that disk outwards: the disk receives
-//! `p a Δφ Σ_k e_k` over its rays. The forces sum to the pressure integral
-//! `∮ p n a dφ` over the wall (zero in total, the hoop load of the continuum on each
-//! side), so the tangential stress at the wall is `σ_θθ(a) = p (b² + a²)/(b² − a²)` for a
-//! disk of outer radius b (the closed-form breakdown check). The set is taken once, in the
-//! reference configuration (small strains).
+//! **Faces seen from the centre** ([`WallFaces::Rays`], the default). The hole of centre
+//! `c` and radius `a` is swept by `N = 3600` equally spaced rays from `c`; each ray of
+//! direction `e_k` meets a first disk among those whose near side lies within
+//! `a + 2 r_max` of `c`. The pressure on the arc `a Δφ` of the hole's circle, `Δφ = 2π/N`,
+//! pushes along the ray: the disk receives the force `p a Δφ e_k` and, the line of action
+//! passing through `c` and not through the disk's centre `x_i`, the moment
+//! `(c − x_i) × p a Δφ e_k` (the lsm solid integrates spins). A ray that meets no disk
+//! (it passes between the lining disks) gives half its arc to the disk met by the
+//! nearest ray before it and half to the one after it, along its own line of action.
+//! The arcs of all rays close the circle: the forces sum to `p a Δφ Σ_k e_k = 0` and
+//! every line of action passes through `c`, so the loads have neither net force nor net
+//! torque (about `c`, and so about any point), to round-off, on any packing and hole
+//! position. A disk seen over the angles `±β` about its own direction receives
+//! `p · 2a sin β` outwards (the hoop load of the smooth hole of radius `a`), so the
+//! tangential stress at the wall is `σ_θθ(a) = p (b² + a²)/(b² − a²)` for a disk of outer
+//! radius b (the closed-form breakdown check). The loads are taken once, in the reference
+//! configuration (small strains).
 //!
 //! **Wetted faces** ([`WallFaces::Wetted`]). A fluid filling the hole does not stop at the
 //! faces seen from the centre: it enters every notch between the lining disks and every
@@ -38,7 +47,8 @@ const RAYS: usize = 3600;
 /// docs).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub enum WallFaces {
-    /// The faces seen from the hole centre (3600 rays).
+    /// The faces seen from the hole centre (3600 rays; a ray passing between the disks
+    /// loads its two neighbours).
     #[default]
     Rays,
     /// The faces a fluid filling the hole wets, notches and connected pockets included.
@@ -65,8 +75,9 @@ pub struct PressureWall {
     pub centre: [f64; 2],
     /// Radius of the hole (m).
     pub radius: f64,
-    /// Each lining particle and its load per unit pressure `a Δφ Σ e_k` (m).
-    pub members: Vec<(u32, [f64; 2])>,
+    /// Each lining particle and its load per unit pressure `[f_x, f_y, m]` (m, m²): the
+    /// force and the moment about the particle's centre.
+    pub members: Vec<(u32, [f64; 3])>,
     /// Pressure (Pa).
     pub pressure: f64,
 }
@@ -95,7 +106,7 @@ impl PressureWall {
         let members = load
             .iter()
             .enumerate()
-            .filter(|(_, l)| l[0] != 0.0 || l[1] != 0.0)
+            .filter(|(_, l)| l.iter().any(|&v| v != 0.0))
             .map(|(i, l)| (i as u32, *l))
             .collect();
         Ok(Self {
@@ -107,10 +118,10 @@ impl PressureWall {
     }
 }
 
-/// Load per unit pressure of every disk on the faces seen from the centre.
-fn ray_loads(disks: &Disks, centre: [f64; 2], radius: f64) -> Result<Vec<[f64; 2]>, LsmError> {
+/// Load per unit pressure `[f_x, f_y, m]` of every disk from the rays (see the module
+/// docs).
+fn ray_loads(disks: &Disks, centre: [f64; 2], radius: f64) -> Result<Vec<[f64; 3]>, LsmError> {
     let n = disks.len();
-    let mut load = vec![[0.0f64; 2]; n];
     let dphi = std::f64::consts::TAU / RAYS as f64;
     // Candidates: disks whose near side is within the largest diameter of the hole.
     let rmax = disks.radius_range()[1];
@@ -120,46 +131,84 @@ fn ray_loads(disks: &Disks, centre: [f64; 2], radius: f64) -> Result<Vec<[f64; 2
             d - disks.r[i] < radius + 2.0 * rmax
         })
         .collect();
-    let mut hit_any = false;
-    for k in 0..RAYS {
+    let dir = |k: usize| {
         let phi = (k as f64 + 0.5) * dphi;
-        let e = [phi.cos(), phi.sin()];
-        let mut best: Option<(f64, usize)> = None;
-        for &i in &near {
-            let q = [disks.x[i][0] - centre[0], disks.x[i][1] - centre[1]];
-            let along = q[0] * e[0] + q[1] * e[1];
-            let perp2 = q[0] * q[0] + q[1] * q[1] - along * along;
-            let r2 = disks.r[i] * disks.r[i];
-            if along > 0.0 && perp2 < r2 {
-                let s = along - (r2 - perp2).sqrt();
-                if best.is_none_or(|(b, _)| s < b) {
-                    best = Some((s, i));
-                }
-            }
-        }
-        if let Some((_, i)) = best {
-            load[i][0] += radius * dphi * e[0];
-            load[i][1] += radius * dphi * e[1];
-            hit_any = true;
-        }
-    }
-    if !hit_any {
+        [phi.cos(), phi.sin()]
+    };
+    let hits: Vec<Option<usize>> = (0..RAYS)
+        .map(|k| first_hit(disks, &near, centre, dir(k)))
+        .collect();
+    let Some(last) = hits.iter().rev().find_map(|h| *h) else {
         return Err(LsmError::bad(
             "hole radius",
             radius,
             "no particle lines the hole",
         ));
+    };
+    // The disks met before and after each ray (cyclically), for the rays that meet none.
+    let mut before = vec![last; RAYS];
+    let mut prev = last;
+    for k in 0..RAYS {
+        prev = hits[k].unwrap_or(prev);
+        before[k] = prev;
+    }
+    let first = hits.iter().find_map(|h| *h).unwrap_or(last);
+    let mut after = vec![first; RAYS];
+    let mut next = first;
+    for k in (0..RAYS).rev() {
+        next = hits[k].unwrap_or(next);
+        after[k] = next;
+    }
+    // The arc `a Δφ` of each ray pushes along the ray: the force `a Δφ e_k` and its
+    // moment about the disk's centre, the line of action passing through the hole centre.
+    let mut load = vec![[0.0f64; 3]; n];
+    let mut push = |i: usize, share: f64, e: [f64; 2]| {
+        let f = [share * radius * dphi * e[0], share * radius * dphi * e[1]];
+        let q = [disks.x[i][0] - centre[0], disks.x[i][1] - centre[1]];
+        let l = &mut load[i];
+        l[0] += f[0];
+        l[1] += f[1];
+        l[2] -= q[0] * f[1] - q[1] * f[0];
+    };
+    for (k, hit) in hits.iter().enumerate() {
+        match hit {
+            Some(i) => push(*i, 1.0, dir(k)),
+            None => {
+                push(before[k], 0.5, dir(k));
+                push(after[k], 0.5, dir(k));
+            }
+        }
     }
     Ok(load)
 }
 
-/// Load per unit pressure of every disk on its wetted faces (see the module docs).
+/// The first of the disks `near` that the ray from `centre` in the unit direction `e`
+/// meets.
+fn first_hit(disks: &Disks, near: &[usize], centre: [f64; 2], e: [f64; 2]) -> Option<usize> {
+    let mut best: Option<(f64, usize)> = None;
+    for &i in near {
+        let q = [disks.x[i][0] - centre[0], disks.x[i][1] - centre[1]];
+        let along = q[0] * e[0] + q[1] * e[1];
+        let perp2 = q[0] * q[0] + q[1] * q[1] - along * along;
+        let r2 = disks.r[i] * disks.r[i];
+        if along > 0.0 && perp2 < r2 {
+            let s = along - (r2 - perp2).sqrt();
+            if best.is_none_or(|(b, _)| s < b) {
+                best = Some((s, i));
+            }
+        }
+    }
+    best.map(|(_, i)| i)
+}
+
+/// Load per unit pressure `[f_x, f_y, 0]` of every disk on its wetted faces (see the
+/// module docs).
 fn wetted_loads(
     disks: &Disks,
     centre: [f64; 2],
     h: f64,
     seal: f64,
-) -> Result<Vec<[f64; 2]>, LsmError> {
+) -> Result<Vec<[f64; 3]>, LsmError> {
     if !(h.is_finite() && h > 0.0) {
         return Err(LsmError::bad("wall spacing", h, "must be positive"));
     }
@@ -272,7 +321,7 @@ fn wetted_loads(
     let load = (0..n)
         .map(|i| {
             let (c, r) = (disks.x[i], seal * disks.r[i]);
-            let mut l = [0.0; 2];
+            let mut l = [0.0; 3];
             for m in 0..ARC_POINTS {
                 let th = (m as f64 + 0.5) * dth;
                 let e = [th.cos(), th.sin()];
