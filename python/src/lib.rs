@@ -680,23 +680,7 @@ impl PyResult_ {
 /// peak). Process-wide and not undone; returns whether it was applied (Linux with glibc).
 #[pyfunction]
 fn retain_freed_memory() -> bool {
-    retain()
-}
-
-#[cfg(all(target_os = "linux", target_env = "gnu"))]
-#[allow(unsafe_code)]
-fn retain() -> bool {
-    // SAFETY: `mallopt` only sets allocator parameters; it is called with constants glibc
-    // documents, and glibc serialises it against concurrent allocation.
-    let no_mmap = unsafe { libc::mallopt(libc::M_MMAP_MAX, 0) } == 1;
-    // SAFETY: as above.
-    let no_trim = unsafe { libc::mallopt(libc::M_TRIM_THRESHOLD, i32::MAX) } == 1;
-    no_mmap && no_trim
-}
-
-#[cfg(not(all(target_os = "linux", target_env = "gnu")))]
-fn retain() -> bool {
-    false
+    porofrac_scene::common::heap::retain_freed_memory()
 }
 
 /// The extension module.

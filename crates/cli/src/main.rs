@@ -7,7 +7,6 @@
 //! finished steps' files are complete and `summary.json` says
 //! `"status": "interrupted at t = …"`).
 
-mod heap;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -81,7 +80,7 @@ enum Command {
 const INTERRUPTED: u8 = 130;
 
 fn main() -> ExitCode {
-    heap::retain_freed_memory();
+    porofrac_scene::common::heap::retain_freed_memory();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Keys {

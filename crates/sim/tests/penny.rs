@@ -36,6 +36,8 @@ use porofrac_mdem::{DemLaw, DemMode, MdemLaw};
 use porofrac_sim::crack_flow::cell_opening;
 use porofrac_sim::*;
 
+mod common;
+
 const A: f64 = 1.0;
 const E: f64 = 1.0e10;
 const NU: f64 = 0.25;
@@ -184,40 +186,8 @@ fn errors(n: usize, outer: f64) -> Errors {
     });
     let dofs = DofMap::new(&grid, &conditions, &[]).unwrap();
     let pattern = Pattern::new(&grid, &dofs).unwrap();
-    // The pressure's nodal forces p N_i on the band cells.
-    let mut full = vec![0.0; dofs.num_dofs()];
+    let u = common::open_band(&grid, &laws, &dofs, &pattern, &band, P);
     let mut nn = vec![Point::<3>::zeros(); 4];
-    for c in (0..grid.num_cells()).filter(|&c| band[c]) {
-        grid.cell_node_normals(c, &mut nn);
-        for (&i, ni) in grid.cell_nodes(c).iter().zip(&nn) {
-            for a in 0..3 {
-                full[3 * i + a] += P * ni[a];
-            }
-        }
-    }
-    let neq = dofs.num_equations();
-    let mut fext = vec![0.0; neq];
-    dofs.reduce_add(&full, &mut fext);
-    let fnorm = fext.iter().map(|v| v * v).sum::<f64>().sqrt();
-    // Newton on the piecewise-linear laws: ends when the stiffness of the solution is
-    // the one solved with (the residual is then at rounding).
-    let mut u = vec![0.0; dofs.num_dofs()];
-    let mut values = vec![0.0; pattern.nnz()];
-    let mut forces = vec![0.0; neq];
-    let mut solver = DirectSolver::new(&pattern).unwrap();
-    let mut converged = false;
-    for _ in 0..40 {
-        assemble(&grid, &laws, &dofs, &pattern, &u, &mut values, &mut forces).unwrap();
-        let mut r: Vec<f64> = fext.iter().zip(&forces).map(|(a, b)| a + b).collect();
-        if r.iter().map(|v| v * v).sum::<f64>().sqrt() <= 1e-9 * fnorm {
-            converged = true;
-            break;
-        }
-        solver.factorize(&pattern, &values).unwrap();
-        solver.solve_in_place(&mut r).unwrap();
-        dofs.scatter_add(&r, &mut u);
-    }
-    assert!(converged, "n = {n}: the open/closed edges did not settle");
 
     // The jump 2 u_z at the nodes of z = h/2 in the uniform part, weighted by the area
     // each node holds of the quarter plane (halved on the planes of symmetry).

@@ -29,6 +29,8 @@ use porofrac_mdem::{DemLaw, DemMode, MdemLaw};
 use porofrac_sim::crack_flow::cell_opening;
 use porofrac_sim::*;
 
+mod common;
+
 const A: f64 = 1.0;
 const E: f64 = 1.0e10;
 const NU: f64 = 0.25;
@@ -121,39 +123,8 @@ fn errors(n: usize) -> (f64, f64, f64) {
     };
     let dofs = DofMap::new(&grid, &[fixed], &[]).unwrap();
     let pattern = Pattern::new(&grid, &dofs).unwrap();
-    // The pressure's nodal forces p N_i on the band cells.
-    let mut full = vec![0.0; dofs.num_dofs()];
+    let u = common::open_band(&grid, &laws, &dofs, &pattern, &band, P);
     let mut nn = vec![Point::<2>::zeros(); 3];
-    for c in (0..grid.num_cells()).filter(|&c| band[c]) {
-        grid.cell_node_normals(c, &mut nn);
-        for (&i, ni) in grid.cell_nodes(c).iter().zip(&nn) {
-            full[2 * i] += P * ni[0];
-            full[2 * i + 1] += P * ni[1];
-        }
-    }
-    let neq = dofs.num_equations();
-    let mut fext = vec![0.0; neq];
-    dofs.reduce_add(&full, &mut fext);
-    let fnorm = fext.iter().map(|v| v * v).sum::<f64>().sqrt();
-    // Newton on the piecewise-linear laws: ends when the stiffness of the solution is
-    // the one solved with (the residual is then at rounding).
-    let mut u = vec![0.0; dofs.num_dofs()];
-    let mut values = vec![0.0; pattern.nnz()];
-    let mut forces = vec![0.0; neq];
-    let mut solver = DirectSolver::new(&pattern).unwrap();
-    let mut converged = false;
-    for _ in 0..40 {
-        assemble(&grid, &laws, &dofs, &pattern, &u, &mut values, &mut forces).unwrap();
-        let mut r: Vec<f64> = fext.iter().zip(&forces).map(|(a, b)| a + b).collect();
-        if r.iter().map(|v| v * v).sum::<f64>().sqrt() <= 1e-9 * fnorm {
-            converged = true;
-            break;
-        }
-        solver.factorize(&pattern, &values).unwrap();
-        solver.solve_in_place(&mut r).unwrap();
-        dofs.scatter_add(&r, &mut u);
-    }
-    assert!(converged, "n = {n}: the open/closed edges did not settle");
 
     // The jump across the band at its nodes (x = −a + i h), trapezoid weights.
     let node_at = |x: f64, y: f64| {

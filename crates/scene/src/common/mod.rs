@@ -1,7 +1,8 @@
 //! What every model of a scene shares: the loaded scene and its errors ([`loaded`]), the
 //! sections every model reads ([`sections`]), the [`model::Model`] trait and the loop that
 //! drives it ([`driver`]), the outputs ([`output`], [`sample`], [`plots`]), the bounds
-//! on what a scene may ask for ([`limits`], [`bounds`]), expressions ([`expr`]) and cell laws
+//! on what a scene may ask for ([`limits`], [`bounds`]), the heap policy of a process
+//! that runs scenes ([`heap`]), expressions ([`expr`]) and cell laws
 //! ([`laws`]); and what two models genuinely share: the particle packing and particle
 //! outputs of `nscd` and `lsm` ([`particles`], [`particle_output`],
 //! [`particle_plots`]), the lattice of `lbm` and of `lsm`'s fluid ([`lattice`]), the grid
@@ -15,6 +16,7 @@ pub mod checkpoint;
 pub mod driver;
 pub mod expr;
 pub mod grid;
+pub mod heap;
 pub mod keys;
 pub mod lattice;
 pub mod laws;

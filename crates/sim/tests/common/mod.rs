@@ -1,4 +1,5 @@
-//! Shared test helpers: a P1 simplex law, isotropic stiffness, grid perturbation.
+//! Shared test helpers: a P1 simplex law, isotropic stiffness, grid perturbation, a
+//! pressurized band of failed cells.
 #![allow(dead_code)]
 
 use nalgebra::{DMatrix, SMatrix};
@@ -183,4 +184,49 @@ pub fn side<const D: usize>(
 /// Relative difference `|a − b| / scale`.
 pub fn rel(a: f64, b: f64, scale: f64) -> f64 {
     (a - b).abs() / scale
+}
+
+/// The displacements of a body whose band of cells (`band[c]`, given a compression-only
+/// law that opens freely) is loaded by a uniform pressure `p` as the pore pressure of a
+/// failed cell: nodal forces `p N_i` (the cell's outward node normals), then Newton on the
+/// piecewise-linear laws until the stiffness of the solution is the one solved with (the
+/// residual at 1e-9 of the load). The sneddon and penny tests open their cracks with it.
+pub fn open_band<const D: usize>(
+    grid: &Grid<D>,
+    laws: &porofrac_sim::LawMap<'_, D>,
+    dofs: &porofrac_sim::DofMap<D>,
+    pattern: &porofrac_sim::Pattern,
+    band: &[bool],
+    p: f64,
+) -> Vec<f64> {
+    let mut full = vec![0.0; dofs.num_dofs()];
+    let mut nn = Vec::new();
+    for c in (0..grid.num_cells()).filter(|&c| band[c]) {
+        nn.resize(grid.cell_nodes(c).len(), Point::<D>::zeros());
+        grid.cell_node_normals(c, &mut nn);
+        for (&i, ni) in grid.cell_nodes(c).iter().zip(&nn) {
+            for a in 0..D {
+                full[D * i + a] += p * ni[a];
+            }
+        }
+    }
+    let neq = dofs.num_equations();
+    let mut fext = vec![0.0; neq];
+    dofs.reduce_add(&full, &mut fext);
+    let fnorm = fext.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let mut u = vec![0.0; dofs.num_dofs()];
+    let mut values = vec![0.0; pattern.nnz()];
+    let mut forces = vec![0.0; neq];
+    let mut solver = porofrac_sim::DirectSolver::new(pattern).unwrap();
+    for _ in 0..40 {
+        porofrac_sim::assemble(grid, laws, dofs, pattern, &u, &mut values, &mut forces).unwrap();
+        let mut r: Vec<f64> = fext.iter().zip(&forces).map(|(a, b)| a + b).collect();
+        if r.iter().map(|v| v * v).sum::<f64>().sqrt() <= 1e-9 * fnorm {
+            return u;
+        }
+        solver.factorize(pattern, &values).unwrap();
+        solver.solve_in_place(&mut r).unwrap();
+        dofs.scatter_add(&r, &mut u);
+    }
+    panic!("the open/closed edges of the band did not settle in 40 Newton steps");
 }

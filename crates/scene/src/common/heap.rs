@@ -1,4 +1,5 @@
-//! Heap policy of the `porofrac` process: keep freed memory for reuse.
+//! Heap policy of a process that runs scenes (the `porofrac` command, the Python
+//! package): keep freed memory for reuse.
 //!
 //! A solve allocates and frees many large arrays: the pattern's passes, the strength
 //! graph, aggregates and prolongators of each multigrid level, work vectors. glibc's
@@ -17,7 +18,8 @@
 //! resident size after a peak stays at the peak until the process ends, and repeated
 //! solves in one process can hold somewhat more than the largest live set (three E2 runs:
 //! 1.70–1.89 GB), which suits a batch simulation. A process-wide setting, so it belongs
-//! to the binary: `main` calls it first thing, before threads start. Elsewhere than Linux
+//! to the program: the command's `main` calls it first thing, before threads start, and
+//! the Python package offers it as `porofrac.retain_freed_memory()`. Elsewhere than Linux
 //! with glibc it does nothing.
 
 /// Keep freed heap memory in the process (see the module docs). Returns whether the
