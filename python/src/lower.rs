@@ -58,7 +58,15 @@ pub fn grid_read(py: Python<'_>, path: PathBuf, dim: Option<usize>) -> PyResult<
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
     let shown = path.display().to_string();
-    let at = |e: porofrac_grid::GridError| value_error(format!("grid file \"{shown}\": {e}"));
+    // The readers name the file (and the line) in most of their errors.
+    let at = |e: porofrac_grid::GridError| {
+        let m = e.to_string();
+        value_error(if m.contains(&shown) {
+            m
+        } else {
+            format!("grid file \"{shown}\": {m}")
+        })
+    };
     let deck = ext == "grdecl" || ext == "data";
     let dim = match (dim, deck) {
         (None | Some(3), true) => 3,
