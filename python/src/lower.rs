@@ -160,7 +160,11 @@ fn box_of<const D: usize>(
     }
     let mut n = [0; D];
     n.copy_from_slice(cells);
-    Ok((Point::<D>::from_column_slice(lo), Point::<D>::from_column_slice(hi), n))
+    Ok((
+        Point::<D>::from_column_slice(lo),
+        Point::<D>::from_column_slice(hi),
+        n,
+    ))
 }
 
 /// A generated box grid: `kind` `cartesian` (squares/cubes) or `simplices`
@@ -299,7 +303,8 @@ fn material_3(e: f64, nu: f64, plane_stress: bool) -> PyResult<Stiffness<3>> {
     if plane_stress {
         return Err(value_error("plane_stress: only for 2D cells"));
     }
-    Stiffness::<3>::isotropic(e, nu).map_err(|err| value_error(format!("E = {e}, nu = {nu}: {err}")))
+    Stiffness::<3>::isotropic(e, nu)
+        .map_err(|err| value_error(format!("E = {e}, nu = {nu}: {err}")))
 }
 
 /// The one-cell grid of a polygon (2D: `cell` the counter-clockwise node order, or all
@@ -362,7 +367,10 @@ pub fn vem_stiffness<'py>(
 fn simplex_2(points: Vec<Point<2>>) -> PyResult<Grid<2>> {
     let (a, b, c) = (points[0], points[1], points[2]);
     let ccw = (b - a).perp(&(c - a)) > 0.0;
-    one_cell_2(points, Some(if ccw { vec![0, 1, 2] } else { vec![0, 2, 1] }))
+    one_cell_2(
+        points,
+        Some(if ccw { vec![0, 1, 2] } else { vec![0, 2, 1] }),
+    )
 }
 
 fn simplex_3(points: Vec<Point<3>>) -> PyResult<Grid<3>> {
