@@ -30,6 +30,8 @@ import numpy as np
 from ._porofrac import RunError, SceneError, _Result, _Scene, __version__, retain_freed_memory
 
 __all__ = [
+    "grid",
+    "laws",
     "Scene",
     "Result",
     "Grid",
@@ -183,7 +185,9 @@ class Grid:
     every cell, cell after cell, ending at ``offsets``; ``cell_types`` VTK types
     (5 triangle, 9 quad, 7 polygon, 10 tetra, 42 polyhedron); ``faces`` /
     ``face_offsets`` the polyhedra's face streams (3D); ``tags`` cell tag name →
-    cell indices.
+    cell indices. Grids from :mod:`porofrac.grid` also have ``volumes`` (n_cells,)
+    cell volumes (m³; areas in 2D, m²) and ``centroids`` (n_cells, dim) cell centroids
+    (m); a run's grid has None there.
     """
 
     def __init__(self, d: Dict[str, Any]) -> None:
@@ -195,6 +199,8 @@ class Grid:
         self.faces: np.ndarray = d["faces"]
         self.face_offsets: np.ndarray = d["face_offsets"]
         self.tags: Dict[str, np.ndarray] = d["tags"]
+        self.volumes: Optional[np.ndarray] = d.get("volumes")
+        self.centroids: Optional[np.ndarray] = d.get("centroids")
 
     @property
     def num_cells(self) -> int:
@@ -371,3 +377,8 @@ class Result:
             f"Result({s.get('scene', '?')!r}, status={s.get('status', 'failed')!r}, "
             f"{len(self.times)} written steps)"
         )
+
+
+# The lower-level modules (grids without a scene, local cell-law matrices); imported last
+# because `grid` builds the `Grid` defined above.
+from . import grid, laws  # noqa: E402

@@ -6,6 +6,8 @@ from typing import Any, Callable, Dict, List, Optional, Union
 import numpy as np
 import numpy.typing as npt
 
+from . import grid as grid, laws as laws
+
 __version__: str
 
 PathLike = Union[str, os.PathLike[str]]
@@ -79,6 +81,10 @@ class Grid:
     faces: npt.NDArray[np.int64]
     face_offsets: npt.NDArray[np.int64]
     tags: Dict[str, npt.NDArray[np.int64]]
+    volumes: Optional[npt.NDArray[np.float64]]
+    """(n_cells,) cell volumes, m³ (areas in 2D, m²); grids of :mod:`porofrac.grid` only."""
+    centroids: Optional[npt.NDArray[np.float64]]
+    """(n_cells, dim) cell centroids, m; grids of :mod:`porofrac.grid` only."""
     @property
     def num_cells(self) -> int: ...
     def cells(self) -> List[npt.NDArray[np.int64]]:

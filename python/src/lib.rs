@@ -5,6 +5,8 @@
 //! these names and adds the helpers that need optional packages (pandas, meshio, pyvista,
 //! tqdm).
 
+mod lower;
+
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
@@ -539,6 +541,25 @@ fn int_array(py: Python<'_>, values: Vec<i64>) -> Bound<'_, PyAny> {
     PyArray1::from_vec(py, values).into_any()
 }
 
+/// A grid in VTK terms as the dict `porofrac.Grid` is made from (numpy arrays that own
+/// the mesh's buffers).
+fn mesh_dict(py: Python<'_>, m: Mesh) -> PyResult<Bound<'_, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("dim", m.dim)?;
+    d.set_item("points", array(py, m.points, 3)?)?;
+    d.set_item("connectivity", int_array(py, m.connectivity))?;
+    d.set_item("offsets", int_array(py, m.offsets))?;
+    d.set_item("cell_types", PyArray1::from_vec(py, m.cell_types))?;
+    d.set_item("faces", int_array(py, m.faces))?;
+    d.set_item("face_offsets", int_array(py, m.face_offsets))?;
+    let tags = PyDict::new(py);
+    for (name, cells) in m.tags {
+        tags.set_item(name, int_array(py, cells))?;
+    }
+    d.set_item("tags", tags)?;
+    Ok(d)
+}
+
 /// The result of a run (see `porofrac.Result`).
 #[pyclass(module = "porofrac._porofrac", name = "_Result")]
 struct PyResult_ {
@@ -643,20 +664,7 @@ impl PyResult_ {
         let grid = match obs.mesh {
             Some(m) => {
                 let m = Arc::try_unwrap(m).unwrap_or_else(|m| (*m).clone());
-                let d = PyDict::new(py);
-                d.set_item("dim", m.dim)?;
-                d.set_item("points", array(py, m.points, 3)?)?;
-                d.set_item("connectivity", int_array(py, m.connectivity))?;
-                d.set_item("offsets", int_array(py, m.offsets))?;
-                d.set_item("cell_types", PyArray1::from_vec(py, m.cell_types))?;
-                d.set_item("faces", int_array(py, m.faces))?;
-                d.set_item("face_offsets", int_array(py, m.face_offsets))?;
-                let tags = PyDict::new(py);
-                for (name, cells) in m.tags {
-                    tags.set_item(name, int_array(py, cells))?;
-                }
-                d.set_item("tags", tags)?;
-                Some(d.unbind())
+                Some(mesh_dict(py, m)?.unbind())
             }
             None => None,
         };
@@ -690,6 +698,11 @@ fn _porofrac(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyScene>()?;
     m.add_function(wrap_pyfunction!(retain_freed_memory, m)?)?;
     m.add_class::<PyResult_>()?;
+    m.add_function(wrap_pyfunction!(lower::grid_read, m)?)?;
+    m.add_function(wrap_pyfunction!(lower::grid_box, m)?)?;
+    m.add_function(wrap_pyfunction!(lower::grid_voronoi, m)?)?;
+    m.add_function(wrap_pyfunction!(lower::vem_stiffness, m)?)?;
+    m.add_function(wrap_pyfunction!(lower::simplex_stiffness, m)?)?;
     m.add("SceneError", py.get_type::<SceneError>())?;
     m.add("RunError", py.get_type::<RunError>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
