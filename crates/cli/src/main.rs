@@ -7,7 +7,6 @@
 //! finished steps' files are complete and `summary.json` says
 //! `"status": "interrupted at t = …"`).
 
-
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
