@@ -162,9 +162,12 @@ pub fn non_finite_outputs(out: &Path) -> Vec<String> {
 
 /// Measures that are `null` by definition when undefined (docs/models/nscd.md): the
 /// fault-propagation measures when no disk of the window moved or no band holds points.
-const UNDEFINED_BY_DEFINITION: [&str; 4] = [
+const UNDEFINED_BY_DEFINITION: [&str; 7] = [
     ".fault.limit_angle_deg",
     ".fault.limit_angle_points",
+    ".fault.limits.left_deg",
+    ".fault.limits.right_deg",
+    ".fault.limits.opening_deg",
     ".fault.run_out",
     ".fault.trishear",
 ];
