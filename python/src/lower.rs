@@ -167,6 +167,27 @@ fn box_of<const D: usize>(
     ))
 }
 
+/// The box grid of [`grid_box`] in `D` dimensions, generated without the GIL.
+fn box_grid<'py, const D: usize>(
+    py: Python<'py>,
+    lo: &[f64],
+    hi: &[f64],
+    cells: &[usize],
+    simplex: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (lo, hi, n) = box_of::<D>(lo, hi, cells)?;
+    let g = py
+        .detach(|| {
+            if simplex {
+                simplices(lo, hi, n)
+            } else {
+                cartesian(lo, hi, n)
+            }
+        })
+        .map_err(|e| value_error(format!("grid: {e}")))?;
+    grid_dict(py, &g)
+}
+
 /// A generated box grid: `kind` `cartesian` (squares/cubes) or `simplices`
 /// (triangles/tetrahedra), of `cells` cells per axis (2 or 3 axes).
 #[pyfunction]
@@ -183,34 +204,9 @@ pub fn grid_box(
         "simplices" => true,
         k => return Err(value_error(format!("kind = {k:?}: not a box grid"))),
     };
-    let at = |e: porofrac_grid::GridError| value_error(format!("grid: {e}"));
     let d = match cells.len() {
-        2 => {
-            let (lo, hi, n) = box_of::<2>(&lo, &hi, &cells)?;
-            let g = py
-                .detach(|| {
-                    if simplex {
-                        simplices(lo, hi, n)
-                    } else {
-                        cartesian(lo, hi, n)
-                    }
-                })
-                .map_err(at)?;
-            grid_dict(py, &g)?
-        }
-        3 => {
-            let (lo, hi, n) = box_of::<3>(&lo, &hi, &cells)?;
-            let g = py
-                .detach(|| {
-                    if simplex {
-                        simplices(lo, hi, n)
-                    } else {
-                        cartesian(lo, hi, n)
-                    }
-                })
-                .map_err(at)?;
-            grid_dict(py, &g)?
-        }
+        2 => box_grid::<2>(py, &lo, &hi, &cells, simplex)?,
+        3 => box_grid::<3>(py, &lo, &hi, &cells, simplex)?,
         n => {
             return Err(value_error(format!(
                 "cells: give 2 or 3 counts (one per axis), got {n}"
