@@ -292,6 +292,27 @@ fn dense_parallelism(k: usize) -> faer::Par {
     }
 }
 
+/// Multiply–adds of the numeric `LDLᵀ` factorisation ([`Ldlt::multiply_adds`]) from which
+/// it runs on all threads; below, on one. faer's parallel supernodal factorisation waits at
+/// spinning barriers, so on a machine busy with other work two threads are slower than one
+/// (the set-up of the solve on the plate, this 2-core machine at load 8, medians of 3
+/// `plate_hole run`: 0.19 against 0.08 s at 8,640 unknowns, 0.40 against 0.20 s at 24,000,
+/// 1.54 against 0.71 s at 61,440),
+/// while on an idle machine they gained at most 8 % up to 61,440 unknowns (1.46·10¹⁰
+/// multiply–adds; docs/BENCHMARKS.md). Above this size the factorisation dominates the run
+/// and two threads pay on an idle machine.
+pub const FACTOR_PARALLEL_MULTIPLY_ADDS: f64 = 2.5e10;
+
+/// The parallelism of the numeric factorisation analysed in `analysis`: one thread below
+/// [`FACTOR_PARALLEL_MULTIPLY_ADDS`], all threads from it on.
+fn factor_parallelism(analysis: &Ldlt) -> faer::Par {
+    if analysis.multiply_adds() >= FACTOR_PARALLEL_MULTIPLY_ADDS {
+        faer::Par::rayon(0)
+    } else {
+        faer::Par::Seq
+    }
+}
+
 /// LU with partial pivoting of a dense square matrix, factorised in place (no copy of
 /// the matrix beside its factors).
 struct DenseLu {
@@ -367,7 +388,10 @@ impl Factor {
         positive: usize,
     ) -> std::result::Result<Self, LdltError> {
         let (c, r, v) = upper;
-        let par = faer::Par::rayon(0);
+        let par = match &analysis {
+            Prepared::Analysis(a) => factor_parallelism(a),
+            Prepared::Single(s) => factor_parallelism(s.analysis()),
+        };
         let mut ldlt = match (precision, analysis) {
             (FactorPrecision::Double, Prepared::Analysis(a)) => a,
             (FactorPrecision::Double, Prepared::Single(s)) => s.into_analysis(),
@@ -712,8 +736,9 @@ fn analyse_last(
         ));
     }
     let prepared = if reserve {
+        let par = factor_parallelism(&analysis);
         let mut single = LdltSingle::new(analysis);
-        single.set_parallelism(faer::Par::rayon(0));
+        single.set_parallelism(par);
         single.reserve().map_err(ldlt_err)?;
         Prepared::Single(single)
     } else {
