@@ -87,7 +87,8 @@
 //! [`FACTOR_PARALLEL_MULTIPLY_ADDS`] and on all threads of the pool above: faer's parallel
 //! supernodal kernels synchronise at spinning barriers, which on a machine busy with other
 //! work made two threads twice as slow as one up to 61,440 unknowns on the plate, for a gain
-//! of at most 8 % on an idle machine. The factors are bitwise the same either way.
+//! of at most 8 % of the run on an idle machine. The solutions are bitwise the same either
+//! way (on the plate: tests/gmres.rs and the runs of docs/BENCHMARKS.md).
 
 //! **Choice.** [`LinearSolver::Auto`] takes, in 2D, [`LinearSolver::LdltSchur`] below
 //! [`AUTO_GMRES_EQUATIONS`] equations (with a dense block of order at most
@@ -301,12 +302,12 @@ fn dense_parallelism(k: usize) -> faer::Par {
 /// Multiply–adds of the numeric `LDLᵀ` factorisation ([`Ldlt::multiply_adds`]) from which
 /// it runs on all threads; below, on one. faer's parallel supernodal factorisation waits at
 /// spinning barriers, so on a machine busy with other work two threads are slower than one
-/// (the set-up of the solve on the plate, this 2-core machine at load 8, medians of 3
-/// `plate_hole run`: 0.19 against 0.08 s at 8,640 unknowns, 0.40 against 0.20 s at 24,000,
-/// 1.54 against 0.71 s at 61,440),
-/// while on an idle machine they gained at most 8 % up to 61,440 unknowns (1.46·10¹⁰
-/// multiply–adds; docs/BENCHMARKS.md). Above this size the factorisation dominates the run
-/// and two threads pay on an idle machine.
+/// (the set-up of the solve on the plate, 2 cores at load 8, medians of 3 `plate_hole
+/// run`: 0.19 against 0.08 s at 8,640 unknowns, 0.40 against 0.20 s at 24,000, 1.54
+/// against 0.71 s at 61,440), while on an idle machine they saved at most 8 % of the run up
+/// to 61,440 unknowns (1.46·10¹⁰ multiply–adds; docs/BENCHMARKS.md, "One thread for a small
+/// factorisation"). Above this size the factorisation dominates the run and two threads pay
+/// on an idle machine.
 pub const FACTOR_PARALLEL_MULTIPLY_ADDS: f64 = 2.5e10;
 
 /// The parallelism of the numeric factorisation analysed in `analysis`: one thread below
