@@ -115,16 +115,17 @@ fn check_wall_probes(ls: &LoadedScene) -> Result<(), SceneError> {
     let load = super::own(ls).loading.as_ref();
     let platens = load.is_some_and(|l| l.platens.is_some());
     let hole = load.is_some_and(|l| l.pressure_rate.is_some())
-        && ls.scene.particles.as_ref().is_some_and(|p| p.hole.is_some());
+        && ls
+            .scene
+            .particles
+            .as_ref()
+            .is_some_and(|p| p.hole.is_some());
     for (i, p) in ls.scene.output.probe.iter().enumerate() {
         let Some(name) = &p.wall else { continue };
         let key = ki("output.probe", i, &["wall"]);
         match name.as_str() {
             "top" | "bottom" if !platens => {
-                return Err(ls.error(
-                    &key,
-                    format!("= \"{name}\" needs [loading] platens"),
-                ));
+                return Err(ls.error(&key, format!("= \"{name}\" needs [loading] platens")));
             }
             "hole" if !hole => {
                 return Err(ls.error(
@@ -394,7 +395,10 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
                     format!("thickness = {} must be positive", p.thickness),
                 )
             })?;
-            let stop = [("stop_displacement", p.stop_displacement), ("stop_time", p.stop_time)];
+            let stop = [
+                ("stop_displacement", p.stop_displacement),
+                ("stop_time", p.stop_time),
+            ];
             if stop.iter().all(|(_, v)| v.is_some()) {
                 return Err(ls.error(
                     &key("platens"),

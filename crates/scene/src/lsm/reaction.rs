@@ -24,12 +24,11 @@ pub fn exerted_on(solid: &LatticeSolid, inside: &[bool], about: [f64; 2]) -> [f6
         out[1] += f[1];
         out[2] += r[0] * f[1] - r[1] * f[0] + m;
     };
-    let mut link = |i: usize, j: usize, f: [f64; 2], mi: f64, mj: f64| {
-        match (inside[i], inside[j]) {
-            (true, false) => add(i, f, mi),
-            (false, true) => add(j, [-f[0], -f[1]], mj),
-            _ => {}
-        }
+    let mut link = |i: usize, j: usize, f: [f64; 2], mi: f64, mj: f64| match (inside[i], inside[j])
+    {
+        (true, false) => add(i, f, mi),
+        (false, true) => add(j, [-f[0], -f[1]], mj),
+        _ => {}
     };
     for (b, f) in solid.bonds().iter().zip(solid.bond_forces()) {
         if b.intact {
