@@ -1,15 +1,19 @@
 //! The lattice solid model (P. Mora, Y. Wang, F. Alonso-Marroquin (2015), J. Earth Sci.
 //! 26(1); `[scene] model = "lsm"`): bonded disks ([`porofrac_lsm`]).
 //!
-//! - *build*: the disks of `[particles]` ([`crate::common::particles`]), the bond law of
+//! - *build*: the disks of `[particles]` ([`crate::common::particles`]) with their
+//!   initial velocities and spins (`[[particles.velocity]]`), the bond law of
 //!   `[bonds]` (E and ν through the hexagonal closed form, or k_n, k_s), `[contacts]`,
-//!   `[lsm]` (time step, damping, gravity) and `[loading]` (platens, a pressure ramp on
+//!   `[lsm]` (time step, damping, gravity) and `[loading]` (platens that may stop, a
+//!   pressure ramp on
 //!   the hole, on the faces seen from its centre or on the faces a fluid would wet,
 //!   [`porofrac_lsm::WallFaces`]); with `[bonds] calibrate = true` a uniaxial compression
 //!   and a Brazilian test of the same packing recipe first ([`porofrac_lsm::calibrate`]);
-//! - *step*: as many LSM steps as fit between two output times;
+//! - *step*: [`sub_steps`] equal LSM steps between two output times (whole steps of
+//!   `[lsm] dt` when the interval is a multiple of it);
 //! - *fields*: particle probes (`x y vx vy omega fx fy radius`), tracked cells (`p q
-//!   anisotropy anisotropy_volume dilation_x dilation_y contacts broken_bonds`), scene
+//!   anisotropy anisotropy_volume dilation_x dilation_y contacts broken_bonds torque`),
+//!   wall probes (`wall = "top" | "bottom" | "hole"`: `fx fy torque`, [`reaction`]), scene
 //!   probes (`pressure platen_force broken broken_tensile broken_shear crack_extent`), with `[lbm]`
 //!   fluid probes at a point (`fluid_pressure fluid_speed`, [`fluid::Fluid::point_values`]),
 //!   lines,
@@ -20,7 +24,7 @@
 //!   `broken.csv` (`time [s],i,j,x [m],y [m],mode`), with a pressurised hole `crack.csv`
 //!   ([`crack::CrackLog`]), field extrema and `summary.json` keys
 //!   (`particles`, `bonds`, `broken_bonds`, `broken_tensile`, `broken_shear`,
-//!   `contacts`, `lsm_steps`, `dt`, `stable_dt`, `bond_updates_per_second`,
+//!   `contacts`, `lsm_steps`, `dt`, `dt_used`, `stable_dt`, `bond_updates_per_second`,
 //!   `contact_updates_per_second`, `initiation_pressure`, `breakdown_pressure`,
 //!   `breakdown_extent`, `crack_extent`, `calibration`);
 //! - *plots*: probe series, `particles.png` (disks coloured by displacement, broken
