@@ -475,3 +475,45 @@ fn bad_platen_stops_and_walls_are_named() {
         assert!(e.contains(want), "{want}: {e}");
     }
 }
+
+/// A column of five bonded disks between the platens (the end disks), three of them
+/// free, locally damped: the platens stop after δ each and the column settles to the
+/// static closed form, four springs k_n in series shortened by 2δ: the platen force
+/// and the top platen's push on the rest are `k_n 2δ/4` (to 1e-6) and held there, the
+/// middle disk stays on the axis and at the centre.
+#[test]
+fn an_elastic_column_holds_the_force_of_its_stopped_platens() {
+    let (kn, delta) = (1.0e9, 1.0e-6);
+    let centres: Vec<[f64; 2]> = (0..5).map(|k| [0.0, f64::from(k)]).collect();
+    let text = format!(
+        "{HEAD}{}[bonds]\nkn = {kn:?}\nks = 0.4e9\n[lsm]\ndt = 1.0e-5\ndamping = \"local\"\n\
+         [loading]\nplatens = {{ velocity = 1.0e-3, thickness = 0.5, stop_time = 1.0e-3 }}\n\
+         [schedule]\nend_time = 0.2\ndt = 1.0e-2\n[output]\nvtk = false\n\
+         [[output.probe]]\nname = \"pf\"\nfield = \"platen_force\"\n{}{}{}{}",
+        list(&centres, 0.5),
+        wall_probe("fy", "fy", "top"),
+        wall_probe("fx", "fx", "top"),
+        probe("x2", "x", 2),
+        probe("y2", "y", 2),
+    );
+    let r = run("column", &text);
+    let want = kn * 2.0 * delta / 4.0;
+    let last = r.rows.last().unwrap();
+    assert!(
+        (last[1] - want).abs() <= 1e-6 * want,
+        "platen force {}",
+        last[1]
+    );
+    assert!((last[2] + want).abs() <= 1e-6 * want, "top fy {}", last[2]);
+    assert_eq!(last[3], 0.0);
+    assert_eq!(last[4], 0.0);
+    assert!((last[5] - 2.0).abs() <= 1e-12, "y2 {}", last[5]);
+    // Settled before the end and held.
+    let settled = &r.rows[r.rows.len() - 5];
+    assert!(
+        (settled[1] - want).abs() <= 1e-6 * want,
+        "at t = {}: {}",
+        settled[0],
+        settled[1]
+    );
+}
