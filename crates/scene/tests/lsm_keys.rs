@@ -87,8 +87,9 @@ fn list(centres: &[[f64; 2]], r: f64) -> String {
 
 /// An output interval of exactly 10 `[lsm] dt` (1e-4 s over dt = 1e-5 s; the old
 /// rounding up of the ratio, whose round-off alternates above and below 10, took 1055
-/// sub-steps over 100 intervals): every interval takes 10 sub-steps, 1000 in all, and
-/// `summary.json` reports the step used, dt itself.
+/// sub-steps over 100 intervals): 1000 sub-steps in all, and as no interval can take
+/// fewer than 10 (its ratio to dt is 10 up to round-off), every interval takes exactly
+/// 10; `summary.json` reports the step used, dt itself.
 #[test]
 fn an_interval_of_ten_dt_takes_ten_sub_steps() {
     let dt = 1e-5;
