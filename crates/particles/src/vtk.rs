@@ -7,7 +7,7 @@
 //!   the caller's extra scalars;
 //! * contacts: one line per contact between the two centres (or the centre and the
 //!   contact point on a rigid body), cell data `normal_force` (the active scalars),
-//!   `tangential_force`, `bonded` (`Int64` 0/1).
+//!   `tangential_force`, `bonded` (`Int64` 0/1), then the caller's extra scalars.
 //!
 //! Arrays are `format="binary"`: each is one base64 stream of a `UInt64` byte count
 //! followed by the little-endian values (`header_type="UInt64"`), which ParaView and the
@@ -98,7 +98,23 @@ pub fn write_particles_with(
 
 /// Write contacts as lines with cell data.
 pub fn write_contacts(path: &Path, lines: &[ContactLine]) -> Result<(), ParticleError> {
+    write_contacts_with(path, lines, &[])
+}
+
+/// Write contacts as lines with their cell data and the extra scalar cell data `extra`
+/// (name, one value per line; a bonded model's bending moments).
+pub fn write_contacts_with(
+    path: &Path,
+    lines: &[ContactLine],
+    extra: &[(&str, &[f64])],
+) -> Result<(), ParticleError> {
     let n = lines.len();
+    if let Some((name, v)) = extra.iter().find(|(_, v)| v.len() != n) {
+        return Err(ParticleError::Io {
+            path: path.display().to_string(),
+            message: format!("cell data `{name}` has {} values for {n} lines", v.len()),
+        });
+    }
     let points: Vec<f64> = lines
         .iter()
         .flat_map(|l| [l.a[0], l.a[1], 0.0, l.b[0], l.b[1], 0.0])
@@ -108,11 +124,12 @@ pub fn write_contacts(path: &Path, lines: &[ContactLine]) -> Result<(), Particle
     let normal: Vec<f64> = lines.iter().map(|l| l.normal_force).collect();
     let tangential: Vec<f64> = lines.iter().map(|l| l.tangential_force).collect();
     let bonded: Vec<i64> = lines.iter().map(|l| i64::from(l.bonded)).collect();
-    let arrays = [
+    let mut arrays = vec![
         DataArray::new("normal_force", 1, &normal[..]),
         DataArray::new("tangential_force", 1, &tangential[..]),
         DataArray::new("bonded", 1, &bonded[..]),
     ];
+    arrays.extend(extra.iter().map(|(name, v)| DataArray::new(name, 1, *v)));
     PolyData {
         points: &points,
         lines: CellArray {

@@ -10,7 +10,7 @@ use std::path::Path;
 use plotters::prelude::*;
 use porofrac_grid::io::PvdWriter;
 use porofrac_particles::Disks;
-use porofrac_particles::vtk::{ContactLine, write_contacts, write_particles_with};
+use porofrac_particles::vtk::{ContactLine, write_contacts_with, write_particles_with};
 
 use crate::common::loaded::LoadedScene;
 use crate::common::model::RunError;
@@ -137,6 +137,22 @@ pub fn write_vtk(
     lines: &[ContactLine],
     contacts_pvd: &RefCell<Option<PvdWriter>>,
 ) -> Result<String, RunError> {
+    write_vtk_with(ls, dir, index, time, d, extra, lines, &[], contacts_pvd)
+}
+
+/// [`write_vtk`] with extra cell data of the contact lines (`line_extra`: name, one
+/// value per line).
+pub fn write_vtk_with(
+    ls: &LoadedScene,
+    dir: &Path,
+    index: usize,
+    time: f64,
+    d: &Disks,
+    extra: &[(&str, &[f64])],
+    lines: &[ContactLine],
+    line_extra: &[(&str, &[f64])],
+    contacts_pvd: &RefCell<Option<PvdWriter>>,
+) -> Result<String, RunError> {
     let io = |e: porofrac_particles::ParticleError| {
         RunError::Output(crate::common::output::OutputError {
             path: dir.to_path_buf(),
@@ -146,7 +162,7 @@ pub fn write_vtk(
     let particles = format!("particles_{index:04}.vtp");
     let contacts = format!("contacts_{index:04}.vtp");
     write_particles_with(&dir.join(&particles), d, extra).map_err(io)?;
-    write_contacts(&dir.join(&contacts), lines).map_err(io)?;
+    write_contacts_with(&dir.join(&contacts), lines, line_extra).map_err(io)?;
     let mut pvd = contacts_pvd.borrow_mut();
     if pvd.is_none() {
         let parent = dir.parent().unwrap_or(Path::new("."));

@@ -55,14 +55,14 @@ impl ParticleVelocity {
     }
 }
 
-/// Check the `[[particles.velocity]]` tables of a scene of `model` (only model `nscd`
-/// reads them): at most one selection, a non-degenerate region, indices ≥ 0, and `v` or
+/// Check the `[[particles.velocity]]` tables of a scene of `model` (models `nscd` and
+/// `lsm` read them): at most one selection, a non-degenerate region, indices ≥ 0, and `v` or
 /// `omega` given as finite numbers or expressions that parse.
 pub fn check(ls: &LoadedScene, model: &str, tables: &[ParticleVelocity]) -> Result<(), SceneError> {
-    if !tables.is_empty() && model != "nscd" {
+    if !tables.is_empty() && !["nscd", "lsm"].contains(&model) {
         return Err(ls.error(
             &ki("particles.velocity", 0, &[]),
-            format!("belongs to model \"nscd\", not \"{model}\""),
+            format!("belongs to models \"nscd\" and \"lsm\", not \"{model}\""),
         ));
     }
     for (i, t) in tables.iter().enumerate() {

@@ -81,7 +81,9 @@ pub struct ParticlesSection {
     /// Instead of `region`: a polygon region, vertices in order (m).
     #[schemars(extend("unit" = "m"))]
     pub polygon: Option<Vec<[f64; 2]>>,
-    /// A circular hole left empty (a borehole): `{ center = [x, y], radius = a }`.
+    /// A circular hole left empty (a borehole): `{ center = [x, y], radius = a }`; the
+    /// disks overlapping it are left out (kind `list` too: the indices of the disks
+    /// then count the kept ones, in the listed order).
     #[schemars(extend("unit" = "m"))]
     pub hole: Option<CircleSpec>,
     /// Random: how radii are drawn (default uniform in `radius`).
@@ -92,7 +94,9 @@ pub struct ParticlesSection {
     #[schemars(extend("unit" = "m"))]
     pub radius_list: Option<Vec<f64>>,
     /// Initial velocities and spins of selected disks, one table per selection, applied
-    /// in the file's order (model nscd; after the settling when there is one).
+    /// in the file's order (model nscd: after the settling when there is one; model
+    /// lsm: before the bonds form, which a velocity does not change; platen disks take
+    /// the platens' velocity).
     #[serde(default)]
     pub velocity: Vec<crate::common::particle_velocity::ParticleVelocity>,
 }
@@ -203,6 +207,39 @@ pub fn hole(p: &ParticlesSection) -> Vec<Hole> {
         .collect()
 }
 
+/// `hole`, when given: a positive radius and a finite centre.
+fn check_hole(ls: &LoadedScene, p: &ParticlesSection) -> Result<(), SceneError> {
+    if let Some(h) = p.hole {
+        positive(ls, "hole", h.radius)?;
+        if !(h.center[0].is_finite() && h.center[1].is_finite()) {
+            return Err(ls.error(&k(&["particles", "hole"]), "center is not finite"));
+        }
+    }
+    Ok(())
+}
+
+/// The listed disks outside the hole of `[particles]` (all of them without one), in
+/// their listed order: a disk is cut when it overlaps the hole, as the generated
+/// packings are carved ([`porofrac_particles::packing::carve`]).
+fn list_outside_hole(p: &ParticlesSection) -> (Vec<[f64; 2]>, Vec<f64>) {
+    let centres = p.centres.clone().unwrap_or_default();
+    let radii = p.radii.clone().unwrap_or_default();
+    if p.hole.is_none() || centres.is_empty() {
+        return (centres, radii);
+    }
+    // A box holding every listed disk with a margin, so that only the hole cuts.
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for (c, &r) in centres.iter().zip(&radii) {
+        for a in 0..2 {
+            lo[a] = lo[a].min(c[a] - 2.0 * r);
+            hi[a] = hi[a].max(c[a] + 2.0 * r);
+        }
+    }
+    let packing = porofrac_particles::packing::Packing { centres, radii };
+    let kept = porofrac_particles::packing::carve(&packing, &Region::Box { lo, hi }, &hole(p));
+    (kept.centres, kept.radii)
+}
+
 /// Check `[particles]` of a scene of `model`.
 pub fn check(ls: &LoadedScene, model: &str) -> Result<(), SceneError> {
     let Some(p) = &ls.scene.particles else {
@@ -282,12 +319,7 @@ pub fn check(ls: &LoadedScene, model: &str) -> Result<(), SceneError> {
                     ));
                 }
             }
-            if let Some(h) = p.hole {
-                positive(ls, "hole", h.radius)?;
-                if !(h.center[0].is_finite() && h.center[1].is_finite()) {
-                    return Err(ls.error(&key("hole"), "center is not finite"));
-                }
-            }
+            check_hole(ls, p)?;
             let radius = match (p.distribution, p.radius, &p.radius_list) {
                 (Distribution::List, _, Some(list)) => {
                     if p.kind == ParticleKind::Hexagonal {
@@ -359,13 +391,13 @@ pub fn check(ls: &LoadedScene, model: &str) -> Result<(), SceneError> {
             for (f, set) in [
                 ("disk", p.disk.is_some()),
                 ("polygon", p.polygon.is_some()),
-                ("hole", p.hole.is_some()),
                 ("radius_list", p.radius_list.is_some()),
             ] {
                 if set {
                     return Err(ls.error(&key(f), "does not apply to kind = \"list\""));
                 }
             }
+            check_hole(ls, p)?;
             let (Some(c), Some(r)) = (&p.centres, &p.radii) else {
                 return Err(ls.error(
                     &key("centres"),
@@ -417,10 +449,7 @@ pub fn generate(ls: &LoadedScene, setup: &mut SetupPoll<'_>) -> Result<Disks, Ru
         .expect("checked: [particles] present");
     let key = |f: &str| k(&["particles", f]);
     let (centres, radii) = match p.kind {
-        ParticleKind::List => (
-            p.centres.clone().unwrap_or_default(),
-            p.radii.clone().unwrap_or_default(),
-        ),
+        ParticleKind::List => list_outside_hole(p),
         ParticleKind::Hexagonal | ParticleKind::Random => {
             let region = region(p).expect("checked");
             let holes = hole(p);

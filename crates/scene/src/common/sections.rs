@@ -783,7 +783,10 @@ pub struct Probe {
     pub obstacle: Option<String>,
     /// The `[[wall]]` (by `name`) whose reaction `fx fy torque` is probed: the force
     /// it exerts on the disks (N/m) and its moment about the wall's centroid (N·m/m).
-    #[schemars(extend("models" = ["nscd"]))]
+    /// Model lsm: `"top"` or `"bottom"` (a platen's force on the rest of the sample and
+    /// its moment about the platen's mean centre), `"hole"` (the hole pressure's force on
+    /// the lining and its moment about the hole centre).
+    #[schemars(extend("models" = ["nscd", "lsm"]))]
     pub wall: Option<String>,
 }
 

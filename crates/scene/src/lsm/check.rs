@@ -8,8 +8,10 @@ use porofrac_lsm::{BondLaw, LsmError};
 
 use super::file::{DampingChoice, NormalChoice};
 
-/// Fields of a tracked cell.
-pub const CELL_FIELDS: [&str; 8] = [
+/// Fields of a tracked cell (`torque`: the moment about the cell's centre of the forces
+/// the rest of the solid exerts on the cell's disks through the bonds and contacts that
+/// cross its boundary, N·m/m, [`super::reaction::exerted_on`]).
+pub const CELL_FIELDS: [&str; 9] = [
     "p",
     "q",
     "anisotropy",
@@ -18,7 +20,15 @@ pub const CELL_FIELDS: [&str; 8] = [
     "dilation_y",
     "contacts",
     "broken_bonds",
+    "torque",
 ];
+
+/// The names a probe's `wall` takes in model `lsm`, with fields `fx fy torque`: the
+/// platens of `[loading] platens` (`"top"`, `"bottom"`: the force each exerts on the
+/// rest of the sample, N/m, and its moment about the mean centre of the platen's disks,
+/// N·m/m) and the pressurised hole (`"hole"`: the force of the hole pressure on the
+/// lining disks and its moment about the hole centre).
+pub const WALLS: [&str; 3] = ["top", "bottom", "hole"];
 /// Fields of the whole scene: wall pressure (Pa), platen load (N/m), broken bonds (all,
 /// tensile, shear), extent of the crack connected to the hole wall (m from the hole
 /// centre; scenes with a pressurised hole).
@@ -40,6 +50,7 @@ pub fn unit(field: &str) -> &'static str {
     crate::common::particle_output::particle_unit(field).unwrap_or(match field {
         "pressure" | "fluid_pressure" => "Pa",
         "platen_force" => "N/m",
+        "torque" => "N·m/m",
         "crack_extent" => "m",
         "fluid_speed" => "m/s",
         _ => "1",
@@ -96,6 +107,46 @@ fn check_fluid_probes(ls: &LoadedScene) -> Result<Option<LoadedScene>, SceneErro
         q.at.clear();
     }
     Ok(out)
+}
+
+/// The `wall = NAME` probes: a name of [`WALLS`] whose platens or pressurised hole the
+/// scene has (the fields are checked with the other particle model's).
+fn check_wall_probes(ls: &LoadedScene) -> Result<(), SceneError> {
+    let load = super::own(ls).loading.as_ref();
+    let platens = load.is_some_and(|l| l.platens.is_some());
+    let hole = load.is_some_and(|l| l.pressure_rate.is_some())
+        && ls
+            .scene
+            .particles
+            .as_ref()
+            .is_some_and(|p| p.hole.is_some());
+    for (i, p) in ls.scene.output.probe.iter().enumerate() {
+        let Some(name) = &p.wall else { continue };
+        let key = ki("output.probe", i, &["wall"]);
+        match name.as_str() {
+            "top" | "bottom" if !platens => {
+                return Err(ls.error(&key, format!("= \"{name}\" needs [loading] platens")));
+            }
+            "hole" if !hole => {
+                return Err(ls.error(
+                    &key,
+                    "= \"hole\" needs a pressurised hole: [particles] hole with [loading] \
+                     pressure_rate",
+                ));
+            }
+            "top" | "bottom" | "hole" => {}
+            _ => {
+                return Err(ls.error(
+                    &key,
+                    format!(
+                        "= \"{name}\" is not a wall of model \"lsm\" (walls: {})",
+                        WALLS.join(", ")
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The key path of a library parameter name such as `bonds.kn`.
@@ -344,6 +395,32 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
                     format!("thickness = {} must be positive", p.thickness),
                 )
             })?;
+            let stop = [
+                ("stop_displacement", p.stop_displacement),
+                ("stop_time", p.stop_time),
+            ];
+            if stop.iter().all(|(_, v)| v.is_some()) {
+                return Err(ls.error(
+                    &key("platens"),
+                    "stop_displacement and stop_time both stop the platens: give one",
+                ));
+            }
+            for (f, v) in stop {
+                if let Some(v) = v
+                    && !(v.is_finite() && v >= 0.0)
+                {
+                    return Err(ls.error(
+                        &key("platens"),
+                        format!("{f} = {v} must be a finite number ≥ 0"),
+                    ));
+                }
+                if v.is_some() && s.lbm.is_some() {
+                    return Err(ls.error(
+                        &key("platens"),
+                        format!("{f} is not available with [lbm] (the platens of a coupled run move at velocity)"),
+                    ));
+                }
+            }
         }
         if let Some(r) = l.pressure_rate {
             if !(r.is_finite() && r >= 0.0) {
@@ -394,6 +471,7 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
              [loading] pressure_rate or [injection]",
         ));
     }
+    check_wall_probes(ls)?;
     crate::common::particles::check_particle_schedule(ls, "lsm")?;
     super::fluid::check(ls)?;
     let shared = check_fluid_probes(ls)?;

@@ -110,7 +110,8 @@ pub struct LsmSection {
 }
 
 /// `[loading] platens`: the particles within `thickness` of the top and of the bottom
-/// of the sample move towards each other at `velocity`.
+/// of the sample move towards each other at `velocity`, until they stop (at
+/// `stop_displacement` or `stop_time`) and then hold their place.
 #[derive(Clone, Copy, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct PlatensSpec {
@@ -120,6 +121,27 @@ pub struct PlatensSpec {
     /// Thickness of the platen layers (m).
     #[schemars(extend("unit" = "m"))]
     pub thickness: f64,
+    /// Each platen stops when it has moved this far (m) and holds its place from then on
+    /// (a displacement-controlled test held at a strain; default: never stops). The
+    /// sub-step that reaches it moves the platen by what is left, so the platen stops
+    /// exactly there.
+    #[schemars(extend("unit" = "m"))]
+    pub stop_displacement: Option<f64>,
+    /// Or the platens stop at this time (s) and hold their place, having moved
+    /// `velocity × stop_time`.
+    #[schemars(extend("unit" = "s"))]
+    pub stop_time: Option<f64>,
+}
+
+impl PlatensSpec {
+    /// How far each platen moves before it stops (m; infinite when it never stops).
+    pub fn travel(&self) -> f64 {
+        match (self.stop_displacement, self.stop_time) {
+            (Some(d), _) => d,
+            (None, Some(t)) => self.velocity * t,
+            (None, None) => f64::INFINITY,
+        }
+    }
 }
 
 /// `[loading] wall`: which faces of the lining particles the hole pressure loads.

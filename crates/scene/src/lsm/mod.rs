@@ -1,24 +1,30 @@
 //! The lattice solid model (P. Mora, Y. Wang, F. Alonso-Marroquin (2015), J. Earth Sci.
 //! 26(1); `[scene] model = "lsm"`): bonded disks ([`porofrac_lsm`]).
 //!
-//! - *build*: the disks of `[particles]` ([`crate::common::particles`]), the bond law of
+//! - *build*: the disks of `[particles]` ([`crate::common::particles`]) with their
+//!   initial velocities and spins (`[[particles.velocity]]`), the bond law of
 //!   `[bonds]` (E and ν through the hexagonal closed form, or k_n, k_s), `[contacts]`,
-//!   `[lsm]` (time step, damping, gravity) and `[loading]` (platens, a pressure ramp on
+//!   `[lsm]` (time step, damping, gravity) and `[loading]` (platens that may stop, a
+//!   pressure ramp on
 //!   the hole, on the faces seen from its centre or on the faces a fluid would wet,
 //!   [`porofrac_lsm::WallFaces`]); with `[bonds] calibrate = true` a uniaxial compression
 //!   and a Brazilian test of the same packing recipe first ([`porofrac_lsm::calibrate`]);
-//! - *step*: as many LSM steps as fit between two output times;
+//! - *step*: [`sub_steps`] equal LSM steps between two output times (whole steps of
+//!   `[lsm] dt` when the interval is a multiple of it);
 //! - *fields*: particle probes (`x y vx vy omega fx fy radius`), tracked cells (`p q
-//!   anisotropy anisotropy_volume dilation_x dilation_y contacts broken_bonds`), scene
+//!   anisotropy anisotropy_volume dilation_x dilation_y contacts broken_bonds torque`),
+//!   wall probes (`wall = "top" | "bottom" | "hole"`: `fx fy torque`, [`reaction`]), scene
 //!   probes (`pressure platen_force broken broken_tensile broken_shear crack_extent`), with `[lbm]`
 //!   fluid probes at a point (`fluid_pressure fluid_speed`, [`fluid::Fluid::point_values`]),
 //!   lines,
 //!   `vtk/particles_NNNN.vtp` (with `broken_bonds` per particle) and
-//!   `vtk/contacts_NNNN.vtp` (intact bonds `bonded = 1`, touching contacts `0`),
+//!   `vtk/contacts_NNNN.vtp` (intact bonds `bonded = 1`, touching contacts `0`; cell
+//!   data `normal_force` and `tangential_force` in N/m, `bending_moment` in N·m/m: the
+//!   bond's `M_b = k_b (θ_j − θ_i − Δθ₀)` on the line's first disk, 0 on a contact),
 //!   `broken.csv` (`time [s],i,j,x [m],y [m],mode`), with a pressurised hole `crack.csv`
 //!   ([`crack::CrackLog`]), field extrema and `summary.json` keys
 //!   (`particles`, `bonds`, `broken_bonds`, `broken_tensile`, `broken_shear`,
-//!   `contacts`, `lsm_steps`, `dt`, `stable_dt`, `bond_updates_per_second`,
+//!   `contacts`, `lsm_steps`, `dt`, `dt_used`, `stable_dt`, `bond_updates_per_second`,
 //!   `contact_updates_per_second`, `initiation_pressure`, `breakdown_pressure`,
 //!   `breakdown_extent`, `crack_extent`, `calibration`);
 //! - *plots*: probe series, `particles.png` (disks coloured by displacement, broken
@@ -28,6 +34,7 @@ pub mod check;
 pub mod crack;
 pub mod file;
 pub mod fluid;
+pub mod reaction;
 
 use crate::common::laws::LawRegistry;
 use crate::common::loaded::SceneError;
@@ -78,6 +85,21 @@ enum ProbeKind {
     Global(usize),
     /// A fluid field ([`check::FLUID_FIELDS`]) at a point (m).
     Fluid([f64; 2], usize),
+    /// `wall = NAME`: `fx fy torque` (component 0, 1, 2) of a platen's action on the
+    /// rest of the sample about its centroid, or of the hole pressure on the lining
+    /// about the hole centre ([`check::WALLS`]).
+    Wall(WallProbe, usize),
+}
+
+/// What a `wall = NAME` probe measures.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum WallProbe {
+    /// The top platen (`"top"`).
+    Top,
+    /// The bottom platen (`"bottom"`).
+    Bottom,
+    /// The hole pressure (`"hole"`).
+    Hole,
 }
 
 /// Results of `[bonds] calibrate = true`.
@@ -98,6 +120,10 @@ pub struct LsmModel<'a> {
     cells: Vec<TrackedCell>,
     top: Vec<usize>,
     bottom: Vec<usize>,
+    /// `[loading] platens`: speed (m/s) and how far each platen moves before it stops
+    /// (m, infinite without a stop).
+    platen_speed: f64,
+    platen_travel: f64,
     wall: Option<usize>,
     pressure_rate: f64,
     pressure_max: f64,
@@ -117,6 +143,25 @@ pub struct LsmModel<'a> {
     fluid: Option<fluid::Fluid>,
     /// Polled between the sub-steps of a step.
     stop: Stop,
+}
+
+/// How close (relative) the ratio of an output interval to `[lsm] dt` must be to an
+/// integer to be taken as that integer: an interval of `10 dt` whose subtraction of two
+/// output times left a round-off of a few ulps takes 10 sub-steps, not 11.
+pub const WHOLE_STEPS_TOLERANCE: f64 = 1e-9;
+
+/// The number of sub-steps of at most `dt` that cover an interval `h`: the ratio `h/dt`
+/// rounded when it lies within [`WHOLE_STEPS_TOLERANCE`] of an integer (so an interval
+/// that is a multiple of `dt` takes whole steps of `dt`), else rounded up; at least 1.
+pub fn sub_steps(h: f64, dt: f64) -> usize {
+    let ratio = h / dt;
+    let nearest = ratio.round();
+    let n = if (ratio - nearest).abs() <= WHOLE_STEPS_TOLERANCE * nearest.max(1.0) {
+        nearest
+    } else {
+        ratio.ceil()
+    };
+    n.max(1.0) as usize
 }
 
 /// Smallest `[lsm] dt` as a fraction of the stable step: below it the run takes a
@@ -255,7 +300,8 @@ fn calibrate(
 /// calibration to `setup`.
 pub fn build<'a>(ls: &'a LoadedScene, setup: &mut SetupPoll<'_>) -> Result<LsmModel<'a>, RunError> {
     let s = &ls.scene;
-    let disks = crate::common::particles::generate(ls, setup)?;
+    let mut disks = crate::common::particles::generate(ls, setup)?;
+    crate::common::particles::initial_velocities(ls, &mut disks)?;
     let spec = spec_of(ls)?;
     let calibration = if own(ls).bonds.as_ref().is_some_and(|b| b.calibrate) {
         Some(calibrate(ls, &spec, setup)?)
@@ -358,7 +404,18 @@ pub fn build<'a>(ls: &'a LoadedScene, setup: &mut SetupPoll<'_>) -> Result<LsmMo
     let mut probes = Vec::new();
     let mut cells = Vec::new();
     for (i, p) in s.output.probe.iter().enumerate() {
-        if let Some(f) = check::FLUID_FIELDS.iter().position(|f| *f == p.field) {
+        if let Some(name) = &p.wall {
+            let component = ["fx", "fy", "torque"]
+                .iter()
+                .position(|f| *f == p.field)
+                .expect("checked");
+            let which = match name.as_str() {
+                "top" => WallProbe::Top,
+                "bottom" => WallProbe::Bottom,
+                _ => WallProbe::Hole,
+            };
+            probes.push(ProbeKind::Wall(which, component));
+        } else if let Some(f) = check::FLUID_FIELDS.iter().position(|f| *f == p.field) {
             probes.push(ProbeKind::Fluid([p.at[0], p.at[1]], f));
         } else if let Some(f) = PARTICLE_FIELDS.iter().position(|f| *f == p.field) {
             let idx = p.particle.expect("checked") as usize;
@@ -406,6 +463,8 @@ pub fn build<'a>(ls: &'a LoadedScene, setup: &mut SetupPoll<'_>) -> Result<LsmMo
         cells,
         top,
         bottom,
+        platen_speed: load.platens.map_or(0.0, |p| p.velocity),
+        platen_travel: load.platens.map_or(f64::INFINITY, |p| p.travel()),
         wall,
         pressure_rate: load.pressure_rate.unwrap_or(0.0),
         pressure_max: load.pressure_max.unwrap_or(f64::INFINITY),
@@ -429,6 +488,66 @@ pub fn build<'a>(ls: &'a LoadedScene, setup: &mut SetupPoll<'_>) -> Result<LsmMo
 }
 
 impl LsmModel<'_> {
+    /// Set the platens' velocity for the next sub-step of `dt` when they stop: the
+    /// speed while the travel `v (t + dt)` stays within the stop, what is left of it
+    /// over `dt` on the sub-step that reaches it, 0 after (held in place, no rotation).
+    fn move_platens(&mut self, dt: f64) {
+        let t = self.solid.time();
+        let (v, travel) = (self.platen_speed, self.platen_travel);
+        let speed = if v * (t + dt) <= travel {
+            v
+        } else if v * t < travel {
+            (travel - v * t) / dt
+        } else {
+            0.0
+        };
+        for &i in &self.top {
+            self.solid.set_motion(i, Motion::Velocity([0.0, -speed]));
+        }
+        for &i in &self.bottom {
+            self.solid.set_motion(i, Motion::Velocity([0.0, speed]));
+        }
+    }
+
+    /// `[F_x, F_y, M]` of a `wall = NAME` probe ([`ProbeKind::Wall`]).
+    fn wall_values(&self, which: WallProbe) -> [f64; 3] {
+        let n = self.solid.disks().len();
+        let members = |list: &[usize]| {
+            let mut m = vec![false; n];
+            for &i in list {
+                m[i] = true;
+            }
+            m
+        };
+        match which {
+            WallProbe::Top | WallProbe::Bottom => {
+                let platen = members(if which == WallProbe::Top {
+                    &self.top
+                } else {
+                    &self.bottom
+                });
+                let about = reaction::centroid(&self.solid, &platen);
+                let rest: Vec<bool> = platen.iter().map(|m| !m).collect();
+                reaction::exerted_on(&self.solid, &rest, about)
+            }
+            WallProbe::Hole => self
+                .wall
+                .map_or([f64::NAN; 3], |w| reaction::wall_load(&self.solid, w)),
+        }
+    }
+
+    /// The largest sub-step taken up to the current output time (s; 0 before the
+    /// first): each output interval `h` takes [`sub_steps`]`(h, dt)` equal sub-steps.
+    fn dt_used(&self) -> f64 {
+        self.times[..=self.current]
+            .windows(2)
+            .map(|w| {
+                let h = w[1] - w[0];
+                h / sub_steps(h, self.dt) as f64
+            })
+            .fold(0.0, f64::max)
+    }
+
     fn forces2(&self) -> Vec<[f64; 2]> {
         self.solid.forces().iter().map(|f| [f[0], f[1]]).collect()
     }
@@ -454,6 +573,14 @@ impl LsmModel<'_> {
     /// Broken bonds per disk and the links drawn, for the VTK files and the in-memory
     /// snapshots.
     fn disk_outputs(&self) -> (Vec<f64>, Vec<ContactLine>) {
+        let (per, lines, _) = self.disk_outputs_with_moments();
+        (per, lines)
+    }
+
+    /// [`Self::disk_outputs`] with the bending moment of each link (N·m/m): an intact
+    /// bond's `M_b = k_b (θ_j − θ_i − Δθ₀)`, the moment on its first disk (the line's
+    /// first end; the opposite acts on the second), 0 for a touching contact.
+    fn disk_outputs_with_moments(&self) -> (Vec<f64>, Vec<ContactLine>, Vec<f64>) {
         let d = self.solid.disks();
         let mut per = vec![0.0; d.len()];
         for b in self.solid.broken() {
@@ -462,7 +589,17 @@ impl LsmModel<'_> {
         }
         let (mut cc, mut lines) = (Vec::new(), Vec::new());
         self.links(&mut cc, &mut lines);
-        (per, lines)
+        // `links` lists the intact bonds first, in order, then the touching contacts.
+        let mut moments: Vec<f64> = self
+            .solid
+            .bonds()
+            .iter()
+            .zip(self.solid.bond_forces())
+            .filter(|(b, _)| b.intact)
+            .map(|(_, f)| f.mb)
+            .collect();
+        moments.resize(lines.len(), 0.0);
+        (per, lines, moments)
     }
 
     fn links(&self, cell: &mut Vec<CellContact>, lines: &mut Vec<ContactLine>) {
@@ -632,6 +769,9 @@ impl Model for LsmModel<'_> {
         m.insert("contacts".into(), self.solid.touching().into());
         m.insert("lsm_steps".into(), self.lsm_steps.into());
         m.insert("dt".into(), self.dt.into());
+        if self.fluid.is_none() {
+            m.insert("dt_used".into(), self.dt_used().into());
+        }
         m.insert("stable_dt".into(), self.solid.stable_dt().into());
         m.insert("bond_updates".into(), bu.into());
         m.insert("bond_updates_per_second".into(), rate(bu).into());
@@ -696,12 +836,15 @@ impl Model for LsmModel<'_> {
             });
         }
         let h = self.times[step] - self.times[step - 1];
-        let n = (h / self.dt).ceil().max(1.0) as usize;
+        let n = sub_steps(h, self.dt);
         let dt = h / n as f64;
         let t0 = Instant::now();
         for _ in 0..n {
             if self.stop.requested() {
                 return Err(RunError::Interrupted);
+            }
+            if self.platen_travel.is_finite() {
+                self.move_platens(dt);
             }
             if let Some(w) = self.wall {
                 self.pressure =
@@ -760,6 +903,7 @@ impl Model for LsmModel<'_> {
                     "crack_extent" => self.crack.as_ref().map_or(f64::NAN, |c| c.extent()),
                     _ => sh as f64,
                 },
+                ProbeKind::Wall(which, c) => self.wall_values(which)[c],
                 ProbeKind::Fluid(x, f) => self
                     .fluid
                     .as_ref()
@@ -774,6 +918,10 @@ impl Model for LsmModel<'_> {
                         "dilation_x" => s.dilation_x,
                         "dilation_y" => s.dilation_y,
                         "contacts" => s.contacts as f64,
+                        "torque" => {
+                            let cell = &self.cells[c];
+                            reaction::exerted_on(&self.solid, &cell.member, cell.center)[2]
+                        }
                         _ => {
                             let cell = &self.cells[c];
                             self.solid
@@ -837,8 +985,8 @@ impl Model for LsmModel<'_> {
 
     fn write_vtk(&self, dir: &Path, index: usize) -> Result<String, RunError> {
         let d = self.solid.disks();
-        let (per, lines) = self.disk_outputs();
-        particle_output::write_vtk(
+        let (per, lines, moments) = self.disk_outputs_with_moments();
+        particle_output::write_vtk_with(
             self.ls,
             dir,
             index,
@@ -846,6 +994,7 @@ impl Model for LsmModel<'_> {
             d,
             &[("broken_bonds", &per)],
             &lines,
+            &[("bending_moment", &moments)],
             &self.contacts_pvd,
         )
     }
