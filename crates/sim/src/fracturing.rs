@@ -188,6 +188,22 @@ pub struct FractureSettings {
     pub max_active_set: usize,
     /// Relative equilibrium residual accepted when the active set has not settled.
     pub active_set_tolerance: f64,
+    /// How a crack-tip cell's stress intensity is measured for the toughness.
+    pub tip: TipRule,
+}
+
+/// How the stress intensity of a crack-tip cell (an intact cell sharing a node with a
+/// failed cell, of a class with a toughness) is measured.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub enum TipRule {
+    /// From the tip cell's own stress: `K_c = σ₁ √(2π r_c)` ([`porofrac_frac::toughness`]).
+    #[default]
+    Stress,
+    /// From the opening of the failed cell next to it (displacement correlation,
+    /// [`crate::tip_opening`]), with the plane-strain modulus `E/(1 − ν²)` (Pa) of every
+    /// cell: the tip cell fails exactly when that `K_I` exceeds `K_Ic`, whatever its own
+    /// stress and tensile strength (the strength still governs the cells away from tips).
+    Opening(Vec<f64>),
 }
 
 impl FractureSettings {
@@ -204,6 +220,7 @@ impl FractureSettings {
             max_rounds: 500,
             max_active_set: 30,
             active_set_tolerance: 1e-6,
+            tip: TipRule::Stress,
         }
     }
 }
@@ -523,6 +540,102 @@ pub struct Fracturing<'a, const D: usize> {
     stress_cache: Option<StressCache>,
     /// Polled before every solve of a step (failure rounds, active-set iterations).
     interrupt: Option<Arc<AtomicBool>>,
+    /// The tip rule [`TipRule::Opening`], when chosen.
+    opening_tips: Option<OpeningTips>,
+}
+
+/// What [`TipRule::Opening`] needs at every failure check: the plane-strain modulus, the
+/// toughness and tensile strength of every cell's class, the tip cells and the cells of
+/// every node.
+struct OpeningTips {
+    e_prime: Vec<f64>,
+    /// `(K_Ic, σ_t)` of every criterion class (`None`: no toughness or no strength).
+    class: Vec<Option<(f64, f64)>>,
+    class_of_cell: Vec<usize>,
+    tips: CrackTips,
+    adjacency: NodeCells,
+}
+
+impl OpeningTips {
+    fn new<const D: usize>(
+        grid: &Grid<D>,
+        settings: &FractureSettings,
+    ) -> FractureResult<Option<Self>> {
+        let TipRule::Opening(e_prime) = &settings.tip else {
+            return Ok(None);
+        };
+        if e_prime.len() != grid.num_cells() {
+            return Err(FractureError::Input(format!(
+                "plane-strain modulus of the tip rule: length {}, want {}",
+                e_prime.len(),
+                grid.num_cells()
+            )));
+        }
+        if let Some(c) = e_prime.iter().position(|e| !(e.is_finite() && *e > 0.0)) {
+            return Err(FractureError::Input(format!(
+                "cell {c}: plane-strain modulus of the tip rule must be finite and > 0"
+            )));
+        }
+        if settings.stress == StressMeasure::Recovered {
+            return Err(FractureError::Input(
+                "the tip rule from the opening reads the cell stress away from tips; \
+                 it cannot be combined with the recovered stress"
+                    .into(),
+            ));
+        }
+        Ok(Some(Self {
+            e_prime: e_prime.clone(),
+            class: settings
+                .criteria
+                .iter()
+                .map(|c| match (&c.toughness, &c.tensile) {
+                    (Some(k), Some(t)) => Some((k.value(), t.strength())),
+                    _ => None,
+                })
+                .collect(),
+            class_of_cell: settings.class_of_cell.clone(),
+            tips: CrackTips::new(grid),
+            adjacency: NodeCells::new(grid),
+        }))
+    }
+
+    /// The stress the criteria see: `stress`, except at the intact tip cells of a class
+    /// with a toughness, which get the isotropic stress `(K_I/K_Ic) · S · I` with
+    /// `S = max(σ_t, K_Ic/√(2π r_c))`: its tensile utilization (the smaller of `σ₁/σ_t`
+    /// and `σ₁ √(2π r_c)/K_Ic`) is `K_I/K_Ic`, with `K_I` from the opening
+    /// ([`crate::tip_opening`]). `opening(c)` is the opening of cell `c`.
+    fn measure<const D: usize>(
+        &self,
+        grid: &Grid<D>,
+        failed: &[bool],
+        stress: &[Tensor<D>],
+        mut opening: impl FnMut(usize) -> crate::crack_flow::Opening<D>,
+    ) -> Vec<Tensor<D>> {
+        let mut out = stress.to_vec();
+        for (c, s) in out.iter_mut().enumerate() {
+            if failed[c] {
+                continue;
+            }
+            let Some((k_ic, sigma_t)) = self.class[self.class_of_cell[c]] else {
+                continue;
+            };
+            let Some(r) = self.tips.tip_radius(c, failed) else {
+                continue;
+            };
+            let k = crate::tip_opening::tip_stress_intensity(
+                grid,
+                &self.adjacency,
+                failed,
+                c,
+                self.e_prime[c],
+                &mut opening,
+            )
+            .unwrap_or(0.0);
+            let reference = sigma_t.max(k_ic / (2.0 * std::f64::consts::PI * r).sqrt());
+            *s = Tensor::<D>::identity() * (k.max(0.0) / k_ic * reference);
+        }
+        out
+    }
 }
 
 /// A failure state's law map and stiffness (at zero displacement).
@@ -598,6 +711,7 @@ impl<'a, const D: usize> Fracturing<'a, D> {
             map: intact,
             stiffness: Some(stiffness),
         });
+        let opening_tips = OpeningTips::new(body.grid, &settings)?;
         let resolution =
             FailureResolution::new(body.grid, settings).map_err(FractureError::Input)?;
         Ok(Self {
@@ -616,6 +730,7 @@ impl<'a, const D: usize> Fracturing<'a, D> {
             elements,
             stress_cache: None,
             interrupt: None,
+            opening_tips,
         })
     }
 
@@ -727,6 +842,7 @@ impl<'a, const D: usize> Fracturing<'a, D> {
             elements,
             stress_cache,
             interrupt,
+            opening_tips,
         } = self;
         let stop = || {
             interrupt
@@ -744,83 +860,99 @@ impl<'a, const D: usize> Fracturing<'a, D> {
         // The state of the previous round of this step: the next round's active set
         // starts from its stiffness (see `active_set_solve`).
         let mut warm: Option<BiotState> = None;
-        let solve = |fs: &FailureState| -> FractureResult<(BiotState, Vec<Tensor<D>>)> {
-            if stop() {
-                return Err(FractureError::Interrupted);
-            }
-            if cached.as_ref().is_none_or(|c| c.flags != fs.flags()) {
-                *cached = Some(Cached {
-                    flags: fs.flags().to_vec(),
-                    map: laws.law_map(grid, fs.flags())?,
-                    stiffness: None,
-                });
-            }
-            let Some(Cached { map, stiffness, .. }) = cached.as_mut() else {
-                return Err(FractureError::Input("law map missing".into()));
-            };
-            if matches!(
-                flow.fracture_permeability,
-                Some(FracturePermeability::CubicLaw(_))
-            ) {
-                // A failed cell is the crack's fluid: it stores the volume it opens.
-                let alpha: Vec<f64> = fs
-                    .flags()
-                    .iter()
-                    .zip(&flow.alpha)
-                    .map(|(&f, &a)| if f { 1.0 } else { a })
-                    .collect();
-                if alpha != operators.alpha {
-                    *operators = Arc::new(operators.with_alpha(grid, body.dofs, alpha));
+        let solve =
+            |fs: &FailureState| -> FractureResult<((BiotState, Vec<Tensor<D>>), Vec<Tensor<D>>)> {
+                if stop() {
+                    return Err(FractureError::Interrupted);
                 }
-            }
-            update_permeability(
-                grid,
-                flow,
-                fs.flags(),
-                perm_of_failed,
-                operators,
-                state.map(|s| s.displacement.as_slice()),
-            )?;
-            let mut system = BiotSystem::from_parts(
-                problem(body, map),
-                &flow.model,
-                operators.clone(),
-                stiffness.clone(),
-                Some(elements.clone()),
-            )?;
-            if stiffness.is_none() {
-                *stiffness = Some(system.parts().1);
-            }
-            if let Scheme::FixedStress(_, k_dr) = scheme {
-                system = system.with_drained_bulk_modulus(k_dr.clone())?;
-            }
-            if let Scheme::ExplicitPressure(ep, extra) = scheme {
-                ep.fractured = flow
-                    .wet_cells(grid, fs.flags())
-                    .iter()
-                    .zip(extra.iter())
-                    .map(|(a, b)| *a || *b)
-                    .collect();
-            }
-            let (new, residual, n) = active_set_solve(
-                &mut system,
-                scheme,
-                state,
-                warm.as_ref(),
-                t,
-                dt,
-                limits,
-                &stop,
-            )?;
-            solves += n;
-            warm = Some(new.clone());
-            worst = worst.max(residual);
-            let cache = stress_cache.get_or_insert_with(|| {
-                StressCache::new(map, operators, coords, grid.cell_volumes())
-            });
-            let stress = stresses(grid, map, operators, coords, cache, &new.displacement)?;
-            Ok((new, stress))
-        };
+                if cached.as_ref().is_none_or(|c| c.flags != fs.flags()) {
+                    *cached = Some(Cached {
+                        flags: fs.flags().to_vec(),
+                        map: laws.law_map(grid, fs.flags())?,
+                        stiffness: None,
+                    });
+                }
+                let Some(Cached { map, stiffness, .. }) = cached.as_mut() else {
+                    return Err(FractureError::Input("law map missing".into()));
+                };
+                if matches!(
+                    flow.fracture_permeability,
+                    Some(FracturePermeability::CubicLaw(_))
+                ) {
+                    // A failed cell is the crack's fluid: it stores the volume it opens.
+                    let alpha: Vec<f64> = fs
+                        .flags()
+                        .iter()
+                        .zip(&flow.alpha)
+                        .map(|(&f, &a)| if f { 1.0 } else { a })
+                        .collect();
+                    if alpha != operators.alpha {
+                        *operators = Arc::new(operators.with_alpha(grid, body.dofs, alpha));
+                    }
+                }
+                update_permeability(
+                    grid,
+                    flow,
+                    fs.flags(),
+                    perm_of_failed,
+                    operators,
+                    state.map(|s| s.displacement.as_slice()),
+                )?;
+                let mut system = BiotSystem::from_parts(
+                    problem(body, map),
+                    &flow.model,
+                    operators.clone(),
+                    stiffness.clone(),
+                    Some(elements.clone()),
+                )?;
+                if stiffness.is_none() {
+                    *stiffness = Some(system.parts().1);
+                }
+                if let Scheme::FixedStress(_, k_dr) = scheme {
+                    system = system.with_drained_bulk_modulus(k_dr.clone())?;
+                }
+                if let Scheme::ExplicitPressure(ep, extra) = scheme {
+                    ep.fractured = flow
+                        .wet_cells(grid, fs.flags())
+                        .iter()
+                        .zip(extra.iter())
+                        .map(|(a, b)| *a || *b)
+                        .collect();
+                }
+                let (new, residual, n) = active_set_solve(
+                    &mut system,
+                    scheme,
+                    state,
+                    warm.as_ref(),
+                    t,
+                    dt,
+                    limits,
+                    &stop,
+                )?;
+                solves += n;
+                warm = Some(new.clone());
+                worst = worst.max(residual);
+                let cache = stress_cache.get_or_insert_with(|| {
+                    StressCache::new(map, operators, coords, grid.cell_volumes())
+                });
+                let stress = stresses(grid, map, operators, coords, cache, &new.displacement)?;
+                if let Some(tips) = opening_tips.as_ref() {
+                    let u = &new.displacement;
+                    let mut uc = Vec::new();
+                    let measure = tips.measure(grid, fs.flags(), &stress, |c| {
+                        let nodes = operators.node_ptr[c]..operators.node_ptr[c + 1];
+                        uc.clear();
+                        uc.extend(
+                            operators.dofs[D * nodes.start..D * nodes.end]
+                                .iter()
+                                .map(|&d| u[d]),
+                        );
+                        crate::crack_flow::cell_opening(grid, c, &operators.normals[nodes], &uc)
+                    });
+                    return Ok(((new, stress), measure));
+                }
+                Ok(((new, stress.clone()), stress))
+            };
         let done = resolution
             .resolve(grid, failures, t1, solve)
             .map_err(|e| match e {
@@ -835,7 +967,7 @@ impl<'a, const D: usize> Fracturing<'a, D> {
                     failed,
                 },
             })?;
-        let (state, stress) = done.solution;
+        let ((state, stress), _) = done.solution;
         Ok(FractureStep {
             state,
             stress,

@@ -96,9 +96,9 @@ fn sneddon(x: f64) -> f64 {
     4.0 * P * (1.0 - NU * NU) / E * (A * A - x * x).max(0.0).sqrt()
 }
 
-/// Relative errors (L2 of the jump, L2 of the smeared cell opening, crack volume) with
-/// `n` cells per half-length.
-fn errors(n: usize) -> (f64, f64, f64) {
+/// The band of `n` cells per half-length opened by `P`: the grid, the nodal
+/// displacement, the band flags and the cell size.
+fn opened_band(n: usize) -> (Grid<2>, Vec<f64>, Vec<bool>, f64) {
     let h = A / n as f64;
     let xs = axis(h, 1.5 * A, 80.0 * A, false);
     let ys = axis(h, 0.5 * A, 80.0 * A, true);
@@ -124,6 +124,13 @@ fn errors(n: usize) -> (f64, f64, f64) {
     let dofs = DofMap::new(&grid, &[fixed], &[]).unwrap();
     let pattern = Pattern::new(&grid, &dofs).unwrap();
     let u = common::open_band(&grid, &laws, &dofs, &pattern, &band, P);
+    (grid, u, band, h)
+}
+
+/// Relative errors (L2 of the jump, L2 of the smeared cell opening, crack volume) with
+/// `n` cells per half-length.
+fn errors(n: usize) -> (f64, f64, f64) {
+    let (grid, u, band, h) = opened_band(n);
     let mut nn = vec![Point::<2>::zeros(); 3];
 
     // The jump across the band at its nodes (x = −a + i h), trapezoid weights.
@@ -223,5 +230,36 @@ fn sneddon_opening_and_volume_converge_at_10_20_40_80_cells_per_half_length() {
             j >= 0.75 && c >= 0.7 && v >= 0.75,
             "orders {j:.2} {c:.2} {v:.2}"
         );
+    }
+}
+
+/// The stress intensity of the tip candidates of Sneddon's band
+/// (`porofrac_sim::tip_opening`) against `K_I = p √(π a)`: the largest estimate over the
+/// intact cells that share a node with the band, with `n` cells per half-length.
+fn tip_ratio(n: usize) -> f64 {
+    let (grid, u, band, _) = opened_band(n);
+    let adjacency = porofrac_frac::recovery::NodeCells::new(&grid);
+    let e_prime = E / (1.0 - NU * NU);
+    let exact = P * (std::f64::consts::PI * A).sqrt();
+    (0..grid.num_cells())
+        .filter(|&c| !band[c])
+        .filter_map(|c| {
+            porofrac_sim::tip_opening::tip_stress_intensity(
+                &grid,
+                &adjacency,
+                &band,
+                c,
+                e_prime,
+                |f| porofrac_sim::tip_opening::opening_at(&grid, f, &u),
+            )
+        })
+        .fold(0.0, f64::max)
+        / exact
+}
+
+#[test]
+fn tip_stress_intensity() {
+    for n in [5, 10, 20, 40] {
+        println!("n = {n}: K_est / K_I = {:.4}", tip_ratio(n));
     }
 }
