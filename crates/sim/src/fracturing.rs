@@ -603,13 +603,13 @@ impl OpeningTips {
     /// with a toughness, which get the isotropic stress `(K_I/K_Ic) · S · I` with
     /// `S = max(σ_t, K_Ic/√(2π r_c))`: its tensile utilization (the smaller of `σ₁/σ_t`
     /// and `σ₁ √(2π r_c)/K_Ic`) is `K_I/K_Ic`, with `K_I` from the opening
-    /// ([`crate::tip_opening`]). `opening(c)` is the opening of cell `c`.
+    /// ([`crate::tip_opening`]) at the nodal displacement `u`.
     fn measure<const D: usize>(
         &self,
         grid: &Grid<D>,
         failed: &[bool],
         stress: &[Tensor<D>],
-        mut opening: impl FnMut(usize) -> crate::crack_flow::Opening<D>,
+        u: &[f64],
     ) -> Vec<Tensor<D>> {
         let mut out = stress.to_vec();
         for (c, s) in out.iter_mut().enumerate() {
@@ -628,7 +628,7 @@ impl OpeningTips {
                 failed,
                 c,
                 self.e_prime[c],
-                &mut opening,
+                u,
             )
             .unwrap_or(0.0);
             let reference = sigma_t.max(k_ic / (2.0 * std::f64::consts::PI * r).sqrt());
@@ -937,18 +937,7 @@ impl<'a, const D: usize> Fracturing<'a, D> {
                 });
                 let stress = stresses(grid, map, operators, coords, cache, &new.displacement)?;
                 if let Some(tips) = opening_tips.as_ref() {
-                    let u = &new.displacement;
-                    let mut uc = Vec::new();
-                    let measure = tips.measure(grid, fs.flags(), &stress, |c| {
-                        let nodes = operators.node_ptr[c]..operators.node_ptr[c + 1];
-                        uc.clear();
-                        uc.extend(
-                            operators.dofs[D * nodes.start..D * nodes.end]
-                                .iter()
-                                .map(|&d| u[d]),
-                        );
-                        crate::crack_flow::cell_opening(grid, c, &operators.normals[nodes], &uc)
-                    });
+                    let measure = tips.measure(grid, fs.flags(), &stress, &new.displacement);
                     return Ok(((new, stress), measure));
                 }
                 Ok(((new, stress.clone()), stress))

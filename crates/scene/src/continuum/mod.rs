@@ -19,6 +19,8 @@ pub mod compose;
 mod explain;
 pub mod fields;
 pub mod flow;
+#[cfg(test)]
+mod kgd_tests;
 pub mod plots;
 
 use crate::common::loaded::SceneError;
