@@ -638,6 +638,10 @@ impl OpeningTips {
     }
 }
 
+/// A solve checked for failures: the state and its cell stresses, and the stress the
+/// criteria see (the same, or with the tip cells of [`TipRule::Opening`]).
+type Checked<const D: usize> = ((BiotState, Vec<Tensor<D>>), Vec<Tensor<D>>);
+
 /// A failure state's law map and stiffness (at zero displacement).
 struct Cached<'a, const D: usize> {
     flags: Vec<bool>,
@@ -860,88 +864,87 @@ impl<'a, const D: usize> Fracturing<'a, D> {
         // The state of the previous round of this step: the next round's active set
         // starts from its stiffness (see `active_set_solve`).
         let mut warm: Option<BiotState> = None;
-        let solve =
-            |fs: &FailureState| -> FractureResult<((BiotState, Vec<Tensor<D>>), Vec<Tensor<D>>)> {
-                if stop() {
-                    return Err(FractureError::Interrupted);
-                }
-                if cached.as_ref().is_none_or(|c| c.flags != fs.flags()) {
-                    *cached = Some(Cached {
-                        flags: fs.flags().to_vec(),
-                        map: laws.law_map(grid, fs.flags())?,
-                        stiffness: None,
-                    });
-                }
-                let Some(Cached { map, stiffness, .. }) = cached.as_mut() else {
-                    return Err(FractureError::Input("law map missing".into()));
-                };
-                if matches!(
-                    flow.fracture_permeability,
-                    Some(FracturePermeability::CubicLaw(_))
-                ) {
-                    // A failed cell is the crack's fluid: it stores the volume it opens.
-                    let alpha: Vec<f64> = fs
-                        .flags()
-                        .iter()
-                        .zip(&flow.alpha)
-                        .map(|(&f, &a)| if f { 1.0 } else { a })
-                        .collect();
-                    if alpha != operators.alpha {
-                        *operators = Arc::new(operators.with_alpha(grid, body.dofs, alpha));
-                    }
-                }
-                update_permeability(
-                    grid,
-                    flow,
-                    fs.flags(),
-                    perm_of_failed,
-                    operators,
-                    state.map(|s| s.displacement.as_slice()),
-                )?;
-                let mut system = BiotSystem::from_parts(
-                    problem(body, map),
-                    &flow.model,
-                    operators.clone(),
-                    stiffness.clone(),
-                    Some(elements.clone()),
-                )?;
-                if stiffness.is_none() {
-                    *stiffness = Some(system.parts().1);
-                }
-                if let Scheme::FixedStress(_, k_dr) = scheme {
-                    system = system.with_drained_bulk_modulus(k_dr.clone())?;
-                }
-                if let Scheme::ExplicitPressure(ep, extra) = scheme {
-                    ep.fractured = flow
-                        .wet_cells(grid, fs.flags())
-                        .iter()
-                        .zip(extra.iter())
-                        .map(|(a, b)| *a || *b)
-                        .collect();
-                }
-                let (new, residual, n) = active_set_solve(
-                    &mut system,
-                    scheme,
-                    state,
-                    warm.as_ref(),
-                    t,
-                    dt,
-                    limits,
-                    &stop,
-                )?;
-                solves += n;
-                warm = Some(new.clone());
-                worst = worst.max(residual);
-                let cache = stress_cache.get_or_insert_with(|| {
-                    StressCache::new(map, operators, coords, grid.cell_volumes())
+        let solve = |fs: &FailureState| -> FractureResult<Checked<D>> {
+            if stop() {
+                return Err(FractureError::Interrupted);
+            }
+            if cached.as_ref().is_none_or(|c| c.flags != fs.flags()) {
+                *cached = Some(Cached {
+                    flags: fs.flags().to_vec(),
+                    map: laws.law_map(grid, fs.flags())?,
+                    stiffness: None,
                 });
-                let stress = stresses(grid, map, operators, coords, cache, &new.displacement)?;
-                if let Some(tips) = opening_tips.as_ref() {
-                    let measure = tips.measure(grid, fs.flags(), &stress, &new.displacement);
-                    return Ok(((new, stress), measure));
-                }
-                Ok(((new, stress.clone()), stress))
+            }
+            let Some(Cached { map, stiffness, .. }) = cached.as_mut() else {
+                return Err(FractureError::Input("law map missing".into()));
             };
+            if matches!(
+                flow.fracture_permeability,
+                Some(FracturePermeability::CubicLaw(_))
+            ) {
+                // A failed cell is the crack's fluid: it stores the volume it opens.
+                let alpha: Vec<f64> = fs
+                    .flags()
+                    .iter()
+                    .zip(&flow.alpha)
+                    .map(|(&f, &a)| if f { 1.0 } else { a })
+                    .collect();
+                if alpha != operators.alpha {
+                    *operators = Arc::new(operators.with_alpha(grid, body.dofs, alpha));
+                }
+            }
+            update_permeability(
+                grid,
+                flow,
+                fs.flags(),
+                perm_of_failed,
+                operators,
+                state.map(|s| s.displacement.as_slice()),
+            )?;
+            let mut system = BiotSystem::from_parts(
+                problem(body, map),
+                &flow.model,
+                operators.clone(),
+                stiffness.clone(),
+                Some(elements.clone()),
+            )?;
+            if stiffness.is_none() {
+                *stiffness = Some(system.parts().1);
+            }
+            if let Scheme::FixedStress(_, k_dr) = scheme {
+                system = system.with_drained_bulk_modulus(k_dr.clone())?;
+            }
+            if let Scheme::ExplicitPressure(ep, extra) = scheme {
+                ep.fractured = flow
+                    .wet_cells(grid, fs.flags())
+                    .iter()
+                    .zip(extra.iter())
+                    .map(|(a, b)| *a || *b)
+                    .collect();
+            }
+            let (new, residual, n) = active_set_solve(
+                &mut system,
+                scheme,
+                state,
+                warm.as_ref(),
+                t,
+                dt,
+                limits,
+                &stop,
+            )?;
+            solves += n;
+            warm = Some(new.clone());
+            worst = worst.max(residual);
+            let cache = stress_cache.get_or_insert_with(|| {
+                StressCache::new(map, operators, coords, grid.cell_volumes())
+            });
+            let stress = stresses(grid, map, operators, coords, cache, &new.displacement)?;
+            if let Some(tips) = opening_tips.as_ref() {
+                let measure = tips.measure(grid, fs.flags(), &stress, &new.displacement);
+                return Ok(((new, stress), measure));
+            }
+            Ok(((new, stress.clone()), stress))
+        };
         let done = resolution
             .resolve(grid, failures, t1, solve)
             .map_err(|e| match e {

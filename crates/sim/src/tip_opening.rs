@@ -45,7 +45,6 @@ use porofrac_frac::recovery::NodeCells;
 use porofrac_grid::{Grid, Point};
 use porofrac_law::{Tensor, principal};
 
-use crate::crack_flow::{Opening, cell_opening};
 /// `K_I` (Pa·√m) of an LEFM crack whose opening is `w` (m) at a distance `r` (m) behind its
 /// tip, in a solid of plane-strain modulus `e_prime` (Pa): `E′ w / (4 √(2/π) √r)`.
 pub fn stress_intensity_from_opening(e_prime: f64, w: f64, r: f64) -> f64 {
@@ -98,7 +97,7 @@ pub fn tip_stress_intensity<const D: usize>(
     let d = grid.cell_centroid(c) - mean;
     let along = d - n * d.dot(&n);
     let rho = along.norm();
-    if !(rho > 0.0) {
+    if rho <= 0.0 || rho.is_nan() {
         return None;
     }
     let t = along / rho;
@@ -174,17 +173,4 @@ pub fn tip_stress_intensity<const D: usize>(
     }
     let w = up / nu as f64 - down / nd as f64;
     Some(stress_intensity_from_opening(e_prime, w.max(0.0), r))
-}
-
-/// The opening of cell `c` at the nodal displacement `u` (all dofs of the grid, `D` per
-/// node in node order) with the node normals of the grid.
-pub fn opening_at<const D: usize>(grid: &Grid<D>, c: usize, u: &[f64]) -> Opening<D> {
-    let nodes = grid.cell_nodes(c);
-    let mut normals = vec![Point::<D>::zeros(); nodes.len()];
-    grid.cell_node_normals(c, &mut normals);
-    let uc: Vec<f64> = nodes
-        .iter()
-        .flat_map(|&i| (0..D).map(move |a| u[D * i + a]))
-        .collect();
-    cell_opening(grid, c, &normals, &uc)
 }

@@ -8,6 +8,11 @@
 //!   pressure and the inlet opening (the jump of `u_y` across the path at x = 50);
 //! - the time exponent of `ℓ` (least squares on `log ℓ` against `log t`).
 //!
+//! The viscosity scene (`scenes/kgd_viscosity.toml`, h = 0.125 m, 5 s) against the
+//! viscosity vertex solution over t ≥ 8 s: the inlet opening within the error measured
+//! (−1.3 % on average, −2.2 % at most), the half-length as long as measured (+27 % on
+//! average: the target of 10 % is missed, see docs/hydrofrac/validation.md).
+//!
 //! The bounds are the values measured at this resolution (2026-11-28: `ℓ` +7.4 % on
 //! average, 7.5 % in absolute value; `p` 6.9 %; `w` 3.8 %; exponent 0.630) rounded up by
 //! about 5 %; the bundled scene (h = 0.0625 m) and the refinement study are in
@@ -111,5 +116,54 @@ fn kgd_toughness_follows_the_vertex_solution() {
     assert!(
         (0.61..0.65).contains(&exponent),
         "time exponent of the half-length {exponent:.4} (2/3 in the vertex solution)"
+    );
+}
+
+#[test]
+fn kgd_viscosity_opening_follows_the_vertex_solution_and_the_length_is_long() {
+    let (e, nu, mu, q0) = (1.0e10, 0.25, 1.0e-3, 1.0e-5);
+    let ep = e / (1.0 - nu * nu);
+    let mup = 12.0 * mu;
+    let h = 0.125;
+    let scene = Scene::parse(
+        include_str!("../../../../scenes/kgd_viscosity.toml"),
+        Path::new("scenes/kgd_viscosity.toml"),
+        LawRegistry::default(),
+    )
+    .unwrap();
+    let out = std::env::temp_dir().join(format!("porofrac_kgd_mu_{}", std::process::id()));
+    scene.run(&out, &mut Silent).unwrap();
+    let probes = csv(&out.join("probes.csv"));
+    let failed: Vec<f64> = csv(&out.join("fracture.csv"))
+        .iter()
+        .map(|r| r[3].parse().unwrap())
+        .collect();
+    std::fs::remove_dir_all(&out).ok();
+    let (mut e_l, mut e_w, mut worst_w, mut m) = (0.0, 0.0, 0.0f64, 0.0);
+    for row in &probes {
+        let v: Vec<f64> = row.iter().map(|x| x.parse().unwrap()).collect();
+        let t = v[0];
+        if t < 8.0 {
+            continue;
+        }
+        let l = failed.iter().filter(|&&tf| tf <= t + 1e-9).count() as f64 * h / 4.0;
+        let lv = 0.6152 * (ep * q0.powi(3) * t.powi(4) / mup).powf(1.0 / 6.0);
+        let wv = 1.1265 * (mup * q0.powi(3) * t * t / ep).powf(1.0 / 6.0);
+        let ew = (v[2] - v[3]) / wv - 1.0;
+        e_l += l / lv - 1.0;
+        e_w += ew;
+        worst_w = worst_w.max(ew.abs());
+        m += 1.0;
+    }
+    let (e_l, e_w) = (e_l / m, e_w / m);
+    println!("KGD viscosity, h = {h} m, t >= 8 s: l {e_l:+.4}, w {e_w:+.4} (largest {worst_w:.4})");
+    assert_eq!(m, 41.0, "probes every 0.8 s from 8 s to 40 s");
+    assert!(
+        e_w.abs() < 0.014 && worst_w < 0.023,
+        "inlet opening {e_w:+.4}, {worst_w:.4}"
+    );
+    assert!(
+        (0.26..0.29).contains(&e_l),
+        "half-length {e_l:+.4}: measured +0.274 (the target 10 % is missed)"
     );
 }
