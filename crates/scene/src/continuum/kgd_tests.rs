@@ -121,7 +121,7 @@ fn kgd_toughness_follows_the_vertex_solution() {
 
 #[test]
 fn kgd_viscosity_opening_follows_the_vertex_solution_and_the_length_is_long() {
-    let (e, nu, mu, q0) = (1.0e10, 0.25, 1.0e-3, 1.0e-5);
+    let (e, nu, mu, q0): (f64, f64, f64, f64) = (1.0e10, 0.25, 1.0e-3, 1.0e-5);
     let ep = e / (1.0 - nu * nu);
     let mup = 12.0 * mu;
     let h = 0.125;
