@@ -188,6 +188,22 @@ pub struct FractureSettings {
     pub max_active_set: usize,
     /// Relative equilibrium residual accepted when the active set has not settled.
     pub active_set_tolerance: f64,
+    /// How a crack-tip cell's stress intensity is measured for the toughness.
+    pub tip: TipRule,
+}
+
+/// How the stress intensity of a crack-tip cell (an intact cell sharing a node with a
+/// failed cell, of a class with a toughness) is measured.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub enum TipRule {
+    /// From the tip cell's own stress: `K_c = σ₁ √(2π r_c)` ([`porofrac_frac::toughness`]).
+    #[default]
+    Stress,
+    /// From the opening of the failed cell next to it (displacement correlation,
+    /// [`crate::tip_opening`]), with the plane-strain modulus `E/(1 − ν²)` (Pa) of every
+    /// cell: the tip cell fails exactly when that `K_I` exceeds `K_Ic`, whatever its own
+    /// stress and tensile strength (the strength still governs the cells away from tips).
+    Opening(Vec<f64>),
 }
 
 impl FractureSettings {
@@ -204,6 +220,7 @@ impl FractureSettings {
             max_rounds: 500,
             max_active_set: 30,
             active_set_tolerance: 1e-6,
+            tip: TipRule::Stress,
         }
     }
 }
@@ -523,7 +540,107 @@ pub struct Fracturing<'a, const D: usize> {
     stress_cache: Option<StressCache>,
     /// Polled before every solve of a step (failure rounds, active-set iterations).
     interrupt: Option<Arc<AtomicBool>>,
+    /// The tip rule [`TipRule::Opening`], when chosen.
+    opening_tips: Option<OpeningTips>,
 }
+
+/// What [`TipRule::Opening`] needs at every failure check: the plane-strain modulus, the
+/// toughness and tensile strength of every cell's class, the tip cells and the cells of
+/// every node.
+struct OpeningTips {
+    e_prime: Vec<f64>,
+    /// `(K_Ic, σ_t)` of every criterion class (`None`: no toughness or no strength).
+    class: Vec<Option<(f64, f64)>>,
+    class_of_cell: Vec<usize>,
+    tips: CrackTips,
+    adjacency: NodeCells,
+}
+
+impl OpeningTips {
+    fn new<const D: usize>(
+        grid: &Grid<D>,
+        settings: &FractureSettings,
+    ) -> FractureResult<Option<Self>> {
+        let TipRule::Opening(e_prime) = &settings.tip else {
+            return Ok(None);
+        };
+        if e_prime.len() != grid.num_cells() {
+            return Err(FractureError::Input(format!(
+                "plane-strain modulus of the tip rule: length {}, want {}",
+                e_prime.len(),
+                grid.num_cells()
+            )));
+        }
+        if let Some(c) = e_prime.iter().position(|e| !(e.is_finite() && *e > 0.0)) {
+            return Err(FractureError::Input(format!(
+                "cell {c}: plane-strain modulus of the tip rule must be finite and > 0"
+            )));
+        }
+        if settings.stress == StressMeasure::Recovered {
+            return Err(FractureError::Input(
+                "the tip rule from the opening reads the cell stress away from tips; \
+                 it cannot be combined with the recovered stress"
+                    .into(),
+            ));
+        }
+        Ok(Some(Self {
+            e_prime: e_prime.clone(),
+            class: settings
+                .criteria
+                .iter()
+                .map(|c| match (&c.toughness, &c.tensile) {
+                    (Some(k), Some(t)) => Some((k.value(), t.strength())),
+                    _ => None,
+                })
+                .collect(),
+            class_of_cell: settings.class_of_cell.clone(),
+            tips: CrackTips::new(grid),
+            adjacency: NodeCells::new(grid),
+        }))
+    }
+
+    /// The stress the criteria see: `stress`, except at the intact tip cells of a class
+    /// with a toughness, which get the isotropic stress `(K_I/K_Ic) · S · I` with
+    /// `S = max(σ_t, K_Ic/√(2π r_c))`: its tensile utilization (the smaller of `σ₁/σ_t`
+    /// and `σ₁ √(2π r_c)/K_Ic`) is `K_I/K_Ic`, with `K_I` from the opening
+    /// ([`crate::tip_opening`]) at the nodal displacement `u`.
+    fn measure<const D: usize>(
+        &self,
+        grid: &Grid<D>,
+        failed: &[bool],
+        stress: &[Tensor<D>],
+        u: &[f64],
+    ) -> Vec<Tensor<D>> {
+        let mut out = stress.to_vec();
+        for (c, s) in out.iter_mut().enumerate() {
+            if failed[c] {
+                continue;
+            }
+            let Some((k_ic, sigma_t)) = self.class[self.class_of_cell[c]] else {
+                continue;
+            };
+            let Some(r) = self.tips.tip_radius(c, failed) else {
+                continue;
+            };
+            let k = crate::tip_opening::tip_stress_intensity(
+                grid,
+                &self.adjacency,
+                failed,
+                c,
+                self.e_prime[c],
+                u,
+            )
+            .unwrap_or(0.0);
+            let reference = sigma_t.max(k_ic / (2.0 * std::f64::consts::PI * r).sqrt());
+            *s = Tensor::<D>::identity() * (k.max(0.0) / k_ic * reference);
+        }
+        out
+    }
+}
+
+/// A solve checked for failures: the state and its cell stresses, and the stress the
+/// criteria see (the same, or with the tip cells of [`TipRule::Opening`]).
+type Checked<const D: usize> = ((BiotState, Vec<Tensor<D>>), Vec<Tensor<D>>);
 
 /// A failure state's law map and stiffness (at zero displacement).
 struct Cached<'a, const D: usize> {
@@ -598,6 +715,7 @@ impl<'a, const D: usize> Fracturing<'a, D> {
             map: intact,
             stiffness: Some(stiffness),
         });
+        let opening_tips = OpeningTips::new(body.grid, &settings)?;
         let resolution =
             FailureResolution::new(body.grid, settings).map_err(FractureError::Input)?;
         Ok(Self {
@@ -616,6 +734,7 @@ impl<'a, const D: usize> Fracturing<'a, D> {
             elements,
             stress_cache: None,
             interrupt: None,
+            opening_tips,
         })
     }
 
@@ -727,6 +846,7 @@ impl<'a, const D: usize> Fracturing<'a, D> {
             elements,
             stress_cache,
             interrupt,
+            opening_tips,
         } = self;
         let stop = || {
             interrupt
@@ -744,7 +864,7 @@ impl<'a, const D: usize> Fracturing<'a, D> {
         // The state of the previous round of this step: the next round's active set
         // starts from its stiffness (see `active_set_solve`).
         let mut warm: Option<BiotState> = None;
-        let solve = |fs: &FailureState| -> FractureResult<(BiotState, Vec<Tensor<D>>)> {
+        let solve = |fs: &FailureState| -> FractureResult<Checked<D>> {
             if stop() {
                 return Err(FractureError::Interrupted);
             }
@@ -819,7 +939,11 @@ impl<'a, const D: usize> Fracturing<'a, D> {
                 StressCache::new(map, operators, coords, grid.cell_volumes())
             });
             let stress = stresses(grid, map, operators, coords, cache, &new.displacement)?;
-            Ok((new, stress))
+            if let Some(tips) = opening_tips.as_ref() {
+                let measure = tips.measure(grid, fs.flags(), &stress, &new.displacement);
+                return Ok(((new, stress), measure));
+            }
+            Ok(((new, stress.clone()), stress))
         };
         let done = resolution
             .resolve(grid, failures, t1, solve)
@@ -835,7 +959,7 @@ impl<'a, const D: usize> Fracturing<'a, D> {
                     failed,
                 },
             })?;
-        let (state, stress) = done.solution;
+        let ((state, stress), _) = done.solution;
         Ok(FractureStep {
             state,
             stress,

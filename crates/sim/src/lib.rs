@@ -77,6 +77,7 @@ pub mod solve;
 #[cfg(feature = "fixtures")]
 pub mod standard;
 mod stress_cache;
+pub mod tip_opening;
 
 pub use assembly::{assemble, nodal_loads};
 pub use bc::{Displacement, Gravity, Loads, Platen, Traction};
@@ -91,6 +92,7 @@ pub use field::{FieldFn, ScalarField, VectorField, VectorFn};
 pub use fracturing::{
     Body, FailureResolution, FractureError, FractureFlow, FractureLaws, FracturePermeability,
     FractureSettings, FractureStep, Fracturing, ResolutionError, Resolved, Scheme, StressMeasure,
+    TipRule,
 };
 pub use laws::LawMap;
 pub use linear::{

@@ -186,6 +186,18 @@ pub enum CrackFlow {
     CubicLaw,
 }
 
+/// `[physics] tip_rule`.
+#[derive(Clone, Copy, Debug, Default, Deserialize, schemars::JsonSchema, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum TipRuleChoice {
+    /// The tip cell's own stress: `σ₁ √(2π r_c) > K_Ic` and `σ₁ > σ_t`.
+    #[default]
+    Stress,
+    /// The opening behind the tip (displacement correlation,
+    /// `K_I = E′ w / (4 √(2/π) √r)`): the tip cell fails when `K_I > K_Ic`.
+    Opening,
+}
+
 /// `[solver] mechanics`.
 #[derive(Clone, Copy, Debug, Default, Deserialize, schemars::JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
@@ -675,6 +687,16 @@ pub struct Physics {
     /// With tracking: no new crack within this distance of a failed cell (default 0).
     #[schemars(extend("unit" = "m"))]
     pub crack_exclusion: Option<f64>,
+    /// How a crack tip grows against `fracture_toughness` (default `"stress"`). `"stress"`:
+    /// the tip cell's stress, `σ₁ √(2π r_c) > K_Ic` and `σ₁ > σ_t`. `"opening"`: the jump
+    /// `w` of the displacement across the band of failed cells on the line of nodes one
+    /// cell behind the tip, at the distance `r` from it, gives
+    /// `K_I = E′ w / (4 √(2/π) √r)` with `E′ = E/(1 − ν²)` (plane stress: `E`); an intact
+    /// cell next to a crack tip fails when `K_I > K_Ic`, whatever its tensile strength
+    /// (which still governs cells away from tips). Meant for cracks along a row of split
+    /// rectangles (a predefined path; docs/hydrofrac/validation.md, "KGD"). Needs
+    /// fracture = true, flow = true and failure_stress = "cell".
+    pub tip_rule: Option<TipRuleChoice>,
 }
 
 /// `[solver]`.

@@ -262,6 +262,27 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
             ));
         }
     }
+    if s.physics.tip_rule == Some(crate::common::sections::TipRuleChoice::Opening) {
+        if s.physics.fracture != Some(true) || s.physics.flow != Some(true) {
+            return Err(ls.error(
+                &k(&["physics", "tip_rule"]),
+                "needs fracture = true and flow = true",
+            ));
+        }
+        if s.physics.failure_stress == Some(crate::common::sections::FailureStress::Recovered) {
+            return Err(ls.error(
+                &k(&["physics", "tip_rule"]),
+                "= \"opening\" reads the cell stress away from tips: it cannot be combined \
+                 with failure_stress = \"recovered\"",
+            ));
+        }
+        if !s.material.values().any(|m| m.fracture_toughness.is_some()) {
+            return Err(ls.error(
+                &k(&["physics", "tip_rule"]),
+                "= \"opening\" needs a material with a fracture_toughness",
+            ));
+        }
+    }
     if let Some(t) = s.physics.fracture_transmissivity {
         positive(ls, &k(&["physics", "fracture_transmissivity"]), t)?;
         if s.physics.fracture_permeability.is_some() {

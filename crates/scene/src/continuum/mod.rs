@@ -19,6 +19,8 @@ pub mod compose;
 mod explain;
 pub mod fields;
 pub mod flow;
+#[cfg(test)]
+mod kgd_tests;
 pub mod plots;
 
 use crate::common::loaded::SceneError;
@@ -961,6 +963,24 @@ fn fracture_settings<const D: usize>(ls: &LoadedScene, comp: &Composition<D>) ->
         }
         settings.tracking_angle = s.physics.crack_tracking;
         settings.exclusion_radius = s.physics.crack_exclusion.unwrap_or(0.0);
+        if s.physics.tip_rule == Some(crate::common::sections::TipRuleChoice::Opening) {
+            let plane_stress =
+                D == 2 && s.scene.plane == Some(crate::common::sections::Plane::Stress);
+            settings.tip = porofrac_sim::TipRule::Opening(
+                comp.material_of_cell()
+                    .into_iter()
+                    .map(|m| {
+                        let mat = &s.material[m];
+                        let nu = mat.poisson_ratio;
+                        if plane_stress {
+                            mat.youngs_modulus
+                        } else {
+                            mat.youngs_modulus / (1.0 - nu * nu)
+                        }
+                    })
+                    .collect(),
+            );
+        }
     }
     settings
 }

@@ -1,0 +1,169 @@
+//! The KGD scene (`scenes/kgd_toughness.toml`) against the toughness vertex solution of
+//! Detournay (2004), at half the bundled scene's resolution (h = 0.125 m, 17 cells per
+//! half-length at 100 s; 5 s in release).
+//!
+//! Checks, over t ≥ 20 s (after the initial transient), against
+//! `ℓ = 0.9324 (E′Q₀t/K′)^{2/3}`, `p = K_Ic/√(πℓ)`, `w(0) = 4pℓ/E′`:
+//! - the mean relative error of the half-length `ℓ` (failed cells · h/4), the inlet net
+//!   pressure and the inlet opening (the jump of `u_y` across the path at x = 50);
+//! - the time exponent of `ℓ` (least squares on `log ℓ` against `log t`).
+//!
+//! The viscosity scene (`scenes/kgd_viscosity.toml`, h = 0.125 m, 5 s) against the
+//! viscosity vertex solution over t ≥ 8 s: the inlet opening within the error measured
+//! (−1.3 % on average, −2.2 % at most), the half-length as long as measured (+27 % on
+//! average: the target of 10 % is missed, see docs/hydrofrac/validation.md).
+//!
+//! The bounds are the values measured at this resolution (2026-11-28: `ℓ` +7.4 % on
+//! average, 7.5 % in absolute value; `p` 6.9 %; `w` 3.8 %; exponent 0.630) rounded up by
+//! about 5 %; the bundled scene (h = 0.0625 m) and the refinement study are in
+//! docs/hydrofrac/validation.md.
+
+use std::path::Path;
+
+use crate::{LawRegistry, Scene, Silent};
+
+const E: f64 = 1.0e10;
+const NU: f64 = 0.25;
+const K_IC: f64 = 1.0e6;
+const Q0: f64 = 1.0e-5;
+
+/// The vertex solution at `t`: half-length, net pressure, inlet opening.
+fn vertex(t: f64) -> (f64, f64, f64) {
+    let ep = E / (1.0 - NU * NU);
+    let kp = 4.0 * (2.0 / std::f64::consts::PI).sqrt() * K_IC;
+    let l = 0.9324 * (ep * Q0 * t / kp).powf(2.0 / 3.0);
+    let p = K_IC / (std::f64::consts::PI * l).sqrt();
+    (l, p, 4.0 * p * l / ep)
+}
+
+/// The columns of a CSV file with a header (the numbers of every row).
+fn csv(path: &Path) -> Vec<Vec<String>> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(str::to_string).collect())
+        .collect()
+}
+
+#[test]
+fn kgd_toughness_follows_the_vertex_solution() {
+    let text = include_str!("../../../../scenes/kgd_toughness.toml")
+        .replace("refine = 32", "refine = 16")
+        .replace(
+            "[[46.001, 50.001], [53.999, 50.0615]]",
+            "[[46.001, 50.001], [53.999, 50.124]]",
+        )
+        .replace(
+            "[[49.9385, 50.001], [50.0615, 50.0615]]",
+            "[[49.876, 50.001], [50.124, 50.124]]",
+        )
+        .replace("at = [50.0001, 50.03125]", "at = [50.0001, 50.0625]")
+        .replace("at = [50.0, 50.0625]", "at = [50.0, 50.125]");
+    assert!(text.contains("refine = 16") && text.contains("50.124]]"));
+    let h = 0.125;
+    let scene = Scene::parse(
+        &text,
+        Path::new("scenes/kgd_toughness.toml"),
+        LawRegistry::default(),
+    )
+    .unwrap();
+    let out = std::env::temp_dir().join(format!("porofrac_kgd_{}", std::process::id()));
+    scene.run(&out, &mut Silent).unwrap();
+    let probes = csv(&out.join("probes.csv"));
+    let failed: Vec<f64> = csv(&out.join("fracture.csv"))
+        .iter()
+        .map(|r| r[3].parse().unwrap())
+        .collect();
+    std::fs::remove_dir_all(&out).ok();
+
+    let (mut e_l, mut a_l, mut a_p, mut a_w) = (0.0, 0.0, 0.0, 0.0);
+    let mut logs = Vec::new();
+    for row in &probes {
+        let v: Vec<f64> = row.iter().map(|x| x.parse().unwrap()).collect();
+        let t = v[0];
+        if t < 20.0 {
+            continue;
+        }
+        let n = failed.iter().filter(|&&tf| tf <= t + 1e-9).count();
+        let l = n as f64 * h / 4.0;
+        let (lv, pv, wv) = vertex(t);
+        e_l += l / lv - 1.0;
+        a_l += (l / lv - 1.0).abs();
+        a_p += (v[1] / pv - 1.0).abs();
+        a_w += ((v[2] - v[3]) / wv - 1.0).abs();
+        logs.push((t.ln(), l.ln()));
+    }
+    let m = logs.len() as f64;
+    assert_eq!(logs.len(), 41, "probes every 2 s from 20 s to 100 s");
+    let (e_l, a_l, a_p, a_w) = (e_l / m, a_l / m, a_p / m, a_w / m);
+    let (mx, my) = (
+        logs.iter().map(|p| p.0).sum::<f64>() / m,
+        logs.iter().map(|p| p.1).sum::<f64>() / m,
+    );
+    let exponent = logs.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>()
+        / logs.iter().map(|p| (p.0 - mx).powi(2)).sum::<f64>();
+    println!(
+        "KGD toughness, h = {h} m, t >= 20 s: l {e_l:+.4} (mean |.| {a_l:.4}), p {a_p:.4}, \
+         w {a_w:.4}, exponent {exponent:.4}"
+    );
+    assert!(
+        e_l > 0.0 && a_l < 0.079,
+        "half-length: mean error {e_l:+.4}, |.| {a_l:.4}"
+    );
+    assert!(a_p < 0.073, "inlet net pressure: mean |error| {a_p:.4}");
+    assert!(a_w < 0.040, "inlet opening: mean |error| {a_w:.4}");
+    assert!(
+        (0.61..0.65).contains(&exponent),
+        "time exponent of the half-length {exponent:.4} (2/3 in the vertex solution)"
+    );
+}
+
+#[test]
+fn kgd_viscosity_opening_follows_the_vertex_solution_and_the_length_is_long() {
+    let (e, nu, mu, q0): (f64, f64, f64, f64) = (1.0e10, 0.25, 1.0e-3, 1.0e-5);
+    let ep = e / (1.0 - nu * nu);
+    let mup = 12.0 * mu;
+    let h = 0.125;
+    let scene = Scene::parse(
+        include_str!("../../../../scenes/kgd_viscosity.toml"),
+        Path::new("scenes/kgd_viscosity.toml"),
+        LawRegistry::default(),
+    )
+    .unwrap();
+    let out = std::env::temp_dir().join(format!("porofrac_kgd_mu_{}", std::process::id()));
+    scene.run(&out, &mut Silent).unwrap();
+    let probes = csv(&out.join("probes.csv"));
+    let failed: Vec<f64> = csv(&out.join("fracture.csv"))
+        .iter()
+        .map(|r| r[3].parse().unwrap())
+        .collect();
+    std::fs::remove_dir_all(&out).ok();
+    let (mut e_l, mut e_w, mut worst_w, mut m) = (0.0, 0.0, 0.0f64, 0.0);
+    for row in &probes {
+        let v: Vec<f64> = row.iter().map(|x| x.parse().unwrap()).collect();
+        let t = v[0];
+        if t < 8.0 {
+            continue;
+        }
+        let l = failed.iter().filter(|&&tf| tf <= t + 1e-9).count() as f64 * h / 4.0;
+        let lv = 0.6152 * (ep * q0.powi(3) * t.powi(4) / mup).powf(1.0 / 6.0);
+        let wv = 1.1265 * (mup * q0.powi(3) * t * t / ep).powf(1.0 / 6.0);
+        let ew = (v[2] - v[3]) / wv - 1.0;
+        e_l += l / lv - 1.0;
+        e_w += ew;
+        worst_w = worst_w.max(ew.abs());
+        m += 1.0;
+    }
+    let (e_l, e_w) = (e_l / m, e_w / m);
+    println!("KGD viscosity, h = {h} m, t >= 8 s: l {e_l:+.4}, w {e_w:+.4} (largest {worst_w:.4})");
+    assert_eq!(m, 41.0, "probes every 0.8 s from 8 s to 40 s");
+    assert!(
+        e_w.abs() < 0.014 && worst_w < 0.023,
+        "inlet opening {e_w:+.4}, {worst_w:.4}"
+    );
+    assert!(
+        (0.26..0.29).contains(&e_l),
+        "half-length {e_l:+.4}: measured +0.274 (the target 10 % is missed)"
+    );
+}
