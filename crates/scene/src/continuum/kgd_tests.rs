@@ -10,8 +10,8 @@
 //!
 //! The viscosity scene (`scenes/kgd_viscosity.toml`, h = 0.125 m, 5 s) against the
 //! viscosity vertex solution over t ≥ 8 s: the inlet opening within the error measured
-//! (−1.3 % on average, −2.2 % at most), the half-length as long as measured (+27 % on
-//! average: the target of 10 % is missed, see docs/hydrofrac/validation.md).
+//! (−1.3 % on average, −2.2 % at most); the half-length's target of 10 % is missed (+27 %
+//! on average, docs/hydrofrac/validation.md) and its test stays ignored with the numbers.
 //!
 //! The bounds are the values measured at this resolution (2026-11-28: `ℓ` +7.4 % on
 //! average, 7.5 % in absolute value; `p` 6.9 %; `w` 3.8 %; exponent 0.630) rounded up by
@@ -119,8 +119,9 @@ fn kgd_toughness_follows_the_vertex_solution() {
     );
 }
 
-#[test]
-fn kgd_viscosity_opening_follows_the_vertex_solution_and_the_length_is_long() {
+/// The viscosity scene's mean relative errors over t ≥ 8 s: half-length, inlet opening,
+/// and the largest |error| of the inlet opening.
+fn kgd_viscosity_errors() -> (f64, f64, f64) {
     let (e, nu, mu, q0): (f64, f64, f64, f64) = (1.0e10, 0.25, 1.0e-3, 1.0e-5);
     let ep = e / (1.0 - nu * nu);
     let mup = 12.0 * mu;
@@ -158,12 +159,26 @@ fn kgd_viscosity_opening_follows_the_vertex_solution_and_the_length_is_long() {
     let (e_l, e_w) = (e_l / m, e_w / m);
     println!("KGD viscosity, h = {h} m, t >= 8 s: l {e_l:+.4}, w {e_w:+.4} (largest {worst_w:.4})");
     assert_eq!(m, 41.0, "probes every 0.8 s from 8 s to 40 s");
+    (e_l, e_w, worst_w)
+}
+
+#[test]
+fn kgd_viscosity_inlet_opening_follows_the_vertex_solution() {
+    let (_, e_w, worst_w) = kgd_viscosity_errors();
     assert!(
         e_w.abs() < 0.014 && worst_w < 0.023,
         "inlet opening {e_w:+.4}, {worst_w:.4}"
     );
-    assert!(
-        (0.26..0.29).contains(&e_l),
-        "half-length {e_l:+.4}: measured +0.274 (the target 10 % is missed)"
-    );
+}
+
+/// The target of 10 % on the half-length: missed (2026-11-28, h = 0.125 m: +27.4 % on
+/// average, +47 % at 8 s, +18 % at 40 s; fitted exponent 0.55 against 2/3). The cells
+/// ahead of the fluid fail nearly dry and their pressure is not bounded below by a
+/// cavitation pressure, so the crack carries a dry tip several cells long that the
+/// vertex solution does not have (docs/hydrofrac/validation.md).
+#[test]
+#[ignore = "missed: half-length +27 % against the viscosity vertex solution (target 10 %)"]
+fn kgd_viscosity_half_length_follows_the_vertex_solution() {
+    let (e_l, _, _) = kgd_viscosity_errors();
+    assert!(e_l.abs() < 0.10, "half-length {e_l:+.4} (target ±10 %)");
 }
