@@ -1,7 +1,7 @@
 //! Keys of model "lsm", run through the library against closed forms and invariants:
 //! whole sub-steps for an output interval that is a multiple of `[lsm] dt`, initial
 //! velocities and spins (`[[particles.velocity]]`), a listed packing with a hole,
-//! platens that stop, `wall = "top" | "bottom" | "hole"` and cell `torque` probes, and
+//! platens that stop or hold a force, `wall = "top" | "bottom" | "hole"` and cell `torque` probes, and
 //! the bending moments of the contacts VTK files.
 
 use std::path::{Path, PathBuf};
@@ -516,5 +516,100 @@ fn an_elastic_column_holds_the_force_of_its_stopped_platens() {
         "at t = {}: {}",
         settled[0],
         settled[1]
+    );
+}
+
+/// `hold_force` on the column of the test above: the platens approach at `velocity` and
+/// the servo holds the platen force at `F`. Four springs k_n in series between platens
+/// that each moved `d` carry `k_n 2d/4`, so the platens stop at `d = 2F/k_n` (closed
+/// form). The held force is `F` to 1e-6, its range over the last tenth of the run is
+/// below 1e-6 F (no growing oscillation), and both platens moved `2F/k_n` to 1e-6.
+#[test]
+fn the_servo_holds_the_force_of_an_elastic_column() {
+    let (kn, force) = (1.0e9, 500.0);
+    let centres: Vec<[f64; 2]> = (0..5).map(|k| [0.0, f64::from(k)]).collect();
+    let text = format!(
+        "{HEAD}{}[bonds]\nkn = {kn:?}\nks = 0.4e9\n[lsm]\ndt = 1.0e-5\ndamping = \"local\"\n\
+         [loading]\nplatens = {{ velocity = 1.0e-3, thickness = 0.5, hold_force = {force:?} }}\n\
+         [schedule]\nend_time = 0.2\ndt = 1.0e-3\n[output]\nvtk = false\n\
+         [[output.probe]]\nname = \"pf\"\nfield = \"platen_force\"\n{}{}{}",
+        list(&centres, 0.5),
+        wall_probe("fy", "fy", "top"),
+        probe("ytop", "y", 4),
+        probe("ybottom", "y", 0),
+    );
+    let r = run("servo", &text);
+    let tol = 1e-6;
+    let last = r.rows.last().unwrap();
+    assert!(
+        (last[1] - force).abs() <= tol * force,
+        "platen force {}",
+        last[1]
+    );
+    assert!((last[2] + force).abs() <= tol * force, "top fy {}", last[2]);
+    let tail = &r.rows[r.rows.len() - r.rows.len() / 10..];
+    let (lo, hi) = tail
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), row| {
+            (a.min(row[1]), b.max(row[1]))
+        });
+    assert!(
+        hi - lo <= tol * force,
+        "force range {lo} .. {hi} over the last tenth"
+    );
+    let d = 2.0 * force / kn;
+    assert!(
+        ((4.0 - last[3]) - d).abs() <= tol * d,
+        "top moved {}",
+        4.0 - last[3]
+    );
+    assert!((last[4] - d).abs() <= tol * d, "bottom moved {}", last[4]);
+    // The approach went at full speed: the force was still below F at half the time
+    // the approach needs at `velocity` (d / velocity = 1 ms).
+    let early = r.rows.iter().find(|row| row[0] >= 0.5e-3 - 1e-12).unwrap();
+    assert!(early[1] < force, "at t = {}: {}", early[0], early[1]);
+}
+
+/// `hold_force` is refused with a stop key, when not positive and with `[lbm]`, naming
+/// the key.
+#[test]
+fn bad_hold_forces_are_named() {
+    let pair = list(&[[0.0, 0.0], [0.0, 1.0]], 0.5);
+    let tail = "[schedule]\nend_time = 1.0e-3\ndt = 1.0e-4\n";
+    let lbm = "[lbm]\nextent = [[-1.0, -1.0], [1.0, 2.0]]\nspacing = 0.1\ndensity = 1000.0\n\
+               viscosity = 0.76\ntau = 0.6\n";
+    for (extra, want) in [
+        (
+            "platens = { velocity = 1.0, thickness = 0.5, hold_force = 1.0, stop_time = 1.0 }\n",
+            "hold_force and stop_time",
+        ),
+        (
+            "platens = { velocity = 1.0, thickness = 0.5, hold_force = 1.0, stop_displacement = 1.0 }\n",
+            "hold_force and stop_displacement",
+        ),
+        (
+            "platens = { velocity = 1.0, thickness = 0.5, hold_force = 0.0 }\n",
+            "hold_force = 0 must be",
+        ),
+        (
+            "platens = { velocity = 1.0, thickness = 0.5, hold_force = -5.0 }\n",
+            "hold_force = -5 must be",
+        ),
+    ] {
+        let e = error_of(&format!(
+            "{HEAD}{pair}[bonds]\nkn = 1.0e9\n{tail}[loading]\n{extra}"
+        ));
+        assert!(
+            e.contains("loading.platens") && e.contains(want),
+            "{want}: {e}"
+        );
+    }
+    let e = error_of(&format!(
+        "{HEAD}{pair}[bonds]\nkn = 1.0e9\n{tail}{lbm}[loading]\n\
+         platens = {{ velocity = 1.0, thickness = 0.5, hold_force = 1.0 }}\n"
+    ));
+    assert!(
+        e.contains("loading.platens") && e.contains("hold_force is not available with [lbm]"),
+        "{e}"
     );
 }

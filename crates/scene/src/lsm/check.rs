@@ -405,6 +405,26 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
                     "stop_displacement and stop_time both stop the platens: give one",
                 ));
             }
+            if let Some(f) = p.hold_force {
+                if let Some((name, _)) = stop.iter().find(|(_, v)| v.is_some()) {
+                    return Err(ls.error(
+                        &key("platens"),
+                        format!("hold_force and {name} both end the approach: give one"),
+                    ));
+                }
+                if !(f.is_finite() && f > 0.0) {
+                    return Err(ls.error(
+                        &key("platens"),
+                        format!("hold_force = {f} must be a finite force > 0 (N/m, compressive)"),
+                    ));
+                }
+                if s.lbm.is_some() {
+                    return Err(ls.error(
+                        &key("platens"),
+                        "hold_force is not available with [lbm] (the platens of a coupled run move at velocity)",
+                    ));
+                }
+            }
             for (f, v) in stop {
                 if let Some(v) = v
                     && !(v.is_finite() && v >= 0.0)

@@ -111,7 +111,8 @@ pub struct LsmSection {
 
 /// `[loading] platens`: the particles within `thickness` of the top and of the bottom
 /// of the sample move towards each other at `velocity`, until they stop (at
-/// `stop_displacement` or `stop_time`) and then hold their place.
+/// `stop_displacement` or `stop_time`) and then hold their place, or until their force
+/// reaches `hold_force`, which a servo then holds.
 #[derive(Clone, Copy, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct PlatensSpec {
@@ -131,6 +132,14 @@ pub struct PlatensSpec {
     /// `velocity × stop_time`.
     #[schemars(extend("unit" = "s"))]
     pub stop_time: Option<f64>,
+    /// Or the platens approach at `velocity` until the platen force (the `platen_force`
+    /// probe: the mean of the two platens' loads, N/m, compressive positive) reaches
+    /// this value, and a servo then holds it: each sub-step of `dt` both platens move
+    /// at `(hold_force − F) / (k_est · 10 dt)`, at most `velocity` either way, with
+    /// `k_est` the stiffness of the bonds and contacts touching the platens (stable
+    /// for any sample; see docs/models/lsm.md). Not with a stop key nor with `[lbm]`.
+    #[schemars(extend("unit" = "N/m"))]
+    pub hold_force: Option<f64>,
 }
 
 impl PlatensSpec {

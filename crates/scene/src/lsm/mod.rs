@@ -4,7 +4,8 @@
 //! - *build*: the disks of `[particles]` ([`crate::common::particles`]) with their
 //!   initial velocities and spins (`[[particles.velocity]]`), the bond law of
 //!   `[bonds]` (E and ν through the hexagonal closed form, or k_n, k_s), `[contacts]`,
-//!   `[lsm]` (time step, damping, gravity) and `[loading]` (platens that may stop, a
+//!   `[lsm]` (time step, damping, gravity) and `[loading]` (platens that may stop or
+//!   hold a force, [`servo`], a
 //!   pressure ramp on
 //!   the hole, on the faces seen from its centre or on the faces a fluid would wet,
 //!   [`porofrac_lsm::WallFaces`]); with `[bonds] calibrate = true` a uniaxial compression
@@ -35,6 +36,7 @@ pub mod crack;
 pub mod file;
 pub mod fluid;
 pub mod reaction;
+pub mod servo;
 
 use crate::common::laws::LawRegistry;
 use crate::common::loaded::SceneError;
@@ -124,6 +126,8 @@ pub struct LsmModel<'a> {
     /// (m, infinite without a stop).
     platen_speed: f64,
     platen_travel: f64,
+    /// `[loading] platens.hold_force`: the servo holding the platen force.
+    servo: Option<servo::Servo>,
     wall: Option<usize>,
     pressure_rate: f64,
     pressure_max: f64,
@@ -454,6 +458,10 @@ pub fn build<'a>(ls: &'a LoadedScene, setup: &mut SetupPoll<'_>) -> Result<LsmMo
         ),
         _ => None,
     };
+    let servo = load.platens.and_then(|p| {
+        p.hold_force
+            .map(|f| servo::Servo::new(f, p.velocity, count, &top, &bottom))
+    });
     Ok(LsmModel {
         ls,
         solid,
@@ -465,6 +473,7 @@ pub fn build<'a>(ls: &'a LoadedScene, setup: &mut SetupPoll<'_>) -> Result<LsmMo
         bottom,
         platen_speed: load.platens.map_or(0.0, |p| p.velocity),
         platen_travel: load.platens.map_or(f64::INFINITY, |p| p.travel()),
+        servo,
         wall,
         pressure_rate: load.pressure_rate.unwrap_or(0.0),
         pressure_max: load.pressure_max.unwrap_or(f64::INFINITY),
@@ -501,6 +510,11 @@ impl LsmModel<'_> {
         } else {
             0.0
         };
+        self.set_platen_speed(speed);
+    }
+
+    /// Move the platens towards each other at `speed` (m/s; negative: apart).
+    fn set_platen_speed(&mut self, speed: f64) {
         for &i in &self.top {
             self.solid.set_motion(i, Motion::Velocity([0.0, -speed]));
         }
@@ -843,7 +857,10 @@ impl Model for LsmModel<'_> {
             if self.stop.requested() {
                 return Err(RunError::Interrupted);
             }
-            if self.platen_travel.is_finite() {
+            if let Some(s) = &self.servo {
+                let v = s.velocity(&self.solid, self.platen_force(), dt);
+                self.set_platen_speed(v);
+            } else if self.platen_travel.is_finite() {
                 self.move_platens(dt);
             }
             if let Some(w) = self.wall {
