@@ -1,7 +1,7 @@
 //! Runs on MPI ranks (cargo feature `mpi`): the part of a distributed run every model
 //! shares. `mpirun -n P porofrac run scene.toml` starts P copies of the program; each
-//! reads the same scene, and [`run`] hands the model's distributed path
-//! ([`ModelKind::run_distributed`]) the communicator of all of them.
+//! reads the same scene, and [`crate::Scene::run_distributed`] hands the model's
+//! distributed path ([`ModelKind::run_distributed`]) the communicator of all of them.
 //!
 //! Rank 0 owns the output folder: it takes its lock ([`OutputLock`]), removes what an
 //! earlier run wrote there, and writes `summary.json` (with `"status": "failed: …"` when
@@ -12,6 +12,8 @@
 //! where all of them meet ([`agree`]): each one then returns the error of the lowest
 //! failing rank, so no rank waits forever on a rank that has stopped, and the command's
 //! exit status is the same on all of them.
+//!
+//! [`ModelKind::run_distributed`]: crate::common::model::ModelKind::run_distributed
 
 use std::path::Path;
 
