@@ -331,6 +331,12 @@ impl Lattice {
         Ok(l)
     }
 
+    /// Nodes of the whole box along x and y (those of [`Lattice::size`] but for a
+    /// [`Lattice::window`]).
+    pub fn box_size(&self) -> (usize, usize) {
+        (self.box_nx, self.grid.ny)
+    }
+
     /// Column of the whole box that local column 0 is (0 but for a [`Lattice::window`]).
     pub fn origin(&self) -> usize {
         self.x0 as usize
