@@ -209,6 +209,16 @@ fn run(
     set: &[String],
 ) -> Result<ExitCode, String> {
     let ranks = ranks::Ranks::start()?;
+    run_on(&ranks, path, out, resume, set).map_err(|e| ranks.failed(e))
+}
+
+fn run_on(
+    ranks: &ranks::Ranks,
+    path: Option<&Path>,
+    out: Option<PathBuf>,
+    resume: Option<PathBuf>,
+    set: &[String],
+) -> Result<ExitCode, String> {
     let set = overrides(set)?;
     let scene = match (path, &resume) {
         (Some(p), _) => Scene::load_with_overrides(p, LawRegistry::default(), &set)

@@ -81,6 +81,24 @@ impl Ranks {
         1
     }
 
+    /// The error `e` every rank of a distributed run ends with: rank 0 prints it, and no
+    /// rank exits before it has (the launcher ends the job when the first rank exits
+    /// with an error). With one rank `e` is returned for the caller to print.
+    pub fn failed(&self, e: String) -> String {
+        #[cfg(feature = "mpi")]
+        if let Some(universe) = &self.universe
+            && self.size() > 1
+        {
+            use mpi::traits::CommunicatorCollectives;
+            if !quiet() {
+                eprintln!("error: {e}");
+                QUIET.store(true, Ordering::Relaxed);
+            }
+            universe.world().barrier();
+        }
+        e
+    }
+
     /// Run `scene` on all the ranks ([`Ranks::size`] > 1), writing into `out`; rank 0
     /// reports to `observer`, the others only share its stop request.
     pub fn run(

@@ -349,6 +349,7 @@ impl Lattice {
     }
 
     /// The populations as stored, and the padded nodes per direction (the slab exchange).
+    #[cfg(feature = "mpi")]
     pub(crate) fn stored_mut(&mut self) -> (&mut [f64], usize) {
         let np = self.grid.np();
         (&mut self.pop, np)

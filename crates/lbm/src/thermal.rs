@@ -128,6 +128,7 @@ impl Thermal {
 
     /// The distributions as stored (padded, node-major) and the padded row length (the
     /// slab exchange).
+    #[cfg(feature = "mpi")]
     pub(crate) fn stored_mut(&mut self) -> (&mut [[f64; 5]], usize) {
         (&mut self.g, self.nx + 2)
     }

@@ -43,7 +43,7 @@ fn refuse(ls: &LoadedScene) -> Result<(), RunError> {
             return Err(ls
                 .error(
                     &ki("obstacle", i, &["velocity"]),
-                    format!(": a moving obstacle {why}"),
+                    format!("is given: a moving obstacle {why}"),
                 )
                 .into());
         }
@@ -51,7 +51,7 @@ fn refuse(ls: &LoadedScene) -> Result<(), RunError> {
             return Err(ls
                 .error(
                     &ki("obstacle", i, &["angular_velocity"]),
-                    format!(": a turning obstacle {why}"),
+                    format!("is given: a turning obstacle {why}"),
                 )
                 .into());
         }
@@ -62,8 +62,8 @@ fn refuse(ls: &LoadedScene) -> Result<(), RunError> {
             .error(
                 &k(&["lbm", "periodic"]),
                 format!(
-                    ": a lattice periodic along x {why} (the slabs are cut along x; a \
-                     lattice periodic along y only is distributed)"
+                    "includes \"x\": a lattice periodic along x {why} (the slabs are cut \
+                     along x; a lattice periodic along y only is distributed)"
                 ),
             )
             .into());
@@ -72,7 +72,10 @@ fn refuse(ls: &LoadedScene) -> Result<(), RunError> {
         return Err(ls
             .error(
                 &k(&["output", "checkpoint_every"]),
-                format!(": checkpoints of a distributed run {why}"),
+                format!(
+                    "= {}: checkpoints of a distributed run {why}",
+                    ls.scene.output.checkpoint_every
+                ),
             )
             .into());
     }
@@ -104,8 +107,9 @@ pub(crate) fn run(
         ls.error(
             &k(&["lbm", "spacing"]),
             format!(
-                ": {nx} columns of nodes cannot be cut into {ranks} slabs of at least 2 \
-                 columns: run on fewer ranks"
+                "= {}: {nx} columns of nodes cannot be cut into {ranks} slabs of at least 2 \
+                 columns: run on fewer ranks",
+                l.spacing
             ),
         )
     })?;
