@@ -9,8 +9,8 @@
 //! those of the box) wherever its inputs are the whole lattice's; where it ends inside the
 //! box it has a wall, whose error travels a column or two per step. So after every step
 //! each rank overwrites the columns of its window that others own with their values
-//! (`Exchange::lattice`, `Exchange::thermal`, with the feature): all nine stored populations of the
-//! AA pattern's layout of the step (the even step's swapped layout keeps a node's
+//! (`Exchange::lattice`, `Exchange::thermal`, with the feature): all nine stored
+//! populations of the AA pattern's layout of the step (the even step's swapped layout keeps a node's
 //! outgoing populations in its neighbours' slots, the odd step's natural layout its
 //! incoming ones, so whole columns of the storage carry exactly what the next step of
 //! either parity reads), and the five temperature distributions. The columns a rank owns
