@@ -19,6 +19,8 @@
 //! second of stepping).
 
 pub mod check;
+#[cfg(feature = "mpi")]
+mod distributed;
 
 use crate::common::checkpoint::State;
 use crate::common::laws::LawRegistry;
@@ -40,8 +42,8 @@ use crate::common::expr::Expr;
 use crate::common::lattice::images;
 use crate::common::lattice::sections::{CollisionChoice, ShapeChoice};
 use crate::common::lattice::{
-    LatticeParts, VelocityExpr, lattice_of, set_side_velocities, thermal_initial, thermal_sides,
-    thermal_tau,
+    LatticeParts, VelocityExpr, set_side_velocities, thermal_initial, thermal_sides, thermal_tau,
+    window_of,
 };
 use crate::common::loaded::{LoadedScene, k, ki};
 use crate::common::model::{Built, Model, Purpose, RunError, Sizes, StepStats};
@@ -94,7 +96,13 @@ struct LbmModel<'a> {
     name: String,
     /// Polled between the lattice steps of an output step.
     stop: Stop,
+    /// After every lattice step: what a distributed run exchanges between ranks (none in
+    /// a serial run).
+    halo: Option<Halo<'a>>,
 }
+
+/// The exchange of a distributed run after every lattice step.
+type Halo<'a> = Box<dyn Fn(&mut Lattice, Option<&mut Thermal>) + 'a>;
 
 /// Build a checked lattice Boltzmann scene's model and hand it to `purpose`.
 pub(crate) fn build_for(
@@ -103,12 +111,45 @@ pub(crate) fn build_for(
     observer: &mut dyn Observer,
 ) -> Result<Built, RunError> {
     let start = Instant::now();
-    let mut model = build(ls, &mut SetupPoll::new(observer))?;
+    let mut model = build(ls, &mut SetupPoll::new(observer), None)?;
     let build_seconds = start.elapsed().as_secs_f64();
     purpose.finish(ls, &mut model, observer, start, build_seconds, 2)
 }
 
-fn build<'a>(ls: &'a LoadedScene, setup: &mut SetupPoll<'_>) -> Result<LbmModel<'a>, RunError> {
+/// The obstacle's shape on the lattice (lattice units from the box's corner `origin`).
+fn shape_of(
+    o: &crate::common::lattice::sections::ObstacleSection,
+    units: &Units,
+    origin: [f64; 2],
+) -> Shape {
+    match &o.shape {
+        ShapeChoice::Circle(c) => Shape::Circle {
+            center: [
+                units.length(c.center[0] - origin[0]),
+                units.length(c.center[1] - origin[1]),
+            ],
+            radius: units.length(c.radius),
+        },
+        ShapeChoice::Box(b) => Shape::aligned_box(
+            [
+                units.length(b[0][0] - origin[0]),
+                units.length(b[0][1] - origin[1]),
+            ],
+            [
+                units.length(b[1][0] - origin[0]),
+                units.length(b[1][1] - origin[1]),
+            ],
+        ),
+    }
+}
+
+/// Build the model of a checked scene: the whole lattice, or (a distributed run) its
+/// columns `window[0] .. window[1]`.
+fn build<'a>(
+    ls: &'a LoadedScene,
+    setup: &mut SetupPoll<'_>,
+    window: Option<[usize; 2]>,
+) -> Result<LbmModel<'a>, RunError> {
     let s = &ls.scene;
     let l = s.lbm.as_ref().expect("checked");
     let LatticeParts {
@@ -116,28 +157,10 @@ fn build<'a>(ls: &'a LoadedScene, setup: &mut SetupPoll<'_>) -> Result<LbmModel<
         units,
         origin,
         sides,
-    } = lattice_of(ls)?;
+    } = window_of(ls, window)?;
     let mut motions = Vec::new();
     for (i, o) in own(ls).obstacle.iter().enumerate() {
-        let shape = match &o.shape {
-            ShapeChoice::Circle(c) => Shape::Circle {
-                center: [
-                    units.length(c.center[0] - origin[0]),
-                    units.length(c.center[1] - origin[1]),
-                ],
-                radius: units.length(c.radius),
-            },
-            ShapeChoice::Box(b) => Shape::aligned_box(
-                [
-                    units.length(b[0][0] - origin[0]),
-                    units.length(b[0][1] - origin[1]),
-                ],
-                [
-                    units.length(b[1][0] - origin[0]),
-                    units.length(b[1][1] - origin[1]),
-                ],
-            ),
-        };
+        let shape = shape_of(o, &units, origin);
         let v = o.velocity.as_ref().map(|v| VelocityExpr::new(v));
         let w = o.angular_velocity.as_ref().map(|w| match w {
             NumOrExpr::Num(x) => Expr::constant(*x),
@@ -154,7 +177,15 @@ fn build<'a>(ls: &'a LoadedScene, setup: &mut SetupPoll<'_>) -> Result<LbmModel<
     let thermal = match &s.thermal {
         None => None,
         Some(t) => {
-            let tsides = thermal_sides(t, &units);
+            let mut tsides = thermal_sides(t, &units);
+            // a window's own sides inside the box (their columns are other ranks')
+            let (w, (nx, _)) = (lat.origin(), lat.size());
+            if w > 0 {
+                tsides[Side::XMin.index()] = porofrac_lbm::ThermalSide::Adiabatic;
+            }
+            if w + nx < lat.box_size().0 {
+                tsides[Side::XMax.index()] = porofrac_lbm::ThermalSide::Adiabatic;
+            }
             let init = thermal_initial(t);
             let tau = thermal_tau(t.diffusivity, &units);
             let tau_s = thermal_tau(t.solid_diffusivity.unwrap_or(t.diffusivity), &units);
@@ -182,6 +213,7 @@ fn build<'a>(ls: &'a LoadedScene, setup: &mut SetupPoll<'_>) -> Result<LbmModel<
         max_mach: 0.0,
         name: s.scene.name.clone(),
         stop: setup.stop_handle(),
+        halo: None,
     };
     for p in &s.output.probe {
         model.probes.push(match &p.obstacle {
@@ -363,14 +395,7 @@ impl LbmModel<'_> {
 
     /// Density and velocity (lattice units) at an SI point, bilinear between nodes.
     fn sample(&self, x: [f64; 2]) -> (f64, [f64; 2]) {
-        let (nx, ny) = self.lat.size();
-        let gx = ((x[0] - self.origin[0]) / self.units.dx - 0.5).clamp(0.0, (nx - 1) as f64);
-        let gy = ((x[1] - self.origin[1]) / self.units.dx - 0.5).clamp(0.0, (ny - 1) as f64);
-        let (i0, j0) = (
-            (gx.floor() as usize).min(nx - 2),
-            (gy.floor() as usize).min(ny - 2),
-        );
-        let (fx, fy) = (gx - i0 as f64, gy - j0 as f64);
+        let ([i0, j0], [fx, fy]) = self.cell_of(x);
         let corners = [
             (0, 0, (1.0 - fx) * (1.0 - fy)),
             (1, 0, fx * (1.0 - fy)),
@@ -487,18 +512,79 @@ impl LbmModel<'_> {
         let Some(th) = &self.thermal else {
             return f64::NAN;
         };
-        let (nx, ny) = self.lat.size();
+        let ([i0, j0], [fx, fy]) = self.cell_of(x);
+        (1.0 - fx) * (1.0 - fy) * th.temperature(i0, j0)
+            + fx * (1.0 - fy) * th.temperature(i0 + 1, j0)
+            + (1.0 - fx) * fy * th.temperature(i0, j0 + 1)
+            + fx * fy * th.temperature(i0 + 1, j0 + 1)
+    }
+
+    /// The cell of nodes that holds SI point `x` (clamped to the box): its lower-left
+    /// node (a column of the lattice, the box's column minus the window's origin) and
+    /// the fractions of the bilinear interpolation.
+    fn cell_of(&self, x: [f64; 2]) -> ([usize; 2], [f64; 2]) {
+        let ([i0, j0], f) = self.box_cell_of(x);
+        ([i0 - self.lat.origin(), j0], f)
+    }
+
+    /// [`LbmModel::cell_of`] in the box's columns.
+    fn box_cell_of(&self, x: [f64; 2]) -> ([usize; 2], [f64; 2]) {
+        let (nx, ny) = self.lat.box_size();
         let gx = ((x[0] - self.origin[0]) / self.units.dx - 0.5).clamp(0.0, (nx - 1) as f64);
         let gy = ((x[1] - self.origin[1]) / self.units.dx - 0.5).clamp(0.0, (ny - 1) as f64);
         let (i0, j0) = (
             (gx.floor() as usize).min(nx - 2),
             (gy.floor() as usize).min(ny - 2),
         );
-        let (fx, fy) = (gx - i0 as f64, gy - j0 as f64);
-        (1.0 - fx) * (1.0 - fy) * th.temperature(i0, j0)
-            + fx * (1.0 - fy) * th.temperature(i0 + 1, j0)
-            + (1.0 - fx) * fy * th.temperature(i0, j0 + 1)
-            + fx * fy * th.temperature(i0 + 1, j0 + 1)
+        ([i0, j0], [gx - i0 as f64, gy - j0 as f64])
+    }
+
+    /// `plots/obstacle_forces.png` and `plots/probes.png`: the probe series.
+    fn probe_plots(
+        &self,
+        dir: &Path,
+        written: &[f64],
+        series: &[Vec<f64>],
+    ) -> Result<(), RunError> {
+        let probes = &self.ls.scene.output.probe;
+        if probes.is_empty() || written.is_empty() {
+            return Ok(());
+        }
+        let column = |(p, s): (&crate::common::sections::Probe, &Vec<f64>)| {
+            Column::new(p.name.clone(), check::unit(&p.field), s.clone())
+        };
+        let forces: Vec<Column> = probes
+            .iter()
+            .zip(series)
+            .filter(|(p, _)| p.obstacle.is_some())
+            .map(column)
+            .collect();
+        if !forces.is_empty() {
+            crate::common::plots::time_series(
+                &dir.join("obstacle_forces.png"),
+                written,
+                &forces,
+                &format!(
+                    "{}: obstacle forces and torques (per metre of depth)",
+                    self.name
+                ),
+            )?;
+        }
+        let fields: Vec<Column> = probes
+            .iter()
+            .zip(series)
+            .filter(|(p, _)| p.obstacle.is_none())
+            .map(column)
+            .collect();
+        if !fields.is_empty() {
+            crate::common::plots::time_series(
+                &dir.join("probes.png"),
+                written,
+                &fields,
+                &format!("{}: probes", self.name),
+            )?;
+        }
+        Ok(())
     }
 
     fn value_at(&self, f: FieldName, x: [f64; 2]) -> f64 {
@@ -577,6 +663,9 @@ impl Model for LbmModel<'_> {
             self.lat
                 .step()
                 .map_err(|e| RunError::Flow(format!("lbm: {e}")))?;
+            if let Some(halo) = &self.halo {
+                halo(&mut self.lat, self.thermal.as_mut());
+            }
             n += 1;
         }
         let dt = t0.elapsed().as_secs_f64();
@@ -796,45 +885,7 @@ impl Model for LbmModel<'_> {
 
     fn plots(&self, dir: &Path, written: &[f64], series: &[Vec<f64>]) -> Result<(), RunError> {
         self.field_images(dir)?;
-        let probes = &self.ls.scene.output.probe;
-        if probes.is_empty() || written.is_empty() {
-            return Ok(());
-        }
-        let column = |(p, s): (&crate::common::sections::Probe, &Vec<f64>)| {
-            Column::new(p.name.clone(), check::unit(&p.field), s.clone())
-        };
-        let forces: Vec<Column> = probes
-            .iter()
-            .zip(series)
-            .filter(|(p, _)| p.obstacle.is_some())
-            .map(column)
-            .collect();
-        if !forces.is_empty() {
-            crate::common::plots::time_series(
-                &dir.join("obstacle_forces.png"),
-                written,
-                &forces,
-                &format!(
-                    "{}: obstacle forces and torques (per metre of depth)",
-                    self.name
-                ),
-            )?;
-        }
-        let fields: Vec<Column> = probes
-            .iter()
-            .zip(series)
-            .filter(|(p, _)| p.obstacle.is_none())
-            .map(column)
-            .collect();
-        if !fields.is_empty() {
-            crate::common::plots::time_series(
-                &dir.join("probes.png"),
-                written,
-                &fields,
-                &format!("{}: probes", self.name),
-            )?;
-        }
-        Ok(())
+        self.probe_plots(dir, written, series)
     }
 
     fn work(&self) -> crate::common::limits::Work {
@@ -941,6 +992,18 @@ impl ModelKind for LbmKind {
     ) -> Result<Built, RunError> {
         let _ = laws;
         build_for(ls, purpose, observer)
+    }
+    #[cfg(feature = "mpi")]
+    fn run_distributed(
+        &self,
+        ls: &LoadedScene,
+        laws: &LawRegistry,
+        out: &Path,
+        world: &mpi::topology::SimpleCommunicator,
+        observer: &mut dyn Observer,
+    ) -> Result<crate::common::output::Summary, RunError> {
+        let _ = laws;
+        distributed::run(ls, out, world, observer)
     }
 }
 

@@ -115,6 +115,15 @@ fn side_of(s: SideChoice) -> Side {
 
 /// Build the lattice of a checked `[lbm]`.
 pub(crate) fn lattice_of(ls: &LoadedScene) -> Result<LatticeParts, RunError> {
+    window_of(ls, None)
+}
+
+/// Build the lattice of a checked `[lbm]`, or its columns `window[0] .. window[1]`
+/// ([`Lattice::window`], a rank's part of a distributed run).
+pub(crate) fn window_of(
+    ls: &LoadedScene,
+    window: Option<[usize; 2]>,
+) -> Result<LatticeParts, RunError> {
     let s = &ls.scene;
     let l = s.lbm.as_ref().expect("checked");
     let units = Units::from_viscosity(l.spacing, l.viscosity, l.density, l.tau)
@@ -164,7 +173,11 @@ pub(crate) fn lattice_of(ls: &LoadedScene) -> Result<LatticeParts, RunError> {
         },
         obstacle_mass: porofrac_lbm::ObstacleMass::Conserved,
     };
-    let lat = Lattice::new(cfg).map_err(|e| ls.error(&k(&["lbm"]), e))?;
+    let lat = match window {
+        None => Lattice::new(cfg),
+        Some([a, b]) => Lattice::window(cfg, a, b - a),
+    }
+    .map_err(|e| ls.error(&k(&["lbm"]), e))?;
     Ok(LatticeParts {
         lat,
         units,
