@@ -68,6 +68,9 @@
 //! `<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">` with one
 //! `<DataSet timestep="t" group="" part="0" file="relative/path"/>` per step.
 //!
+//! **Parallel pieces.** A `.pvtu` file ([`write_pvtu`]) names the `.vtu` pieces of one
+//! data set (one per process of a distributed run) and declares their arrays.
+//!
 //! Attribute values and names are XML-escaped (`& < > " '`).
 
 mod array;
@@ -77,6 +80,7 @@ mod error;
 mod image;
 mod poly;
 mod pvd;
+mod pvtu;
 mod unstructured;
 
 pub use array::{Attributes, DataArray, Encoding, Values, component_names};
@@ -85,4 +89,5 @@ pub use error::VtkError;
 pub use image::ImageData;
 pub use poly::{CellArray, PolyData};
 pub use pvd::PvdWriter;
+pub use pvtu::{pvtu_text, write_pvtu};
 pub use unstructured::{CellType, Polyhedra, UnstructuredGrid};
