@@ -151,6 +151,16 @@ impl Accumulator {
         }
         self.val[k] += v;
     }
+    /// Append the accumulated entries (local index, value) in the order met; resets.
+    fn drain_local(&mut self, col: &mut Vec<u32>, val: &mut Vec<f64>) {
+        for &k in &self.touched {
+            col.push(k as u32);
+            val.push(self.val[k]);
+            self.val[k] = 0.0;
+            self.mark[k] = false;
+        }
+        self.touched.clear();
+    }
     /// The accumulated entries as (global column, value), sorted by column; resets.
     fn drain(&mut self, cols: &ColMap, out: &mut Vec<(usize, f64)>) {
         out.clear();
@@ -280,6 +290,9 @@ fn smooth_prolongator(
     let plan = a.plan();
     let (gp, gc) = plan.forward_records(comm, tp, tc);
     let (_, gv) = plan.forward_records(comm, tp, tv);
+    // Local column indices, looked up once.
+    let tk: Vec<usize> = tc.iter().map(|&g| cols.index(g)).collect();
+    let gk: Vec<usize> = gc.iter().map(|&g| cols.index(g)).collect();
     let (d, o) = (a.diag(), a.offd());
     let n = a.rows().local();
     let mut acc = Accumulator::default();
@@ -287,21 +300,21 @@ fn smooth_prolongator(
     let (mut ptr, mut col, mut val) = (vec![0usize], Vec::new(), Vec::new());
     for i in 0..n {
         for q in tp[i]..tp[i + 1] {
-            acc.add(cols.index(tc[q]), tv[q]);
+            acc.add(tk[q], tv[q]);
         }
         let s = -omega * dinv[i];
         for p in d.row_ptr[i]..d.row_ptr[i + 1] {
             let j = d.col[p] as usize;
             let w = s * d.val[p];
             for q in tp[j]..tp[j + 1] {
-                acc.add(cols.index(tc[q]), w * tv[q]);
+                acc.add(tk[q], w * tv[q]);
             }
         }
         for p in o.row_ptr[i]..o.row_ptr[i + 1] {
             let j = o.col[p] as usize;
             let w = s * o.val[p];
             for q in gp[j]..gp[j + 1] {
-                acc.add(cols.index(gc[q]), w * gv[q]);
+                acc.add(gk[q], w * gv[q]);
             }
         }
         acc.drain(cols, &mut row);
@@ -318,6 +331,9 @@ fn galerkin(comm: &Comm, a: &DistCsr, p: &Rows, coarse: &Layout, cols: &mut ColM
     let plan = a.plan();
     let (gp, gc) = plan.forward_records(comm, pp, pc);
     let (_, gv) = plan.forward_records(comm, pp, pv);
+    // Local column indices, looked up once.
+    let pk: Vec<usize> = pc.iter().map(|&g| cols.index(g)).collect();
+    let gk: Vec<usize> = gc.iter().map(|&g| cols.index(g)).collect();
     let (d, o) = (a.diag(), a.offd());
     let n = a.rows().local();
     // AP, owned rows, columns in the local index space of `cols`.
@@ -328,26 +344,21 @@ fn galerkin(comm: &Comm, a: &DistCsr, p: &Rows, coarse: &Layout, cols: &mut ColM
         for q in d.row_ptr[i]..d.row_ptr[i + 1] {
             let j = d.col[q] as usize;
             for r in pp[j]..pp[j + 1] {
-                acc.add(cols.index(pc[r]), d.val[q] * pv[r]);
+                acc.add(pk[r], d.val[q] * pv[r]);
             }
         }
         for q in o.row_ptr[i]..o.row_ptr[i + 1] {
             let j = o.col[q] as usize;
             for r in gp[j]..gp[j + 1] {
-                acc.add(cols.index(gc[r]), o.val[q] * gv[r]);
+                acc.add(gk[r], o.val[q] * gv[r]);
             }
         }
-        acc.drain(cols, &mut row);
-        for &(g, v) in &row {
-            ap_col.push(cols.index(g) as u32);
-            ap_val.push(v);
-        }
+        acc.drain_local(&mut ap_col, &mut ap_val);
         ap_ptr.push(ap_col.len());
     }
     // Pᵀ by coarse column: the fine rows (and values) of every local coarse index.
     let nk = cols.len();
     let mut tptr = vec![0usize; nk + 1];
-    let pk: Vec<usize> = pc.iter().map(|&g| cols.index(g)).collect();
     for &k in &pk {
         tptr[k + 1] += 1;
     }
@@ -628,7 +639,8 @@ impl DistAmg {
     }
 
     /// `ν` Chebyshev steps on level `l` from `x` (`zero`: from `x = 0`); returns the
-    /// residual `b − A x` after the steps.
+    /// residual `b − A x` after the steps (when `zero`: the pre-smoother's residual is
+    /// restricted; the post-smoother's is not needed).
     fn smooth(&self, comm: &Comm, l: usize, b: &[f64], x: &mut [f64], zero: bool) -> Vec<f64> {
         let lev = &self.levels[l];
         let n = b.len();
@@ -666,9 +678,11 @@ impl DistAmg {
             }
             rho = rn;
         }
-        lev.a.mul(comm, &d, &mut ad);
-        for i in 0..n {
-            r[i] -= ad[i];
+        if zero {
+            lev.a.mul(comm, &d, &mut ad);
+            for i in 0..n {
+                r[i] -= ad[i];
+            }
         }
         r
     }

@@ -60,6 +60,6 @@ pub use error::{DistError, Result};
 pub use matrix::{Comm, DistCsr, Exchange, Layout};
 pub use partition::recursive_bisection;
 #[cfg(feature = "mpi")]
-pub use porofrac_amg::{AmgOptions, NearNullSpace};
-#[cfg(feature = "mpi")]
 pub use pcg::DistCgStats;
+#[cfg(feature = "mpi")]
+pub use porofrac_amg::{AmgOptions, NearNullSpace};
