@@ -6,6 +6,11 @@
 //! file, line and key), 2 for command-line misuse, 130 when interrupted by Ctrl-C (the
 //! finished steps' files are complete and `summary.json` says
 //! `"status": "interrupted at t = …"`).
+//!
+//! `mpirun -n P porofrac run scene.toml` runs the scene on P ranks when built with the
+//! `mpi` feature ([`ranks`]).
+
+mod ranks;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -104,7 +109,9 @@ fn main() -> ExitCode {
         } => run(scene.as_deref(), out, resume, &set),
     };
     result.unwrap_or_else(|msg| {
-        eprintln!("error: {msg}");
+        if !ranks::quiet() {
+            eprintln!("error: {msg}");
+        }
         ExitCode::from(1)
     })
 }
@@ -201,6 +208,7 @@ fn run(
     resume: Option<PathBuf>,
     set: &[String],
 ) -> Result<ExitCode, String> {
+    let ranks = ranks::Ranks::start()?;
     let set = overrides(set)?;
     let scene = match (path, &resume) {
         (Some(p), _) => Scene::load_with_overrides(p, LawRegistry::default(), &set)
@@ -224,13 +232,24 @@ fn run(
     let flag = Arc::clone(&stop);
     let _ = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed));
     let mut progress = Progress::new(stop);
-    let summary = if resume.is_some() {
+    let summary = if resume.is_some() && ranks.size() > 1 {
+        return Err("--resume continues a run on one rank: run it without mpirun".into());
+    } else if resume.is_some() {
         scene.resume(&out, &mut progress)
+    } else if ranks.size() > 1 {
+        ranks.run(&scene, &out, &mut progress)
     } else {
         scene.run(&out, &mut progress)
     }
     .map_err(|e| e.to_string())?;
     progress.finish();
+    if ranks::quiet() {
+        return Ok(ExitCode::from(if summary.interrupted() {
+            INTERRUPTED
+        } else {
+            0
+        }));
+    }
     eprintln!(
         "{}: {}, {} steps in {:.2} s; output in {}{}",
         summary.scene,

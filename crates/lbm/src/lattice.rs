@@ -216,6 +216,12 @@ pub struct Lattice {
     side_links: Vec<SideLink>,
     pressure_links: Vec<PressureLink>,
     steps: u64,
+    /// Column of the whole box that local column 0 is (0 unless a window of a bigger box,
+    /// [`Lattice::window`]): positions are those of the whole box, so a window computes
+    /// the same numbers as the whole lattice.
+    x0: isize,
+    /// Columns of the whole box.
+    box_nx: usize,
 }
 
 /// What a lattice with fixed obstacles carries from one step to the next
@@ -287,11 +293,59 @@ impl Lattice {
             side_links: Vec::new(),
             pressure_links: Vec::new(),
             steps: 0,
+            x0: 0,
+            box_nx: cfg.nx,
             cfg,
         };
         l.build_side_links();
         l.init(|_| (1.0, [0.0, 0.0]));
         Ok(l)
+    }
+
+    /// The columns `x0 .. x0 + width` of the lattice `cfg` describes, with every row: a
+    /// window that computes, node for node, the numbers of the whole lattice wherever its
+    /// inputs are those of the whole lattice (positions, obstacles, sides and the
+    /// interpolation are those of the whole box). Where the window ends inside the box
+    /// it has a wall; what comes in there is wrong, so a distributed run
+    /// ([`crate::slab`]) overwrites the columns next to it with their owners' before
+    /// every step. The x axis may not be periodic. Obstacles are added in the box's
+    /// coordinates and may lie partly outside the window.
+    pub fn window(cfg: LatticeConfig, x0: usize, width: usize) -> Result<Self, LbmError> {
+        if cfg.periodic[0] || width < 2 || x0 + width > cfg.nx {
+            return Err(LbmError::Size(width, cfg.ny));
+        }
+        let box_nx = cfg.nx;
+        let mut local = cfg;
+        local.nx = width;
+        if x0 > 0 {
+            local.sides[Side::XMin.index()] = SideKind::Wall;
+        }
+        if x0 + width < box_nx {
+            local.sides[Side::XMax.index()] = SideKind::Wall;
+        }
+        let mut l = Lattice::new(local)?;
+        l.x0 = x0 as isize;
+        l.box_nx = box_nx;
+        l.build_side_links();
+        l.init(|_| (1.0, [0.0, 0.0]));
+        Ok(l)
+    }
+
+    /// Column of the whole box that local column 0 is (0 but for a [`Lattice::window`]).
+    pub fn origin(&self) -> usize {
+        self.x0 as usize
+    }
+
+    /// Position of local column `i` (node centre, lattice units of the whole box).
+    #[inline]
+    fn gx(&self, i: isize) -> f64 {
+        (i + self.x0) as f64 + 0.5
+    }
+
+    /// The populations as stored, and the padded nodes per direction (the slab exchange).
+    pub(crate) fn stored_mut(&mut self) -> (&mut [f64], usize) {
+        let np = self.grid.np();
+        (&mut self.pop, np)
     }
 
     /// The configuration.
@@ -367,7 +421,7 @@ impl Lattice {
         for j in 0..g.ny as isize {
             for i in 0..g.nx as isize {
                 let node = g.node(i, j);
-                let p = [i as f64 + 0.5, j as f64 + 0.5];
+                let p = [self.gx(i), j as f64 + 0.5];
                 let (rho, u) = if self.owner[node] == NONE {
                     f(p)
                 } else {
@@ -724,7 +778,7 @@ impl Lattice {
     /// Along a non-periodic axis the shape must lie inside the box; along a periodic one its
     /// centre is brought into the first period.
     fn check_inside(&self, k: usize, s: &mut Shape) -> Result<(), LbmError> {
-        let n = [self.grid.nx as f64, self.grid.ny as f64];
+        let n = [self.box_nx as f64, self.grid.ny as f64];
         let c = s.center();
         let mut d = [0.0; 2];
         for a in 0..2 {
@@ -808,7 +862,7 @@ impl Lattice {
                             });
                         }
                         Some(s) => {
-                            let p = [i as f64 + 0.5, j as f64 + 0.5];
+                            let p = [self.gx(i), j as f64 + 0.5];
                             let at = [p[0] - 0.5 * C[q][0] as f64, p[1] - 0.5 * C[q][1] as f64];
                             match self.cfg.sides[s.index()] {
                                 SideKind::Wall | SideKind::Velocity => {
@@ -1009,7 +1063,7 @@ impl Lattice {
         let (i, j) = self.ij(n);
         let c = self.obstacles[k].shape.center();
         [
-            self.near(0, i as f64 + 0.5, c[0]),
+            self.near(0, self.gx(i), c[0]),
             self.near(1, j as f64 + 0.5, c[1]),
         ]
     }
@@ -1043,7 +1097,12 @@ impl Lattice {
         let [lo, hi] = shape.bounds();
         let (i0, j0, i1, j1) = if let Shape::Hollow { .. } = shape {
             // solid beyond its circle: the whole lattice
-            (0, 0, self.grid.nx as isize - 1, self.grid.ny as isize - 1)
+            (
+                self.x0,
+                0,
+                self.x0 + self.grid.nx as isize - 1,
+                self.grid.ny as isize - 1,
+            )
         } else {
             (
                 (lo[0] - 0.5).floor() as isize,
@@ -1066,7 +1125,7 @@ impl Lattice {
                     let r = (dx * dx + dy * dy).sqrt();
                     margin = margin.min((r - radius).abs());
                     if r <= radius
-                        && let Some(n) = self.wrap(i, j)
+                        && let Some(n) = self.wrap(i - self.x0, j)
                     {
                         out.push(n as u32);
                     }
@@ -1076,7 +1135,7 @@ impl Lattice {
             for j in j0..=j1 {
                 for i in i0..=i1 {
                     if shape.contains([i as f64 + 0.5, j as f64 + 0.5])
-                        && let Some(n) = self.wrap(i, j)
+                        && let Some(n) = self.wrap(i - self.x0, j)
                     {
                         out.push(n as u32);
                     }

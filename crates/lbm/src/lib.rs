@@ -13,7 +13,8 @@
 //! re-rasterised, and the momentum of covered and uncovered nodes is reported). Mass
 //! sources ([`Lattice::add_source`]) inject fluid (as in that paper's Fig. 9); the
 //! temperature lattice ([`Thermal`]) keeps the books of the heat through the sides and out
-//! of each obstacle.
+//! of each obstacle. [`slab`] cuts a lattice into slabs of columns for a run on several
+//! MPI ranks (the `mpi` feature) whose numbers are those of the serial run, bit for bit.
 //!
 //! ```
 //! use porofrac_lbm::{Lattice, LatticeConfig, Obstacle, Shape};
@@ -34,6 +35,7 @@ pub mod d2q9;
 pub mod geometry;
 pub mod kernel;
 pub mod lattice;
+pub mod slab;
 pub mod thermal;
 pub mod units;
 

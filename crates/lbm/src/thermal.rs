@@ -114,14 +114,22 @@ impl Thermal {
             side_heat: [0.0; 4],
             obstacle_heat: vec![0.0; lat.obstacles().len()],
         };
+        // a window of a bigger lattice ([`Lattice::window`]) starts at column `x0` of the box
+        let x0 = lat.origin();
         for j in 0..ny {
             for i in 0..nx {
-                let t = t0([i as f64 + 0.5, j as f64 + 0.5]);
+                let t = t0([(i + x0) as f64 + 0.5, j as f64 + 0.5]);
                 let u = lat.moments(i, j).1;
                 th.g[(j + 1) * (nx + 2) + i + 1] = equilibrium(t, u);
             }
         }
         Ok(th)
+    }
+
+    /// The distributions as stored (padded, node-major) and the padded row length (the
+    /// slab exchange).
+    pub(crate) fn stored_mut(&mut self) -> (&mut [[f64; 5]], usize) {
+        (&mut self.g, self.nx + 2)
     }
 
     /// Temperature of interior node `(i, j)`.

@@ -181,6 +181,22 @@ impl Scene {
         result
     }
 
+    /// Run the scene on the MPI ranks of `world` (`mpirun -n P porofrac run`), writing
+    /// the outputs of [`Scene::run`] into `out`: rank 0 locks `out`, removes what an
+    /// earlier run wrote there and writes `summary.json`; every rank returns the same
+    /// result (an error on one rank ends the run on all of them, with that error). A
+    /// model without a distributed path refuses with an error naming `[scene] model`.
+    /// Collective: every rank of `world` calls it.
+    #[cfg(feature = "mpi")]
+    pub fn run_distributed(
+        &self,
+        out: &Path,
+        world: &mpi::topology::SimpleCommunicator,
+        observer: &mut dyn Observer,
+    ) -> Result<Summary, RunError> {
+        common::distributed::run(&self.loaded, &self.laws, out, world, observer)
+    }
+
     /// Run the scene and keep its results in memory, writing nothing: the observer gets
     /// the probe values of every sampled step ([`Observer::sampled`]) and the lines and
     /// the model's state ([`common::snapshot::Snapshot`]) of every written step

@@ -7,12 +7,15 @@
 //! outputs of `nscd` and `lsm` ([`particles`], [`particle_output`],
 //! [`particle_plots`]), the lattice of `lbm` and of `lsm`'s fluid ([`lattice`]), the grid
 //! builder of `continuum` and `cosserat` ([`grid`]) and the Cosserat keys of the shared
-//! sections ([`rotation_keys`]).
+//! sections ([`rotation_keys`]); with the `mpi` feature, what every distributed run
+//! shares (`distributed`).
 //!
 //! Nothing here imports a model folder.
 
 pub mod bounds;
 pub mod checkpoint;
+#[cfg(feature = "mpi")]
+pub mod distributed;
 pub mod driver;
 pub mod expr;
 pub mod grid;

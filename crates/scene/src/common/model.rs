@@ -61,6 +61,10 @@ pub enum RunError {
     /// A checkpoint could not be used or written ([`crate::common::checkpoint`]).
     #[error("checkpoint {0}")]
     Checkpoint(String),
+    /// Another rank of a distributed run failed with this error (`mpirun -n P`, the
+    /// `mpi` feature), or the ranks could not exchange what they hold.
+    #[error("{0}")]
+    Distributed(String),
 }
 
 /// What a step did, for progress and statistics.
@@ -266,6 +270,24 @@ pub trait ModelKind: Sync {
         purpose: &Purpose<'_>,
         observer: &mut dyn Observer,
     ) -> Result<Built, RunError>;
+    /// Run the scene on the ranks of `world` (`mpirun -n P porofrac run`, P > 1) and
+    /// write its outputs into `out`: each rank builds and steps its part, and the files
+    /// are those of a serial run (`summary.json` is written by the caller,
+    /// [`crate::Scene::run_distributed`]). Collective: every rank calls it and returns
+    /// what the others return. A model without a distributed path refuses (the default):
+    /// `model "X" has no distributed path: run it without mpirun (or with -n 1)`.
+    #[cfg(feature = "mpi")]
+    fn run_distributed(
+        &self,
+        ls: &LoadedScene,
+        laws: &LawRegistry,
+        out: &Path,
+        world: &mpi::topology::SimpleCommunicator,
+        observer: &mut dyn Observer,
+    ) -> Result<Summary, RunError> {
+        let _ = (laws, out, world, observer);
+        Err(crate::common::distributed::no_distributed_path(ls))
+    }
 }
 
 /// What a model is built for: the one difference between `run` and `check`.
