@@ -13,15 +13,15 @@
 //! 1. [`partition`]: recursive coordinate bisection of the grid's nodes into `P` parts,
 //!    balanced to one node — the rows a process owns are the equations of its nodes,
 //!    numbered part by part. (Without MPI: this module is all the crate offers.)
-//! 2. [`matrix`] (feature `mpi`): the distributed CSR matrix split into the block of
+//! 2. `matrix` (feature `mpi`): the distributed CSR matrix split into the block of
 //!    owned columns and the block of ghost columns, a ghost-exchange plan built once, the
 //!    product `y = A x` with the exchange overlapped, the transpose product, and dot
 //!    products by all-reduce.
-//! 3. [`amg`] (feature `mpi`): smoothed-aggregation AMG whose aggregates stay inside a
+//! 3. `amg` (feature `mpi`): smoothed-aggregation AMG whose aggregates stay inside a
 //!    process (built by `porofrac-amg` on the owned block), with the smoothed prolongator
 //!    `P = (I − ωD⁻¹A)T` and the Galerkin product `PᵀAP` across processes, the coarsest
 //!    level gathered to every process and factorized by sparse Cholesky, and the V-cycle.
-//! 4. [`pcg`] (feature `mpi`): CG preconditioned by the V-cycle, reporting its iterations
+//! 4. `pcg` (feature `mpi`): CG preconditioned by the V-cycle, reporting its iterations
 //!    and residual.
 //!
 //! # Cost per CG iteration
