@@ -25,6 +25,8 @@
 //! 7. [`pcg`]: preconditioned CG that reports its iterations and residual and fails loudly;
 //!    with a hierarchy stored in single precision ([`Precision`]) it multiplies by the
 //!    caller's double-precision upper triangle ([`upper`]).
+//! 8. [`local`]: one aggregation step with its tentative prolongator as plain arrays, for
+//!    hierarchies built elsewhere (the distributed one of `porofrac-dist`).
 //!
 //! All parallel kernels (rayon) give bitwise the same results for any number of threads.
 //! [`Amg::memory`] reports what a hierarchy holds, by part.
@@ -57,6 +59,7 @@ pub mod coarse;
 pub mod csr;
 pub mod error;
 pub mod hierarchy;
+pub mod local;
 pub mod nullspace;
 pub mod pcg;
 pub mod product;
@@ -66,5 +69,6 @@ pub mod upper;
 pub use csr::{CsrMatrix, Precision, SymCsr};
 pub use error::{AmgError, Result};
 pub use hierarchy::{Amg, AmgMemory, AmgOptions, LevelInfo};
+pub use local::{LocalAggregation, aggregate_tentative};
 pub use nullspace::NearNullSpace;
 pub use pcg::CgStats;

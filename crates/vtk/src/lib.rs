@@ -68,6 +68,9 @@
 //! `<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">` with one
 //! `<DataSet timestep="t" group="" part="0" file="relative/path"/>` per step.
 //!
+//! **Parallel pieces.** A `.pvtu` file ([`write_pvtu`]) names the `.vtu` pieces of one
+//! data set (one per process of a distributed run) and declares their arrays.
+//!
 //! Attribute values and names are XML-escaped (`& < > " '`).
 
 mod array;
@@ -78,6 +81,7 @@ mod image;
 mod pimage;
 mod poly;
 mod pvd;
+mod pvtu;
 mod unstructured;
 
 pub use array::{Attributes, DataArray, Encoding, Values, component_names};
@@ -87,4 +91,5 @@ pub use image::ImageData;
 pub use pimage::{ImagePiece, PImageData};
 pub use poly::{CellArray, PolyData};
 pub use pvd::PvdWriter;
+pub use pvtu::{pvtu_text, write_pvtu};
 pub use unstructured::{CellType, Polyhedra, UnstructuredGrid};

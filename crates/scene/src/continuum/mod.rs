@@ -11,11 +11,15 @@
 //!   ([`porofrac_sim::Fracturing`]). Failures are resolved within a step by
 //!   [`porofrac_sim::FailureResolution`] in all of them, with the same settings;
 //! - *fields*: displacement, stress, principal stresses, pressure and the failure flag
-//!   ([`fields`]) for probes, lines, VTK and `field_extrema`, and the plots ([`plots`]).
+//!   ([`fields`]) for probes, lines, VTK and `field_extrema`, and the plots ([`plots`]);
+//! - *on MPI ranks* (feature `mpi`): static linear elasticity distributed over the ranks
+//!   (`distributed`, with `porofrac-dist`).
 
 pub mod check;
 mod checkpoint;
 pub mod compose;
+#[cfg(feature = "mpi")]
+mod distributed;
 mod explain;
 pub mod fields;
 pub mod flow;
@@ -1136,5 +1140,16 @@ impl ModelKind for ContinuumKind {
         observer: &mut dyn Observer,
     ) -> Result<Built, RunError> {
         build(ls, laws, purpose, observer)
+    }
+    #[cfg(feature = "mpi")]
+    fn run_distributed(
+        &self,
+        ls: &LoadedScene,
+        laws: &LawRegistry,
+        out: &Path,
+        world: &mpi::topology::SimpleCommunicator,
+        observer: &mut dyn Observer,
+    ) -> Result<crate::common::output::Summary, RunError> {
+        distributed::run_distributed(ls, laws, out, world, observer)
     }
 }
