@@ -12,6 +12,8 @@
 //! * [`mdem`]: MDEM and central-force DEM laws;
 //! * [`sparse`]: sparse direct solvers (Cholesky, LDLᵀ, low-rank updates, orderings);
 //! * [`amg`]: smoothed-aggregation multigrid and conjugate gradients;
+//! * [`dist`]: the partitioner and, with MPI (its `mpi` feature), the distributed matrix,
+//!   multigrid and conjugate gradients;
 //! * [`flow`]: TPFA single-phase flow;
 //! * [`frac`]: failure criteria, failure state, stress recovery;
 //! * [`sim`]: the continuum model: assembly, solvers, Biot coupling, fracturing;
@@ -28,6 +30,7 @@
 
 pub use porofrac_amg as amg;
 pub use porofrac_cosserat as cosserat;
+pub use porofrac_dist as dist;
 pub use porofrac_flow as flow;
 pub use porofrac_frac as frac;
 pub use porofrac_grid as grid;
