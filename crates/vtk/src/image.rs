@@ -58,9 +58,21 @@ impl ImageData<'_> {
     }
 
     fn emit(&self, w: &mut dyn io::Write, enc: Encoding) -> io::Result<()> {
-        const KIND: &str = "ImageData";
         let [nx, ny, nz] = self.size;
         let extent = format!("0 {} 0 {} 0 {}", nx - 1, ny - 1, nz - 1);
+        self.emit_extents(w, enc, &extent, &extent)
+    }
+
+    /// The document with a `WholeExtent` and a piece `Extent` of their own (the same for
+    /// a whole image; a piece of a parallel set names the whole and its own part).
+    pub(crate) fn emit_extents(
+        &self,
+        w: &mut dyn io::Write,
+        enc: Encoding,
+        whole: &str,
+        extent: &str,
+    ) -> io::Result<()> {
+        const KIND: &str = "ImageData";
         let [ox, oy, oz] = self.origin;
         let [sx, sy, sz] = self.spacing;
         let origin = format!("{ox:?} {oy:?} {oz:?}");
@@ -70,7 +82,7 @@ impl ImageData<'_> {
             enc,
             KIND,
             &[
-                ("WholeExtent", &extent),
+                ("WholeExtent", whole),
                 ("Origin", &origin),
                 ("Spacing", &spacing),
             ],
@@ -78,7 +90,7 @@ impl ImageData<'_> {
         if !self.field_data.is_empty() {
             doc.section("FieldData", &[], self.field_data)?;
         }
-        doc.open("Piece", &[("Extent", &extent)])?;
+        doc.open("Piece", &[("Extent", extent)])?;
         doc.attributes("PointData", &self.point_data)?;
         doc.attributes("CellData", &self.cell_data)?;
         doc.close("Piece")?;

@@ -13,7 +13,7 @@ use std::io;
 use std::path::Path;
 
 use crate::array::{DataArray, Encoding, Values};
-use crate::doc::{Doc, escape, to_bytes, to_file};
+use crate::doc::{escape, to_bytes, to_file};
 use crate::error::VtkError;
 use crate::image::ImageData;
 
@@ -58,32 +58,9 @@ impl ImagePiece<'_> {
     }
 
     fn emit(&self, w: &mut dyn io::Write, enc: Encoding) -> io::Result<()> {
-        const KIND: &str = "ImageData";
-        let im = &self.image;
         let whole = extent([0; 3], self.whole);
-        let piece = extent(self.offset, im.size);
-        let [ox, oy, oz] = im.origin;
-        let [sx, sy, sz] = im.spacing;
-        let origin = format!("{ox:?} {oy:?} {oz:?}");
-        let spacing = format!("{sx:?} {sy:?} {sz:?}");
-        let mut doc = Doc::start(
-            w,
-            enc,
-            KIND,
-            &[
-                ("WholeExtent", &whole),
-                ("Origin", &origin),
-                ("Spacing", &spacing),
-            ],
-        )?;
-        if !im.field_data.is_empty() {
-            doc.section("FieldData", &[], im.field_data)?;
-        }
-        doc.open("Piece", &[("Extent", &piece)])?;
-        doc.attributes("PointData", &im.point_data)?;
-        doc.attributes("CellData", &im.cell_data)?;
-        doc.close("Piece")?;
-        doc.finish(KIND)
+        let piece = extent(self.offset, self.image.size);
+        self.image.emit_extents(w, enc, &whole, &piece)
     }
 
     /// The piece file's bytes.
