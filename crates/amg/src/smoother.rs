@@ -115,21 +115,9 @@ pub(crate) fn spectral_radius(a: &CsrMatrix, dinv: &[f64], steps: usize) -> f64 
         prev_scale = q_scale;
         q_scale = 1.0 / bn;
     }
-    let k = alpha.len();
-    let t = DMatrix::<f64>::from_fn(k, k, |i, j| {
-        if i == j {
-            alpha[i]
-        } else if i + 1 == j {
-            beta[i]
-        } else if j + 1 == i {
-            beta[j]
-        } else {
-            0.0
-        }
-    });
     // A Ritz value never exceeds λ_max ≤ the Gershgorin bound, so the bound (a pass over
     // the matrix) is needed only where Lanczos failed.
-    let ritz = t.symmetric_eigenvalues().max();
+    let ritz = largest_ritz_value(&alpha, &beta);
     if ritz.is_finite() && ritz > 0.0 {
         ritz
     } else {
@@ -241,6 +229,26 @@ impl Chebyshev {
             a.par_products(dd, r, |_, ad, ri| *ri -= ad);
         }
     }
+}
+
+/// The largest eigenvalue of the symmetric tridiagonal Lanczos matrix with diagonal
+/// `alpha` and off-diagonal `beta` (`beta.len() ≥ alpha.len() − 1`): the largest Ritz
+/// value, a lower bound of `λ_max` that Lanczos steps raise towards it. NaN when the
+/// entries are not finite.
+pub fn largest_ritz_value(alpha: &[f64], beta: &[f64]) -> f64 {
+    let k = alpha.len();
+    let t = DMatrix::<f64>::from_fn(k, k, |i, j| {
+        if i == j {
+            alpha[i]
+        } else if i + 1 == j {
+            beta[i]
+        } else if j + 1 == i {
+            beta[j]
+        } else {
+            0.0
+        }
+    });
+    t.symmetric_eigenvalues().max()
 }
 
 #[cfg(test)]

@@ -36,7 +36,6 @@
 use std::cell::RefCell;
 use std::collections::HashMap;
 
-use nalgebra::DMatrix;
 use porofrac_amg::{Amg, AmgOptions, NearNullSpace, SymCsr, aggregate_tentative};
 
 use crate::error::{DistError, Result};
@@ -239,19 +238,7 @@ fn spectral_radius(comm: &Comm, a: &DistCsr, dinv: &[f64], steps: usize) -> f64 
             q[i] = w[i] / bn;
         }
     }
-    let k = alpha.len();
-    let t = DMatrix::<f64>::from_fn(k, k, |i, j| {
-        if i == j {
-            alpha[i]
-        } else if i + 1 == j {
-            beta[i]
-        } else if j + 1 == i {
-            beta[j]
-        } else {
-            0.0
-        }
-    });
-    let ritz = t.symmetric_eigenvalues().max();
+    let ritz = porofrac_amg::smoother::largest_ritz_value(&alpha, &beta);
     if ritz.is_finite() && ritz > 0.0 {
         ritz
     } else {
