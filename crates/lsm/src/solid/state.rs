@@ -223,6 +223,7 @@ impl LatticeSolid {
             })
             .collect();
         self.rebuild_pair_adjacency();
+        self.sync_counts();
         self.x_build = unflat("x_build", s.real("x_build")?, n)?;
         self.force = unflat("force", s.real("force")?, n)?;
         self.applied = unflat("applied", s.real("applied")?, n)?;
