@@ -92,10 +92,11 @@ struct Adjacency {
 }
 
 impl Adjacency {
-    fn build(&mut self, n: usize, links: impl Iterator<Item = (u32, u32)> + Clone) {
+    /// Index the links `(index, i, j)`, in their order, by particle.
+    fn build(&mut self, n: usize, links: impl Iterator<Item = (u32, u32, u32)> + Clone) {
         self.start.clear();
         self.start.resize(n + 1, 0);
-        for (i, j) in links.clone() {
+        for (_, i, j) in links.clone() {
             self.start[i as usize + 1] += 1;
             self.start[j as usize + 1] += 1;
         }
@@ -105,7 +106,7 @@ impl Adjacency {
         self.items.clear();
         self.items.resize(self.start[n] as usize, 0);
         let mut next: Vec<u32> = self.start[..n].to_vec();
-        for (b, (i, j)) in links.enumerate() {
+        for (b, i, j) in links {
             for (p, side) in [(i, 0u32), (j, 1u32)] {
                 let s = &mut next[p as usize];
                 self.items[*s as usize] = (b as u32) << 1 | side;
@@ -138,7 +139,11 @@ pub struct LatticeSolid {
     bond_adj: Adjacency,
     pairs: Vec<Pair>,
     pair_force: Vec<ContactForce>,
+    /// Per disk, the candidate contacts that can carry a force (no intact bond).
     pair_adj: Adjacency,
+    /// Per disk, bit 0: it is side `i` of a pair left out of `pair_adj` (an intact bond);
+    /// bit 1: it is either side of one. See [`LatticeSolid::rebuild_pair_adjacency`].
+    pair_skipped: Vec<u8>,
     cells: CellList,
     scratch_pairs: Vec<(u32, u32)>,
     scratch: Vec<Pair>,
@@ -222,7 +227,10 @@ impl LatticeSolid {
             }
         }
         let mut bond_adj = Adjacency::default();
-        bond_adj.build(n, bonds.iter().map(|b| (b.i, b.j)));
+        bond_adj.build(
+            n,
+            bonds.iter().enumerate().map(|(k, b)| (k as u32, b.i, b.j)),
+        );
         let mut s = Self {
             motion: vec![Motion::Free; n],
             bond_force: vec![BondForce::default(); bonds.len()],
@@ -235,6 +243,7 @@ impl LatticeSolid {
             pairs: Vec::new(),
             pair_force: Vec::new(),
             pair_adj: Adjacency::default(),
+            pair_skipped: Vec::new(),
             cells,
             scratch_pairs: near,
             scratch: Vec::new(),
@@ -508,16 +517,39 @@ impl LatticeSolid {
             d.angle[i] += s[2];
             self.dx[i] = s;
             if let Some(b) = self.x_build.get(i) {
-                moved |= crate::bond::dist(d.x[i], *b) > half_skin;
+                moved |= beyond(d.x[i], *b, half_skin);
             }
         }
         moved
     }
 
-    /// The per-disk index of the candidate contacts (after the pairs were put back).
+    /// The per-disk index of the candidate contacts that can carry a force (after the
+    /// pairs were put back, rebuilt or a bond broke).
+    ///
+    /// A pair with an intact bond has a force of +0.0 in every component. Adding +0.0 to
+    /// a sum changes only a −0.0 into +0.0 (call it `N`), and `N(a) + b = N(a + b)` for
+    /// any `a`, `b` (an exact cancellation gives +0.0), so leaving these pairs out of the
+    /// gather and applying `N` once at the end gives the same bits: for the moment if the
+    /// disk is either side of such a pair, for the force if it is side `i` (on side `j`
+    /// the term is −0.0, which changes nothing).
     pub(crate) fn rebuild_pair_adjacency(&mut self) {
-        self.pair_adj
-            .build(self.disks.len(), self.pairs.iter().map(|p| (p.i, p.j)));
+        let n = self.disks.len();
+        let live = &self.bond_live;
+        let zero = |p: &Pair| p.bond != u32::MAX && live[p.bond as usize];
+        self.pair_adj.build(
+            n,
+            self.pairs
+                .iter()
+                .enumerate()
+                .filter(|(_, p)| !zero(p))
+                .map(|(k, p)| (k as u32, p.i, p.j)),
+        );
+        self.pair_skipped.clear();
+        self.pair_skipped.resize(n, 0);
+        for p in self.pairs.iter().filter(|p| zero(p)) {
+            self.pair_skipped[p.i as usize] |= 3;
+            self.pair_skipped[p.j as usize] |= 2;
+        }
     }
 
     /// Rebuild the Verlet list of candidate contacts, keeping the tangential springs of
@@ -552,10 +584,9 @@ impl LatticeSolid {
         self.pair_force.clear();
         self.pair_force
             .resize(self.pairs.len(), ContactForce::default());
-        self.pair_adj
-            .build(d.len(), self.pairs.iter().map(|p| (p.i, p.j)));
         self.x_build.clear();
         self.x_build.extend_from_slice(&d.x);
+        self.rebuild_pair_adjacency();
     }
 
     /// Bond forces, breakage, contact forces and the sum per particle; returns the
@@ -620,6 +651,11 @@ impl LatticeSolid {
                 broken += 1;
             }
         }
+        if broken > 0 {
+            self.rebuild_pair_adjacency();
+        }
+        let disks = &self.disks;
+        let dx = &self.dx;
         let live = &self.bond_live;
         let claw = self.spec.contacts;
         // A pair with an intact bond keeps a zero spring and force: written only when
@@ -658,6 +694,7 @@ impl LatticeSolid {
             &self.pair_force,
             &self.pair_adj,
         );
+        let skipped = &self.pair_skipped;
         let g = self.spec.gravity;
         let loads = &self.loads;
         let gather = |(i, out): (usize, &mut [f64; 3])| {
@@ -684,6 +721,14 @@ impl LatticeSolid {
                 f[0] += s * c.f[0];
                 f[1] += s * c.f[1];
                 f[2] += if side { c.mj } else { c.mi };
+            }
+            let z = skipped[i];
+            if z & 1 != 0 {
+                f[0] += 0.0;
+                f[1] += 0.0;
+            }
+            if z & 2 != 0 {
+                f[2] += 0.0;
             }
             *out = f;
         };
@@ -814,4 +859,20 @@ fn contact_is_zero(f: &ContactForce) -> bool {
     [f.f[0], f.f[1], f.mi, f.mj, f.fn_, f.ft]
         .iter()
         .all(|v| v.to_bits() == 0)
+}
+
+/// `dist(a, b) > h`, as [`crate::bond::dist`] decides it, with the square root taken only
+/// when the squared distance is within a relative 1e-9 of `h²` (far from it the
+/// comparison of squares decides the same).
+#[inline]
+fn beyond(a: [f64; 2], b: [f64; 2], h: f64) -> bool {
+    let d2 = (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2);
+    let h2 = h * h;
+    if d2 < h2 * (1.0 - 1e-9) {
+        false
+    } else if d2 > h2 * (1.0 + 1e-9) {
+        true
+    } else {
+        crate::bond::dist(a, b) > h
+    }
 }
