@@ -109,7 +109,7 @@ impl Adjacency {
         for (b, i, j) in links {
             for (p, side) in [(i, 0u32), (j, 1u32)] {
                 let s = &mut next[p as usize];
-                self.items[*s as usize] = (b as u32) << 1 | side;
+                self.items[*s as usize] = b << 1 | side;
                 *s += 1;
             }
         }
