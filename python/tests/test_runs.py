@@ -175,8 +175,12 @@ def test_ctrl_c_stops_a_run_with_its_partial_result(root):
     def progress(step, total, t):
         if step == 2 and not fired:
             fired.append(step)
-            # As Ctrl-C does: a KeyboardInterrupt pending in the main thread.
-            threading.Timer(0.0, _thread.interrupt_main).start()
+            # As Ctrl-C does: a KeyboardInterrupt pending in the main thread, raised from
+            # another thread; joined, so that it is pending before the run goes on however
+            # late the thread is scheduled on a loaded machine.
+            timer = threading.Timer(0.0, _thread.interrupt_main)
+            timer.start()
+            timer.join()
             time.sleep(0.05)
 
     with pytest.raises(KeyboardInterrupt) as e:
