@@ -92,11 +92,10 @@ struct Adjacency {
 }
 
 impl Adjacency {
-    /// Index the links `(index, i, j)`, in their order, by particle.
-    fn build(&mut self, n: usize, links: impl Iterator<Item = (u32, u32, u32)> + Clone) {
+    fn build(&mut self, n: usize, links: impl Iterator<Item = (u32, u32)> + Clone) {
         self.start.clear();
         self.start.resize(n + 1, 0);
-        for (_, i, j) in links.clone() {
+        for (i, j) in links.clone() {
             self.start[i as usize + 1] += 1;
             self.start[j as usize + 1] += 1;
         }
@@ -106,10 +105,10 @@ impl Adjacency {
         self.items.clear();
         self.items.resize(self.start[n] as usize, 0);
         let mut next: Vec<u32> = self.start[..n].to_vec();
-        for (b, i, j) in links {
+        for (b, (i, j)) in links.enumerate() {
             for (p, side) in [(i, 0u32), (j, 1u32)] {
                 let s = &mut next[p as usize];
-                self.items[*s as usize] = b << 1 | side;
+                self.items[*s as usize] = (b as u32) << 1 | side;
                 *s += 1;
             }
         }
@@ -130,20 +129,10 @@ pub struct LatticeSolid {
     bonds: Vec<Bond>,
     bond_force: Vec<BondForce>,
     bond_break: Vec<Option<BreakMode>>,
-    /// `bonds[k].intact` as a compact array (the contact kernel reads it per pair).
-    bond_live: Vec<bool>,
-    /// Number of intact bonds.
-    intact_count: usize,
-    /// Touching unbonded pairs at the last force evaluation.
-    touching_count: usize,
     bond_adj: Adjacency,
     pairs: Vec<Pair>,
     pair_force: Vec<ContactForce>,
-    /// Per disk, the candidate contacts that can carry a force (no intact bond).
     pair_adj: Adjacency,
-    /// Per disk, bit 0: it is side `i` of a pair left out of `pair_adj` (an intact bond);
-    /// bit 1: it is either side of one. See [`LatticeSolid::rebuild_pair_adjacency`].
-    pair_skipped: Vec<u8>,
     cells: CellList,
     scratch_pairs: Vec<(u32, u32)>,
     scratch: Vec<Pair>,
@@ -227,23 +216,16 @@ impl LatticeSolid {
             }
         }
         let mut bond_adj = Adjacency::default();
-        bond_adj.build(
-            n,
-            bonds.iter().enumerate().map(|(k, b)| (k as u32, b.i, b.j)),
-        );
+        bond_adj.build(n, bonds.iter().map(|b| (b.i, b.j)));
         let mut s = Self {
             motion: vec![Motion::Free; n],
             bond_force: vec![BondForce::default(); bonds.len()],
             bond_break: vec![None; bonds.len()],
-            bond_live: vec![true; bonds.len()],
-            intact_count: bonds.len(),
-            touching_count: 0,
             bonds,
             bond_adj,
             pairs: Vec::new(),
             pair_force: Vec::new(),
             pair_adj: Adjacency::default(),
-            pair_skipped: Vec::new(),
             cells,
             scratch_pairs: near,
             scratch: Vec::new(),
@@ -300,21 +282,12 @@ impl LatticeSolid {
 
     /// Number of intact bonds.
     pub fn intact_bonds(&self) -> usize {
-        self.intact_count
+        self.bonds.iter().filter(|b| b.intact).count()
     }
 
     /// Unbonded pairs in contact at the last step.
     pub fn touching(&self) -> usize {
-        self.touching_count
-    }
-
-    /// Recount what [`Self::intact_bonds`] and [`Self::touching`] report and mirror the
-    /// bonds' intact flags (after the state was put back).
-    pub(crate) fn sync_counts(&mut self) {
-        self.bond_live.clear();
-        self.bond_live.extend(self.bonds.iter().map(|b| b.intact));
-        self.intact_count = self.bond_live.iter().filter(|&&b| b).count();
-        self.touching_count = self.pair_force.iter().filter(|f| f.fn_ > 0.0).count();
+        self.pair_force.iter().filter(|f| f.fn_ > 0.0).count()
     }
 
     /// The parameters.
@@ -453,7 +426,14 @@ impl LatticeSolid {
                 what: "external force",
             });
         }
-        let moved = self.kick_drift(0.5 * dt, dt, external);
+        self.kick(0.5 * dt, external);
+        self.drift(dt);
+        let moved = self
+            .disks
+            .x
+            .iter()
+            .zip(&self.x_build)
+            .any(|(a, b)| crate::bond::dist(*a, *b) > 0.5 * self.skin);
         if moved {
             self.rebuild_pairs();
         }
@@ -479,77 +459,60 @@ impl LatticeSolid {
     }
 
     fn kick(&mut self, h: f64, external: &[[f64; 3]]) {
+        let d = &mut self.disks;
         let damping = self.spec.damping;
-        for i in 0..self.disks.len() {
-            kick_one(
-                &mut self.disks,
-                i,
-                self.motion[i],
-                self.force[i],
-                external.get(i),
-                damping,
-                h,
-            );
+        for i in 0..d.len() {
+            let mut f = self.force[i];
+            if let Some(e) = external.get(i) {
+                f = [f[0] + e[0], f[1] + e[1], f[2] + e[2]];
+            }
+            let (m, inertia) = (d.mass[i], d.inertia[i]);
+            let free = |v: f64, f: f64, m: f64| {
+                if m.is_finite() {
+                    v + h * damping.apply(f, v, m) / m
+                } else {
+                    v
+                }
+            };
+            match self.motion[i] {
+                Motion::Free => {
+                    d.v[i][0] = free(d.v[i][0], f[0], m);
+                    d.v[i][1] = free(d.v[i][1], f[1], m);
+                    d.omega[i] = free(d.omega[i], f[2], inertia);
+                }
+                Motion::Fixed => {
+                    d.v[i] = [0.0; 2];
+                    d.omega[i] = 0.0;
+                }
+                Motion::Velocity(u) => {
+                    d.v[i] = u;
+                    d.omega[i] = 0.0;
+                }
+                Motion::Axis { axis, velocity } => {
+                    let other = 1 - axis;
+                    d.v[i][axis] = velocity;
+                    d.v[i][other] = free(d.v[i][other], f[other], m);
+                    d.omega[i] = free(d.omega[i], f[2], inertia);
+                }
+            }
         }
     }
 
-    /// The first half-kick by `h` and the drift by `dt` in one pass over the particles;
-    /// true if a particle moved by more than half the skin since the contact list was
-    /// built.
-    fn kick_drift(&mut self, h: f64, dt: f64, external: &[[f64; 3]]) -> bool {
-        let damping = self.spec.damping;
-        let half_skin = 0.5 * self.skin;
-        let mut moved = false;
-        for i in 0..self.disks.len() {
-            kick_one(
-                &mut self.disks,
-                i,
-                self.motion[i],
-                self.force[i],
-                external.get(i),
-                damping,
-                h,
-            );
-            let d = &mut self.disks;
+    fn drift(&mut self, dt: f64) {
+        let d = &mut self.disks;
+        for i in 0..d.len() {
             let s = [dt * d.v[i][0], dt * d.v[i][1], dt * d.omega[i]];
             d.x[i][0] += s[0];
             d.x[i][1] += s[1];
             d.angle[i] += s[2];
             self.dx[i] = s;
-            if let Some(b) = self.x_build.get(i) {
-                moved |= beyond(d.x[i], *b, half_skin);
-            }
         }
-        moved
     }
 
-    /// The per-disk index of the candidate contacts that can carry a force (after the
-    /// pairs were put back, rebuilt or a bond broke).
-    ///
-    /// A pair with an intact bond has a force of +0.0 in every component. Adding +0.0 to
-    /// a sum changes only a −0.0 into +0.0 (call it `N`), and `N(a) + b = N(a + b)` for
-    /// any `a`, `b` (an exact cancellation gives +0.0), so leaving these pairs out of the
-    /// gather and applying `N` once at the end gives the same bits: for the moment if the
-    /// disk is either side of such a pair, for the force if it is side `i` (on side `j`
-    /// the term is −0.0, which changes nothing).
+    /// The per-disk index of the candidate contacts (after the pairs were put back).
     pub(crate) fn rebuild_pair_adjacency(&mut self) {
-        let n = self.disks.len();
-        let live = &self.bond_live;
-        let zero = |p: &Pair| p.bond != u32::MAX && live[p.bond as usize];
-        self.pair_adj.build(
-            n,
-            self.pairs
-                .iter()
-                .enumerate()
-                .filter(|(_, p)| !zero(p))
-                .map(|(k, p)| (k as u32, p.i, p.j)),
-        );
-        self.pair_skipped.clear();
-        self.pair_skipped.resize(n, 0);
-        for p in self.pairs.iter().filter(|p| zero(p)) {
-            self.pair_skipped[p.i as usize] |= 3;
-            self.pair_skipped[p.j as usize] |= 2;
-        }
+        self.pair_adj
+            .build(self.disks.len(), self.pairs.iter().map(|p| (p.i, p.j)));
     }
 
     /// Rebuild the Verlet list of candidate contacts, keeping the tangential springs of
@@ -584,9 +547,10 @@ impl LatticeSolid {
         self.pair_force.clear();
         self.pair_force
             .resize(self.pairs.len(), ContactForce::default());
+        self.pair_adj
+            .build(d.len(), self.pairs.iter().map(|p| (p.i, p.j)));
         self.x_build.clear();
         self.x_build.extend_from_slice(&d.x);
-        self.rebuild_pair_adjacency();
     }
 
     /// Bond forces, breakage, contact forces and the sum per particle; returns the
@@ -596,22 +560,16 @@ impl LatticeSolid {
         let dx = &self.dx;
         let law = self.spec.bonds;
         let tan_phi = law.friction_angle.tan();
-        // The breakage test is fused in the force loop; the count of breaks (an integer
-        // sum, the same for any thread count) skips the serial pass when nothing broke.
         let kernel = |(b, (f, brk)): (&mut Bond, (&mut BondForce, &mut Option<BreakMode>))| {
             if b.intact {
                 *f = b.update(disks, dx, &law);
                 *brk = b.breaks_with(f, tan_phi);
-                usize::from(brk.is_some())
             } else {
-                if !force_is_zero(f) {
-                    *f = BondForce::default();
-                }
+                *f = BondForce::default();
                 *brk = None;
-                0
             }
         };
-        let breaking: usize = if self.bonds.len() >= PAR_MIN {
+        if self.bonds.len() >= PAR_MIN {
             self.bonds
                 .par_iter_mut()
                 .zip(
@@ -620,22 +578,18 @@ impl LatticeSolid {
                         .zip(self.bond_break.par_iter_mut()),
                 )
                 .with_min_len(1024)
-                .map(kernel)
-                .sum()
+                .for_each(kernel);
         } else {
             self.bonds
                 .iter_mut()
                 .zip(self.bond_force.iter_mut().zip(self.bond_break.iter_mut()))
-                .map(kernel)
-                .sum()
-        };
+                .for_each(kernel);
+        }
         let mut broken = 0;
-        for k in 0..if breaking > 0 { self.bonds.len() } else { 0 } {
+        for k in 0..self.bonds.len() {
             if let Some(mode) = self.bond_break[k] {
                 let b = &mut self.bonds[k];
                 b.intact = false;
-                self.bond_live[k] = false;
-                self.intact_count -= 1;
                 self.bond_force[k] = BondForce::default();
                 let (i, j) = (b.i as usize, b.j as usize);
                 let (xi, xj) = (disks.x[i], disks.x[j]);
@@ -651,50 +605,34 @@ impl LatticeSolid {
                 broken += 1;
             }
         }
-        if broken > 0 {
-            self.rebuild_pair_adjacency();
-        }
-        let disks = &self.disks;
-        let dx = &self.dx;
-        let live = &self.bond_live;
+        let bonds = &self.bonds;
         let claw = self.spec.contacts;
-        // A pair with an intact bond keeps a zero spring and force: written only when
-        // they are not zero already (bitwise), so that its cache lines stay clean.
         let ckernel = |(p, f): (&mut Pair, &mut ContactForce)| {
-            if p.bond != u32::MAX && live[p.bond as usize] {
-                if p.ut.to_bits() != 0 {
-                    p.ut = 0.0;
-                }
-                if !contact_is_zero(f) {
-                    *f = ContactForce::default();
-                }
-                0
+            if p.bond != u32::MAX && bonds[p.bond as usize].intact {
+                p.ut = 0.0;
+                *f = ContactForce::default();
             } else {
                 *f = p.update(disks, dx, &claw);
-                usize::from(f.fn_ > 0.0)
             }
         };
-        self.touching_count = if self.pairs.len() >= PAR_MIN {
+        if self.pairs.len() >= PAR_MIN {
             self.pairs
                 .par_iter_mut()
                 .zip(self.pair_force.par_iter_mut())
                 .with_min_len(1024)
-                .map(ckernel)
-                .sum()
+                .for_each(ckernel);
         } else {
             self.pairs
                 .iter_mut()
                 .zip(self.pair_force.iter_mut())
-                .map(ckernel)
-                .sum()
-        };
+                .for_each(ckernel);
+        }
         let (bf, ba, pf, pa) = (
             &self.bond_force,
             &self.bond_adj,
             &self.pair_force,
             &self.pair_adj,
         );
-        let skipped = &self.pair_skipped;
         let g = self.spec.gravity;
         let loads = &self.loads;
         let gather = |(i, out): (usize, &mut [f64; 3])| {
@@ -704,31 +642,29 @@ impl LatticeSolid {
                 0.0
             };
             let mut f = [g[0] * m + loads[i][0], g[1] * m + loads[i][1], loads[i][2]];
-            // Without branches on the side: `a + (−1)·b` is `a − b` bitwise (the product
-            // by ±1 is exact), so the sums are those of the signed form.
             for &l in ba.of(i) {
                 let b = &bf[(l >> 1) as usize];
-                let side = l & 1 == 1;
-                let s = if side { -1.0 } else { 1.0 };
-                f[0] += s * b.f[0];
-                f[1] += s * b.f[1];
-                f[2] += if side { b.mj } else { b.mi };
+                if l & 1 == 0 {
+                    f[0] += b.f[0];
+                    f[1] += b.f[1];
+                    f[2] += b.mi;
+                } else {
+                    f[0] -= b.f[0];
+                    f[1] -= b.f[1];
+                    f[2] += b.mj;
+                }
             }
             for &l in pa.of(i) {
                 let c = &pf[(l >> 1) as usize];
-                let side = l & 1 == 1;
-                let s = if side { -1.0 } else { 1.0 };
-                f[0] += s * c.f[0];
-                f[1] += s * c.f[1];
-                f[2] += if side { c.mj } else { c.mi };
-            }
-            let z = skipped[i];
-            if z & 1 != 0 {
-                f[0] += 0.0;
-                f[1] += 0.0;
-            }
-            if z & 2 != 0 {
-                f[2] += 0.0;
+                if l & 1 == 0 {
+                    f[0] += c.f[0];
+                    f[1] += c.f[1];
+                    f[2] += c.mi;
+                } else {
+                    f[0] -= c.f[0];
+                    f[1] -= c.f[1];
+                    f[2] += c.mj;
+                }
             }
             *out = f;
         };
@@ -795,84 +731,5 @@ impl LatticeSolid {
             }
             _ => 2.0 / w,
         }
-    }
-}
-
-/// Half-kick of particle `i` by `h` under `force` plus its external force, following its
-/// motion `motion` (see [`Motion`]).
-#[inline]
-fn kick_one(
-    d: &mut Disks,
-    i: usize,
-    motion: Motion,
-    force: [f64; 3],
-    external: Option<&[f64; 3]>,
-    damping: Damping,
-    h: f64,
-) {
-    let mut f = force;
-    if let Some(e) = external {
-        f = [f[0] + e[0], f[1] + e[1], f[2] + e[2]];
-    }
-    let (m, inertia) = (d.mass[i], d.inertia[i]);
-    let free = |v: f64, f: f64, m: f64| {
-        if m.is_finite() {
-            v + h * damping.apply(f, v, m) / m
-        } else {
-            v
-        }
-    };
-    match motion {
-        Motion::Free => {
-            d.v[i][0] = free(d.v[i][0], f[0], m);
-            d.v[i][1] = free(d.v[i][1], f[1], m);
-            d.omega[i] = free(d.omega[i], f[2], inertia);
-        }
-        Motion::Fixed => {
-            d.v[i] = [0.0; 2];
-            d.omega[i] = 0.0;
-        }
-        Motion::Velocity(u) => {
-            d.v[i] = u;
-            d.omega[i] = 0.0;
-        }
-        Motion::Axis { axis, velocity } => {
-            let other = 1 - axis;
-            d.v[i][axis] = velocity;
-            d.v[i][other] = free(d.v[i][other], f[other], m);
-            d.omega[i] = free(d.omega[i], f[2], inertia);
-        }
-    }
-}
-
-/// All components of `f` are +0.0 (bitwise), as [`BondForce::default`].
-#[inline]
-fn force_is_zero(f: &BondForce) -> bool {
-    [f.f[0], f.f[1], f.mi, f.mj, f.fn_, f.fs, f.mb]
-        .iter()
-        .all(|v| v.to_bits() == 0)
-}
-
-/// All components of `f` are +0.0 (bitwise), as [`ContactForce::default`].
-#[inline]
-fn contact_is_zero(f: &ContactForce) -> bool {
-    [f.f[0], f.f[1], f.mi, f.mj, f.fn_, f.ft]
-        .iter()
-        .all(|v| v.to_bits() == 0)
-}
-
-/// `dist(a, b) > h`, as [`crate::bond::dist`] decides it, with the square root taken only
-/// when the squared distance is within a relative 1e-9 of `h²` (far from it the
-/// comparison of squares decides the same).
-#[inline]
-fn beyond(a: [f64; 2], b: [f64; 2], h: f64) -> bool {
-    let d2 = (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2);
-    let h2 = h * h;
-    if d2 < h2 * (1.0 - 1e-9) {
-        false
-    } else if d2 > h2 * (1.0 + 1e-9) {
-        true
-    } else {
-        crate::bond::dist(a, b) > h
     }
 }

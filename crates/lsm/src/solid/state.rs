@@ -222,7 +222,6 @@ impl LatticeSolid {
                 ft: v[5],
             })
             .collect();
-        self.sync_counts();
         self.rebuild_pair_adjacency();
         self.x_build = unflat("x_build", s.real("x_build")?, n)?;
         self.force = unflat("force", s.real("force")?, n)?;
