@@ -46,6 +46,21 @@ fn csv(path: &Path) -> Vec<Vec<String>> {
         .collect()
 }
 
+/// Run a KGD scene's text (named `path` in errors) in a temporary folder: its probe rows
+/// and the failure time of every failed cell (`fracture.csv`).
+fn run_kgd(text: &str, path: &str, tag: &str) -> (Vec<Vec<String>>, Vec<f64>) {
+    let scene = Scene::parse(text, Path::new(path), LawRegistry::default()).unwrap();
+    let out = std::env::temp_dir().join(format!("porofrac_{tag}_{}", std::process::id()));
+    scene.run(&out, &mut Silent).unwrap();
+    let probes = csv(&out.join("probes.csv"));
+    let failed = csv(&out.join("fracture.csv"))
+        .iter()
+        .map(|r| r[3].parse().unwrap())
+        .collect();
+    std::fs::remove_dir_all(&out).ok();
+    (probes, failed)
+}
+
 #[test]
 fn kgd_toughness_follows_the_vertex_solution() {
     let text = include_str!("../../../../scenes/kgd_toughness.toml")
@@ -62,20 +77,7 @@ fn kgd_toughness_follows_the_vertex_solution() {
         .replace("at = [50.0, 50.0625]", "at = [50.0, 50.125]");
     assert!(text.contains("refine = 16") && text.contains("50.124]]"));
     let h = 0.125;
-    let scene = Scene::parse(
-        &text,
-        Path::new("scenes/kgd_toughness.toml"),
-        LawRegistry::default(),
-    )
-    .unwrap();
-    let out = std::env::temp_dir().join(format!("porofrac_kgd_{}", std::process::id()));
-    scene.run(&out, &mut Silent).unwrap();
-    let probes = csv(&out.join("probes.csv"));
-    let failed: Vec<f64> = csv(&out.join("fracture.csv"))
-        .iter()
-        .map(|r| r[3].parse().unwrap())
-        .collect();
-    std::fs::remove_dir_all(&out).ok();
+    let (probes, failed) = run_kgd(&text, "scenes/kgd_toughness.toml", "kgd");
 
     let (mut e_l, mut a_l, mut a_p, mut a_w) = (0.0, 0.0, 0.0, 0.0);
     let mut logs = Vec::new();
@@ -126,20 +128,11 @@ fn kgd_viscosity_errors() -> (f64, f64, f64) {
     let ep = e / (1.0 - nu * nu);
     let mup = 12.0 * mu;
     let h = 0.125;
-    let scene = Scene::parse(
+    let (probes, failed) = run_kgd(
         include_str!("../../../../scenes/kgd_viscosity.toml"),
-        Path::new("scenes/kgd_viscosity.toml"),
-        LawRegistry::default(),
-    )
-    .unwrap();
-    let out = std::env::temp_dir().join(format!("porofrac_kgd_mu_{}", std::process::id()));
-    scene.run(&out, &mut Silent).unwrap();
-    let probes = csv(&out.join("probes.csv"));
-    let failed: Vec<f64> = csv(&out.join("fracture.csv"))
-        .iter()
-        .map(|r| r[3].parse().unwrap())
-        .collect();
-    std::fs::remove_dir_all(&out).ok();
+        "scenes/kgd_viscosity.toml",
+        "kgd_mu",
+    );
     let (mut e_l, mut e_w, mut worst_w, mut m) = (0.0, 0.0, 0.0f64, 0.0);
     for row in &probes {
         let v: Vec<f64> = row.iter().map(|x| x.parse().unwrap()).collect();
