@@ -68,25 +68,8 @@ fn without_the_feature_a_launch_on_several_ranks_is_refused() {
 mod launched {
     use super::*;
     use std::path::Path;
-    use std::process::Command;
 
-    /// `mpirun -n ranks --oversubscribe porofrac args…`: exit status and stderr. Open MPI
-    /// is allowed to run as root (CI containers) and ends the job after 300 s.
-    pub fn mpirun(ranks: usize, args: &[&str]) -> (i32, String) {
-        let o = Command::new("mpirun")
-            .args(["--oversubscribe", "--timeout", "300", "-n"])
-            .arg(ranks.to_string())
-            .arg(env!("CARGO_BIN_EXE_porofrac"))
-            .args(args)
-            .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
-            .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-            .output()
-            .expect("mpirun (scripts/install-mpi installs it)");
-        (
-            o.status.code().unwrap_or(-1),
-            String::from_utf8_lossy(&o.stderr).into_owned(),
-        )
-    }
+    use common::mpirun;
 
     fn path(p: &Path) -> &str {
         p.to_str().unwrap()

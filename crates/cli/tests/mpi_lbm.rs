@@ -21,9 +21,8 @@ mod common;
 
 use std::collections::BTreeMap;
 use std::path::Path;
-use std::process::Command;
 
-use common::{porofrac, summary, tmp_dir};
+use common::{mpirun, porofrac, summary, tmp_dir};
 
 const CHANNEL: &str = r#"
 [scene]
@@ -120,22 +119,6 @@ name = "t_mid"
 field = "temperature"
 at = [1.13, 0.33]
 "#;
-
-fn mpirun(ranks: usize, args: &[&str]) -> (i32, String) {
-    let o = Command::new("mpirun")
-        .args(["--oversubscribe", "--timeout", "300", "-n"])
-        .arg(ranks.to_string())
-        .arg(env!("CARGO_BIN_EXE_porofrac"))
-        .args(args)
-        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
-        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-        .output()
-        .expect("mpirun (scripts/install-mpi installs it)");
-    (
-        o.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&o.stderr).into_owned(),
-    )
-}
 
 /// `(extent, arrays by name)` of a `.vti` written with raw appended data.
 fn read_vti(path: &Path) -> ([usize; 6], BTreeMap<String, Vec<f64>>) {

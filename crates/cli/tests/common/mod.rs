@@ -125,3 +125,21 @@ pub fn send_ctrl_c(child: &Child) {
             .success()
     );
 }
+
+/// `mpirun -n ranks --oversubscribe porofrac args…`: exit status and stderr. Open MPI
+/// is allowed to run as root (CI containers) and ends the job after 300 s.
+pub fn mpirun(ranks: usize, args: &[&str]) -> (i32, String) {
+    let o = Command::new("mpirun")
+        .args(["--oversubscribe", "--timeout", "300", "-n"])
+        .arg(ranks.to_string())
+        .arg(env!("CARGO_BIN_EXE_porofrac"))
+        .args(args)
+        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+        .output()
+        .expect("mpirun (scripts/install-mpi installs it)");
+    (
+        o.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
