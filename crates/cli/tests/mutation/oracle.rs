@@ -162,7 +162,7 @@ pub fn non_finite_outputs(out: &Path) -> Vec<String> {
 
 /// Measures that are `null` by definition when undefined (docs/models/nscd.md): the
 /// fault-propagation measures when no disk of the window moved or no band holds points.
-const UNDEFINED_BY_DEFINITION: [&str; 7] = [
+const UNDEFINED_BY_DEFINITION: [&str; 12] = [
     ".fault.limit_angle_deg",
     ".fault.limit_angle_points",
     ".fault.limits.left_deg",
@@ -170,6 +170,11 @@ const UNDEFINED_BY_DEFINITION: [&str; 7] = [
     ".fault.limits.opening_deg",
     ".fault.run_out",
     ".fault.trishear",
+    ".fault.trishear.layer",
+    ".fault.area.axis_deg",
+    ".fault.area.left_deg",
+    ".fault.area.right_deg",
+    ".fault.area.opening_deg",
 ];
 
 /// Non-finite values of a summary: strings that spell one and `null` below the top

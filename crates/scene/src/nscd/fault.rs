@@ -19,10 +19,19 @@
 //! * `trishear`: velocities averaged over the last `velocity_window` seconds
 //!   (displacement over that time), compared with the analytic field of tip x_T at the
 //!   middle of that time; `half_apex_deg` fitted (1° steps) unless given, and the
-//!   relative L2 mismatch `l2`.
+//!   relative L2 mismatch `l2`; `layer` the same over the particles of the layer only
+//!   (current centre at or below the initial free surface y_top: without the uplifted
+//!   hanging wall and the surface flow above the footwall);
+//! * `area`: the fault area as two rays from the current tip (Fig. 12's dashed lines,
+//!   drawn from the tip as in trishear), each the ray that best separates the particles
+//!   moved by at least a fraction of the slip (on its left) from the others, over the
+//!   particles of the window between the tip height and y_top ([`ray_angle`]):
+//!   `left_deg` for |u| = (1 − f)s, `right_deg` for |u| = f s, `axis_deg` for |u| = s/2,
+//!   and `opening_deg` = left − right, the angle of the fault area between its limits
+//!   (the paper's θ_l read as the one angle its two limits reduce to).
 
 use porofrac_nscd::Nscd;
-use porofrac_particles::fault::{fault_limits, fit_trishear, limit_angle, run_out};
+use porofrac_particles::fault::{fault_limits, fit_trishear, limit_angle, moved_by, run_out};
 use porofrac_particles::trishear::Trishear;
 
 use super::file::FaultSection;
@@ -131,19 +140,48 @@ impl FaultProbe {
                     half_apex: self.section.half_apex.unwrap_or(45.0).to_radians(),
                     v0: self.section.slip_rate,
                 };
-                let (apex, l2) = match self.section.half_apex {
-                    Some(_) => (base.half_apex, base.l2_mismatch(&x, &v)),
-                    None => fit_trishear(base, &x, &v),
+                let fit = |x: &[[f64; 2]], v: &[[f64; 2]]| match self.section.half_apex {
+                    Some(_) => (base.half_apex, base.l2_mismatch(x, v)),
+                    None => fit_trishear(base, x, v),
                 };
+                let (apex, l2) = fit(&x, &v);
+                let (xl, vl): (Vec<[f64; 2]>, Vec<[f64; 2]>) = x
+                    .iter()
+                    .zip(&v)
+                    .filter(|(p, _)| p[1] <= self.y_top)
+                    .map(|(p, vi)| (*p, *vi))
+                    .unzip();
+                let layer = (!xl.is_empty()).then(|| {
+                    let (apex, l2) = fit(&xl, &vl);
+                    serde_json::json!({
+                        "half_apex_deg": apex.to_degrees(),
+                        "l2": l2,
+                        "particles": xl.len(),
+                    })
+                });
                 serde_json::json!({
                     "half_apex_deg": apex.to_degrees(),
                     "fitted": self.section.half_apex.is_none(),
                     "l2": l2,
                     "from_time": t0,
                     "to_time": t,
+                    "layer": layer,
                 })
             })
         });
+        // The fault area as rays from the tip, over the layer between the tip height and
+        // the initial free surface.
+        let (xa, ua): (Vec<[f64; 2]>, Vec<[f64; 2]>) = x
+            .iter()
+            .zip(&u)
+            .filter(|(p, _)| p[1] > tip[1] && p[1] <= self.y_top)
+            .map(|(p, d)| (*p, *d))
+            .unzip();
+        let ray = |fraction: f64| {
+            let moved: Vec<bool> = ua.iter().map(|d| moved_by(*d, slip, fraction)).collect();
+            ray_angle(&xa, &moved, tip)
+        };
+        let (area_left, area_right) = (ray(1.0 - f), ray(f));
         serde_json::json!({
             "slip": slip,
             "tip": tip,
@@ -158,6 +196,121 @@ impl FaultProbe {
             },
             "run_out": ro,
             "trishear": trishear,
+            "area": {
+                "particles": xa.len(),
+                "axis_deg": ray(0.5),
+                "left_deg": area_left,
+                "right_deg": area_right,
+                "opening_deg": area_left.zip(area_right).map(|(l, r)| l - r),
+            },
         })
+    }
+}
+
+/// The angle (degrees from +x, in [1°, 179°], 0.5° steps) of the ray from `tip` that
+/// best separates the points `x` flagged `moved` (expected on its left, at larger polar
+/// angles about the tip) from the others: the number of moved points below the ray plus
+/// other points on or above it is smallest; where several neighbouring angles share the
+/// smallest count, the middle of the first such run. `None` when no point is moved or
+/// every point is.
+pub fn ray_angle(x: &[[f64; 2]], moved: &[bool], tip: [f64; 2]) -> Option<f64> {
+    let m = moved.iter().filter(|&&b| b).count();
+    if m == 0 || m == moved.len() {
+        return None;
+    }
+    let polar: Vec<f64> = x
+        .iter()
+        .map(|p| (p[1] - tip[1]).atan2(p[0] - tip[0]).to_degrees())
+        .collect();
+    let cost = |alpha: f64| {
+        polar
+            .iter()
+            .zip(moved)
+            .filter(|(a, mv)| if **mv { **a < alpha } else { **a >= alpha })
+            .count()
+    };
+    let grid: Vec<f64> = (2..=358).map(|k| 0.5 * k as f64).collect();
+    let costs: Vec<usize> = grid.iter().map(|&a| cost(a)).collect();
+    let best = *costs.iter().min()?;
+    let first = costs.iter().position(|&c| c == best)?;
+    let last = first + costs[first..].iter().take_while(|&&c| c == best).count() - 1;
+    Some(0.5 * (grid[first] + grid[last]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Points of a lattice above a tip, moved where their polar angle about the tip is at
+    /// least β: the ray comes back as β to the grid's 0.5° (the lattice is dense enough
+    /// that no grid angle between the two points nearest to β is empty of both).
+    #[test]
+    fn ray_recovers_a_straight_boundary_through_the_tip() {
+        let tip = [3.0, 1.0];
+        for beta in [12.5f64, 30.0, 64.5, 90.0, 121.0] {
+            let (mut x, mut moved) = (Vec::new(), Vec::new());
+            for j in 1..=80 {
+                for i in -400..400 {
+                    let p = [
+                        tip[0] + 0.013 * i as f64 + 0.0061,
+                        tip[1] + 0.011 * j as f64,
+                    ];
+                    let a = (p[1] - tip[1]).atan2(p[0] - tip[0]).to_degrees();
+                    x.push(p);
+                    moved.push(a >= beta);
+                }
+            }
+            let r = ray_angle(&x, &moved, tip).unwrap();
+            assert!((r - beta).abs() <= 0.5, "β = {beta}: {r}");
+        }
+    }
+
+    /// A fan of displacement between rays from the tip at 40° (right) and 70° (left),
+    /// |u| rising linearly in polar angle from 0 to s across it, with a quarter of the
+    /// points flipped to the wrong class at random near the boundary (noise): the rays
+    /// of the contours f s, s/2 and (1 − f) s come back at 40 + 30 f, 55 and 70 − 30 f
+    /// within 1°, so the opening is (1 − 2f)·30° within 2°.
+    #[test]
+    fn rays_of_a_fan_give_its_limits_and_opening() {
+        let tip = [0.0, 0.0];
+        let mut x = Vec::new();
+        let mut frac = Vec::new();
+        let mut state = 12345u64;
+        for j in 1..=60 {
+            for i in -300..300 {
+                let p = [0.02 * i as f64 + 0.01, 0.1 * j as f64];
+                let a = p[1].atan2(p[0]).to_degrees();
+                let mut m = ((a - 40.0) / 30.0).clamp(0.0, 1.0);
+                // Deterministic jitter of ±0.05 in the fraction.
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                m += 0.1 * ((state >> 11) as f64 / (1u64 << 53) as f64 - 0.5);
+                x.push(p);
+                frac.push(m);
+            }
+        }
+        let f = 0.2;
+        let ray = |k: f64| {
+            let moved: Vec<bool> = frac.iter().map(|&m| m >= k).collect();
+            ray_angle(&x, &moved, tip).unwrap()
+        };
+        let (l, a, r) = (ray(1.0 - f), ray(0.5), ray(f));
+        assert!((l - 64.0).abs() <= 1.0, "left {l}");
+        assert!((a - 55.0).abs() <= 1.0, "axis {a}");
+        assert!((r - 46.0).abs() <= 1.0, "right {r}");
+        assert!(((l - r) - 18.0).abs() <= 2.0, "opening {}", l - r);
+    }
+
+    /// No boundary to find: nothing moved, or everything did.
+    #[test]
+    fn ray_is_undefined_without_both_classes() {
+        let x = [[1.0, 1.0], [-1.0, 1.0]];
+        assert_eq!(ray_angle(&x, &[false, false], [0.0, 0.0]), None);
+        assert_eq!(ray_angle(&x, &[true, true], [0.0, 0.0]), None);
+        assert_eq!(ray_angle(&[], &[], [0.0, 0.0]), None);
+        // One each, the moved one on the left: the grid rays above 45° up to 135°
+        // separate them; the middle of that run is 90.25°.
+        assert_eq!(ray_angle(&x, &[false, true], [0.0, 0.0]), Some(90.25));
     }
 }
