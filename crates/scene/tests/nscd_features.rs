@@ -132,6 +132,10 @@ fn bad_keys_are_named() {
             vec!["output.probe[0].wall", "\"roof\"", "floor"],
         ),
         (
+            format!("{wall}{wall}"),
+            vec!["wall[1].name", "\"floor\"", "wall[0]"],
+        ),
+        (
             format!("{wall}[[output.probe]]\nname = \"a\"\nfield = \"vx\"\nwall = \"floor\"\n"),
             vec!["output.probe[0].wall", "fx, fy or torque"],
         ),

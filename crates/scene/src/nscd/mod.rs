@@ -253,7 +253,7 @@ pub fn build<'a>(
                     )
                     .into());
             };
-            let component = ["fx", "fy", "torque"]
+            let component = crate::common::particles::WALL_FIELDS
                 .iter()
                 .position(|f| *f == p.field)
                 .expect("checked");
