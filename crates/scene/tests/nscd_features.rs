@@ -261,7 +261,9 @@ fn disks_set_in_flight_follow_their_parabolas() {
 /// A column of five disks dropped from 2 mm gaps onto a floor whose centre is 0.3 m to
 /// its left, settled (`settle_ratio`), then run at rest: the floor's probes read
 /// fx = 0, fy = N m g and torque = 0.3 N m g about the floor's centre (to 1e-9 relative,
-/// the solver's tolerance 1e-12 on the impulses).
+/// the solver's tolerance 1e-12 on the impulses). Every contact keeps an overlap of at
+/// most h(1 − θ)v_n, v_n ≤ √(2 g (k + 1) · 2 mm) the speed at which disk k (from the
+/// bottom) arrived after falling (k + 1) gaps (θ = ½, h = 1 ms).
 #[test]
 fn a_settled_column_weighs_on_its_floor() {
     let (n, r, a, rho) = (5, 0.05, 0.3, 2000.0);
@@ -276,8 +278,11 @@ fn a_settled_column_weighs_on_its_floor() {
          [schedule]\nend_time = 0.01\ndt = 1.0e-3\n[output]\nevery = 10\nprobe_every = 1\n\
          [[output.probe]]\nname = \"fx\"\nfield = \"fx\"\nwall = \"floor\"\n\
          [[output.probe]]\nname = \"fy\"\nfield = \"fy\"\nwall = \"floor\"\n\
-         [[output.probe]]\nname = \"torque\"\nfield = \"torque\"\nwall = \"floor\"\n",
-        vec![r; n]
+         [[output.probe]]\nname = \"torque\"\nfield = \"torque\"\nwall = \"floor\"\n{}",
+        vec![r; n],
+        (0..n)
+            .map(|i| probe(&format!("y{i}"), "y", i))
+            .collect::<String>()
     );
     let (rows, json) = run("settled", &text);
     assert!(json["settling"]["steps"].as_u64().unwrap() > 10, "{json}");
@@ -294,6 +299,19 @@ fn a_settled_column_weighs_on_its_floor() {
             (torque - a * weight).abs() < 1e-9 * a * weight,
             "t = {t}: torque {torque}, {}",
             a * weight
+        );
+    }
+    let y = &rows.last().unwrap()[4..];
+    for k in 0..n {
+        let overlap = if k == 0 {
+            r - y[0]
+        } else {
+            2.0 * r - (y[k] - y[k - 1])
+        };
+        let bound = 0.5 * 1e-3 * (2.0 * 9.81 * (k + 1) as f64 * 0.002).sqrt();
+        assert!(
+            (-1e-12..=bound).contains(&overlap),
+            "contact {k}: overlap {overlap}, h(1 − θ)v_n ≤ {bound}"
         );
     }
 }
