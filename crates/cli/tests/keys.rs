@@ -149,4 +149,12 @@ fn summaries_of_short_bundled_scenes_match_the_schema() {
         let s = summary(&out);
         assert_eq!(s["status"], "ok", "{scene}");
     }
+    // The keys of model nscd are described, not merely allowed: a contact count that is
+    // a number instead of `{ last, mean, max }` is refused, for model nscd only.
+    let mut s = summary(&dir.join("nscd_column"));
+    let schema = common::schema::summary_schema();
+    s["contacts"] = serde_json::json!(10);
+    assert!(common::schema::validate(&schema, &s).is_err());
+    s["model"] = serde_json::json!("lsm");
+    assert!(common::schema::validate(&schema, &s).is_ok());
 }

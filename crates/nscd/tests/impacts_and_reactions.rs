@@ -225,3 +225,104 @@ fn bad_restitution_is_refused() {
         assert!(e.to_string().starts_with("restitution"), "{e}");
     }
 }
+
+/// The same ball (e = ½, θ = ½) through three bounces: every rebound speed is e times
+/// the arrival speed before it (to 1e-12, the impact step's velocity is exact), every
+/// arrival speed is the rebound speed before it (free flight is exact with θ = ½: the
+/// ball leaves and comes back through the same predicted contact, to g·h), so the
+/// apexes go as H e², H e⁴, H e⁶, each within 4 v₀ h (the impact step's overlap and the
+/// sampling of the apex).
+#[test]
+fn bounce_heights_go_as_powers_of_e_squared() {
+    let (r, height, e, h) = (0.1, 1.0, 0.5, 1e-4);
+    let d = Disks::new(&[[0.0, r + height]], &[r], 2500.0).unwrap();
+    let floor = RigidBody::segment([-5.0, 0.0], [5.0, 0.0]);
+    let law = ContactLaw::frictional(0.3).with_restitution(e);
+    let mut s = Nscd::new(d, vec![floor], law, params(0.5), [0.0, -G]).unwrap();
+    let v0 = (2.0 * G * height).sqrt();
+    // (arrival, rebound, apex) of each bounce.
+    let mut bounces: Vec<(f64, f64, f64)> = Vec::new();
+    let mut rising = false;
+    for _ in 0..30_000 {
+        let before = s.disks.v[0][1];
+        s.step(h).unwrap();
+        let after = s.disks.v[0][1];
+        let y = s.disks.x[0][1] - r;
+        if before < 0.0 && after > 0.0 {
+            bounces.push((before, after, f64::NEG_INFINITY));
+            rising = true;
+        } else if rising {
+            let b = bounces.last_mut().unwrap();
+            b.2 = b.2.max(y);
+            if after < 0.0 {
+                rising = false;
+                if bounces.len() == 3 {
+                    break;
+                }
+            }
+        }
+    }
+    assert_eq!(bounces.len(), 3, "{bounces:?}");
+    let mut speed = v0;
+    for (k, &(arrival, rebound, apex)) in bounces.iter().enumerate() {
+        assert!(
+            (arrival + speed).abs() <= G * h,
+            "bounce {k}: arrival {arrival}, expected {}",
+            -speed
+        );
+        assert!(
+            (rebound + e * arrival).abs() <= 1e-12 * v0,
+            "bounce {k}: rebound {rebound} after {arrival}"
+        );
+        let want = height * e.powi(2 * (k as i32 + 1));
+        assert!(
+            (apex - want).abs() <= 4.0 * v0 * h,
+            "bounce {k}: apex {apex}, H e^{} = {want}",
+            2 * (k + 1)
+        );
+        speed = rebound;
+    }
+}
+
+/// Two equal disks closing head-on at 3 m/s (1.5 m/s each), no gravity, e = 0,
+/// h = 1 ms, from start gaps spread over one step's travel: they stop, and the overlap
+/// they keep is ≤ h(1 − θ)v_n = 1.5 mm for θ = ½ (to 1e-12 relative) and reaches 0.95
+/// of it for some start; 0 for θ = 1.
+#[test]
+fn head_on_overlap_is_at_most_h_one_minus_theta_v() {
+    let (r, v, h) = (0.1, 3.0, 1e-3);
+    for theta in [0.5, 1.0] {
+        let bound = h * (1.0 - theta) * v;
+        let mut largest = 0.0f64;
+        for k in 0..50 {
+            let gap = 2.0 * h * v + h * v * k as f64 / 50.0;
+            let mut d = Disks::new(&[[0.0, 0.0], [2.0 * r + gap, 0.0]], &[r, r], 2500.0).unwrap();
+            d.v[0] = [0.5 * v, 0.0];
+            d.v[1] = [-0.5 * v, 0.0];
+            let p = SolverParams {
+                alert: Some(0.05),
+                ..params(theta)
+            };
+            let mut s = Nscd::new(d, vec![], ContactLaw::default(), p, [0.0; 2]).unwrap();
+            for _ in 0..10 {
+                s.step(h).unwrap();
+            }
+            assert!(
+                s.disks.v[0][0].abs() < 1e-12 && s.disks.v[1][0].abs() < 1e-12,
+                "at rest: {:?}",
+                s.disks.v
+            );
+            let overlap = 2.0 * r - (s.disks.x[1][0] - s.disks.x[0][0]);
+            assert!(
+                overlap <= bound * (1.0 + 1e-12) + 1e-15,
+                "θ = {theta}: overlap {overlap} > h(1 − θ)v_n = {bound}"
+            );
+            largest = largest.max(overlap);
+        }
+        if theta == 0.5 {
+            assert!(largest >= 0.95 * bound, "largest {largest} of {bound}");
+        } else {
+            assert!(largest <= 1e-12 * h * v, "θ = 1: overlap {largest}");
+        }
+    }
+}

@@ -132,6 +132,10 @@ fn bad_keys_are_named() {
             vec!["output.probe[0].wall", "\"roof\"", "floor"],
         ),
         (
+            format!("{wall}{wall}"),
+            vec!["wall[1].name", "\"floor\"", "wall[0]"],
+        ),
+        (
             format!("{wall}[[output.probe]]\nname = \"a\"\nfield = \"vx\"\nwall = \"floor\"\n"),
             vec!["output.probe[0].wall", "fx, fy or torque"],
         ),
@@ -173,4 +177,195 @@ fn bad_keys_are_named() {
         !e.contains("particles.velocity") && e.contains("bonds is missing"),
         "{e}"
     );
+}
+
+/// Three disks under gravity given velocities and spins: two by a rigid rotation
+/// v = ω(−y, x), ω = 2 rad/s (an expression) with spin ω, the third overridden by index
+/// with v = (1.5, 4) and spin −1. The state set at t = 0 has the momentum Σ m v and the
+/// angular momentum about the origin Σ m x × v + I ω of those values (to 1e-12
+/// relative); then each disk flies on its parabola x₀ + v₀ t − ½ g t² ĵ with
+/// v₀ − g t ĵ, its spin unchanged (θ = ½ integrates a constant acceleration exactly:
+/// to 1e-12).
+#[test]
+fn disks_set_in_flight_follow_their_parabolas() {
+    let centres = [[0.0, 3.0], [4.0, 0.0], [-5.0, 2.0]];
+    let (r, rho, w, g) = (0.5, 1000.0, 2.0, 9.81);
+    let mut probes = String::new();
+    for i in 0..3 {
+        for f in ["x", "y", "vx", "vy", "omega"] {
+            probes += &probe(&format!("{f}{i}"), f, i);
+        }
+    }
+    let text = format!(
+        "{HEAD}[particles]\nkind = \"list\"\ncentres = {centres:?}\nradii = [{r}, {r}, {r}]\n\
+         density = {rho}\n\
+         [[particles.velocity]]\nv = [\"-{w}*y\", \"{w}*x\"]\nomega = {w}\n\
+         [[particles.velocity]]\nparticles = [2]\nv = [1.5, 4.0]\nomega = -1.0\n\
+         [schedule]\nend_time = 0.5\ndt = 0.01\n[output]\nevery = 10\nprobe_every = 5\n{probes}"
+    );
+    let (rows, json) = run("parabola", &text);
+    assert_eq!(json["contacts"]["max"], 0);
+    let m = rho * std::f64::consts::PI * r * r;
+    let inertia = 0.5 * m * r * r;
+    let v0: Vec<[f64; 3]> = vec![
+        [-w * centres[0][1], w * centres[0][0], w],
+        [-w * centres[1][1], w * centres[1][0], w],
+        [1.5, 4.0, -1.0],
+    ];
+    // Momentum and angular momentum of the state set at t = 0.
+    let first = &rows[0];
+    assert_eq!(first[0], 0.0);
+    let (mut p, mut l, mut p_want, mut l_want) = ([0.0; 2], 0.0, [0.0; 2], 0.0);
+    for i in 0..3 {
+        let c = &first[1 + 5 * i..6 + 5 * i];
+        p[0] += m * c[2];
+        p[1] += m * c[3];
+        l += m * (c[0] * c[3] - c[1] * c[2]) + inertia * c[4];
+        let [x, y] = centres[i];
+        let [vx, vy, om] = v0[i];
+        p_want[0] += m * vx;
+        p_want[1] += m * vy;
+        l_want += m * (x * vy - y * vx) + inertia * om;
+    }
+    let scale = m * 10.0;
+    for a in 0..2 {
+        assert!(
+            (p[a] - p_want[a]).abs() < 1e-12 * scale,
+            "P {p:?}, {p_want:?}"
+        );
+    }
+    assert!((l - l_want).abs() < 1e-12 * scale * 10.0, "L {l}, {l_want}");
+    assert_eq!(rows.last().unwrap()[0], 0.5);
+    for row in &rows {
+        let t = row[0];
+        for i in 0..3 {
+            let c = &row[1 + 5 * i..6 + 5 * i];
+            let [vx, vy, om] = v0[i];
+            let want = [
+                centres[i][0] + vx * t,
+                centres[i][1] + vy * t - 0.5 * g * t * t,
+                vx,
+                vy - g * t,
+                om,
+            ];
+            for (k, (got, want)) in c.iter().zip(want).enumerate() {
+                assert!(
+                    (got - want).abs() < 1e-12 * (1.0 + want.abs()),
+                    "t = {t}, disk {i}, column {k}: {got} against {want}"
+                );
+            }
+        }
+    }
+}
+
+/// A column of five disks dropped from 2 mm gaps onto a floor whose centre is 0.3 m to
+/// its left, settled (`settle_ratio`), then run at rest: the floor's probes read
+/// fx = 0, fy = N m g and torque = 0.3 N m g about the floor's centre (to 1e-9 relative,
+/// the solver's tolerance 1e-12 on the impulses). Every contact keeps an overlap of at
+/// most h(1 − θ)v_n, v_n ≤ √(2 g (k + 1) · 2 mm) the speed at which disk k (from the
+/// bottom) arrived after falling (k + 1) gaps (θ = ½, h = 1 ms).
+#[test]
+fn a_settled_column_weighs_on_its_floor() {
+    let (n, r, a, rho) = (5, 0.05, 0.3, 2000.0);
+    let centres: Vec<[f64; 2]> = (0..n)
+        .map(|k| [a, r + 0.002 + (2.0 * r + 0.002) * k as f64])
+        .collect();
+    let text = format!(
+        "{HEAD}[particles]\nkind = \"list\"\ncentres = {centres:?}\nradii = {:?}\n\
+         density = {rho}\n[[wall]]\nname = \"floor\"\nfrom = [-1.0, 0.0]\nto = [1.0, 0.0]\n\
+         [contact]\nmu = 0.3\n[nscd]\ntolerance = 1e-12\nmin_sweeps = 1\nmax_sweeps = 100000\n\
+         settle_ratio = 1e-8\n\
+         [schedule]\nend_time = 0.01\ndt = 1.0e-3\n[output]\nevery = 10\nprobe_every = 1\n\
+         [[output.probe]]\nname = \"fx\"\nfield = \"fx\"\nwall = \"floor\"\n\
+         [[output.probe]]\nname = \"fy\"\nfield = \"fy\"\nwall = \"floor\"\n\
+         [[output.probe]]\nname = \"torque\"\nfield = \"torque\"\nwall = \"floor\"\n{}",
+        vec![r; n],
+        (0..n)
+            .map(|i| probe(&format!("y{i}"), "y", i))
+            .collect::<String>()
+    );
+    let (rows, json) = run("settled", &text);
+    assert!(json["settling"]["steps"].as_u64().unwrap() > 10, "{json}");
+    let weight = n as f64 * rho * std::f64::consts::PI * r * r * 9.81;
+    assert_eq!(rows.len(), 11);
+    for row in &rows[1..] {
+        let [t, fx, fy, torque] = [row[0], row[1], row[2], row[3]];
+        assert!(fx.abs() < 1e-9 * weight, "t = {t}: fx {fx}");
+        assert!(
+            (fy - weight).abs() < 1e-9 * weight,
+            "t = {t}: fy {fy}, N m g {weight}"
+        );
+        assert!(
+            (torque - a * weight).abs() < 1e-9 * a * weight,
+            "t = {t}: torque {torque}, {}",
+            a * weight
+        );
+    }
+    let y = &rows.last().unwrap()[4..];
+    for k in 0..n {
+        let overlap = if k == 0 {
+            r - y[0]
+        } else {
+            2.0 * r - (y[k] - y[k - 1])
+        };
+        let bound = 0.5 * 1e-3 * (2.0 * 9.81 * (k + 1) as f64 * 0.002).sqrt();
+        assert!(
+            (-1e-12..=bound).contains(&overlap),
+            "contact {k}: overlap {overlap}, h(1 − θ)v_n ≤ {bound}"
+        );
+    }
+}
+
+/// Collects the solver's sweeps of every step.
+#[derive(Default)]
+struct Sweeps(Vec<usize>);
+
+impl porofrac_scene::Observer for Sweeps {
+    fn step(&mut self, report: &porofrac_scene::StepReport) {
+        if report.step > 0 {
+            self.0.push(report.iterations);
+        }
+    }
+}
+
+/// `min_sweeps` is a floor in a run, for each `ordering`: the bundled column with
+/// `min_sweeps = 100` (its impulses at an exact fixed point after a few sweeps) does at
+/// least 100 sweeps in every step, exactly 100 once warm-started at rest, and
+/// `summary.json` says so (`sweeps.mean` ≥ 100; `contacts` last = mean = max = 10).
+#[test]
+fn min_sweeps_is_a_floor_in_every_ordering() {
+    let column = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/nscd/column.toml"),
+    )
+    .unwrap();
+    for ordering in ["sorted", "random", "coloured", "slabs"] {
+        let text = column.replace(
+            "min_sweeps = 1\n",
+            &format!("min_sweeps = 100\nordering = \"{ordering}\"\n"),
+        );
+        assert_ne!(text, column);
+        let scene = Scene::parse(&text, &path(), LawRegistry::default()).unwrap();
+        let out = out_dir(&format!("floor-{ordering}"));
+        let mut sweeps = Sweeps::default();
+        let summary = scene.run(&out, &mut sweeps).unwrap();
+        assert_eq!(summary.status, "ok");
+        let json: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
+                .unwrap();
+        std::fs::remove_dir_all(&out).unwrap();
+        let s = &sweeps.0;
+        assert_eq!(s.len(), 50, "{ordering}");
+        assert!(s.iter().all(|&k| k >= 100), "{ordering}: {s:?}");
+        assert!(s[5..].iter().all(|&k| k == 100), "{ordering}: {s:?}");
+        let mean = json["sweeps"]["mean"].as_f64().unwrap();
+        let want = s.iter().sum::<usize>() as f64 / s.len() as f64;
+        assert!(
+            mean >= 100.0 && (mean - want).abs() < 1e-12,
+            "{ordering}: {mean}"
+        );
+        for key in ["last", "max"] {
+            assert_eq!(json["contacts"][key], 10, "{ordering}: contacts.{key}");
+        }
+        assert_eq!(json["contacts"]["mean"], 10.0, "{ordering}");
+    }
 }

@@ -777,11 +777,47 @@ pub const SUMMARY_SCHEMA_COMMAND: &str =
 /// `null` (`serde_json` writes a NaN or an infinity so).
 pub fn summary_schema() -> String {
     // The schema of what serializing writes: keys skipped when empty are optional.
-    let mut v = schemars::generate::SchemaSettings::draft2020_12()
+    let mut generator = schemars::generate::SchemaSettings::draft2020_12()
         .for_serialize()
-        .into_generator()
+        .into_generator();
+    // Each model's own keys: a model that publishes them is one form of `anyOf`, the
+    // other models another, told apart by `model`.
+    let (mut forms, mut others) = (Vec::new(), Vec::new());
+    for m in crate::MODELS {
+        match m.summary_schema(&mut generator) {
+            Some(s) => {
+                let mut form = s.to_value();
+                if let Some(o) = form.as_object_mut() {
+                    o.insert(
+                        "properties".into(),
+                        serde_json::json!({ "model": { "const": m.name() } }),
+                    );
+                    o.insert("required".into(), serde_json::json!(["model"]));
+                }
+                forms.push(form);
+            }
+            None => others.push(m.name()),
+        }
+    }
+    let mut v = generator
         .into_root_schema_for::<crate::common::output::Summary>()
         .to_value();
+    if !forms.is_empty() {
+        // A run that stops before its model is built writes none of the model's keys:
+        // they are described, not required.
+        for f in &forms {
+            if let Some(name) = f["$ref"].as_str().and_then(|r| r.strip_prefix("#/$defs/"))
+                && let Some(def) = v.pointer_mut(&format!("/$defs/{name}"))
+                && let Some(o) = def.as_object_mut()
+            {
+                o.remove("required");
+            }
+        }
+        forms.push(serde_json::json!({ "properties": { "model": { "enum": others } } }));
+        if let Some(o) = v.as_object_mut() {
+            o.insert("anyOf".into(), Value::Array(forms));
+        }
+    }
     if let Some(o) = v.as_object_mut() {
         o.insert(
             "$comment".into(),

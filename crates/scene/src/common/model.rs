@@ -257,6 +257,17 @@ pub trait ModelKind: Sync {
     fn own_schema(&self) -> Option<schemars::Schema> {
         None
     }
+    /// The schema of the keys the model adds to `summary.json`
+    /// ([`Model::summary_extras`]) as `generator` makes it (a reference into its
+    /// definitions), for [`crate::common::keys::summary_schema`]; `None` (by default):
+    /// not published.
+    fn summary_schema(
+        &self,
+        generator: &mut schemars::SchemaGenerator,
+    ) -> Option<schemars::Schema> {
+        let _ = generator;
+        None
+    }
     /// Check every value the model reads (after the checks every model shares).
     fn check(&self, ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError>;
     /// Build the model — everything a run does before its first step: files read, grid

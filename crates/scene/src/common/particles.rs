@@ -568,6 +568,10 @@ pub fn check_particle_schedule(ls: &LoadedScene, model: &str) -> Result<(), Scen
     Ok(())
 }
 
+/// Fields of a wall probe (`wall = NAME`, models `nscd` and `lsm`), in the order of
+/// their index: the force on the disks (N/m) and its moment (N·m/m).
+pub const WALL_FIELDS: [&str; 3] = ["fx", "fy", "torque"];
+
 /// Check the probes and lines of a particle scene of `model`: particle fields with
 /// `particle = N`, `cell_fields` with `cell = { center, radius }`, `global_fields` with
 /// neither.
@@ -601,8 +605,8 @@ pub fn check_output_of(
         }
         let f = p.field.as_str();
         if p.wall.is_some() {
-            // Model nscd: the reaction of a wall (its name is checked by the model).
-            if !["fx", "fy", "torque"].contains(&f) || p.particle.is_some() || p.cell.is_some() {
+            // The reaction of a wall (its name is checked by the model).
+            if !WALL_FIELDS.contains(&f) || p.particle.is_some() || p.cell.is_some() {
                 return Err(ls.error(
                     &key("wall"),
                     format!(

@@ -258,8 +258,22 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
 }
 
 fn check_walls(ls: &LoadedScene) -> Result<(), SceneError> {
-    for (i, w) in super::own(ls).wall.iter().enumerate() {
+    let walls = &super::own(ls).wall;
+    for (i, w) in walls.iter().enumerate() {
         let key = |f: &str| ki("wall", i, &[f]);
+        if let Some(name) = &w.name
+            && let Some(j) = walls[..i]
+                .iter()
+                .position(|o| o.name.as_ref() == Some(name))
+        {
+            return Err(ls.error(
+                &key("name"),
+                format!(
+                    "= \"{name}\" is the name of wall[{j}] too: a name picks one wall \
+                     (`wall = NAME` probes)"
+                ),
+            ));
+        }
         match (&w.from, &w.to, &w.polygon) {
             (Some(a), Some(b), None) => {
                 if a == b || !a.iter().chain(b).all(|v| v.is_finite()) {

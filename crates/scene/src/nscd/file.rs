@@ -21,7 +21,8 @@ pub enum WallComponent {
 #[derive(Clone, Debug, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct WallSection {
-    /// Name (for messages).
+    /// Name, unique among the walls: messages and wall probes
+    /// (`[[output.probe]] wall = NAME`) use it.
     pub name: Option<String>,
     /// Segment start (m).
     #[schemars(extend("unit" = "m"))]

@@ -22,6 +22,7 @@
 pub mod check;
 pub mod fault;
 pub mod file;
+pub mod summary;
 
 use crate::common::laws::LawRegistry;
 use crate::common::loaded::SceneError;
@@ -252,7 +253,7 @@ pub fn build<'a>(
                     )
                     .into());
             };
-            let component = ["fx", "fy", "torque"]
+            let component = crate::common::particles::WALL_FIELDS
                 .iter()
                 .position(|f| *f == p.field)
                 .expect("checked");
@@ -322,57 +323,49 @@ impl NscdModel<'_> {
     }
 
     /// Keys added to `summary.json`.
-    fn particle_statistics(&self) -> Vec<(&'static str, serde_json::Value)> {
+    fn particle_statistics(&self) -> summary::NscdSummary {
         let st = &self.stats;
-        let mean = if st.steps > 0 {
-            st.sweeps as f64 / st.steps as f64
-        } else {
-            0.0
+        let per_step = |total: f64| {
+            if st.steps > 0 {
+                total / st.steps as f64
+            } else {
+                0.0
+            }
         };
         let rate = if st.solve_seconds > 0.0 {
             st.updates as f64 / st.solve_seconds
         } else {
             0.0
         };
-        vec![
-            ("particles", self.sys.disks.len().into()),
-            (
-                "contacts",
-                serde_json::json!({
-                    "last": self.sys.contacts().len(),
-                    "mean": if st.steps > 0 { st.contact_steps as f64 / st.steps as f64 } else { 0.0 },
-                    "max": st.max_contacts,
+        summary::NscdSummary {
+            particles: self.sys.disks.len(),
+            contacts: summary::NscdContactCounts {
+                last: self.sys.contacts().len(),
+                mean: per_step(st.contact_steps as f64),
+                max: st.max_contacts,
+            },
+            sweeps: summary::NscdSweepCounts {
+                mean: per_step(st.sweeps as f64),
+                max: st.max_sweeps,
+                total: st.sweeps,
+            },
+            final_residual: st.final_residual,
+            not_converged_steps: st.not_converged,
+            contact_updates: st.updates,
+            contact_updates_per_second: rate,
+            nlgs_seconds: st.solve_seconds,
+            settling: self
+                .settling
+                .as_ref()
+                .map(|(s, secs)| summary::NscdSettling {
+                    steps: s.steps,
+                    kinetic_energy: s.kinetic,
+                    potential_energy_released: s.released,
+                    sweeps: s.sweeps,
+                    seconds: *secs,
                 }),
-            ),
-            (
-                "sweeps",
-                serde_json::json!({ "mean": mean, "max": st.max_sweeps, "total": st.sweeps }),
-            ),
-            ("final_residual", st.final_residual.into()),
-            ("not_converged_steps", st.not_converged.into()),
-            ("contact_updates", st.updates.into()),
-            ("contact_updates_per_second", rate.into()),
-            ("nlgs_seconds", st.solve_seconds.into()),
-            (
-                "settling",
-                match &self.settling {
-                    Some((s, secs)) => serde_json::json!({
-                        "steps": s.steps,
-                        "kinetic_energy": s.kinetic,
-                        "potential_energy_released": s.released,
-                        "sweeps": s.sweeps,
-                        "seconds": secs,
-                    }),
-                    None => serde_json::Value::Null,
-                },
-            ),
-            (
-                "fault",
-                self.fault
-                    .as_ref()
-                    .map_or(serde_json::Value::Null, |f| f.measure(&self.sys)),
-            ),
-        ]
+            fault: self.fault.as_ref().map(|f| f.measure(&self.sys)),
+        }
     }
 }
 
@@ -519,10 +512,7 @@ impl Model for NscdModel<'_> {
     }
 
     fn summary_extras(&self) -> serde_json::Map<String, serde_json::Value> {
-        self.particle_statistics()
-            .into_iter()
-            .map(|(k, v)| (k.to_string(), v))
-            .collect()
+        self.particle_statistics().into_map()
     }
 
     fn times(&self) -> &[f64] {
@@ -747,6 +737,12 @@ impl ModelKind for NscdKind {
     }
     fn own_schema(&self) -> Option<schemars::Schema> {
         Some(schemars::schema_for!(file::NscdSections))
+    }
+    fn summary_schema(
+        &self,
+        generator: &mut schemars::SchemaGenerator,
+    ) -> Option<schemars::Schema> {
+        Some(generator.subschema_for::<summary::NscdSummary>())
     }
     fn check(&self, ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
         let _ = laws;
