@@ -10,8 +10,12 @@
 //!   axis);
 //! - the time exponent of `R` (least squares on `log R` against `log t`; 2/5).
 //!
-//! The bounds are the values measured on this grid (docs/hydrofrac/validation.md,
-//! "Penny-shaped crack", with the finer grid h = 1/3 m) rounded up by about 5 %.
+//! The bounds are the values measured on this grid (2026-11-29: `R` +1.1 % on average,
+//! 2.1 % in absolute value; `p` +44.7 %; `w` +28.7 %; exponent 0.418) within about 5 % of
+//! themselves; docs/hydrofrac/validation.md ("Penny-shaped crack") has them with the finer
+//! grid (h = 1/3 m) and why the pressure and the opening are high: the band is stiffer than
+//! Sneddon's crack at a few cells per radius, and the volume a cell opened before it failed
+//! is never filled, so the crack opens more than the injected volume.
 
 use std::path::Path;
 
@@ -108,7 +112,10 @@ fn penny_toughness_follows_the_vertex_solution() {
         (0.40..0.47).contains(&e_p),
         "inlet net pressure: mean error {e_p:+.4}"
     );
-    assert!((0.25..0.31).contains(&e_w), "inlet opening: mean error {e_w:+.4}");
+    assert!(
+        (0.25..0.30).contains(&e_w),
+        "inlet opening: mean error {e_w:+.4}"
+    );
     assert!(
         (0.40..0.44).contains(&exponent),
         "time exponent of the radius {exponent:.4} (2/5 in the vertex solution)"
