@@ -13,9 +13,10 @@
 //! The bounds are the values measured on this grid (2026-11-29: `R` +1.1 % on average,
 //! 2.1 % in absolute value; `p` +44.7 %; `w` +28.7 %; exponent 0.418) within about 5 % of
 //! themselves; docs/hydrofrac/validation.md ("Penny-shaped crack") has them with the finer
-//! grid (h = 1/3 m) and why the pressure and the opening are high: the band is stiffer than
-//! Sneddon's crack at a few cells per radius, and the volume a cell opened before it failed
-//! is never filled, so the crack opens more than the injected volume.
+//! grid (h = 1/3 m) and why the pressure and the opening are high: the tip rule's estimate
+//! of `K_I` on a staircase front is low (0.64–0.74 of it on Sneddon's penny), the band is
+//! stiffer than Sneddon's crack at a few cells per radius, and the volume a cell opened
+//! before it failed is never filled.
 
 use std::path::Path;
 
