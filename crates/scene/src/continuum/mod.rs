@@ -25,6 +25,8 @@ pub mod fields;
 pub mod flow;
 #[cfg(test)]
 mod kgd_tests;
+#[cfg(test)]
+mod penny_tests;
 pub mod plots;
 
 use crate::common::loaded::SceneError;
