@@ -10,13 +10,14 @@
 //!   axis);
 //! - the time exponent of `R` (least squares on `log R` against `log t`; 2/5).
 //!
-//! The bounds are the values measured on this grid (2026-11-29: `R` +1.1 % on average,
-//! 2.1 % in absolute value; `p` +44.7 %; `w` +28.7 %; exponent 0.418) within about 5 % of
-//! themselves; docs/hydrofrac/validation.md ("Penny-shaped crack") has them with the finer
-//! grid (h = 1/3 m) and why the pressure and the opening are high: the tip rule's estimate
-//! of `K_I` on a staircase front is low (0.64–0.74 of it on Sneddon's penny), the band is
-//! stiffer than Sneddon's crack at a few cells per radius, and the volume a cell opened
-//! before it failed is never filled.
+//! The radius and its exponent are asserted against the vertex solution (measured
+//! 2026-11-29 on this grid: `R` +1.1 % on average, 2.1 % in absolute value, exponent
+//! 0.418). The inlet net pressure and opening miss it (+44.7 % and +28.7 % here, +38.9 %
+//! and +26.8 % at h = 1/3 m): their test is ignored with those numbers.
+//! docs/hydrofrac/validation.md ("Penny-shaped crack") says why they are high: the tip
+//! rule's estimate of `K_I` on a staircase front is low (0.64–0.74 of it on Sneddon's
+//! penny), the band is stiffer than Sneddon's crack at a few cells per radius, and the
+//! volume a cell opened before it failed is never filled.
 
 use std::path::Path;
 
@@ -60,8 +61,22 @@ fn the_constant_of_the_toughness_vertex_is_0_8546() {
     assert!((volume / (Q0 * 50.0) - 1.0).abs() < 1e-12, "{volume}");
 }
 
-#[test]
-fn penny_toughness_follows_the_vertex_solution() {
+/// Errors of the bundled scene against the vertex solution over t ≥ 20 s.
+struct PennyErrors {
+    /// Mean relative error of the equivalent radius.
+    radius: f64,
+    /// Mean absolute relative error of the equivalent radius.
+    radius_abs: f64,
+    /// Mean relative error of the inlet net pressure.
+    pressure: f64,
+    /// Mean relative error of the inlet opening.
+    opening: f64,
+    /// Fitted time exponent of the radius.
+    exponent: f64,
+}
+
+/// Runs the bundled scene once (about 30 s of CPU) and measures it.
+fn penny_errors() -> PennyErrors {
     let h = 0.5;
     let text = include_str!("../../../../scenes/penny_toughness.toml");
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/penny_toughness.toml");
@@ -105,20 +120,46 @@ fn penny_toughness_follows_the_vertex_solution() {
         "penny toughness, h = {h} m, t >= 20 s: R {e_r:+.4} (mean |.| {a_r:.4}), \
          p {e_p:+.4}, w {e_w:+.4}, exponent {exponent:.4}"
     );
+    PennyErrors {
+        radius: e_r,
+        radius_abs: a_r,
+        pressure: e_p,
+        opening: e_w,
+        exponent,
+    }
+}
+
+#[test]
+fn penny_toughness_radius_follows_the_vertex_solution() {
+    let e = penny_errors();
     assert!(
-        e_r.abs() < 0.012 && a_r < 0.022,
-        "radius: mean error {e_r:+.4}, |.| {a_r:.4}"
+        e.radius.abs() < 0.012 && e.radius_abs < 0.022,
+        "radius: mean error {:+.4}, |.| {:.4}",
+        e.radius,
+        e.radius_abs
     );
     assert!(
-        (0.40..0.47).contains(&e_p),
-        "inlet net pressure: mean error {e_p:+.4}"
+        (0.40..0.44).contains(&e.exponent),
+        "time exponent of the radius {:.4} (2/5 in the vertex solution)",
+        e.exponent
+    );
+}
+
+/// The inlet net pressure and opening within 10 % of the vertex solution: missed
+/// (+44.7 % and +28.7 % at h = 0.5 m, +38.9 % and +26.8 % at h = 1/3 m; see the module
+/// docs for why).
+#[test]
+#[ignore = "missed: inlet pressure +44.7 %, opening +28.7 % at h = 0.5 m (docs/hydrofrac/validation.md)"]
+fn penny_toughness_inlet_pressure_and_opening_follow_the_vertex_solution() {
+    let e = penny_errors();
+    assert!(
+        e.pressure.abs() < 0.10,
+        "inlet net pressure: mean error {:+.4}",
+        e.pressure
     );
     assert!(
-        (0.25..0.30).contains(&e_w),
-        "inlet opening: mean error {e_w:+.4}"
-    );
-    assert!(
-        (0.40..0.44).contains(&exponent),
-        "time exponent of the radius {exponent:.4} (2/5 in the vertex solution)"
+        e.opening.abs() < 0.10,
+        "inlet opening: mean error {:+.4}",
+        e.opening
     );
 }
