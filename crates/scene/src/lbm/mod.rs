@@ -1081,7 +1081,7 @@ pub struct LbmSections {
     /// `[[obstacle]]`.
     #[serde(default)]
     pub obstacle: Vec<crate::common::lattice::sections::ObstacleSection>,
-    /// `[grains]`: the solid map from an image of the rock.
+    /// `[grains]`: The lattice's solid map from an image of the rock.
     pub grains: Option<grains::GrainsSection>,
 }
 
