@@ -9,7 +9,8 @@
 //!   conjugate grains cool.
 //! * Bad `[grains]` are refused with the key, the file and, for a bad PGM, its line: a
 //!   missing file, a malformed value, a hostile size, a threshold out of 0–1, a pixel size
-//!   that is not positive, an image off the lattice, `held` without a temperature,
+//!   that is not positive, an image off the lattice, a noisy image that would make
+//!   20 000 obstacles or more, `held` without a temperature,
 //!   `temperature` without `[thermal]`, and `thermal.books` in a lattice solid scene.
 
 use std::path::{Path, PathBuf};
@@ -168,6 +169,24 @@ fn bad_grains_name_the_key_the_file_and_the_line() {
         &dir,
         "grains.image",
         "100000 × 100000",
+    );
+    // a checkerboard of single-node grains: 20 000 obstacles or more are refused
+    let mut noise = b"P5 300 200 255\n".to_vec();
+    noise.extend((0..300 * 200).map(|n| {
+        if (n % 300 + n / 300) % 2 == 0 {
+            255u8
+        } else {
+            0
+        }
+    }));
+    std::fs::write(dir.join("noise.pgm"), noise).unwrap();
+    refused(
+        &with_image("noise.pgm")
+            .replace("pixel_size = 1.0e-4", "pixel_size = 5.0e-5")
+            .replace("spacing = 1.0e-4", "spacing = 5.0e-5"),
+        &dir,
+        "grains.image",
+        "rectangles",
     );
     std::fs::write(dir.join("notes.txt"), "hello").unwrap();
     refused(&with_image("notes.txt"), &dir, "grains.image", "not a PGM");

@@ -75,6 +75,10 @@ fn read(ls: &LoadedScene, g: &GrainsSection) -> Result<GreyImage, SceneError> {
     })
 }
 
+/// Most rectangles of grain nodes a scene may have (each is an obstacle of the lattice,
+/// and adding one costs a pass over those before it).
+pub const MAX_RECTANGLES: usize = 20_000;
+
 /// Most lattice steps whose books a run keeps (one row of `heat_books.csv` each).
 pub const MAX_BOOK_STEPS: f64 = 1e6;
 
@@ -150,7 +154,20 @@ fn check(ls: &LoadedScene, g: &GrainsSection) -> Result<(), SceneError> {
     let l = ls.scene.lbm.as_ref().expect("checked");
     let (nx, ny) = crate::common::lattice::nodes(l);
     let (nx, ny) = (nx as usize, ny as usize);
-    if solid_map(ls, g, &img, nx, ny).iter().all(|s| !s) {
+    let solid = solid_map(ls, g, &img, nx, ny);
+    let pieces = rectangles(&solid, nx, ny).len();
+    if pieces > MAX_RECTANGLES {
+        return Err(ls.error(
+            &key("image"),
+            format!(
+                "= \"{}\": its grains cut into {pieces} rectangles of lattice nodes (at most \
+                 {MAX_RECTANGLES}; each is an obstacle of the lattice): a noisy image — \
+                 smooth it, or segment it into grains and pores first",
+                g.image
+            ),
+        ));
+    }
+    if solid.iter().all(|s| !s) {
         return Err(ls.error(
             &key("image"),
             format!(
