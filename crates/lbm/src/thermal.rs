@@ -29,6 +29,15 @@
 //! does not cover (fluid, another obstacle or a side): for an obstacle that does not move,
 //! `Σ_{its nodes} T` drops by exactly that. A moving obstacle also takes or leaves the
 //! heat of the nodes it covers or uncovers (the heat stays on the lattice).
+//!
+//! **Held nodes** ([`Thermal::hold`]): solid grains kept at a temperature by a reservoir
+//! (a Dirichlet condition on the solid); after the collision their populations are the
+//! equilibrium at rest at that temperature, and [`Thermal::held_heat`] is what this took
+//! from the reservoir in the step.
+//!
+//! **Heat books** ([`Thermal::keep_books`], [`HeatBooks`]): per step, over the fluid nodes
+//! of the step, the change of the stored heat against conduction and advection through the
+//! sides and the heat the solid nodes gave, exact to round-off.
 
 use rayon::prelude::*;
 
