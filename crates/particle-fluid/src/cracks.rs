@@ -19,14 +19,21 @@
 //! change sign within a step), which is refused ([`CrackError::TooWide`]): such a crack is
 //! wide enough for the lattice to carry it.
 //!
-//! **Mouths.** Each end of a channel is attached to the fluid node nearest to it within
-//! two spacings (none: the channel is dry and carries nothing). A mouth that an obstacle
-//! covers later carries nothing in that step (both ends must be fluid), so no mass is
-//! created or lost.
+//! **Mouths and pores.** Each end of a channel is attached to the fluid node nearest to it
+//! within two spacings (a mouth). An end with no fluid node that near is a *pore* of the
+//! crack network inside the rock: ends within 1e-6 spacings of each other are the same
+//! pore, which joins its channels. A pore stores the fluid of half of each of its channels,
+//! volume `V = Σ w L / 2` (per unit depth), at density `ρ = m / V` (the lattice's equation
+//! of state, `p = c_s² ρ`), starting at the reference density; it is advanced with the
+//! same explicit fluxes, so the mass of lattice plus pores is conserved to round-off. A
+//! mouth that an obstacle covers later carries nothing in that step. The explicit
+//! exchange needs `Σ K` of a mouth node below ½ and `Σ K / V` of a pore below ½
+//! ([`CrackError::TooWide`]; for a pore `K/V ∝ w²/L²`, so only a crack wide and short
+//! against the spacing is refused).
 //!
-//! What is not done here: the crack network of a broken rock (channels along the broken
-//! bonds' faces joined at the pores between three particles) and its coupling to
-//! [`crate::ParticleFluid`]; this module is the channel, its exchange and its test.
+//! What is not done here: building the network from the broken bonds of a lattice solid
+//! (a channel along each broken bond's face, pores at the openings between three
+//! particles) and its coupling to [`crate::ParticleFluid`].
 
 use porofrac_lbm::d2q9::CS2;
 use porofrac_lbm::{Lattice, LbmError};
@@ -55,17 +62,19 @@ pub enum CrackError {
         /// Its value.
         value: f64,
     },
-    /// A mouth whose channels conduct too much for the explicit exchange.
+    /// A mouth node or pore whose channels conduct too much for the explicit exchange.
     #[error(
-        "lattice node ({i}, {j}): its crack channels conduct K = {k:.3} per step (limit 0.5); \
-         a crack that wide is carried by the lattice itself"
+        "{what} at ({x:.3}, {y:.3}): its crack channels conduct {k:.3} of its content per \
+         step (limit 0.5); a crack that wide is carried by the lattice itself"
     )]
     TooWide {
-        /// Node column.
-        i: usize,
-        /// Node row.
-        j: usize,
-        /// Its `Σ K`.
+        /// "lattice node" or "crack pore".
+        what: &'static str,
+        /// Its position (lattice units).
+        x: f64,
+        /// Its position (lattice units).
+        y: f64,
+        /// `Σ K` (node) or `Σ K / V` (pore).
         k: f64,
     },
     /// An error of the lattice.
@@ -73,32 +82,54 @@ pub enum CrackError {
     Lbm(#[from] LbmError),
 }
 
+/// Where a channel's end is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum End {
+    /// A mouth: index into `nodes`.
+    Node(usize),
+    /// A pore of the network: index into `pores`.
+    Pore(usize),
+}
+
+/// A pore of the crack network.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Pore {
+    at: [f64; 2],
+    volume: f64,
+    mass: f64,
+}
+
 /// The crack channels of a lattice and their mass exchange.
 #[derive(Clone, Debug)]
 pub struct CrackFlow {
     channels: Vec<CrackChannel>,
-    /// Per channel: its mouths' indices into `nodes`, or `None` (dry).
-    mouths: Vec<Option<[usize; 2]>>,
+    /// Per channel: where its ends are.
+    ends: Vec<[End; 2]>,
     /// Mouth nodes and their lattice source.
     nodes: Vec<((usize, usize), usize)>,
+    pores: Vec<Pore>,
     /// Lattice kinematic viscosity.
     nu: f64,
     /// Mass carried by each channel in the last step, from end 0 to end 1.
     carried: Vec<f64>,
-    /// Mass carried through all channels since the start, from end 0 to end 1.
-    total: f64,
+    /// Mass carried by each channel since the start, from end 0 to end 1.
+    cumulative: Vec<f64>,
 }
 
 impl CrackFlow {
     /// Attach `channels` to `lat` (its relaxation time gives the viscosity). Mouths are
-    /// found now, from the nodes that are fluid now.
+    /// found now, from the nodes that are fluid now; the pores start at the reference
+    /// density 1.
     pub fn new(lat: &mut Lattice, channels: Vec<CrackChannel>) -> Result<Self, CrackError> {
         let nu = (lat.config().tau - 0.5) / 3.0;
         let mut nodes: Vec<((usize, usize), usize)> = Vec::new();
-        let mut mouths = Vec::with_capacity(channels.len());
+        let mut pores: Vec<Pore> = Vec::new();
+        let mut ends = Vec::with_capacity(channels.len());
         for (c, ch) in channels.iter().enumerate() {
             for (what, value) in [("aperture", ch.aperture), ("length", ch.length)] {
-                if !(value.is_finite() && value > 0.0) {
+                if !(value.is_finite() && value > 0.0)
+                    || !ch.ends.iter().flatten().all(|v| v.is_finite())
+                {
                     return Err(CrackError::Value {
                         channel: c,
                         what,
@@ -106,39 +137,66 @@ impl CrackFlow {
                     });
                 }
             }
-            let ends = [
-                nearest_fluid(lat, ch.ends[0]),
-                nearest_fluid(lat, ch.ends[1]),
-            ];
-            let m = match ends {
-                [Some(a), Some(b)] if a != b => {
-                    let mut idx = [0; 2];
-                    for (k, n) in [a, b].into_iter().enumerate() {
-                        idx[k] = match nodes.iter().position(|(x, _)| *x == n) {
-                            Some(p) => p,
-                            None => {
-                                let s = lat.add_source(&[n])?;
-                                nodes.push((n, s));
-                                nodes.len() - 1
-                            }
-                        };
+            let mut e = [End::Pore(0); 2];
+            for k in 0..2 {
+                let p = ch.ends[k];
+                e[k] = match nearest_fluid(lat, p) {
+                    Some(n) => match nodes.iter().position(|(x, _)| *x == n) {
+                        Some(i) => End::Node(i),
+                        None => {
+                            let s = lat.add_source(&[n])?;
+                            nodes.push((n, s));
+                            End::Node(nodes.len() - 1)
+                        }
+                    },
+                    None => {
+                        let near = pores
+                            .iter()
+                            .position(|q| (q.at[0] - p[0]).hypot(q.at[1] - p[1]) < 1e-6);
+                        let i = near.unwrap_or_else(|| {
+                            pores.push(Pore {
+                                at: p,
+                                volume: 0.0,
+                                mass: 0.0,
+                            });
+                            pores.len() - 1
+                        });
+                        End::Pore(i)
                     }
-                    Some(idx)
-                }
-                _ => None,
-            };
-            mouths.push(m);
+                };
+            }
+            ends.push(e);
         }
-        let flow = CrackFlow {
+        let mut flow = CrackFlow {
             carried: vec![0.0; channels.len()],
+            cumulative: vec![0.0; channels.len()],
             channels,
-            mouths,
+            ends,
             nodes,
+            pores,
             nu,
-            total: 0.0,
         };
+        flow.set_volumes();
+        for p in &mut flow.pores {
+            p.mass = p.volume;
+        }
         flow.check_conductance()?;
         Ok(flow)
+    }
+
+    /// Pore volumes from the channels' apertures (the mass stays).
+    fn set_volumes(&mut self) {
+        for p in &mut self.pores {
+            p.volume = 0.0;
+        }
+        for (c, e) in self.ends.iter().enumerate() {
+            let ch = &self.channels[c];
+            for end in e {
+                if let End::Pore(i) = *end {
+                    self.pores[i].volume += 0.5 * ch.aperture * ch.length;
+                }
+            }
+        }
     }
 
     /// `K = w³ c_s² / (12 ν L)` of channel `c` (mass per step and unit density difference).
@@ -148,24 +206,47 @@ impl CrackFlow {
     }
 
     fn check_conductance(&self) -> Result<(), CrackError> {
-        let mut k = vec![0.0; self.nodes.len()];
-        for (c, m) in self.mouths.iter().enumerate() {
-            if let Some([a, b]) = *m {
-                let kc = self.conductance(c);
-                k[a] += kc;
-                k[b] += kc;
+        let mut kn = vec![0.0; self.nodes.len()];
+        let mut kp = vec![0.0; self.pores.len()];
+        for (c, e) in self.ends.iter().enumerate() {
+            if e[0] == e[1] {
+                continue;
+            }
+            let k = self.conductance(c);
+            for end in e {
+                match *end {
+                    End::Node(i) => kn[i] += k,
+                    End::Pore(i) => kp[i] += k,
+                }
             }
         }
-        for (n, &kn) in k.iter().enumerate() {
-            if kn > 0.5 {
-                let (i, j) = self.nodes[n].0;
-                return Err(CrackError::TooWide { i, j, k: kn });
+        for (i, &k) in kn.iter().enumerate() {
+            if k > 0.5 {
+                let (x, y) = self.nodes[i].0;
+                return Err(CrackError::TooWide {
+                    what: "lattice node",
+                    x: x as f64 + 0.5,
+                    y: y as f64 + 0.5,
+                    k,
+                });
+            }
+        }
+        for (i, &k) in kp.iter().enumerate() {
+            let p = &self.pores[i];
+            if p.volume > 0.0 && k / p.volume > 0.5 {
+                return Err(CrackError::TooWide {
+                    what: "crack pore",
+                    x: p.at[0],
+                    y: p.at[1],
+                    k: k / p.volume,
+                });
             }
         }
         Ok(())
     }
 
-    /// Change the aperture of channel `c` (an opening or closing crack).
+    /// Change the aperture of channel `c` (an opening or closing crack; 0 closes it). The
+    /// pores keep their mass: their volume and so their density change.
     pub fn set_aperture(&mut self, c: usize, aperture: f64) -> Result<(), CrackError> {
         if !(aperture.is_finite() && aperture >= 0.0) {
             return Err(CrackError::Value {
@@ -176,8 +257,10 @@ impl CrackFlow {
         }
         let old = self.channels[c].aperture;
         self.channels[c].aperture = aperture;
+        self.set_volumes();
         if let Err(e) = self.check_conductance() {
             self.channels[c].aperture = old;
+            self.set_volumes();
             return Err(e);
         }
         Ok(())
@@ -188,9 +271,32 @@ impl CrackFlow {
         &self.channels
     }
 
-    /// The mouth nodes of channel `c` (`None`: dry, no fluid node near an end).
-    pub fn mouths(&self, c: usize) -> Option<[(usize, usize); 2]> {
-        self.mouths[c].map(|[a, b]| [self.nodes[a].0, self.nodes[b].0])
+    /// The mouth nodes of channel `c`'s two ends (`None`: that end is a pore).
+    pub fn mouths(&self, c: usize) -> [Option<(usize, usize)>; 2] {
+        self.ends[c].map(|e| match e {
+            End::Node(i) => Some(self.nodes[i].0),
+            End::Pore(_) => None,
+        })
+    }
+
+    /// Density of the pore at channel `c`'s end `k` (`None`: a mouth).
+    pub fn pore_density(&self, c: usize, k: usize) -> Option<f64> {
+        match self.ends[c][k] {
+            End::Pore(i) => {
+                let p = &self.pores[i];
+                Some(if p.volume > 0.0 {
+                    p.mass / p.volume
+                } else {
+                    1.0
+                })
+            }
+            End::Node(_) => None,
+        }
+    }
+
+    /// Mass held in the pores of the network (lattice units).
+    pub fn pore_mass(&self) -> f64 {
+        self.pores.iter().map(|p| p.mass).sum()
     }
 
     /// Mass channel `c` carried in the last step from end 0 to end 1 (lattice units).
@@ -198,29 +304,49 @@ impl CrackFlow {
         self.carried[c]
     }
 
-    /// Mass carried through all channels since the start, end 0 to end 1.
-    pub fn total_carried(&self) -> f64 {
-        self.total
+    /// Mass channel `c` carried since the start from end 0 to end 1 (lattice units).
+    pub fn cumulative(&self, c: usize) -> f64 {
+        self.cumulative[c]
     }
 
-    /// Set the lattice's mouth sources for its next step from the mouths' densities now
-    /// (call before [`Lattice::step`]; the sources act at the end of that step).
+    /// Set the lattice's mouth sources for its next step from the densities now, and
+    /// advance the pores by the same fluxes (call before [`Lattice::step`]; the sources
+    /// act at the end of that step).
     pub fn update(&mut self, lat: &mut Lattice) -> Result<(), CrackError> {
         let mut rate = vec![0.0; self.nodes.len()];
-        for (c, m) in self.mouths.iter().enumerate() {
+        let mut gain = vec![0.0; self.pores.len()];
+        let density = |e: End, lat: &Lattice| -> Option<f64> {
+            match e {
+                End::Node(i) => {
+                    let (x, y) = self.nodes[i].0;
+                    (!lat.is_solid(x, y)).then(|| lat.moments(x, y).0)
+                }
+                End::Pore(i) => {
+                    let p = &self.pores[i];
+                    (p.volume > 0.0).then(|| p.mass / p.volume)
+                }
+            }
+        };
+        for (c, e) in self.ends.iter().enumerate() {
             self.carried[c] = 0.0;
-            let Some([a, b]) = *m else { continue };
-            let ((ia, ja), (ib, jb)) = (self.nodes[a].0, self.nodes[b].0);
-            if lat.is_solid(ia, ja) || lat.is_solid(ib, jb) {
+            if e[0] == e[1] {
                 continue;
             }
-            let ch = &self.channels[c];
-            let k = ch.aperture.powi(3) * CS2 / (12.0 * self.nu * ch.length);
-            let s = k * (lat.moments(ia, ja).0 - lat.moments(ib, jb).0);
-            rate[a] -= s;
-            rate[b] += s;
+            let (Some(a), Some(b)) = (density(e[0], lat), density(e[1], lat)) else {
+                continue;
+            };
+            let s = self.conductance(c) * (a - b);
+            for (end, sign) in [(e[0], -1.0), (e[1], 1.0)] {
+                match end {
+                    End::Node(i) => rate[i] += sign * s,
+                    End::Pore(i) => gain[i] += sign * s,
+                }
+            }
             self.carried[c] = s;
-            self.total += s;
+            self.cumulative[c] += s;
+        }
+        for (p, g) in self.pores.iter_mut().zip(gain) {
+            p.mass += g;
         }
         for (n, r) in rate.into_iter().enumerate() {
             lat.set_source_rate(self.nodes[n].1, r)?;
