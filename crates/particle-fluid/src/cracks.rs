@@ -52,8 +52,11 @@ pub struct CrackChannel {
 /// Errors of the crack flow.
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum CrackError {
-    /// An aperture or length that is not positive and finite.
-    #[error("crack channel {channel}: {what} = {value} must be positive and finite")]
+    /// An aperture or length that is not positive and finite, or an end that is not
+    /// finite.
+    #[error(
+        "crack channel {channel}: {what} = {value} must be finite (and positive for an aperture or length)"
+    )]
     Value {
         /// The channel.
         channel: usize,
@@ -126,10 +129,15 @@ impl CrackFlow {
         let mut pores: Vec<Pore> = Vec::new();
         let mut ends = Vec::with_capacity(channels.len());
         for (c, ch) in channels.iter().enumerate() {
+            if let Some(&v) = ch.ends.iter().flatten().find(|v| !v.is_finite()) {
+                return Err(CrackError::Value {
+                    channel: c,
+                    what: "end coordinate",
+                    value: v,
+                });
+            }
             for (what, value) in [("aperture", ch.aperture), ("length", ch.length)] {
-                if !(value.is_finite() && value > 0.0)
-                    || !ch.ends.iter().flatten().all(|v| v.is_finite())
-                {
+                if !(value.is_finite() && value > 0.0) {
                     return Err(CrackError::Value {
                         channel: c,
                         what,
