@@ -33,6 +33,7 @@ pub mod boundary;
 pub mod collision;
 pub mod d2q9;
 pub mod geometry;
+pub mod image;
 pub mod kernel;
 pub mod lattice;
 pub mod slab;
@@ -45,7 +46,7 @@ pub use geometry::Shape;
 pub use lattice::{
     Lattice, LatticeConfig, LatticeState, MAX_MACH, Obstacle, ObstacleMass, ObstacleMotion,
 };
-pub use thermal::{Thermal, ThermalSide, ThermalState};
+pub use thermal::{HeatBooks, Thermal, ThermalSide, ThermalState};
 pub use units::Units;
 
 /// Smallest relaxation time accepted: `τ` must exceed `½ + 0.005` (at `τ → ½` the viscosity

@@ -29,6 +29,15 @@
 //! does not cover (fluid, another obstacle or a side): for an obstacle that does not move,
 //! `Σ_{its nodes} T` drops by exactly that. A moving obstacle also takes or leaves the
 //! heat of the nodes it covers or uncovers (the heat stays on the lattice).
+//!
+//! **Held nodes** ([`Thermal::hold`]): solid grains kept at a temperature by a reservoir
+//! (a Dirichlet condition on the solid); after the collision their populations are the
+//! equilibrium at rest at that temperature, and [`Thermal::held_heat`] is what this took
+//! from the reservoir in the step.
+//!
+//! **Heat books** ([`Thermal::keep_books`], [`HeatBooks`]): per step, over the fluid nodes
+//! of the step, the change of the stored heat against conduction and advection through the
+//! sides and the heat the solid nodes gave, exact to round-off.
 
 use rayon::prelude::*;
 
@@ -70,6 +79,51 @@ pub struct Thermal {
     side_heat: [f64; 4],
     /// Heat that left each obstacle's nodes in the last step.
     obstacle_heat: Vec<f64>,
+    /// Nodes held at a temperature (padded index, temperature).
+    held: Vec<(usize, f64)>,
+    /// Heat the held nodes took from their reservoir in the last step.
+    held_heat: f64,
+    /// The books of the last step, when kept ([`Thermal::keep_books`]).
+    books: Option<HeatBooks>,
+}
+
+/// The heat books of one step over the fluid nodes of that step (lattice units:
+/// temperature × nodes; `ρ c_p Δx²` per unit depth turns them into J/m).
+///
+/// `stored_after − stored_before = conduction_in + advection_in − advection_out + solids`
+/// to round-off, where:
+/// * `solids` is the net heat the solid nodes (grains, obstacles) gave the fluid nodes
+///   across their links (what hot grains give);
+/// * through the sides that are not periodic, the net of each link (what enters minus
+///   what leaves) is split into an advective part `u_n T` and the remainder,
+///   `conduction_in` (the diffusive flux, `−χ ∂T/∂n` to first order): on a side of fixed
+///   temperature (an inlet) `T` is that temperature, on an outflow side the node's; `u_n`
+///   is the velocity of the node into the box; the part is `advection_in` or
+///   `advection_out` by its sign. Adiabatic and flux sides carry no advection (a wall lets
+///   no fluid through).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct HeatBooks {
+    /// `Σ T` over the step's fluid nodes before the step.
+    pub stored_before: f64,
+    /// `Σ T` over the same nodes after the step.
+    pub stored_after: f64,
+    /// Diffusive heat in through the sides.
+    pub conduction_in: f64,
+    /// Advected heat in through the sides.
+    pub advection_in: f64,
+    /// Advected heat out through the sides.
+    pub advection_out: f64,
+    /// Heat the solid nodes gave the fluid nodes.
+    pub solids: f64,
+}
+
+impl HeatBooks {
+    /// `stored_after − stored_before − (conduction_in + advection_in − advection_out +
+    /// solids)`: zero to round-off.
+    pub fn defect(&self) -> f64 {
+        (self.stored_after - self.stored_before)
+            - (self.conduction_in + self.advection_in - self.advection_out + self.solids)
+    }
 }
 
 /// What a temperature field carries from one step to the next ([`Thermal::raw_state`]).
@@ -113,6 +167,9 @@ impl Thermal {
             post: vec![[0.0; 5]; np],
             side_heat: [0.0; 4],
             obstacle_heat: vec![0.0; lat.obstacles().len()],
+            held: Vec::new(),
+            held_heat: 0.0,
+            books: None,
         };
         // a window of a bigger lattice ([`Lattice::window`]) starts at column `x0` of the box
         let x0 = lat.origin();
@@ -223,6 +280,39 @@ impl Thermal {
         (n > 0).then(|| s / n as f64)
     }
 
+    /// Set interior node `(i, j)` to temperature `t` (equilibrium at rest).
+    pub fn set_temperature(&mut self, i: usize, j: usize, t: f64) {
+        self.g[(j + 1) * (self.nx + 2) + i + 1] = equilibrium(t, [0.0, 0.0]);
+    }
+
+    /// Hold interior nodes `nodes` at temperature `t` (a Dirichlet condition on solid
+    /// grains kept hot by a reservoir): from now on their post-collision populations are
+    /// the equilibrium at rest at `t`, and the heat this takes from the reservoir is
+    /// [`Thermal::held_heat`].
+    pub fn hold(&mut self, nodes: impl IntoIterator<Item = (usize, usize)>, t: f64) {
+        let w = self.nx + 2;
+        for (i, j) in nodes {
+            self.set_temperature(i, j, t);
+            self.held.push(((j + 1) * w + i + 1, t));
+        }
+    }
+
+    /// Heat the held nodes ([`Thermal::hold`]) took from their reservoir in the last step
+    /// (`Σ (t − T)` over them, `T` their temperature before the step).
+    pub fn held_heat(&self) -> f64 {
+        self.held_heat
+    }
+
+    /// Keep the books of every step from now on ([`HeatBooks`], [`Thermal::books`]).
+    pub fn keep_books(&mut self) {
+        self.books = Some(HeatBooks::default());
+    }
+
+    /// The books of the last step (`None` unless [`Thermal::keep_books`] was called).
+    pub fn books(&self) -> Option<HeatBooks> {
+        self.books
+    }
+
     /// One step with the velocities of `lat` (call before `lat.step()`, so both use the
     /// same time level).
     pub fn step(&mut self, lat: &Lattice) {
@@ -249,8 +339,17 @@ impl Thermal {
                     }
                 }
             });
+        if !self.held.is_empty() {
+            let mut taken = 0.0;
+            for &(n, t) in &self.held {
+                taken += t - self.g[n].iter().sum::<f64>();
+                self.post[n] = equilibrium(t, [0.0, 0.0]);
+            }
+            self.held_heat = taken;
+        }
         self.fill_ghosts();
         self.sum_obstacle_heat(lat);
+        let mut books = self.books.map(|_| self.books_before(lat));
         let post = &self.post;
         self.g.par_chunks_mut(w).enumerate().for_each(|(jp, row)| {
             if jp == 0 || jp > ny {
@@ -264,6 +363,93 @@ impl Thermal {
                 }
             }
         });
+        if let Some(b) = &mut books {
+            b.stored_after = self.fluid_total(lat);
+            self.books = Some(*b);
+        }
+    }
+
+    /// `Σ T` over the fluid nodes of `lat`.
+    fn fluid_total(&self, lat: &Lattice) -> f64 {
+        let mut s = 0.0;
+        for j in 0..self.ny {
+            for i in 0..self.nx {
+                if !lat.is_solid(i, j) {
+                    s += self.temperature(i, j);
+                }
+            }
+        }
+        s
+    }
+
+    /// The books of this step but `stored_after`, from the post-collision populations and
+    /// the filled ghosts: every link between a fluid node and a solid node or a side.
+    fn books_before(&self, lat: &Lattice) -> HeatBooks {
+        let (nx, ny) = (self.nx as isize, self.ny as isize);
+        let w = self.nx + 2;
+        let idx = |i: isize, j: isize| ((j + 1) as usize) * w + (i + 1) as usize;
+        let mut b = HeatBooks {
+            stored_before: self.fluid_total(lat),
+            ..HeatBooks::default()
+        };
+        for j in 0..ny {
+            for i in 0..nx {
+                if lat.is_solid(i as usize, j as usize) {
+                    continue;
+                }
+                let n = idx(i, j);
+                for q in 1..5 {
+                    // the neighbour whose population q arrives here
+                    let (mi, mj) = (i - C5[q][0], j - C5[q][1]);
+                    let inside = (0..nx).contains(&mi) && (0..ny).contains(&mj);
+                    let (wi, wj) = (
+                        if self.periodic[0] {
+                            mi.rem_euclid(nx)
+                        } else {
+                            mi
+                        },
+                        if self.periodic[1] {
+                            mj.rem_euclid(ny)
+                        } else {
+                            mj
+                        },
+                    );
+                    let wrapped = (0..nx).contains(&wi) && (0..ny).contains(&wj);
+                    let net = self.post[idx(mi, mj)][q] - self.post[n][OPP5[q]];
+                    if wrapped {
+                        if lat.is_solid(wi as usize, wj as usize) {
+                            b.solids += net;
+                        }
+                        continue;
+                    }
+                    debug_assert!(!inside);
+                    let side = match (mi < 0, mi >= nx, mj < 0) {
+                        (true, _, _) => Side::XMin,
+                        (_, true, _) => Side::XMax,
+                        (_, _, true) => Side::YMin,
+                        _ => Side::YMax,
+                    };
+                    // heat is advected through a side of fixed temperature (an inlet) or
+                    // an outflow; adiabatic and flux sides only conduct
+                    let t = match self.sides[side.index()] {
+                        ThermalSide::Temperature(t) => Some(t),
+                        ThermalSide::Outflow => Some(self.temperature(i as usize, j as usize)),
+                        ThermalSide::Adiabatic | ThermalSide::Flux(_) => None,
+                    };
+                    let adv = t.map_or(0.0, |t| {
+                        let u = lat.moments(i as usize, j as usize).1;
+                        ((C5[q][0] as f64) * u[0] + (C5[q][1] as f64) * u[1]) * t
+                    });
+                    if adv >= 0.0 {
+                        b.advection_in += adv;
+                    } else {
+                        b.advection_out -= adv;
+                    }
+                    b.conduction_in += net - adv;
+                }
+            }
+        }
+        b
     }
 
     /// What leaves each obstacle's nodes in this step towards nodes it does not cover

@@ -53,12 +53,15 @@
 //! the smallest particle of Mora et al. (2015), read as a radius, is two lattice spacings).
 //! A gap between solids narrower than about `2Δx` holds no fluid node, or one without a
 //! second fluid node behind it (the interpolation then falls back to plain bounce-back), so
-//! fluid does not enter cracks narrower than the spacing.
+//! fluid does not enter cracks narrower than the spacing; [`cracks`] carries the flow of
+//! such cracks by the cubic law between the lattice nodes at their mouths.
 
+pub mod cracks;
 mod injection;
 mod lsm;
 mod solver;
 
+pub use cracks::{CrackChannel, CrackError, CrackFlow};
 pub use injection::{Injection, InjectionControl};
 pub use solver::{ParticleSolver, RigidDiskError, RigidDisks};
 

@@ -45,10 +45,7 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
         ));
     }
     if let Some(t) = &s.thermal {
-        for (name, set) in [
-            ("particle_temperature", t.particle_temperature.is_some()),
-            ("heat_capacity", t.heat_capacity.is_some()),
-        ] {
+        for (name, set) in [("particle_temperature", t.particle_temperature.is_some())] {
             if set {
                 return Err(ls.error(
                     &k(&["thermal", name]),
@@ -107,6 +104,7 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
     }
     check_thermal(ls, &units, seen)?;
     check_schedule(ls, &units)?;
+    super::grains::check_keys(ls, &units)?;
     check_output(ls, &names)
 }
 

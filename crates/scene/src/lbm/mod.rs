@@ -21,6 +21,7 @@
 pub mod check;
 #[cfg(feature = "mpi")]
 mod distributed;
+pub mod grains;
 
 use crate::common::checkpoint::State;
 use crate::common::laws::LawRegistry;
@@ -96,6 +97,10 @@ struct LbmModel<'a> {
     name: String,
     /// Polled between the lattice steps of an output step.
     stop: Stop,
+    /// The heat books of every lattice step so far (`thermal.books`, [`grains::row`]).
+    books: Vec<[f64; 9]>,
+    /// `ρ c_p Δx²`: lattice heat (temperature × nodes) → J per metre of depth.
+    joules: f64,
     /// After every lattice step: what a distributed run exchanges between ranks (none in
     /// a serial run).
     halo: Option<Halo<'a>>,
@@ -174,6 +179,10 @@ fn build<'a>(
         .map_err(|e| ls.error(&ki("obstacle", i, &["shape"]), e))?;
         motions.push((v, w));
     }
+    let grain_nodes = match &own(ls).grains {
+        Some(g) => grains::add(ls, g, &mut lat)?,
+        None => Vec::new(),
+    };
     let thermal = match &s.thermal {
         None => None,
         Some(t) => {
@@ -190,14 +199,29 @@ fn build<'a>(
             let tau = thermal_tau(t.diffusivity, &units);
             let tau_s = thermal_tau(t.solid_diffusivity.unwrap_or(t.diffusivity), &units);
             let (dx, o) = (units.dx, origin);
-            Some(
-                Thermal::new(&lat, tau, tau_s, tsides, |p| {
-                    init.eval(&[o[0] + p[0] * dx, o[1] + p[1] * dx], 0.0)
-                })
-                .map_err(|e| ls.error(&k(&["thermal", "diffusivity"]), e))?,
-            )
+            let mut th = Thermal::new(&lat, tau, tau_s, tsides, |p| {
+                init.eval(&[o[0] + p[0] * dx, o[1] + p[1] * dx], 0.0)
+            })
+            .map_err(|e| ls.error(&k(&["thermal", "diffusivity"]), e))?;
+            if let Some(g) = &own(ls).grains {
+                grains::heat(g, &mut th, &grain_nodes);
+            }
+            if t.books == Some(true) {
+                if window.is_some() {
+                    return Err(ls
+                        .error(
+                            &k(&["thermal", "books"]),
+                            "are kept in serial runs only (run without mpirun)",
+                        )
+                        .into());
+                }
+                th.keep_books();
+            }
+            Some(th)
         }
     };
+    let heat_capacity = s.thermal.as_ref().and_then(|t| t.heat_capacity);
+    let joules = heat_capacity.unwrap_or(4.18e6) * units.dx * units.dx;
     let mut model = LbmModel {
         ls,
         lat,
@@ -214,6 +238,8 @@ fn build<'a>(
         name: s.scene.name.clone(),
         stop: setup.stop_handle(),
         halo: None,
+        books: Vec::new(),
+        joules,
     };
     for p in &s.output.probe {
         model.probes.push(match &p.obstacle {
@@ -635,6 +661,31 @@ impl Model for LbmModel<'_> {
             0.0
         };
         json.insert("mlups".into(), serde_json::json!(mlups));
+        if self.thermal.as_ref().is_some_and(|t| t.books().is_some()) {
+            let sum = |c: usize| self.books.iter().map(|r| r[c]).sum::<f64>();
+            let worst = self.books.iter().map(|r| r[8].abs()).fold(0.0, f64::max);
+            let change = match (self.books.first(), self.books.last()) {
+                (Some(a), Some(b)) => b[2] - a[1],
+                _ => 0.0,
+            };
+            json.insert(
+                "heat_books".into(),
+                serde_json::json!({
+                    "unit": "J/m",
+                    "steps": self.books.len(),
+                    "conduction_in": sum(3),
+                    "advection_in": sum(4),
+                    "advection_out": sum(5),
+                    "solids": sum(6),
+                    "stored_change": change,
+                    "max_relative_defect": worst,
+                    "file": "heat_books.csv",
+                    "note": "over the fluid nodes of each lattice step; stored_change is the \
+                             last step's stored heat after minus the first step's before \
+                             (equal to the sum of the terms while no obstacle moves)",
+                }),
+            );
+        }
         json
     }
 
@@ -659,6 +710,10 @@ impl Model for LbmModel<'_> {
             }
             if let Some(th) = &mut self.thermal {
                 th.step(&self.lat);
+                if let Some(b) = th.books() {
+                    self.books
+                        .push(grains::row(self.lat.steps() + 1, &b, self.joules));
+                }
             }
             self.lat
                 .step()
@@ -709,13 +764,25 @@ impl Model for LbmModel<'_> {
         }
     }
 
-    fn after_step(&mut self, _out: &Path) -> Result<(), RunError> {
+    fn after_step(&mut self, out: &Path) -> Result<(), RunError> {
+        if self.thermal.as_ref().is_some_and(|t| t.books().is_some()) {
+            let mut text = String::from(grains::HEADER);
+            text.push('\n');
+            for r in &self.books {
+                let cells: Vec<String> = r.iter().map(|v| format!("{v:e}")).collect();
+                text.push_str(&cells.join(","));
+                text.push('\n');
+            }
+            write_atomic(&out.join("heat_books.csv"), text.as_bytes())?;
+        }
         Ok(())
     }
 
     fn checkpoints(&self) -> bool {
-        // Obstacles that move change the lattice's geometry, which is not saved.
+        // Obstacles that move change the lattice's geometry, which is not saved; the heat
+        // books of the steps before a checkpoint are not saved either.
         self.motions.iter().all(|(v, w)| v.is_none() && w.is_none())
+            && self.thermal.as_ref().is_none_or(|t| t.books().is_none())
     }
 
     fn save_state(&self, state: &mut State) -> Result<(), RunError> {
@@ -954,7 +1021,7 @@ impl ModelKind for LbmKind {
         "lbm"
     }
     fn sections(&self) -> &'static [&'static str] {
-        &["lbm", "obstacle", "thermal"]
+        &["lbm", "obstacle", "thermal", "grains"]
     }
     fn reads(&self) -> &'static [&'static str] {
         // Refused by `refuse` when they hold a key of the continuum model.
@@ -1014,6 +1081,8 @@ pub struct LbmSections {
     /// `[[obstacle]]`.
     #[serde(default)]
     pub obstacle: Vec<crate::common::lattice::sections::ObstacleSection>,
+    /// `[grains]`: The lattice's solid map from an image of the rock.
+    pub grains: Option<grains::GrainsSection>,
 }
 
 /// The model's own sections of a checked scene.

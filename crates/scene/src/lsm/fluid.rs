@@ -104,6 +104,12 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
         if let Some(c) = t.heat_capacity {
             positive(ls, &k(&["thermal", "heat_capacity"]), c)?;
         }
+        if t.books.is_some() {
+            return Err(ls.error(
+                &k(&["thermal", "books"]),
+                "belongs to model \"lbm\" (the lattice solid model writes heat.csv)",
+            ));
+        }
         if let Some(v) = t.particle_temperature
             && !v.is_finite()
         {

@@ -205,10 +205,16 @@ pub struct ThermalSection {
     /// centres).
     #[schemars(extend("unit" = "°C", "models" = ["lsm"]))]
     pub particle_temperature: Option<f64>,
-    /// Heat capacity per volume ρ c_p of fluid and particles, J/(m³·K), for the heat books
-    /// (model `lsm`; default 4.18e6).
-    #[schemars(extend("unit" = "J/(m³·K)", "models" = ["lsm"]))]
+    /// Heat capacity per volume ρ c_p of fluid and particles (grains), J/(m³·K), for the
+    /// heat books (default 4.18e6).
+    #[schemars(extend("unit" = "J/(m³·K)", "models" = ["lsm", "lbm"]))]
     pub heat_capacity: Option<f64>,
+    /// Keep the heat books of every lattice step: `heat_books.csv` (one row per step:
+    /// the fluid's stored heat before and after, conduction in, advection in and out
+    /// through the sides, what the solid nodes gave, the defect) and summary `heat_books`
+    /// (model `lbm`, serial runs; default false).
+    #[schemars(extend("models" = ["lbm"]))]
+    pub books: Option<bool>,
 }
 
 /// `[[thermal.boundary]]`.
