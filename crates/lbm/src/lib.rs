@@ -35,6 +35,7 @@ pub mod d2q9;
 pub mod geometry;
 pub mod kernel;
 pub mod lattice;
+pub mod populations;
 pub mod slab;
 pub mod thermal;
 pub mod units;
@@ -42,8 +43,10 @@ pub mod units;
 pub use boundary::{MomentumExchange, Side, SideKind};
 pub use collision::{Collision, Rates};
 pub use geometry::Shape;
+pub use populations::Precision;
 pub use lattice::{
     Lattice, LatticeConfig, LatticeState, MAX_MACH, Obstacle, ObstacleMass, ObstacleMotion,
+    ObstacleOverhang,
 };
 pub use thermal::{Thermal, ThermalSide, ThermalState};
 pub use units::Units;
@@ -77,7 +80,8 @@ pub enum LbmError {
         /// Its Mach number.
         mach: f64,
     },
-    /// An obstacle not inside the box.
+    /// An obstacle outside the box (partly, or with [`ObstacleOverhang::Clipped`]
+    /// entirely) along an axis that is not periodic.
     #[error("obstacle {obstacle} is not inside the box")]
     Outside {
         /// Its index.
