@@ -1086,7 +1086,8 @@ impl Lattice {
             });
         for (links, back_k) in self.links.iter().zip(&backs) {
             for (l, &b) in links.iter().zip(back_k) {
-                self.pop.set(g.loc(lay, l.node as usize, OPP[l.alpha as usize]), b);
+                self.pop
+                    .set(g.loc(lay, l.node as usize, OPP[l.alpha as usize]), b);
             }
         }
         self.backs = backs;

@@ -43,11 +43,11 @@ pub mod units;
 pub use boundary::{MomentumExchange, Side, SideKind};
 pub use collision::{Collision, Rates};
 pub use geometry::Shape;
-pub use populations::Precision;
 pub use lattice::{
     Lattice, LatticeConfig, LatticeState, MAX_MACH, Obstacle, ObstacleMass, ObstacleMotion,
     ObstacleOverhang,
 };
+pub use populations::Precision;
 pub use thermal::{Thermal, ThermalSide, ThermalState};
 pub use units::Units;
 

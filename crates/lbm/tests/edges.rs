@@ -127,7 +127,12 @@ fn carried_disk(x0: f64, steps: usize) -> (Vec<[f64; 3]>, Vec<f64>, f64, f64) {
         })
         .unwrap();
     // the fluid streams along with a shear, so the disk is loaded all the way
-    l.init(|p| (1.0, [0.5 * u * (1.0 + (p[1] / ny as f64 * 6.283).sin()), 0.0]));
+    l.init(|p| {
+        (
+            1.0,
+            [0.5 * u * (1.0 + (p[1] / ny as f64 * 6.283).sin()), 0.0],
+        )
+    });
     let (mut forces, mut mass) = (Vec::new(), Vec::new());
     let (mut worst, mut scale) = (0.0f64, 0.0f64);
     let mut p0 = l.momentum();
@@ -209,7 +214,12 @@ fn single_precision_stores_the_double_step_rounded() {
     let mut cfg = LatticeConfig::periodic(24, 16, 0.7);
     cfg.accel = [1e-5, 0.0];
     let mut d = Lattice::new(cfg).unwrap();
-    d.init(|p| (1.0 + 0.01 * (p[0] * 0.3).sin(), [0.03 * (p[1] * 0.4).cos(), 0.01]));
+    d.init(|p| {
+        (
+            1.0 + 0.01 * (p[0] * 0.3).sin(),
+            [0.03 * (p[1] * 0.4).cos(), 0.01],
+        )
+    });
     let mut s = d.clone();
     // f64 storage again changes nothing, bit for bit
     let before: Vec<f64> = (0..9).map(|q| d.population(3, 5, q)).collect();
@@ -303,7 +313,10 @@ fn the_accuracy_cost_of_single_precision() {
             let s = f(ny, Precision::Single);
             eprintln!("{name} ny = {ny}: L2 double {d:.3e}, single {s:.3e}");
             // what f32 storage adds stays far below what a resolution step changes
-            assert!(s < d + 1e-4, "{name} ny = {ny}: single {s:.3e}, double {d:.3e}");
+            assert!(
+                s < d + 1e-4,
+                "{name} ny = {ny}: single {s:.3e}, double {d:.3e}"
+            );
         }
     }
 }
