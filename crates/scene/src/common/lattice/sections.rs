@@ -156,7 +156,9 @@ pub struct LbmBoundary {
 pub struct ObstacleSection {
     /// Name (for obstacle probes).
     pub name: String,
-    /// Shape and position.
+    /// Shape and position (m). It may overhang a side that is not periodic (clipped to the
+    /// lattice: the force is that on the part inside) and lie across a periodic one; it may
+    /// not overlap another obstacle.
     pub shape: ShapeChoice,
     /// Prescribed velocity of the centre (m/s), numbers or expressions in t.
     #[schemars(extend("unit" = "m/s"))]
