@@ -15,6 +15,10 @@
 //! temperature lattice ([`Thermal`]) keeps the books of the heat through the sides and out
 //! of each obstacle. [`slab`] cuts a lattice into slabs of columns for a run on several
 //! MPI ranks (the `mpi` feature) whose numbers are those of the serial run, bit for bit.
+//! Populations are stored in `f64` or, with [`Lattice::set_precision`], in `f32`
+//! ([`Precision`]; the arithmetic stays `f64`). Obstacles may lie across periodic sides,
+//! and with [`ObstacleOverhang::Clipped`] overhang the other sides (clipped to the box);
+//! [`Lattice::contact`] reports an obstacle that overlaps another.
 //!
 //! ```
 //! use porofrac_lbm::{Lattice, LatticeConfig, Obstacle, Shape};

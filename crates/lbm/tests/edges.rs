@@ -130,7 +130,10 @@ fn carried_disk(x0: f64, steps: usize) -> (Vec<[f64; 3]>, Vec<f64>, f64, f64) {
     l.init(|p| {
         (
             1.0,
-            [0.5 * u * (1.0 + (p[1] / ny as f64 * 6.283).sin()), 0.0],
+            [
+                0.5 * u * (1.0 + (p[1] / ny as f64 * std::f64::consts::TAU).sin()),
+                0.0,
+            ],
         )
     });
     let (mut forces, mut mass) = (Vec::new(), Vec::new());

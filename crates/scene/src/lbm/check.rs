@@ -99,7 +99,8 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
         };
         // clipped to the lattice along a side that is not periodic, wrapped along one that is
         for a in 0..2 {
-            if !periodic[a] && !(lo[a] < extent[1][a] && hi[a] > extent[0][a]) {
+            let reaches = lo[a] < extent[1][a] && hi[a] > extent[0][a];
+            if !(periodic[a] || reaches) {
                 return Err(ls.error(
                     &ok("shape"),
                     format!(
