@@ -1,14 +1,15 @@
 //! One fused stream–collide step on a periodic D2Q9 lattice: in-place AA streaming against
-//! the two-array push kernel, from cache-resident to memory-bound sizes; `lattice_step` is
-//! the whole `Lattice::step` (kernel and periodic copies); `memory/copy_256MB` the copy
+//! the two-array push kernel, from cache-resident to memory-bound sizes; `aa_f32` the AA
+//! kernel on `f32` storage; `lattice_step` is the whole `Lattice::step` (kernel and
+//! periodic copies), `lattice_step_single` the same with `f32` populations; `memory/copy_256MB` the copy
 //! bandwidth of the machine for comparison, and `memory/update_256MB` the bandwidth of the
 //! AA kernel's own traffic pattern (each 8-byte value read and written back in place, no
 //! write-allocate), on the rayon pool's threads (`RAYON_NUM_THREADS`).
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use porofrac_lbm::d2q9::{Q, feq};
-use porofrac_lbm::kernel::{Grid, Layout, Physics, aa_step, push_step_periodic};
-use porofrac_lbm::{Collision, Lattice, LatticeConfig};
+use porofrac_lbm::d2q9::{Q, W, feq};
+use porofrac_lbm::kernel::{Grid, Layout, Physics, Storage, aa_step, push_step_periodic};
+use porofrac_lbm::{Collision, Lattice, LatticeConfig, Precision};
 
 fn bench(c: &mut Criterion) {
     let phys = Physics {
@@ -30,6 +31,15 @@ fn bench(c: &mut Criterion) {
         group.bench_with_input(BenchmarkId::new("aa", n), &n, |b, _| {
             b.iter(|| layout = aa_step(&mut pop, g, layout, None, phys))
         });
+        // f32 storage of f − w, collision in f64: half the bytes per node
+        let mut pop32: Vec<f32> = (0..Q * g.np())
+            .map(|i| f32::store(pop[i], W[i / g.np()]))
+            .collect();
+        let mut layout32 = Layout::Natural;
+        group.bench_with_input(BenchmarkId::new("aa_f32", n), &n, |b, _| {
+            b.iter(|| layout32 = aa_step(&mut pop32, g, layout32, None, phys))
+        });
+        drop(pop32);
         let mut src = pop.clone();
         let mut dst = pop.clone();
         group.bench_with_input(BenchmarkId::new("two_array_push", n), &n, |b, _| {
@@ -41,6 +51,10 @@ fn bench(c: &mut Criterion) {
         drop((src, dst));
         let mut lat = Lattice::new(LatticeConfig::periodic(n, n, 0.8)).expect("lattice");
         group.bench_with_input(BenchmarkId::new("lattice_step", n), &n, |b, _| {
+            b.iter(|| lat.step().expect("step"))
+        });
+        lat.set_precision(Precision::Single);
+        group.bench_with_input(BenchmarkId::new("lattice_step_single", n), &n, |b, _| {
             b.iter(|| lat.step().expect("step"))
         });
     }

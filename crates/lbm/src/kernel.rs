@@ -1,6 +1,6 @@
 //! Fused stream–collide kernels over a padded structure-of-arrays population array.
 //!
-//! Memory: one `f64` array of `9 · (nx+2)(ny+2)` values, direction-major (`slot · np +
+//! Memory: one `f64` (or `f32`, [`Storage`]) array of `9 · (nx+2)(ny+2)` values, direction-major (`slot · np +
 //! node`), with one ghost layer around the `nx × ny` interior nodes.
 //!
 //! **AA pattern** (Bailey et al. 2009), in place in that one array. An *even* step reads
@@ -23,7 +23,42 @@
 use rayon::prelude::*;
 
 use crate::collision::{Rates, collide_with};
-use crate::d2q9::{C, OPP};
+use crate::d2q9::{C, OPP, W};
+
+/// The floating-point type populations are stored in; collision always runs in `f64`.
+///
+/// `f64` stores `f_i` itself. `f32` stores the deviation `f_i − w_i` from the fluid at rest
+/// with unit density (zero-centred storage, as lbmpy does): the populations of a slow flow
+/// all sit near `w_i`, and storing what they differ by keeps the digits that carry the
+/// velocity (a stored `f32` loses about `6·10⁻⁸` of the value it holds).
+pub trait Storage: Copy + Send + Sync + Default + std::fmt::Debug + 'static {
+    /// `f_i` from the stored value of a slot of weight `w`.
+    fn load(self, w: f64) -> f64;
+    /// The stored value of `f_i` in a slot of weight `w`.
+    fn store(f: f64, w: f64) -> Self;
+}
+
+impl Storage for f64 {
+    #[inline(always)]
+    fn load(self, _w: f64) -> f64 {
+        self
+    }
+    #[inline(always)]
+    fn store(f: f64, _w: f64) -> Self {
+        f
+    }
+}
+
+impl Storage for f32 {
+    #[inline(always)]
+    fn load(self, w: f64) -> f64 {
+        self as f64 + w
+    }
+    #[inline(always)]
+    fn store(f: f64, w: f64) -> Self {
+        (f - w) as f32
+    }
+}
 
 /// Where the populations of the interior nodes live after a step (see the module docs).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -92,13 +127,14 @@ fn band_rows(ny: usize) -> usize {
 
 /// Split the nine direction slices of `pop` into row bands; direction `j` of band `b`
 /// starts at padded row `1 + row0 + shift(j)`.
-fn bands<'a>(
-    pop: &'a mut [f64],
+#[allow(clippy::type_complexity)]
+fn bands<'a, T>(
+    pop: &'a mut [T],
     g: Grid,
     shift: impl Fn(usize) -> usize,
-) -> Vec<(usize, usize, [&'a mut [f64]; 9])> {
+) -> Vec<(usize, usize, [&'a mut [T]; 9])> {
     let (w, np) = (g.stride(), g.np());
-    let mut rest: Vec<&'a mut [f64]> = pop
+    let mut rest: Vec<&'a mut [T]> = pop
         .chunks_mut(np)
         .enumerate()
         .map(|(j, s)| &mut s[shift(j) * w..])
@@ -108,7 +144,7 @@ fn bands<'a>(
     let mut row0 = 0;
     while row0 < g.ny {
         let n = rows.min(g.ny - row0);
-        let slices: [&'a mut [f64]; 9] = std::array::from_fn(|j| {
+        let slices: [&'a mut [T]; 9] = std::array::from_fn(|j| {
             let s = std::mem::take(&mut rest[j]);
             let (head, tail) = s.split_at_mut(n * w);
             rest[j] = tail;
@@ -122,9 +158,10 @@ fn bands<'a>(
 
 /// One fused AA step over all interior nodes; `layout` is the layout before the step
 /// (Natural: even step, Swapped: odd step). `mask` (1 fluid, 0 solid, padded) may be
-/// omitted when every node is fluid. Returns the layout after the step.
-pub fn aa_step(
-    pop: &mut [f64],
+/// omitted when every node is fluid. Returns the layout after the step. `pop` holds `f64`
+/// or `f32` values ([`Storage`]); the collision runs in `f64` either way.
+pub fn aa_step<T: Storage>(
+    pop: &mut [T],
     g: Grid,
     layout: Layout,
     mask: Option<&[u8]>,
@@ -132,14 +169,14 @@ pub fn aa_step(
 ) -> Layout {
     let force = phys.accel != [0.0, 0.0];
     match (layout, mask, force) {
-        (Layout::Natural, None, false) => aa::<false, false, false>(pop, g, &[], phys),
-        (Layout::Natural, Some(m), false) => aa::<false, true, false>(pop, g, m, phys),
-        (Layout::Swapped, None, false) => aa::<true, false, false>(pop, g, &[], phys),
-        (Layout::Swapped, Some(m), false) => aa::<true, true, false>(pop, g, m, phys),
-        (Layout::Natural, None, true) => aa::<false, false, true>(pop, g, &[], phys),
-        (Layout::Natural, Some(m), true) => aa::<false, true, true>(pop, g, m, phys),
-        (Layout::Swapped, None, true) => aa::<true, false, true>(pop, g, &[], phys),
-        (Layout::Swapped, Some(m), true) => aa::<true, true, true>(pop, g, m, phys),
+        (Layout::Natural, None, false) => aa::<T, false, false, false>(pop, g, &[], phys),
+        (Layout::Natural, Some(m), false) => aa::<T, false, true, false>(pop, g, m, phys),
+        (Layout::Swapped, None, false) => aa::<T, true, false, false>(pop, g, &[], phys),
+        (Layout::Swapped, Some(m), false) => aa::<T, true, true, false>(pop, g, m, phys),
+        (Layout::Natural, None, true) => aa::<T, false, false, true>(pop, g, &[], phys),
+        (Layout::Natural, Some(m), true) => aa::<T, false, true, true>(pop, g, m, phys),
+        (Layout::Swapped, None, true) => aa::<T, true, false, true>(pop, g, &[], phys),
+        (Layout::Swapped, Some(m), true) => aa::<T, true, true, true>(pop, g, m, phys),
     }
     match layout {
         Layout::Natural => Layout::Swapped,
@@ -147,8 +184,8 @@ pub fn aa_step(
     }
 }
 
-fn aa<const ODD: bool, const MASK: bool, const FORCE: bool>(
-    pop: &mut [f64],
+fn aa<T: Storage, const ODD: bool, const MASK: bool, const FORCE: bool>(
+    pop: &mut [T],
     g: Grid,
     mask: &[u8],
     phys: Physics,
@@ -158,7 +195,7 @@ fn aa<const ODD: bool, const MASK: bool, const FORCE: bool>(
     let bands = bands(pop, g, |j| if ODD { (1 + C[j][1]) as usize } else { 1 });
     let arch = pulp::Arch::new();
     bands.into_par_iter().for_each(|(row0, n, s)| {
-        arch.dispatch(AaBand::<ODD, MASK, FORCE> {
+        arch.dispatch(AaBand::<T, ODD, MASK, FORCE> {
             s,
             row0,
             n,
@@ -173,8 +210,8 @@ fn aa<const ODD: bool, const MASK: bool, const FORCE: bool>(
 /// One band of an AA step, compiled for the widest vector instructions of the processor
 /// (`pulp` picks AVX2 or plain code at run time; the arithmetic is the same, so are the
 /// results).
-struct AaBand<'a, const ODD: bool, const MASK: bool, const FORCE: bool> {
-    s: [&'a mut [f64]; 9],
+struct AaBand<'a, T, const ODD: bool, const MASK: bool, const FORCE: bool> {
+    s: [&'a mut [T]; 9],
     row0: usize,
     n: usize,
     w: usize,
@@ -183,8 +220,8 @@ struct AaBand<'a, const ODD: bool, const MASK: bool, const FORCE: bool> {
     phys: Physics,
 }
 
-impl<const ODD: bool, const MASK: bool, const FORCE: bool> pulp::WithSimd
-    for AaBand<'_, ODD, MASK, FORCE>
+impl<T: Storage, const ODD: bool, const MASK: bool, const FORCE: bool> pulp::WithSimd
+    for AaBand<'_, T, ODD, MASK, FORCE>
 {
     type Output = ();
     #[inline(always)]
@@ -206,7 +243,7 @@ impl<const ODD: bool, const MASK: bool, const FORCE: bool> pulp::WithSimd
             };
             let col = |j: usize| r * w + if ODD { (1 + C[j][0]) as usize } else { 1 };
             let [s0, s1, s2, s3, s4, s5, s6, s7, s8] = &mut s;
-            aa_row::<ODD, MASK, FORCE>(
+            aa_row::<T, ODD, MASK, FORCE>(
                 [
                     &mut s0[col(0)..][..nx],
                     &mut s1[col(1)..][..nx],
@@ -227,8 +264,8 @@ impl<const ODD: bool, const MASK: bool, const FORCE: bool> pulp::WithSimd
 
 /// Collide one row: slot `j` of node `x` is `r[j][x]` (see the module docs).
 #[inline(always)]
-fn aa_row<const ODD: bool, const MASK: bool, const FORCE: bool>(
-    r: [&mut [f64]; 9],
+fn aa_row<T: Storage, const ODD: bool, const MASK: bool, const FORCE: bool>(
+    r: [&mut [T]; 9],
     m: &[u8],
     phys: Physics,
 ) {
@@ -239,34 +276,53 @@ fn aa_row<const ODD: bool, const MASK: bool, const FORCE: bool>(
     let m = if MASK { &m[..nx] } else { m };
     for x in 0..nx {
         let on = if MASK { m[x] as f64 } else { 1.0 };
+        // slot j holds direction j or its opposite: the same weight W[j] either way
+        let ld = |v: T, j: usize| v.load(W[j]);
+        let st = |v: f64, j: usize| T::store(v, W[j]);
         if ODD {
             let f = [
-                r0[x], r3[x], r4[x], r1[x], r2[x], r7[x], r8[x], r5[x], r6[x],
+                ld(r0[x], 0),
+                ld(r3[x], 3),
+                ld(r4[x], 4),
+                ld(r1[x], 1),
+                ld(r2[x], 2),
+                ld(r7[x], 7),
+                ld(r8[x], 8),
+                ld(r5[x], 5),
+                ld(r6[x], 6),
             ];
             let o = collide_with::<FORCE>(f, phys.rates, phys.accel, on);
-            r0[x] = o[0];
-            r1[x] = o[1];
-            r2[x] = o[2];
-            r3[x] = o[3];
-            r4[x] = o[4];
-            r5[x] = o[5];
-            r6[x] = o[6];
-            r7[x] = o[7];
-            r8[x] = o[8];
+            r0[x] = st(o[0], 0);
+            r1[x] = st(o[1], 1);
+            r2[x] = st(o[2], 2);
+            r3[x] = st(o[3], 3);
+            r4[x] = st(o[4], 4);
+            r5[x] = st(o[5], 5);
+            r6[x] = st(o[6], 6);
+            r7[x] = st(o[7], 7);
+            r8[x] = st(o[8], 8);
         } else {
             let f = [
-                r0[x], r1[x], r2[x], r3[x], r4[x], r5[x], r6[x], r7[x], r8[x],
+                ld(r0[x], 0),
+                ld(r1[x], 1),
+                ld(r2[x], 2),
+                ld(r3[x], 3),
+                ld(r4[x], 4),
+                ld(r5[x], 5),
+                ld(r6[x], 6),
+                ld(r7[x], 7),
+                ld(r8[x], 8),
             ];
             let o = collide_with::<FORCE>(f, phys.rates, phys.accel, on);
-            r0[x] = o[0];
-            r1[x] = o[3];
-            r2[x] = o[4];
-            r3[x] = o[1];
-            r4[x] = o[2];
-            r5[x] = o[7];
-            r6[x] = o[8];
-            r7[x] = o[5];
-            r8[x] = o[6];
+            r0[x] = st(o[0], 0);
+            r1[x] = st(o[3], 1);
+            r2[x] = st(o[4], 2);
+            r3[x] = st(o[1], 3);
+            r4[x] = st(o[2], 4);
+            r5[x] = st(o[7], 5);
+            r6[x] = st(o[8], 6);
+            r7[x] = st(o[5], 7);
+            r8[x] = st(o[6], 8);
         }
     }
 }

@@ -36,6 +36,17 @@
 //! **Periodic sides**: an obstacle may cross a periodic side; its nodes are taken modulo the
 //! period and its geometry is computed with the image nearest its centre, which is kept in
 //! the first period.
+//!
+//! **Sides that are not periodic**: with [`ObstacleOverhang::Clipped`] (set by
+//! [`Lattice::set_obstacle_overhang`]) an obstacle may overhang them. It is clipped to the
+//! box: the nodes inside that it covers are solid, its cut links are those of the fluid
+//! nodes inside, and its force and torque are what the fluid exerts on the part inside
+//! (a link that leaves the box belongs to the side's rule, not to the obstacle).
+//!
+//! **Overlapping obstacles**: a node two obstacles cover belongs to the one that took it
+//! first (in a coupled rock, touching particles), and every cut link into it to that one.
+//! [`Lattice::contact`] says which obstacle each one found in its way at its last
+//! rasterisation, so that a caller whose bodies must not overlap can refuse it.
 
 use crate::LbmError;
 use crate::boundary::{
@@ -44,7 +55,8 @@ use crate::boundary::{
 use crate::collision::{Collision, Rates};
 use crate::d2q9::{C, OPP, Q, W, cf, feq};
 use crate::geometry::Shape;
-use crate::kernel::{Grid, Layout, Physics, aa_step};
+use crate::kernel::{Grid, Layout, Physics};
+use crate::populations::{Populations, Precision};
 
 /// Largest Mach number `|u|/c_s` accepted for prescribed velocities and reached in a run.
 pub const MAX_MACH: f64 = 0.3;
@@ -134,6 +146,18 @@ impl Obstacle {
     }
 }
 
+/// Whether an obstacle may reach beyond a side that is not periodic.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ObstacleOverhang {
+    /// It must lie inside the box: one that does not is an error, [`LbmError::Outside`]
+    /// (default; a coupled particle that leaves the lattice is a failed run).
+    #[default]
+    Refused,
+    /// It is clipped to the box (a wall block that overhangs a side); only one that lies
+    /// entirely outside is an error.
+    Clipped,
+}
+
 /// Who moves the obstacles.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum ObstacleMotion {
@@ -192,7 +216,7 @@ pub struct Lattice {
     cfg: LatticeConfig,
     grid: Grid,
     rates: Rates,
-    pop: Vec<f64>,
+    pop: Populations,
     layout: Layout,
     /// 1 fluid, 0 solid (padded).
     mask: Vec<u8>,
@@ -208,6 +232,10 @@ pub struct Lattice {
     forces: Vec<[f64; 3]>,
     exchange: Vec<[f64; 3]>,
     motion: ObstacleMotion,
+    overhang: ObstacleOverhang,
+    /// Per obstacle: another obstacle that held a node of its raster at its last
+    /// rasterisation.
+    contact: Vec<Option<usize>>,
     scratch: Scratch,
     sources: Vec<Source>,
     injected: f64,
@@ -271,7 +299,7 @@ impl Lattice {
         let mut l = Lattice {
             grid,
             rates,
-            pop: vec![0.0; Q * np],
+            pop: Populations::new(Precision::Double, np),
             layout: Layout::Natural,
             mask: vec![1; np],
             owner: vec![NONE; np],
@@ -282,6 +310,8 @@ impl Lattice {
             forces: Vec::new(),
             exchange: Vec::new(),
             motion: ObstacleMotion::Integrated,
+            overhang: ObstacleOverhang::Refused,
+            contact: Vec::new(),
             scratch: Scratch {
                 fresh: vec![false; np],
                 ..Scratch::default()
@@ -350,7 +380,7 @@ impl Lattice {
 
     /// The populations as stored, and the padded nodes per direction (the slab exchange).
     #[cfg(feature = "mpi")]
-    pub(crate) fn stored_mut(&mut self) -> (&mut [f64], usize) {
+    pub(crate) fn stored_mut(&mut self) -> (&mut Populations, usize) {
         let np = self.grid.np();
         (&mut self.pop, np)
     }
@@ -375,7 +405,7 @@ impl Lattice {
     /// ([`LatticeState`]), for a checkpoint.
     pub fn raw_state(&self) -> LatticeState {
         LatticeState {
-            populations: self.pop.clone(),
+            populations: self.pop.to_f64(),
             swapped: self.layout == Layout::Swapped,
             steps: self.steps,
             injected: self.injected,
@@ -402,7 +432,9 @@ impl Lattice {
                 self.forces.len()
             ));
         }
-        self.pop = s.populations;
+        for (i, f) in s.populations.into_iter().enumerate() {
+            self.pop.set(i, f);
+        }
         self.layout = if s.swapped {
             Layout::Swapped
         } else {
@@ -415,9 +447,20 @@ impl Lattice {
         Ok(())
     }
 
+    /// Store the populations as `precision` from now on (default [`Precision::Double`]);
+    /// the values held are kept (rounded to `f32` for [`Precision::Single`]).
+    pub fn set_precision(&mut self, precision: Precision) {
+        self.pop = self.pop.converted(precision, self.grid.np());
+    }
+
+    /// The floating-point type of the populations.
+    pub fn precision(&self) -> Precision {
+        self.pop.precision()
+    }
+
     /// Bytes of population storage.
     pub fn population_bytes(&self) -> usize {
-        self.pop.len() * std::mem::size_of::<f64>()
+        self.pop.bytes()
     }
 
     /// Set every interior fluid node to the equilibrium of `(ρ, u) = f(node position)`.
@@ -439,7 +482,7 @@ impl Lattice {
                     u[1] - 0.5 * self.cfg.accel[1],
                 ];
                 for q in 0..Q {
-                    self.pop[g.loc(self.layout, node, q)] = feq(q, rho, u);
+                    self.pop.set(g.loc(self.layout, node, q), feq(q, rho, u));
                 }
             }
         }
@@ -455,14 +498,17 @@ impl Lattice {
         }
     }
 
-    /// Add an obstacle; it must lie inside the box along axes that are not periodic.
-    /// Returns its index.
+    /// Add an obstacle; along an axis that is not periodic it must lie inside the box, or
+    /// with [`ObstacleOverhang::Clipped`] reach into it, what lies beyond a side being
+    /// clipped away (the nodes inside are solid, and its force is what the fluid exerts on
+    /// that part). Returns its index.
     pub fn add_obstacle(&mut self, ob: Obstacle) -> Result<usize, LbmError> {
         let k = self.obstacles.len();
         let mut ob = ob;
         self.check_inside(k, &mut ob.shape)?;
         self.obstacles.push(ob);
         self.solid_nodes.push(Vec::new());
+        self.contact.push(None);
         self.links.push(Vec::new());
         self.forces.push([0.0; 3]);
         self.exchange.push([0.0; 3]);
@@ -493,6 +539,12 @@ impl Lattice {
         }
         self.geometry_tolerance = tolerance;
         Ok(())
+    }
+
+    /// Whether obstacles may overhang the sides that are not periodic (default
+    /// [`ObstacleOverhang::Refused`]); set it before adding them.
+    pub fn set_obstacle_overhang(&mut self, overhang: ObstacleOverhang) {
+        self.overhang = overhang;
     }
 
     /// Who moves the obstacles (default [`ObstacleMotion::Integrated`]).
@@ -539,7 +591,8 @@ impl Lattice {
 
     /// Re-rasterise the obstacles placed since the last update: cover and uncover nodes
     /// (refill, momentum bookkeeping in [`Lattice::node_exchange`]) and rebuild what
-    /// changed. Errors if an obstacle left the box along an axis that is not periodic.
+    /// changed. Errors if an obstacle left the box (entirely, with
+    /// [`ObstacleOverhang::Clipped`]) along an axis that is not periodic.
     pub fn update_obstacles(&mut self) -> Result<(), LbmError> {
         for e in &mut self.exchange {
             *e = [0.0; 3];
@@ -575,6 +628,14 @@ impl Lattice {
     /// and uncovering nodes at its last update (lattice units; zero if it did not move).
     pub fn node_exchange(&self, k: usize) -> [f64; 3] {
         self.exchange[k]
+    }
+
+    /// An obstacle that already covered a node of obstacle `k`'s shape when `k` was last
+    /// rasterised (the node stayed with it), or `None` if `k` overlaps no other obstacle
+    /// by a node. An obstacle added on top of an earlier one reports it at once; one that
+    /// moves into another, at the update that makes them share a node.
+    pub fn contact(&self, k: usize) -> Option<usize> {
+        self.contact[k]
     }
 
     /// Whether an interior node is solid.
@@ -615,7 +676,7 @@ impl Lattice {
         let g = self.grid;
         let (mut rho, mut jx, mut jy) = (0.0, 0.0, 0.0);
         for q in 0..Q {
-            let f = self.pop[g.loc(self.layout, node, q)];
+            let f = self.pop.get(g.loc(self.layout, node, q));
             rho += f;
             jx += C[q][0] as f64 * f;
             jy += C[q][1] as f64 * f;
@@ -642,9 +703,10 @@ impl Lattice {
 
     /// Population `f_q` arriving at interior node `(i, j)`.
     pub fn population(&self, i: usize, j: usize, q: usize) -> f64 {
-        self.pop[self
-            .grid
-            .loc(self.layout, self.grid.node(i as isize, j as isize), q)]
+        self.pop.get(
+            self.grid
+                .loc(self.layout, self.grid.node(i as isize, j as isize), q),
+        )
     }
 
     /// Largest speed over fluid nodes, or an error if a density is not positive and finite.
@@ -758,7 +820,7 @@ impl Lattice {
         } else {
             Some(&self.mask[..])
         };
-        self.layout = aa_step(&mut self.pop, self.grid, self.layout, mask, phys);
+        self.layout = self.pop.aa_step(self.grid, self.layout, mask, phys);
         self.apply_copies();
         self.apply_sides();
         self.apply_obstacles();
@@ -782,8 +844,9 @@ impl Lattice {
         Ok(())
     }
 
-    /// Along a non-periodic axis the shape must lie inside the box; along a periodic one its
-    /// centre is brought into the first period.
+    /// Along a non-periodic axis the shape must lie inside the box, or with
+    /// [`ObstacleOverhang::Clipped`] reach into it (the part beyond a side is clipped
+    /// away); along a periodic one its centre is brought into the first period.
     fn check_inside(&self, k: usize, s: &mut Shape) -> Result<(), LbmError> {
         let n = [self.box_nx as f64, self.grid.ny as f64];
         let c = s.center();
@@ -801,8 +864,13 @@ impl Lattice {
         }
         let [lo, hi] = s.bounds();
         for a in 0..2 {
-            let inside = lo[a] >= 0.0 && hi[a] <= n[a];
-            if !self.cfg.periodic[a] && !inside {
+            let ok = match self.overhang {
+                ObstacleOverhang::Refused => lo[a] >= 0.0 && hi[a] <= n[a],
+                ObstacleOverhang::Clipped => {
+                    lo[a] < n[a] && hi[a] > 0.0 && lo[a].is_finite() && hi[a].is_finite()
+                }
+            };
+            if !self.cfg.periodic[a] && !ok {
                 return Err(LbmError::Outside { obstacle: k });
             }
         }
@@ -900,7 +968,8 @@ impl Lattice {
         let (g, lay) = (self.grid, self.layout);
         for c in &self.copies {
             let q = c.dir as usize;
-            self.pop[g.loc(lay, c.dst as usize, q)] = self.pop[g.loc(lay, c.src as usize, q)];
+            let f = self.pop.get(g.loc(lay, c.src as usize, q));
+            self.pop.set(g.loc(lay, c.dst as usize, q), f);
         }
     }
 
@@ -911,15 +980,15 @@ impl Lattice {
             let a = OPP[i];
             let xb = g.shift(l.node as usize, a);
             let cu = C[i][0] as f64 * l.u[0] + C[i][1] as f64 * l.u[1];
-            self.pop[g.loc(lay, l.node as usize, i)] =
-                self.pop[g.loc(lay, xb, a)] + 6.0 * W[i] * cu;
+            let f = self.pop.get(g.loc(lay, xb, a)) + 6.0 * W[i] * cu;
+            self.pop.set(g.loc(lay, l.node as usize, i), f);
         }
         let acc = self.cfg.accel;
         for l in &self.pressure_links {
             let x = l.node as usize;
             let (mut rho, mut jx, mut jy) = (0.0, 0.0, 0.0);
             for q in 0..Q {
-                let f = self.pop[g.loc(lay, g.shift(x, q), q)];
+                let f = self.pop.get(g.loc(lay, g.shift(x, q), q));
                 rho += f;
                 jx += C[q][0] as f64 * f;
                 jy += C[q][1] as f64 * f;
@@ -931,8 +1000,9 @@ impl Lattice {
             let cu = c[0] * u[0] + c[1] * u[1];
             let usq = u[0] * u[0] + u[1] * u[1];
             let xb = g.shift(x, a);
-            self.pop[g.loc(lay, x, i)] = -self.pop[g.loc(lay, xb, a)]
+            let f = -self.pop.get(g.loc(lay, xb, a))
                 + 2.0 * W[i] * l.density * (1.0 + 4.5 * cu * cu - 1.5 * usq);
+            self.pop.set(g.loc(lay, x, i), f);
         }
     }
 
@@ -967,14 +1037,14 @@ impl Lattice {
                     let uw = ob.velocity_at(l.xw);
                     let ca = cf(a);
                     let wall = 6.0 * W[a] * (ca[0] * uw[0] + ca[1] * uw[1]);
-                    let into = pop[g.loc(lay, g.shift(xf, a), a)];
+                    let into = pop.get(g.loc(lay, g.shift(xf, a), a));
                     let back = if l.f2 == NONE {
                         into - wall
                     } else {
                         let d = l.delta;
-                        ((1.0 - d) * pop[g.loc(lay, xf, a)]
+                        ((1.0 - d) * pop.get(g.loc(lay, xf, a))
                             + d * into
-                            + d * pop[g.loc(lay, l.f2 as usize, i)]
+                            + d * pop.get(g.loc(lay, l.f2 as usize, i))
                             - wall)
                             / (1.0 + d)
                     };
@@ -995,7 +1065,7 @@ impl Lattice {
                     let xf = l.node as usize;
                     let uw = ob.velocity_at(l.xw);
                     let ca = cf(a);
-                    let into = pop[g.loc(lay, g.shift(xf, a), a)];
+                    let into = pop.get(g.loc(lay, g.shift(xf, a), a));
                     // the reference density's share, 2 w_α ρ₀ c_α: only gauge pressure
                     // loads the body (zero for a body wetted all round)
                     let amb = 2.0 * W[a];
@@ -1016,7 +1086,8 @@ impl Lattice {
             });
         for (links, back_k) in self.links.iter().zip(&backs) {
             for (l, &b) in links.iter().zip(back_k) {
-                self.pop[g.loc(lay, l.node as usize, OPP[l.alpha as usize])] = b;
+                self.pop
+                    .set(g.loc(lay, l.node as usize, OPP[l.alpha as usize]), b);
             }
         }
         self.backs = backs;
@@ -1034,7 +1105,8 @@ impl Lattice {
                     continue;
                 }
                 for q in 0..Q {
-                    self.pop[g.loc(lay, n, q)] += W[q] * s.rate;
+                    let i = g.loc(lay, n, q);
+                    self.pop.set(i, self.pop.get(i) + W[q] * s.rate);
                 }
                 self.injected += s.rate;
             }
@@ -1163,10 +1235,15 @@ impl Lattice {
         self.raster(k);
         let kk = k as u32;
         let mut new = std::mem::take(&mut self.scratch.nodes);
+        let mut met = None;
         new.retain(|&n| {
             let o = self.owner[n as usize];
+            if o != NONE && o != kk && met.is_none() {
+                met = Some(o as usize);
+            }
             o == NONE || o == kk
         });
+        self.contact[k] = met;
         let old = std::mem::take(&mut self.solid_nodes[k]);
         if new != old {
             let (mut a, mut b) = (0, 0);
@@ -1244,7 +1321,7 @@ impl Lattice {
             let a = self.cfg.accel;
             let ue = [u[0] - 0.5 * a[0], u[1] - 0.5 * a[1]];
             for q in 0..Q {
-                self.pop[g.loc(self.layout, n, q)] = feq(q, rho, ue);
+                self.pop.set(g.loc(self.layout, n, q), feq(q, rho, ue));
             }
             let c = self.obstacles[k].shape.center();
             let m = [rho * u[0], rho * u[1]];

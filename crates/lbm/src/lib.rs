@@ -15,6 +15,10 @@
 //! temperature lattice ([`Thermal`]) keeps the books of the heat through the sides and out
 //! of each obstacle. [`slab`] cuts a lattice into slabs of columns for a run on several
 //! MPI ranks (the `mpi` feature) whose numbers are those of the serial run, bit for bit.
+//! Populations are stored in `f64` or, with [`Lattice::set_precision`], in `f32`
+//! ([`Precision`]; the arithmetic stays `f64`). Obstacles may lie across periodic sides,
+//! and with [`ObstacleOverhang::Clipped`] overhang the other sides (clipped to the box);
+//! [`Lattice::contact`] reports an obstacle that overlaps another.
 //!
 //! ```
 //! use porofrac_lbm::{Lattice, LatticeConfig, Obstacle, Shape};
@@ -36,6 +40,7 @@ pub mod geometry;
 pub mod image;
 pub mod kernel;
 pub mod lattice;
+pub mod populations;
 pub mod slab;
 pub mod thermal;
 pub mod units;
@@ -45,7 +50,9 @@ pub use collision::{Collision, Rates};
 pub use geometry::Shape;
 pub use lattice::{
     Lattice, LatticeConfig, LatticeState, MAX_MACH, Obstacle, ObstacleMass, ObstacleMotion,
+    ObstacleOverhang,
 };
+pub use populations::Precision;
 pub use thermal::{HeatBooks, Thermal, ThermalSide, ThermalState};
 pub use units::Units;
 
@@ -78,7 +85,8 @@ pub enum LbmError {
         /// Its Mach number.
         mach: f64,
     },
-    /// An obstacle not inside the box.
+    /// An obstacle outside the box (partly, or with [`ObstacleOverhang::Clipped`]
+    /// entirely) along an axis that is not periodic.
     #[error("obstacle {obstacle} is not inside the box")]
     Outside {
         /// Its index.

@@ -203,12 +203,12 @@ mod exchange {
             let (pop, np) = lat.stored_mut();
             let rows = ny + 2;
             let stride = nx + 2;
-            let pack = |c: [usize; 2], pop: &[f64]| {
+            let pack = |c: [usize; 2], pop: &crate::populations::Populations| {
                 let mut buf = Vec::with_capacity((c[1] - c[0]) * Q * rows);
                 for col in c[0]..c[1] {
                     let ip = col - w0 + 1;
                     for q in 0..Q {
-                        buf.extend((0..rows).map(|jp| pop[q * np + jp * stride + ip]));
+                        buf.extend((0..rows).map(|jp| pop.get(q * np + jp * stride + ip)));
                     }
                 }
                 buf
@@ -226,7 +226,7 @@ mod exchange {
                     let ip = col - w0 + 1;
                     for q in 0..Q {
                         for jp in 0..rows {
-                            pop[q * np + jp * stride + ip] = *v.next().expect("sized above");
+                            pop.set(q * np + jp * stride + ip, *v.next().expect("sized above"));
                         }
                     }
                 }

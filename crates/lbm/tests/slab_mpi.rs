@@ -11,6 +11,9 @@
 //!   obstacle equal the serial run's bits.
 //! * **Heated**: the same channel with a temperature lattice (hot inlet, outflow,
 //!   adiabatic walls, a conducting obstacle): the temperature of every node too.
+//! * **Single**: the channel with `f32` populations and a wall block overhanging the top
+//!   side across the border of 2 ranks (clipped to the lattice): the same bits again (the
+//!   halo carries the `f32` values widened to `f64`, which is exact).
 //!
 //! The test starts `mpirun -n P --oversubscribe` on its own executable, which then runs
 //! the distributed part (the environment variable below says so); rank 0 computes the
@@ -20,7 +23,8 @@
 
 use porofrac_lbm::slab::{Exchange, Plan};
 use porofrac_lbm::{
-    Collision, Lattice, LatticeConfig, Obstacle, Shape, Side, SideKind, Thermal, ThermalSide,
+    Collision, Lattice, LatticeConfig, Obstacle, ObstacleOverhang, Precision, Shape, Side,
+    SideKind, Thermal, ThermalSide,
 };
 
 const CHILD: &str = "POROFRAC_LBM_SLAB_TEST_CHILD";
@@ -55,13 +59,27 @@ fn shapes() -> Vec<Shape> {
     ]
 }
 
-/// The channel: the whole lattice (`window` `None`) or the columns `x0 .. x0 + width`.
-fn channel(window: Option<[usize; 2]>, heated: bool) -> (Lattice, Option<Thermal>) {
+/// The obstacles of a run: [`shapes`], and with `single` a wall block overhanging the top.
+fn shapes_of(single: bool) -> Vec<Shape> {
+    let mut s = shapes();
+    if single {
+        s.push(Shape::aligned_box([50.3, 30.2], [80.0, 40.0]));
+    }
+    s
+}
+
+/// The channel: the whole lattice (`window` `None`) or the columns `x0 .. x0 + width`;
+/// with `single`, `f32` populations and the overhanging block.
+fn channel(window: Option<[usize; 2]>, heated: bool, single: bool) -> (Lattice, Option<Thermal>) {
     let mut lat = match window {
         None => Lattice::new(config()).unwrap(),
         Some([x0, x1]) => Lattice::window(config(), x0, x1 - x0).unwrap(),
     };
-    for shape in shapes() {
+    if single {
+        lat.set_precision(Precision::Single);
+        lat.set_obstacle_overhang(ObstacleOverhang::Clipped);
+    }
+    for shape in shapes_of(single) {
         lat.add_obstacle(Obstacle {
             shape,
             velocity: [0.0, 0.0],
@@ -120,8 +138,8 @@ fn step(lat: &mut Lattice, th: Option<&mut Thermal>, ex: Option<&Exchange>) {
     }
 }
 
-fn serial(heated: bool, checks: &[usize]) -> Vec<(Vec<f64>, Vec<[f64; 3]>)> {
-    let (mut lat, mut th) = channel(None, heated);
+fn serial(heated: bool, single: bool, checks: &[usize]) -> Vec<(Vec<f64>, Vec<[f64; 3]>)> {
+    let (mut lat, mut th) = channel(None, heated, single);
     let mut out = Vec::new();
     for n in 1..=*checks.last().unwrap() {
         step(&mut lat, th.as_mut(), None);
@@ -140,13 +158,13 @@ fn serial(heated: bool, checks: &[usize]) -> Vec<(Vec<f64>, Vec<[f64; 3]>)> {
 }
 
 /// The distributed run on the ranks of `mpirun`, compared on rank 0.
-fn child(heated: bool) {
+fn child(heated: bool, single: bool) {
     use mpi::traits::Communicator;
     let universe = mpi::initialize().unwrap();
     let world = universe.world();
-    let plan = Plan::new(NX, world.size() as usize, &shapes()).unwrap();
+    let plan = Plan::new(NX, world.size() as usize, &shapes_of(single)).unwrap();
     let ex = Exchange::new(&world, plan);
-    let (mut lat, mut th) = channel(Some(ex.slab().window), heated);
+    let (mut lat, mut th) = channel(Some(ex.slab().window), heated, single);
     let checks = [100, 201];
     let mut got = Vec::new();
     for n in 1..=checks[1] {
@@ -159,7 +177,7 @@ fn child(heated: bool) {
     if world.rank() != 0 {
         return;
     }
-    let want = serial(heated, &checks);
+    let want = serial(heated, single, &checks);
     for ((n, (v, f)), (wv, wf)) in checks.iter().zip(got).zip(want) {
         let v = v.unwrap();
         assert_eq!(v.len(), wv.len());
@@ -206,7 +224,7 @@ fn on_ranks(test: &str, ranks: usize) {
 #[test]
 fn channel_with_obstacles_across_borders_is_the_serial_run() {
     if std::env::var_os(CHILD).is_some() {
-        return child(false);
+        return child(false, false);
     }
     for ranks in [1, 2, 4] {
         on_ranks(
@@ -219,10 +237,23 @@ fn channel_with_obstacles_across_borders_is_the_serial_run() {
 #[test]
 fn heated_channel_is_the_serial_run() {
     if std::env::var_os(CHILD).is_some() {
-        return child(true);
+        return child(true, false);
     }
     for ranks in [1, 2, 4] {
         on_ranks("heated_channel_is_the_serial_run", ranks);
+    }
+}
+
+#[test]
+fn single_precision_channel_with_an_overhanging_block_is_the_serial_run() {
+    if std::env::var_os(CHILD).is_some() {
+        return child(false, true);
+    }
+    for ranks in [1, 2, 4] {
+        on_ranks(
+            "single_precision_channel_with_an_overhanging_block_is_the_serial_run",
+            ranks,
+        );
     }
 }
 

@@ -10,7 +10,7 @@
 //!   the Poiseuille channel reaches the linear profile (1e-9), and `temperature` is in
 //!   `field_extrema` and the `.vti`.
 //! * Bad scenes are refused with the key: keys of the continuum model, `tau = 0.5`, an
-//!   obstacle outside the extent, a wall faster than the Mach limit, a thermal diffusivity
+//!   unknown precision, an obstacle entirely outside the extent, a wall faster than the Mach limit, a thermal diffusivity
 //!   too small for the lattice, a thermal side without a condition, a field
 //!   of another model, and `[lbm]` in a continuum scene.
 
@@ -202,17 +202,21 @@ fn bad_lbm_scenes_name_the_key() {
         "0.505",
     );
     refused(
-        &POISEUILLE.replace("precision", "x").replace(
+        &POISEUILLE.replace(
             "collision = \"trt\"",
-            "collision = \"trt\"\nprecision = \"single\"",
+            "collision = \"trt\"\nprecision = \"half\"",
         ),
-        "lbm.precision",
-        "single",
+        "precision",
+        "half",
     );
     let with_disk = format!(
-        "{POISEUILLE}\n[[obstacle]]\nname = \"d\"\nshape = {{ circle = {{ center = [0.001, 0.005], radius = 0.002 }} }}\n"
+        "{POISEUILLE}\n[[obstacle]]\nname = \"d\"\nshape = {{ circle = {{ center = [0.002, 0.0125], radius = 0.002 }} }}\n"
     );
-    refused(&with_disk, "obstacle[0].shape", "not inside");
+    refused(
+        &with_disk,
+        "obstacle[0].shape",
+        "entirely outside lbm.extent along y",
+    );
     refused(
         &POISEUILLE.replace(
             "side = \"ymax\"\nkind = \"wall\"",

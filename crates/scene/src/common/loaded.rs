@@ -91,6 +91,11 @@ impl LoadedScene {
             message: bound_echoes(&format!("{} {}", key_text(path), message)),
         }
     }
+    /// The line of `path` in the file (that of its deepest part written there; 1 if none
+    /// is), to point at a second key in a message.
+    pub(crate) fn line_of(&self, path: &[KeyPart]) -> usize {
+        self.lines.line(path)
+    }
     /// The model of the scene (`[scene] model`, default `"continuum"`).
     pub fn model(&self) -> &str {
         self.scene.scene.model.as_deref().unwrap_or("continuum")

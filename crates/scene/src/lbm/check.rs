@@ -57,8 +57,12 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
     let (units, seen) = check_section(ls)?;
     let l = s.lbm.as_ref().expect("checked by check_section");
     let mut names = std::collections::BTreeSet::new();
-    let (x0, y0) = (l.extent[0][0], l.extent[0][1]);
-    let (x1, y1) = (l.extent[1][0], l.extent[1][1]);
+    let extent = [
+        [l.extent[0][0], l.extent[0][1]],
+        [l.extent[1][0], l.extent[1][1]],
+    ];
+    let periodic = super::periodic_axes(l);
+    let mut placed: Vec<Placed> = Vec::new();
     for (i, o) in super::own(ls).obstacle.iter().enumerate() {
         let ok = |f: &str| ki("obstacle", i, &[f]);
         if o.name.is_empty() || !names.insert(o.name.clone()) {
@@ -67,7 +71,7 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
                 format!("= \"{}\" is empty or repeated", o.name),
             ));
         }
-        let (lo, hi) = match &o.shape {
+        let (lo, hi, disk) = match &o.shape {
             ShapeChoice::Circle(c) => {
                 if c.center.len() != 2 || !c.center.iter().all(|v| v.is_finite()) {
                     return Err(ls.error(&ok("shape"), "circle center must be two finite numbers"));
@@ -76,6 +80,7 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
                 (
                     [c.center[0] - c.radius, c.center[1] - c.radius],
                     [c.center[0] + c.radius, c.center[1] + c.radius],
+                    Some(([c.center[0], c.center[1]], c.radius)),
                 )
             }
             ShapeChoice::Box(b) => {
@@ -86,14 +91,39 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
                 if !(b[1][0] > b[0][0] && b[1][1] > b[0][1]) {
                     return Err(ls.error(&ok("shape"), "box needs x0 < x1 and y0 < y1"));
                 }
-                ([b[0][0], b[0][1]], [b[1][0], b[1][1]])
+                ([b[0][0], b[0][1]], [b[1][0], b[1][1]], None)
             }
         };
-        let inside_x = lo[0] >= x0 && hi[0] <= x1;
-        let inside_y = lo[1] >= y0 && hi[1] <= y1;
-        if !(inside_x && inside_y) {
-            return Err(ls.error(&ok("shape"), "is not inside lbm.extent"));
+        // clipped to the lattice along a side that is not periodic, wrapped along one that is
+        for a in 0..2 {
+            let reaches = lo[a] < extent[1][a] && hi[a] > extent[0][a];
+            if !(periodic[a] || reaches) {
+                return Err(ls.error(
+                    &ok("shape"),
+                    format!(
+                        "lies entirely outside lbm.extent along {} (an obstacle may overhang                          a side, and is clipped to the lattice, but must reach into it)",
+                        ["x", "y"][a]
+                    ),
+                ));
+            }
         }
+        let this = Placed { lo, hi, disk };
+        for (j, other) in placed.iter().enumerate() {
+            if overlap(&this, other, &extent, periodic) {
+                let first = ki("obstacle", j, &["shape"]);
+                return Err(ls.error(
+                    &ok("shape"),
+                    format!(
+                        "overlaps obstacle[{j}].shape (\"{}\", line {}): obstacles may not \
+                         overlap (a node both cover would give its links, and the force, to \
+                         one of them only); move or shrink one",
+                        super::own(ls).obstacle[j].name,
+                        ls.line_of(&first)
+                    ),
+                ));
+            }
+        }
+        placed.push(this);
         if let Some(v) = &o.velocity {
             vector(ls, &ok("velocity"), v)?;
             mach_of(ls, &ok("velocity"), v, &units)?;
@@ -106,6 +136,62 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
     check_schedule(ls, &units)?;
     super::grains::check_keys(ls, &units)?;
     check_output(ls, &names)
+}
+
+/// An obstacle's shape in scene units: its bounding box, and the disk it is, if one.
+struct Placed {
+    lo: [f64; 2],
+    hi: [f64; 2],
+    disk: Option<([f64; 2], f64)>,
+}
+
+/// Whether two obstacles overlap by an area inside the lattice, with the images of `b`
+/// across the periodic sides. Two disks overlap when their centres are closer than the sum
+/// of the radii, a disk and a box when the box's nearest point to the centre is closer than
+/// the radius, two boxes when their intervals overlap along both axes; touching is not
+/// overlapping. The overlap must lie inside `extent` (the bounding boxes' common part
+/// reaches into it), since what overhangs a side is clipped away.
+fn overlap(a: &Placed, b: &Placed, extent: &[[f64; 2]; 2], periodic: [bool; 2]) -> bool {
+    let span = [extent[1][0] - extent[0][0], extent[1][1] - extent[0][1]];
+    let shifts = |p: bool| if p { vec![-1.0, 0.0, 1.0] } else { vec![0.0] };
+    for sx in shifts(periodic[0]) {
+        for sy in shifts(periodic[1]) {
+            let d = [sx * span[0], sy * span[1]];
+            let b = Placed {
+                lo: [b.lo[0] + d[0], b.lo[1] + d[1]],
+                hi: [b.hi[0] + d[0], b.hi[1] + d[1]],
+                disk: b.disk.map(|(c, r)| ([c[0] + d[0], c[1] + d[1]], r)),
+            };
+            let common_lo = [a.lo[0].max(b.lo[0]), a.lo[1].max(b.lo[1])];
+            let common_hi = [a.hi[0].min(b.hi[0]), a.hi[1].min(b.hi[1])];
+            let in_lattice = (0..2).all(|k| {
+                common_lo[k] < common_hi[k]
+                    && (periodic[k] || (common_lo[k] < extent[1][k] && common_hi[k] > extent[0][k]))
+            });
+            if !in_lattice {
+                continue;
+            }
+            let hit = match (a.disk, b.disk) {
+                (Some((c, r)), Some((e, q))) => {
+                    (c[0] - e[0]).powi(2) + (c[1] - e[1]).powi(2) < (r + q).powi(2)
+                }
+                (Some((c, r)), None) => box_disk(&b, c, r),
+                (None, Some((c, r))) => box_disk(a, c, r),
+                (None, None) => true,
+            };
+            if hit {
+                return true;
+            }
+        }
+    }
+    false
+}
+
+/// Whether the box of `b` and the disk `(c, r)` overlap by an area.
+fn box_disk(b: &Placed, c: [f64; 2], r: f64) -> bool {
+    let dx = c[0] - c[0].clamp(b.lo[0], b.hi[0]);
+    let dy = c[1] - c[1].clamp(b.lo[1], b.hi[1]);
+    dx * dx + dy * dy < r * r
 }
 
 fn check_schedule(ls: &LoadedScene, units: &Units) -> Result<(), SceneError> {

@@ -34,7 +34,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::time::Instant;
 
-use porofrac_lbm::{Lattice, MAX_MACH, Obstacle, Shape, Side, Thermal, Units};
+use porofrac_lbm::{Lattice, MAX_MACH, Obstacle, ObstacleOverhang, Shape, Side, Thermal, Units};
 
 pub use check::check;
 
@@ -164,6 +164,8 @@ fn build<'a>(
         sides,
     } = window_of(ls, window)?;
     let mut motions = Vec::new();
+    // a wall block may overhang a side that is not periodic: clipped to the lattice
+    lat.set_obstacle_overhang(ObstacleOverhang::Clipped);
     for (i, o) in own(ls).obstacle.iter().enumerate() {
         let shape = shape_of(o, &units, origin);
         let v = o.velocity.as_ref().map(|v| VelocityExpr::new(v));
@@ -415,6 +417,37 @@ impl LbmModel<'_> {
                 "lbm: the flow reached Mach {ma:.3} (limit {MAX_MACH}) at t = {:.6e} s: refine lbm.spacing or lower lbm.tau",
                 self.lat.steps() as f64 * self.units.dt
             )));
+        }
+        Ok(())
+    }
+
+    /// An error if a moving obstacle ran into another (they came to cover a common node):
+    /// the check refuses obstacles that overlap at the start, and this is the same rule
+    /// during the run.
+    fn check_contacts(&self) -> Result<(), RunError> {
+        for (kk, (v, w)) in self.motions.iter().enumerate() {
+            if v.is_none() && w.is_none() {
+                continue;
+            }
+            if let Some(j) = self.lat.contact(kk) {
+                let obs = &own(self.ls).obstacle;
+                let other = ki("obstacle", j, &["shape"]);
+                return Err(self
+                    .ls
+                    .error(
+                        &ki("obstacle", kk, &["velocity"]),
+                        format!(
+                            "carries obstacle[{kk}] (\"{}\") into obstacle[{j}] (\"{}\", \
+                             line {}) at t = {:.6e} s: obstacles may not overlap (a node both \
+                             cover would give its links, and the force, to one of them only)",
+                            obs[kk].name,
+                            obs[j].name,
+                            self.ls.line_of(&other),
+                            self.lat.steps() as f64 * self.units.dt
+                        ),
+                    )
+                    .into());
+            }
         }
         Ok(())
     }
@@ -718,6 +751,7 @@ impl Model for LbmModel<'_> {
             self.lat
                 .step()
                 .map_err(|e| RunError::Flow(format!("lbm: {e}")))?;
+            self.check_contacts()?;
             if let Some(halo) = &self.halo {
                 halo(&mut self.lat, self.thermal.as_mut());
             }
@@ -1083,6 +1117,18 @@ pub struct LbmSections {
     pub obstacle: Vec<crate::common::lattice::sections::ObstacleSection>,
     /// `[grains]`: The lattice's solid map from an image of the rock.
     pub grains: Option<grains::GrainsSection>,
+}
+
+/// The axes `[lbm] periodic` names.
+pub(crate) fn periodic_axes(l: &crate::common::lattice::sections::LbmSection) -> [bool; 2] {
+    let mut p = [false; 2];
+    for a in &l.periodic {
+        p[match a {
+            crate::common::lattice::sections::AxisChoice::X => 0,
+            crate::common::lattice::sections::AxisChoice::Y => 1,
+        }] = true;
+    }
+    p
 }
 
 /// The model's own sections of a checked scene.

@@ -4,7 +4,7 @@
 
 use porofrac_lbm::{MAX_MACH, TAU_MIN, Units};
 
-use super::sections::{BoundaryKindChoice, PrecisionChoice};
+use super::sections::BoundaryKindChoice;
 use crate::common::expr::Expr;
 use crate::common::loaded::{LoadedScene, SceneError, k, ki};
 use crate::common::sections::{KeyPart, NumOrExpr};
@@ -106,12 +106,6 @@ pub(crate) fn check_section(ls: &LoadedScene) -> Result<(Units, [bool; 2]), Scen
             return Err(ls.error(&key("magic"), "applies to collision = \"trt\" only"));
         }
         positive(ls, &key("magic"), m)?;
-    }
-    if l.precision == PrecisionChoice::Single {
-        return Err(ls.error(
-            &key("precision"),
-            "= \"single\" is not available in this version of porofrac (double only)",
-        ));
     }
     let (nx, ny) = super::nodes(l);
     if !((2.0..=32768.0).contains(&nx) && (2.0..=32768.0).contains(&ny)) || nx * ny > MAX_NODES {

@@ -173,11 +173,14 @@ pub(crate) fn window_of(
         },
         obstacle_mass: porofrac_lbm::ObstacleMass::Conserved,
     };
-    let lat = match window {
+    let mut lat = match window {
         None => Lattice::new(cfg),
         Some([a, b]) => Lattice::window(cfg, a, b - a),
     }
     .map_err(|e| ls.error(&k(&["lbm"]), e))?;
+    if l.precision == sections::PrecisionChoice::Single {
+        lat.set_precision(porofrac_lbm::Precision::Single);
+    }
     Ok(LatticeParts {
         lat,
         units,
