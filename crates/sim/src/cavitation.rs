@@ -62,10 +62,72 @@ pub struct BoundedStep {
     pub solves: usize,
 }
 
+/// The responses of the pressure to a unit void in a cell, kept from one bounded step to
+/// the next (see [`bounded_step`]): the cavitating cells of a crack's tips change little
+/// from one solve to the next, and neither does the response of the coupled system to a
+/// void in one of them. A kept response only steers the iteration; every state accepted
+/// is a solve of the current system.
+#[derive(Clone, Debug, Default)]
+pub struct ResponseCache {
+    /// Per cell: the pressure change of a void of the cell's own volume over a step, as
+    /// (cell, value) pairs above a small fraction of the largest.
+    entries: Vec<(usize, Vec<(usize, f64)>)>,
+}
+
+/// Responses kept at most; the oldest go first.
+const MAX_RESPONSES: usize = 256;
+
+impl ResponseCache {
+    /// An empty cache.
+    pub fn new() -> Self {
+        Self::default()
+    }
+    /// Forget every response (e.g. for a new grid or system).
+    pub fn clear(&mut self) {
+        self.entries.clear();
+    }
+    /// The number of responses kept.
+    pub fn len(&self) -> usize {
+        self.entries.len()
+    }
+    /// Whether no response is kept.
+    pub fn is_empty(&self) -> bool {
+        self.entries.is_empty()
+    }
+    fn get(&self, d: usize) -> Option<&[(usize, f64)]> {
+        self.entries
+            .iter()
+            .find(|(e, _)| *e == d)
+            .map(|(_, r)| r.as_slice())
+    }
+    fn put(&mut self, d: usize, dp: &[f64]) {
+        self.entries.retain(|(e, _)| *e != d);
+        if self.entries.len() >= MAX_RESPONSES {
+            self.entries.remove(0);
+        }
+        let big = dp.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let kept = dp
+            .iter()
+            .enumerate()
+            .filter(|(_, v)| v.abs() > 1e-12 * big)
+            .map(|(c, &v)| (c, v))
+            .collect();
+        self.entries.push((d, kept));
+    }
+    /// The response at cell `c` of a void in cell `d` (0 when not kept there).
+    fn at(&self, d: usize, c: usize) -> f64 {
+        self.get(d)
+            .and_then(|r| r.iter().find(|(i, _)| *i == c).map(|(_, v)| *v))
+            .unwrap_or(0.0)
+    }
+}
+
 /// One step of a coupling (`step`, called with `system` and the void sources set) with
 /// the pore pressure of every cell bounded below by `p_cav` (Pa, absolute) and the void
 /// `void` (m³ per cell; m² in 2D) at the start of the step (see the module docs). `dt`
-/// is the step (> 0). The void sources of `system` are reset to none at the end.
+/// is the step (> 0); `cache` keeps the responses of the cavitating cells between calls
+/// (they steer the iteration; a stale one costs iterations, not accuracy). The void
+/// sources of `system` are reset to none at the end.
 ///
 /// Errors: lengths, a non-finite bound, `dt ≤ 0`, an error of `step`, or a cavitating set
 /// that does not settle within [`MAX_ACTIVE_SET`] changes.
@@ -74,6 +136,7 @@ pub fn bounded_step<const D: usize>(
     p_cav: f64,
     void: &[f64],
     dt: f64,
+    cache: &mut ResponseCache,
     mut step: impl FnMut(&BiotSystem<'_, D>) -> BiotResult<BiotStep>,
 ) -> BiotResult<BoundedStep> {
     let nc = system.num_cells();
@@ -94,10 +157,14 @@ pub fn bounded_step<const D: usize>(
         )));
     }
     let volumes = system.mechanics().grid.cell_volumes().to_vec();
-    let result = settle(system, p_cav, void, dt, &volumes, &mut step);
+    let result = settle(system, p_cav, void, dt, &volumes, cache, &mut step);
     system.set_void_source(None)?;
     result
 }
+
+/// Newton corrections of the voids of one cavitating set before its responses are
+/// measured again (kept ones) or the set is given up (fresh ones).
+const MAX_CORRECTIONS: usize = 8;
 
 /// The active-set iteration of [`bounded_step`].
 fn settle<const D: usize>(
@@ -106,6 +173,7 @@ fn settle<const D: usize>(
     void: &[f64],
     dt: f64,
     volumes: &[f64],
+    cache: &mut ResponseCache,
     step: &mut impl FnMut(&BiotSystem<'_, D>) -> BiotResult<BiotStep>,
 ) -> BiotResult<BoundedStep> {
     let nc = void.len();
@@ -127,88 +195,110 @@ fn settle<const D: usize>(
         .iter()
         .fold(p_cav.abs(), |m, p| m.max(p.abs()));
     let tol = 1e-10 * scale;
-    let mut active: Vec<usize> = (0..nc).filter(|&c| holds_void(c)).collect();
-    active.extend((0..nc).filter(|&c| !holds_void(c) && free.state.pressure[c] < p_cav - tol));
-    active.sort_unstable();
-    // The pressure change of a void source of `volumes[d] / dt` in cell `d` (the cell's
-    // own volume opened in the step), computed once per cell.
-    let mut response: Vec<(usize, Vec<f64>)> = Vec::new();
-    let mut cx = Responses {
+    let mut active: Vec<usize> = (0..nc)
+        .filter(|&c| holds_void(c) || free.state.pressure[c] < p_cav - tol)
+        .collect();
+    // The cells whose response was measured with the system of this call.
+    let mut fresh: Vec<usize> = Vec::new();
+    let base = Base {
         free: &free.state.pressure,
         volumes,
         dt,
     };
-    for c in (0..nc).filter(|&c| holds_void(c)) {
-        solves += cx.respond(system, step, c, &mut response)?;
-    }
     for _ in 0..MAX_ACTIVE_SET {
         for &c in &active {
-            solves += cx.respond(system, step, c, &mut response)?;
+            if cache.get(c).is_none() {
+                base.measure(c, system, cache, step)?;
+                solves += 1;
+                fresh.push(c);
+            }
         }
-        // Void changes in units of each cell's volume: the closing voids outside S are
-        // known, those of S solve p_S = p_c.
+        // Void changes in units of each cell's volume: the closing voids outside the set
+        // are known, those of the set make its pressure p_c.
         let mut amount = vec![0.0; nc];
         for c in (0..nc).filter(|&c| holds_void(c) && active.binary_search(&c).is_err()) {
             amount[c] = -void[c] / volumes[c];
         }
-        let pressure_of = |amount: &[f64]| -> Vec<f64> {
-            let mut p = free.state.pressure.clone();
-            for (d, dp) in &response {
-                if amount[*d] != 0.0 {
-                    p.iter_mut().zip(dp).for_each(|(p, r)| *p += amount[*d] * r);
+        let m = active.len();
+        let jacobian = |cache: &ResponseCache| {
+            let mut g = vec![0.0; m * m];
+            for (i, &c) in active.iter().enumerate() {
+                for (j, &d) in active.iter().enumerate() {
+                    g[i * m + j] = cache.at(d, c);
                 }
             }
-            p
+            g
         };
-        let base = pressure_of(&amount);
-        let m = active.len();
-        let mut g = vec![0.0; m * m];
-        let mut rhs = vec![0.0; m];
-        for (i, &c) in active.iter().enumerate() {
-            rhs[i] = p_cav - base[c];
-            for (j, &d) in active.iter().enumerate() {
-                let Some((_, dp)) = response.iter().find(|(e, _)| *e == d) else {
-                    return Err(BiotError::Solver(format!(
-                        "cavitation: no response of cell {d}"
-                    )));
-                };
-                g[i * m + j] = dp[c];
-            }
-        }
-        let x = dense_solve(&mut g, &mut rhs, m).ok_or_else(|| {
-            BiotError::Solver("cavitation: the response of the cavitating cells is singular".into())
-        })?;
-        for (&c, &a) in active.iter().zip(&x) {
-            amount[c] = a;
-        }
-        let p = pressure_of(&amount);
-        let mut next: Vec<usize> = active
+        let mut g = jacobian(cache);
+        // The first guess from the free step, then Newton corrections with real solves.
+        let mut r: Vec<f64> = active
             .iter()
-            .zip(&x)
-            .filter(|&(&c, &a)| void[c] + a * volumes[c] >= -1e-12 * volumes[c])
-            .map(|(&c, _)| c)
+            .map(|&c| p_cav - free.state.pressure[c])
             .collect();
-        let released = next.len() != active.len();
-        if !released {
-            next.extend(
-                (0..nc).filter(|&c| active.binary_search(&c).is_err() && p[c] < p_cav - tol),
-            );
-            next.sort_unstable();
-        }
-        if next == active {
-            // Solve the step once more with the sources found: the state is that of the
-            // coupled system, the mass balance exact to rounding.
+        let mut solved = None;
+        let mut last = f64::INFINITY;
+        for k in 0..2 * MAX_CORRECTIONS {
+            let dx = dense_solve(&mut g.clone(), &mut r.clone(), m).ok_or_else(|| {
+                BiotError::Solver(
+                    "cavitation: the response of the cavitating cells is singular".into(),
+                )
+            })?;
+            for (&c, d) in active.iter().zip(&dx) {
+                amount[c] += d;
+            }
             let q: Vec<f64> = amount
                 .iter()
                 .zip(volumes)
                 .map(|(a, v)| a * v / dt)
                 .collect();
             system.set_void_source(Some(q))?;
-            let mut s = step(system)?;
+            let s = step(system)?;
             solves += 1;
+            r = active.iter().map(|&c| p_cav - s.state.pressure[c]).collect();
+            let err = r.iter().fold(0.0f64, |e, v| e.max(v.abs()));
+            if err <= 1e-2 * tol {
+                solved = Some(s);
+                break;
+            }
+            // Slow progress with kept responses: measure those of the set again.
+            let stale: Vec<usize> = active
+                .iter()
+                .copied()
+                .filter(|c| !fresh.contains(c))
+                .collect();
+            if (err > 0.1 * last || k + 1 == MAX_CORRECTIONS) && !stale.is_empty() {
+                for c in stale {
+                    base.measure(c, system, cache, step)?;
+                    solves += 1;
+                    fresh.push(c);
+                }
+                g = jacobian(cache);
+            }
+            last = err;
+        }
+        let Some(mut s) = solved else {
+            return Err(BiotError::Solver(format!(
+                "cavitation: the pressure of {m} cavitating cells did not reach the bound"
+            )));
+        };
+        let mut next: Vec<usize> = active
+            .iter()
+            .copied()
+            .filter(|&c| void[c] + amount[c] * volumes[c] >= -1e-12 * volumes[c])
+            .collect();
+        if next.len() == active.len() {
+            next.extend(
+                (0..nc).filter(|&c| {
+                    active.binary_search(&c).is_err() && s.state.pressure[c] < p_cav - tol
+                }),
+            );
+            next.sort_unstable();
+        }
+        if next == active {
             let mut void_change: Vec<f64> =
                 amount.iter().zip(volumes).map(|(a, v)| a * v).collect();
             for &c in &active {
+                // The pressure differs from the bound by the rounding of the solve.
                 s.state.pressure[c] = p_cav;
                 // A void emptied to rounding is closed.
                 if void[c] + void_change[c] < 0.0 {
@@ -229,39 +319,35 @@ fn settle<const D: usize>(
     )))
 }
 
-/// What the responses of the pressure to unit void sources are measured against.
-struct Responses<'r> {
+/// What the responses of the pressure to unit voids are measured against.
+struct Base<'r> {
     free: &'r [f64],
     volumes: &'r [f64],
     dt: f64,
 }
 
-impl Responses<'_> {
-    /// Add the pressure change of a void source of `volumes[d] / dt` in cell `d` to
-    /// `response` unless it is there; returns the solves done (0 or 1).
-    fn respond<const D: usize>(
-        &mut self,
-        system: &mut BiotSystem<'_, D>,
-        step: &mut impl FnMut(&BiotSystem<'_, D>) -> BiotResult<BiotStep>,
+impl Base<'_> {
+    /// Measure and keep the pressure change of a void of cell `d`'s volume over the step.
+    fn measure<const D: usize>(
+        &self,
         d: usize,
-        response: &mut Vec<(usize, Vec<f64>)>,
-    ) -> BiotResult<usize> {
-        if response.iter().any(|(e, _)| *e == d) {
-            return Ok(0);
-        }
+        system: &mut BiotSystem<'_, D>,
+        cache: &mut ResponseCache,
+        step: &mut impl FnMut(&BiotSystem<'_, D>) -> BiotResult<BiotStep>,
+    ) -> BiotResult<()> {
         let mut q = vec![0.0; self.free.len()];
         q[d] = self.volumes[d] / self.dt;
         system.set_void_source(Some(q))?;
         let s = step(system)?;
-        let dp = s
+        let dp: Vec<f64> = s
             .state
             .pressure
             .iter()
             .zip(self.free)
             .map(|(a, b)| a - b)
             .collect();
-        response.push((d, dp));
-        Ok(1)
+        cache.put(d, &dp);
+        Ok(())
     }
 }
 

@@ -549,6 +549,8 @@ pub struct Fracturing<'a, const D: usize> {
     cavitation: Option<f64>,
     /// The void of every cell (m³; m² in 2D) at the end of the last step.
     void: Vec<f64>,
+    /// The responses of cavitating cells kept between steps.
+    responses: crate::cavitation::ResponseCache,
 }
 
 /// What [`TipRule::Opening`] needs at every failure check: the plane-strain modulus, the
@@ -745,6 +747,7 @@ impl<'a, const D: usize> Fracturing<'a, D> {
             opening_tips,
             cavitation: None,
             void: vec![0.0; nc],
+            responses: crate::cavitation::ResponseCache::new(),
         })
     }
 
@@ -911,8 +914,9 @@ impl<'a, const D: usize> Fracturing<'a, D> {
             opening_tips,
             cavitation,
             void,
+            responses,
         } = self;
-        let cav = cavitation.map(|p| (p, void.as_slice()));
+        let void_start = void.clone();
         let stop = || {
             interrupt
                 .as_ref()
@@ -987,6 +991,11 @@ impl<'a, const D: usize> Fracturing<'a, D> {
                     .map(|(a, b)| *a || *b)
                     .collect();
             }
+            let cav = cavitation.map(|p| Cavity {
+                pressure: p,
+                void: &void_start,
+                cache: &mut *responses,
+            });
             let (new, residual, n, void_change) = active_set_solve(
                 &mut system,
                 scheme,
@@ -1190,7 +1199,7 @@ fn active_set_solve<const D: usize>(
     dt: f64,
     limits: ActiveSetLimits,
     stop: &dyn Fn() -> bool,
-    cav: Option<(f64, &[f64])>,
+    mut cav: Option<Cavity<'_>>,
 ) -> FractureResult<(BiotState, f64, usize, Vec<f64>)> {
     let t1 = t + dt;
     if system.mechanics().laws.all_linear() {
@@ -1198,7 +1207,7 @@ fn active_set_solve<const D: usize>(
         return Ok(match state {
             None => (system.initial_state(t)?, 0.0, 1, Vec::new()),
             Some(s) => {
-                let (res, void_change, n) = scheme_step(system, scheme, s, t, dt, cav)?;
+                let (res, void_change, n) = scheme_step(system, scheme, s, t, dt, cav.as_mut())?;
                 (res.state, res.residual, n, void_change)
             }
         });
@@ -1225,7 +1234,7 @@ fn active_set_solve<const D: usize>(
                 (st, p0.clone(), None)
             }
             Some(s) => {
-                let (res, dv, n) = scheme_step(system, scheme, s, t, dt, cav)?;
+                let (res, dv, n) = scheme_step(system, scheme, s, t, dt, cav.as_mut())?;
                 extra += n - 1;
                 void_change = dv;
                 // The explicit-pressure mechanics is in equilibrium with the old pressure.
@@ -1293,6 +1302,14 @@ fn active_set_solve<const D: usize>(
     })
 }
 
+/// The cavitation bound of a step: the pressure, the void at the start of the step and the
+/// kept responses ([`crate::cavitation::bounded_step`]).
+struct Cavity<'c> {
+    pressure: f64,
+    void: &'c [f64],
+    cache: &'c mut crate::cavitation::ResponseCache,
+}
+
 /// One step of `scheme`, bounded below by the cavitation pressure of `cav` with the void
 /// of every cell at the start of the step ([`crate::cavitation::bounded_step`]) when given
 /// and `dt > 0`. Returns the step, the void change (empty without a bound) and the
@@ -1303,7 +1320,7 @@ fn scheme_step<const D: usize>(
     s: &BiotState,
     t: f64,
     dt: f64,
-    cav: Option<(f64, &[f64])>,
+    cav: Option<&mut Cavity<'_>>,
 ) -> FractureResult<(crate::BiotStep, Vec<f64>, usize)> {
     let mut run = |sys: &BiotSystem<'_, D>| match scheme {
         Scheme::Monolithic(m) => m.step(sys, s, t, dt),
@@ -1311,8 +1328,9 @@ fn scheme_step<const D: usize>(
         Scheme::ExplicitPressure(e, _) => e.step(sys, s, t, dt),
     };
     match cav {
-        Some((p_cav, void)) if dt > 0.0 => {
-            let b = crate::cavitation::bounded_step(system, p_cav, void, dt, run)?;
+        Some(c) if dt > 0.0 => {
+            let b =
+                crate::cavitation::bounded_step(system, c.pressure, c.void, dt, c.cache, run)?;
             Ok((b.step, b.void_change, b.solves))
         }
         _ => Ok((run(system)?, Vec::new(), 1)),
