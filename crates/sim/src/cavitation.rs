@@ -254,9 +254,15 @@ fn settle<const D: usize>(
             system.set_void_source(Some(q))?;
             let s = step(system)?;
             solves += 1;
-            r = active.iter().map(|&c| p_cav - s.state.pressure[c]).collect();
+            r = active
+                .iter()
+                .map(|&c| p_cav - s.state.pressure[c])
+                .collect();
             let err = r.iter().fold(0.0f64, |e, v| e.max(v.abs()));
-            if err <= 1e-2 * tol {
+            let all_fresh = active.iter().all(|c| fresh.contains(c));
+            // Converged, or at the rounding of the solves (no progress with responses of
+            // the current system).
+            if err <= tol || (all_fresh && err > 0.5 * last && err <= 1e-7 * scale) {
                 solved = Some(s);
                 break;
             }
@@ -278,7 +284,8 @@ fn settle<const D: usize>(
         }
         let Some(mut s) = solved else {
             return Err(BiotError::Solver(format!(
-                "cavitation: the pressure of {m} cavitating cells did not reach the bound"
+                "cavitation: the pressure of {m} cavitating cells did not reach the bound \
+                 (largest miss {last:.3e} Pa)"
             )));
         };
         let mut next: Vec<usize> = active
@@ -287,11 +294,9 @@ fn settle<const D: usize>(
             .filter(|&c| void[c] + amount[c] * volumes[c] >= -1e-12 * volumes[c])
             .collect();
         if next.len() == active.len() {
-            next.extend(
-                (0..nc).filter(|&c| {
-                    active.binary_search(&c).is_err() && s.state.pressure[c] < p_cav - tol
-                }),
-            );
+            next.extend((0..nc).filter(|&c| {
+                active.binary_search(&c).is_err() && s.state.pressure[c] < p_cav - tol
+            }));
             next.sort_unstable();
         }
         if next == active {

@@ -1329,8 +1329,7 @@ fn scheme_step<const D: usize>(
     };
     match cav {
         Some(c) if dt > 0.0 => {
-            let b =
-                crate::cavitation::bounded_step(system, c.pressure, c.void, dt, c.cache, run)?;
+            let b = crate::cavitation::bounded_step(system, c.pressure, c.void, dt, c.cache, run)?;
             Ok((b.step, b.void_change, b.solves))
         }
         _ => Ok((run(system)?, Vec::new(), 1)),

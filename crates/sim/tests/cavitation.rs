@@ -51,14 +51,12 @@ fn flow_model(s: &Setup, rate: f64) -> (FlowModel<2>, Permeability<2>) {
     (FlowModel::new(&s.grid, &problem).unwrap(), permeability)
 }
 
+/// A step's state, its void change and the void after it.
+type Stepped = (BiotState, Vec<f64>, Vec<f64>);
+
 /// Steps of `dt` with the source rates `rates` (one per step), bounded by `p_cav` when
 /// given; per step the state, the void change and the void after it.
-fn run(
-    s: &Setup,
-    rates: &[f64],
-    dt: f64,
-    p_cav: Option<f64>,
-) -> (BiotState, Vec<(BiotState, Vec<f64>, Vec<f64>)>) {
+fn run(s: &Setup, rates: &[f64], dt: f64, p_cav: Option<f64>) -> (BiotState, Vec<Stepped>) {
     let grid = &s.grid;
     let nc = grid.num_cells();
     let stiffness = Stiffness::<2>::isotropic(1e9, 0.25).unwrap();
@@ -113,7 +111,7 @@ fn run(
         };
         let void_old: Vec<f64> = states
             .last()
-            .map(|(_, _, v): &(BiotState, Vec<f64>, Vec<f64>)| v.clone())
+            .map(|(_, _, v): &Stepped| v.clone())
             .unwrap_or_else(|| vec![0.0; nc]);
         frac.resume_void(&void_old).unwrap();
         let step = frac.step(&start, n as f64 * dt, dt).unwrap();
