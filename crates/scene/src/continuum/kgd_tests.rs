@@ -125,8 +125,9 @@ fn kgd_toughness_follows_the_vertex_solution() {
 }
 
 /// The viscosity scene's mean relative errors over t ≥ 8 s: half-length, inlet opening,
-/// the largest |error| of the inlet opening, and the time exponent of the half-length.
-fn kgd_viscosity_errors() -> (f64, f64, f64, f64) {
+/// the largest |error| of the inlet opening, and the time exponent of the half-length;
+/// `tag` names the run's folder (the tests run at the same time).
+fn kgd_viscosity_errors(tag: &str) -> (f64, f64, f64, f64) {
     let (e, nu, mu, q0): (f64, f64, f64, f64) = (1.0e10, 0.25, 1.0e-3, 1.0e-5);
     let ep = e / (1.0 - nu * nu);
     let mup = 12.0 * mu;
@@ -134,7 +135,7 @@ fn kgd_viscosity_errors() -> (f64, f64, f64, f64) {
     let (probes, failed) = run_kgd(
         include_str!("../../../../scenes/kgd_viscosity.toml"),
         "scenes/kgd_viscosity.toml",
-        "kgd_mu",
+        tag,
     );
     let (mut e_l, mut e_w, mut worst_w, mut m) = (0.0, 0.0, 0.0f64, 0.0);
     let mut logs = Vec::new();
@@ -171,7 +172,7 @@ fn kgd_viscosity_errors() -> (f64, f64, f64, f64) {
 
 #[test]
 fn kgd_viscosity_inlet_opening_follows_the_vertex_solution() {
-    let (_, e_w, worst_w, _) = kgd_viscosity_errors();
+    let (_, e_w, worst_w, _) = kgd_viscosity_errors("kgd_mu_w");
     assert!(
         e_w.abs() < 0.10 && worst_w < 0.22,
         "inlet opening {e_w:+.4}, {worst_w:.4}"
@@ -185,7 +186,7 @@ fn kgd_viscosity_inlet_opening_follows_the_vertex_solution() {
 /// conducted the fluid to the tip with little viscous drop.
 #[test]
 fn kgd_viscosity_half_length_follows_the_vertex_solution() {
-    let (e_l, _, _, exponent) = kgd_viscosity_errors();
+    let (e_l, _, _, exponent) = kgd_viscosity_errors("kgd_mu_l");
     assert!(e_l.abs() < 0.10, "half-length {e_l:+.4} (target ±10 %)");
     assert!(
         (0.60..0.70).contains(&exponent),
