@@ -517,6 +517,9 @@ pub struct FractureStep<const D: usize> {
     /// no active set to settle (the stiffness does not depend on the displacement), and
     /// this is the residual of the coupled step ([`crate::BiotStep::residual`]).
     pub residual: f64,
+    /// The change of the void of every cell over the step (m³; m² in 2D) under a
+    /// cavitation bound ([`Fracturing::set_cavitation_pressure`]); empty without one.
+    pub void_change: Vec<f64>,
 }
 
 /// A fracturing poroelastic body advanced step by step (see the module docs).
@@ -542,6 +545,12 @@ pub struct Fracturing<'a, const D: usize> {
     interrupt: Option<Arc<AtomicBool>>,
     /// The tip rule [`TipRule::Opening`], when chosen.
     opening_tips: Option<OpeningTips>,
+    /// The cavitation pressure bounding the pore pressure below (Pa), when set.
+    cavitation: Option<f64>,
+    /// The void of every cell (m³; m² in 2D) at the end of the last step.
+    void: Vec<f64>,
+    /// The responses of cavitating cells kept between steps.
+    responses: crate::cavitation::ResponseCache,
 }
 
 /// What [`TipRule::Opening`] needs at every failure check: the plane-strain modulus, the
@@ -640,7 +649,8 @@ impl OpeningTips {
 
 /// A solve checked for failures: the state and its cell stresses, and the stress the
 /// criteria see (the same, or with the tip cells of [`TipRule::Opening`]).
-type Checked<const D: usize> = ((BiotState, Vec<Tensor<D>>), Vec<Tensor<D>>);
+/// The solution carries the void change of its step (empty without a cavitation bound).
+type Checked<const D: usize> = ((BiotState, Vec<Tensor<D>>, Vec<f64>), Vec<Tensor<D>>);
 
 /// A failure state's law map and stiffness (at zero displacement).
 struct Cached<'a, const D: usize> {
@@ -735,6 +745,9 @@ impl<'a, const D: usize> Fracturing<'a, D> {
             stress_cache: None,
             interrupt: None,
             opening_tips,
+            cavitation: None,
+            void: vec![0.0; nc],
+            responses: crate::cavitation::ResponseCache::new(),
         })
     }
 
@@ -746,6 +759,58 @@ impl<'a, const D: usize> Fracturing<'a, D> {
             f.set_interrupt(flag.clone());
         }
         self.interrupt = flag;
+    }
+
+    /// Bound the pore pressure of every cell below by `p_cav` (Pa, absolute) from the next
+    /// step on ([`crate::cavitation`]): a cell that would fall below it stays at it and
+    /// the volume it opens without fluid is a void, booked per cell ([`Self::void`]).
+    /// `None` (the default): no bound, the steps as without it, bit for bit.
+    ///
+    /// Errors: a non-finite pressure.
+    pub fn set_cavitation_pressure(&mut self, p_cav: Option<f64>) -> FractureResult<()> {
+        if let Some(p) = p_cav
+            && !p.is_finite()
+        {
+            return Err(FractureError::Input(format!(
+                "cavitation pressure must be finite, got {p}"
+            )));
+        }
+        self.cavitation = p_cav;
+        Ok(())
+    }
+
+    /// The cavitation pressure bounding the pore pressure, when set.
+    pub fn cavitation_pressure(&self) -> Option<f64> {
+        self.cavitation
+    }
+
+    /// The void of every cell (m³; m² per unit height in 2D) at the end of the last step:
+    /// the volume opened at the cavitation pressure that fluid has not filled (all zero
+    /// without a bound).
+    pub fn void(&self) -> &[f64] {
+        &self.void
+    }
+
+    /// Go on with the void `void` of every cell (m³; m² in 2D) of an earlier run of the
+    /// same scene ([`Self::void`]).
+    ///
+    /// Errors: a length other than the number of cells, a negative or non-finite void.
+    pub fn resume_void(&mut self, void: &[f64]) -> FractureResult<()> {
+        if void.len() != self.void.len() {
+            return Err(FractureError::Input(format!(
+                "void of {} cells, the grid has {}",
+                void.len(),
+                self.void.len()
+            )));
+        }
+        if let Some(c) = void.iter().position(|v| !(v.is_finite() && *v >= 0.0)) {
+            return Err(FractureError::Input(format!(
+                "cell {c}: void must be finite and >= 0, got {}",
+                void[c]
+            )));
+        }
+        self.void.copy_from_slice(void);
+        Ok(())
     }
 
     /// The failure state (flags and the log of failures).
@@ -847,7 +912,11 @@ impl<'a, const D: usize> Fracturing<'a, D> {
             stress_cache,
             interrupt,
             opening_tips,
+            cavitation,
+            void,
+            responses,
         } = self;
+        let void_start = void.clone();
         let stop = || {
             interrupt
                 .as_ref()
@@ -922,7 +991,12 @@ impl<'a, const D: usize> Fracturing<'a, D> {
                     .map(|(a, b)| *a || *b)
                     .collect();
             }
-            let (new, residual, n) = active_set_solve(
+            let cav = cavitation.map(|p| Cavity {
+                pressure: p,
+                void: &void_start,
+                cache: &mut *responses,
+            });
+            let (new, residual, n, void_change) = active_set_solve(
                 &mut system,
                 scheme,
                 state,
@@ -931,6 +1005,7 @@ impl<'a, const D: usize> Fracturing<'a, D> {
                 dt,
                 limits,
                 &stop,
+                cav,
             )?;
             solves += n;
             warm = Some(new.clone());
@@ -941,9 +1016,9 @@ impl<'a, const D: usize> Fracturing<'a, D> {
             let stress = stresses(grid, map, operators, coords, cache, &new.displacement)?;
             if let Some(tips) = opening_tips.as_ref() {
                 let measure = tips.measure(grid, fs.flags(), &stress, &new.displacement);
-                return Ok(((new, stress), measure));
+                return Ok(((new, stress, void_change), measure));
             }
-            Ok(((new, stress.clone()), stress))
+            Ok(((new, stress.clone(), void_change), stress))
         };
         let done = resolution
             .resolve(grid, failures, t1, solve)
@@ -959,7 +1034,12 @@ impl<'a, const D: usize> Fracturing<'a, D> {
                     failed,
                 },
             })?;
-        let ((state, stress), _) = done.solution;
+        let ((state, stress, void_change), _) = done.solution;
+        if !void_change.is_empty() {
+            for (v, dv) in void.iter_mut().zip(&void_change) {
+                *v = (*v + dv).max(0.0);
+            }
+        }
         Ok(FractureStep {
             state,
             stress,
@@ -967,6 +1047,7 @@ impl<'a, const D: usize> Fracturing<'a, D> {
             rounds: done.rounds,
             solves,
             residual: worst,
+            void_change,
         })
     }
 }
@@ -1118,22 +1199,21 @@ fn active_set_solve<const D: usize>(
     dt: f64,
     limits: ActiveSetLimits,
     stop: &dyn Fn() -> bool,
-) -> FractureResult<(BiotState, f64, usize)> {
+    mut cav: Option<Cavity<'_>>,
+) -> FractureResult<(BiotState, f64, usize, Vec<f64>)> {
     let t1 = t + dt;
     if system.mechanics().laws.all_linear() {
         // The stiffness does not depend on the displacement: one solve is exact.
         return Ok(match state {
-            None => (system.initial_state(t)?, 0.0, 1),
+            None => (system.initial_state(t)?, 0.0, 1, Vec::new()),
             Some(s) => {
-                let res = match scheme {
-                    Scheme::Monolithic(m) => m.step(system, s, t, dt)?,
-                    Scheme::FixedStress(f, _) => f.step(system, s, t, dt)?,
-                    Scheme::ExplicitPressure(e, _) => e.step(system, s, t, dt)?,
-                };
-                (res.state, res.residual, 1)
+                let (res, void_change, n) = scheme_step(system, scheme, s, t, dt, cav.as_mut())?;
+                (res.state, res.residual, n, void_change)
             }
         });
     }
+    let mut extra = 0;
+    let mut void_change = Vec::new();
     let p0 = system.initial_pressure().to_vec();
     // The first stiffness only (its residual is not used).
     match (warm, state) {
@@ -1154,11 +1234,9 @@ fn active_set_solve<const D: usize>(
                 (st, p0.clone(), None)
             }
             Some(s) => {
-                let res = match scheme {
-                    Scheme::Monolithic(m) => m.step(system, s, t, dt)?,
-                    Scheme::FixedStress(f, _) => f.step(system, s, t, dt)?,
-                    Scheme::ExplicitPressure(e, _) => e.step(system, s, t, dt)?,
-                };
+                let (res, dv, n) = scheme_step(system, scheme, s, t, dt, cav.as_mut())?;
+                extra += n - 1;
+                void_change = dv;
                 // The explicit-pressure mechanics is in equilibrium with the old pressure.
                 let p_used = match scheme {
                     Scheme::ExplicitPressure(..) => s.pressure.clone(),
@@ -1172,11 +1250,11 @@ fn active_set_solve<const D: usize>(
         // residual is measured only when the tangent changed).
         let changed = system.tangent_at(&new.displacement)?;
         if !changed && let Some(r) = solve_residual {
-            return Ok((new, r, it));
+            return Ok((new, r, it + extra, void_change));
         }
         residual = system.equilibrium_residual(&new.displacement, &p_used, t1)?;
         if !changed || residual <= limits.tolerance {
-            return Ok((new, residual, it));
+            return Ok((new, residual, it + extra, void_change));
         }
         let Some((b_state, b_p, b_res)) = best.take() else {
             best = Some((new, p_used, residual));
@@ -1205,7 +1283,7 @@ fn active_set_solve<const D: usize>(
             let l = system.linearize(&cand.displacement, &cand_p, t1)?;
             residual = l.residual;
             if residual <= limits.tolerance {
-                return Ok((cand, residual, it));
+                return Ok((cand, residual, it + extra, void_change));
             }
             let descent = residual < b_res;
             next = Some((cand, cand_p, residual));
@@ -1222,6 +1300,40 @@ fn active_set_solve<const D: usize>(
         residual,
         tolerance: limits.tolerance,
     })
+}
+
+/// The cavitation bound of a step: the pressure, the void at the start of the step and the
+/// kept responses ([`crate::cavitation::bounded_step`]).
+struct Cavity<'c> {
+    pressure: f64,
+    void: &'c [f64],
+    cache: &'c mut crate::cavitation::ResponseCache,
+}
+
+/// One step of `scheme`, bounded below by the cavitation pressure of `cav` with the void
+/// of every cell at the start of the step ([`crate::cavitation::bounded_step`]) when given
+/// and `dt > 0`. Returns the step, the void change (empty without a bound) and the
+/// coupled solves done.
+fn scheme_step<const D: usize>(
+    system: &mut BiotSystem<'_, D>,
+    scheme: &mut Scheme,
+    s: &BiotState,
+    t: f64,
+    dt: f64,
+    cav: Option<&mut Cavity<'_>>,
+) -> FractureResult<(crate::BiotStep, Vec<f64>, usize)> {
+    let mut run = |sys: &BiotSystem<'_, D>| match scheme {
+        Scheme::Monolithic(m) => m.step(sys, s, t, dt),
+        Scheme::FixedStress(f, _) => f.step(sys, s, t, dt),
+        Scheme::ExplicitPressure(e, _) => e.step(sys, s, t, dt),
+    };
+    match cav {
+        Some(c) if dt > 0.0 => {
+            let b = crate::cavitation::bounded_step(system, c.pressure, c.void, dt, c.cache, run)?;
+            Ok((b.step, b.void_change, b.solves))
+        }
+        _ => Ok((run(system)?, Vec::new(), 1)),
+    }
 }
 
 #[cfg(test)]

@@ -61,6 +61,7 @@
 pub mod assembly;
 pub mod bc;
 pub mod biot;
+pub mod cavitation;
 pub mod crack_flow;
 pub mod dofs;
 pub mod error;

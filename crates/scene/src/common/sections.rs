@@ -697,6 +697,13 @@ pub struct Physics {
     /// rectangles (a predefined path; docs/hydrofrac/validation.md, "KGD"). Needs
     /// fracture = true, flow = true and failure_stress = "cell".
     pub tip_rule: Option<TipRuleChoice>,
+    /// The pore pressure of a cell never falls below this absolute pressure (the fluid's
+    /// vapour pressure; default none: unbounded suction). A cell that opens faster than
+    /// fluid reaches it (a crack tip ahead of the fluid) stays at it, and the volume it
+    /// opens is a void that the fluid fills first when it arrives (docs/models/continuum.md,
+    /// "Cavitation"). Needs flow = true.
+    #[schemars(extend("unit" = "Pa"))]
+    pub cavitation_pressure: Option<f64>,
 }
 
 /// `[solver]`.

@@ -239,6 +239,17 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
     if let Some(kf) = s.physics.fracture_permeability {
         positive(ls, &k(&["physics", "fracture_permeability"]), kf)?;
     }
+    if let Some(p) = s.physics.cavitation_pressure {
+        if !p.is_finite() {
+            return Err(ls.error(
+                &k(&["physics", "cavitation_pressure"]),
+                format!("= {p} must be a finite pressure (Pa)"),
+            ));
+        }
+        if s.physics.flow != Some(true) {
+            return Err(ls.error(&k(&["physics", "cavitation_pressure"]), "needs flow = true"));
+        }
+    }
     if s.physics.fluid_lag.is_some()
         && (s.physics.fracture != Some(true) || s.physics.flow != Some(true))
     {

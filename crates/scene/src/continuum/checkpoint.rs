@@ -95,6 +95,9 @@ pub(super) fn save<const D: usize>(s: &Stepper<'_, D>, state: &mut State) {
             state.put_f64("continuum/biot/p", b.pressure.as_slice());
         }
         save_memory(state, &frac.scheme_memory());
+        if frac.cavitation_pressure().is_some() {
+            state.put_f64("continuum/void", frac.void().to_vec());
+        }
     }
 }
 
@@ -226,6 +229,10 @@ pub(super) fn restore<const D: usize>(
     // Factorizations from here on add to the saved count.
     s.count_base = s.stats.factorizations;
     if let Driver::Coupled { frac, state: biot } = &mut s.driver {
+        if state.f64s("continuum/void").is_ok() {
+            frac.resume_void(state.f64s_len("continuum/void", nc)?)
+                .map_err(|e| bad(e.to_string()))?;
+        }
         if state.f64s("continuum/biot/u").is_ok() {
             *biot = Some(BiotState {
                 displacement: state.f64s_len("continuum/biot/u", D * nn)?.to_vec(),

@@ -8,10 +8,13 @@
 //!   pressure and the inlet opening (the jump of `u_y` across the path at x = 50);
 //! - the time exponent of `ℓ` (least squares on `log ℓ` against `log t`).
 //!
-//! The viscosity scene (`scenes/kgd_viscosity.toml`, h = 0.125 m, 5 s) against the
-//! viscosity vertex solution over t ≥ 8 s: the inlet opening within the error measured
-//! (−1.3 % on average, −2.2 % at most); the half-length's target of 10 % is missed (+27 %
-//! on average, docs/hydrofrac/validation.md) and its test stays ignored with the numbers.
+//! The viscosity scene (`scenes/kgd_viscosity.toml`, h = 0.125 m, 3 s) against the
+//! viscosity vertex solution over t ≥ 8 s, with the pore pressure bounded by a cavitation
+//! pressure 10 MPa below the rock's and a closed crack's transmissivity floor of 1e-18 m³:
+//! the half-length and the inlet opening within the target of 10 % on average (measured
+//! 2026-11-29: +9.2 % and +9.6 %, the opening +21 % at most), the time exponent of the
+//! length within 0.60–0.70 (0.630; 2/3). docs/hydrofrac/validation.md has the refinement
+//! study.
 //!
 //! The bounds are the values measured at this resolution (2026-11-28: `ℓ` +7.4 % on
 //! average, 7.5 % in absolute value; `p` 6.9 %; `w` 3.8 %; exponent 0.630) rounded up by
@@ -122,8 +125,9 @@ fn kgd_toughness_follows_the_vertex_solution() {
 }
 
 /// The viscosity scene's mean relative errors over t ≥ 8 s: half-length, inlet opening,
-/// and the largest |error| of the inlet opening.
-fn kgd_viscosity_errors() -> (f64, f64, f64) {
+/// the largest |error| of the inlet opening, and the time exponent of the half-length;
+/// `tag` names the run's folder (the tests run at the same time).
+fn kgd_viscosity_errors(tag: &str) -> (f64, f64, f64, f64) {
     let (e, nu, mu, q0): (f64, f64, f64, f64) = (1.0e10, 0.25, 1.0e-3, 1.0e-5);
     let ep = e / (1.0 - nu * nu);
     let mup = 12.0 * mu;
@@ -131,9 +135,10 @@ fn kgd_viscosity_errors() -> (f64, f64, f64) {
     let (probes, failed) = run_kgd(
         include_str!("../../../../scenes/kgd_viscosity.toml"),
         "scenes/kgd_viscosity.toml",
-        "kgd_mu",
+        tag,
     );
     let (mut e_l, mut e_w, mut worst_w, mut m) = (0.0, 0.0, 0.0f64, 0.0);
+    let mut logs = Vec::new();
     for row in &probes {
         let v: Vec<f64> = row.iter().map(|x| x.parse().unwrap()).collect();
         let t = v[0];
@@ -146,32 +151,45 @@ fn kgd_viscosity_errors() -> (f64, f64, f64) {
         let ew = (v[2] - v[3]) / wv - 1.0;
         e_l += l / lv - 1.0;
         e_w += ew;
+        logs.push((t.ln(), l.ln()));
         worst_w = worst_w.max(ew.abs());
         m += 1.0;
     }
     let (e_l, e_w) = (e_l / m, e_w / m);
-    println!("KGD viscosity, h = {h} m, t >= 8 s: l {e_l:+.4}, w {e_w:+.4} (largest {worst_w:.4})");
+    let (mx, my) = (
+        logs.iter().map(|v| v.0).sum::<f64>() / m,
+        logs.iter().map(|v| v.1).sum::<f64>() / m,
+    );
+    let exponent = logs.iter().map(|v| (v.0 - mx) * (v.1 - my)).sum::<f64>()
+        / logs.iter().map(|v| (v.0 - mx) * (v.0 - mx)).sum::<f64>();
+    println!(
+        "KGD viscosity, h = {h} m, t >= 8 s: l {e_l:+.4}, w {e_w:+.4} (largest {worst_w:.4}), \
+         exponent of l {exponent:.4}"
+    );
     assert_eq!(m, 41.0, "probes every 0.8 s from 8 s to 40 s");
-    (e_l, e_w, worst_w)
+    (e_l, e_w, worst_w, exponent)
 }
 
 #[test]
 fn kgd_viscosity_inlet_opening_follows_the_vertex_solution() {
-    let (_, e_w, worst_w) = kgd_viscosity_errors();
+    let (_, e_w, worst_w, _) = kgd_viscosity_errors("kgd_mu_w");
     assert!(
-        e_w.abs() < 0.014 && worst_w < 0.023,
+        e_w.abs() < 0.10 && worst_w < 0.22,
         "inlet opening {e_w:+.4}, {worst_w:.4}"
     );
 }
 
-/// The target of 10 % on the half-length: missed (2026-11-28, h = 0.125 m: +27.4 % on
-/// average, +47 % at 8 s, +18 % at 40 s; fitted exponent 0.55 against 2/3). The cells
-/// ahead of the fluid fail nearly dry and their pressure is not bounded below by a
-/// cavitation pressure, so the crack carries a dry tip several cells long that the
-/// vertex solution does not have (docs/hydrofrac/validation.md).
+/// The target of 10 % on the half-length (2026-11-29, h = 0.125 m: +9.2 % on average,
+/// +14.7 % at 8 s, +6.5 % at 40 s) and its time exponent (0.630 against 2/3). Before the
+/// cavitation bound and the lower transmissivity floor the crack was +27 % long: the
+/// floor of 1e-15 m³ (a residual aperture of 23 microns against an inlet opening of 40)
+/// conducted the fluid to the tip with little viscous drop.
 #[test]
-#[ignore = "missed: half-length +27 % against the viscosity vertex solution (target 10 %)"]
 fn kgd_viscosity_half_length_follows_the_vertex_solution() {
-    let (e_l, _, _) = kgd_viscosity_errors();
+    let (e_l, _, _, exponent) = kgd_viscosity_errors("kgd_mu_l");
     assert!(e_l.abs() < 0.10, "half-length {e_l:+.4} (target ±10 %)");
+    assert!(
+        (0.60..0.70).contains(&exponent),
+        "time exponent of the half-length {exponent:.4} (2/3)"
+    );
 }

@@ -1057,7 +1057,7 @@ fn coupled<'a, const D: usize>(
         }
     }
     let tolerance = s.solver.tolerance.unwrap_or(1e-10);
-    Ok(Fracturing::new(body, laws, settings, flow, |sys| {
+    let mut run = Fracturing::new(body, laws, settings, flow, |sys| {
         let sys: &porofrac_sim::BiotSystem<'_, D> = sys;
         Ok(match coupling {
             CouplingChoice::FixedStress => {
@@ -1068,7 +1068,9 @@ fn coupled<'a, const D: usize>(
             }
             _ => Scheme::Monolithic(Monolithic::new(sys, None)?),
         })
-    })?)
+    })?;
+    run.set_cavitation_pressure(s.physics.cavitation_pressure)?;
+    Ok(run)
 }
 
 /// The cells holding the probes and the points of the output lines, with their fields;

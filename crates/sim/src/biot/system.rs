@@ -53,6 +53,9 @@ pub struct BiotSystem<'a, const D: usize> {
     /// Their stiffness matrices in `k_values` (concatenated in the order of
     /// `free_cells`), when `k_values` is this system's own assembly at a known point.
     pub(super) free_tangents: Option<Vec<f64>>,
+    /// The void created in every cell over a step, as a fluid source rate (m³/s per cell;
+    /// m²/s in 2D) added to the flow forcing ([`Self::set_void_source`]).
+    pub(super) void_source: Option<Vec<f64>>,
 }
 
 /// The coupling data of a grid: α and `p₀` per cell, and the node normals `N_i` of every
@@ -254,6 +257,7 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
             elements,
             free_cells,
             free_tangents: None,
+            void_source: None,
         })
     }
 
@@ -276,6 +280,27 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
         }
         self.drained_bulk = Some(k_dr);
         Ok(self)
+    }
+
+    /// Add the rate `q` (m³/s per cell; m²/s in 2D; one per cell) to the flow forcing of
+    /// every step: the volume `q Δt` a step opens in a cell without fluid to fill it (a
+    /// cavitation void, [`crate::cavitation`]) counts as a source of that volume in the
+    /// cell's mass balance `M Δp + α ΔV + Δt A p = Δt (b + q)`. `None` (the default):
+    /// no such term, the forcing as it was.
+    ///
+    /// Errors: a length other than the number of cells, a non-finite rate.
+    pub fn set_void_source(&mut self, q: Option<Vec<f64>>) -> BiotResult<()> {
+        if let Some(q) = &q {
+            check_len("void source", q.len(), self.num_cells())?;
+            if let Some(c) = q.iter().position(|v| !v.is_finite()) {
+                return Err(BiotError::Input(format!(
+                    "cell {c}: void source must be finite, got {}",
+                    q[c]
+                )));
+            }
+        }
+        self.void_source = q;
+        Ok(())
     }
 
     /// Number of cells (pressure unknowns).
@@ -583,6 +608,9 @@ impl<'a, const D: usize> BiotSystem<'a, D> {
         out: &mut [f64],
     ) -> BiotResult<()> {
         self.flow.forcing(t, out)?;
+        if let Some(q) = &self.void_source {
+            out.iter_mut().zip(q).for_each(|(o, q)| *o += q);
+        }
         let a = self.flow.flux_matrix();
         let (cp, ri, v) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
         for (q, pk) in cp.windows(2).zip(p_old) {

@@ -1,0 +1,389 @@
+//! The pore pressure bounded below by a cavitation (vapour) pressure: a step of a Biot
+//! coupling with an active set of cavitating cells, and the void they open.
+//!
+//! # The bound
+//!
+//! A cell that opens faster than fluid can reach it (the cells of a crack ahead of the
+//! fluid front, fluid lag) would otherwise fall to an unbounded suction: its undrained
+//! mass balance `M Δp + α ΔV = 0` gives `Δp = −α ΔV / M`, tens of MPa below zero for a
+//! small storage `M`. A liquid cannot hold such a tension: below its vapour
+//! (cavitation) pressure `p_c` it boils, or the crack fills with vapour and the gas of the
+//! rock, and the pressure stays at `p_c`. The volume the cell opens beyond what its fluid
+//! fills is then a void `V ≥ 0`.
+//!
+//! Per cell, with the void `Vⁿ` at the start of a step and its change `ΔV_v` over the step,
+//! the mass balance of the fluid (the Biot rows of [`crate::biot`]) becomes
+//!
+//! ```text
+//!   M Δp + α ΔV + Δt A p = Δt b + ΔV_v ,
+//!   p ≥ p_c ,   Vⁿ + ΔV_v ≥ 0 ,   (p − p_c) (Vⁿ + ΔV_v) = 0 :
+//! ```
+//!
+//! the void opens only at the cavitation pressure, and a cell above it holds no void. The
+//! void change enters the coupled system as a source `ΔV_v / Δt` of the cell
+//! ([`BiotSystem::set_void_source`]); since the step is linear in its sources, the
+//! complementarity problem is solved by a primal–dual active set on the few cells
+//! concerned:
+//!
+//! * the *cavitating* set `S`: `p = p_c`, the void change `ΔV_v` unknown;
+//! * every other cell: the void it held closes, `ΔV_v = −Vⁿ` (the fluid that arrives
+//!   fills it first), and its pressure is free.
+//!
+//! The step without void sources and the response of the pressure to a unit void source
+//! in each cell of `S` (one solve each, with the same matrix: a back-substitution for
+//! the monolithic scheme) give the pressure of any choice of sources by superposition;
+//! the void changes of `S` solve the small dense system `p_S = p_c`. A cell of `S` whose
+//! void would become negative leaves `S`; a cell outside `S` below `p_c` joins it; the
+//! iteration ends when `S` does not change (at most [`MAX_ACTIVE_SET`] times). The step is
+//! then solved once more with the sources found, and the pressure of the cells of `S`
+//! set to `p_c` (it differs from it by the rounding of that solve). The fluid volume is
+//! balanced to rounding: over a closed domain the injected volume equals the stored one
+//! (`Σ M Δp + α ΔV`) less the void change, `Σ ΔV_v`.
+//!
+//! Without a bound ([`bounded_step`] is not called) the step is the scheme's own, bit for
+//! bit.
+
+use crate::biot::{BiotError, BiotResult, BiotStep, BiotSystem};
+
+/// The most changes of the cavitating set within one step.
+pub const MAX_ACTIVE_SET: usize = 50;
+
+/// A step with the pore pressure bounded below ([`bounded_step`]).
+#[derive(Clone, Debug)]
+pub struct BoundedStep {
+    /// The step, with the pressure of every cavitating cell equal to the bound.
+    pub step: BiotStep,
+    /// The change of the void of every cell over the step (m³; m² per unit height in 2D):
+    /// positive where a cavitating cell opened, `−Vⁿ` where a void closed.
+    pub void_change: Vec<f64>,
+    /// The cells at the cavitation pressure at the end of the step.
+    pub cavitating: Vec<usize>,
+    /// Coupled solves done (1 when no cell cavitates).
+    pub solves: usize,
+}
+
+/// The responses of the pressure to a unit void in a cell, kept from one bounded step to
+/// the next (see [`bounded_step`]): the cavitating cells of a crack's tips change little
+/// from one solve to the next, and neither does the response of the coupled system to a
+/// void in one of them. A kept response only steers the iteration; every state accepted
+/// is a solve of the current system.
+#[derive(Clone, Debug, Default)]
+pub struct ResponseCache {
+    /// Per cell: the pressure change of a void of the cell's own volume over a step, as
+    /// (cell, value) pairs above a small fraction of the largest.
+    entries: Vec<(usize, Vec<(usize, f64)>)>,
+}
+
+/// Responses kept at most; the oldest go first.
+const MAX_RESPONSES: usize = 256;
+
+impl ResponseCache {
+    /// An empty cache.
+    pub fn new() -> Self {
+        Self::default()
+    }
+    /// Forget every response (e.g. for a new grid or system).
+    pub fn clear(&mut self) {
+        self.entries.clear();
+    }
+    /// The number of responses kept.
+    pub fn len(&self) -> usize {
+        self.entries.len()
+    }
+    /// Whether no response is kept.
+    pub fn is_empty(&self) -> bool {
+        self.entries.is_empty()
+    }
+    fn get(&self, d: usize) -> Option<&[(usize, f64)]> {
+        self.entries
+            .iter()
+            .find(|(e, _)| *e == d)
+            .map(|(_, r)| r.as_slice())
+    }
+    fn put(&mut self, d: usize, dp: &[f64]) {
+        self.entries.retain(|(e, _)| *e != d);
+        if self.entries.len() >= MAX_RESPONSES {
+            self.entries.remove(0);
+        }
+        let big = dp.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let kept = dp
+            .iter()
+            .enumerate()
+            .filter(|(_, v)| v.abs() > 1e-12 * big)
+            .map(|(c, &v)| (c, v))
+            .collect();
+        self.entries.push((d, kept));
+    }
+    /// The response at cell `c` of a void in cell `d` (0 when not kept there).
+    fn at(&self, d: usize, c: usize) -> f64 {
+        self.get(d)
+            .and_then(|r| r.iter().find(|(i, _)| *i == c).map(|(_, v)| *v))
+            .unwrap_or(0.0)
+    }
+}
+
+/// One step of a coupling (`step`, called with `system` and the void sources set) with
+/// the pore pressure of every cell bounded below by `p_cav` (Pa, absolute) and the void
+/// `void` (m³ per cell; m² in 2D) at the start of the step (see the module docs). `dt`
+/// is the step (> 0); `cache` keeps the responses of the cavitating cells between calls
+/// (they steer the iteration; a stale one costs iterations, not accuracy). The void
+/// sources of `system` are reset to none at the end.
+///
+/// Errors: lengths, a non-finite bound, `dt ≤ 0`, an error of `step`, or a cavitating set
+/// that does not settle within [`MAX_ACTIVE_SET`] changes.
+pub fn bounded_step<const D: usize>(
+    system: &mut BiotSystem<'_, D>,
+    p_cav: f64,
+    void: &[f64],
+    dt: f64,
+    cache: &mut ResponseCache,
+    mut step: impl FnMut(&BiotSystem<'_, D>) -> BiotResult<BiotStep>,
+) -> BiotResult<BoundedStep> {
+    let nc = system.num_cells();
+    if void.len() != nc {
+        return Err(BiotError::Input(format!(
+            "void of {} cells, the system has {nc}",
+            void.len()
+        )));
+    }
+    if !p_cav.is_finite() {
+        return Err(BiotError::Input(format!(
+            "cavitation pressure must be finite, got {p_cav}"
+        )));
+    }
+    if !(dt.is_finite() && dt > 0.0) {
+        return Err(BiotError::Input(format!(
+            "a step bounded by a cavitation pressure needs Δt > 0, got {dt}"
+        )));
+    }
+    let volumes = system.mechanics().grid.cell_volumes().to_vec();
+    let result = settle(system, p_cav, void, dt, &volumes, cache, &mut step);
+    system.set_void_source(None)?;
+    result
+}
+
+/// Newton corrections of the voids of one cavitating set before its responses are
+/// measured again (kept ones) or the set is given up (fresh ones).
+const MAX_CORRECTIONS: usize = 8;
+
+/// The active-set iteration of [`bounded_step`].
+fn settle<const D: usize>(
+    system: &mut BiotSystem<'_, D>,
+    p_cav: f64,
+    void: &[f64],
+    dt: f64,
+    volumes: &[f64],
+    cache: &mut ResponseCache,
+    step: &mut impl FnMut(&BiotSystem<'_, D>) -> BiotResult<BiotStep>,
+) -> BiotResult<BoundedStep> {
+    let nc = void.len();
+    system.set_void_source(None)?;
+    let free = step(system)?;
+    let mut solves = 1;
+    let holds_void = |c: usize| void[c] > 0.0;
+    if free.state.pressure.iter().all(|&p| p >= p_cav) && !(0..nc).any(holds_void) {
+        return Ok(BoundedStep {
+            step: free,
+            void_change: vec![0.0; nc],
+            cavitating: Vec::new(),
+            solves,
+        });
+    }
+    let scale = free
+        .state
+        .pressure
+        .iter()
+        .fold(p_cav.abs(), |m, p| m.max(p.abs()));
+    let tol = 1e-10 * scale;
+    let mut active: Vec<usize> = (0..nc)
+        .filter(|&c| holds_void(c) || free.state.pressure[c] < p_cav - tol)
+        .collect();
+    // The cells whose response was measured with the system of this call.
+    let mut fresh: Vec<usize> = Vec::new();
+    let base = Base {
+        free: &free.state.pressure,
+        volumes,
+        dt,
+    };
+    for _ in 0..MAX_ACTIVE_SET {
+        for &c in &active {
+            if cache.get(c).is_none() {
+                base.measure(c, system, cache, step)?;
+                solves += 1;
+                fresh.push(c);
+            }
+        }
+        // Void changes in units of each cell's volume: the closing voids outside the set
+        // are known, those of the set make its pressure p_c.
+        let mut amount = vec![0.0; nc];
+        for c in (0..nc).filter(|&c| holds_void(c) && active.binary_search(&c).is_err()) {
+            amount[c] = -void[c] / volumes[c];
+        }
+        let m = active.len();
+        let jacobian = |cache: &ResponseCache| {
+            let mut g = vec![0.0; m * m];
+            for (i, &c) in active.iter().enumerate() {
+                for (j, &d) in active.iter().enumerate() {
+                    g[i * m + j] = cache.at(d, c);
+                }
+            }
+            g
+        };
+        let mut g = jacobian(cache);
+        // The first guess from the free step, then Newton corrections with real solves.
+        let mut r: Vec<f64> = active
+            .iter()
+            .map(|&c| p_cav - free.state.pressure[c])
+            .collect();
+        let mut solved = None;
+        let mut last = f64::INFINITY;
+        for k in 0..2 * MAX_CORRECTIONS {
+            let dx = dense_solve(&mut g.clone(), &mut r.clone(), m).ok_or_else(|| {
+                BiotError::Solver(
+                    "cavitation: the response of the cavitating cells is singular".into(),
+                )
+            })?;
+            for (&c, d) in active.iter().zip(&dx) {
+                amount[c] += d;
+            }
+            let q: Vec<f64> = amount
+                .iter()
+                .zip(volumes)
+                .map(|(a, v)| a * v / dt)
+                .collect();
+            system.set_void_source(Some(q))?;
+            let s = step(system)?;
+            solves += 1;
+            r = active
+                .iter()
+                .map(|&c| p_cav - s.state.pressure[c])
+                .collect();
+            let err = r.iter().fold(0.0f64, |e, v| e.max(v.abs()));
+            let all_fresh = active.iter().all(|c| fresh.contains(c));
+            // Converged, or at the rounding of the solves (no progress with responses of
+            // the current system).
+            if err <= tol || (all_fresh && err > 0.5 * last && err <= 1e-7 * scale) {
+                solved = Some(s);
+                break;
+            }
+            // Slow progress with kept responses: measure those of the set again.
+            let stale: Vec<usize> = active
+                .iter()
+                .copied()
+                .filter(|c| !fresh.contains(c))
+                .collect();
+            if (err > 0.1 * last || k + 1 == MAX_CORRECTIONS) && !stale.is_empty() {
+                for c in stale {
+                    base.measure(c, system, cache, step)?;
+                    solves += 1;
+                    fresh.push(c);
+                }
+                g = jacobian(cache);
+            }
+            last = err;
+        }
+        let Some(mut s) = solved else {
+            return Err(BiotError::Solver(format!(
+                "cavitation: the pressure of {m} cavitating cells did not reach the bound \
+                 (largest miss {last:.3e} Pa)"
+            )));
+        };
+        let mut next: Vec<usize> = active
+            .iter()
+            .copied()
+            .filter(|&c| void[c] + amount[c] * volumes[c] >= -1e-12 * volumes[c])
+            .collect();
+        if next.len() == active.len() {
+            next.extend((0..nc).filter(|&c| {
+                active.binary_search(&c).is_err() && s.state.pressure[c] < p_cav - tol
+            }));
+            next.sort_unstable();
+        }
+        if next == active {
+            let mut void_change: Vec<f64> =
+                amount.iter().zip(volumes).map(|(a, v)| a * v).collect();
+            for &c in &active {
+                // The pressure differs from the bound by the rounding of the solve.
+                s.state.pressure[c] = p_cav;
+                // A void emptied to rounding is closed.
+                if void[c] + void_change[c] < 0.0 {
+                    void_change[c] = -void[c];
+                }
+            }
+            return Ok(BoundedStep {
+                step: s,
+                void_change,
+                cavitating: active,
+                solves,
+            });
+        }
+        active = next;
+    }
+    Err(BiotError::Solver(format!(
+        "the cavitating cells did not settle within {MAX_ACTIVE_SET} changes of the set"
+    )))
+}
+
+/// What the responses of the pressure to unit voids are measured against.
+struct Base<'r> {
+    free: &'r [f64],
+    volumes: &'r [f64],
+    dt: f64,
+}
+
+impl Base<'_> {
+    /// Measure and keep the pressure change of a void of cell `d`'s volume over the step.
+    fn measure<const D: usize>(
+        &self,
+        d: usize,
+        system: &mut BiotSystem<'_, D>,
+        cache: &mut ResponseCache,
+        step: &mut impl FnMut(&BiotSystem<'_, D>) -> BiotResult<BiotStep>,
+    ) -> BiotResult<()> {
+        let mut q = vec![0.0; self.free.len()];
+        q[d] = self.volumes[d] / self.dt;
+        system.set_void_source(Some(q))?;
+        let s = step(system)?;
+        let dp: Vec<f64> = s
+            .state
+            .pressure
+            .iter()
+            .zip(self.free)
+            .map(|(a, b)| a - b)
+            .collect();
+        cache.put(d, &dp);
+        Ok(())
+    }
+}
+
+/// Solve the dense `m × m` system `g x = b` (row-major `g`, overwritten) by Gaussian
+/// elimination with partial pivoting; `None` when a pivot vanishes.
+fn dense_solve(g: &mut [f64], b: &mut [f64], m: usize) -> Option<Vec<f64>> {
+    for k in 0..m {
+        let piv = (k..m).max_by(|&i, &j| g[i * m + k].abs().total_cmp(&g[j * m + k].abs()))?;
+        if g[piv * m + k] == 0.0 || !g[piv * m + k].is_finite() {
+            return None;
+        }
+        if piv != k {
+            for j in 0..m {
+                g.swap(k * m + j, piv * m + j);
+            }
+            b.swap(k, piv);
+        }
+        for i in k + 1..m {
+            let f = g[i * m + k] / g[k * m + k];
+            if f != 0.0 {
+                for j in k..m {
+                    g[i * m + j] -= f * g[k * m + j];
+                }
+                b[i] -= f * b[k];
+            }
+        }
+    }
+    let mut x = vec![0.0; m];
+    for k in (0..m).rev() {
+        let s: f64 = (k + 1..m).map(|j| g[k * m + j] * x[j]).sum();
+        x[k] = (b[k] - s) / g[k * m + k];
+    }
+    Some(x)
+}
