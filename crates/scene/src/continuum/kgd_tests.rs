@@ -170,12 +170,15 @@ fn kgd_viscosity_errors(tag: &str) -> (f64, f64, f64, f64) {
     (e_l, e_w, worst_w, exponent)
 }
 
+/// The target of 10 % on the inlet opening, on average over t ≥ 8 s (2026-11-29,
+/// h = 0.125 m: +9.6 %, +20.6 % at most, early; at h = 0.0625 m +23.7 %: the tip rule
+/// reads the viscous `r^{2/3}` opening as `√r`, docs/hydrofrac/validation.md).
 #[test]
 fn kgd_viscosity_inlet_opening_follows_the_vertex_solution() {
     let (_, e_w, worst_w, _) = kgd_viscosity_errors("kgd_mu_w");
     assert!(
-        e_w.abs() < 0.10 && worst_w < 0.22,
-        "inlet opening {e_w:+.4}, {worst_w:.4}"
+        e_w.abs() < 0.10,
+        "inlet opening {e_w:+.4} on average (target ±10 %), {worst_w:.4} at most"
     );
 }
 
