@@ -40,13 +40,24 @@ fn vertex(t: f64) -> (f64, f64, f64) {
 }
 
 /// The columns of a CSV file with a header (the numbers of every row).
-fn csv(path: &Path) -> Vec<Vec<String>> {
+pub(super) fn csv(path: &Path) -> Vec<Vec<String>> {
     std::fs::read_to_string(path)
         .unwrap()
         .lines()
         .skip(1)
         .map(|l| l.split(',').map(str::to_string).collect())
         .collect()
+}
+
+/// The least-squares slope of `(log t, log ℓ)` pairs: the time exponent of a length.
+pub(super) fn log_slope(logs: &[(f64, f64)]) -> f64 {
+    let m = logs.len() as f64;
+    let (mx, my) = (
+        logs.iter().map(|p| p.0).sum::<f64>() / m,
+        logs.iter().map(|p| p.1).sum::<f64>() / m,
+    );
+    logs.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>()
+        / logs.iter().map(|p| (p.0 - mx).powi(2)).sum::<f64>()
 }
 
 /// Run a KGD scene's text (named `path` in errors) in a temporary folder: its probe rows
@@ -102,12 +113,7 @@ fn kgd_toughness_follows_the_vertex_solution() {
     let m = logs.len() as f64;
     assert_eq!(logs.len(), 41, "probes every 2 s from 20 s to 100 s");
     let (e_l, a_l, a_p, a_w) = (e_l / m, a_l / m, a_p / m, a_w / m);
-    let (mx, my) = (
-        logs.iter().map(|p| p.0).sum::<f64>() / m,
-        logs.iter().map(|p| p.1).sum::<f64>() / m,
-    );
-    let exponent = logs.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>()
-        / logs.iter().map(|p| (p.0 - mx).powi(2)).sum::<f64>();
+    let exponent = log_slope(&logs);
     println!(
         "KGD toughness, h = {h} m, t >= 20 s: l {e_l:+.4} (mean |.| {a_l:.4}), p {a_p:.4}, \
          w {a_w:.4}, exponent {exponent:.4}"
@@ -156,12 +162,7 @@ fn kgd_viscosity_errors(tag: &str) -> (f64, f64, f64, f64) {
         m += 1.0;
     }
     let (e_l, e_w) = (e_l / m, e_w / m);
-    let (mx, my) = (
-        logs.iter().map(|v| v.0).sum::<f64>() / m,
-        logs.iter().map(|v| v.1).sum::<f64>() / m,
-    );
-    let exponent = logs.iter().map(|v| (v.0 - mx) * (v.1 - my)).sum::<f64>()
-        / logs.iter().map(|v| (v.0 - mx) * (v.0 - mx)).sum::<f64>();
+    let exponent = log_slope(&logs);
     println!(
         "KGD viscosity, h = {h} m, t >= 8 s: l {e_l:+.4}, w {e_w:+.4} (largest {worst_w:.4}), \
          exponent of l {exponent:.4}"

@@ -21,6 +21,7 @@
 
 use std::path::Path;
 
+use super::kgd_tests::{csv, log_slope};
 use crate::{LawRegistry, Scene, Silent};
 
 const E: f64 = 1.0e10;
@@ -37,16 +38,6 @@ fn vertex(t: f64) -> (f64, f64, f64) {
     let r = (3.0 / (pi * 2f64.sqrt())).powf(0.4) * (ep * Q0 * t / kp).powf(0.4);
     let p = pi.sqrt() * K_IC / (2.0 * r.sqrt());
     (r, p, 8.0 * p * r / (pi * ep))
-}
-
-/// The rows of a CSV file with a header, as text fields.
-fn csv(path: &Path) -> Vec<Vec<String>> {
-    std::fs::read_to_string(path)
-        .unwrap()
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').map(str::to_string).collect())
-        .collect()
 }
 
 #[test]
@@ -110,12 +101,7 @@ fn penny_errors() -> PennyErrors {
     let m = logs.len() as f64;
     assert_eq!(logs.len(), 41, "probes every 2 s from 20 s to 100 s");
     let (e_r, a_r, e_p, e_w) = (e_r / m, a_r / m, e_p / m, e_w / m);
-    let (mx, my) = (
-        logs.iter().map(|p| p.0).sum::<f64>() / m,
-        logs.iter().map(|p| p.1).sum::<f64>() / m,
-    );
-    let exponent = logs.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>()
-        / logs.iter().map(|p| (p.0 - mx).powi(2)).sum::<f64>();
+    let exponent = log_slope(&logs);
     println!(
         "penny toughness, h = {h} m, t >= 20 s: R {e_r:+.4} (mean |.| {a_r:.4}), \
          p {e_p:+.4}, w {e_w:+.4}, exponent {exponent:.4}"
