@@ -26,19 +26,32 @@ def vertex(t):
     return l, p, 4 * p * l / EP
 
 
-def scene_at(text, r):
+def scene_at(text, r, h_scene=2.0 / 32):
+    """A KGD scene's text (`h_scene`: its own cell size along the path) at refine = r: the
+    path's row, the mouth and the probes moved to the row 50 < y < 50 + h, h = 2/r."""
     h = 2.0 / r
+
+    def at(x):
+        return repr(round(x, 6))
+
     text = re.sub(r"refine = \d+", f"refine = {r}", text)
-    text = text.replace("[[46.001, 50.001], [53.999, 50.0615]]",
-                        f"[[46.001, 50.001], [53.999, {50 + h - 0.001}]]")
-    text = text.replace("[[49.9385, 50.001], [50.0615, 50.0615]]",
-                        f"[[{50 - h + 0.001}, 50.001], [{50 + h - 0.001}, {50 + h - 0.001}]]")
-    text = text.replace("at = [50.0001, 50.03125]", f"at = [50.0001, {50 + h / 2}]")
-    text = text.replace("at = [50.0, 50.0625]", f"at = [50.0, {50 + h}]")
+    b = h_scene
+    for old, new in [
+        (f"[[46.001, 50.001], [53.999, {at(50 + b - 0.001)}]]",
+         f"[[46.001, 50.001], [53.999, {50 + h - 0.001}]]"),
+        (f"[[{at(50 - b + 0.001)}, 50.001], [{at(50 + b - 0.001)}, {at(50 + b - 0.001)}]]",
+         f"[[{50 - h + 0.001}, 50.001], [{50 + h - 0.001}, {50 + h - 0.001}]]"),
+        (f"at = [50.0001, {at(50 + b / 2)}]", f"at = [50.0001, {50 + h / 2}]"),
+        (f"at = [50.0, {at(50 + b)}]", f"at = [50.0, {50 + h}]"),
+    ]:
+        assert old in text, old
+        text = text.replace(old, new)
     return text
 
 
-def results(out, h):
+def results(out, h, p0=0.0):
+    """Rows (t, half-length, inlet net pressure (inlet pressure − p0), inlet opening) of
+    a run's folder, t > 0."""
     probes = list(csv.DictReader(open(os.path.join(out, "probes.csv"))))
     failed = [float(f["time [s]"]) for f in csv.DictReader(open(os.path.join(out, "fracture.csv")))]
     rows = []
@@ -48,7 +61,7 @@ def results(out, h):
             continue
         n = sum(1 for tf in failed if tf <= t + 1e-9)
         w = float(r["uy_top [m]"]) - float(r["uy_bottom [m]"])
-        rows.append((t, n * h / 4, float(r["p_inlet [Pa]"]), w))
+        rows.append((t, n * h / 4, float(r["p_inlet [Pa]"]) - p0, w))
     return rows
 
 

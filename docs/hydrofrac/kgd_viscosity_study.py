@@ -14,7 +14,9 @@ mu' = 12 mu, and the time exponents fitted by least squares on the logarithms: o
 not compared). The half-length is (failed cells of the path and mouth) h / 4. Needs
 matplotlib for the plot.
 """
-import csv, math, os, re, subprocess, sys, tempfile, time
+import math, os, subprocess, sys, tempfile, time
+
+from kgd_study import results, scene_at  # the same path, mouth and probes moved with h
 
 E, NU, MU, Q0, P0 = 1.0e10, 0.25, 1.0e-3, 1.0e-5, 1.0e7
 EP = E / (1 - NU * NU)
@@ -26,32 +28,6 @@ def vertex(t):
     l = 0.6152 * (EP * Q0 ** 3 * t ** 4 / MUP) ** (1 / 6)
     w = 1.1265 * (MUP * Q0 ** 3 * t * t / EP) ** (1 / 6)
     return l, w
-
-
-def scene_at(text, r):
-    h = 2.0 / r
-    text = re.sub(r"refine = \d+", f"refine = {r}", text)
-    text = text.replace("[[46.001, 50.001], [53.999, 50.124]]",
-                        f"[[46.001, 50.001], [53.999, {50 + h - 0.001}]]")
-    text = text.replace("[[49.876, 50.001], [50.124, 50.124]]",
-                        f"[[{50 - h + 0.001}, 50.001], [{50 + h - 0.001}, {50 + h - 0.001}]]")
-    text = text.replace("at = [50.0001, 50.0625]", f"at = [50.0001, {50 + h / 2}]")
-    text = text.replace("at = [50.0, 50.125]", f"at = [50.0, {50 + h}]")
-    return text
-
-
-def results(out, h):
-    probes = list(csv.DictReader(open(os.path.join(out, "probes.csv"))))
-    failed = [float(f["time [s]"]) for f in csv.DictReader(open(os.path.join(out, "fracture.csv")))]
-    rows = []
-    for r in probes:
-        t = float(r["time [s]"])
-        if t == 0:
-            continue
-        n = sum(1 for tf in failed if tf <= t + 1e-9)
-        w = float(r["uy_top [m]"]) - float(r["uy_bottom [m]"])
-        rows.append((t, n * h / 4, float(r["p_inlet [Pa]"]) - P0, w))
-    return rows
 
 
 def fit(xs, ys):
@@ -79,12 +55,12 @@ def main():
     with tempfile.TemporaryDirectory() as tmp:
         for r in (8, 16, 32):
             path = os.path.join(tmp, f"kgd_{r}.toml")
-            open(path, "w").write(scene_at(text, r))
+            open(path, "w").write(scene_at(text, r, h_scene=0.125))
             out = os.path.join(tmp, f"out_{r}")
             start = time.time()
             subprocess.run([exe, "run", path, "--out", out], check=True, capture_output=True)
             walls[r] = time.time() - start
-            runs[r] = results(out, 2.0 / r)
+            runs[r] = results(out, 2.0 / r, P0)
     print("| refine | h (m) | cells per half-length at 40 s | l: mean, mean abs, largest | w: mean, mean abs, largest | exponent of l (2/3) | exponent of p (-1/3) | wall (s) |")
     print("|---:|---:|---:|---|---|---:|---:|---:|")
     for r, rows in runs.items():
