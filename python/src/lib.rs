@@ -361,6 +361,11 @@ impl PyScene {
             Some(out) => scene.run(out, &mut obs),
             None => scene.run_in_memory(&mut obs),
         });
+        // An interrupt that arrived after the run's last check is taken now, as Ctrl-C
+        // during the last step would be: it stops nothing more but is raised with the result.
+        if let Err(e) = py.check_signals() {
+            obs.fail(e);
+        }
         let pending = obs.take_pending();
         let summary = match summary {
             Ok(s) => s,
