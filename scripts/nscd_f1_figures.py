@@ -3,15 +3,16 @@
 its four acceptance gates and the figures of the paper's Figs. 6-10.
 
     python3 scripts/nscd_f1_figures.py OUT_DIR [--scale S] [--figures DIR] [--prefix NAME]
-                                       [--stages N] [--every K]
+                                       [--stages N] [--every K] [--until T]
 
 OUT_DIR is the output directory of `porofrac run scenes/nscd/forced_fold_paper.toml`
 (scale 1, the default) or of `scenes/nscd/forced_fold_wedge.toml` (`--scale 0.2`): the
 particle and contact frames `vtk/particles_*.vtp`, `vtk/contacts_*.vtp` (binary base64,
 UInt64 headers) listed with their times in `*.pvd`, and `probes.csv` with p, q,
 dilation_x and dilation_y of the tracked cells W1-W6. A run still going (or stopped and
-resumed) can be read at any time: the frames written so far are used, and the gates are
-stated for the time reached. Nothing in OUT_DIR is written.
+resumed) can be read at any time: the frames written so far are used (or those up to
+--until T seconds), and the gates are stated for the time reached. Nothing in OUT_DIR is
+written.
 
 The geometry is the paper's scaled by S: a layer of thickness h = 30 S m on the base,
 the left wall moving at 0.5 m/s (the speed is not scaled), the tracked cells W1-W6 at
@@ -145,6 +146,7 @@ def main():
     ap.add_argument("--prefix", default=None)
     ap.add_argument("--stages", type=int, default=4)
     ap.add_argument("--every", type=int, default=1)
+    ap.add_argument("--until", type=float, default=None)
     a = ap.parse_args()
     import matplotlib
 
@@ -158,6 +160,10 @@ def main():
     top = LAYER * s
     rows = frames(a.out)
     probes = read_probes(a.out)
+    if a.until is not None:
+        rows = [r for r in rows if r[0] <= a.until]
+        keep = probes["time"] <= a.until
+        probes = {k: v[keep] for k, v in probes.items()}
     t_end = probes["time"][-1]
     wall_of = lambda t: SPEED * t
     os.makedirs(a.figures, exist_ok=True)
@@ -230,7 +236,7 @@ def main():
         x, r, _ = particles(p)
         ec = EllipseCollection(2 * r, 2 * r, np.zeros_like(r), units="xy", offsets=x,
                                offset_transform=ax.transData, facecolors=colours[band],
-                               edgecolors="none")
+                               edgecolors="none", antialiased=False)
         ax.add_collection(ec)
         for (cx, cy, rc), name in zip(cells, [f"W{j}" for j in range(1, 7)]):
             ax.add_patch(plt.Circle((cx, cy), rc, fill=False, lw=0.8, color="k"))
@@ -242,7 +248,7 @@ def main():
         ax.set_title(f"t = {t:g} s, shortening {wall_of(t):g} m", fontsize=9)
     axes[-1, 0].set_xlabel("x (m)")
     fig.tight_layout()
-    fig.savefig(os.path.join(a.figures, f"{prefix}_layers.png"), dpi=110)
+    fig.savefig(os.path.join(a.figures, f"{prefix}_layers.png"), dpi=100)
     plt.close(fig)
 
     # Fig. 7: the wedge front.
