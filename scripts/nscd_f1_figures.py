@@ -8,8 +8,9 @@ its four acceptance gates and the figures of the paper's Figs. 6-10.
 OUT_DIR is the output directory of `porofrac run scenes/nscd/forced_fold_paper.toml`
 (scale 1, the default) or of `scenes/nscd/forced_fold_wedge.toml` (`--scale 0.2`): the
 particle and contact frames `vtk/particles_*.vtp`, `vtk/contacts_*.vtp` (binary base64,
-UInt64 headers) listed with their times in `*.pvd`, and `probes.csv` with p, q,
-dilation_x and dilation_y of the tracked cells W1-W6. A run still going (or stopped and
+UInt64 headers) listed with their times in `*.pvd`, `probes.csv` with p, q,
+dilation_x and dilation_y of the tracked cells W1-W6, and `summary.json` once the run
+has ended (its status, steps, sweeps and contacts are printed). A run still going (or stopped and
 resumed) can be read at any time: the frames written so far are used (or those up to
 --until T seconds), and the gates are stated for the time reached. Nothing in OUT_DIR is
 written.
@@ -175,6 +176,19 @@ def main():
     tracked = [np.hypot(init[:, 0] - cx, init[:, 1] - cy) <= rc for cx, cy, rc in cells]
 
     done = t_end >= END * s * (1.0 - 1e-9)
+    summary = os.path.join(a.out, "summary.json")
+    if os.path.exists(summary):
+        import json
+
+        sm = json.load(open(summary))
+        sw, ct = sm.get("sweeps") or {}, sm.get("contacts") or {}
+        print(f"summary.json: status {sm.get('status')!r}, {sm.get('steps')} steps, "
+              f"{sm.get('particles')} disks, sweeps per step mean {sw.get('mean')} max "
+              f"{sw.get('max')}, contacts mean {ct.get('mean')} max {ct.get('max')}, "
+              f"not converged steps {sm.get('not_converged_steps')}, wall "
+              f"{(sm.get('wall_seconds') or {}).get('total')} s")
+    else:
+        print("no summary.json yet: the run is going or was stopped")
 
     # Gate 1: the wedge front over the frames.
     fronts = []
@@ -227,8 +241,9 @@ def main():
     pick = sorted(set(int(round(k)) for k in np.linspace(0, len(rows) - 1, n)))
     lo, hi = float(np.min(init[:, 1] - r0)), top
     band = np.clip(((init[:, 1] - lo) / (hi - lo) * 9).astype(int), 0, 9)
-    colours = plt.get_cmap("tab10")(np.arange(10))
-    colours[9] = (0.75, 0.75, 0.75, 1.0)  # above the layer: the wedge
+    # Nine layers in the colours of tab10 but its grey, the wedge above them in grey.
+    colours = plt.get_cmap("tab10")(np.array([0, 1, 2, 3, 4, 5, 6, 8, 9, 7]))
+    colours[9] = (0.75, 0.75, 0.75, 1.0)
     xmax = float(np.max(init[:, 0] + r0))
     fig, axes = plt.subplots(len(pick), 1, figsize=(16, 0.6 + 2.0 * len(pick)), squeeze=False)
     for ax, k in zip(axes[:, 0], pick):
