@@ -188,6 +188,7 @@ impl Nlgs {
                     &mut self.masks,
                     &mut self.starts,
                 );
+                self.shared.load(v, omega, body_v);
             } else {
                 self.slabs.partition(
                     contacts,
@@ -196,80 +197,95 @@ impl Nlgs {
                     &body_moving,
                     rayon::current_num_threads(),
                 );
+                self.slabs.load(contacts, v, omega, body_v, inv.m, inv.i);
             }
-            self.shared.load(v, omega, body_v);
         }
         if !contacts.is_empty() {
-            for k in 1..=options.max_sweeps {
-                if self
-                    .interrupt
-                    .as_ref()
-                    .is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed))
-                {
-                    stats.interrupted = true;
-                    break;
-                }
-                let (num, den) = if coloured {
-                    crate::colour::sweep(
-                        contacts,
-                        &self.starts,
-                        serial_last,
-                        &self.shared,
-                        inv.m,
-                        inv.i,
-                        inv.body,
-                    )
-                } else if slabs {
-                    self.slabs
-                        .sweep(contacts, &self.shared, inv.m, inv.i, inv.body)
-                } else {
-                    match rng.as_mut() {
-                        None => sweep(contacts, None, v, omega, inv.m, inv.i, body_v, inv.body),
-                        Some(rng) => {
-                            self.order.clear();
-                            self.order.extend(0..contacts.len() as u32);
-                            for a in (1..self.order.len()).rev() {
-                                self.order.swap(a, rng.below(a + 1));
-                            }
-                            sweep(
-                                contacts,
-                                Some(&self.order),
-                                v,
-                                omega,
-                                inv.m,
-                                inv.i,
-                                body_v,
-                                inv.body,
-                            )
-                        }
+            // The sweeps of the step, with the stopping test.
+            let mut run = || {
+                for k in 1..=options.max_sweeps {
+                    if self
+                        .interrupt
+                        .as_ref()
+                        .is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed))
+                    {
+                        stats.interrupted = true;
+                        break;
                     }
-                };
-                stats.sweeps = k;
-                stats.residual = if den > 0.0 {
-                    (num / den).sqrt()
-                } else if num > 0.0 {
-                    f64::INFINITY
-                } else {
-                    0.0
-                };
-                if k >= options.min_sweeps && (num == 0.0 || stats.residual <= options.tolerance) {
-                    stats.converged = true;
-                    break;
+                    let (num, den) = if coloured {
+                        crate::colour::sweep(
+                            contacts,
+                            &self.starts,
+                            serial_last,
+                            &self.shared,
+                            inv.m,
+                            inv.i,
+                            inv.body,
+                        )
+                    } else if slabs {
+                        self.slabs.sweep(inv.body)
+                    } else {
+                        match rng.as_mut() {
+                            None => sweep(contacts, None, v, omega, inv.m, inv.i, body_v, inv.body),
+                            Some(rng) => {
+                                self.order.clear();
+                                self.order.extend(0..contacts.len() as u32);
+                                for a in (1..self.order.len()).rev() {
+                                    self.order.swap(a, rng.below(a + 1));
+                                }
+                                sweep(
+                                    contacts,
+                                    Some(&self.order),
+                                    v,
+                                    omega,
+                                    inv.m,
+                                    inv.i,
+                                    body_v,
+                                    inv.body,
+                                )
+                            }
+                        }
+                    };
+                    stats.sweeps = k;
+                    stats.residual = if den > 0.0 {
+                        (num / den).sqrt()
+                    } else if num > 0.0 {
+                        f64::INFINITY
+                    } else {
+                        0.0
+                    };
+                    if k >= options.min_sweeps
+                        && (num == 0.0 || stats.residual <= options.tolerance)
+                    {
+                        stats.converged = true;
+                        break;
+                    }
                 }
+            };
+            if slabs {
+                // On a worker of the pool for the whole step: each sweep then hands one
+                // slab to the other workers, and the calling thread waits once per step
+                // rather than once per sweep.
+                rayon::scope(|_| run());
+            } else {
+                run();
             }
         } else {
             stats.converged = true;
         }
-        if coloured || slabs {
+        if coloured {
             self.shared.store(v, omega, body_v);
+        } else if slabs {
+            self.slabs.store(contacts, v, omega, body_v);
         }
         stats
     }
 }
 
-/// One Gauss–Seidel sweep; returns (Σ ΔPᵀWΔP, Σ PᵀWP).
+/// One Gauss–Seidel sweep; returns (Σ ΔPᵀWΔP, Σ PᵀWP). Also the sweep of every slab
+/// of [`crate::slabs`], on the slab's own arrays.
 #[allow(clippy::too_many_arguments)]
-fn sweep(
+pub(crate) fn sweep(
     contacts: &mut [Contact],
     order: Option<&[u32]>,
     v: &mut [[f64; 2]],
