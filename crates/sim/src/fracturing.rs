@@ -890,6 +890,38 @@ impl<'a, const D: usize> Fracturing<'a, D> {
         self.cavitation
     }
 
+    /// The fronts of the tip rule [`TipRule::Asymptote`] at the end of the last step, as
+    /// `D` coordinates per front (`None` with another rule).
+    pub fn tip_fronts(&self) -> Option<&[f64]> {
+        self.opening_tips
+            .as_ref()
+            .filter(|t| t.mu_prime.is_some())
+            .map(|t| t.fronts.coordinates())
+    }
+
+    /// Resume the fronts of [`TipRule::Asymptote`] saved by [`Fracturing::tip_fronts`].
+    ///
+    /// Errors: another rule, or not `D` finite coordinates per front.
+    pub fn resume_tip_fronts(&mut self, points: &[f64]) -> FractureResult<()> {
+        let tips = self
+            .opening_tips
+            .as_mut()
+            .filter(|t| t.mu_prime.is_some())
+            .ok_or_else(|| {
+                FractureError::Input(
+                    "tip fronts saved, but the tip rule is not the asymptote".into(),
+                )
+            })?;
+        tips.fronts =
+            crate::tip_asymptote::FrontMemory::from_coordinates(D, points).ok_or_else(|| {
+                FractureError::Input(format!(
+                    "tip fronts: {} values, not {D} finite per front",
+                    points.len()
+                ))
+            })?;
+        Ok(())
+    }
+
     /// The void of every cell (m³; m² per unit height in 2D) at the end of the last step:
     /// the volume opened at the cavitation pressure that fluid has not filled (all zero
     /// without a bound).

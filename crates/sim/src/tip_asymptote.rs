@@ -191,6 +191,23 @@ impl FrontMemory {
         }
     }
 
+    /// Fronts at the points given as `dim` coordinates each (a checkpoint's), or `None`
+    /// when the length is not a multiple of `dim` or a coordinate is not finite.
+    pub fn from_coordinates(dim: usize, points: &[f64]) -> Option<Self> {
+        if dim == 0 || !points.len().is_multiple_of(dim) || points.iter().any(|x| !x.is_finite()) {
+            return None;
+        }
+        Some(Self {
+            points: points.to_vec(),
+            dim,
+        })
+    }
+
+    /// The points' coordinates, `dim` each.
+    pub fn coordinates(&self) -> &[f64] {
+        &self.points
+    }
+
     /// The number of fronts remembered.
     pub fn len(&self) -> usize {
         self.points.len().checked_div(self.dim).unwrap_or(0)
@@ -244,12 +261,12 @@ mod tests {
     #[test]
     fn the_limits_are_the_toughness_and_the_viscosity_asymptotes() {
         let at_rest = kgd(1.0e6, 1.0e-3);
-        for r in [1e-3, 0.1, 2.0] {
+        for r in [1e-3f64, 0.1, 2.0] {
             let wk = at_rest.k_prime / at_rest.e_prime * r.sqrt();
             assert!((at_rest.opening(r, 0.0) / wk - 1.0).abs() < 1e-14);
         }
         let viscous = kgd(0.0, 1.0e-3);
-        for (r, v) in [(1e-3, 0.1), (0.1, 0.05), (2.0, 1e-3)] {
+        for (r, v) in [(1e-3f64, 0.1), (0.1, 0.05), (2.0, 1e-3)] {
             let wm = beta_m() * (viscous.mu_prime * v / viscous.e_prime).cbrt() * r.powf(2.0 / 3.0);
             assert!((viscous.opening(r, v) / wm - 1.0).abs() < 1e-14);
         }
@@ -289,7 +306,10 @@ mod tests {
         assert_eq!(f.speed, 0.0);
         assert!((f.position - back - 0.01).abs() < 1e-12);
         // Without toughness and time, nothing holds the front.
-        assert_eq!(kgd(0.0, 1e-3).front(1e-4, 0.0, 0.0, 0.0).position, f64::INFINITY);
+        assert_eq!(
+            kgd(0.0, 1e-3).front(1e-4, 0.0, 0.0, 0.0).position,
+            f64::INFINITY
+        );
         let f = kgd(0.0, 1e-3).front(1e-4, 0.0, 0.0, 0.5);
         assert!(f.position.is_finite() && (f.position - 0.5 * f.speed).abs() < 1e-9);
     }
@@ -303,5 +323,9 @@ mod tests {
         assert_eq!(m.previous(&Point::<2>::new(-0.9, 0.0), &t, 0.2), Some(-1.0));
         assert_eq!(m.previous(&Point::<2>::new(0.0, 0.0), &t, 0.2), None);
         assert!(FrontMemory::default().is_empty());
+        let back = FrontMemory::from_coordinates(2, m.coordinates()).unwrap();
+        assert_eq!(back, m);
+        assert!(FrontMemory::from_coordinates(2, &[1.0, 2.0, 3.0]).is_none());
+        assert!(FrontMemory::from_coordinates(2, &[1.0, f64::NAN]).is_none());
     }
 }

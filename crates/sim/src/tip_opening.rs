@@ -83,7 +83,11 @@ pub fn tip_stress_intensity<const D: usize>(
     u: &[f64],
 ) -> Option<f64> {
     let s = tip_sample(grid, adjacency, failed, c, u)?;
-    Some(stress_intensity_from_opening(e_prime, s.opening.max(0.0), s.distance))
+    Some(stress_intensity_from_opening(
+        e_prime,
+        s.opening.max(0.0),
+        s.distance,
+    ))
 }
 
 /// The opening behind the tip next to an intact cell, as the module docs read it.

@@ -978,17 +978,17 @@ fn fracture_settings<const D: usize>(ls: &LoadedScene, comp: &Composition<D>) ->
                 D == 2 && s.scene.plane == Some(crate::common::sections::Plane::Stress);
             let e_prime: Vec<f64> = comp
                 .material_of_cell()
-                    .into_iter()
-                    .map(|m| {
-                        let mat = &s.material[m];
-                        let nu = mat.poisson_ratio;
-                        if plane_stress {
-                            mat.youngs_modulus
-                        } else {
-                            mat.youngs_modulus / (1.0 - nu * nu)
-                        }
-                    })
-                    .collect();
+                .into_iter()
+                .map(|m| {
+                    let mat = &s.material[m];
+                    let nu = mat.poisson_ratio;
+                    if plane_stress {
+                        mat.youngs_modulus
+                    } else {
+                        mat.youngs_modulus / (1.0 - nu * nu)
+                    }
+                })
+                .collect();
             settings.tip = if rule == crate::common::sections::TipRuleChoice::Asymptote {
                 porofrac_sim::TipRule::Asymptote {
                     e_prime,
