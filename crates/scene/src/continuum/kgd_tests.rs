@@ -288,9 +288,10 @@ fn kgd_viscosity_converges_under_refinement() {
 #[test]
 fn the_asymptote_tip_rule_refuses_the_recovered_stress() {
     let text = include_str!("../../../../scenes/kgd_viscosity.toml").replace(
-        "tip_rule = \"asymptote\"",
-        "tip_rule = \"asymptote\"\nfailure_stress = \"recovered\"",
+        "\ntip_rule = \"asymptote\"\n",
+        "\ntip_rule = \"asymptote\"\nfailure_stress = \"recovered\"\n",
     );
+    assert!(text.contains("failure_stress"));
     let line = text
         .lines()
         .position(|l| l.starts_with("tip_rule"))
