@@ -204,6 +204,17 @@ pub enum TipRule {
     /// cell: the tip cell fails exactly when that `K_I` exceeds `K_Ic`, whatever its own
     /// stress and tensile strength (the strength still governs the cells away from tips).
     Opening(Vec<f64>),
+    /// From the opening behind the tip read with the regime's tip asymptote
+    /// ([`crate::tip_asymptote`]): the front's position and speed follow from the opening
+    /// on the back line ([`crate::tip_opening`]), and the tip cell fails when the front
+    /// lies beyond the tip. The plane-strain modulus `E/(1 − ν²)` (Pa) of every cell and the
+    /// fluid's `μ′ = 12 μ` (Pa·s).
+    Asymptote {
+        /// `E′` (Pa) of every cell.
+        e_prime: Vec<f64>,
+        /// `μ′ = 12 μ` (Pa·s).
+        mu_prime: f64,
+    },
 }
 
 impl FractureSettings {
@@ -563,6 +574,10 @@ struct OpeningTips {
     class_of_cell: Vec<usize>,
     tips: CrackTips,
     adjacency: NodeCells,
+    /// `μ′` of [`TipRule::Asymptote`] (`None`: [`TipRule::Opening`]).
+    mu_prime: Option<f64>,
+    /// The fronts at the end of the last step ([`TipRule::Asymptote`]).
+    fronts: crate::tip_asymptote::FrontMemory,
 }
 
 impl OpeningTips {
@@ -570,8 +585,17 @@ impl OpeningTips {
         grid: &Grid<D>,
         settings: &FractureSettings,
     ) -> FractureResult<Option<Self>> {
-        let TipRule::Opening(e_prime) = &settings.tip else {
-            return Ok(None);
+        let (e_prime, mu_prime) = match &settings.tip {
+            TipRule::Stress => return Ok(None),
+            TipRule::Opening(e_prime) => (e_prime, None),
+            TipRule::Asymptote { e_prime, mu_prime } => {
+                if !(mu_prime.is_finite() && *mu_prime >= 0.0) {
+                    return Err(FractureError::Input(format!(
+                        "fluid viscosity of the tip rule must be finite and >= 0, got {mu_prime}"
+                    )));
+                }
+                (e_prime, Some(*mu_prime))
+            }
         };
         if e_prime.len() != grid.num_cells() {
             return Err(FractureError::Input(format!(
@@ -605,6 +629,8 @@ impl OpeningTips {
             class_of_cell: settings.class_of_cell.clone(),
             tips: CrackTips::new(grid),
             adjacency: NodeCells::new(grid),
+            mu_prime,
+            fronts: Default::default(),
         }))
     }
 
@@ -613,12 +639,17 @@ impl OpeningTips {
     /// `S = max(σ_t, K_Ic/√(2π r_c))`: its tensile utilization (the smaller of `σ₁/σ_t`
     /// and `σ₁ √(2π r_c)/K_Ic`) is `K_I/K_Ic`, with `K_I` from the opening
     /// ([`crate::tip_opening`]) at the nodal displacement `u`.
+    ///
+    /// With [`TipRule::Asymptote`] the utilization is instead `d/r`: the distance `d` from
+    /// the back line to the front over the step `dt` against the distance `r` to the tip
+    /// ([`crate::tip_asymptote`]).
     fn measure<const D: usize>(
         &self,
         grid: &Grid<D>,
         failed: &[bool],
         stress: &[Tensor<D>],
         u: &[f64],
+        dt: f64,
     ) -> Vec<Tensor<D>> {
         let mut out = stress.to_vec();
         for (c, s) in out.iter_mut().enumerate() {
@@ -631,19 +662,94 @@ impl OpeningTips {
             let Some(r) = self.tips.tip_radius(c, failed) else {
                 continue;
             };
-            let k = crate::tip_opening::tip_stress_intensity(
-                grid,
-                &self.adjacency,
-                failed,
-                c,
-                self.e_prime[c],
-                u,
-            )
-            .unwrap_or(0.0);
+            let k = match self.mu_prime {
+                None => crate::tip_opening::tip_stress_intensity(
+                    grid,
+                    &self.adjacency,
+                    failed,
+                    c,
+                    self.e_prime[c],
+                    u,
+                )
+                .unwrap_or(0.0),
+                Some(mu_prime) => self
+                    .front(grid, failed, c, u, dt, k_ic, mu_prime)
+                    .map_or(0.0, |(f, s)| {
+                        k_ic * (f.position - (s.tip.dot(&s.along) - s.distance)) / s.distance
+                    }),
+            };
             let reference = sigma_t.max(k_ic / (2.0 * std::f64::consts::PI * r).sqrt());
             *s = Tensor::<D>::identity() * (k.max(0.0) / k_ic * reference);
         }
         out
+    }
+}
+
+impl OpeningTips {
+    /// The front ahead of the intact cell `c` over a step of `dt` and its opening sample
+    /// ([`crate::tip_asymptote`]), or `None` when `c` is not ahead of a tip.
+    #[allow(clippy::too_many_arguments)]
+    fn front<const D: usize>(
+        &self,
+        grid: &Grid<D>,
+        failed: &[bool],
+        c: usize,
+        u: &[f64],
+        dt: f64,
+        k_ic: f64,
+        mu_prime: f64,
+    ) -> Option<(
+        crate::tip_asymptote::Front,
+        crate::tip_opening::TipSample<D>,
+    )> {
+        let s = crate::tip_opening::tip_sample(grid, &self.adjacency, failed, c, u)?;
+        let asymptote = crate::tip_asymptote::TipAsymptote {
+            k_prime: crate::tip_asymptote::k_prime(k_ic),
+            e_prime: self.e_prime[c],
+            mu_prime,
+        };
+        let tip = s.tip.dot(&s.along);
+        let previous = self
+            .fronts
+            .previous(&s.tip, &s.along, 2.0 * s.length)
+            .unwrap_or(tip);
+        let front = asymptote.front(s.opening.max(0.0), tip - s.distance, previous, dt);
+        Some((front, s))
+    }
+
+    /// Remember the fronts ahead of every intact tip cell at the end of a step of `dt`
+    /// (nothing without [`TipRule::Asymptote`] or for `dt ≤ 0`).
+    fn remember_fronts<const D: usize>(
+        &mut self,
+        grid: &Grid<D>,
+        failed: &[bool],
+        u: &[f64],
+        dt: f64,
+    ) {
+        let Some(mu_prime) = self.mu_prime else {
+            return;
+        };
+        if dt <= 0.0 {
+            return;
+        }
+        let mut points = Vec::new();
+        for c in 0..grid.num_cells() {
+            if failed[c] {
+                continue;
+            }
+            let Some((k_ic, _)) = self.class[self.class_of_cell[c]] else {
+                continue;
+            };
+            if self.tips.tip_radius(c, failed).is_none() {
+                continue;
+            }
+            if let Some((f, s)) = self.front(grid, failed, c, u, dt, k_ic, mu_prime)
+                && f.position.is_finite()
+            {
+                points.push(s.tip + s.along * (f.position - s.tip.dot(&s.along)));
+            }
+        }
+        self.fronts = crate::tip_asymptote::FrontMemory::new(&points);
     }
 }
 
@@ -782,6 +888,38 @@ impl<'a, const D: usize> Fracturing<'a, D> {
     /// The cavitation pressure bounding the pore pressure, when set.
     pub fn cavitation_pressure(&self) -> Option<f64> {
         self.cavitation
+    }
+
+    /// The fronts of the tip rule [`TipRule::Asymptote`] at the end of the last step, as
+    /// `D` coordinates per front (`None` with another rule).
+    pub fn tip_fronts(&self) -> Option<&[f64]> {
+        self.opening_tips
+            .as_ref()
+            .filter(|t| t.mu_prime.is_some())
+            .map(|t| t.fronts.coordinates())
+    }
+
+    /// Resume the fronts of [`TipRule::Asymptote`] saved by [`Fracturing::tip_fronts`].
+    ///
+    /// Errors: another rule, or not `D` finite coordinates per front.
+    pub fn resume_tip_fronts(&mut self, points: &[f64]) -> FractureResult<()> {
+        let tips = self
+            .opening_tips
+            .as_mut()
+            .filter(|t| t.mu_prime.is_some())
+            .ok_or_else(|| {
+                FractureError::Input(
+                    "tip fronts saved, but the tip rule is not the asymptote".into(),
+                )
+            })?;
+        tips.fronts =
+            crate::tip_asymptote::FrontMemory::from_coordinates(D, points).ok_or_else(|| {
+                FractureError::Input(format!(
+                    "tip fronts: {} values, not {D} finite per front",
+                    points.len()
+                ))
+            })?;
+        Ok(())
     }
 
     /// The void of every cell (m³; m² per unit height in 2D) at the end of the last step:
@@ -1015,7 +1153,7 @@ impl<'a, const D: usize> Fracturing<'a, D> {
             });
             let stress = stresses(grid, map, operators, coords, cache, &new.displacement)?;
             if let Some(tips) = opening_tips.as_ref() {
-                let measure = tips.measure(grid, fs.flags(), &stress, &new.displacement);
+                let measure = tips.measure(grid, fs.flags(), &stress, &new.displacement, dt);
                 return Ok(((new, stress, void_change), measure));
             }
             Ok(((new, stress.clone(), void_change), stress))
@@ -1035,6 +1173,9 @@ impl<'a, const D: usize> Fracturing<'a, D> {
                 },
             })?;
         let ((state, stress, void_change), _) = done.solution;
+        if let Some(tips) = opening_tips.as_mut() {
+            tips.remember_fronts(grid, failures.flags(), &state.displacement, dt);
+        }
         if !void_change.is_empty() {
             for (v, dv) in void.iter_mut().zip(&void_change) {
                 *v = (*v + dv).max(0.0);

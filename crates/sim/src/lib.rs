@@ -78,6 +78,7 @@ pub mod solve;
 #[cfg(feature = "fixtures")]
 pub mod standard;
 mod stress_cache;
+pub mod tip_asymptote;
 pub mod tip_opening;
 
 pub use assembly::{assemble, nodal_loads};

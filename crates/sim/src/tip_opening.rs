@@ -82,6 +82,39 @@ pub fn tip_stress_intensity<const D: usize>(
     e_prime: f64,
     u: &[f64],
 ) -> Option<f64> {
+    let s = tip_sample(grid, adjacency, failed, c, u)?;
+    Some(stress_intensity_from_opening(
+        e_prime,
+        s.opening.max(0.0),
+        s.distance,
+    ))
+}
+
+/// The opening behind the tip next to an intact cell, as the module docs read it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TipSample<const D: usize> {
+    /// The jump of `u·n` across the band on the back line (m; may be negative).
+    pub opening: f64,
+    /// The distance `r` from the back line to the tip along the crack (m).
+    pub distance: f64,
+    /// The unit direction `t` along the crack, from the crack towards the tip cell.
+    pub along: Point<D>,
+    /// The tip: the mean of the nodes the tip cell shares with failed cells.
+    pub tip: Point<D>,
+    /// The length `L` of the tip cell along `t` (m).
+    pub length: f64,
+}
+
+/// The opening sample behind the tip next to the intact cell `c` (see the module docs),
+/// or `None` when `c` is not ahead of a crack tip; `u` and `adjacency` as in
+/// [`tip_stress_intensity`].
+pub fn tip_sample<const D: usize>(
+    grid: &Grid<D>,
+    adjacency: &NodeCells,
+    failed: &[bool],
+    c: usize,
+    u: &[f64],
+) -> Option<TipSample<D>> {
     let failed_at = |nodes: &[usize], out: &mut Vec<usize>| {
         for &node in nodes {
             for &g in adjacency.of(node) {
@@ -135,13 +168,16 @@ pub fn tip_stress_intensity<const D: usize>(
     }
     // The tip: the mean position along the crack of the nodes `c` shares with failed cells.
     let (mut sum, mut count) = (0.0, 0usize);
+    let mut tip_point = Point::<D>::zeros();
     for &node in grid.cell_nodes(c) {
         if adjacency.of(node).iter().any(|&g| failed[g]) {
             sum += grid.node(node).dot(&t);
+            tip_point += grid.node(node);
             count += 1;
         }
     }
     let tip = sum / count as f64;
+    tip_point /= count as f64;
     // The back line: the line of nodes of the crack near `c` closest behind the tip by
     // at least three quarters of the length `L` of `c` along the crack.
     let length = {
@@ -191,5 +227,11 @@ pub fn tip_stress_intensity<const D: usize>(
         return None;
     }
     let w = up / nu as f64 - down / nd as f64;
-    Some(stress_intensity_from_opening(e_prime, w.max(0.0), r))
+    Some(TipSample {
+        opening: w,
+        distance: r,
+        along: t,
+        tip: tip_point,
+        length,
+    })
 }

@@ -196,6 +196,10 @@ pub enum TipRuleChoice {
     /// The opening behind the tip (displacement correlation,
     /// `K_I = E′ w / (4 √(2/π) √r)`): the tip cell fails when `K_I > K_Ic`.
     Opening,
+    /// The opening behind the tip read with the tip asymptote of a fluid-driven crack
+    /// (toughness `√r`, viscosity `r^{2/3}` at the front's speed): the tip cell fails when
+    /// the front lies beyond the tip.
+    Asymptote,
 }
 
 /// `[solver] mechanics`.
@@ -694,7 +698,14 @@ pub struct Physics {
     /// `K_I = E′ w / (4 √(2/π) √r)` with `E′ = E/(1 − ν²)` (plane stress: `E`); an intact
     /// cell next to a crack tip fails when `K_I > K_Ic`, whatever its tensile strength
     /// (which still governs cells away from tips). Meant for cracks along a row of split
-    /// rectangles (a predefined path; docs/hydrofrac/validation.md, "KGD"). Needs
+    /// rectangles (a predefined path; docs/hydrofrac/validation.md, "KGD"). `"asymptote"`:
+    /// the same opening `w` read with the tip asymptote of a fluid-driven crack moving at
+    /// the speed `V`, `w³ = (K′/E′)³ r^{3/2} + 18√3 (μ′V/E′) r²` (`K′ = 4√(2/π) K_Ic`,
+    /// `μ′ = 12 μ` of `[fluid] viscosity`), gives the front's distance `r` and, with its
+    /// position at the start of the step, its speed; the tip cell fails when the front
+    /// lies beyond the tip (the same as `"opening"` for a crack at rest; it converges for
+    /// viscous cracks, where `"opening"` does not;
+    /// docs/hydrofrac/validation.md, "KGD, viscosity-dominated"). Both need
     /// fracture = true, flow = true and failure_stress = "cell".
     pub tip_rule: Option<TipRuleChoice>,
     /// The pore pressure of a cell never falls below this absolute pressure (the fluid's

@@ -273,7 +273,16 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
             ));
         }
     }
-    if s.physics.tip_rule == Some(crate::common::sections::TipRuleChoice::Opening) {
+    if let Some(
+        rule @ (crate::common::sections::TipRuleChoice::Opening
+        | crate::common::sections::TipRuleChoice::Asymptote),
+    ) = s.physics.tip_rule
+    {
+        let name = if rule == crate::common::sections::TipRuleChoice::Opening {
+            "opening"
+        } else {
+            "asymptote"
+        };
         if s.physics.fracture != Some(true) || s.physics.flow != Some(true) {
             return Err(ls.error(
                 &k(&["physics", "tip_rule"]),
@@ -283,14 +292,16 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
         if s.physics.failure_stress == Some(crate::common::sections::FailureStress::Recovered) {
             return Err(ls.error(
                 &k(&["physics", "tip_rule"]),
-                "= \"opening\" reads the cell stress away from tips: it cannot be combined \
-                 with failure_stress = \"recovered\"",
+                format!(
+                    "= \"{name}\" reads the cell stress away from tips: it cannot be combined \
+                     with failure_stress = \"recovered\""
+                ),
             ));
         }
         if !s.material.values().any(|m| m.fracture_toughness.is_some()) {
             return Err(ls.error(
                 &k(&["physics", "tip_rule"]),
-                "= \"opening\" needs a material with a fracture_toughness",
+                format!("= \"{name}\" needs a material with a fracture_toughness"),
             ));
         }
     }

@@ -98,6 +98,9 @@ pub(super) fn save<const D: usize>(s: &Stepper<'_, D>, state: &mut State) {
         if frac.cavitation_pressure().is_some() {
             state.put_f64("continuum/void", frac.void().to_vec());
         }
+        if let Some(fronts) = frac.tip_fronts() {
+            state.put_f64("continuum/tip_fronts", fronts.to_vec());
+        }
     }
 }
 
@@ -231,6 +234,10 @@ pub(super) fn restore<const D: usize>(
     if let Driver::Coupled { frac, state: biot } = &mut s.driver {
         if state.f64s("continuum/void").is_ok() {
             frac.resume_void(state.f64s_len("continuum/void", nc)?)
+                .map_err(|e| bad(e.to_string()))?;
+        }
+        if let Ok(fronts) = state.f64s("continuum/tip_fronts") {
+            frac.resume_tip_fronts(fronts)
                 .map_err(|e| bad(e.to_string()))?;
         }
         if state.f64s("continuum/biot/u").is_ok() {

@@ -969,23 +969,34 @@ fn fracture_settings<const D: usize>(ls: &LoadedScene, comp: &Composition<D>) ->
         }
         settings.tracking_angle = s.physics.crack_tracking;
         settings.exclusion_radius = s.physics.crack_exclusion.unwrap_or(0.0);
-        if s.physics.tip_rule == Some(crate::common::sections::TipRuleChoice::Opening) {
+        if let Some(
+            rule @ (crate::common::sections::TipRuleChoice::Opening
+            | crate::common::sections::TipRuleChoice::Asymptote),
+        ) = s.physics.tip_rule
+        {
             let plane_stress =
                 D == 2 && s.scene.plane == Some(crate::common::sections::Plane::Stress);
-            settings.tip = porofrac_sim::TipRule::Opening(
-                comp.material_of_cell()
-                    .into_iter()
-                    .map(|m| {
-                        let mat = &s.material[m];
-                        let nu = mat.poisson_ratio;
-                        if plane_stress {
-                            mat.youngs_modulus
-                        } else {
-                            mat.youngs_modulus / (1.0 - nu * nu)
-                        }
-                    })
-                    .collect(),
-            );
+            let e_prime: Vec<f64> = comp
+                .material_of_cell()
+                .into_iter()
+                .map(|m| {
+                    let mat = &s.material[m];
+                    let nu = mat.poisson_ratio;
+                    if plane_stress {
+                        mat.youngs_modulus
+                    } else {
+                        mat.youngs_modulus / (1.0 - nu * nu)
+                    }
+                })
+                .collect();
+            settings.tip = if rule == crate::common::sections::TipRuleChoice::Asymptote {
+                porofrac_sim::TipRule::Asymptote {
+                    e_prime,
+                    mu_prime: 12.0 * s.fluid.as_ref().map_or(0.0, |f| f.viscosity),
+                }
+            } else {
+                porofrac_sim::TipRule::Opening(e_prime)
+            };
         }
     }
     settings
