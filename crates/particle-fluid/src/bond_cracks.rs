@@ -35,9 +35,11 @@
 //!   pores conserve mass to round-off whether or not the iteration converged. The lattice
 //!   nodes stay explicit: a channel between two mouth nodes carries at most `K = ¼` per
 //!   step, and a mouth node gives (or takes) at most half of its largest density gap to
-//!   the network's ends per step — its channels' fluxes are scaled down together
-//!   otherwise (counted in [`CrackSolveStats::limited`]) — so a network that stores more
-//!   than a node cannot make the node overshoot.
+//!   the network's ends per step (before or after the solve) — otherwise the fluxes of the whole connected part of
+//!   the network it belongs to are scaled down by one factor `f` (counted in
+//!   [`CrackSolveStats::limited`]), so that every pore of it moves to `(1 − f) m + f m'`,
+//!   between its old and its implicit mass, and stays non-negative — so a network that
+//!   stores more than a node cannot make the node overshoot.
 //! * **Loads.** The pressure of a channel is the mean gauge pressure of its two ends,
 //!   `p = c_s² (ρ̄ − 1)` in lattice units, floored at zero: a pore whose opening outruns
 //!   the fluid is at the ambient pressure (the fluid lag of a hydraulic fracture), not
@@ -603,7 +605,9 @@ impl BondCracks {
                 End::Pore(p) => self.pores[p].mass / self.pores[p].volume,
             };
             let s = k[c] * (rho(ch.ends[0]) - rho(ch.ends[1]));
-            let gap = (old(ch.ends[0]) - old(ch.ends[1])).abs();
+            let gap = (old(ch.ends[0]) - old(ch.ends[1]))
+                .abs()
+                .max((rho(ch.ends[0]) - rho(ch.ends[1])).abs());
             for (e, sign) in [(ch.ends[0], -1.0), (ch.ends[1], 1.0)] {
                 if let End::Node(n) = e {
                     rate[n] += sign * s;
@@ -612,22 +616,45 @@ impl BondCracks {
             }
             self.carried[c] = s;
         }
-        let scale: Vec<f64> = rate
-            .iter()
-            .zip(&cap)
-            .map(|(r, c)| if r.abs() > *c { c / r.abs() } else { 1.0 })
-            .collect();
+        // one factor per connected part of the network (the smallest of its mouths'), so
+        // every pore moves to `(1 − f) m + f m'`, between two non-negative masses
+        let nn = self.nodes.len();
+        let id = |e: End| match e {
+            End::Node(n) => n,
+            End::Pore(p) => nn + p,
+        };
+        let mut part: Vec<usize> = (0..nn + self.pores.len()).collect();
+        fn root(part: &mut [usize], mut a: usize) -> usize {
+            while part[a] != a {
+                part[a] = part[part[a]];
+                a = part[a];
+            }
+            a
+        }
+        for ch in &self.channels {
+            if active(ch) {
+                let (a, b) = (
+                    root(&mut part, id(ch.ends[0])),
+                    root(&mut part, id(ch.ends[1])),
+                );
+                part[a] = b;
+            }
+        }
+        let mut factor = vec![1.0f64; part.len()];
+        for (n, (r, c)) in rate.iter().zip(&cap).enumerate() {
+            if r.abs() > *c {
+                let k = root(&mut part, n);
+                factor[k] = factor[k].min(c / r.abs());
+            }
+        }
         rate.fill(0.0);
         let mut gain = vec![0.0; self.pores.len()];
         for (c, ch) in self.channels.iter().enumerate() {
-            let f = ch
-                .ends
-                .iter()
-                .map(|e| match *e {
-                    End::Node(n) => scale[n],
-                    End::Pore(_) => 1.0,
-                })
-                .fold(1.0, f64::min);
+            let f = if active(ch) {
+                factor[root(&mut part, id(ch.ends[0]))]
+            } else {
+                1.0
+            };
             if f < 1.0 {
                 self.stats.limited += 1;
             }
