@@ -31,9 +31,8 @@
 //! ([`CrackError::TooWide`]; for a pore `K/V ∝ w²/L²`, so only a crack wide and short
 //! against the spacing is refused).
 //!
-//! What is not done here: building the network from the broken bonds of a lattice solid
-//! (a channel along each broken bond's face, pores at the openings between three
-//! particles) and its coupling to [`crate::ParticleFluid`].
+//! The network of a lattice solid's broken bonds, with its pressure on the particles and
+//! its coupling to [`crate::ParticleFluid`], is [`crate::bond_cracks`].
 
 use porofrac_lbm::d2q9::CS2;
 use porofrac_lbm::{Lattice, LbmError};
@@ -364,7 +363,7 @@ impl CrackFlow {
 }
 
 /// The fluid node nearest to `p` within two spacings.
-fn nearest_fluid(lat: &Lattice, p: [f64; 2]) -> Option<(usize, usize)> {
+pub(crate) fn nearest_fluid(lat: &Lattice, p: [f64; 2]) -> Option<(usize, usize)> {
     let (nx, ny) = lat.size();
     let mut best: Option<((usize, usize), f64)> = None;
     let (ci, cj) = ((p[0] - 0.5).round() as isize, (p[1] - 0.5).round() as isize);

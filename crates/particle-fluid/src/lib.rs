@@ -54,13 +54,19 @@
 //! A gap between solids narrower than about `2Δx` holds no fluid node, or one without a
 //! second fluid node behind it (the interpolation then falls back to plain bounce-back), so
 //! fluid does not enter cracks narrower than the spacing; [`cracks`] carries the flow of
-//! such cracks by the cubic law between the lattice nodes at their mouths.
+//! such cracks by the cubic law between the lattice nodes at their mouths, and
+//! [`bond_cracks`] builds that network from a bonded model's broken bonds
+//! ([`ParticleFluid::with_crack_flow`]): after step 2 it advances the crack fluid and sets
+//! its mouth sources, and its pressure loads the disks on both sides of every broken
+//! bond, added to the loads of step 5.
 
+pub mod bond_cracks;
 pub mod cracks;
 mod injection;
 mod lsm;
 mod solver;
 
+pub use bond_cracks::{BondCrackOptions, BondCracks, CrackSolveStats};
 pub use cracks::{CrackChannel, CrackError, CrackFlow};
 pub use injection::{Injection, InjectionControl};
 pub use solver::{ParticleSolver, RigidDiskError, RigidDisks};
@@ -229,6 +235,8 @@ pub struct CouplingStats {
     pub fluid_seconds: f64,
     /// Seconds in the particle solver.
     pub particle_seconds: f64,
+    /// Seconds in the crack network (part of `fluid_seconds`).
+    pub crack_seconds: f64,
 }
 
 /// The fluid side of disks in a lattice Boltzmann fluid, optionally with heat (see the
@@ -247,6 +255,7 @@ pub struct ParticleFluid {
     /// Loads of the previous step (two-step averaging).
     previous: Vec<[f64; 3]>,
     injection: Option<Injection>,
+    cracks: Option<BondCracks>,
     heat: HeatBudget,
     stats: CouplingStats,
     time: f64,
@@ -332,6 +341,7 @@ impl ParticleFluid {
             loads: vec![[0.0; 3]; n],
             previous: vec![[0.0; 3]; n],
             injection: None,
+            cracks: None,
             heat: HeatBudget::default(),
             stats: CouplingStats::default(),
             time: 0.0,
@@ -403,6 +413,28 @@ impl ParticleFluid {
         )?;
         self.injection = Some(inj);
         Ok(self)
+    }
+
+    /// Carry the fluid in the cracks of the broken bonds of `particles` (the model given
+    /// at construction) by the cubic law, its pressure loading the disks
+    /// ([`bond_cracks`]).
+    pub fn with_crack_flow<P: ParticleSolver>(
+        mut self,
+        particles: &P,
+        options: BondCrackOptions,
+    ) -> Result<Self, CouplingError> {
+        self.cracks = Some(BondCracks::new(
+            particles,
+            &self.lattice,
+            &self.units,
+            options,
+        )?);
+        Ok(self)
+    }
+
+    /// The crack network of the broken bonds.
+    pub fn crack_flow(&self) -> Option<&BondCracks> {
+        self.cracks.as_ref()
     }
 
     /// The fluid lattice.
@@ -512,6 +544,11 @@ impl ParticleFluid {
         if let Some(inj) = &self.injection {
             inj.apply(&mut self.lattice, &self.units, self.time)?;
         }
+        if let Some(c) = &mut self.cracks {
+            let tc = Instant::now();
+            c.update(particles, &mut self.lattice, &self.units, self.origin)?;
+            self.stats.crack_seconds += tc.elapsed().as_secs_f64();
+        }
         if let Some(th) = &mut self.thermal {
             th.step(&self.lattice);
             let first = self.first;
@@ -535,6 +572,12 @@ impl ParticleFluid {
                 *p = now;
             } else {
                 *l = now;
+            }
+        }
+        if let Some(c) = &self.cracks {
+            for (l, f) in self.loads.iter_mut().zip(c.loads()) {
+                l[0] += f[0];
+                l[1] += f[1];
             }
         }
         if let Some(th) = &self.thermal {

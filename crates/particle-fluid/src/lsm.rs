@@ -22,4 +22,17 @@ impl ParticleSolver for LatticeSolid {
     fn advance(&mut self, dt: f64, external: &[[f64; 3]]) -> Result<(), LsmError> {
         self.step(dt, external).map(|_| ())
     }
+
+    fn bond_pairs(&self) -> Vec<[usize; 2]> {
+        self.bonds()
+            .iter()
+            .map(|b| [b.i as usize, b.j as usize])
+            .collect()
+    }
+
+    fn broken_pairs(&self, from: usize, out: &mut Vec<[usize; 2]>) {
+        if let Some(b) = self.broken().get(from..) {
+            out.extend(b.iter().map(|b| [b.i, b.j]));
+        }
+    }
 }

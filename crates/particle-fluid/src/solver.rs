@@ -17,6 +17,16 @@ pub trait ParticleSolver {
     fn stable_dt(&self) -> f64;
     /// Advance by `dt` (s) under `external` (one entry per disk).
     fn advance(&mut self, dt: f64, external: &[[f64; 3]]) -> Result<(), Self::Error>;
+    /// The bonded pairs of disks at the start (intact or not), for the pores of the crack
+    /// network ([`crate::bond_cracks`]); none for a model without bonds.
+    fn bond_pairs(&self) -> Vec<[usize; 2]> {
+        Vec::new()
+    }
+    /// Append to `out` the pairs of the bonds broken so far, in the order they broke,
+    /// from the `from`-th on (a model's broken bonds never heal); none without bonds.
+    fn broken_pairs(&self, from: usize, out: &mut Vec<[usize; 2]>) {
+        let _ = (from, out);
+    }
 }
 
 /// A rigid disk's state stopped being finite.

@@ -54,6 +54,20 @@ pub struct InjectionSection {
     pub ramp_time: f64,
     /// Pressure control: fraction of the density gap closed per step (default 0.5).
     pub gain: Option<f64>,
+    /// Carry the fluid in the cracks narrower than the lattice: every broken bond is a
+    /// cubic-law channel of the disks' gap between the pores on its two sides, joined to
+    /// the lattice nodes at its mouths; its pressure pushes the two disks apart (default
+    /// false).
+    pub crack_flow: Option<bool>,
+    /// Smallest aperture of a crack channel (m; default 1e-5): a broken bond whose disks
+    /// still touch is a channel this wide.
+    #[schemars(extend("unit" = "m"))]
+    pub crack_min_aperture: Option<f64>,
+    /// Kinematic viscosity of the fluid in the crack channels (m²/s; default
+    /// `lbm.viscosity`): the fluid's own where the lattice's is raised to carry rock
+    /// pressures.
+    #[schemars(extend("unit" = "m²/s"))]
+    pub crack_viscosity: Option<f64>,
 }
 
 fn positive(
@@ -176,6 +190,7 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
         {
             return Err(ls.error(&key("gain"), format!("= {g} must be in (0, 1]")));
         }
+        super::crack_flow::check(ls, inj)?;
         if super::own(ls)
             .loading
             .as_ref()
@@ -292,6 +307,7 @@ impl Fluid {
             pf = pf
                 .with_injection(center, radius, control)
                 .map_err(|e| ls.error(&k(&["injection", "radius"]), format!(": {e}")))?;
+            pf = super::crack_flow::attach(ls, inj, pf, solid)?;
         }
         let time_dependent = sides.iter().any(|(_, v)| v.varies_in_time());
         let mut f = Fluid {
@@ -469,15 +485,20 @@ impl Fluid {
                 "particle_seconds": st.particle_seconds,
                 "particle_share": st.particle_seconds
                     / (st.fluid_seconds + st.particle_seconds).max(1e-300),
+                "fluid_share": st.fluid_seconds
+                    / (st.fluid_seconds + st.particle_seconds).max(1e-300),
             }),
         );
+        super::crack_flow::summary(&self.pf, m);
         if let Some(inj) = self.pf.injection() {
             m.insert(
                 "injection".into(),
                 serde_json::json!({
                     "pressure": self.pressure(),
                     "target_pressure": inj.target_pressure(self.pf.time()),
-                    "injected_mass": lat.injected_mass() * u.density * u.dx * u.dx,
+                    "injected_mass": (lat.injected_mass()
+                        - self.pf.crack_flow().map_or(0.0, |c| c.exchanged_mass()))
+                        * u.density * u.dx * u.dx,
                     "source_nodes": inj.nodes(),
                 }),
             );

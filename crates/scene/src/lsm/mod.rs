@@ -33,6 +33,7 @@
 
 pub mod check;
 pub mod crack;
+pub mod crack_flow;
 pub mod file;
 pub mod fluid;
 pub mod reaction;
