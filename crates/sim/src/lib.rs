@@ -80,7 +80,7 @@ pub mod standard;
 mod stress_cache;
 pub mod tip_opening;
 
-pub use assembly::{assemble, nodal_loads};
+pub use assembly::{assemble, nodal_loads, nodal_loads_of_cells};
 pub use bc::{Displacement, Gravity, Loads, Platen, Traction};
 pub use biot::{
     BiotCoupling, BiotError, BiotState, BiotStep, BiotSystem, CouplingStats, ExplicitPressure,
