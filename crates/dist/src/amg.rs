@@ -445,8 +445,8 @@ impl DistAmg {
         Self::with_gathering(comm, a, node_of_equation, near_null, options, 0)
     }
 
-    /// [`Self::new`], but the first level with at most `gather_below` equations (in all)
-    /// is gathered on every process and handled there by a serial `porofrac-amg`
+    /// [`Self::new`], but the first coarse level (not the finest) with at most
+    /// `gather_below` equations (in all) is gathered on every process and handled there by a serial `porofrac-amg`
     /// hierarchy built with the same options (its V-cycle, redundant on every process,
     /// is this level's correction); with `gather_below ≤ options.max_coarse` this is
     /// [`Self::new`]. Each level left distributed costs a message exchange per smoother
@@ -496,7 +496,13 @@ impl DistAmg {
             }
             let dinv: Vec<f64> = diag.iter().map(|d| 1.0 / d).collect();
             let global = a.rows().global();
-            if global <= gather_below || levels.len() + 1 >= options.max_levels {
+            // The finest level is never gathered (that would be the serial solve).
+            let limit = if levels.is_empty() {
+                options.max_coarse
+            } else {
+                gather_below
+            };
+            if global <= limit || levels.len() + 1 >= options.max_levels {
                 return Self::finish(comm, levels, a, &nodes, null.as_ref(), options);
             }
             let agg = if nl > 0 {
@@ -619,7 +625,10 @@ impl DistAmg {
         } else {
             let all_nodes = all_gather_vec(comm, nodes);
             let m_local = null.map_or(0, NearNullSpace::num_vectors);
-            let m = all_gather_vec(comm, &[m_local]).into_iter().max().unwrap_or(0);
+            let m = all_gather_vec(comm, &[m_local])
+                .into_iter()
+                .max()
+                .unwrap_or(0);
             let mut data = Vec::with_capacity(n * m);
             for k in 0..m {
                 let part: &[f64] = match null {

@@ -231,8 +231,7 @@ fn rank_body(dim: usize, n: usize, gather_below: usize) {
     let dofs: Vec<(usize, usize)> = p.dofs[own.clone()].to_vec();
     let null = NearNullSpace::rigid_body_modes(&p.coords, dim, &dofs).unwrap();
     let nodes: Vec<usize> = dofs.iter().map(|d| d.0).collect();
-    let amg =
-        DistAmg::with_gathering(&world, a, &nodes, &null, &options(), gather_below).unwrap();
+    let amg = DistAmg::with_gathering(&world, a, &nodes, &null, &options(), gather_below).unwrap();
     let mut x = vec![0.0; own.len()];
     let stats = amg
         .solve(&world, &mut x, &p.b[own.clone()], tol, 500)
