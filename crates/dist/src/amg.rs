@@ -20,11 +20,16 @@
 //!    equations owned elsewhere are sent to their owners (an all-to-all of triplets) and
 //!    added there.
 //!
-//! It stops when the global size is at most `max_coarse`, at `max_levels`, or when the
-//! coarse level would keep more than `min_coarsening` of the equations. The coarsest
-//! matrix is gathered whole on every process and factorized there by sparse Cholesky
-//! (`porofrac-amg`'s one-level hierarchy, i.e. `porofrac-sparse`); its solve is redundant
-//! on every process, which costs no communication beyond gathering the right-hand side.
+//! It stops when the global size is at most `max_coarse` (or the `gather_below` of
+//! [`DistAmg::with_gathering`]), at `max_levels`, or when the coarse level would keep more
+//! than `min_coarsening` of the equations. The last matrix is gathered whole on every
+//! process and factorized there by sparse Cholesky (`porofrac-amg`'s one-level
+//! hierarchy, i.e. `porofrac-sparse`) or, above `max_coarse` equations, given to a serial
+//! `porofrac-amg` hierarchy (with the gathered node ids and near-null space); its solve
+//! or V-cycle is redundant on every process, which costs no communication beyond
+//! gathering the right-hand side — on two to a few processes cheaper than the message
+//! exchanges of the small levels it replaces (each smoother product and transfer of a
+//! distributed level waits for the neighbours).
 //!
 //! # V-cycle
 //!
@@ -74,7 +79,7 @@ pub struct DistLevelInfo {
     pub ghosts: usize,
 }
 
-/// The coarsest level, gathered on every process.
+/// The last level, gathered on every process (factorized, or a serial hierarchy).
 #[derive(Debug)]
 struct Coarsest {
     layout: Layout,
@@ -437,6 +442,28 @@ impl DistAmg {
         near_null: &NearNullSpace,
         options: &AmgOptions,
     ) -> Result<Self> {
+        Self::with_gathering(comm, a, node_of_equation, near_null, options, 0)
+    }
+
+    /// [`Self::new`], but the first coarse level (not the finest) with at most
+    /// `gather_below` equations (in all) is gathered on every process and handled there by a serial `porofrac-amg`
+    /// hierarchy built with the same options (its V-cycle, redundant on every process,
+    /// is this level's correction); with `gather_below ≤ options.max_coarse` this is
+    /// [`Self::new`]. Each level left distributed costs a message exchange per smoother
+    /// product and per transfer; a gathered level costs one gather of its right-hand
+    /// side per cycle. Node ids of the finest level must be unique across processes
+    /// (grid nodes are); the coarse levels number theirs globally.
+    ///
+    /// Errors: as [`Self::new`].
+    pub fn with_gathering(
+        comm: &Comm,
+        a: DistCsr,
+        node_of_equation: &[usize],
+        near_null: &NearNullSpace,
+        options: &AmgOptions,
+        gather_below: usize,
+    ) -> Result<Self> {
+        let gather_below = gather_below.max(options.max_coarse);
         let n = a.rows().local();
         if node_of_equation.len() != n || (n > 0 && near_null.len() != n) {
             return Err(DistError::Input(format!(
@@ -469,8 +496,14 @@ impl DistAmg {
             }
             let dinv: Vec<f64> = diag.iter().map(|d| 1.0 / d).collect();
             let global = a.rows().global();
-            if global <= options.max_coarse || levels.len() + 1 >= options.max_levels {
-                return Self::finish(comm, levels, a, options);
+            // The finest level is never gathered (that would be the serial solve).
+            let limit = if levels.is_empty() {
+                options.max_coarse
+            } else {
+                gather_below
+            };
+            if global <= limit || levels.len() + 1 >= options.max_levels {
+                return Self::finish(comm, levels, a, &nodes, null.as_ref(), options);
             }
             let agg = if nl > 0 {
                 let block = owned_block(&a)?;
@@ -493,7 +526,7 @@ impl DistAmg {
             let coarse = Layout::from_local(comm, nc_local);
             let nc = coarse.global();
             if nc == 0 || nc as f64 > options.min_coarsening * global as f64 {
-                return Self::finish(comm, levels, a, options);
+                return Self::finish(comm, levels, a, &nodes, null.as_ref(), options);
             }
             let rho = spectral_radius(comm, &a, &dinv, options.lanczos_steps);
             let omega = options.prolongation_damping / rho;
@@ -518,9 +551,15 @@ impl DistAmg {
             // The next level's nodes (the aggregates) and near-null space.
             match agg {
                 Some(g) => {
+                    // An aggregate's id is the global index of its first coarse equation
+                    // (unique across processes, for a gathered level).
+                    let c0 = coarse.start();
                     nodes = (0..g.coarse_ptr.len() - 1)
                         .flat_map(|ag| {
-                            std::iter::repeat_n(ag, g.coarse_ptr[ag + 1] - g.coarse_ptr[ag])
+                            std::iter::repeat_n(
+                                c0 + g.coarse_ptr[ag],
+                                g.coarse_ptr[ag + 1] - g.coarse_ptr[ag],
+                            )
                         })
                         .collect();
                     null = if nc_local > 0 {
@@ -544,11 +583,15 @@ impl DistAmg {
         }
     }
 
-    /// Gather the coarsest operator on every process and factorize it.
+    /// Gather the last operator on every process and factorize it (at most
+    /// `options.max_coarse` equations) or build a serial hierarchy for it from the
+    /// gathered node ids `nodes` and near-null space `null` (the owned parts).
     fn finish(
         comm: &Comm,
         mut levels: Vec<Level>,
         a: DistCsr,
+        nodes: &[usize],
+        null: Option<&NearNullSpace>,
         options: &AmgOptions,
     ) -> Result<Self> {
         let (ptr, col, val) = a.global_rows();
@@ -573,11 +616,43 @@ impl DistAmg {
             col_ptr.push(rows.len());
         }
         let sym = SymCsr::from_upper_csc(n, &col_ptr, &rows, &vals)?;
-        let one = AmgOptions {
-            max_coarse: n.max(1),
-            ..options.clone()
+        let solver = if n <= options.max_coarse {
+            let one = AmgOptions {
+                max_coarse: n.max(1),
+                ..options.clone()
+            };
+            Amg::scalar(sym, &one)?
+        } else {
+            let all_nodes = all_gather_vec(comm, nodes);
+            let m_local = null.map_or(0, NearNullSpace::num_vectors);
+            let m = all_gather_vec(comm, &[m_local])
+                .into_iter()
+                .max()
+                .unwrap_or(0);
+            let mut data = Vec::with_capacity(n * m);
+            for k in 0..m {
+                let part: &[f64] = match null {
+                    Some(b) if k < m_local => b.vector(k),
+                    _ => &[],
+                };
+                data.extend(all_gather_vec(comm, part));
+            }
+            if data.len() != n * m || all_nodes.len() != n {
+                return Err(DistError::Input(format!(
+                    "a gathered level of {n} equations with {} node ids and {} near-null \
+                     entries",
+                    all_nodes.len(),
+                    data.len()
+                )));
+            }
+            let null = NearNullSpace::from_vectors(n, data)?;
+            let serial = AmgOptions {
+                aggressive_levels: options.aggressive_levels.saturating_sub(levels.len()),
+                max_levels: options.max_levels.saturating_sub(levels.len()).max(1),
+                ..options.clone()
+            };
+            Amg::new(sym, &all_nodes, &null, &serial)?
         };
-        let solver = Amg::scalar(sym, &one)?;
         let dinv = a.diagonal().iter().map(|d| 1.0 / d).collect();
         let layout = a.rows().clone();
         levels.push(Level {
@@ -612,6 +687,12 @@ impl DistAmg {
                 ghosts: l.a.ghosts().len(),
             })
             .collect()
+    }
+
+    /// The levels of the serial hierarchy of the gathered last level (one level when it
+    /// is factorized directly).
+    pub fn gathered_levels(&self) -> Vec<porofrac_amg::LevelInfo> {
+        self.coarsest.solver.borrow().level_info()
     }
 
     /// Heap bytes held on this process (operators, prolongators, the gathered coarsest
@@ -681,8 +762,8 @@ impl DistAmg {
             // Coarsest: gather the right-hand side, solve, keep the owned part.
             let all = all_gather_vec(comm, b);
             let mut z = vec![0.0; all.len()];
-            // The gathered operator was factorized at setup; the V-cycle of a one-level
-            // hierarchy is the direct solve.
+            // The gathered operator's serial hierarchy was built at setup (the V-cycle of
+            // a one-level hierarchy is the direct solve).
             self.coarsest.solver.borrow_mut().apply(&all, &mut z)?;
             let r = self.coarsest.layout.range_of(self.coarsest.layout.rank());
             x.copy_from_slice(&z[r]);

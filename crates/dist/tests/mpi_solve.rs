@@ -207,8 +207,9 @@ fn serial(p: &Problem, tol: f64) -> (Vec<f64>, usize) {
     (x, stats.iterations)
 }
 
-/// The rank body: distributed solve, compared with the serial one on rank 0.
-fn rank_body(dim: usize, n: usize) {
+/// The rank body: distributed solve, compared with the serial one on rank 0; levels of
+/// at most `gather_below` equations are gathered ([`DistAmg::with_gathering`]).
+fn rank_body(dim: usize, n: usize, gather_below: usize) {
     let universe = mpi::initialize().expect("MPI initializes once");
     let world = universe.world();
     use mpi::traits::Communicator;
@@ -230,7 +231,7 @@ fn rank_body(dim: usize, n: usize) {
     let dofs: Vec<(usize, usize)> = p.dofs[own.clone()].to_vec();
     let null = NearNullSpace::rigid_body_modes(&p.coords, dim, &dofs).unwrap();
     let nodes: Vec<usize> = dofs.iter().map(|d| d.0).collect();
-    let amg = DistAmg::new(&world, a, &nodes, &null, &options()).unwrap();
+    let amg = DistAmg::with_gathering(&world, a, &nodes, &null, &options(), gather_below).unwrap();
     let mut x = vec![0.0; own.len()];
     let stats = amg
         .solve(&world, &mut x, &p.b[own.clone()], tol, 500)
@@ -268,11 +269,21 @@ fn rank_body(dim: usize, n: usize) {
             diff / norm
         );
         let levels = amg.level_info(&world);
+        let gathered = amg.gathered_levels();
+        if gather_below > options().max_coarse {
+            // The gathered level is above the direct-solve size: a serial multilevel
+            // hierarchy handles it.
+            assert!(
+                gathered.len() >= 2 && gathered[0].rows > options().max_coarse,
+                "gathered levels {gathered:?}"
+            );
+        }
         println!(
-            "DIST dim={dim} n={n} ranks={size} iterations={} serial_iterations={its} rel_diff={:.3e} levels={:?}",
+            "DIST dim={dim} n={n} ranks={size} iterations={} serial_iterations={its} rel_diff={:.3e} levels={:?} gathered={:?}",
             stats.iterations,
             diff / norm,
-            levels.iter().map(|l| l.rows).collect::<Vec<_>>()
+            levels.iter().map(|l| l.rows).collect::<Vec<_>>(),
+            gathered.iter().map(|l| l.rows).collect::<Vec<_>>()
         );
     } else {
         let _ = amg.level_info(&world);
@@ -282,13 +293,19 @@ fn rank_body(dim: usize, n: usize) {
 #[test]
 #[ignore = "rank body: runs under mpirun from the driver tests"]
 fn rank_elasticity_2d() {
-    rank_body(2, 48);
+    rank_body(2, 48, 0);
 }
 
 #[test]
 #[ignore = "rank body: runs under mpirun from the driver tests"]
 fn rank_elasticity_3d() {
-    rank_body(3, 14);
+    rank_body(3, 14, 0);
+}
+
+#[test]
+#[ignore = "rank body: runs under mpirun from the driver tests"]
+fn rank_elasticity_3d_gathered() {
+    rank_body(3, 14, 1500);
 }
 
 /// Run `name` on `ranks` processes; returns its iteration count.
@@ -345,4 +362,9 @@ fn elasticity_2d_on_1_2_4_ranks_matches_serial() {
 #[test]
 fn elasticity_3d_on_1_2_4_ranks_matches_serial() {
     check_iterations("rank_elasticity_3d");
+}
+
+#[test]
+fn elasticity_3d_gathered_coarse_levels_on_1_2_4_ranks_matches_serial() {
+    check_iterations("rank_elasticity_3d_gathered");
 }

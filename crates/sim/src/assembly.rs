@@ -521,6 +521,23 @@ pub fn nodal_loads<const D: usize>(
     t: f64,
     out: &mut [f64],
 ) -> Result<()> {
+    nodal_loads_of_cells(grid, loads, t, &|_| true, out)
+}
+
+/// [`nodal_loads`] with the body force and gravity of the cells `c` with `keep(c)` only
+/// (tractions on every face). A node all of whose cells are kept gets the value
+/// [`nodal_loads`] gives it, bit for bit (the same blocks of cells, summed in the same
+/// order): a process of a distributed run computes the loads of its own nodes from the
+/// cells that touch them.
+///
+/// Errors: as [`nodal_loads`].
+pub fn nodal_loads_of_cells<const D: usize>(
+    grid: &Grid<D>,
+    loads: &Loads<D>,
+    t: f64,
+    keep: &(dyn Fn(usize) -> bool + Sync),
+    out: &mut [f64],
+) -> Result<()> {
     let ndof = D * grid.num_nodes();
     if out.len() != ndof {
         return Err(SimError::Input(format!(
@@ -560,6 +577,9 @@ pub fn nodal_loads<const D: usize>(
                 let (mut pts, mut ids) = (Vec::new(), Vec::new());
                 let mut simplices = SimplexBatch::<D>::default();
                 for c in cells.clone() {
+                    if !keep(c) {
+                        continue;
+                    }
                     if grid.cell_nodes(c).len() == D + 1 {
                         simplices.cells.push(c);
                         if simplices.cells.len() == SimplexBatch::<D>::CELLS {

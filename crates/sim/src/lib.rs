@@ -81,7 +81,7 @@ mod stress_cache;
 pub mod tip_asymptote;
 pub mod tip_opening;
 
-pub use assembly::{assemble, nodal_loads};
+pub use assembly::{assemble, nodal_loads, nodal_loads_of_cells};
 pub use bc::{Displacement, Gravity, Loads, Platen, Traction};
 pub use biot::{
     BiotCoupling, BiotError, BiotState, BiotStep, BiotSystem, CouplingStats, ExplicitPressure,

@@ -317,3 +317,57 @@ fn body_loads_do_not_depend_on_the_cell_order() {
         assert!((a - b).abs() <= 1e-14 * scale, "dof {i}: {a} vs {b}");
     }
 }
+
+/// The loads of the nodes of one part of the grid, from the cells touching them (as a
+/// process of a distributed run computes them): those nodes get `nodal_loads`'s values
+/// bit for bit, and a node none of whose cells is kept gets nothing.
+#[test]
+fn body_loads_of_the_cells_of_some_nodes_are_those_of_the_whole_grid() {
+    let grid =
+        generate::simplices::<3>(Point::<3>::zeros(), Point::<3>::repeat(1.0), [5, 4, 3]).unwrap();
+    let loads = Loads {
+        body_force: Some(
+            [
+                ScalarField::from_fn(|x, _| (3.0 * x[0]).sin() + x[1] * x[2]),
+                ScalarField::from_fn(|x, _| (2.0 * x[1]).cos() * x[0]),
+                ScalarField::from_fn(|x, _| x[2] * x[2] - 0.5 * x[0]),
+            ]
+            .into(),
+        ),
+        ..Loads::default()
+    };
+    let nn = grid.num_nodes();
+    let mut all = vec![0.0; 3 * nn];
+    nodal_loads(&grid, &loads, 0.0, &mut all).unwrap();
+    // The nodes with x < 0.45 (two of five columns of cells and their border).
+    let mine: Vec<bool> = (0..nn).map(|v| grid.node(v)[0] < 0.45).collect();
+    let touches = |c: usize| grid.cell_nodes(c).iter().any(|&v| mine[v]);
+    let mut part = vec![0.0; 3 * nn];
+    nodal_loads_of_cells(&grid, &loads, 0.0, &touches, &mut part).unwrap();
+    let (mut same, mut zero) = (0, 0);
+    for v in 0..nn {
+        let kept = (0..grid.num_cells())
+            .filter(|&c| grid.cell_nodes(c).contains(&v))
+            .map(touches);
+        let (any, every) = kept.fold((false, true), |(a, e), k| (a || k, e && k));
+        for a in 0..3 {
+            let (p, w) = (part[3 * v + a], all[3 * v + a]);
+            if mine[v] {
+                assert!(every);
+                assert_eq!(
+                    p.to_bits(),
+                    w.to_bits(),
+                    "node {v} component {a}: {p} vs {w}"
+                );
+                same += 1;
+            } else if !any {
+                assert_eq!(p, 0.0, "node {v} component {a}");
+                zero += 1;
+            }
+        }
+    }
+    assert!(
+        same > 0 && zero > 0,
+        "{same} kept and {zero} untouched components"
+    );
+}

@@ -18,10 +18,14 @@
 //!    its law (`K_K`), and the rows of its owned nodes are added into block rows (one
 //!    `D × D` block per neighbouring node); the columns of prescribed dofs move to the
 //!    right-hand side (`b = f − K_fp u_p`), as in the serial static solve. A cell on a
-//!    partition border is evaluated by every rank that owns one of its nodes.
+//!    partition border is evaluated by every rank that owns one of its nodes. The body
+//!    loads are integrated over the same cells only
+//!    ([`porofrac_sim::nodal_loads_of_cells`]: the owned nodes get the serial values).
 //! 4. **Solve**: CG preconditioned by the distributed AMG (rigid-body modes of the owned
 //!    equations; the options of the serial CG-AMG,
-//!    [`porofrac_sim::elasticity_amg_options`]) to the scene's `[solver] tolerance`.
+//!    [`porofrac_sim::elasticity_amg_options`]) to the scene's `[solver] tolerance`. The
+//!    first level of at most `GATHER_BELOW` equations is gathered on every rank and
+//!    handled by a serial hierarchy there.
 //! 5. **Output**: the solution is gathered on every rank (the displacement of every node);
 //!    each rank writes the cells whose first node it owns as its piece
 //!    `vtk/step_0000_p<r>.vtu`, rank 0 writes `vtk/step_0000.pvtu` naming the pieces and
@@ -41,7 +45,7 @@ use porofrac_dist::matrix::{all_gather_vec, max as global_max, sum_usize};
 use porofrac_dist::{DistAmg, DistCsr, Layout, NearNullSpace, recursive_bisection};
 use porofrac_grid::Grid;
 use porofrac_law::{CellLaw, GeometryBuffer, Scratch};
-use porofrac_sim::{DofMap, LawMap, elasticity_amg_options, nodal_loads};
+use porofrac_sim::{DofMap, LawMap, elasticity_amg_options, nodal_loads_of_cells};
 use porofrac_vtk::{
     Attributes, CellType, DataArray, Encoding, Polyhedra, PvdWriter, UnstructuredGrid,
 };
@@ -56,6 +60,14 @@ use crate::common::output::{SolverStats, Summary, WallSeconds, peak_memory_bytes
 use crate::common::sections::MechanicsSolver;
 
 use super::compose::{compose, conditions};
+
+/// A level of the distributed hierarchy with at most this many equations is gathered
+/// on every rank and handled there by a serial hierarchy
+/// ([`DistAmg::with_gathering`]): on E3 n = 40 (177 957 equations, level 1 of 3 072) two
+/// ranks then exchange messages on the finest level only, on E2 n = 1000 on the finest
+/// two (level 2 of 16 770 is gathered). A gathered level costs one gather of its
+/// right-hand side per cycle and its serial V-cycle on every rank.
+const GATHER_BELOW: usize = 20_000;
 
 /// Refuse, by key, what the distributed path does not model.
 fn refuse(ls: &LoadedScene) -> Result<(), RunError> {
@@ -181,8 +193,6 @@ fn run_dim<const D: usize>(
     let nn = grid.num_nodes();
     let mut u = vec![0.0; dofs.num_dofs()];
     dofs.set_prescribed(grid, t, &mut u);
-    let mut f = vec![0.0; D * nn];
-    nodal_loads(grid, &cond.loads, t, &mut f)?;
 
     // Partition and numbering.
     let coords: Vec<f64> = grid
@@ -191,6 +201,11 @@ fn run_dim<const D: usize>(
         .flat_map(|p| p.iter().copied())
         .collect();
     let part = recursive_bisection(&coords, D, size);
+    // The loads of the owned nodes, from the cells that touch them (the values of the
+    // serial run's, bit for bit).
+    let mut f = vec![0.0; D * nn];
+    let touches = |c: usize| grid.cell_nodes(c).iter().any(|&v| part[v] == rank);
+    nodal_loads_of_cells(grid, &cond.loads, t, &touches, &mut f)?;
     const NONE: usize = usize::MAX;
     let mut eq = vec![NONE; D * nn];
     let mut counts = vec![0usize; size + 1];
@@ -326,7 +341,8 @@ fn run_dim<const D: usize>(
     let nodes_of: Vec<usize> = eq_dofs.iter().map(|d| d.0).collect();
     let amg = agree(
         world,
-        DistAmg::new(world, a, &nodes_of, &null, &options).map_err(dist_error),
+        DistAmg::with_gathering(world, a, &nodes_of, &null, &options, GATHER_BELOW)
+            .map_err(dist_error),
     )?;
     let setup = global_max(world, t_solve.elapsed().as_secs_f64());
     let tolerance = s.solver.tolerance.unwrap_or(1e-8);
@@ -345,6 +361,7 @@ fn run_dim<const D: usize>(
     let solve = global_max(world, t_solve.elapsed().as_secs_f64());
     let cg_seconds = global_max(world, stats.seconds);
     let levels = amg.level_info(world);
+    let gathered = amg.gathered_levels();
     let amg_bytes = amg.bytes();
     drop(amg);
 
@@ -403,6 +420,7 @@ fn run_dim<const D: usize>(
             "partition": "recursive coordinate bisection of the nodes",
             "equations_per_rank": counts.windows(2).map(|w| w[1]).collect::<Vec<_>>(),
             "levels": levels.iter().map(|l| serde_json::json!({"rows": l.rows, "nnz": l.nnz})).collect::<Vec<_>>(),
+            "gathered_levels": gathered.iter().map(|l| serde_json::json!({"rows": l.rows, "nnz": l.nnz})).collect::<Vec<_>>(),
             "amg_setup_seconds": setup,
             "cg_seconds": cg_seconds,
             "seconds_per_iteration": if iterations > 0 { cg_seconds / iterations as f64 } else { 0.0 },
