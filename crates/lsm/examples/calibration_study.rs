@@ -4,7 +4,7 @@
 //! E = 10 GPa and a Poisson's ratio ν_set: E and ν of boxes of several sizes and seeds,
 //! measured on the core (affine fit, the result of `calibrate::uniaxial`) and at the
 //! boundary (platen travel, side disks), as `[bonds] calibrate = true` loads them
-//! (ε_yy = 1e-3, platens at 2e-4 of the lattice wave speed, local damping 0.7).
+//! (ε_yy = 1e-4, platens at 2e-4 of the lattice wave speed, local damping 0.7).
 //!
 //! `cargo run --release -p porofrac-lsm --example calibration_study -- [SIDE ...]
 //! [--seeds N] [--nu NU_SET]` (box sides in largest radii, default 20 30 40; 5 seeds;
@@ -59,7 +59,9 @@ fn main() {
         speed: 2e-4 * c,
         ..QuasiStatic::new(1.0)
     };
-    println!("side_rmax\tseed\tdisks\tcore\tE/E_hex\tnu\tE_platens/E_hex\tnu_sides\tsteps\tseconds");
+    println!(
+        "side_rmax\tseed\tdisks\tcore\tE/E_hex\tnu\tE_platens/E_hex\tnu_sides\tsteps\tseconds"
+    );
     for &side in &sides {
         let (mut es, mut nus) = (vec![], vec![]);
         for seed in 1..=seeds {
@@ -76,7 +78,7 @@ fn main() {
                 .expect("packing");
             let disks = Disks::new(&p.centres, &p.radii, rho).expect("disks");
             let n = disks.len();
-            match uniaxial(disks, spec, 1e-3, &q) {
+            match uniaxial(disks, spec, 1e-4, &q) {
                 Ok(u) => {
                     println!(
                         "{side}\t{seed}\t{n}\t{}\t{:.4}\t{:.4}\t{:.4}\t{:.4}\t{}\t{:.1}",

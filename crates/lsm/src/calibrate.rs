@@ -23,7 +23,7 @@
 //!   measures are kept in [`Uniaxial::e_platens`] and [`Uniaxial::nu_sides`]. The test
 //!   holds the strain until the kinetic energy of that network is below 1e-10 of the
 //!   bond energy (a rattler, which local damping does not stop, is left out),
-//!   or until E and ν hold steady to 1e-4 over 5000 steps.
+//!   or until E holds steady to 1e-4 (relative) and ν to 1e-3 over 5000 steps.
 //! * [`brazilian`]: a disk sample of radius R squeezed between two caps of particles
 //!   moving towards each other; the peak load F (N/m) gives the splitting tensile
 //!   strength `σ_t = 2F/(πD) = F/(πR)` (plane elasticity of a diametrically loaded disk).
@@ -131,7 +131,10 @@ fn largest_cluster(n: usize, bonds: &[crate::Bond]) -> Vec<bool> {
     }
     let mut parent: Vec<usize> = (0..n).collect();
     for b in bonds.iter().filter(|b| b.intact) {
-        let (ri, rj) = (root(&mut parent, b.i as usize), root(&mut parent, b.j as usize));
+        let (ri, rj) = (
+            root(&mut parent, b.i as usize),
+            root(&mut parent, b.j as usize),
+        );
         if ri != rj {
             parent[ri.max(rj)] = ri.min(rj);
         }
@@ -140,7 +143,9 @@ fn largest_cluster(n: usize, bonds: &[crate::Bond]) -> Vec<bool> {
     for i in 0..n {
         size[root(&mut parent, i)] += 1;
     }
-    let biggest = (0..n).max_by_key(|&i| (size[i], std::cmp::Reverse(i))).unwrap_or(0);
+    let biggest = (0..n)
+        .max_by_key(|&i| (size[i], std::cmp::Reverse(i)))
+        .unwrap_or(0);
     (0..n).map(|i| root(&mut parent, i) == biggest).collect()
 }
 
@@ -155,9 +160,8 @@ impl Affine {
     /// Distance of disk i's displacement from the field.
     fn residual(&self, x0: &[f64; 2], x: &[f64; 2]) -> f64 {
         let dx = [x0[0] - self.xm[0], x0[1] - self.xm[1]];
-        let r = [0, 1].map(|c| {
-            x[c] - x0[c] - self.um[c] - self.g[c][0] * dx[0] - self.g[c][1] * dx[1]
-        });
+        let r =
+            [0, 1].map(|c| x[c] - x0[c] - self.um[c] - self.g[c][0] * dx[0] - self.g[c][1] * dx[1]);
         r[0].hypot(r[1])
     }
 }
@@ -202,10 +206,7 @@ fn affine_fit(x0: &[[f64; 2]], x: &[[f64; 2]], set: &[usize]) -> Option<Affine> 
     let mut b = [[0.0; 2]; 2];
     for &i in set {
         let dx = [x0[i][0] - xm[0], x0[i][1] - xm[1]];
-        let du = [
-            x[i][0] - x0[i][0] - um[0],
-            x[i][1] - x0[i][1] - um[1],
-        ];
+        let du = [x[i][0] - x0[i][0] - um[0], x[i][1] - x0[i][1] - um[1]];
         for p in 0..2 {
             for q in 0..2 {
                 m[p][q] += dx[p] * dx[q];
@@ -215,7 +216,7 @@ fn affine_fit(x0: &[[f64; 2]], x: &[[f64; 2]], set: &[usize]) -> Option<Affine> 
     }
     let det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
     let scale = m[0][0] * m[1][1];
-    if set.len() < 3 || !(det > 1e-12 * scale) {
+    if set.len() < 3 || det.is_nan() || det <= 1e-12 * scale {
         return None;
     }
     let inv = [
@@ -243,7 +244,10 @@ fn bounds(d: &Disks) -> ([f64; 2], [f64; 2]) {
     (lo, hi)
 }
 
-/// Uniaxial compression of a rectangular sample to the strain `strain` (module docs).
+/// Uniaxial compression of a rectangular sample to the strain `strain` (module docs). A
+/// bond broken by the test is an error: the moduli are elastic, the strain must stay
+/// below the bonds' strength (1e-4 for the rock of the bundled scenes, whose bonds break
+/// from about 1e-3).
 pub fn uniaxial(
     disks: Disks,
     spec: LsmSpec,
@@ -258,7 +262,7 @@ pub fn uniaxial(
 /// of disks turning at no cost).
 const STEADY_STEPS: usize = 5000;
 
-/// How steady (relative for E, absolute for ν) over [`STEADY_STEPS`].
+/// How steady over [`STEADY_STEPS`]: E relative, ν absolute to ten times this.
 const STEADY: f64 = 1e-4;
 
 /// Steps between two calls of the progress callback of the calibration tests.
@@ -423,7 +427,7 @@ pub fn uniaxial_polled(
         })
     };
     // At rest: the kinetic energy of the bonded disks below 1e-10 of the bond energy,
-    // or E and ν of the core steady to 1e-4 over `STEADY_STEPS` (a slow creep of a few
+    // or E of the core steady to 1e-4 and ν to 1e-3 over `STEADY_STEPS` (a slow creep of a few
     // loose disks that never comes to rest does not move the core).
     let mut last = measure(&s)?;
     let mut since = 0;
@@ -439,7 +443,9 @@ pub fn uniaxial_polled(
         }
         if since >= STEADY_STEPS {
             let now = measure(&s)?;
-            if (now.e - last.e).abs() < STEADY * now.e.abs() && (now.nu - last.nu).abs() < STEADY {
+            if (now.e - last.e).abs() < STEADY * now.e.abs()
+                && (now.nu - last.nu).abs() < 10.0 * STEADY
+            {
                 break;
             }
             last = now;
@@ -450,6 +456,13 @@ pub fn uniaxial_polled(
                 "uniaxial: not at rest after {steps} steps"
             )));
         }
+    }
+    if !s.broken().is_empty() {
+        return Err(LsmError::Calibration(format!(
+            "uniaxial: {} bonds broke at the strain {strain:e}; E and ν are elastic moduli: \
+             lower the strain",
+            s.broken().len()
+        )));
     }
     Ok(Uniaxial {
         steps,
@@ -624,7 +637,7 @@ pub fn packing_springs(
             )));
         }
         let slope = (fb.1 - fa.1) / (b - a);
-        if !(slope.abs() > 1e-9) {
+        if slope.is_nan() || slope.abs() <= 1e-9 {
             return Err(LsmError::Calibration(
                 "packing springs: ν does not change with k_s/k_n".into(),
             ));

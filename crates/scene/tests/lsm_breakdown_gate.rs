@@ -57,5 +57,8 @@ fn flooded_breakdown_within_20_percent_on_every_packing_and_geometry() {
             }
         }
     }
-    assert!(misses.is_empty(), "outside ±20 % (b, seed, ratio): {misses:?}");
+    assert!(
+        misses.is_empty(),
+        "outside ±20 % (b, seed, ratio): {misses:?}"
+    );
 }
