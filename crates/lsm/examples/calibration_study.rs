@@ -60,7 +60,7 @@ fn main() {
         ..QuasiStatic::new(1.0)
     };
     println!(
-        "side_rmax\tseed\tdisks\tcore\tE/E_hex\tnu\tE_platens/E_hex\tnu_sides\tsteps\tseconds"
+        "side_rmax\tseed\tdisks\tcore\tE/E_hex\tnu\tE_platens/E_hex\tnu_sides\tsteps\tbroken\tseconds"
     );
     for &side in &sides {
         let (mut es, mut nus) = (vec![], vec![]);
@@ -81,13 +81,14 @@ fn main() {
             match uniaxial(disks, spec, 1e-4, &q) {
                 Ok(u) => {
                     println!(
-                        "{side}\t{seed}\t{n}\t{}\t{:.4}\t{:.4}\t{:.4}\t{:.4}\t{}\t{:.1}",
+                        "{side}\t{seed}\t{n}\t{}\t{:.4}\t{:.4}\t{:.4}\t{:.4}\t{}\t{}\t{:.1}",
                         u.core,
                         u.e / e_hex,
                         u.nu,
                         u.e_platens / e_hex,
                         u.nu_sides,
                         u.steps,
+                        u.broken,
                         t0.elapsed().as_secs_f64()
                     );
                     es.push(u.e / e_hex);

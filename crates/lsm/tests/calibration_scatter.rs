@@ -79,7 +79,14 @@ fn measure(kn: f64, ks: f64, strain: f64) -> Result<Vec<(f64, f64)>, LsmError> {
         ..QuasiStatic::new(1.0)
     };
     SEEDS
-        .map(|seed| uniaxial(boxed(seed), spec(kn, ks), strain, &q).map(|u| (u.e, u.nu)))
+        .map(|seed| {
+            let u = uniaxial(boxed(seed), spec(kn, ks), strain, &q)?;
+            assert_eq!(
+                u.broken, 0,
+                "seed {seed}: bonds broke at the strain {strain:e}"
+            );
+            Ok((u.e, u.nu))
+        })
         .collect()
 }
 
