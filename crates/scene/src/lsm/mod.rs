@@ -278,7 +278,7 @@ fn calibrate(
         speed: 2e-4 * c,
         ..QuasiStatic::new(1.0)
     };
-    let u = uniaxial_polled(boxed, *spec, 1e-3, &q, &mut setup.callback()).map_err(error)?;
+    let u = uniaxial_polled(boxed, *spec, 1e-4, &q, &mut setup.callback()).map_err(error)?;
     let rad = 10.0 * r1;
     let disk = packing(
         [-rad; 2],

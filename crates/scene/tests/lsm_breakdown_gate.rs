@@ -1,0 +1,64 @@
+//! Dry breakdown of the flooded borehole on every packing of five, against the
+//! thick-walled cylinder estimate `p_b = σ_t (b² − a²)/(b² + a²)` with the recipe's
+//! σ_t = 3.44 MPa: the mean Brazilian strength of disks of radius 20 r_max (caps 0.2 R
+//! thick) over seeds 1–5, 3.44 ± 0.42 MPa (`crates/lsm/tests/calibration_scatter.rs`),
+//! the size at which it has settled (4.58 MPa at 10 r_max, 3.70 at 15).
+//!
+//! The gate (breakdown, the wall crack reaching 2a, within ±20 % of p_b on each of seeds
+//! 1–5, on `scenes/lsm/borehole_flooded.toml` with b = 22 m and with b = 12 m, a = 3 m)
+//! is missed: measured with `scripts/lsm_breakdown_geometry.sh 3.44e6 22.0 1 2 3 4 5`
+//! 1.579, 1.257, 1.284, 1.470, 1.517 (1.42 ± 0.14, 0 of 5), with b = 12 m 1.207, 0.887,
+//! 1.029, 1.047, 1.318 (1.10 ± 0.17, 3 of 5). Against the size-consistent σ_t the wall
+//! of a hole of three largest radii is stronger than a large sample, and more so the
+//! larger the rock around it (docs/models/lsm.md). Ignored with these numbers.
+
+use std::path::Path;
+
+use porofrac_scene::{LawRegistry, Scene, Silent};
+
+/// The recipe's tensile strength (Pa).
+const SIGMA_T: f64 = 3.44e6;
+
+/// Breakdown / p_b of the bundled flooded rock with outer radius `b` and packing `seed`.
+fn ratio(b: f64, seed: u64) -> f64 {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/lsm/borehole_flooded.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    let scene = text
+        .replace("radius = 22.0 }", &format!("radius = {b:.1} }}"))
+        .replace("seed = 1\n", &format!("seed = {seed}\n"));
+    let out = std::env::temp_dir().join(format!(
+        "porofrac-lsmgate-{}-{b}-{seed}",
+        std::process::id()
+    ));
+    let _ = std::fs::remove_dir_all(&out);
+    std::fs::create_dir_all(&out).unwrap();
+    Scene::parse(&scene, Path::new("gate.toml"), LawRegistry::default())
+        .unwrap()
+        .run(&out, &mut Silent)
+        .unwrap();
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let a = s["breakdown_extent"].as_f64().unwrap() / 2.0;
+    let pb = SIGMA_T * (b * b - a * a) / (b * b + a * a);
+    let bd = s["breakdown_pressure"].as_f64().unwrap_or(f64::NAN);
+    bd / pb
+}
+
+#[test]
+#[ignore = "misses the gate: breakdown 1.42 ± 0.14 p_b (b = 22 m, 0 of 5) and 1.10 ± 0.17 (b = 12 m, 3 of 5) with the recipe's σ_t; ten runs of 10-50 s"]
+fn flooded_breakdown_within_20_percent_on_every_packing_and_geometry() {
+    let mut misses = Vec::new();
+    for b in [22.0, 12.0] {
+        for seed in 1..=5 {
+            let r = ratio(b, seed);
+            eprintln!("b = {b} m, seed {seed}: breakdown {r:.3} p_b");
+            if r.is_nan() || (r - 1.0).abs() >= 0.2 {
+                misses.push((b, seed, r));
+            }
+        }
+    }
+    assert!(
+        misses.is_empty(),
+        "outside ±20 % (b, seed, ratio): {misses:?}"
+    );
+}

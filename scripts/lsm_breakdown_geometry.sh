@@ -1,0 +1,56 @@
+#!/usr/bin/env bash
+# Dry breakdown of the flooded borehole (scenes/lsm/borehole_flooded.toml: rays wall,
+# flood_cracks, 2.5 MPa/s, a = 3 m) over packings and outer radii b, through `porofrac run`,
+# against p_b = sigma_t (b^2 - a^2)/(b^2 + a^2) with sigma_t given (Pa) rather than the
+# scene's own calibration:
+#
+#   scripts/lsm_breakdown_geometry.sh SIGMA_T B SEED...   e.g. ... 3.44e6 12 1 2 3 4 5
+#
+# SIGMA_T: the tensile strength for p_b (the recipe's Brazilian sigma_t of docs/models/lsm.md,
+# "Calibration"); B: the outer radius (m; the bundled scene has 22). PORFRAC_BIN overrides the
+# binary (default target/release/porofrac). Runs go to target/lsm_geometry/bB-SEED. One row per
+# run: b, seed, particles, initiation (MPa), breakdown (MPa, the wall crack at 2a), breakdown /
+# p_b, the scene's calibrated sigma_t (MPa), seconds; then mean, sd, range and the count within
+# +-20 %.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+sigma=$1; b=$2; shift 2
+bin=${PORFRAC_BIN:-target/release/porofrac}
+rows=$(mktemp)
+trap 'rm -f "$rows"' EXIT
+printf 'b\tseed\tparticles\tinit_MPa\tbreakdown_MPa\tbd/p_b\tscene_sigma_t_MPa\tseconds\n'
+for seed in "$@"; do
+  dir=target/lsm_geometry/b$b-$seed
+  rm -rf "$dir"; mkdir -p "$dir"
+  sed -e "s/^seed = 1$/seed = $seed/" \
+      -e "s/^disk = { center = \[0.0, 0.0\], radius = 22.0 }$/disk = { center = [0.0, 0.0], radius = $b }/" \
+      scenes/lsm/borehole_flooded.toml > "$dir/scene.toml"
+  grep -q "^seed = $seed$" "$dir/scene.toml"
+  grep -q "radius = $b }" "$dir/scene.toml"
+  t0=$(date +%s.%N)
+  "$bin" run "$dir/scene.toml" --out "$dir/out" > "$dir/log.txt" 2>&1
+  t1=$(date +%s.%N)
+  python3 - "$sigma" "$b" "$seed" "$dir/out" "$(echo "$t1 - $t0" | bc)" <<'PY' | tee -a "$rows"
+import json, sys
+sigma, b, seed, out, secs = sys.argv[1:]
+sigma, b = float(sigma), float(b)
+s = json.load(open(f"{out}/summary.json"))
+a = s["breakdown_extent"] / 2
+pb = sigma * (b * b - a * a) / (b * b + a * a)
+nan = float("nan")
+init = s.get("initiation_pressure") or nan
+bd = s.get("breakdown_pressure") or nan
+print(f"{b:g}\t{seed}\t{s['particles']}\t{init / 1e6:.3f}\t{bd / 1e6:.3f}\t{bd / pb:.3f}\t"
+      f"{s['calibration']['tensile_strength'] / 1e6:.3f}\t{float(secs):.0f}")
+PY
+done
+python3 - "$rows" <<'PY'
+import math, sys
+v = [float(l.split("\t")[5]) for l in open(sys.argv[1]) if l.strip()]
+ok = [x for x in v if not math.isnan(x)]
+m = sum(ok) / len(ok)
+sd = (sum((x - m) ** 2 for x in ok) / max(len(ok) - 1, 1)) ** 0.5
+inside = sum(1 for x in ok if abs(x - 1) < 0.2)
+print(f"breakdown / p_b: mean {m:.3f}, sd {sd:.3f}, range {min(ok):.3f}-{max(ok):.3f}, "
+      f"{inside} of {len(v)} within +-20 %")
+PY
