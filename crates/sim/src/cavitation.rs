@@ -30,11 +30,16 @@
 //!   fills it first), and its pressure is free.
 //!
 //! The step without void sources and the response of the pressure to a unit void source
-//! in each cell of `S` (one solve each, with the same matrix: a back-substitution for
-//! the monolithic scheme) give the pressure of any choice of sources by superposition;
+//! in each cell of `S` give the pressure of any choice of sources by superposition. The
+//! monolithic scheme gives those responses from its factors without a solve
+//! ([`CavitationSolver::responses`], `Monolithic::pressure_responses`: the Schur
+//! complement of the coupled matrix on the pressures of `S`); other schemes measure them,
+//! one solve each with the same matrix, kept between steps ([`ResponseCache`]);
 //! the void changes of `S` solve the small dense system `p_S = p_c`. A cell of `S` whose
 //! void would become negative leaves `S`; a cell outside `S` below `p_c` joins it; the
-//! iteration ends when `S` does not change (at most [`MAX_ACTIVE_SET`] times). The step is
+//! iteration starts from the set of the last bounded step (the cells of it that still
+//! hold a void or fall below `p_c`) and ends when `S` does not change (at most
+//! [`MAX_ACTIVE_SET`] times). The step is
 //! then solved once more with the sources found, and the pressure of the cells of `S`
 //! set to `p_c` (it differs from it by the rounding of that solve). The fluid volume is
 //! balanced to rounding: over a closed domain the injected volume equals the stored one
