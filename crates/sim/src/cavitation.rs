@@ -30,11 +30,16 @@
 //!   fills it first), and its pressure is free.
 //!
 //! The step without void sources and the response of the pressure to a unit void source
-//! in each cell of `S` (one solve each, with the same matrix: a back-substitution for
-//! the monolithic scheme) give the pressure of any choice of sources by superposition;
+//! in each cell of `S` give the pressure of any choice of sources by superposition. The
+//! monolithic scheme gives those responses from its factors without a solve
+//! ([`CavitationSolver::responses`], `Monolithic::pressure_responses`: the Schur
+//! complement of the coupled matrix on the pressures of `S`); other schemes measure them,
+//! one solve each with the same matrix, kept between steps ([`ResponseCache`]);
 //! the void changes of `S` solve the small dense system `p_S = p_c`. A cell of `S` whose
 //! void would become negative leaves `S`; a cell outside `S` below `p_c` joins it; the
-//! iteration ends when `S` does not change (at most [`MAX_ACTIVE_SET`] times). The step is
+//! iteration starts from the set of the last bounded step (the cells of it that still
+//! hold a void or fall below `p_c`) and ends when `S` does not change (at most
+//! [`MAX_ACTIVE_SET`] times). The step is
 //! then solved once more with the sources found, and the pressure of the cells of `S`
 //! set to `p_c` (it differs from it by the rounding of that solve). The fluid volume is
 //! balanced to rounding: over a closed domain the injected volume equals the stored one
@@ -72,6 +77,41 @@ pub struct ResponseCache {
     /// Per cell: the pressure change of a void of the cell's own volume over a step, as
     /// (cell, value) pairs above a small fraction of the largest.
     entries: Vec<(usize, Vec<(usize, f64)>)>,
+    /// The cavitating cells at the end of the last bounded step: the next one starts
+    /// from those of them that still hold a void or fall below the bound.
+    last: Vec<usize>,
+}
+
+/// A coupled step as [`bounded_step`] uses it: solves with the void sources of the system,
+/// and, where the scheme can, the responses of the pressure to void sources from the
+/// matrix of its last solve without a solve (the Schur complement of the coupled matrix
+/// on the pressures of a few cells). Every closure `FnMut(&BiotSystem) -> BiotResult<BiotStep>`
+/// is one that has no such responses (they are then measured by solves).
+pub trait CavitationSolver<const D: usize> {
+    /// One step of `system` with its void sources.
+    fn solve(&mut self, system: &BiotSystem<'_, D>) -> BiotResult<BiotStep>;
+    /// The pressure change at `cells[i]` of a void of `volumes[j]` opened in `cells[j]`
+    /// over the step (row-major `k × k`), with the matrix of the last [`Self::solve`];
+    /// `None` when the scheme has no such responses (the default) or `system` is not the
+    /// last one solved.
+    fn responses(
+        &mut self,
+        system: &BiotSystem<'_, D>,
+        cells: &[usize],
+        volumes: &[f64],
+    ) -> BiotResult<Option<Vec<f64>>> {
+        let _ = (system, cells, volumes);
+        Ok(None)
+    }
+}
+
+impl<const D: usize, F> CavitationSolver<D> for F
+where
+    F: FnMut(&BiotSystem<'_, D>) -> BiotResult<BiotStep>,
+{
+    fn solve(&mut self, system: &BiotSystem<'_, D>) -> BiotResult<BiotStep> {
+        self(system)
+    }
 }
 
 /// Responses kept at most; the oldest go first.
@@ -85,6 +125,7 @@ impl ResponseCache {
     /// Forget every response (e.g. for a new grid or system).
     pub fn clear(&mut self) {
         self.entries.clear();
+        self.last.clear();
     }
     /// The number of responses kept.
     pub fn len(&self) -> usize {
@@ -137,7 +178,7 @@ pub fn bounded_step<const D: usize>(
     void: &[f64],
     dt: f64,
     cache: &mut ResponseCache,
-    mut step: impl FnMut(&BiotSystem<'_, D>) -> BiotResult<BiotStep>,
+    mut step: impl CavitationSolver<D>,
 ) -> BiotResult<BoundedStep> {
     let nc = system.num_cells();
     if void.len() != nc {
@@ -174,11 +215,11 @@ fn settle<const D: usize>(
     dt: f64,
     volumes: &[f64],
     cache: &mut ResponseCache,
-    step: &mut impl FnMut(&BiotSystem<'_, D>) -> BiotResult<BiotStep>,
+    step: &mut impl CavitationSolver<D>,
 ) -> BiotResult<BoundedStep> {
     let nc = void.len();
     system.set_void_source(None)?;
-    let free = step(system)?;
+    let free = step.solve(system)?;
     let mut solves = 1;
     let holds_void = |c: usize| void[c] > 0.0;
     if free.state.pressure.iter().all(|&p| p >= p_cav) && !(0..nc).any(holds_void) {
@@ -195,9 +236,19 @@ fn settle<const D: usize>(
         .iter()
         .fold(p_cav.abs(), |m, p| m.max(p.abs()));
     let tol = 1e-10 * scale;
-    let mut active: Vec<usize> = (0..nc)
-        .filter(|&c| holds_void(c) || free.state.pressure[c] < p_cav - tol)
+    let below = |c: usize| holds_void(c) || free.state.pressure[c] < p_cav - tol;
+    // The cells of the last set that still hold a void or are below the bound: the
+    // solves of a step (failure rounds, the laws' active set) end at nearly the same set,
+    // and the voids of the others then close. Without one, every such cell.
+    let mut active: Vec<usize> = cache
+        .last
+        .iter()
+        .copied()
+        .filter(|&c| c < nc && below(c))
         .collect();
+    if active.is_empty() {
+        active = (0..nc).filter(|&c| below(c)).collect();
+    }
     // The cells whose response was measured with the system of this call.
     let mut fresh: Vec<usize> = Vec::new();
     let base = Base {
@@ -206,7 +257,24 @@ fn settle<const D: usize>(
         dt,
     };
     for _ in 0..MAX_ACTIVE_SET {
-        for &c in &active {
+        // The responses from the matrix of the free step when the scheme gives them
+        // (exact to the rounding of the factors: no cached response steers).
+        // With them, the responses of the closing voids outside the set too: the first
+        // correction then accounts for them.
+        let closing: Vec<usize> = (0..nc)
+            .filter(|&c| holds_void(c) && active.binary_search(&c).is_err())
+            .collect();
+        let asked: Vec<usize> = active.iter().chain(&closing).copied().collect();
+        let asked_volumes: Vec<f64> = asked.iter().map(|&c| volumes[c]).collect();
+        let all = step.responses(system, &asked, &asked_volumes)?;
+        let (m, k_asked) = (active.len(), asked.len());
+        // The set's own block and the response of the set to the closing voids.
+        let exact = all.as_ref().map(|g| {
+            (0..m)
+                .flat_map(|i| g[i * k_asked..i * k_asked + m].iter().copied())
+                .collect::<Vec<f64>>()
+        });
+        for &c in active.iter().filter(|_| exact.is_none()) {
             if cache.get(c).is_none() {
                 base.measure(c, system, cache, step)?;
                 solves += 1;
@@ -219,7 +287,6 @@ fn settle<const D: usize>(
         for c in (0..nc).filter(|&c| holds_void(c) && active.binary_search(&c).is_err()) {
             amount[c] = -void[c] / volumes[c];
         }
-        let m = active.len();
         let jacobian = |cache: &ResponseCache| {
             let mut g = vec![0.0; m * m];
             for (i, &c) in active.iter().enumerate() {
@@ -229,11 +296,21 @@ fn settle<const D: usize>(
             }
             g
         };
-        let mut g = jacobian(cache);
+        let mut g = exact.clone().unwrap_or_else(|| jacobian(cache));
         // The first guess from the free step, then Newton corrections with real solves.
         let mut r: Vec<f64> = active
             .iter()
-            .map(|&c| p_cav - free.state.pressure[c])
+            .enumerate()
+            .map(|(i, &c)| {
+                let shift: f64 = all.as_ref().map_or(0.0, |g| {
+                    closing
+                        .iter()
+                        .enumerate()
+                        .map(|(j, &d)| g[i * k_asked + m + j] * amount[d])
+                        .sum()
+                });
+                p_cav - free.state.pressure[c] - shift
+            })
             .collect();
         let mut solved = None;
         let mut last = f64::INFINITY;
@@ -252,14 +329,14 @@ fn settle<const D: usize>(
                 .map(|(a, v)| a * v / dt)
                 .collect();
             system.set_void_source(Some(q))?;
-            let s = step(system)?;
+            let s = step.solve(system)?;
             solves += 1;
             r = active
                 .iter()
                 .map(|&c| p_cav - s.state.pressure[c])
                 .collect();
             let err = r.iter().fold(0.0f64, |e, v| e.max(v.abs()));
-            let all_fresh = active.iter().all(|c| fresh.contains(c));
+            let all_fresh = exact.is_some() || active.iter().all(|c| fresh.contains(c));
             // Converged, or at the rounding of the solves (no progress with responses of
             // the current system).
             if err <= tol || (all_fresh && err > 0.5 * last && err <= 1e-7 * scale) {
@@ -270,7 +347,7 @@ fn settle<const D: usize>(
             let stale: Vec<usize> = active
                 .iter()
                 .copied()
-                .filter(|c| !fresh.contains(c))
+                .filter(|c| exact.is_none() && !fresh.contains(c))
                 .collect();
             if (err > 0.1 * last || k + 1 == MAX_CORRECTIONS) && !stale.is_empty() {
                 for c in stale {
@@ -310,6 +387,7 @@ fn settle<const D: usize>(
                     void_change[c] = -void[c];
                 }
             }
+            cache.last.clone_from(&active);
             return Ok(BoundedStep {
                 step: s,
                 void_change,
@@ -338,12 +416,12 @@ impl Base<'_> {
         d: usize,
         system: &mut BiotSystem<'_, D>,
         cache: &mut ResponseCache,
-        step: &mut impl FnMut(&BiotSystem<'_, D>) -> BiotResult<BiotStep>,
+        step: &mut impl CavitationSolver<D>,
     ) -> BiotResult<()> {
         let mut q = vec![0.0; self.free.len()];
         q[d] = self.volumes[d] / self.dt;
         system.set_void_source(Some(q))?;
-        let s = step(system)?;
+        let s = step.solve(system)?;
         let dp: Vec<f64> = s
             .state
             .pressure

@@ -1463,17 +1463,56 @@ fn scheme_step<const D: usize>(
     dt: f64,
     cav: Option<&mut Cavity<'_>>,
 ) -> FractureResult<(crate::BiotStep, Vec<f64>, usize)> {
-    let mut run = |sys: &BiotSystem<'_, D>| match scheme {
-        Scheme::Monolithic(m) => m.step(sys, s, t, dt),
-        Scheme::FixedStress(f, _) => f.step(sys, s, t, dt),
-        Scheme::ExplicitPressure(e, _) => e.step(sys, s, t, dt),
+    use crate::cavitation::CavitationSolver;
+    let mut solver = SchemeSolver {
+        scheme,
+        state: s,
+        t,
+        dt,
     };
     match cav {
         Some(c) if dt > 0.0 => {
-            let b = crate::cavitation::bounded_step(system, c.pressure, c.void, dt, c.cache, run)?;
+            let b =
+                crate::cavitation::bounded_step(system, c.pressure, c.void, dt, c.cache, solver)?;
             Ok((b.step, b.void_change, b.solves))
         }
-        _ => Ok((run(system)?, Vec::new(), 1)),
+        _ => Ok((
+            CavitationSolver::<D>::solve(&mut solver, system)?,
+            Vec::new(),
+            1,
+        )),
+    }
+}
+
+/// A step of `scheme` from `state` as the cavitation bound solves it: the monolithic
+/// scheme gives the responses to void sources from its factors
+/// ([`crate::Monolithic::pressure_responses`]), the split ones by solves.
+struct SchemeSolver<'a> {
+    scheme: &'a mut Scheme,
+    state: &'a BiotState,
+    t: f64,
+    dt: f64,
+}
+
+impl<const D: usize> crate::cavitation::CavitationSolver<D> for SchemeSolver<'_> {
+    fn solve(&mut self, sys: &BiotSystem<'_, D>) -> crate::biot::BiotResult<crate::BiotStep> {
+        let (s, t, dt) = (self.state, self.t, self.dt);
+        match self.scheme {
+            Scheme::Monolithic(m) => m.step(sys, s, t, dt),
+            Scheme::FixedStress(f, _) => f.step(sys, s, t, dt),
+            Scheme::ExplicitPressure(e, _) => e.step(sys, s, t, dt),
+        }
+    }
+    fn responses(
+        &mut self,
+        sys: &BiotSystem<'_, D>,
+        cells: &[usize],
+        volumes: &[f64],
+    ) -> crate::biot::BiotResult<Option<Vec<f64>>> {
+        match self.scheme {
+            Scheme::Monolithic(m) => m.pressure_responses(sys, cells, volumes),
+            _ => Ok(None),
+        }
     }
 }
 

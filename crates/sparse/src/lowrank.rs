@@ -292,13 +292,19 @@ impl LowRank {
     /// Cache the forward solves of the support's unknowns not cached yet, and their
     /// products `G` with every cached one.
     fn extend_cache(&mut self, ldlt: &mut Ldlt) -> Result<(), LdltError> {
-        let n = self.slot.len();
         let new: Vec<usize> = self
             .support
             .iter()
             .copied()
             .filter(|&u| self.slot[u] == NONE)
             .collect();
+        self.cache_new(ldlt, &new)
+    }
+
+    /// Cache the forward solves of the unknowns `new` (none cached yet, no repeats) and
+    /// their products `G` with every cached one.
+    fn cache_new(&mut self, ldlt: &mut Ldlt, new: &[usize]) -> Result<(), LdltError> {
+        let n = self.slot.len();
         let mut paths = Vec::new();
         for chunk in new.chunks(BATCH) {
             let old = self.w.len();
@@ -456,6 +462,69 @@ impl LowRank {
 }
 
 impl LowRank {
+    /// The entries `(A⁻¹)_{uw}` of the inverse of the current matrix between the unknowns
+    /// `units` (`k` of them; row-major `k × k`, `out[i k + j] = (A⁻¹)_{units[i] units[j]}`):
+    /// `A = A₀` without a change set up, else `A₀ + P Δ Pᵀ` ([`LowRank::prepare`]), whose
+    /// set-up is kept. With `G = Pᵀ A₀⁻¹ P` over the cached columns (those of `units` not
+    /// cached yet are computed, a forward sweep over each one's path), the capacitance form
+    /// of the module docs applied to `b = e_w` gives
+    ///
+    /// ```text
+    ///   (A⁻¹)_{uw} = G_uw − G_uT Δ (I + G_TT Δ)⁻¹ G_Tw ,
+    /// ```
+    ///
+    /// no sweep over the whole factor: the Schur complement of `A` on a few unknowns.
+    /// Its rounding is that of the capacitance solve (an updated solve's, before the
+    /// caller's refinement).
+    pub fn inverse_entries(
+        &mut self,
+        ldlt: &mut Ldlt,
+        units: &[usize],
+    ) -> Result<Vec<f64>, LdltError> {
+        let n = self.slot.len();
+        if let Some(&u) = units.iter().find(|&&u| u >= n) {
+            return Err(LdltError(format!(
+                "inverse entry of unknown {u} of a matrix of {n} unknowns"
+            )));
+        }
+        let mut seen = vec![false; n];
+        let new: Vec<usize> = units
+            .iter()
+            .copied()
+            .filter(|&u| self.slot[u] == NONE && !std::mem::replace(&mut seen[u], true))
+            .collect();
+        self.cache_new(ldlt, &new)?;
+        let g = |a: usize, b: usize| self.gram[a.max(b)][a.min(b)];
+        let k = units.len();
+        let slots: Vec<usize> = units.iter().map(|&u| self.slot[u]).collect();
+        let mut out = vec![0.0; k * k];
+        for (i, &a) in slots.iter().enumerate() {
+            for (j, &b) in slots.iter().enumerate() {
+                out[i * k + j] = g(a, b);
+            }
+        }
+        let Some(lu) = &self.lu else {
+            return Ok(out);
+        };
+        let m = self.support.len();
+        let support: Vec<usize> = self.support.iter().map(|&u| self.slot[u]).collect();
+        let mut t = vec![0.0; m];
+        for (j, &b) in slots.iter().enumerate() {
+            // y = (I + G Δ)⁻¹ G_Tw, then Δ y.
+            let mut y = Mat::<f64>::from_fn(m, 1, |i, _| g(support[i], b));
+            lu.solve_in_place(y.as_mut());
+            t.fill(0.0);
+            for &(r, c, v) in &self.delta {
+                t[r] += v * y[(c, 0)];
+            }
+            for (i, &a) in slots.iter().enumerate() {
+                let s: f64 = support.iter().zip(&t).map(|(&s, ts)| g(a, s) * ts).sum();
+                out[i * k + j] -= s;
+            }
+        }
+        Ok(out)
+    }
+
     /// `Σ_{u ∈ T} r_u²`: the part of the residual `r` on the support of the change.
     pub fn support_norm2(&self, r: &[f64]) -> f64 {
         self.support.iter().map(|&u| r[u] * r[u]).sum()
@@ -597,6 +666,59 @@ mod tests {
         lr2.solve(&mut again, &mut y).unwrap();
         assert_eq!(x, y);
         assert!(lr2.cache_columns(&mut again, &[n]).is_err());
+    }
+
+    /// The inverse entries of the changed matrix between a few unknowns equal the
+    /// entries of full solves with unit right-hand sides (to rounding), with and without
+    /// a change set up, and the change stays set up.
+    #[test]
+    fn inverse_entries_are_those_of_unit_solves() {
+        let (n, cp, ri, base) = matrix(12);
+        let mut changed = base.clone();
+        for q in cp[40]..cp[41] {
+            changed[q] *= 1e-3;
+        }
+        for q in cp[n - 2]..cp[n - 1] {
+            changed[q] *= 3.0;
+        }
+        let units = [n - 5, 40, 7, n - 1];
+        for (values, update) in [(&base, false), (&changed, true)] {
+            let mut ldlt = Ldlt::analyse(n, &cp, &ri, None).unwrap();
+            ldlt.factorize(&cp, &ri, &base).unwrap();
+            let mut lr = LowRank::new(n);
+            if update {
+                assert!(lr.prepare(&mut ldlt, &cp, &ri, &base, values, 64).unwrap());
+            }
+            let g = lr.inverse_entries(&mut ldlt, &units).unwrap();
+            assert_eq!(lr.is_active(), update);
+            let k = units.len();
+            for (j, &w) in units.iter().enumerate() {
+                let mut e = vec![0.0; n];
+                e[w] = 1.0;
+                let mut x = e.clone();
+                lr.solve(&mut ldlt, &mut x).unwrap();
+                // The solve is the inverse's column: its residual is at rounding.
+                let r = mul(n, &cp, &ri, values, &x);
+                let res = r
+                    .iter()
+                    .zip(&e)
+                    .map(|(a, b)| (a - b).abs())
+                    .fold(0.0, f64::max);
+                assert!(res < 1e-12, "residual {res}");
+                for (i, &u) in units.iter().enumerate() {
+                    let d = (g[i * k + j] - x[u]).abs();
+                    assert!(
+                        d <= 1e-12 * x[u].abs().max(1e-3),
+                        "{u},{w}: {} vs {}",
+                        g[i * k + j],
+                        x[u]
+                    );
+                }
+            }
+        }
+        let mut ldlt = Ldlt::analyse(n, &cp, &ri, None).unwrap();
+        ldlt.factorize(&cp, &ri, &base).unwrap();
+        assert!(LowRank::new(n).inverse_entries(&mut ldlt, &[n]).is_err());
     }
 
     #[test]

@@ -785,6 +785,49 @@ impl<const D: usize> BiotCoupling<D> for Monolithic {
 }
 
 impl Monolithic {
+    /// The pressure change at every cell of `cells` of a void source `volumes[d] / Δt`
+    /// in cell `d` over the last step's matrix (row-major `k × k`, `out[i k + j]` at
+    /// `cells[i]` for a source in `cells[j]`): the source enters the pressure row of `d`
+    /// as `−s · volumes[d]`, and the pressure of `c` is `s` times its unknown, so the
+    /// entry is `−s² volumes[d] (A⁻¹)_{cd}`, entries of the inverse of the block matrix
+    /// from the factors and the low-rank update of the last step
+    /// (`porofrac_sparse::LowRank::inverse_entries`): no solve over the whole factor.
+    /// `None` when `sys` is not the system of the last step's matrix.
+    pub fn pressure_responses<const D: usize>(
+        &mut self,
+        sys: &BiotSystem<'_, D>,
+        cells: &[usize],
+        volumes: &[f64],
+    ) -> BiotResult<Option<Vec<f64>>> {
+        let Some(dt) = self.factored.as_ref().map(|f| f.dt) else {
+            return Ok(None);
+        };
+        if cells.iter().any(|&c| c >= sys.num_cells()) || volumes.len() != cells.len() {
+            return Err(BiotError::Input(format!(
+                "responses of {} cells with {} volumes in a system of {} cells",
+                cells.len(),
+                volumes.len(),
+                sys.num_cells()
+            )));
+        }
+        if !self.is_factored(sys, self.s, dt) {
+            return Ok(None);
+        }
+        let units: Vec<usize> = cells.iter().map(|&c| self.nm + c).collect();
+        let mut g = self
+            .low_rank
+            .inverse_entries(&mut self.ldlt, &units)
+            .map_err(|e| BiotError::Solver(e.0))?;
+        let k = cells.len();
+        let s2 = self.s * self.s;
+        for row in g.chunks_mut(k.max(1)) {
+            for (v, vol) in row.iter_mut().zip(volumes) {
+                *v *= -s2 * vol;
+            }
+        }
+        Ok(Some(g))
+    }
+
     /// The mechanical part of the right-hand side at `t` into `work.rhs` and the
     /// prescribed displacements into `work.uf` (see `BiotSystem::mechanics_base`), kept
     /// from the first step when the conditions and loads do not depend on time.

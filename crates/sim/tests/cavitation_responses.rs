@@ -1,0 +1,248 @@
+//! The responses of the pressure to void sources from the monolithic scheme's factors
+//! ([`Monolithic::pressure_responses`]) and the bounded step steered by them
+//! (`porofrac_sim::cavitation::CavitationSolver`).
+//!
+//! The tight poroelastic square of `tests/cavitation.rs` (fixed boundary, closed to
+//! flow, a source withdrawing fluid from the cells about its centre):
+//!
+//! 1. the responses from the factors equal those measured by solves with a unit void
+//!    source (the step with the source less the step without), to 1e-9 of the largest,
+//!    with the matrix factorized and with a matrix solved by a low-rank update of the
+//!    factors of another (the permeability of a few cells changed);
+//! 2. the bounded step steered by them ends at the step steered by measured responses to
+//!    the solver's tolerance (1e-10 of the pressure scale, the iteration's own), with the
+//!    same cavitating cells, and with fewer coupled solves (2 against 1 + one per
+//!    cavitating cell + corrections).
+
+use porofrac_flow::{FlowModel, FlowProblem, Fluid, Permeability, Rock, SourceRate};
+use porofrac_grid::generate::simplices;
+use porofrac_grid::{Grid, Point};
+use porofrac_law::{CellLaw, Stiffness, Tensor};
+use porofrac_mdem::MdemLaw;
+use porofrac_sim::cavitation::{CavitationSolver, ResponseCache, bounded_step};
+use porofrac_sim::*;
+
+fn grid() -> Grid<2> {
+    simplices(Point::<2>::new(0.0, 0.0), Point::<2>::new(4.0, 4.0), [8, 8]).unwrap()
+}
+
+/// The flow model of the square with a source of `rate` (m²/s) in the cells within 0.5 m
+/// of the centre; the permeability of the cells of `tight` is lowered 100-fold.
+fn flow_model(grid: &Grid<2>, rate: f64, tight: &[usize]) -> FlowModel<2> {
+    let nc = grid.num_cells();
+    let centre: Vec<usize> = (0..nc)
+        .filter(|&c| (grid.cell_centroid(c) - Point::<2>::new(2.0, 2.0)).norm() < 0.5)
+        .collect();
+    let mut permeability = Permeability::uniform(nc, 1e-19).unwrap();
+    for &c in tight {
+        permeability
+            .set(c, Tensor::<2>::identity() * 1e-21)
+            .unwrap();
+    }
+    let mut rock = Rock::new(vec![0.1; nc], permeability);
+    rock.biot_alpha = vec![0.8; nc];
+    let fluid = Fluid {
+        viscosity: 1e-3,
+        compressibility: 1e-9,
+    };
+    let problem = FlowProblem::new(rock, fluid).source("pump", centre, SourceRate::Total(rate));
+    FlowModel::new(grid, &problem).unwrap()
+}
+
+/// The monolithic scheme from `state` with the responses of its factors.
+struct Factored<'a> {
+    mono: &'a mut Monolithic,
+    state: &'a BiotState,
+    dt: f64,
+}
+
+impl CavitationSolver<2> for Factored<'_> {
+    fn solve(&mut self, sys: &BiotSystem<'_, 2>) -> Result<BiotStep, BiotError> {
+        self.mono.step(sys, self.state, 0.0, self.dt)
+    }
+    fn responses(
+        &mut self,
+        sys: &BiotSystem<'_, 2>,
+        cells: &[usize],
+        volumes: &[f64],
+    ) -> Result<Option<Vec<f64>>, BiotError> {
+        self.mono.pressure_responses(sys, cells, volumes)
+    }
+}
+
+/// Run `f` with a coupled system of the square whose flow is `model`.
+fn with_system<R>(
+    grid: &Grid<2>,
+    model: &FlowModel<2>,
+    f: impl FnOnce(BiotSystem<'_, 2>) -> R,
+) -> R {
+    let nc = grid.num_cells();
+    let stiffness = Stiffness::<2>::isotropic(1e9, 0.25).unwrap();
+    let mdem = MdemLaw::<2>::new(&stiffness).unwrap();
+    let fixed = Displacement {
+        name: "boundary".into(),
+        faces: grid.boundary_faces(),
+        components: [Some(0.0.into()), Some(0.0.into())],
+    };
+    let dofs = DofMap::new(grid, &[fixed], &[]).unwrap();
+    let pattern = Pattern::new(grid, &dofs).unwrap();
+    let loads = Loads::default();
+    let laws = LawMap::uniform(grid, &mdem as &dyn CellLaw<2>).unwrap();
+    let problem = StaticProblem {
+        grid,
+        laws: &laws,
+        dofs: &dofs,
+        pattern: &pattern,
+        loads: &loads,
+    };
+    let system = BiotSystem::new(problem, model, vec![0.8; nc], vec![1e6; nc]).unwrap();
+    f(system)
+}
+
+#[test]
+fn responses_from_the_factors_are_the_measured_ones() {
+    let grid = grid();
+    let nc = grid.num_cells();
+    let dt = 10.0;
+    let volumes = grid.cell_volumes().to_vec();
+    let cells: Vec<usize> = vec![3, 40, 41, 77, nc - 1];
+    let vols: Vec<f64> = cells.iter().map(|&c| volumes[c]).collect();
+    let base = flow_model(&grid, -2e-5, &[]);
+    let changed = flow_model(&grid, -2e-5, &[40, 60, 61]);
+    let mut mono = None;
+    let mut updates = Vec::new();
+    for model in [&base, &changed] {
+        with_system(&grid, model, |mut sys| {
+            let m = mono.get_or_insert_with(|| Monolithic::new(&sys, None).unwrap());
+            let state = sys.initial_state(0.0).unwrap();
+            sys.set_void_source(None).unwrap();
+            let free = m.step(&sys, &state, 0.0, dt).unwrap();
+            let g = m.pressure_responses(&sys, &cells, &vols).unwrap().unwrap();
+            updates.push(m.stats().low_rank_updates);
+            let k = cells.len();
+            let mut measured = vec![0.0; k * k];
+            for (j, &d) in cells.iter().enumerate() {
+                let mut q = vec![0.0; nc];
+                q[d] = volumes[d] / dt;
+                sys.set_void_source(Some(q)).unwrap();
+                let s = m.step(&sys, &state, 0.0, dt).unwrap();
+                for (i, &c) in cells.iter().enumerate() {
+                    measured[i * k + j] = s.state.pressure[c] - free.state.pressure[c];
+                }
+            }
+            let big = measured.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+            assert!(big > 1e3, "responses of {big:.3e} Pa");
+            for (a, b) in g.iter().zip(&measured) {
+                assert!((a - b).abs() <= 1e-9 * big, "{a:.9e} against {b:.9e}");
+            }
+            // Symmetric up to the volumes: the coupled matrix is.
+            for i in 0..k {
+                for j in 0..k {
+                    let (a, b) = (g[i * k + j] / vols[j], g[j * k + i] / vols[i]);
+                    assert!((a - b).abs() <= 1e-9 * big / vols[j].min(vols[i]));
+                }
+            }
+        });
+    }
+    // The second matrix went through the low-rank update of the first's factors.
+    assert_eq!(updates, vec![0, 1]);
+}
+
+#[test]
+fn the_bounded_step_steered_by_the_factors_is_the_measured_one() {
+    let grid = grid();
+    let nc = grid.num_cells();
+    let (dt, p_cav) = (10.0, 2.0e3);
+    let model = flow_model(&grid, -2e-5, &[]);
+    with_system(&grid, &model, |mut sys| {
+        let state = sys.initial_state(0.0).unwrap();
+        // A few steps of withdrawal: a void opens, then grows.
+        let mut void = vec![0.0; nc];
+        let mut measured_state = state.clone();
+        let mut factored_state = state.clone();
+        let mut cavitating = 0;
+        let (mut measured_solves, mut factored_solves) = (0, 0);
+        for n in 0..6 {
+            let mut m1 = Monolithic::new(&sys, None).unwrap();
+            let mut cache = ResponseCache::new();
+            let from = measured_state.clone();
+            let a = bounded_step(
+                &mut sys,
+                p_cav,
+                &void,
+                dt,
+                &mut cache,
+                |s: &BiotSystem<'_, 2>| m1.step(s, &from, 0.0, dt),
+            )
+            .unwrap();
+            let mut m2 = Monolithic::new(&sys, None).unwrap();
+            let from = factored_state.clone();
+            let solver = Factored {
+                mono: &mut m2,
+                state: &from,
+                dt,
+            };
+            let b = bounded_step(
+                &mut sys,
+                p_cav,
+                &void,
+                dt,
+                &mut ResponseCache::new(),
+                solver,
+            )
+            .unwrap();
+            assert_eq!(a.cavitating, b.cavitating, "step {n}");
+            cavitating = cavitating.max(b.cavitating.len());
+            let scale = a
+                .step
+                .state
+                .pressure
+                .iter()
+                .fold(p_cav, |m, p| m.max(p.abs()));
+            for (x, y) in a.step.state.pressure.iter().zip(&b.step.state.pressure) {
+                assert!((x - y).abs() <= 1e-10 * scale, "step {n}: {x} against {y}");
+            }
+            let umax = a
+                .step
+                .state
+                .displacement
+                .iter()
+                .fold(0.0f64, |m, u| m.max(u.abs()));
+            for (x, y) in a
+                .step
+                .state
+                .displacement
+                .iter()
+                .zip(&b.step.state.displacement)
+            {
+                assert!((x - y).abs() <= 1e-9 * umax, "step {n}: {x} against {y}");
+            }
+            for (x, y) in a.void_change.iter().zip(&b.void_change) {
+                assert!(
+                    (x - y).abs() <= 1e-9 * 2e-5 * dt,
+                    "step {n}: {x} against {y}"
+                );
+            }
+            // The free step and one with the sources found, per change of the set.
+            measured_solves += a.solves;
+            factored_solves += b.solves;
+            assert!(
+                b.solves <= a.solves,
+                "step {n}: {} against {}",
+                b.solves,
+                a.solves
+            );
+            assert!(b.solves <= 4, "step {n}: {} solves", b.solves);
+            for (v, dv) in void.iter_mut().zip(&b.void_change) {
+                *v = (*v + dv).max(0.0);
+            }
+            measured_state = a.step.state;
+            factored_state = b.step.state;
+        }
+        assert!(cavitating > 1);
+        assert!(
+            factored_solves < measured_solves,
+            "{factored_solves} against {measured_solves} solves"
+        );
+    });
+}
