@@ -80,9 +80,12 @@ cal = s["calibration"]
 pb = cal["breakdown_estimate"]
 # the same closed form with the size-consistent sigma_t = 3.4 MPa of the Brazilian size study
 pb34 = pb * 3.4e6 / cal["tensile_strength"]
-crack = [(float(r["pressure"]), float(r["extent"])) for r in csv.DictReader(open(f"{out}/crack.csv"))]
+def rows(path):
+    # the CSV headers carry units ("pressure [Pa]"): key the columns by their names
+    return [{k.split(" [")[0]: v for k, v in r.items()} for r in csv.DictReader(open(path))]
+crack = [(float(r["pressure"]), float(r["extent"])) for r in rows(f"{out}/crack.csv")]
 p3a = next((p for p, e in crack if e >= 3 * a), nan)
-breaks = list(csv.DictReader(open(f"{out}/broken.csv")))
+breaks = rows(f"{out}/broken.csv")
 r1 = math.hypot(float(breaks[0]["x"]), float(breaks[0]["y"])) if breaks else nan
 print("\t".join([mode, seed, str(s["particles"]), f"{cal['tensile_strength'] / 1e6:.3f}",
                  f"{pb / 1e6:.3f}", f"{init / 1e6:.3f}", f"{init / pb:.3f}", f"{bd / 1e6:.3f}",

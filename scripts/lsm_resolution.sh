@@ -77,7 +77,10 @@ nan = float("nan")
 a = s["breakdown_extent"] / 2
 cal = s["calibration"]
 pb = cal["breakdown_estimate"]
-crack = [(float(r["pressure"]), float(r["extent"])) for r in csv.DictReader(open(f"{out}/crack.csv"))]
+def rows(path):
+    # the CSV headers carry units ("pressure [Pa]"): key the columns by their names
+    return [{k.split(" [")[0]: v for k, v in r.items()} for r in csv.DictReader(open(path))]
+crack = [(float(r["pressure"]), float(r["extent"])) for r in rows(f"{out}/crack.csv")]
 p3a = next((p for p, e in crack if e >= 3 * a), nan)
 init = s.get("initiation_pressure") or nan
 bd = s.get("breakdown_pressure") or nan
