@@ -24,6 +24,7 @@ use rayon::prelude::*;
 
 use crate::collision::{Rates, collide_with};
 use crate::d2q9::{C, OPP, W};
+use crate::runs::FluidRuns;
 
 /// The floating-point type populations are stored in; collision always runs in `f64`.
 ///
@@ -167,16 +168,42 @@ pub fn aa_step<T: Storage>(
     mask: Option<&[u8]>,
     phys: Physics,
 ) -> Layout {
+    aa_dispatch(pop, g, layout, mask, None, phys)
+}
+
+/// [`aa_step`] over the fluid nodes of `runs` only (built from `mask`, see
+/// [`crate::runs`]): every fluid node gets the same bits as from [`aa_step`] with `mask`;
+/// solid nodes are not touched (a row of many short runs is stepped whole with the mask).
+pub fn aa_step_runs<T: Storage>(
+    pop: &mut [T],
+    g: Grid,
+    layout: Layout,
+    mask: &[u8],
+    runs: &FluidRuns,
+    phys: Physics,
+) -> Layout {
+    aa_dispatch(pop, g, layout, Some(mask), Some(runs), phys)
+}
+
+fn aa_dispatch<T: Storage>(
+    pop: &mut [T],
+    g: Grid,
+    layout: Layout,
+    mask: Option<&[u8]>,
+    runs: Option<&FluidRuns>,
+    phys: Physics,
+) -> Layout {
     let force = phys.accel != [0.0, 0.0];
+    let r = runs;
     match (layout, mask, force) {
-        (Layout::Natural, None, false) => aa::<T, false, false, false>(pop, g, &[], phys),
-        (Layout::Natural, Some(m), false) => aa::<T, false, true, false>(pop, g, m, phys),
-        (Layout::Swapped, None, false) => aa::<T, true, false, false>(pop, g, &[], phys),
-        (Layout::Swapped, Some(m), false) => aa::<T, true, true, false>(pop, g, m, phys),
-        (Layout::Natural, None, true) => aa::<T, false, false, true>(pop, g, &[], phys),
-        (Layout::Natural, Some(m), true) => aa::<T, false, true, true>(pop, g, m, phys),
-        (Layout::Swapped, None, true) => aa::<T, true, false, true>(pop, g, &[], phys),
-        (Layout::Swapped, Some(m), true) => aa::<T, true, true, true>(pop, g, m, phys),
+        (Layout::Natural, None, false) => aa::<T, false, false, false>(pop, g, &[], r, phys),
+        (Layout::Natural, Some(m), false) => aa::<T, false, true, false>(pop, g, m, r, phys),
+        (Layout::Swapped, None, false) => aa::<T, true, false, false>(pop, g, &[], r, phys),
+        (Layout::Swapped, Some(m), false) => aa::<T, true, true, false>(pop, g, m, r, phys),
+        (Layout::Natural, None, true) => aa::<T, false, false, true>(pop, g, &[], r, phys),
+        (Layout::Natural, Some(m), true) => aa::<T, false, true, true>(pop, g, m, r, phys),
+        (Layout::Swapped, None, true) => aa::<T, true, false, true>(pop, g, &[], r, phys),
+        (Layout::Swapped, Some(m), true) => aa::<T, true, true, true>(pop, g, m, r, phys),
     }
     match layout {
         Layout::Natural => Layout::Swapped,
@@ -188,6 +215,7 @@ fn aa<T: Storage, const ODD: bool, const MASK: bool, const FORCE: bool>(
     pop: &mut [T],
     g: Grid,
     mask: &[u8],
+    runs: Option<&FluidRuns>,
     phys: Physics,
 ) {
     let w = g.stride();
@@ -202,6 +230,7 @@ fn aa<T: Storage, const ODD: bool, const MASK: bool, const FORCE: bool>(
             w,
             nx,
             mask,
+            runs,
             phys,
         });
     });
@@ -217,6 +246,8 @@ struct AaBand<'a, T, const ODD: bool, const MASK: bool, const FORCE: bool> {
     w: usize,
     nx: usize,
     mask: &'a [u8],
+    /// With `MASK`: visit only the fluid runs of each row.
+    runs: Option<&'a FluidRuns>,
     phys: Physics,
 }
 
@@ -233,6 +264,7 @@ impl<T: Storage, const ODD: bool, const MASK: bool, const FORCE: bool> pulp::Wit
             w,
             nx,
             mask,
+            runs,
             phys,
         } = self;
         for r in 0..n {
@@ -243,6 +275,29 @@ impl<T: Storage, const ODD: bool, const MASK: bool, const FORCE: bool> pulp::Wit
             };
             let col = |j: usize| r * w + if ODD { (1 + C[j][0]) as usize } else { 1 };
             let [s0, s1, s2, s3, s4, s5, s6, s7, s8] = &mut s;
+            if MASK && let Some(runs) = runs.filter(|rs| !rs.whole(row0 + r)) {
+                // fluid nodes only: `on = 1` exactly, so the unmasked collision gives the
+                // masked one's bits
+                for &[a, b] in runs.row(row0 + r) {
+                    let (a, len) = (a as usize, (b - a) as usize);
+                    aa_row::<T, ODD, false, FORCE>(
+                        [
+                            &mut s0[col(0) + a..][..len],
+                            &mut s1[col(1) + a..][..len],
+                            &mut s2[col(2) + a..][..len],
+                            &mut s3[col(3) + a..][..len],
+                            &mut s4[col(4) + a..][..len],
+                            &mut s5[col(5) + a..][..len],
+                            &mut s6[col(6) + a..][..len],
+                            &mut s7[col(7) + a..][..len],
+                            &mut s8[col(8) + a..][..len],
+                        ],
+                        &[],
+                        phys,
+                    );
+                }
+                continue;
+            }
             aa_row::<T, ODD, MASK, FORCE>(
                 [
                     &mut s0[col(0)..][..nx],

@@ -57,6 +57,7 @@ use crate::d2q9::{C, OPP, Q, W, cf, feq};
 use crate::geometry::Shape;
 use crate::kernel::{Grid, Layout, Physics};
 use crate::populations::{Populations, Precision};
+use crate::runs::FluidRuns;
 
 /// Largest Mach number `|u|/c_s` accepted for prescribed velocities and reached in a run.
 pub const MAX_MACH: f64 = 0.3;
@@ -220,6 +221,10 @@ pub struct Lattice {
     layout: Layout,
     /// 1 fluid, 0 solid (padded).
     mask: Vec<u8>,
+    /// The fluid nodes of each row as runs, the nodes a step visits ([`crate::runs`]).
+    runs: FluidRuns,
+    /// Whether a step visits the fluid nodes only ([`Lattice::set_skip_solid`]).
+    skip_solid: bool,
     /// Obstacle owning a solid node, or NONE.
     owner: Vec<u32>,
     obstacles: Vec<Obstacle>,
@@ -302,6 +307,8 @@ impl Lattice {
             pop: Populations::new(Precision::Double, np),
             layout: Layout::Natural,
             mask: vec![1; np],
+            runs: FluidRuns::new(cfg.nx, cfg.ny),
+            skip_solid: true,
             owner: vec![NONE; np],
             obstacles: Vec::new(),
             solid_nodes: Vec::new(),
@@ -451,6 +458,27 @@ impl Lattice {
     /// the values held are kept (rounded to `f32` for [`Precision::Single`]).
     pub fn set_precision(&mut self, precision: Precision) {
         self.pop = self.pop.converted(precision, self.grid.np());
+    }
+
+    /// Whether a step visits the fluid nodes only (default `true`) or every node, solid
+    /// ones included (collided with rate 0 and streamed, as before runs of fluid nodes
+    /// existed). The fluid is the same bit for bit either way, and so is everything read
+    /// from the lattice: solid nodes' populations are never read ([`crate::runs`]); only
+    /// the time of a step differs, and the solid nodes' storage
+    /// ([`Lattice::raw_state`]).
+    pub fn set_skip_solid(&mut self, skip: bool) {
+        self.skip_solid = skip;
+    }
+
+    /// Nodes the next step visits: the fluid nodes (with rows cut into many short runs
+    /// counted whole, see [`crate::runs`]), or every node without obstacles or with
+    /// [`Lattice::set_skip_solid`]`(false)`.
+    pub fn visited_nodes(&mut self) -> usize {
+        if self.obstacles.is_empty() || !self.skip_solid {
+            return self.grid.nx * self.grid.ny;
+        }
+        self.runs.refresh(&self.mask);
+        self.runs.visited_nodes()
     }
 
     /// The floating-point type of the populations.
@@ -815,12 +843,16 @@ impl Lattice {
             rates: self.rates,
             accel: self.cfg.accel,
         };
-        let mask = if self.obstacles.is_empty() {
-            None
+        self.layout = if self.obstacles.is_empty() {
+            self.pop.aa_step(self.grid, self.layout, None, phys)
+        } else if self.skip_solid {
+            self.runs.refresh(&self.mask);
+            self.pop
+                .aa_step_runs(self.grid, self.layout, &self.mask, &self.runs, phys)
         } else {
-            Some(&self.mask[..])
+            self.pop
+                .aa_step(self.grid, self.layout, Some(&self.mask), phys)
         };
-        self.layout = self.pop.aa_step(self.grid, self.layout, mask, phys);
         self.apply_copies();
         self.apply_sides();
         self.apply_obstacles();
@@ -1259,6 +1291,7 @@ impl Lattice {
                         let x = x as usize;
                         self.owner[x] = NONE;
                         self.mask[x] = 1;
+                        self.runs.touch(x / self.grid.stride() - 1);
                         self.scratch.fresh[x] = true;
                         self.scratch.released.push((x as u32, kk));
                         self.scratch.changed.push(x as u32);
@@ -1281,6 +1314,7 @@ impl Lattice {
                         }
                         self.owner[y] = kk;
                         self.mask[y] = 0;
+                        self.runs.touch(y / self.grid.stride() - 1);
                         self.scratch.changed.push(y as u32);
                         b += 1;
                     }

@@ -41,6 +41,7 @@ pub mod image;
 pub mod kernel;
 pub mod lattice;
 pub mod populations;
+pub mod runs;
 pub mod slab;
 pub mod thermal;
 pub mod units;

@@ -2,7 +2,8 @@
 //! collides in place, and element access for the boundary rules, which compute in `f64`.
 
 use crate::d2q9::{Q, W};
-use crate::kernel::{Grid, Layout, Physics, Storage, aa_step};
+use crate::kernel::{Grid, Layout, Physics, Storage, aa_step, aa_step_runs};
+use crate::runs::FluidRuns;
 
 /// The floating-point type the populations are stored in.
 ///
@@ -117,6 +118,21 @@ impl Populations {
         match self {
             Populations::Double(v) => aa_step(v, g, layout, mask, phys),
             Populations::Single(v, _) => aa_step(v, g, layout, mask, phys),
+        }
+    }
+
+    /// One fused AA step over the fluid nodes of `runs` ([`aa_step_runs`]).
+    pub(crate) fn aa_step_runs(
+        &mut self,
+        g: Grid,
+        layout: Layout,
+        mask: &[u8],
+        runs: &FluidRuns,
+        phys: Physics,
+    ) -> Layout {
+        match self {
+            Populations::Double(v) => aa_step_runs(v, g, layout, mask, runs, phys),
+            Populations::Single(v, _) => aa_step_runs(v, g, layout, mask, runs, phys),
         }
     }
 }
