@@ -225,6 +225,8 @@ pub struct Lattice {
     runs: FluidRuns,
     /// Whether a step visits the fluid nodes only ([`Lattice::set_skip_solid`]).
     skip_solid: bool,
+    /// Nodes the last step visited.
+    visited: usize,
     /// Obstacle owning a solid node, or NONE.
     owner: Vec<u32>,
     obstacles: Vec<Obstacle>,
@@ -309,6 +311,7 @@ impl Lattice {
             mask: vec![1; np],
             runs: FluidRuns::new(cfg.nx, cfg.ny),
             skip_solid: true,
+            visited: 0,
             owner: vec![NONE; np],
             obstacles: Vec::new(),
             solid_nodes: Vec::new(),
@@ -470,15 +473,11 @@ impl Lattice {
         self.skip_solid = skip;
     }
 
-    /// Nodes the next step visits: the fluid nodes (with rows cut into many short runs
-    /// counted whole, see [`crate::runs`]), or every node without obstacles or with
-    /// [`Lattice::set_skip_solid`]`(false)`.
-    pub fn visited_nodes(&mut self) -> usize {
-        if self.obstacles.is_empty() || !self.skip_solid {
-            return self.grid.nx * self.grid.ny;
-        }
-        self.runs.refresh(&self.mask);
-        self.runs.visited_nodes()
+    /// Nodes the last step collided and streamed: the fluid nodes (rows cut into many
+    /// short runs counted whole, see [`crate::runs`]), or every node without obstacles or
+    /// with [`Lattice::set_skip_solid`]`(false)`; 0 before the first step.
+    pub fn visited_nodes(&self) -> usize {
+        self.visited
     }
 
     /// The floating-point type of the populations.
@@ -843,10 +842,12 @@ impl Lattice {
             rates: self.rates,
             accel: self.cfg.accel,
         };
+        self.visited = self.grid.nx * self.grid.ny;
         self.layout = if self.obstacles.is_empty() {
             self.pop.aa_step(self.grid, self.layout, None, phys)
         } else if self.skip_solid {
             self.runs.refresh(&self.mask);
+            self.visited = self.runs.visited_nodes();
             self.pop
                 .aa_step_runs(self.grid, self.layout, &self.mask, &self.runs, phys)
         } else {

@@ -84,7 +84,7 @@ fn poison_solid(l: &mut Lattice) {
 /// Step `runs` (fluid nodes only, solid storage poisoned every 37 steps), `clean` (fluid
 /// nodes only) and `every` (every node) together and compare them after every step;
 /// `between` moves the obstacles before a step (placed by the caller). Returns the
-/// nodes the skipping lattice visited in its last step.
+/// nodes the skipping lattice visited in its last step and its fluid nodes then.
 fn run(
     every: Lattice,
     steps: usize,
@@ -103,10 +103,12 @@ fn run(
         for l in [&mut every, &mut runs, &mut clean] {
             between(l, n);
         }
-        visited = (clean.visited_nodes(), clean.fluid_nodes());
+        let fluid = clean.fluid_nodes();
         for l in [&mut every, &mut runs, &mut clean] {
             l.step().unwrap();
         }
+        visited = (clean.visited_nodes(), fluid);
+        assert_eq!(every.visited_nodes(), every.size().0 * every.size().1);
         assert_same(&runs, &every, n);
         assert_same(&clean, &every, n);
     }

@@ -487,6 +487,11 @@ impl Fluid {
                     / (st.fluid_seconds + st.particle_seconds).max(1e-300),
                 "fluid_share": st.fluid_seconds
                     / (st.fluid_seconds + st.particle_seconds).max(1e-300),
+                "visited_nodes": lat.visited_nodes(),
+                "mlups_fluid_nodes": lat.fluid_nodes() as f64 * st.steps as f64
+                    / st.fluid_seconds.max(1e-300) / 1e6,
+                "mlups_all_nodes": (nx * ny) as f64 * st.steps as f64
+                    / st.fluid_seconds.max(1e-300) / 1e6,
             }),
         );
         super::crack_flow::summary(&self.pf, m);
