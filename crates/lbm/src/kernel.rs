@@ -171,9 +171,9 @@ pub fn aa_step<T: Storage>(
     aa_dispatch(pop, g, layout, mask, None, phys)
 }
 
-/// [`aa_step`] over the fluid nodes of `runs` only (built from `mask`, see
-/// [`crate::runs`]): every fluid node gets the same bits as from [`aa_step`] with `mask`;
-/// solid nodes are not touched (a row of many short runs is stepped whole with the mask).
+/// [`aa_step`] over the segments of `runs` only (built from `mask`, see [`crate::runs`]):
+/// every fluid node gets the same bits as from [`aa_step`] with `mask`; solid nodes in
+/// long stretches between segments are not touched.
 pub fn aa_step_runs<T: Storage>(
     pop: &mut [T],
     g: Grid,
@@ -246,7 +246,7 @@ struct AaBand<'a, T, const ODD: bool, const MASK: bool, const FORCE: bool> {
     w: usize,
     nx: usize,
     mask: &'a [u8],
-    /// With `MASK`: visit only the fluid runs of each row.
+    /// With `MASK`: visit only the segments of each row.
     runs: Option<&'a FluidRuns>,
     phys: Physics,
 }
@@ -275,26 +275,27 @@ impl<T: Storage, const ODD: bool, const MASK: bool, const FORCE: bool> pulp::Wit
             };
             let col = |j: usize| r * w + if ODD { (1 + C[j][0]) as usize } else { 1 };
             let [s0, s1, s2, s3, s4, s5, s6, s7, s8] = &mut s;
-            if MASK && let Some(runs) = runs.filter(|rs| !rs.whole(row0 + r)) {
-                // fluid nodes only: `on = 1` exactly, so the unmasked collision gives the
-                // masked one's bits
-                for &[a, b] in runs.row(row0 + r) {
-                    let (a, len) = (a as usize, (b - a) as usize);
-                    aa_row::<T, ODD, false, FORCE>(
-                        [
-                            &mut s0[col(0) + a..][..len],
-                            &mut s1[col(1) + a..][..len],
-                            &mut s2[col(2) + a..][..len],
-                            &mut s3[col(3) + a..][..len],
-                            &mut s4[col(4) + a..][..len],
-                            &mut s5[col(5) + a..][..len],
-                            &mut s6[col(6) + a..][..len],
-                            &mut s7[col(7) + a..][..len],
-                            &mut s8[col(8) + a..][..len],
-                        ],
-                        &[],
-                        phys,
-                    );
+            if MASK && let Some(runs) = runs {
+                // the segments only; a segment of fluid nodes alone has `on = 1` exactly,
+                // so the unmasked collision gives the masked one's bits
+                for seg in runs.row(row0 + r) {
+                    let (a, len) = (seg.a as usize, (seg.b - seg.a) as usize);
+                    let sl = [
+                        &mut s0[col(0) + a..][..len],
+                        &mut s1[col(1) + a..][..len],
+                        &mut s2[col(2) + a..][..len],
+                        &mut s3[col(3) + a..][..len],
+                        &mut s4[col(4) + a..][..len],
+                        &mut s5[col(5) + a..][..len],
+                        &mut s6[col(6) + a..][..len],
+                        &mut s7[col(7) + a..][..len],
+                        &mut s8[col(8) + a..][..len],
+                    ];
+                    if seg.masked {
+                        aa_row::<T, ODD, true, FORCE>(sl, &m[a..][..len], phys);
+                    } else {
+                        aa_row::<T, ODD, false, FORCE>(sl, &[], phys);
+                    }
                 }
                 continue;
             }

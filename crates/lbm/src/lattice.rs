@@ -57,7 +57,7 @@ use crate::d2q9::{C, OPP, Q, W, cf, feq};
 use crate::geometry::Shape;
 use crate::kernel::{Grid, Layout, Physics};
 use crate::populations::{Populations, Precision};
-use crate::runs::FluidRuns;
+use crate::runs::{DEFAULT_GAP, FluidRuns};
 
 /// Largest Mach number `|u|/c_s` accepted for prescribed velocities and reached in a run.
 pub const MAX_MACH: f64 = 0.3;
@@ -221,9 +221,9 @@ pub struct Lattice {
     layout: Layout,
     /// 1 fluid, 0 solid (padded).
     mask: Vec<u8>,
-    /// The fluid nodes of each row as runs, the nodes a step visits ([`crate::runs`]).
+    /// The segments of each row a step visits ([`crate::runs`]).
     runs: FluidRuns,
-    /// Whether a step visits the fluid nodes only ([`Lattice::set_skip_solid`]).
+    /// Whether a step skips long stretches of solid nodes ([`Lattice::set_skip_solid`]).
     skip_solid: bool,
     /// Nodes the last step visited.
     visited: usize,
@@ -463,19 +463,27 @@ impl Lattice {
         self.pop = self.pop.converted(precision, self.grid.np());
     }
 
-    /// Whether a step visits the fluid nodes only (default `true`) or every node, solid
-    /// ones included (collided with rate 0 and streamed, as before runs of fluid nodes
-    /// existed). The fluid is the same bit for bit either way, and so is everything read
-    /// from the lattice: solid nodes' populations are never read ([`crate::runs`]); only
-    /// the time of a step differs, and the solid nodes' storage
-    /// ([`Lattice::raw_state`]).
-    pub fn set_skip_solid(&mut self, skip: bool) {
-        self.skip_solid = skip;
+    /// Which solid nodes a step leaves alone: `Some(gap)` skips every stretch of at least
+    /// `gap` solid nodes along a row (default [`DEFAULT_GAP`]; 1 skips every solid node),
+    /// `None` visits every node (solid ones collided with rate 0 and streamed, as before).
+    /// The fluid is the same bit for bit either way, and so is everything read from the
+    /// lattice: solid nodes' populations are never read ([`crate::runs`]); only the time of
+    /// a step differs, and the solid nodes' storage ([`Lattice::raw_state`]).
+    pub fn set_skip_solid(&mut self, gap: Option<usize>) {
+        self.skip_solid = gap.is_some();
+        let gap = gap.unwrap_or(DEFAULT_GAP).max(1);
+        if gap != self.runs.gap() {
+            self.runs = FluidRuns::with_gap(self.grid.nx, self.grid.ny, gap);
+            for j in 0..self.grid.ny {
+                self.runs.touch(j);
+            }
+        }
     }
 
-    /// Nodes the last step collided and streamed: the fluid nodes (rows cut into many
-    /// short runs counted whole, see [`crate::runs`]), or every node without obstacles or
-    /// with [`Lattice::set_skip_solid`]`(false)`; 0 before the first step.
+    /// Nodes the last step collided and streamed: those of the segments of
+    /// [`crate::runs`] (the fluid nodes and the solid stretches shorter than the gap of
+    /// [`Lattice::set_skip_solid`]), or every node without obstacles or with
+    /// [`Lattice::set_skip_solid`]`(None)`; 0 before the first step.
     pub fn visited_nodes(&self) -> usize {
         self.visited
     }
