@@ -18,7 +18,10 @@
 //! Populations are stored in `f64` or, with [`Lattice::set_precision`], in `f32`
 //! ([`Precision`]; the arithmetic stays `f64`). Obstacles may lie across periodic sides,
 //! and with [`ObstacleOverhang::Clipped`] overhang the other sides (clipped to the box);
-//! [`Lattice::contact`] reports an obstacle that overlaps another.
+//! [`Lattice::contact`] reports an obstacle that overlaps another. With obstacles, a step
+//! skips the long stretches of solid nodes along each row ([`runs`],
+//! [`Lattice::set_skip_solid`]): the fluid is the same to the bit, only faster where the
+//! lattice is mostly solid.
 //!
 //! ```
 //! use porofrac_lbm::{Lattice, LatticeConfig, Obstacle, Shape};

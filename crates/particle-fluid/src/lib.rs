@@ -13,7 +13,8 @@
 //! 3. **Heat**: the temperature lattice collides and streams with the velocities of the
 //!    fluid and the disks (solid nodes carry the solid diffusivity; §002.2).
 //! 4. **Fluid**: collide, stream, interpolated bounce-back on the cut links (Mora et al.
-//!    (2015) eq. 7).
+//!    (2015) eq. 7). Long stretches of solid nodes (the disks' nodes) are skipped
+//!    ([`porofrac_lbm::runs`]); the rasterisation of step 1 marks the rows it changed.
 //! 5. **Loads**: momentum exchange on the cut links (Mora et al. (2015) eq. 8) plus the
 //!    node exchange of step 1, in SI per metre of depth: `F = F* ρ Δx³/Δt²` (N/m), `T = T*
 //!    ρ Δx⁴/Δt²` (N).
