@@ -12,7 +12,10 @@
 # Usage (from the repository root, after `cargo build --release -p porofrac-cli`):
 #     scripts/hydrofrac_refinement.sh [OUTDIR] [REFINE...]
 # PORO_BIN overrides the binary (default target/release/porofrac); SCENE the base scene
-# (default scenes/hydrofrac_seed.toml; it must hold a line `refine = 12 ...`).
+# (default scenes/hydrofrac_seed.toml; it must hold a line `refine = 12 ...`); SET keys
+# given to every run as `--set` (space-separated `key=value`, e.g.
+# SET="physics.cavitation_pressure=2.3e3" for the fluid-lag scene bounded by cavitation).
+# Also printed: the fractured cells and the reach at every 300 s.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 bin=${PORO_BIN:-$root/target/release/porofrac}
@@ -28,7 +31,9 @@ for r in "${refines[@]}"; do
     sed -e "s/^refine = 12 .*/refine = $r/" -e "0,/^name = \".*\"/s//name = \"hydrofrac_refine_$r\"/" \
         "$scene" >"$d/scene.toml"
     grep -q "^refine = $r\$" "$d/scene.toml" || { echo "refine key not found" >&2; exit 1; }
-    "$bin" run "$d/scene.toml" --out "$d/out" >"$d/log.txt" 2>&1 || { echo "refine $r failed, see $d/log.txt" >&2; exit 1; }
+    sets=()
+    for kv in ${SET:-}; do sets+=(--set "$kv"); done
+    "$bin" run "$d/scene.toml" --out "$d/out" "${sets[@]}" >"$d/log.txt" 2>&1 || { echo "refine $r failed, see $d/log.txt" >&2; exit 1; }
 done
 python3 - "$out" "${refines[@]}" <<'PY'
 import csv, json, math, sys
@@ -39,19 +44,29 @@ rows = []
 for r in refines:
     d = out / f"refine_{r}" / "out"
     s = json.loads((d / "summary.json").read_text())
-    pts = [(float(f["x"]) - cx, float(f["y"]) - cy) for f in csv.DictReader(open(d / "fracture.csv"))
-           if float(f["time"]) <= 2400.0]
+    # Columns `x [m]`, `y [m]`, `time [s]`.
+    cells = [(float(f["x [m]"]) - cx, float(f["y [m]"]) - cy, float(f["time [s]"]))
+             for f in csv.DictReader(open(d / "fracture.csv"))]
+    pts = [(x, y) for x, y, t in cells if t <= 2400.0]
+    history = [(sum(1 for _, _, t in cells if t <= T),
+                max([math.hypot(x, y) for x, y, t in cells if t <= T], default=0.0))
+               for T in range(300, 2401, 300)]
     # Axis through the centre: principal direction of the second moments about the centre.
     sxx = sum(x * x for x, _ in pts); syy = sum(y * y for _, y in pts); sxy = sum(x * y for x, y in pts)
     ang = 0.5 * math.degrees(math.atan2(2 * sxy, sxx - syy)) % 180.0
     dist = [math.hypot(x, y) for x, y in pts]
     up = max([h for (x, y), h in zip(pts, dist) if y > 0], default=0.0)
     down = max([h for (x, y), h in zip(pts, dist) if y < 0], default=0.0)
-    rows.append((r, s["cells"], len(pts), up, down, max(up, down), ang, s["wall_seconds"]["total"]))
+    rows.append((r, s["cells"], len(pts), up, down, max(up, down), ang, s["wall_seconds"]["total"], history))
 print("| h (m) | refine | cells | fractured | reach up (m) | reach down (m) | reach (m) | direction (° from x) | wall (s) |")
 print("|---|---|---|---|---|---|---|---|---|")
-for r, c, n, up, down, reach, ang, wall in rows:
+for r, c, n, up, down, reach, ang, wall, _ in rows:
     print(f"| 1/{r} | {r} | {c} | {n} | {up:.3f} | {down:.3f} | {reach:.3f} | {ang:.1f} | {wall:.1f} |")
+print("\nfractured cells / reach (m) against time\n")
+print("| refine | " + " | ".join(f"{T} s" for T in range(300, 2401, 300)) + " |")
+print("|---" * 9 + "|")
+for row in rows:
+    print(f"| {row[0]} | " + " | ".join(f"{n} / {h:.2f}" for n, h in row[8]) + " |")
 if len(rows) >= 2:
     a, b = rows[-2], rows[-1]
     print(f"\nbetween refine {a[0]} and {b[0]}: reach change {abs(b[5] - a[5]) / b[5] * 100:.1f} % "
