@@ -74,7 +74,7 @@ impl Pockets {
                     continue;
                 }
                 let gap = FLOOR - lat.moments(i, j).0;
-                if !(gap > 0.0) {
+                if gap.is_nan() || gap <= 0.0 {
                     continue;
                 }
                 let s = match self.sources.get(&(i, j)) {
