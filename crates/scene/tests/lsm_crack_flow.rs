@@ -208,7 +208,7 @@ fn the_crack_flow_run_goes_past_the_pockets_that_stopped_it() {
 /// Measured on this packing (run to 0.3 s): 6.485 MPa against p_b = 3.144 MPa, 2.06 p_b
 /// (1.48 p_b without the crack flow, `lsm_hydrofrac.rs`); the wall crack reaches 5.15 m
 /// by 0.3 s. The bundled rock (`scenes/lsm_hydrofrac.toml`, b = 22 m) over five packings
-/// (docs/BENCHMARKS.md): 1.397, 1.176, 1.350, 0.815, 0.714 p_b (1.09 ± 0.31, 2 of 5 within
+/// (docs/BENCHMARKS.md): 1.396, 1.176, 1.350, 0.815, 0.714 p_b (1.09 ± 0.31, 2 of 5 within
 /// ±20 %), initiation 0.45–0.52 p_b, tensile, at the wall in one packing only: the hole's
 /// fluid fills pockets of the rock's open pore space 2.5 m behind the wall
 /// (`porofrac-particle-fluid` test `reach`) and the bonds behind them break first. The same
