@@ -56,8 +56,7 @@ impl Pockets {
 
     /// Set the sources of the coming [`Lattice::step`]: every fluid node of the interior
     /// whose eight neighbours are solid and whose density is below [`FLOOR`] receives
-    /// `FLOOR − ρ`.
-    /// Call after the obstacles are placed, before the step.
+    /// `FLOOR − ρ`. Call after the obstacles are placed, before the step.
     pub fn update(&mut self, lat: &mut Lattice) -> Result<(), CouplingError> {
         for s in self.active.drain(..) {
             lat.set_source_rate(s, 0.0)?;
