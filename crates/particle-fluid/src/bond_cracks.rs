@@ -46,12 +46,16 @@
 //!   under suction. It pushes the two disks apart along their centre line `n`: `+p L n` on
 //!   `j`, `−p L n` on `i`, per metre of depth — equal and opposite forces on one line, so
 //!   no net force and no net moment per channel.
+//! * **Pockets.** A fluid node the disks enclose alone is a pore the lattice does not
+//!   resolve; as the walls around it move apart it is kept at half the reference density
+//!   or above ([`crate::pockets`]) instead of being stretched through zero density.
 
 use std::collections::HashMap;
 
 use porofrac_lbm::d2q9::CS2;
 use porofrac_lbm::{Lattice, Units};
 
+use crate::pockets::Pockets;
 use crate::{CouplingError, ParticleSolver};
 
 /// Options of the crack network.
@@ -161,6 +165,8 @@ pub struct BondCracks {
     created: f64,
     exchanged: f64,
     stats: CrackSolveStats,
+    /// The lattice's one-node pockets, kept from zero density.
+    pockets: Pockets,
 }
 
 impl BondCracks {
@@ -227,6 +233,7 @@ impl BondCracks {
             created: 0.0,
             exchanged: 0.0,
             stats: CrackSolveStats::default(),
+            pockets: Pockets::new(),
         })
     }
 
@@ -295,6 +302,10 @@ impl BondCracks {
     pub fn stats(&self) -> &CrackSolveStats {
         &self.stats
     }
+    /// The lattice's one-node pockets kept from zero density ([`crate::pockets`]).
+    pub fn pockets(&self) -> &Pockets {
+        &self.pockets
+    }
 
     /// Take in the bonds broken since the last call, refresh every channel from the disks'
     /// positions, advance the pores and set the mouth nodes' sources for the lattice's next
@@ -323,6 +334,7 @@ impl BondCracks {
             ]
         };
         let rad = |i: usize| d.r[i] / units.dx;
+        self.pockets.update(lat)?;
         let w_min = self.options.min_aperture / units.dx;
         // new channels
         let mut fresh = Vec::new();

@@ -65,11 +65,13 @@ pub mod bond_cracks;
 pub mod cracks;
 mod injection;
 mod lsm;
+pub mod pockets;
 mod solver;
 
 pub use bond_cracks::{BondCrackOptions, BondCracks, CrackSolveStats};
 pub use cracks::{CrackChannel, CrackError, CrackFlow};
 pub use injection::{Injection, InjectionControl};
+pub use pockets::Pockets;
 pub use solver::{ParticleSolver, RigidDiskError, RigidDisks};
 
 use std::time::Instant;

@@ -92,6 +92,8 @@ pub fn summary(pf: &ParticleFluid, m: &mut serde_json::Map<String, serde_json::V
             "max_aperture": w_max,
             "max_sweeps": st.max_sweeps,
             "unconverged_steps": st.unconverged_steps,
+            "pocket_mass": c.pockets().added_mass() * mass,
+            "pocket_steps": c.pockets().topped(),
             "seconds": pf.stats().crack_seconds,
         }),
     );
