@@ -39,10 +39,131 @@
 //! a, linear elastic fracture mechanics), so it keeps growing at a rising pressure; a
 //! dry crack (pressure on the hole wall only) is loaded by the hoop stress
 //! `σ_θθ ∝ p a²/r²` alone, which falls away from the wall, and it stalls.
+//!
+//! **Which width.** The bond width `w = 2 min(R_i, R_j)` is the bond's section, not the
+//! length of crack face it stands for: along a crack through a random packing of radii
+//! 0.1–1 m the flooded bonds of a straight notch push its faces apart with
+//! `Σ w_k |n_k · m|` = 0.3–0.6 of `p` times the notch length (m the notch normal;
+//! [`crate::toughness::NotchTest::face_load`]), in a hexagonal lattice with √3 times it.
+//! [`FaceWidths::radical`] gives every bond the length of its *face*: the edge shared by
+//! the two disks' cells of the power (radical Voronoi) diagram, between the radical
+//! centres of the bonded triangles on either side. The cells tile the plane, so the faces
+//! crossed by a straight crack add up, projected, to its length, and the flooded loads of
+//! [`CrackExtent::flood_loads_on_faces`] are a pressure `p` on the crack: in a hexagonal
+//! lattice exactly (`flooded_faces_of_a_hexagonal_lattice_carry_the_pressure`). A side
+//! with no bonded triangle (a pore of four or more disks, a free surface) ends the face
+//! at `min(R_i, R_j)` from the centre line, as the bond width does.
 
 use crate::LsmError;
-use crate::bond::BrokenBond;
+use crate::bond::{Bond, BrokenBond};
 use porofrac_particles::Disks;
+
+/// Which length of crack face a flooded broken bond stands for (module docs, "Which
+/// width").
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum CrackFaces {
+    /// The bond width `w = 2 min(R_i, R_j)` ([`CrackExtent::flood_loads`]).
+    #[default]
+    BondWidth,
+    /// The power-diagram face ([`FaceWidths::radical`],
+    /// [`CrackExtent::flood_loads_on_faces`]).
+    Radical,
+}
+
+/// The crack-face length of every bond of a packing (module docs, "Which width").
+#[derive(Clone, Debug, PartialEq)]
+pub struct FaceWidths {
+    /// `(i, j)` of every bond, `i < j`, sorted.
+    pairs: Vec<(u32, u32)>,
+    /// Face length (m) of each.
+    width: Vec<f64>,
+}
+
+impl FaceWidths {
+    /// The power-diagram face of each of `bonds` (intact or broken) between the disks
+    /// of `disks` in their current configuration: the segment of the radical line of
+    /// `i` and `j` between the radical centres of the triangles `(i, j, k)` closest to
+    /// the bond on either side, `k` bonded to both; a side without one ends at
+    /// `min(R_i, R_j)`; each end at most `max(R_i, R_j)` from the centre line.
+    pub fn radical(disks: &Disks, bonds: &[Bond]) -> Self {
+        let n = disks.len();
+        let mut adj: Vec<Vec<u32>> = vec![Vec::new(); n];
+        for b in bonds {
+            adj[b.i as usize].push(b.j);
+            adj[b.j as usize].push(b.i);
+        }
+        adj.iter_mut().for_each(|a| a.sort_unstable());
+        let mut order: Vec<usize> = (0..bonds.len()).collect();
+        order.sort_unstable_by_key(|&k| (bonds[k].i.min(bonds[k].j), bonds[k].i.max(bonds[k].j)));
+        let mut pairs = Vec::with_capacity(bonds.len());
+        let mut width = Vec::with_capacity(bonds.len());
+        for k in order {
+            let (i, j) = (bonds[k].i.min(bonds[k].j), bonds[k].i.max(bonds[k].j));
+            pairs.push((i, j));
+            width.push(radical_face(disks, i as usize, j as usize, &adj));
+        }
+        Self { pairs, width }
+    }
+
+    /// The face length (m) of the bond between `i` and `j`, if there is one.
+    pub fn get(&self, i: usize, j: usize) -> Option<f64> {
+        let key = (i.min(j) as u32, i.max(j) as u32);
+        self.pairs
+            .binary_search(&key)
+            .ok()
+            .map(|k| self.width[k])
+    }
+}
+
+/// The power-diagram face of the bond `i`–`j` ([`FaceWidths::radical`]).
+fn radical_face(disks: &Disks, i: usize, j: usize, adj: &[Vec<u32>]) -> f64 {
+    let (xi, xj) = (disks.x[i], disks.x[j]);
+    let (ri, rj) = (disks.r[i], disks.r[j]);
+    let e = [xj[0] - xi[0], xj[1] - xi[1]];
+    let d = e[0].hypot(e[1]);
+    let t = [-e[1] / d, e[0] / d];
+    let (rmin, rmax) = (ri.min(rj), ri.max(rj));
+    let power = |x: [f64; 2], r: f64| x[0] * x[0] + x[1] * x[1] - r * r;
+    let (mut left, mut right) = (f64::INFINITY, f64::NEG_INFINITY);
+    let (ai, aj) = (&adj[i], &adj[j]);
+    let (mut p, mut q) = (0, 0);
+    while p < ai.len() && q < aj.len() {
+        if ai[p] < aj[q] {
+            p += 1;
+            continue;
+        }
+        if aj[q] < ai[p] {
+            q += 1;
+            continue;
+        }
+        let k = ai[p] as usize;
+        p += 1;
+        q += 1;
+        let xk = disks.x[k];
+        let f = [xk[0] - xi[0], xk[1] - xi[1]];
+        // the radical centre c: 2 e·c = P_j − P_i, 2 f·c = P_k − P_i (P = |x|² − R²)
+        let det = 2.0 * (e[0] * f[1] - e[1] * f[0]);
+        if det == 0.0 {
+            continue;
+        }
+        let g = power(xj, rj) - power(xi, ri);
+        let h = power(xk, disks.r[k]) - power(xi, ri);
+        let c = [(g * f[1] - h * e[1]) / det, (e[0] * h - f[0] * g) / det];
+        let s = ((c[0] - xi[0]) * t[0] + (c[1] - xi[1]) * t[1]).clamp(-rmax, rmax);
+        if f[0] * t[0] + f[1] * t[1] > 0.0 {
+            left = left.min(s);
+        } else {
+            right = right.max(s);
+        }
+    }
+    if left == f64::INFINITY {
+        left = rmin;
+    }
+    if right == f64::NEG_INFINITY {
+        right = -rmin;
+    }
+    (left - right).max(0.0)
+}
 
 /// The crack connected to a hole wall, grown one broken bond at a time (module docs).
 #[derive(Clone, Debug, PartialEq)]
@@ -135,6 +256,39 @@ impl CrackExtent {
         p: f64,
         loads: &mut [[f64; 3]],
     ) -> Result<usize, LsmError> {
+        self.flood_with(disks, broken, p, loads, |b| {
+            Ok(2.0 * disks.r[b.i].min(disks.r[b.j]))
+        })
+    }
+
+    /// [`Self::flood_loads`] with the face length of each broken bond from `faces`
+    /// (module docs, "Which width"): `±p ℓ_k n` instead of `±p w n`. A broken bond that
+    /// `faces` does not know is an error.
+    pub fn flood_loads_on_faces(
+        &mut self,
+        disks: &Disks,
+        broken: &[BrokenBond],
+        p: f64,
+        faces: &FaceWidths,
+        loads: &mut [[f64; 3]],
+    ) -> Result<usize, LsmError> {
+        self.flood_with(disks, broken, p, loads, |b| {
+            faces.get(b.i, b.j).ok_or(LsmError::bad(
+                "faces",
+                b.i as f64,
+                "has no face for a broken bond of this disk",
+            ))
+        })
+    }
+
+    fn flood_with(
+        &mut self,
+        disks: &Disks,
+        broken: &[BrokenBond],
+        p: f64,
+        loads: &mut [[f64; 3]],
+        width: impl Fn(&BrokenBond) -> Result<f64, LsmError>,
+    ) -> Result<usize, LsmError> {
         let n = self.parent.len() - 1;
         if disks.len() != n || loads.len() != n {
             return Err(LsmError::bad(
@@ -165,7 +319,7 @@ impl CrackExtent {
             if d == 0.0 {
                 continue;
             }
-            let f = p * 2.0 * disks.r[b.i].min(disks.r[b.j]) / d;
+            let f = p * width(b)? / d;
             loads[b.j][0] += f * e[0];
             loads[b.j][1] += f * e[1];
             loads[b.i][0] -= f * e[0];
