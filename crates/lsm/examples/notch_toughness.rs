@@ -10,7 +10,8 @@
 //! `cargo run --release -p porofrac-lsm --example notch_toughness -- C... [--seeds N]
 //! [--rmax R] [--rate PA_PER_S] [--radius M] [--growth M] [--radical]` (default c = 3 6,
 //! 3 seeds, r_max 1 m, 2.5 MPa/s; `--radical`: flooded bonds load their power-diagram
-//! face, [`porofrac_lsm::FaceWidths`], instead of the bond width). One row per (c, seed); the mean and sd of K_Ic per c.
+//! face, [`porofrac_lsm::FaceWidths`], instead of the bond width; `--pores`: the crack joins
+//! across pores, [`porofrac_lsm::CrackExtent::across_pores`]). One row per (c, seed); the mean and sd of K_Ic per c.
 
 use porofrac_lsm::calibrate::hexagonal_springs;
 use porofrac_lsm::toughness::{NotchRamp, griffith_toughness, pressurised_notch};
@@ -22,6 +23,7 @@ fn main() {
     let (mut seeds, mut r1, mut rate) = (3u64, 1.0, 2.5e6);
     let (mut radius, mut growth): (Option<f64>, Option<f64>) = (None, None);
     let mut faces = CrackFaces::BondWidth;
+    let mut pores = false;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         let mut num = |name: &str| -> f64 {
@@ -36,6 +38,7 @@ fn main() {
             "--radius" => radius = Some(num("--radius")),
             "--growth" => growth = Some(num("--growth")),
             "--radical" => faces = CrackFaces::Radical,
+            "--pores" => pores = true,
             _ => cs.push(a.parse::<f64>().expect("a notch half-length (m)")),
         }
     }
@@ -67,9 +70,10 @@ fn main() {
         growth,
         max_pressure: 100e6,
         faces,
+        across_pores: pores,
     };
     println!(
-        "# disk radius {radius} m, r_max {r1} m, growth {growth} m, rate {:.3} MPa/s, faces {faces:?}",
+        "# disk radius {radius} m, r_max {r1} m, growth {growth} m, rate {:.3} MPa/s, faces {faces:?}, across pores {pores}",
         rate / 1e6
     );
     println!(

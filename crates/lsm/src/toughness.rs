@@ -61,6 +61,8 @@ pub struct NotchRamp {
     pub max_pressure: f64,
     /// The crack-face length of a flooded bond.
     pub faces: CrackFaces,
+    /// Join the crack across pores ([`CrackExtent::across_pores`]).
+    pub across_pores: bool,
 }
 
 /// What [`pressurised_notch`] measured.
@@ -148,6 +150,9 @@ pub fn pressurised_notch(
     let n = solid.disks().len();
     let lining: Vec<usize> = cut.iter().flat_map(|b| [b.i, b.j]).collect();
     let mut crack = CrackExtent::new(n, &lining, centre)?;
+    if ramp.across_pores {
+        crack = crack.across_pores(solid.disks(), solid.bonds())?;
+    }
     let mut cut_extent: f64 = 0.0;
     for b in &cut {
         cut_extent = cut_extent.max(crack.add(b.i, b.j, [b.x, b.y])?);
