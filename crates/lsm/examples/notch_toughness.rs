@@ -111,12 +111,8 @@ fn main() {
             );
         }
         let m = ks.iter().sum::<f64>() / ks.len() as f64;
-        let sd = (ks.iter().map(|k| (k - m).powi(2)).sum::<f64>() / (ks.len().max(2) - 1) as f64)
-            .sqrt();
-        println!(
-            "# c = {c} m: K_Ic {:.3} ± {:.3} MPa√m",
-            m / 1e6,
-            sd / 1e6
-        );
+        let sd =
+            (ks.iter().map(|k| (k - m).powi(2)).sum::<f64>() / (ks.len().max(2) - 1) as f64).sqrt();
+        println!("# c = {c} m: K_Ic {:.3} ± {:.3} MPa√m", m / 1e6, sd / 1e6);
     }
 }

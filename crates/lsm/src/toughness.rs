@@ -130,10 +130,7 @@ pub fn pressurised_notch(
     }
     spec.damping = Damping::Local { alpha: ramp.alpha };
     let mut solid = LatticeSolid::new(disks, spec)?;
-    let cut: Vec<BrokenBond> = solid.cut(
-        [centre[0] - c, centre[1]],
-        [centre[0] + c, centre[1]],
-    )?;
+    let cut: Vec<BrokenBond> = solid.cut([centre[0] - c, centre[1]], [centre[0] + c, centre[1]])?;
     if cut.is_empty() {
         return Err(LsmError::Calibration(format!(
             "a notch of half-length {c} m cuts no bond"
@@ -287,6 +284,41 @@ mod tests {
         let pb = strength_breakdown(st, big, 7.3 * big);
         assert!(point_stress_breakdown(st, big, 7.3 * big, 1.0) / pb - 1.0 < 2.1e-4);
         assert!(average_stress_breakdown(st, big, 7.3 * big, 1.0) / pb - 1.0 < 1.1e-4);
+    }
+
+    /// A saw cut between two rows of a hexagonal lattice breaks the two bonds per
+    /// spacing that cross it, and only those; a cut of no length is refused.
+    #[test]
+    fn a_cut_breaks_the_bonds_it_crosses() {
+        use crate::law::BondLaw;
+        let d = 1.0;
+        let h = d * 3f64.sqrt() / 2.0;
+        let mut centres = Vec::new();
+        for row in 0..6 {
+            for col in 0..10 {
+                let x = col as f64 * d + if row % 2 == 1 { 0.5 * d } else { 0.0 };
+                centres.push([x, row as f64 * h]);
+            }
+        }
+        let n = centres.len();
+        let disks = Disks::new(&centres, &vec![0.5 * d; n], 2600.0).unwrap();
+        let mut s =
+            LatticeSolid::new(disks, LsmSpec::new(BondLaw::elastic(1e9, 1e9, 0.0))).unwrap();
+        let intact = s.intact_bonds();
+        let y = 2.5 * h;
+        let cut = s.cut([2.2, y], [7.2, y]).unwrap();
+        // bonds whose midpoints lie at x = 2.25, 2.75, ..., 6.75 between rows 2 and 3
+        assert_eq!(cut.len(), 10);
+        assert_eq!(s.intact_bonds(), intact - 10);
+        assert!(s.broken().is_empty());
+        for b in &cut {
+            let (yi, yj) = (centres[b.i][1], centres[b.j][1]);
+            assert!((yi - y) * (yj - y) < 0.0 && b.x > 2.2 && b.x < 7.2, "{b:?}");
+        }
+        // cutting again breaks nothing more
+        assert!(s.cut([2.2, y], [7.2, y]).unwrap().is_empty());
+        let e = s.cut([1.0, 1.0], [1.0, 1.0]).unwrap_err();
+        assert!(e.to_string().starts_with("to = 0"), "{e}");
     }
 
     /// ℓ of a Griffith crack: the crack of half-length ℓ runs at p = σ_t.

@@ -87,7 +87,11 @@ fn a_pressurised_notch_gives_one_toughness_for_two_lengths() {
             / 3.0
     };
     let (k3, k6) = (mean_k(3.0), mean_k(6.0));
-    eprintln!("K_Ic: {:.3} MPa√m (c = 3 m), {:.3} (c = 6 m)", k3 / 1e6, k6 / 1e6);
+    eprintln!(
+        "K_Ic: {:.3} MPa√m (c = 3 m), {:.3} (c = 6 m)",
+        k3 / 1e6,
+        k6 / 1e6
+    );
     assert!((k3 / k6 - 1.0).abs() < 0.2, "{k3} vs {k6}");
     // 5–15 MPa√m: ℓ between 0.7 and 6 r_max
     assert!(k3 > 5e6 && k3 < 15e6, "{k3}");

@@ -7,6 +7,8 @@
 //! is the set of disks seen from the hole centre (the rays of
 //! [`porofrac_lsm::WallFaces::Rays`]) in the reference configuration, whatever loads the
 //! wall (rays, wetted faces or fluid), so that every loading is measured alike.
+//! With `[loading] crack_across_pores` the crack also joins across the pores it opens
+//! ([`porofrac_lsm::CrackExtent::across_pores`]).
 //!
 //! Output: `crack.csv` (`time [s],i,j,pressure [Pa],extent [m]`, one row per broken bond in the order
 //! of `broken.csv`), the scene-wide probe `crack_extent` (m) and the `summary.json` keys
