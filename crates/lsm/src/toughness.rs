@@ -36,9 +36,11 @@
 //!   [`average_stress_breakdown`]: `p = σ_t (b² − a²)/(a² + a b²/(a + d₀))`);
 //!
 //! both distances are those at which the criterion reproduces `K_Ic` for a Griffith crack
-//! in tension. Both tend to `p_b` as `a/ℓ → ∞` and to `p_b (b² + a²)/a²`-type limits for
-//! small holes; for `b ≫ a` they read `p ≈ p_b (1 + d₀/a)²` (point) and
-//! `p ≈ p_b (1 + d₀/a)` (average).
+//! in tension. Both tend to `p_b` as `a/ℓ → ∞`; for `b ≫ a` they read
+//! `p ≈ p_b (1 + d₀/a)²` (point) and `p ≈ p_b (1 + d₀/a)` (average). Neither puts the
+//! pressure in the crack: a flaw at the wall whose faces carry `p` as well breaks at
+//! `σ_θθ(a) + p = σ_t`, `p = σ_t (b² − a²)/(2b²)` for a large hole (about half of `p_b`),
+//! which is the limit of the flooded borehole scenes (docs/models/lsm.md).
 
 use crate::bond::BrokenBond;
 use crate::crack::{CrackExtent, CrackFaces, FaceWidths};
