@@ -12,7 +12,9 @@
 //!   breakdown of a borehole as an event);
 //! * [`calibrate`]: spring stiffnesses from E and ν on a hexagonal lattice (closed form
 //!   below) and numerical calibration of random packings (uniaxial compression for E
-//!   and ν, Brazilian test for the tensile strength).
+//!   and ν, Brazilian test for the tensile strength);
+//! * [`toughness`]: the fracture toughness of a packing from a pressurised notch, and
+//!   the strength and fracture-mechanics estimates of a pressurised hole's breakdown.
 //!
 //! Everything is per metre of thickness: forces N/m, moments N·m/m, stiffnesses
 //! `k_n`, `k_s` in N/m² (Pa), `k_b` in N·m/m per radian, masses kg/m.
@@ -49,10 +51,11 @@ pub mod contact;
 pub mod crack;
 pub mod law;
 pub mod solid;
+pub mod toughness;
 pub mod wall;
 
 pub use bond::{Bond, BondForce, BreakMode, BrokenBond};
-pub use crack::CrackExtent;
+pub use crack::{CrackExtent, CrackFaces, FaceWidths};
 pub use law::{BondLaw, ContactLaw, Damping, Motion, NormalLaw};
 pub use solid::state::SolidState;
 pub use solid::{LatticeSolid, LsmSpec, StepReport};

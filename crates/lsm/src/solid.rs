@@ -388,6 +388,55 @@ impl LatticeSolid {
         }
     }
 
+    /// Cut a notch: break every intact bond whose centre line `x_i → x_j` crosses the
+    /// segment `from → to` (m), as a saw cut would. The cut bonds are returned (contact
+    /// point, time now, recorded as [`BreakMode::Tensile`]: a notch is an opened crack)
+    /// and are *not* added to [`Self::broken`], which keeps the bonds broken by the load.
+    /// Their forces leave the particles at the next step. Errors on a non-finite or
+    /// zero-length segment.
+    pub fn cut(&mut self, from: [f64; 2], to: [f64; 2]) -> Result<Vec<BrokenBond>, LsmError> {
+        if !from.iter().chain(&to).all(|v| v.is_finite()) {
+            return Err(LsmError::bad("from, to", f64::NAN, "must be finite"));
+        }
+        let s = [to[0] - from[0], to[1] - from[1]];
+        if s[0] == 0.0 && s[1] == 0.0 {
+            return Err(LsmError::bad("to", 0.0, "the cut has no length"));
+        }
+        let cross = |a: [f64; 2], b: [f64; 2]| a[0] * b[1] - a[1] * b[0];
+        let mut cut = Vec::new();
+        for (k, b) in self.bonds.iter_mut().enumerate() {
+            if !b.intact {
+                continue;
+            }
+            let (i, j) = (b.i as usize, b.j as usize);
+            let (xi, xj) = (self.disks.x[i], self.disks.x[j]);
+            let e = [xj[0] - xi[0], xj[1] - xi[1]];
+            let den = cross(e, s);
+            if den == 0.0 {
+                continue;
+            }
+            let w = [from[0] - xi[0], from[1] - xi[1]];
+            // x_i + t e = from + u s
+            let t = cross(w, s) / den;
+            let u = cross(w, e) / den;
+            if !((0.0..=1.0).contains(&t) && (0.0..=1.0).contains(&u)) {
+                continue;
+            }
+            b.intact = false;
+            self.bond_force[k] = BondForce::default();
+            let f = self.disks.r[i] / (self.disks.r[i] + self.disks.r[j]);
+            cut.push(BrokenBond {
+                time: self.time,
+                i,
+                j,
+                x: xi[0] + f * e[0],
+                y: xi[1] + f * e[1],
+                mode: BreakMode::Tensile,
+            });
+        }
+        Ok(cut)
+    }
+
     /// Total elastic energy of the intact bonds (J/m).
     pub fn bond_energy(&self) -> f64 {
         let law = &self.spec.bonds;

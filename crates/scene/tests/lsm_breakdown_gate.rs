@@ -5,12 +5,16 @@
 //! the size at which it has settled (4.58 MPa at 10 r_max, 3.70 at 15).
 //!
 //! The gate (breakdown, the wall crack reaching 2a, within ±20 % of p_b on each of seeds
-//! 1–5, on `scenes/lsm/borehole_flooded.toml` with b = 22 m and with b = 12 m, a = 3 m)
-//! is missed: measured with `scripts/lsm_breakdown_geometry.sh 3.44e6 22.0 1 2 3 4 5`
-//! 1.579, 1.257, 1.284, 1.470, 1.517 (1.42 ± 0.14, 0 of 5), with b = 12 m 1.207, 0.887,
-//! 1.029, 1.047, 1.318 (1.10 ± 0.17, 3 of 5). Against the size-consistent σ_t the wall
-//! of a hole of three largest radii is stronger than a large sample, and more so the
-//! larger the rock around it (docs/models/lsm.md). Ignored with these numbers.
+//! 1–5, on `scenes/lsm/borehole_flooded.toml` with b = 22 m and with b = 12 m, a = 3 m,
+//! and the crack joined across pores (`[loading] crack_across_pores = true`, added here)
+//! is missed: measured with `LSM_GEOMETRY_PORES=1 scripts/lsm_breakdown_geometry.sh 3.44e6
+//! 22 1 2 3 4 5` 1.302, 1.100, 1.180,
+//! 1.143, 0.706 (1.09 ± 0.23, 3 of 5), with b = 12 m 0.843, 0.774, 0.899, 0.692, 1.164
+//! (0.87 ± 0.18, 3 of 5). The hole is not large against the lattice's characteristic
+//! length: K_Ic ≈ 10.3 MPa√m from a pressurised notch, ℓ = (K_Ic/σ_t)²/π = 2.8 m,
+//! a/ℓ = 1.07 (docs/models/lsm.md, "Toughness and the size of the hole"). As bundled
+//! (cracks joined through shared disks only): 1.42 ± 0.14 (0 of 5) and 1.10 ± 0.17
+//! (3 of 5). Ignored with these numbers.
 
 use std::path::Path;
 
@@ -25,7 +29,12 @@ fn ratio(b: f64, seed: u64) -> f64 {
     let text = std::fs::read_to_string(path).unwrap();
     let scene = text
         .replace("radius = 22.0 }", &format!("radius = {b:.1} }}"))
-        .replace("seed = 1\n", &format!("seed = {seed}\n"));
+        .replace("seed = 1\n", &format!("seed = {seed}\n"))
+        .replace(
+            "flood_cracks = true\n",
+            "flood_cracks = true\ncrack_across_pores = true\n",
+        );
+    assert!(scene.contains("crack_across_pores = true"));
     let out = std::env::temp_dir().join(format!(
         "porofrac-lsmgate-{}-{b}-{seed}",
         std::process::id()
@@ -45,7 +54,7 @@ fn ratio(b: f64, seed: u64) -> f64 {
 }
 
 #[test]
-#[ignore = "misses the gate: breakdown 1.42 ± 0.14 p_b (b = 22 m, 0 of 5) and 1.10 ± 0.17 (b = 12 m, 3 of 5) with the recipe's σ_t; ten runs of 10-50 s"]
+#[ignore = "misses the gate: breakdown 1.09 ± 0.23 p_b (b = 22 m, 3 of 5) and 0.87 ± 0.18 (b = 12 m, 3 of 5) with the recipe's σ_t, a/ℓ = 1.07; ten runs of 10-150 s"]
 fn flooded_breakdown_within_20_percent_on_every_packing_and_geometry() {
     let mut misses = Vec::new();
     for b in [22.0, 12.0] {

@@ -107,3 +107,19 @@ fn wall_keys_are_checked() {
         assert!(e.contains(key), "{key}: {e}");
     }
 }
+
+/// `[loading] crack_across_pores` joins the cracks of a hole: without one it is refused,
+/// naming the key and its line.
+#[test]
+fn crack_across_pores_needs_a_hole() {
+    let rock = ROCK.replace("hole = { center = [0.0, 0.0], radius = 1.5 }\n", "");
+    assert_ne!(rock, ROCK);
+    let text = format!("{rock}[loading]\ncrack_across_pores = true\n");
+    let line = text.lines().count();
+    let e = parse(&text).unwrap_err();
+    assert!(
+        e.contains("loading.crack_across_pores") && e.contains("needs a hole"),
+        "{e}"
+    );
+    assert!(e.contains(&format!(":{line}")), "{e}");
+}

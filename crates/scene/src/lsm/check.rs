@@ -462,6 +462,12 @@ pub fn check(ls: &LoadedScene) -> Result<(), SceneError> {
         if l.flood_cracks && l.pressure_rate.is_none() {
             return Err(ls.error(&key("flood_cracks"), "needs pressure_rate"));
         }
+        if l.crack_across_pores && s.particles.as_ref().is_none_or(|p| p.hole.is_none()) {
+            return Err(ls.error(
+                &key("crack_across_pores"),
+                "needs a hole: [particles] hole = { center, radius }",
+            ));
+        }
         if l.wall != super::file::WallChoice::Rays && l.pressure_rate.is_none() {
             return Err(ls.error(&key("wall"), "needs pressure_rate"));
         }

@@ -7,6 +7,8 @@
 //! is the set of disks seen from the hole centre (the rays of
 //! [`porofrac_lsm::WallFaces::Rays`]) in the reference configuration, whatever loads the
 //! wall (rays, wetted faces or fluid), so that every loading is measured alike.
+//! With `[loading] crack_across_pores` the crack also joins across the pores it opens
+//! ([`porofrac_lsm::CrackExtent::across_pores`]).
 //!
 //! Output: `crack.csv` (`time [s],i,j,pressure [Pa],extent [m]`, one row per broken bond in the order
 //! of `broken.csv`), the scene-wide probe `crack_extent` (m) and the `summary.json` keys
@@ -36,16 +38,26 @@ pub struct CrackLog {
 
 impl CrackLog {
     /// The log of the hole of `centre` and `radius` in the reference configuration of
-    /// `solid`.
-    pub fn new(solid: &LatticeSolid, centre: [f64; 2], radius: f64) -> Result<Self, LsmError> {
+    /// `solid`; `across_pores`: the crack joins across the pores it opens
+    /// ([`CrackExtent::across_pores`]).
+    pub fn new(
+        solid: &LatticeSolid,
+        centre: [f64; 2],
+        radius: f64,
+        across_pores: bool,
+    ) -> Result<Self, LsmError> {
         let d = solid.disks();
         let lining: Vec<usize> = PressureWall::new(d, centre, radius)?
             .members
             .iter()
             .map(|m| m.0 as usize)
             .collect();
+        let mut extent = CrackExtent::new(d.len(), &lining, centre)?;
+        if across_pores {
+            extent = extent.across_pores(d, solid.bonds())?;
+        }
         Ok(Self {
-            extent: CrackExtent::new(d.len(), &lining, centre)?,
+            extent,
             threshold: BREAKDOWN_REACH * radius,
             rows: Vec::new(),
             initiation: None,

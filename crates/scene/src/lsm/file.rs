@@ -189,6 +189,14 @@ pub struct LoadingSection {
     /// follows without lag, [`porofrac_lsm::CrackExtent::flood_loads`]; default false).
     #[serde(default)]
     pub flood_cracks: bool,
+    /// The crack connected to the hole wall also joins across the pores it opens: a
+    /// broken bond joins every disk of the pores (faces of the bond network, up to 8
+    /// disks) on its two sides, so a crack that crosses a pore of four or more disks is
+    /// one crack for the breakdown event and for `flood_cracks`
+    /// ([`porofrac_lsm::CrackExtent::across_pores`]; default false: only broken bonds
+    /// that share a disk are joined).
+    #[serde(default)]
+    pub crack_across_pores: bool,
 }
 
 /// The sections of model `lsm` read by the model itself (`[particles]` is shared with

@@ -454,7 +454,7 @@ pub fn build<'a>(ls: &'a LoadedScene, setup: &mut SetupPoll<'_>) -> Result<LsmMo
     let fluid = fluid::Fluid::build(ls, &solid, dt)?;
     let crack = match s.particles.as_ref().and_then(|p| p.hole) {
         Some(h) if wall.is_some() || fluid.as_ref().is_some_and(|f| f.injects()) => Some(
-            crack::CrackLog::new(&solid, h.center, h.radius)
+            crack::CrackLog::new(&solid, h.center, h.radius, load.crack_across_pores)
                 .map_err(|e| check::lsm_error(ls, &e))?,
         ),
         _ => None,
