@@ -12,7 +12,7 @@
 # the MPI run the slowest rank's: assembly of the owned rows, AMG setup and CG), assembly
 # + solve for the peer (one pass, BEST_OF_CHEAP_S=0). One line per run: round, problem,
 # tool, seconds, L2 error, CG iterations, extra (MPI: AMG setup s, CG s per iteration,
-# peak memory per rank in MB).
+# peak memory per rank in MB; the peer: its assembly and solve s).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 venv=$1
@@ -47,7 +47,7 @@ for r in $(seq 1 "$rounds"); do
         mpirun --oversubscribe -n 2 -x RAYON_NUM_THREADS=1 target/release/porofrac run "scenes/bench/$p.toml" --out "$out/$p-m" >/dev/null 2>&1
         summary "$r" "$p" mpi2 "$out/$p-m/summary.json"
         (cd "$peer" && BEST_OF_CHEAP_S=0 "$venv/bin/mpiexec" -n 2 "$venv/bin/python" run_dolfinx.py "$dim" "$n" gamg) | sed -n 's/^RESULT //p' |
-            python3 -c "import json,sys; d=json.loads(sys.stdin.read()); print($r, '$p', 'fenicsx2', round(d['t_assemble']+d['t_solve'],3), d['l2_err'], d['iters'], 'nprocs=%d' % d['nprocs'])"
+            python3 -c "import json,sys; d=json.loads(sys.stdin.read()); print($r, '$p', 'fenicsx2', round(d['t_assemble']+d['t_solve'],3), d['l2_err'], d['iters'], 'nprocs=%d assembly=%.3f solve=%.3f' % (d['nprocs'], d['t_assemble'], d['t_solve']))"
     done
 done
 rm -rf "$out"

@@ -21,7 +21,7 @@ pub struct Args {
 }
 
 /// Parse `[sizes…] [--tol T] [--cholesky-max N] [--degree K] [--ratio R] [--coarse N]
-/// [--theta T]`.
+/// [--theta T] [--damping W] [--aggressive L] [--upper U]`.
 pub fn args(default_sizes: &[usize], cholesky_max: usize) -> Args {
     let mut out = Args {
         sizes: Vec::new(),
@@ -42,6 +42,10 @@ pub fn args(default_sizes: &[usize], cholesky_max: usize) -> Args {
             "--coarse" => out.options.max_coarse = val().parse().expect("--coarse N"),
             "--theta" => out.options.strength_threshold = val().parse().expect("--theta T"),
             "--damping" => out.options.prolongation_damping = val().parse().expect("--damping W"),
+            "--aggressive" => {
+                out.options.aggressive_levels = val().parse().expect("--aggressive L")
+            }
+            "--upper" => out.options.chebyshev_upper = val().parse().expect("--upper U"),
             s => {
                 out.sizes.push(s.parse().expect("a size"));
                 k += 1;
