@@ -419,10 +419,10 @@ def main():
     for cell in tracked:
         face[cell.member] = (0.0, 0.0, 0.0, 1.0)
     xmax = float(np.max(init[:, 0] + r0))
+    stages = [(rows[k][0], *particles(rows[k][1])[:2]) for k in pick]
+    ymax = 1.15 * max(float(np.max(x[:, 1] + r)) for _, x, r in stages)
     fig, axes = plt.subplots(len(pick), 1, figsize=(16, 0.9 + 2.0 * len(pick)), squeeze=False)
-    for ax, k in zip(axes[:, 0], pick):
-        t, p, _ = rows[k]
-        x, r, _ = particles(p)
+    for ax, (t, x, r) in zip(axes[:, 0], stages):
         ec = EllipseCollection(2 * r, 2 * r, np.zeros_like(r), units="xy", offsets=x,
                                offset_transform=ax.transData, facecolors=face,
                                edgecolors="none", antialiased=False)
@@ -433,7 +433,7 @@ def main():
             ax.text(cx, ytop + 2.0 * s, f"W{j + 1}", ha="center", va="bottom", fontsize=8)
         ax.axvline(wall_of(t), color="k", lw=1.5)
         ax.set_xlim(-0.02 * xmax, 1.02 * xmax)
-        ax.set_ylim(0, float(np.max(x[:, 1] + r)) * 1.15)
+        ax.set_ylim(0, ymax)
         ax.set_aspect("equal")
         ax.set_ylabel("y (m)")
         ax.set_title(f"t = {t:g} s, left wall moved {wall_of(t):g} m (black line); tracked "
