@@ -3,7 +3,7 @@
 its four acceptance gates and the figures of the paper's Figs. 6-10.
 
     python3 scripts/nscd_f1_figures.py OUT_DIR [--scale S] [--figures DIR] [--prefix NAME]
-                                       [--stages N] [--every K] [--until T]
+                                       [--stages N] [--every K] [--until T] [--lift H]
 
 OUT_DIR is the output directory of `porofrac run scenes/nscd/forced_fold_paper.toml`
 (scale 1, the default) or of `scenes/nscd/forced_fold_wedge.toml` (`--scale 0.2`): the
@@ -17,7 +17,8 @@ written.
 
 The geometry is the paper's scaled by S: a layer of thickness h = 30 S m on the base,
 the left wall moving at 0.5 m/s (the speed is not scaled), the tracked cells W1-W6 at
-the paper's centres and radii times S.
+the paper's centres and radii times S. --lift H raises the layer's top and the cells by
+H m (the rough-base variants of scripts/nscd_f1_rough_base.py --height H).
 
 The tracked cells are the paper's: the set Omega of the particles whose centres lie in
 the circle (cx, cy, R) at t = 0 (the settled sample), followed through the run; the
@@ -278,6 +279,7 @@ def main():
     ap.add_argument("--stages", type=int, default=4)
     ap.add_argument("--every", type=int, default=1)
     ap.add_argument("--until", type=float, default=None)
+    ap.add_argument("--lift", type=float, default=0.0)
     a = ap.parse_args()
     import matplotlib
 
@@ -287,8 +289,8 @@ def main():
 
     s = a.scale
     prefix = a.prefix or ("f1_paper" if s == 1.0 else "f1_wedge")
-    cells = [(cx * s, cy * s, rc * s) for cx, cy, rc in CELLS]
-    top = LAYER * s
+    cells = [(cx * s, cy * s + a.lift, rc * s) for cx, cy, rc in CELLS]
+    top = LAYER * s + a.lift
     rows = frames(a.out)
     probes = read_probes(a.out)
     if a.until is not None:
@@ -357,6 +359,9 @@ def main():
         print(f"probes against the frames' cells at t = {t_last:g} s (contacts between tracked "
               f"particles, vol = disks' area / initial packing): largest relative difference "
               f"{worst:.1e}")
+        if worst > 1e-9:
+            print("  the script's cells are not the probes' sets: are the centres those of the "
+                  "scene (a rough-base variant needs --lift)?")
 
     # Gate 1: the wedge front.
     if len(fr) >= 4:
