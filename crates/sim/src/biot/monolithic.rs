@@ -501,6 +501,33 @@ impl Monolithic {
         self.ldlt.solve_in_place(&mut work.z)
     }
 
+    /// Iterative refinement of a step's first solve with new factors (fresh or updated)
+    /// whose relative residual is above [`FRESH_RESIDUAL`], the limit of a usable solve:
+    /// a matrix of widely spread scales (stiff rock beside a cell that has nearly lost
+    /// its stiffness, pressures of tens of MPa at a held crack tip) can leave such a
+    /// solve just above it, and a correction `z += solve(b − A z)` with the same factors
+    /// brings it back to round-off, as direct solvers refine. A solve at or below the
+    /// limit is left as it is (no arithmetic changes); one the corrections do not bring
+    /// below it is reported by [`Self::finish`] as numerically singular.
+    fn refine_fresh(&mut self, work: &mut MonolithicWork) -> Result<(), LdltError> {
+        let mut r = vec![0.0; work.z.len()];
+        for _ in 0..FRESH_REFINEMENTS {
+            if self.relative_residual(&work.z, &work.rhs) <= FRESH_RESIDUAL {
+                return Ok(());
+            }
+            r.fill(0.0);
+            self.sym_mul_add(&work.z, &mut r);
+            for (ri, b) in r.iter_mut().zip(&work.rhs) {
+                *ri = b - *ri;
+            }
+            self.low_rank.solve(&mut self.ldlt, &mut r)?;
+            for (z, d) in work.z.iter_mut().zip(&r) {
+                *z += d;
+            }
+        }
+        Ok(())
+    }
+
     /// Factorize `values` (the current matrix) and drop the low-rank update.
     fn refactorize(&mut self) -> BiotResult<()> {
         self.low_rank.clear();
@@ -576,6 +603,14 @@ const LOW_RANK_RESIDUAL: f64 = 1e-12;
 
 /// Refinement steps of a low-rank solve before the matrix is factorized instead.
 const LOW_RANK_REFINEMENTS: usize = 3;
+
+/// Largest relative residual of a step's first solve with new factors; above it the
+/// solve is refined ([`Monolithic::refine_fresh`]) and, if still above, the system is
+/// reported as numerically singular.
+const FRESH_RESIDUAL: f64 = 1e-8;
+
+/// Corrections of a first solve above [`FRESH_RESIDUAL`] before it is reported.
+const FRESH_REFINEMENTS: usize = 3;
 
 /// Unknowns per leaf of the dissection of the block system.
 const DISSECTION_LEAF: usize = 8;
@@ -777,6 +812,13 @@ impl<const D: usize> BiotCoupling<D> for Monolithic {
             self.low_rank.solve(&mut self.ldlt, &mut w.z)
         };
         let result = solved
+            .and_then(|()| {
+                if fresh {
+                    self.refine_fresh(&mut w)
+                } else {
+                    Ok(())
+                }
+            })
             .map_err(|e| BiotError::Solver(e.0))
             .and_then(|()| self.finish(sys, state, &w, fresh));
         self.work = w;
@@ -883,7 +925,7 @@ impl Monolithic {
         }
         if fresh {
             let residual = self.relative_residual(z, rhs);
-            if residual > 1e-8 {
+            if residual > FRESH_RESIDUAL {
                 // The factors are unusable: the next step factorizes again.
                 self.factored = None;
                 return Err(BiotError::Solver(format!(
