@@ -9,8 +9,8 @@
 //! [--cap-fraction F]` (default R = 10 15 22, 3 seeds, caps 2 m thick; with F the caps are
 //! F·R thick). Prints one row per (R, seed) and the mean per R.
 
-use porofrac_lsm::calibrate::{QuasiStatic, brazilian, hexagonal_moduli, hexagonal_springs};
-use porofrac_lsm::{BondLaw, ContactLaw, Damping, LsmSpec};
+use porofrac_lsm::Damping;
+use porofrac_lsm::calibrate::{QuasiStatic, brazilian, hexagonal_moduli, scene_rock};
 use porofrac_particles::{Disks, RandomPacking, Region};
 
 fn main() {
@@ -32,21 +32,8 @@ fn main() {
         sizes = vec![10.0, 15.0, 22.0];
     }
     let (r0, r1, rho) = (0.1, 1.0, 2600.0);
-    let (kn, ks) = hexagonal_springs(10e9, 0.2).expect("springs");
-    let law = BondLaw {
-        kn,
-        ks,
-        kb: 0.0,
-        tensile: 5e6,
-        cohesion: 10e6,
-        friction_angle: 30f64.to_radians(),
-    };
-    let mut spec = LsmSpec::new(law);
-    spec.bond_tolerance = 0.05;
-    spec.contacts = ContactLaw {
-        friction: 0.6,
-        ..ContactLaw::like_bonds(&law)
-    };
+    let mut spec = scene_rock(0.2).expect("springs");
+    let (kn, ks) = (spec.bonds.kn, spec.bonds.ks);
     spec.damping = Damping::Local { alpha: 0.7 };
     let c = (hexagonal_moduli(kn, ks).0 / rho).sqrt();
     let q = QuasiStatic {

@@ -11,8 +11,7 @@
 //! ν_set 0.2). Prints one row per (side, seed) and the mean and standard deviation per
 //! side.
 
-use porofrac_lsm::calibrate::{QuasiStatic, hexagonal_moduli, hexagonal_springs, uniaxial};
-use porofrac_lsm::{BondLaw, ContactLaw, LsmSpec};
+use porofrac_lsm::calibrate::{QuasiStatic, hexagonal_moduli, scene_rock, uniaxial};
 use porofrac_particles::{Disks, RandomPacking, Region};
 
 fn stats(v: &[f64]) -> (f64, f64) {
@@ -38,21 +37,8 @@ fn main() {
         sides = vec![20.0, 30.0, 40.0];
     }
     let (r0, r1, rho) = (0.1, 1.0, 2600.0);
-    let (kn, ks) = hexagonal_springs(10e9, nu_set).expect("springs");
-    let law = BondLaw {
-        kn,
-        ks,
-        kb: 0.0,
-        tensile: 5e6,
-        cohesion: 10e6,
-        friction_angle: 30f64.to_radians(),
-    };
-    let mut spec = LsmSpec::new(law);
-    spec.bond_tolerance = 0.05;
-    spec.contacts = ContactLaw {
-        friction: 0.6,
-        ..ContactLaw::like_bonds(&law)
-    };
+    let spec = scene_rock(nu_set).expect("springs");
+    let (kn, ks) = (spec.bonds.kn, spec.bonds.ks);
     let (e_hex, nu_hex) = hexagonal_moduli(kn, ks);
     let c = (e_hex / rho).sqrt();
     let q = QuasiStatic {

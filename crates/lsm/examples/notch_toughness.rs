@@ -13,9 +13,9 @@
 //! face, [`porofrac_lsm::FaceWidths`], instead of the bond width; `--pores`: the crack joins
 //! across pores, [`porofrac_lsm::CrackExtent::across_pores`]). One row per (c, seed); the mean and sd of K_Ic per c.
 
-use porofrac_lsm::calibrate::hexagonal_springs;
+use porofrac_lsm::CrackFaces;
+use porofrac_lsm::calibrate::scene_rock;
 use porofrac_lsm::toughness::{NotchRamp, griffith_toughness, pressurised_notch};
-use porofrac_lsm::{BondLaw, ContactLaw, CrackFaces, LsmSpec};
 use porofrac_particles::{Disks, RandomPacking, Region};
 
 fn main() {
@@ -48,21 +48,7 @@ fn main() {
     let cmax = cs.iter().copied().fold(0.0, f64::max);
     let radius = radius.unwrap_or(4.0 * cmax + 4.0 * r1);
     let growth = growth.unwrap_or(2.0 * r1);
-    let (kn, ks) = hexagonal_springs(10e9, 0.2).expect("springs");
-    let law = BondLaw {
-        kn,
-        ks,
-        kb: 0.0,
-        tensile: 5e6,
-        cohesion: 10e6,
-        friction_angle: 30f64.to_radians(),
-    };
-    let mut spec = LsmSpec::new(law);
-    spec.bond_tolerance = 0.05;
-    spec.contacts = ContactLaw {
-        friction: 0.6,
-        ..ContactLaw::like_bonds(&law)
-    };
+    let spec = scene_rock(0.2).expect("springs");
     let ramp = NotchRamp {
         rate,
         alpha: 0.7,

@@ -31,8 +31,36 @@
 //! Both use local damping and a constant platen speed; the speed should be far below
 //! the wave speed (a few 1e-3 of `√(E/ρ)` keeps the sample near equilibrium).
 
-use crate::{LatticeSolid, LsmError, LsmSpec, Motion};
+use crate::{BondLaw, ContactLaw, LatticeSolid, LsmError, LsmSpec, Motion};
 use porofrac_particles::Disks;
+
+/// The rock of the bundled borehole scenes (`scenes/lsm/borehole_*.toml`,
+/// `scenes/lsm_hydrofrac.toml`) as a spec: springs of the hexagonal lattice for
+/// E = 10 GPa and Poisson's ratio `nu` (0.2 in the scenes), no bending spring, a tensile
+/// strength of 5 MPa, a cohesion of 10 MPa and a friction angle of 30°, bonds between
+/// disks within 5 % of their radii, frictional contacts (μ = 0.6) as stiff as the bonds;
+/// damping and the step left at [`LsmSpec::new`]'s. The studies of that rock outside a
+/// scene (calibration, size effect, toughness, wall loads) start from it.
+///
+/// Errors: `nu` outside the hexagonal lattice's range ([`hexagonal_springs`]).
+pub fn scene_rock(nu: f64) -> Result<LsmSpec, LsmError> {
+    let (kn, ks) = hexagonal_springs(10e9, nu)?;
+    let law = BondLaw {
+        kn,
+        ks,
+        kb: 0.0,
+        tensile: 5e6,
+        cohesion: 10e6,
+        friction_angle: 30f64.to_radians(),
+    };
+    let mut spec = LsmSpec::new(law);
+    spec.bond_tolerance = 0.05;
+    spec.contacts = ContactLaw {
+        friction: 0.6,
+        ..ContactLaw::like_bonds(&law)
+    };
+    Ok(spec)
+}
 
 /// Spring stiffnesses `(k_n, k_s)` of a hexagonal lattice with the 2D Young's modulus
 /// `e` (Pa) and Poisson's ratio `nu` (at most 1/3).

@@ -15,30 +15,15 @@
 //!   former rule) the c = 3 m notch of seed 1 needs more than 1.5 times the pressure
 //!   (measured 8.97 against 4.14 MPa): its crack stalls at pores of four or more disks.
 
-use porofrac_lsm::calibrate::hexagonal_springs;
+use porofrac_lsm::calibrate::scene_rock;
 use porofrac_lsm::toughness::{NotchRamp, griffith_toughness, pressurised_notch};
-use porofrac_lsm::{BondLaw, ContactLaw, CrackFaces, LsmSpec};
+use porofrac_lsm::{CrackFaces, LsmSpec};
 use porofrac_particles::{Disks, RandomPacking, Region};
 
 const RADIUS: f64 = 28.0;
 
 fn spec() -> LsmSpec {
-    let (kn, ks) = hexagonal_springs(10e9, 0.2).unwrap();
-    let law = BondLaw {
-        kn,
-        ks,
-        kb: 0.0,
-        tensile: 5e6,
-        cohesion: 10e6,
-        friction_angle: 30f64.to_radians(),
-    };
-    let mut s = LsmSpec::new(law);
-    s.bond_tolerance = 0.05;
-    s.contacts = ContactLaw {
-        friction: 0.6,
-        ..ContactLaw::like_bonds(&law)
-    };
-    s
+    scene_rock(0.2).unwrap()
 }
 
 fn disks(seed: u64) -> Disks {

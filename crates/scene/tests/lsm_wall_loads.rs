@@ -6,8 +6,8 @@
 //! faces seen from the centre), and that a dry wall on the wetted faces reproduces it.
 
 use porofrac_lbm::{Lattice, LatticeConfig, Obstacle, Shape, SideKind};
-use porofrac_lsm::calibrate::hexagonal_springs;
-use porofrac_lsm::{BondLaw, ContactLaw, Damping, LatticeSolid, LsmSpec, PressureWall, WallFaces};
+use porofrac_lsm::calibrate::scene_rock;
+use porofrac_lsm::{Damping, LatticeSolid, LsmSpec, PressureWall, WallFaces};
 use porofrac_particles::{Disks, Hole, RandomPacking, Region};
 
 fn rock(b: f64, a: f64, r: [f64; 2], seed: u64) -> Disks {
@@ -28,21 +28,7 @@ fn rock(b: f64, a: f64, r: [f64; 2], seed: u64) -> Disks {
 }
 
 fn spec() -> LsmSpec {
-    let (kn, ks) = hexagonal_springs(10e9, 0.2).unwrap();
-    let law = BondLaw {
-        kn,
-        ks,
-        kb: 0.0,
-        tensile: 5e6,
-        cohesion: 10e6,
-        friction_angle: 30f64.to_radians(),
-    };
-    let mut s = LsmSpec::new(law);
-    s.bond_tolerance = 0.05;
-    s.contacts = ContactLaw {
-        friction: 0.6,
-        ..ContactLaw::like_bonds(&law)
-    };
+    let mut s = scene_rock(0.2).unwrap();
     s.damping = Damping::Local { alpha: 0.7 };
     s
 }
