@@ -53,7 +53,6 @@ use crate::boundary::{
     CopyLink, MomentumExchange, ObstacleLink, PressureLink, Side, SideKind, SideLink,
 };
 use crate::collision::{Collision, Rates};
-use crate::cut_links::CutLinkOrder;
 use crate::d2q9::{C, OPP, Q, W, cf, feq};
 use crate::geometry::Shape;
 use crate::kernel::{Grid, Layout, Physics};
@@ -235,10 +234,8 @@ pub struct Lattice {
     solid_nodes: Vec<Vec<u32>>,
     /// Cut links of each obstacle.
     links: Vec<Vec<ObstacleLink>>,
-    /// The cut links of all obstacles in memory order ([`crate::cut_links`]).
-    order: CutLinkOrder,
-    /// Unknowns of all obstacles' cut links in the current step, by obstacle (scratch).
-    backs: Vec<f64>,
+    /// Unknowns of each obstacle's cut links in the current step (scratch).
+    backs: Vec<Vec<f64>>,
     forces: Vec<[f64; 3]>,
     exchange: Vec<[f64; 3]>,
     motion: ObstacleMotion,
@@ -319,7 +316,6 @@ impl Lattice {
             obstacles: Vec::new(),
             solid_nodes: Vec::new(),
             links: Vec::new(),
-            order: CutLinkOrder::new(),
             backs: Vec::new(),
             forces: Vec::new(),
             exchange: Vec::new(),
@@ -1051,56 +1047,51 @@ impl Lattice {
         }
     }
 
-    /// The obstacle rules in three passes ([`crate::cut_links`]): the populations every
-    /// rule reads loaded in memory order, every body's unknowns and force in parallel
-    /// from them (a rule reads no unknown of another rule, see [`crate::boundary`]), then
-    /// the unknowns stored in memory order.
+    /// The obstacle rules, in two passes: every obstacle's unknowns and force in parallel
+    /// (a rule reads no unknown of another rule, see [`crate::boundary`]), then the
+    /// unknowns written back.
     fn apply_obstacles(&mut self) {
         use rayon::prelude::*;
         let (g, lay) = (self.grid, self.layout);
         let gi = self.cfg.momentum_exchange == MomentumExchange::GalileanInvariant;
         let conserve = self.cfg.obstacle_mass == ObstacleMass::Conserved;
-        self.order.refresh(&self.links, g);
-        self.order.gather(&self.pop, g, lay);
         let mut backs = std::mem::take(&mut self.backs);
-        backs.clear();
-        backs.resize(self.order.len(), 0.0);
-        let mut parts = Vec::with_capacity(self.links.len());
-        let mut rest = backs.as_mut_slice();
-        for links in &self.links {
-            let (part, tail) = rest.split_at_mut(links.len());
-            parts.push(part);
-            rest = tail;
-        }
-        let order = &self.order;
+        backs.resize_with(self.links.len(), Vec::new);
+        let pop = &self.pop;
         let obstacles = &self.obstacles;
         self.forces
             .par_iter_mut()
-            .zip(parts.into_par_iter())
+            .zip(backs.par_iter_mut())
             .zip(self.links.par_iter())
             .enumerate()
             .for_each(|(k, ((force, back_k), links))| {
                 let ob = &obstacles[k];
                 let c = ob.shape.center();
-                let first = order.offset(k);
                 let mut f = [0.0; 3];
+                back_k.clear();
                 // what the rules return, and the mass they create: Σ (back − into)
                 let (mut gained, mut weights) = (0.0, 0.0);
-                for (n, (l, back_l)) in links.iter().zip(back_k.iter_mut()).enumerate() {
+                for l in links {
                     let a = l.alpha as usize;
+                    let i = OPP[a];
+                    let xf = l.node as usize;
                     let uw = ob.velocity_at(l.xw);
                     let ca = cf(a);
                     let wall = 6.0 * W[a] * (ca[0] * uw[0] + ca[1] * uw[1]);
-                    let [into, at_xf, at_xf2] = order.read(first + n);
+                    let into = pop.get(g.loc(lay, g.shift(xf, a), a));
                     let back = if l.f2 == NONE {
                         into - wall
                     } else {
                         let d = l.delta;
-                        ((1.0 - d) * at_xf + d * into + d * at_xf2 - wall) / (1.0 + d)
+                        ((1.0 - d) * pop.get(g.loc(lay, xf, a))
+                            + d * into
+                            + d * pop.get(g.loc(lay, l.f2 as usize, i))
+                            - wall)
+                            / (1.0 + d)
                     };
                     gained += back - into;
                     weights += W[a];
-                    *back_l = back;
+                    back_k.push(back);
                 }
                 if conserve && weights > 0.0 {
                     // no net flux through a rigid surface: the mass the rules created
@@ -1110,11 +1101,12 @@ impl Lattice {
                         *back -= per_weight * W[l.alpha as usize];
                     }
                 }
-                for (n, (l, &back)) in links.iter().zip(back_k.iter()).enumerate() {
+                for (l, &back) in links.iter().zip(back_k.iter()) {
                     let a = l.alpha as usize;
+                    let xf = l.node as usize;
                     let uw = ob.velocity_at(l.xw);
                     let ca = cf(a);
-                    let into = order.read(first + n)[0];
+                    let into = pop.get(g.loc(lay, g.shift(xf, a), a));
                     // the reference density's share, 2 w_α ρ₀ c_α: only gauge pressure
                     // loads the body (zero for a body wetted all round)
                     let amb = 2.0 * W[a];
@@ -1133,7 +1125,12 @@ impl Lattice {
                 }
                 *force = f;
             });
-        self.order.scatter(&mut self.pop, g, lay, &backs);
+        for (links, back_k) in self.links.iter().zip(&backs) {
+            for (l, &b) in links.iter().zip(back_k) {
+                self.pop
+                    .set(g.loc(lay, l.node as usize, OPP[l.alpha as usize]), b);
+            }
+        }
         self.backs = backs;
     }
 
@@ -1446,9 +1443,6 @@ impl Lattice {
                 });
         }
         self.links = links;
-        if work.contains(&LinkWork::Rebuild) {
-            self.order.invalidate();
-        }
         for (k, w) in work.iter().enumerate() {
             if *w != LinkWork::Keep {
                 self.scratch.linked_at[k] = self.obstacles[k].shape;

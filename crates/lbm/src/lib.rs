@@ -38,7 +38,6 @@
 
 pub mod boundary;
 pub mod collision;
-mod cut_links;
 pub mod d2q9;
 pub mod geometry;
 pub mod image;

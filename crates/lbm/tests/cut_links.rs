@@ -1,13 +1,16 @@
-//! The obstacle rules load and store their populations in memory order, not body by body
-//! (`crate::cut_links`); what they compute must not depend on it:
+//! The obstacle rules of the cut links (`crate::boundary`) as a caller can check them, the
+//! reference for any change to how they load and store their populations (an order of
+//! their own, a pass fused into the kernel):
 //!
 //! * after every step, every unknown `L(x_f, ᾱ)` of every cut link and every body's force
-//!   and torque are those of the rule of `crate::boundary` evaluated from the populations
-//!   the rule read (interpolated bounce-back of a moving wall, plain bounce-back where
-//!   `x_f2` is solid, the mass correction per body, standard and Galilean-invariant
-//!   momentum exchange), while the bodies are placed, moved and their links rebuilt;
+//!   and torque are those of the rule evaluated from the populations it read (what crossed
+//!   into the body is left in its solid node; neither `L(x_f, α)` nor `L(x_f2, ᾱ)` is an
+//!   unknown): interpolated bounce-back of a moving wall, plain bounce-back where `x_f2`
+//!   is solid, the mass correction per body, standard and Galilean-invariant momentum
+//!   exchange, while the bodies are placed, moved and their links rebuilt;
 //! * the same bodies added in the opposite order give every fluid population, force and
-//!   torque to the bit, in `f64` and `f32` storage.
+//!   torque to the bit, in `f64` and `f32` storage (each body's rule depends on its own
+//!   links only, whatever order the bodies are visited in).
 
 use porofrac_lbm::d2q9::{C, OPP, W, cf};
 use porofrac_lbm::{
@@ -108,7 +111,10 @@ fn every_unknown_and_force_is_the_rule_of_its_body() {
         let mut l = Lattice::new(cfg).unwrap();
         l.init(|p| {
             let y = p[1] / 48.0;
-            (1.0 + 0.01 * y, [0.03 * y * (1.0 - y), 0.004 * (p[0] / 9.0).sin()])
+            (
+                1.0 + 0.01 * y,
+                [0.03 * y * (1.0 - y), 0.004 * (p[0] / 9.0).sin()],
+            )
         });
         for (c, r) in DISKS {
             l.add_obstacle(disk(c, r, [0.0, 0.0], 0.0)).unwrap();
