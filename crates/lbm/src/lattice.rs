@@ -678,6 +678,59 @@ impl Lattice {
         self.owner[self.grid.node(i as isize, j as isize)] != NONE
     }
 
+    /// The fluid nodes `(i, j)` off the box's edge rows and columns whose eight
+    /// neighbours are all solid (pores of one node, which the lattice cannot resolve),
+    /// row by row and along each row.
+    ///
+    /// Reads the mask (one byte per node, 1 fluid and 0 solid) eight nodes at a time: a
+    /// candidate is a fluid node between two solid ones along its row, `m & !m_left &
+    /// !m_right` of the words of eight bytes at its column, one to its left and one to its
+    /// right; only those are checked against the rows above and below.
+    pub fn enclosed_fluid_nodes(&self) -> Vec<(usize, usize)> {
+        let (nx, ny, w) = (self.grid.nx, self.grid.ny, self.grid.stride());
+        let mut out = Vec::new();
+        if nx < 3 || ny < 3 {
+            return out;
+        }
+        let word = |row: &[u8], c: usize| {
+            let mut b = [0u8; 8];
+            b.copy_from_slice(&row[c..c + 8]);
+            u64::from_le_bytes(b)
+        };
+        // padded rows j, j + 1, j + 2 are interior rows j − 1, j, j + 1
+        for j in 1..ny - 1 {
+            let below = &self.mask[j * w..(j + 1) * w];
+            let row = &self.mask[(j + 1) * w..(j + 2) * w];
+            let above = &self.mask[(j + 2) * w..(j + 3) * w];
+            let enclosed = |c: usize| {
+                row[c] == 1
+                    && row[c - 1] == 0
+                    && row[c + 1] == 0
+                    && below[c - 1..=c + 1] == [0, 0, 0]
+                    && above[c - 1..=c + 1] == [0, 0, 0]
+            };
+            // padded column c is interior column c − 1; candidates c in 2 .. nx
+            let mut c = 2;
+            while c + 8 <= nx {
+                let lone = word(row, c) & !word(row, c - 1) & !word(row, c + 1);
+                if lone != 0 {
+                    for k in 0..8 {
+                        if (lone >> (8 * k)) & 1 == 1 && enclosed(c + k) {
+                            out.push((c + k - 1, j));
+                        }
+                    }
+                }
+                c += 8;
+            }
+            for c in c..nx {
+                if enclosed(c) {
+                    out.push((c - 1, j));
+                }
+            }
+        }
+        out
+    }
+
     /// The obstacle covering interior node `(i, j)`, if any.
     pub fn owner(&self, i: usize, j: usize) -> Option<usize> {
         let o = self.owner[self.grid.node(i as isize, j as isize)];

@@ -61,34 +61,23 @@ impl Pockets {
         for s in self.active.drain(..) {
             lat.set_source_rate(s, 0.0)?;
         }
-        let (nx, ny) = lat.size();
-        for j in 1..ny.saturating_sub(1) {
-            for i in 1..nx.saturating_sub(1) {
-                if lat.is_solid(i, j) {
-                    continue;
-                }
-                let enclosed = (j - 1..=j + 1)
-                    .all(|b| (i - 1..=i + 1).all(|a| (a, b) == (i, j) || lat.is_solid(a, b)));
-                if !enclosed {
-                    continue;
-                }
-                let gap = FLOOR - lat.moments(i, j).0;
-                if gap.is_nan() || gap <= 0.0 {
-                    continue;
-                }
-                let s = match self.sources.get(&(i, j)) {
-                    Some(&s) => s,
-                    None => {
-                        let s = lat.add_source(&[(i, j)])?;
-                        self.sources.insert((i, j), s);
-                        s
-                    }
-                };
-                lat.set_source_rate(s, gap)?;
-                self.active.push(s);
-                self.added += gap;
-                self.topped += 1;
+        for (i, j) in lat.enclosed_fluid_nodes() {
+            let gap = FLOOR - lat.moments(i, j).0;
+            if gap.is_nan() || gap <= 0.0 {
+                continue;
             }
+            let s = match self.sources.get(&(i, j)) {
+                Some(&s) => s,
+                None => {
+                    let s = lat.add_source(&[(i, j)])?;
+                    self.sources.insert((i, j), s);
+                    s
+                }
+            };
+            lat.set_source_rate(s, gap)?;
+            self.active.push(s);
+            self.added += gap;
+            self.topped += 1;
         }
         Ok(())
     }
