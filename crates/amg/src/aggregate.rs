@@ -144,24 +144,6 @@ impl Strength {
     }
 }
 
-/// A dense accumulator over `n` columns with a marker per column (node `I` marks `I + 1`,
-/// so the zero-initialised markers cost nothing until touched).
-struct Spa {
-    mark: Vec<u32>,
-    acc: Vec<f64>,
-    list: Vec<u32>,
-}
-
-impl Spa {
-    fn new(n: usize) -> Self {
-        Self {
-            mark: vec![0; n],
-            acc: vec![0.0; n],
-            list: Vec::new(),
-        }
-    }
-}
-
 /// `f(j, Σ_q a_{i_q j}²)` over the columns `j` of the rows `i_q` of node `node`. When the
 /// node's equations are consecutive rows of one group of `a` (the common case), their
 /// shared columns are read once for all of them ([`CsrMatrix::for_each_in_group`]).
@@ -183,75 +165,100 @@ fn node_columns(a: &CsrMatrix, blocks: &Blocks, node: usize, mut f: impl FnMut(u
     }
 }
 
-/// `‖A_IJ‖_F²` for every structural neighbour `J ≠ I` of node `I`, in `spa`.
-fn block_norms(a: &CsrMatrix, blocks: &Blocks, node: usize, spa: &mut Spa) {
-    spa.list.clear();
-    let stamp = node as u32 + 1;
+/// The structural neighbours `J` of node `I` with `‖A_IJ‖_F²`, `J` increasing, appended to
+/// `adj` and `w`; returns `‖A_II‖_F²`.
+///
+/// The entries `(J, a²)` of the node's rows are listed in the order they are read and
+/// sorted by `J` with a stable sort (no sort at all when the equations are numbered node
+/// by node, as the columns of a row then come with `J` non-decreasing), so each block
+/// norm is summed in the order its entries were read: the same sums, bit for bit, as a
+/// dense accumulator over all nodes, without one (whose `12 B` per node, touched at
+/// random, cost more than the norms on large levels).
+fn block_norms(
+    a: &CsrMatrix,
+    blocks: &Blocks,
+    node: usize,
+    entries: &mut Vec<(u32, f64)>,
+    adj: &mut Vec<u32>,
+    w: &mut Vec<f64>,
+) -> f64 {
+    entries.clear();
     node_columns(a, blocks, node, |j, v2| {
-        let nj = blocks.node_of[j as usize];
-        let slot = nj as usize;
-        if slot == node {
-            return;
-        }
-        if spa.mark[slot] != stamp {
-            spa.mark[slot] = stamp;
-            spa.acc[slot] = 0.0;
-            spa.list.push(nj);
-        }
-        spa.acc[slot] += v2;
+        entries.push((blocks.node_of[j as usize], v2))
     });
-}
-
-/// `‖A_II‖_F`.
-fn diagonal_block_norm(a: &CsrMatrix, blocks: &Blocks, node: usize) -> f64 {
-    let mut s = 0.0f64;
-    node_columns(a, blocks, node, |j, v2| {
-        if blocks.node_of[j as usize] as usize == node {
-            s += v2;
+    if !entries.is_sorted_by_key(|e| e.0) {
+        entries.sort_by_key(|e| e.0);
+    }
+    let mut diag = 0.0;
+    let mut k = 0;
+    while k < entries.len() {
+        let nj = entries[k].0;
+        let mut sum = 0.0;
+        while k < entries.len() && entries[k].0 == nj {
+            sum += entries[k].1;
+            k += 1;
         }
-    });
-    s.sqrt()
+        if nj as usize == node {
+            diag = sum;
+        } else {
+            adj.push(nj);
+            w.push(sum);
+        }
+    }
+    diag
 }
 
 /// The strong-connection graph of the nodes of `a` with threshold `theta`.
+///
+/// One pass over the matrix lists every structural neighbour with its block norm and the
+/// diagonal block norms (in parallel parts of [`ROWS_PER_TASK`] nodes); a second pass over
+/// these lists, once all diagonal norms are known, keeps the strong ones.
 pub(crate) fn strength(a: &CsrMatrix, blocks: &Blocks, theta: f64) -> Strength {
     let nn = blocks.len();
-    let nblocks = nn.div_ceil(ROWS_PER_TASK);
-    let diag: Vec<f64> = (0..nn)
+    let nparts = nn.div_ceil(ROWS_PER_TASK);
+    let mut parts: Vec<(StrengthPart, Vec<f64>)> = (0..nparts)
         .into_par_iter()
-        .with_min_len(ROWS_PER_TASK)
-        .map(|node| diagonal_block_norm(a, blocks, node))
+        .map_init(Vec::new, |entries, b| {
+            let range = b * ROWS_PER_TASK..((b + 1) * ROWS_PER_TASK).min(nn);
+            let mut counts = Vec::with_capacity(range.len());
+            let mut diag = Vec::with_capacity(range.len());
+            let (mut adj, mut w) = (Vec::new(), Vec::new());
+            for node in range {
+                let before = adj.len();
+                diag.push(block_norms(a, blocks, node, entries, &mut adj, &mut w).sqrt());
+                counts.push(adj.len() - before);
+            }
+            ((counts, adj, w), diag)
+        })
         .collect();
-    let parts: Vec<StrengthPart> = (0..nblocks)
-        .into_par_iter()
-        .map_init(
-            || Spa::new(nn),
-            |spa, b| {
-                let range = b * ROWS_PER_TASK..((b + 1) * ROWS_PER_TASK).min(nn);
-                let mut counts = Vec::with_capacity(range.len());
-                let mut adj = Vec::new();
-                let mut w = Vec::new();
-                let mut row: Vec<(u32, f64)> = Vec::new();
-                for node in range {
-                    block_norms(a, blocks, node, spa);
-                    row.clear();
-                    for &nj in &spa.list {
-                        let j = nj as usize;
-                        let s = spa.acc[j].sqrt();
-                        if s > theta * (diag[node] * diag[j]).sqrt() {
-                            row.push((nj, s));
-                        }
+    let diag: Vec<f64> = parts.iter().flat_map(|(_, d)| d.iter().copied()).collect();
+    parts
+        .par_iter_mut()
+        .enumerate()
+        .for_each(|(b, ((counts, adj, w), _))| {
+            let mut at = 0;
+            let mut kept = 0;
+            for (k, count) in counts.iter_mut().enumerate() {
+                let node = b * ROWS_PER_TASK + k;
+                let end = at + *count;
+                let mut c = 0;
+                for p in at..end {
+                    let j = adj[p] as usize;
+                    let s = w[p].sqrt();
+                    if s > theta * (diag[node] * diag[j]).sqrt() {
+                        adj[kept] = adj[p];
+                        w[kept] = s;
+                        kept += 1;
+                        c += 1;
                     }
-                    row.sort_unstable_by_key(|&(j, _)| j);
-                    counts.push(row.len());
-                    adj.extend(row.iter().map(|&(j, _)| j));
-                    w.extend(row.iter().map(|&(_, s)| s));
                 }
-                (counts, adj, w)
-            },
-        )
-        .collect();
-    Strength::concat(nn, parts)
+                at = end;
+                *count = c;
+            }
+            adj.truncate(kept);
+            w.truncate(kept);
+        });
+    Strength::concat(nn, parts.into_iter().map(|(p, _)| p).collect())
 }
 
 impl Strength {
@@ -593,6 +600,90 @@ mod tests {
             "{} aggregates",
             explicit.1
         );
+    }
+
+    #[test]
+    fn strength_graph_is_the_block_criterion() {
+        // Two equations per node on a 9 × 9 grid of nodes, couplings to the eight
+        // neighbours of varying size (some below θ), and the nodes numbered in order (the
+        // columns of a row come node by node) or scrambled (they do not). Against the
+        // definition: J is kept when ‖A_IJ‖_F > θ √(‖A_II‖_F ‖A_JJ‖_F), with weight ‖A_IJ‖_F.
+        let m = 9;
+        let nn = m * m;
+        let n = 2 * nn;
+        let coupling = |i: usize, j: usize, p: usize, q: usize| {
+            let (lo, hi) = (i.min(j), i.max(j));
+            let k = (lo * 31 + hi * 17 + p * 5 + q * 3) % 11;
+            if i == j {
+                if p == q { 8.0 } else { 0.5 }
+            } else {
+                -(0.01 + 0.1 * k as f64)
+            }
+        };
+        let (mut cp, mut ri, mut v) = (vec![0usize], Vec::new(), Vec::new());
+        for c in 0..n {
+            let (j, q) = (c / 2, c % 2);
+            let (xj, yj) = ((j % m) as i64, (j / m) as i64);
+            for r in 0..=c {
+                let (i, p) = (r / 2, r % 2);
+                let (xi, yi) = ((i % m) as i64, (i / m) as i64);
+                if (xi - xj).abs() <= 1 && (yi - yj).abs() <= 1 {
+                    ri.push(r);
+                    v.push(coupling(i, j, p.min(q), p.max(q)));
+                }
+            }
+            cp.push(ri.len());
+        }
+        let a = SymCsr::from_upper_csc(n, &cp, &ri, &v).unwrap();
+        let dense = |r: usize, c: usize| {
+            let (r, c) = (r.min(c), r.max(c));
+            ri[cp[c]..cp[c + 1]]
+                .iter()
+                .position(|&x| x == r)
+                .map_or(0.0, |k| v[cp[c] + k])
+        };
+        let theta = 0.1;
+        for scrambled in [false, true] {
+            // Node id of grid node g (a permutation when scrambled: 7 is prime to 81).
+            let id = |g: usize| if scrambled { (7 * g) % nn } else { g };
+            let ids: Vec<usize> = (0..n).map(|e| id(e / 2)).collect();
+            let blocks = Blocks::from_ids(&ids).unwrap();
+            let s = strength(a.matrix(), &blocks, theta);
+            // Grid node of block node I: the node with id I.
+            let grid_node = |big: usize| (0..nn).find(|&g| id(g) == big).unwrap();
+            let norm = |bi: usize, bj: usize| {
+                let (gi, gj) = (grid_node(bi), grid_node(bj));
+                let mut s2 = 0.0;
+                for p in 0..2 {
+                    for q in 0..2 {
+                        s2 += dense(2 * gi + p, 2 * gj + q).powi(2);
+                    }
+                }
+                s2.sqrt()
+            };
+            let (mut kept, mut filtered) = (0, 0);
+            for bi in 0..nn {
+                let mut want = Vec::new();
+                for bj in 0..nn {
+                    let w = norm(bi, bj);
+                    if bj != bi && w > 0.0 {
+                        if w > theta * (norm(bi, bi) * norm(bj, bj)).sqrt() {
+                            want.push((bj as u32, w));
+                        } else {
+                            filtered += 1;
+                        }
+                    }
+                }
+                let (adj, w) = s.nbrs(bi);
+                kept += want.len();
+                assert_eq!(adj.len(), want.len(), "node {bi}, scrambled {scrambled}");
+                for ((&j, &wj), &(wj_id, ww)) in adj.iter().zip(w).zip(&want) {
+                    assert_eq!(j, wj_id);
+                    assert!((wj - ww).abs() <= 1e-14 * ww, "{wj} vs {ww}");
+                }
+            }
+            assert!(kept > 0 && filtered > 0, "θ keeps {kept}, drops {filtered}");
+        }
     }
 
     #[test]
