@@ -4,6 +4,7 @@ its four acceptance gates and the figures of the paper's Figs. 6-10.
 
     python3 scripts/nscd_f1_figures.py OUT_DIR [--scale S] [--figures DIR] [--prefix NAME]
                                        [--stages N] [--every K] [--until T] [--lift H]
+                                       [--speed V]
 
 OUT_DIR is the output directory of `porofrac run scenes/nscd/forced_fold_paper.toml`
 (scale 1, the default) or of `scenes/nscd/forced_fold_wedge.toml` (`--scale 0.2`): the
@@ -18,7 +19,9 @@ written.
 The geometry is the paper's scaled by S: a layer of thickness h = 30 S m on the base,
 the left wall moving at 0.5 m/s (the speed is not scaled), the tracked cells W1-W6 at
 the paper's centres and radii times S. --lift H raises the layer's top and the cells by
-H m (the rough-base variants of scripts/nscd_f1_rough_base.py --height H).
+H m (the rough-base variants of scripts/nscd_f1_rough_base.py --height H); --speed V
+reads a run whose left wall moves at V m/s instead (the end of the experiment is then
+the time the wall has travelled the paper's 250 S m).
 
 The tracked cells are the paper's: the set Omega of the particles whose centres lie in
 the circle (cx, cy, R) at t = 0 (the settled sample), followed through the run; the
@@ -280,6 +283,7 @@ def main():
     ap.add_argument("--every", type=int, default=1)
     ap.add_argument("--until", type=float, default=None)
     ap.add_argument("--lift", type=float, default=0.0)
+    ap.add_argument("--speed", type=float, default=SPEED)
     a = ap.parse_args()
     import matplotlib
 
@@ -298,7 +302,11 @@ def main():
         keep = probes["time"] <= a.until
         probes = {k: v[keep] for k, v in probes.items()}
     t_end = probes["time"][-1]
-    wall_of = lambda t: SPEED * t
+    if not a.speed > 0:
+        raise SystemExit("--speed must be a positive wall speed (m/s)")
+    wall_of = lambda t: a.speed * t
+    # The end of the experiment: 25 % of the layer's length travelled by the wall.
+    end = END * s * SPEED / a.speed
     os.makedirs(a.figures, exist_ok=True)
 
     # Initial state (the settled sample at t = 0): the tracked sets and the layers.
@@ -307,7 +315,7 @@ def main():
     diameter = 2.0 * float(np.mean(r0))
     tracked = [Cell(init, r0, (cx, cy), rc) for cx, cy, rc in cells]
 
-    done = t_end >= END * s * (1.0 - 1e-9)
+    done = t_end >= end * (1.0 - 1e-9)
     summary = os.path.join(a.out, "summary.json")
     if os.path.exists(summary):
         import json
@@ -340,7 +348,7 @@ def main():
                              for cell in tracked]))
     fr = np.array(fronts)
     print(f"{len(rows)} frames, t = {rows[0][0]:g} .. {rows[-1][0]:g} s; probes to t = {t_end:g} s "
-          f"(end of the experiment: {END * s:g} s); {len(r0)} disks, mean diameter {diameter:.3f} m")
+          f"(end of the experiment: {end:g} s); {len(r0)} disks, mean diameter {diameter:.3f} m")
     print("wall (m)  front (m)")
     for w, f in fr:
         print(f"{w:8.2f}  {f:8.2f}")

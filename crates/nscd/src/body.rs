@@ -4,6 +4,13 @@
 //! under a prescribed force ([`Axis::Loaded`], with the body's mass): a wall pushed by a
 //! known load.
 //!
+//! Friction: a body may carry its own Coulomb coefficient μ_b ([`RigidBody::with_friction`]),
+//! used by every contact of a disk with it, whether it stuck at the previous step or not
+//! (a single coefficient, static and dynamic); without one the contact law's coefficients
+//! apply. A disk on such a body slides when its tangential force would exceed μ_b times
+//! its normal force: a block of weight m g pushed along a flat base at constant speed
+//! needs μ_b m g.
+//!
 //! Closest point: a disk of centre c faces the closest point of the body's boundary;
 //! the normal points from that point to c and the gap is the distance minus the radius.
 //! A centre inside a polygon gives a negative gap, the outward normal of the nearest
@@ -39,6 +46,9 @@ pub struct RigidBody {
     pub axes: [Axis; 2],
     /// Mass (kg per metre), used along loaded axes.
     pub mass: f64,
+    /// Coulomb coefficient of the contacts of disks with this body; `None`: the contact
+    /// law's.
+    pub friction: Option<f64>,
 }
 
 impl RigidBody {
@@ -55,6 +65,7 @@ impl RigidBody {
             velocity: [0.0; 2],
             axes: [Axis::Prescribed(0.0); 2],
             mass: f64::INFINITY,
+            friction: None,
         }
     }
 
@@ -74,6 +85,13 @@ impl RigidBody {
                 self.velocity[a] = v;
             }
         }
+        self
+    }
+
+    /// The same body with its own friction coefficient μ_b for the contacts of disks with
+    /// it (instead of the contact law's).
+    pub fn with_friction(mut self, mu: f64) -> Self {
+        self.friction = Some(mu);
         self
     }
 
@@ -104,6 +122,11 @@ impl RigidBody {
                     return bad("is not convex and counter-clockwise");
                 }
             }
+        }
+        if let Some(mu) = self.friction
+            && !(mu.is_finite() && mu >= 0.0)
+        {
+            return bad("has a friction coefficient that is not a non-negative number");
         }
         let loaded = self.axes.iter().any(|a| matches!(a, Axis::Loaded(_)));
         if loaded && !(self.mass.is_finite() && self.mass > 0.0) {

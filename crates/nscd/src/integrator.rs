@@ -36,6 +36,8 @@ pub struct MoreauJean {
     body_v_old: Vec<[f64; 2]>,
     /// Inverse mass of every rigid body per axis (0 on a prescribed axis).
     pub(crate) body_inv: Vec<[f64; 2]>,
+    /// Every rigid body's own friction coefficient (`None`: the contact law's).
+    pub(crate) body_mu: Vec<Option<f64>>,
 }
 
 impl MoreauJean {
@@ -131,6 +133,7 @@ impl MoreauJean {
         self.body_v_old.clear();
         self.body_v.clear();
         self.body_inv.clear();
+        self.body_mu.clear();
         for b in bodies {
             self.body_v_old.push(b.velocity);
             let mut v = b.velocity;
@@ -142,6 +145,7 @@ impl MoreauJean {
             }
             self.body_v.push(v);
             self.body_inv.push(b.inverse_mass());
+            self.body_mu.push(b.friction);
         }
     }
 

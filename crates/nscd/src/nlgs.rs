@@ -359,6 +359,7 @@ mod tests {
             &inv_m,
             &inv_i,
             &body_inv,
+            &[None],
             1e-3,
             0.5,
         );
@@ -402,7 +403,16 @@ mod tests {
                 .unwrap();
             let (inv_m, inv_i, body_inv) = ([1.0 / d.mass[0]], [1.0 / d.inertia[0]], [[0.0; 2]]);
             let law = ContactLaw::frictional(0.3);
-            crate::problem::build(&mut set, &law, &inv_m, &inv_i, &body_inv, 1e-3, 0.5);
+            crate::problem::build(
+                &mut set,
+                &law,
+                &inv_m,
+                &inv_i,
+                &body_inv,
+                &[None],
+                1e-3,
+                0.5,
+            );
             let options = NlgsOptions {
                 min_sweeps,
                 ..NlgsOptions::default()

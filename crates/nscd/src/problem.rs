@@ -16,8 +16,9 @@
 //! `nᵀ diag(b) t` and `tᵀ diag(b) t` instead of the disk j terms. W itself is never
 //! formed: the local solver keeps the velocities `q̇ = q̇_free + M⁻¹ H P` up to date.
 //!
-//! Per contact and step: the friction coefficient is the static one if the contact was
-//! sticking at the end of the previous step, else the dynamic one; a cohesive contact
+//! Per contact and step: the friction coefficient is the body's own for a contact with a
+//! body that has one ([`crate::RigidBody::friction`]), else the static one if the contact
+//! was sticking at the end of the previous step and the dynamic one otherwise; a cohesive contact
 //! (gap ≤ `cohesion_distance`) shifts its normal impulse by hγ; the bias of the local
 //! problem is `[max(0, g)/(θh) − W_nn·shift, −W_nt·shift]`. Contacts between two
 //! immovable bodies (`W_nn = 0`) are dropped.
@@ -33,7 +34,8 @@ use crate::law::{Block, ContactLaw};
 /// Set up the local problems of the step's contacts (blocks of W, friction, cohesive
 /// shift, bias and warm-start impulse) for a step of length `h` with θ `theta`, and drop
 /// the contacts between immovable bodies. `inv_m`, `inv_i`: the disks' inverse masses
-/// and inertias; `body_inv`: the bodies' inverse masses per axis.
+/// and inertias; `body_inv`: the bodies' inverse masses per axis; `body_mu`: the bodies'
+/// own friction coefficients (`None`: the law's).
 #[allow(clippy::too_many_arguments)]
 pub fn build(
     contacts: &mut ContactSet,
@@ -41,6 +43,7 @@ pub fn build(
     inv_m: &[f64],
     inv_i: &[f64],
     body_inv: &[[f64; 2]],
+    body_mu: &[Option<f64>],
     h: f64,
     theta: f64,
 ) {
@@ -65,7 +68,11 @@ pub fn build(
         }
         ct.w = Block { nn, nt, tt };
         let (p0, stick) = contacts.warm_start(&mut prev, (ct.i, ct.other));
-        ct.mu = if stick { law.mu_static } else { law.mu_dynamic };
+        let own = match ct.other {
+            Antagonist::Body(b) => body_mu[b as usize],
+            Antagonist::Disk(_) => None,
+        };
+        ct.mu = own.unwrap_or(if stick { law.mu_static } else { law.mu_dynamic });
         let cohesive = law.cohesion > 0.0 && ct.gap <= law.cohesion_distance;
         ct.shift = if cohesive { h * law.cohesion } else { 0.0 };
         ct.bias = [

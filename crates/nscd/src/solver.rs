@@ -374,6 +374,7 @@ impl Nscd {
             &ig.inv_m,
             &ig.inv_i,
             &ig.body_inv,
+            &ig.body_mu,
             h,
             theta,
         );

@@ -1,5 +1,6 @@
 //! Scenes of model "nscd" with initial velocities and spins (`[[particles.velocity]]`),
-//! restitution (`[contact] restitution`) and wall reaction probes (`wall = NAME`),
+//! restitution (`[contact] restitution`), wall reaction probes (`wall = NAME`) and a
+//! wall's own friction (`[[wall]] mu`),
 //! through the library, against closed forms; bad input refused with the key named.
 
 use std::path::{Path, PathBuf};
@@ -112,6 +113,61 @@ fn restitution_of_the_contact_law_reaches_the_run() {
     assert_eq!(rows[k + 3][2], 0.0, "no reaction in flight");
 }
 
+/// A disk launched at v₀ = 3 m/s without spin along a floor of its own friction μ_b =
+/// 0.2 (the contact law's μ = 0.9): it slides with v = v₀ − μ_b g t, ω = −2 μ_b g t / r
+/// while the floor pushes back with μ_b m g (to 1e-12 relative), until it rolls at
+/// t* = v₀ / (3 μ_b g) = 0.51 s with v = 2v₀/3 and the floor's push 0 (to 1e-12). With
+/// the law's μ it would roll from 0.11 s.
+#[test]
+fn a_wall_of_its_own_friction_brakes_a_sliding_disk() {
+    let (v0, mu_b, r, g) = (3.0, 0.2, 0.5, 9.81);
+    let rho = 1000.0;
+    let m = rho * std::f64::consts::PI * r * r;
+    let text = format!(
+        "{HEAD}[particles]\nkind = \"list\"\ncentres = [[0.0, 0.5]]\nradii = [0.5]\n\
+         density = {rho}\n[[particles.velocity]]\nv = [{v0}, 0.0]\n\
+         [[wall]]\nname = \"floor\"\nfrom = [-10.0, 0.0]\nto = [10.0, 0.0]\nmu = {mu_b}\n\
+         [contact]\nmu = 0.9\n[nscd]\nmin_sweeps = 1\ntolerance = 1e-12\n\
+         [schedule]\nend_time = 0.8\ndt = 1.0e-3\n[output]\nevery = 1000\nprobe_every = 1\n\
+         {}{}[[output.probe]]\nname = \"fx\"\nfield = \"fx\"\nwall = \"floor\"\n",
+        probe("vx", "vx", 0),
+        probe("w", "omega", 0),
+    );
+    let (rows, _) = run("brake", &text);
+    let t_roll = v0 / (3.0 * mu_b * g);
+    let (mut sliding, mut rolling) = (0, 0);
+    for row in &rows[1..] {
+        let (t, vx, w, fx) = (row[0], row[1], row[2], row[3]);
+        if t < t_roll - 2e-3 {
+            sliding += 1;
+            let (v, spin) = (v0 - mu_b * g * t, -2.0 * mu_b * g * t / r);
+            assert!((vx - v).abs() < 1e-12 * v0, "t = {t}: v {vx} against {v}");
+            assert!(
+                (w - spin).abs() < 1e-12 * v0 / r,
+                "t = {t}: ω {w} against {spin}"
+            );
+            assert!(
+                (fx + mu_b * m * g).abs() < 1e-12 * m * g,
+                "t = {t}: floor fx {fx} against −μ_b m g {}",
+                -mu_b * m * g
+            );
+        } else if t > t_roll + 2e-3 {
+            rolling += 1;
+            assert!((vx - 2.0 * v0 / 3.0).abs() < 1e-12 * v0, "t = {t}: v {vx}");
+            assert!(
+                (vx + w * r).abs() < 1e-12 * v0,
+                "t = {t}: slip {}",
+                vx + w * r
+            );
+            assert!(fx.abs() < 1e-12 * m * g, "t = {t}: floor fx {fx}");
+        }
+    }
+    assert!(
+        sliding > 400 && rolling > 250,
+        "{sliding} sliding, {rolling} rolling steps"
+    );
+}
+
 #[test]
 fn bad_keys_are_named() {
     let one = "[particles]\nkind = \"list\"\ncentres = [[0.0, 0.5]]\nradii = [0.5]\n\
@@ -134,6 +190,10 @@ fn bad_keys_are_named() {
         (
             format!("{wall}{wall}"),
             vec!["wall[1].name", "\"floor\"", "wall[0]"],
+        ),
+        (
+            format!("{wall}mu = -0.1\n"),
+            vec!["wall[0].mu", "≥ 0"],
         ),
         (
             format!("{wall}[[output.probe]]\nname = \"a\"\nfield = \"vx\"\nwall = \"floor\"\n"),

@@ -335,6 +335,9 @@ fn check_walls(ls: &LoadedScene) -> Result<(), SceneError> {
                 finite(ls, &key("force"), v)?;
             }
         }
+        if let Some(mu) = w.mu {
+            non_negative(ls, &key("mu"), mu)?;
+        }
     }
     Ok(())
 }

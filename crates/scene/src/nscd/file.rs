@@ -42,6 +42,9 @@ pub struct WallSection {
     /// Mass (kg per metre), needed with a free component.
     #[schemars(extend("unit" = "kg/m"))]
     pub mass: Option<f64>,
+    /// Coulomb friction coefficient of the contacts of disks with this wall, static and
+    /// dynamic (default `[contact] mu` and `mu_static`): a base of its own roughness.
+    pub mu: Option<f64>,
 }
 
 /// `[contact]`: the law between disks, and between disks and walls.

@@ -149,8 +149,12 @@ fn walls(ls: &LoadedScene) -> Vec<RigidBody> {
                 WallComponent::Velocity(x) => Axis::Prescribed(*x),
                 WallComponent::Word(_) => Axis::Loaded(force[a]),
             };
-            RigidBody::polygon(vertices)
-                .with_axes([axis(0), axis(1)], w.mass.unwrap_or(f64::INFINITY))
+            let body = RigidBody::polygon(vertices)
+                .with_axes([axis(0), axis(1)], w.mass.unwrap_or(f64::INFINITY));
+            match w.mu {
+                Some(mu) => body.with_friction(mu),
+                None => body,
+            }
         })
         .collect()
 }
