@@ -275,7 +275,8 @@ fn crack_band<const D: usize>(n: usize) {
         1.0 / n as f64,
         0.2,
     );
-    let band = |x: &Point<D>| (x[1] - 0.5).abs() < 0.5 / n as f64;
+    // The layer of cells between y = 0.5 and 0.5 + 1/n (centroids perturbed by < 0.2 h).
+    let band = |x: &Point<D>| (x[1] - 0.5 - 0.5 / n as f64).abs() < 0.25 / n as f64;
     let load = ScalarField::from_fn(|x, _| if x[0] < 0.5 { -1e6 } else { 0.0 });
     let s = setup(grid, 1e9, 0.25, Some(load), |g| {
         let k: Vec<f64> = g
