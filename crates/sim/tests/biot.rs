@@ -294,7 +294,7 @@ fn crack_band<const D: usize>(n: usize) {
                 compressibility: 4.4e-10,
             },
         )
-        .pressure_bc(g.boundary("xmin").unwrap(), 1.2e7.into())
+        .pressure_bc(g.boundary("xmin").unwrap(), 1.2e7)
     });
     let nc = s.grid.num_cells();
     let cells: Vec<usize> = (0..nc)
