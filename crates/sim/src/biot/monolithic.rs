@@ -34,8 +34,11 @@
 //! the factorization and of the sweeps is then scaled exactly. The factorization of `A`
 //! *is* the factorization of the scaled system; the scaling enters where it changes
 //! something, the measure of the residual, and the solutions of the scenes are unchanged
-//! bit for bit. The low-rank update keeps its own target on the plain residual (a miss
-//! factorizes afresh, whose solve is then judged here).
+//! bit for bit. The corrections keep aiming at the plain residual: the low-rank update
+//! at its own target (a miss factorizes afresh), a fresh solve above the limit in it
+//! corrected up to [`FRESH_REFINEMENTS`] times with the same factors (which lowers it
+//! where it is an error of the solve and leaves it where it is the floor of one row).
+//! Only the verdict on a fresh solve is the scaled residual.
 //!
 //! A singular system (a body held by no condition, a flow region without storage or
 //! anchor) is still refused: the pivots of its null space are round-off, the scaled
@@ -562,13 +565,15 @@ impl Monolithic {
     /// a matrix of widely spread scales (stiff rock beside a cell that has nearly lost
     /// its stiffness, pressures of tens of MPa at a held crack tip) can leave such a
     /// solve just above it, and a correction `z += solve(b − A z)` with the same factors
-    /// brings it back to round-off, as direct solvers refine. A solve at or below the
-    /// limit is left as it is (no arithmetic changes); one the corrections do not bring
-    /// below it is reported by [`Self::finish`] as numerically singular.
+    /// brings it back to round-off, as direct solvers refine. The corrections aim at the
+    /// plain residual `‖b − A z‖/‖b‖`: a solve at or below the limit in it is left as it
+    /// is (no arithmetic changes), and where that residual has a floor set by one row
+    /// far larger than the others (see the module docs) they leave it there; the verdict
+    /// is the Jacobi-scaled residual of [`Self::finish`].
     fn refine_fresh(&mut self, work: &mut MonolithicWork) -> Result<(), LdltError> {
         let mut r = vec![0.0; work.z.len()];
         for _ in 0..FRESH_REFINEMENTS {
-            if self.relative_residual(&work.z, &work.rhs) <= FRESH_RESIDUAL {
+            if self.plain_relative_residual(&work.z, &work.rhs) <= FRESH_RESIDUAL {
                 return Ok(());
             }
             r.fill(0.0);
