@@ -272,8 +272,9 @@ pub struct BiotStep {
     pub state: BiotState,
     /// Iterations (1 for the monolithic and explicit schemes).
     pub iterations: usize,
-    /// Monolithic: relative residual of the linear solve; fixed-stress: the last relative
-    /// change; explicit: 0.
+    /// Monolithic: relative residual of the linear solve in the Jacobi-scaled system
+    /// (`‖D (b − A z)‖/‖D b‖`, see [`Monolithic`]); fixed-stress: the last relative change;
+    /// explicit: 0.
     pub residual: f64,
 }
 
