@@ -71,7 +71,11 @@
 //! `[[K, −s Cᵀ], [−s C, −s² (M + Δt A)]]`. The default
 //! `s = mean diag(K) / mean |C_{K,e}|` (units Pa/m) makes the coupling block as large as
 //! the stiffness; `s` is a pure change of variables, so the solution does not depend on it
-//! (tested to 1e-10).
+//! (tested to 1e-10). One `s` cannot level every row: a crack cell that conducts by the
+//! cubic law has a pressure row far larger than the rock's, and [`Monolithic`] judges
+//! its solves in the Jacobi-scaled system `D A D`, `D = diag(|a_ii|)^{-1/2}` (see
+//! `monolithic.rs`: the factors of `A` are those of `D A D`, so only the residual test
+//! changes).
 //!
 //! # What a step costs
 //!
@@ -268,8 +272,9 @@ pub struct BiotStep {
     pub state: BiotState,
     /// Iterations (1 for the monolithic and explicit schemes).
     pub iterations: usize,
-    /// Monolithic: relative residual of the linear solve; fixed-stress: the last relative
-    /// change; explicit: 0.
+    /// Monolithic: relative residual of the linear solve in the Jacobi-scaled system
+    /// (`‖D (b − A z)‖/‖D b‖`, see [`Monolithic`]); fixed-stress: the last relative change;
+    /// explicit: 0.
     pub residual: f64,
 }
 

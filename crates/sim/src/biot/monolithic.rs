@@ -1,5 +1,52 @@
 //! The fully implicit monolithic scheme (Nilsen et al. (2017) eq. 30): the symmetric
 //! quasi-definite block system, its `LDLᵀ` factorization and low-rank updates.
+//!
+//! # The residual of a solve, in the Jacobi-scaled system
+//!
+//! The pressure scale `s` (see [`super`]) brings the blocks of `A` to one size on
+//! average, not row by row. A cell whose crack conducts by the cubic law has the
+//! pressure row `−s² (M_K + Δt Σ_f T_f)` with `T_f ∝ w³/12μ`: the crack cell at a
+//! well's wall, opened by centimetres, gives a diagonal 1e15 times that of the rock
+//! around it (`Δt A_KK / M_K` = 1.7e15 at 39 minutes on the seed's fluid-lag scene
+//! with the cubic law, docs/hydrofrac/validation.md). A
+//! backward-stable solve `z` leaves a residual of about `ε |A| |z|` row by row, so the
+//! relative residual `‖b − A z‖ / ‖b‖` has a floor set by that one row, whatever the
+//! accuracy of the solution elsewhere, and can sit above the limit of a usable solve
+//! ([`FRESH_RESIDUAL`]) while the solution is as good as the data.
+//!
+//! The solve is therefore judged in the symmetrically (Jacobi) scaled system
+//!
+//! ```text
+//!   Â ŷ = b̂,    Â = D A D,   b̂ = D b,   z = D ŷ,   D = diag(|a_ii|)^{-1/2},
+//! ```
+//!
+//! whose diagonal is `±1` (`+1` on the displacement rows of `K`, `−1` on the pressure
+//! rows): every row counts relative to its own diagonal. The residual test is
+//!
+//! ```text
+//!   ‖b̂ − Â ŷ‖ / ‖b̂‖ = ‖D (b − A z)‖ / ‖D b‖ ≤ FRESH_RESIDUAL .
+//! ```
+//!
+//! The factors need not be computed from `Â`: a quasi-definite matrix is factorized
+//! without pivoting and without regularisation, and the factors of `D A D` are those of
+//! `A` rescaled, `Â = (D L D⁻¹)(D Λ D)(D L D⁻¹)ᵀ` — the very same floating-point numbers
+//! times powers of two when `D` is rounded to powers of two, since each multiply–add of
+//! the factorization and of the sweeps is then scaled exactly. The factorization of `A`
+//! *is* the factorization of the scaled system; the scaling enters where it changes
+//! something, the measure of the residual, and the solutions of the scenes are unchanged
+//! bit for bit. The corrections keep aiming at the plain residual: the low-rank update
+//! at its own target (a miss factorizes afresh), a fresh solve above the limit in it
+//! corrected up to [`FRESH_REFINEMENTS`] times with the same factors (which lowers it
+//! where it is an error of the solve and leaves it where it is the floor of one row).
+//! Only the verdict on a fresh solve is the scaled residual.
+//!
+//! A singular system (a body held by no condition, a flow region without storage or
+//! anchor) is still refused: the pivots of its null space are round-off, the scaled
+//! solution `ŷ = D⁻¹ z` is then [`SINGULAR_GROWTH`] times the scaled data `D b` or more,
+//! and the scaled residual is far above the limit; it is reported as numerically
+//! singular. A refused solve whose scaled solution stays bounded is reported as an
+//! inaccurate solve of a matrix whose diagonal spans the range it names, not as a
+//! missing support.
 
 use std::ops::Range;
 use std::sync::Arc;
@@ -44,6 +91,8 @@ pub struct Monolithic {
     low_rank: Box<LowRank>,
     /// Row access to the pattern (the residual of an updated solve on its support).
     rows: UpperRows,
+    /// The position of each unknown's diagonal entry in `values`.
+    diag: Vec<usize>,
     /// The forward sweep `L⁻¹ Π b` of the last updated solve: the factorization it was
     /// swept with (their count), `b` and the sweep.
     forward: Option<(usize, Vec<f64>, Vec<f64>)>,
@@ -162,6 +211,15 @@ impl Monolithic {
         let ldlt = block_ordering(system, &col_ptr, &row_idx)?;
         let nnz = row_idx.len();
         let rows = UpperRows::new(&col_ptr, &row_idx);
+        let diag = (0..n)
+            .map(|j| {
+                (col_ptr[j]..col_ptr[j + 1])
+                    .find(|&q| row_idx[q] == j)
+                    .ok_or_else(|| {
+                        BiotError::Input(format!("coupled pattern without diagonal at {j}"))
+                    })
+            })
+            .collect::<BiotResult<Vec<_>>>()?;
         Ok(Self {
             scale,
             s: 1.0,
@@ -175,6 +233,7 @@ impl Monolithic {
             factor_values: Vec::new(),
             low_rank: Box::new(LowRank::new(n)),
             rows,
+            diag,
             forward: None,
             max_rank: DEFAULT_MAX_RANK,
             updates: 0,
@@ -493,7 +552,7 @@ impl Monolithic {
                 *z += d;
             }
         }
-        if self.relative_residual(&work.z, &work.rhs) <= LOW_RANK_RESIDUAL {
+        if self.plain_relative_residual(&work.z, &work.rhs) <= LOW_RANK_RESIDUAL {
             return Ok(());
         }
         self.refactorize().map_err(|e| LdltError(e.to_string()))?;
@@ -506,13 +565,15 @@ impl Monolithic {
     /// a matrix of widely spread scales (stiff rock beside a cell that has nearly lost
     /// its stiffness, pressures of tens of MPa at a held crack tip) can leave such a
     /// solve just above it, and a correction `z += solve(b − A z)` with the same factors
-    /// brings it back to round-off, as direct solvers refine. A solve at or below the
-    /// limit is left as it is (no arithmetic changes); one the corrections do not bring
-    /// below it is reported by [`Self::finish`] as numerically singular.
+    /// brings it back to round-off, as direct solvers refine. The corrections aim at the
+    /// plain residual `‖b − A z‖/‖b‖`: a solve at or below the limit in it is left as it
+    /// is (no arithmetic changes), and where that residual has a floor set by one row
+    /// far larger than the others (see the module docs) they leave it there; the verdict
+    /// is the Jacobi-scaled residual of [`Self::finish`].
     fn refine_fresh(&mut self, work: &mut MonolithicWork) -> Result<(), LdltError> {
         let mut r = vec![0.0; work.z.len()];
         for _ in 0..FRESH_REFINEMENTS {
-            if self.relative_residual(&work.z, &work.rhs) <= FRESH_RESIDUAL {
+            if self.plain_relative_residual(&work.z, &work.rhs) <= FRESH_RESIDUAL {
                 return Ok(());
             }
             r.fill(0.0);
@@ -545,8 +606,50 @@ impl Monolithic {
         Ok(())
     }
 
+    /// Why a first solve of relative residual `residual` (above [`FRESH_RESIDUAL`]) is
+    /// refused: a singular system gives a scaled solution `y = D⁻¹ z` far larger than the
+    /// scaled right-hand side `D b` (the pivots of its null space are round-off), named
+    /// as such; otherwise the solve is only inaccurate, and the spread of the diagonal is
+    /// named instead of a missing support.
+    fn refusal(&self, residual: f64, z: &[f64], rhs: &[f64]) -> String {
+        let (mut y, mut b) = ((0.0f64, 0), 0.0f64);
+        let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+        for (i, (&q, (zi, bi))) in self.diag.iter().zip(z.iter().zip(rhs)).enumerate() {
+            let a = self.values[q].abs();
+            let d2 = jacobi_weight2(self.values[q]);
+            if (zi * zi / d2).sqrt() > y.0 {
+                y = ((zi * zi / d2).sqrt(), i);
+            }
+            b = b.max((bi * bi * d2).sqrt());
+            if a > 0.0 {
+                lo = lo.min(a);
+                hi = hi.max(a);
+            }
+        }
+        let what = if y.1 < self.nm {
+            format!("displacement unknown {}", y.1)
+        } else {
+            format!("the pressure of cell {}", y.1 - self.nm)
+        };
+        if y.0 > SINGULAR_GROWTH * b {
+            format!(
+                "coupled system numerically singular: relative residual {residual:.2e} \
+                 (Jacobi-scaled), the scaled solution {:.1e} times the right-hand side, \
+                 largest at {what}",
+                y.0 / b
+            )
+        } else {
+            format!(
+                "coupled solve inaccurate: relative residual {residual:.2e} (Jacobi-scaled) \
+                 above {FRESH_RESIDUAL:e} after {FRESH_REFINEMENTS} corrections; the \
+                 diagonal of the coupled matrix spans {lo:.1e} to {hi:.1e}, the largest \
+                 scaled change at {what}"
+            )
+        }
+    }
+
     /// `‖A z − b‖ / ‖b‖` (`‖A z − b‖` for `b = 0`) with the current matrix.
-    fn relative_residual(&self, z: &[f64], rhs: &[f64]) -> f64 {
+    fn plain_relative_residual(&self, z: &[f64], rhs: &[f64]) -> f64 {
         let mut az = vec![0.0; z.len()];
         self.sym_mul_add(z, &mut az);
         let rn = rhs.iter().map(|v| v * v).sum::<f64>().sqrt();
@@ -556,6 +659,22 @@ impl Monolithic {
             .map(|(a, b)| (a - b) * (a - b))
             .sum::<f64>()
             .sqrt();
+        if rn > 0.0 { en / rn } else { en }
+    }
+
+    /// The relative residual of `z` in the Jacobi-scaled system (see the module docs):
+    /// `‖D (A z − b)‖ / ‖D b‖` (`‖D (A z − b)‖` for `b = 0`) with the current matrix and
+    /// `D = diag(|A_ii|)^{-1/2}`.
+    fn relative_residual(&self, z: &[f64], rhs: &[f64]) -> f64 {
+        let mut az = vec![0.0; z.len()];
+        self.sym_mul_add(z, &mut az);
+        let (mut rn, mut en) = (0.0, 0.0);
+        for ((&q, a), b) in self.diag.iter().zip(&az).zip(rhs) {
+            let d2 = jacobi_weight2(self.values[q]);
+            rn += d2 * b * b;
+            en += d2 * (a - b) * (a - b);
+        }
+        let (rn, en) = (rn.sqrt(), en.sqrt());
         if rn > 0.0 { en / rn } else { en }
     }
 
@@ -608,6 +727,20 @@ const LOW_RANK_REFINEMENTS: usize = 3;
 /// solve is refined ([`Monolithic::refine_fresh`]) and, if still above, the system is
 /// reported as numerically singular.
 const FRESH_RESIDUAL: f64 = 1e-8;
+
+/// The squared weight `D_ii² = 1/|a_ii|` of an unknown with diagonal entry `a_ii` in the
+/// Jacobi scaling of the residual (1 for a zero diagonal).
+fn jacobi_weight2(a: f64) -> f64 {
+    if a != 0.0 { 1.0 / a.abs() } else { 1.0 }
+}
+
+/// A refused solve whose scaled solution `D⁻¹ z` exceeds the scaled right-hand side
+/// `D b` (largest entries) this many times is reported as singular: the factors of a
+/// system with a null space give it pivots of round-off size and a solution of the
+/// order of `1/ε` times the data, while a nonsingular one stays bounded by the condition
+/// of the scaled matrix (1 to 2e3 over the fresh solves of the seed's fluid-lag scene
+/// with the cubic law on `refine = 17`, docs/hydrofrac/validation.md).
+const SINGULAR_GROWTH: f64 = 1e10;
 
 /// Corrections of a first solve above [`FRESH_RESIDUAL`] before it is reported.
 const FRESH_REFINEMENTS: usize = 3;
@@ -928,9 +1061,7 @@ impl Monolithic {
             if residual > FRESH_RESIDUAL {
                 // The factors are unusable: the next step factorizes again.
                 self.factored = None;
-                return Err(BiotError::Solver(format!(
-                    "coupled system numerically singular: relative residual {residual:.2e}"
-                )));
+                return Err(BiotError::Solver(self.refusal(residual, z, rhs)));
             }
             self.residual = residual;
         }
