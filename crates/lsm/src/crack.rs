@@ -235,10 +235,11 @@ impl BondFaces {
         }
         // half-edge u → around[s] is slot s; the slot of v → u among v's neighbours
         let slot = |v: usize, u: u32| {
-            start[v] + around[start[v]..start[v + 1]]
-                .iter()
-                .position(|&w| w == u)
-                .expect("every bond is listed at both ends")
+            start[v]
+                + around[start[v]..start[v + 1]]
+                    .iter()
+                    .position(|&w| w == u)
+                    .expect("every bond is listed at both ends")
         };
         let mut owner = vec![u32::MAX; around.len()];
         let mut count = 0usize;
@@ -259,7 +260,11 @@ impl BondFaces {
                     area += 0.5 * (a[0] * b[1] - b[0] * a[1]);
                     winding += crossing(a, b, centre);
                     let k = slot(v, u as u32);
-                    let s_next = if k == start[v] { start[v + 1] - 1 } else { k - 1 };
+                    let s_next = if k == start[v] {
+                        start[v + 1] - 1
+                    } else {
+                        k - 1
+                    };
                     (u, s) = (v, s_next);
                     if s == s0 {
                         break;
@@ -273,12 +278,7 @@ impl BondFaces {
         }
         let sides = pairs
             .iter()
-            .map(|&(i, j)| {
-                [
-                    owner[slot(i as usize, j)],
-                    owner[slot(j as usize, i)],
-                ]
-            })
+            .map(|&(i, j)| [owner[slot(i as usize, j)], owner[slot(j as usize, i)]])
             .collect();
         let faces = Self {
             pairs: pairs.to_vec(),
@@ -420,9 +420,14 @@ impl CrackExtent {
     fn ends(&self, i: usize, j: usize) -> Result<(usize, usize), LsmError> {
         match &self.faces {
             None => Ok((i, j)),
-            Some(f) => f.of(i, j).map(|s| (s[0] as usize, s[1] as usize)).ok_or(
-                LsmError::bad("j", j as f64, "is not bonded to i in the bond network"),
-            ),
+            Some(f) => f
+                .of(i, j)
+                .map(|s| (s[0] as usize, s[1] as usize))
+                .ok_or(LsmError::bad(
+                    "j",
+                    j as f64,
+                    "is not bonded to i in the bond network",
+                )),
         }
     }
 
@@ -452,6 +457,20 @@ impl CrackExtent {
             k = self.parent[k] as usize;
         }
         self.reach[k]
+    }
+
+    /// The bonds `(i, j)`, `i < j`, that bound the pore holding the hole (with
+    /// [`Self::across_pores`]; empty otherwise).
+    pub fn hole_pore(&self) -> Vec<(usize, usize)> {
+        let Some(f) = &self.faces else {
+            return Vec::new();
+        };
+        f.pairs
+            .iter()
+            .zip(&f.sides)
+            .filter(|(_, s)| s.iter().any(|&k| k as usize == self.hole))
+            .map(|(&(i, j), _)| (i as usize, j as usize))
+            .collect()
     }
 
     /// Whether the broken bond between disks `i` and `j` belongs to the crack connected
@@ -677,7 +696,10 @@ mod tests {
         let mut centres = Vec::new();
         for row in -8i32..=8 {
             for col in -9i32..=9 {
-                let x = [col as f64 + 0.5 * (row.rem_euclid(2)) as f64, row as f64 * h];
+                let x = [
+                    col as f64 + 0.5 * (row.rem_euclid(2)) as f64,
+                    row as f64 * h,
+                ];
                 if x[0].hypot(x[1]) > 1.5 {
                     centres.push(x);
                 }

@@ -50,18 +50,34 @@ fn the_scene_rocks_bond_network_is_planar() {
                     }
                 }
             }
-            assert_eq!(crossings, 0, "b = {b} m, seed {seed}: {crossings} crossings");
+            assert_eq!(
+                crossings, 0,
+                "b = {b} m, seed {seed}: {crossings} crossings"
+            );
             let lining: Vec<usize> = PressureWall::new(d, [0.0; 2], 3.0)
                 .unwrap()
                 .members
                 .iter()
                 .map(|m| m.0 as usize)
                 .collect();
-            CrackExtent::new(d.len(), &lining, [0.0; 2])
+            let x = CrackExtent::new(d.len(), &lining, [0.0; 2])
                 .unwrap()
                 .across_pores(d, bonds)
                 .unwrap();
-            eprintln!("b = {b} m, seed {seed}: {} disks, {} bonds, planar", d.len(), bonds.len());
+            let pore = x.hole_pore();
+            let reach = pore
+                .iter()
+                .flat_map(|&(i, j)| [i, j])
+                .map(|k| d.x[k][0].hypot(d.x[k][1]) + d.r[k])
+                .fold(0.0, f64::max);
+            eprintln!(
+                "b = {b} m, seed {seed}: {} disks, {} bonds, planar; the hole's pore: {} bonds, \
+                 reach {reach:.2} m, {} lining disks",
+                d.len(),
+                bonds.len(),
+                pore.len(),
+                lining.len()
+            );
         }
     }
 }
