@@ -24,6 +24,8 @@
 # LSM_BREAKDOWN_FLUID_END sets the fluid runs' end time (s, default 0.45: the injection
 # target reaches 10.8 MPa, about 2.2 p_b); LSM_BREAKDOWN_PLOT=0 skips the PNGs.
 # A run that stops with an error is named on stderr and has no row (the series goes on).
+# LSM_BREAKDOWN_PORES=1 adds [loading] crack_across_pores = true (the crack traced through the
+# pores, the faces of the bond network, it opens); runs then go to target/lsm_breakdown/pores-MODE-SEED.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 modes=$1; shift
@@ -41,6 +43,7 @@ printf 'mode\tseed\tparticles\tsigma_t\tp_b\tinit\tinit/p_b\tbreakdown\tbd/p_b\t
 for mode in ${modes//,/ }; do
   for seed in "$@"; do
     dir="$root/$mode-$seed"
+    [ "${LSM_BREAKDOWN_PORES:-0}" = 1 ] && dir="$root/pores-$mode-$seed"
     reuse=0
     if [ "${LSM_BREAKDOWN_REUSE:-0}" = 1 ] && [ -f "$dir/out/summary.json" ]; then
       reuse=1
@@ -61,6 +64,10 @@ for mode in ${modes//,/ }; do
             scenes/lsm_hydrofrac.toml > "$dir/scene.toml" ;;
       *) echo "unknown mode $mode" >&2; exit 2 ;;
     esac
+    if [ "${LSM_BREAKDOWN_PORES:-0}" = 1 ]; then
+      sed -i 's/^\[loading\]$/&\ncrack_across_pores = true/' "$dir/scene.toml"
+      grep -q "^crack_across_pores = true$" "$dir/scene.toml"
+    fi
     grep -q "^seed = $seed$" "$dir/scene.toml"
     if [ $reuse = 0 ]; then
       t0=$(date +%s.%N)

@@ -16,7 +16,7 @@
 # LSM_GEOMETRY_SCALE=S divides every radius by S (a/r_max = 3 S at the same a and b; the
 # ramp against the wave transit of the rock is unchanged); LSM_GEOMETRY_CALIBRATE=0 skips
 # the scene's own calibration (its sigma_t column reads nan); LSM_GEOMETRY_PORES=1 adds
-# [loading] crack_across_pores = true (the crack joined across the pores it opens). Runs with
+# [loading] crack_across_pores = true (the crack traced through the pores it opens). Runs with
 # S != 1 go to target/lsm_geometry/sS-bB-SEED, with PORES=1 to .../pores-....
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -10,8 +10,8 @@
 //! `cargo run --release -p porofrac-lsm --example notch_toughness -- C... [--seeds N]
 //! [--rmax R] [--rate PA_PER_S] [--radius M] [--growth M] [--radical]` (default c = 3 6,
 //! 3 seeds, r_max 1 m, 2.5 MPa/s; `--radical`: flooded bonds load their power-diagram
-//! face, [`porofrac_lsm::FaceWidths`], instead of the bond width; `--pores`: the crack joins
-//! across pores, [`porofrac_lsm::CrackExtent::across_pores`]). One row per (c, seed); the mean and sd of K_Ic per c.
+//! face, [`porofrac_lsm::FaceWidths`], instead of the bond width; `--pores`: the crack is traced
+//! through the faces of the bond network, [`porofrac_lsm::CrackExtent::across_pores`]). One row per (c, seed); the mean and sd of K_Ic per c.
 
 use porofrac_lsm::CrackFaces;
 use porofrac_lsm::calibrate::scene_rock;

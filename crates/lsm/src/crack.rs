@@ -20,18 +20,40 @@
 //! disk, so the bonds broken along one crack form a connected set of edges. A crack that
 //! crosses a pore bounded by four or more disks can be split in two by this rule (it
 //! has no edge across the pore); the extent then stops at the pore, which errs towards a
-//! later, higher breakdown. [`CrackExtent::across_pores`] closes that gap: a broken bond
-//! then also joins the disks of the pores on its two sides (the faces of the bond
-//! network), so a crack is one crack across any pore it opens. It matters: a pressurised
+//! later, higher breakdown. Sharing a disk also joins too much: microcracks that touch
+//! the lining disks, or touch each other at a disk without opening a common gap, count
+//! as the wall's crack. [`CrackExtent::across_pores`] traces the crack the way a fluid
+//! would follow it instead (next section).
+//!
+//! **Across pores: the faces of the bond network.** With the disk centres as vertices
+//! and the bonds as straight edges, the bond network of a packing is a plane graph (no
+//! two bonds cross: `tests/bond_faces.rs` checks the borehole scenes' packings, seeds
+//! 1–5); its faces are the pores — bonded triangles, pores of four or more disks, the
+//! hole, the outside. They are traced from the rotation system: the bonded neighbours of
+//! every disk sorted by angle, the face left of the half-edge `u → v` continued at `v`
+//! by the neighbour just clockwise of `u`. Every bond separates two faces (one face on
+//! both sides for a bond that hangs free). A broken bond *opens* its two faces into one
+//! gap: the crack is the connected component of faces joined by broken bonds, i.e. two
+//! broken bonds are one crack when a chain of broken bonds joins them in which each
+//! consecutive pair bounds a common face. The crack connected to the hole is the
+//! component of the face that holds the hole centre (the bounded face of smallest area
+//! whose boundary winds around it; the lining disks of [`CrackExtent::new`] no longer
+//! enter), its extent as above over its broken bonds. A pressure in the hole can cross
+//! an opened pore from one broken bond to another; it cannot cross from one broken bond
+//! to another that only touches the same disk, so those stay two cracks. The faces are
+//! traced once, in the reference configuration (bonds do not form during a run).
+//! It matters: a pressurised
 //! notch of half-length 3 m in the packing of the borehole scenes (radii 0.1–1 m) runs at
-//! 4.14 MPa when joined across pores and at 8.97 MPa when not, after 268 broken bonds of
-//! diffuse damage around a crack that its own pressure never reaches
-//! (`crates/lsm/tests/notch_toughness.rs`). Broken bonds in the rock that are not connected to the hole
-//! (isolated microcracks, or cracks in fluid-filled pockets behind the lining that have
-//! not yet joined the wall) do not count.
+//! 6.62 MPa traced through faces (103 broken bonds) and at 8.97 MPa joined through shared
+//! disks, after 268 broken bonds of diffuse damage around a crack that its own pressure
+//! does not reach across the pores (`crates/lsm/tests/notch_toughness.rs`). Broken bonds in
+//! the rock that are not connected to the hole (isolated microcracks, or cracks in
+//! fluid-filled pockets behind the lining that have not yet joined the wall) do not
+//! count.
 //!
 //! The extent never decreases (bonds do not heal), and is computed incrementally with a
-//! disjoint-set forest (union by size, path halving): `O(α(n))` per broken bond.
+//! disjoint-set forest over the disks (or the faces) (union by size, path halving):
+//! `O(α(n))` per broken bond, plus a binary search for the bond's faces.
 //!
 //! **A flooded crack** ([`CrackExtent::flood_loads`]). A fluid that follows the crack
 //! (the zero-lag limit of hydraulic fracturing) puts the hole pressure `p` on its faces.
@@ -64,9 +86,6 @@
 use crate::LsmError;
 use crate::bond::{Bond, BrokenBond};
 use porofrac_particles::Disks;
-
-/// The most disks of a pore that [`CrackExtent::across_pores`] joins.
-pub const MAX_PORE: usize = 8;
 
 /// Which length of crack face a flooded broken bond stands for (module docs, "Which
 /// width").
@@ -172,14 +191,135 @@ fn radical_face(disks: &Disks, i: usize, j: usize, adj: &[Vec<u32>]) -> f64 {
     (left - right).max(0.0)
 }
 
+/// The faces of the planar bond network (module docs, "Across pores"): every bond's two
+/// sides, and the face that holds the hole.
+#[derive(Clone, Debug, PartialEq)]
+struct BondFaces {
+    /// `(i, j)` of every bond, `i < j`, sorted, without repeats.
+    pairs: Vec<(u32, u32)>,
+    /// The face left of `i → j` and the face left of `j → i`, per pair.
+    sides: Vec<[u32; 2]>,
+    /// Number of faces.
+    count: usize,
+}
+
+impl BondFaces {
+    /// Trace the faces of the bonds `pairs` between the disks of `disks` (module docs);
+    /// returns them and the bounded face that holds `centre` (the smallest when pores
+    /// nest), `None` when no bounded face does.
+    fn trace(disks: &Disks, pairs: &[(u32, u32)], centre: [f64; 2]) -> (Self, Option<usize>) {
+        let n = disks.len();
+        let mut start = vec![0usize; n + 1];
+        for &(i, j) in pairs {
+            start[i as usize + 1] += 1;
+            start[j as usize + 1] += 1;
+        }
+        for k in 0..n {
+            start[k + 1] += start[k];
+        }
+        let mut around = vec![0u32; start[n]];
+        let mut next: Vec<usize> = start[..n].to_vec();
+        for &(i, j) in pairs {
+            for (u, v) in [(i, j), (j, i)] {
+                around[next[u as usize]] = v;
+                next[u as usize] += 1;
+            }
+        }
+        for u in 0..n {
+            let x = disks.x[u];
+            let angle = |v: &u32| {
+                let y = disks.x[*v as usize];
+                (y[1] - x[1]).atan2(y[0] - x[0])
+            };
+            around[start[u]..start[u + 1]].sort_by(|a, b| angle(a).total_cmp(&angle(b)));
+        }
+        // half-edge u → around[s] is slot s; the slot of v → u among v's neighbours
+        let slot = |v: usize, u: u32| {
+            start[v]
+                + around[start[v]..start[v + 1]]
+                    .iter()
+                    .position(|&w| w == u)
+                    .expect("every bond is listed at both ends")
+        };
+        let mut owner = vec![u32::MAX; around.len()];
+        let mut count = 0usize;
+        let mut hole: Option<(usize, f64)> = None;
+        for first in 0..n {
+            for s0 in start[first]..start[first + 1] {
+                if owner[s0] != u32::MAX {
+                    continue;
+                }
+                // walk the face left of the half-edge s0: at v, arriving from u, leave by
+                // the neighbour of v just clockwise of u
+                let (mut u, mut s) = (first, s0);
+                let (mut area, mut winding) = (0.0, 0i32);
+                loop {
+                    owner[s] = count as u32;
+                    let v = around[s] as usize;
+                    let (a, b) = (disks.x[u], disks.x[v]);
+                    area += 0.5 * (a[0] * b[1] - b[0] * a[1]);
+                    winding += crossing(a, b, centre);
+                    let k = slot(v, u as u32);
+                    let s_next = if k == start[v] {
+                        start[v + 1] - 1
+                    } else {
+                        k - 1
+                    };
+                    (u, s) = (v, s_next);
+                    if s == s0 {
+                        break;
+                    }
+                }
+                if area > 0.0 && winding != 0 && hole.is_none_or(|(_, a)| area < a) {
+                    hole = Some((count, area));
+                }
+                count += 1;
+            }
+        }
+        let sides = pairs
+            .iter()
+            .map(|&(i, j)| [owner[slot(i as usize, j)], owner[slot(j as usize, i)]])
+            .collect();
+        let faces = Self {
+            pairs: pairs.to_vec(),
+            sides,
+            count,
+        };
+        (faces, hole.map(|h| h.0))
+    }
+
+    /// The two faces of the bond `i`–`j`, if it is one.
+    fn of(&self, i: usize, j: usize) -> Option<[u32; 2]> {
+        let key = (i.min(j) as u32, i.max(j) as u32);
+        self.pairs.binary_search(&key).ok().map(|k| self.sides[k])
+    }
+}
+
+/// The signed crossing of the segment `a → b` with the ray from `c` towards +x: `+1`
+/// upwards, `−1` downwards, `0` if it misses (the winding number is their sum).
+fn crossing(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> i32 {
+    let side = (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]);
+    if a[1] <= c[1] && b[1] > c[1] && side > 0.0 {
+        1
+    } else if a[1] > c[1] && b[1] <= c[1] && side < 0.0 {
+        -1
+    } else {
+        0
+    }
+}
+
 /// The crack connected to a hole wall, grown one broken bond at a time (module docs).
 #[derive(Clone, Debug, PartialEq)]
 pub struct CrackExtent {
     centre: [f64; 2],
-    /// With [`Self::across_pores`]: the bonded neighbours of every disk in
-    /// counter-clockwise order (offsets, items).
-    pores: Option<(Vec<u32>, Vec<u32>)>,
-    /// Parent of every disk; index `n` is the hole.
+    /// Number of disks.
+    disks: usize,
+    /// With [`Self::across_pores`]: the faces of the bond network; the nodes of the
+    /// forest are then the faces, else the disks and the hole.
+    faces: Option<BondFaces>,
+    /// The node of the hole: index `disks`, or the face that holds the hole.
+    hole: usize,
+    /// Parent of every node.
     parent: Vec<u32>,
     /// Size of the tree of every root.
     size: Vec<u32>,
@@ -203,11 +343,14 @@ impl CrackExtent {
         }
         let mut s = Self {
             centre,
-            pores: None,
-            parent: (0..=disks as u32).collect(),
-            size: vec![1; disks + 1],
-            reach: vec![0.0; disks + 1],
+            disks,
+            faces: None,
+            hole: disks,
+            parent: Vec::new(),
+            size: Vec::new(),
+            reach: Vec::new(),
         };
+        s.reset(disks + 1);
         for &i in lining {
             if i >= disks {
                 return Err(LsmError::bad(
@@ -221,14 +364,23 @@ impl CrackExtent {
         Ok(s)
     }
 
-    /// Join cracks across pores: a broken bond also joins every disk of the pores on its
-    /// two sides (the faces of the bond network `bonds` of `disks`, traced in the current
-    /// configuration; faces of more than [`MAX_PORE`] disks, such as the hole or the
-    /// outer surface, are left alone), so that a crack that crosses a pore of four or more
-    /// disks stays one crack (module docs). Errors when `disks` is not the packing of
-    /// [`Self::new`].
+    /// A forest of `nodes` single-node trees.
+    fn reset(&mut self, nodes: usize) {
+        self.parent = (0..nodes as u32).collect();
+        self.size = vec![1; nodes];
+        self.reach = vec![0.0; nodes];
+    }
+
+    /// Join cracks through the faces of the bond network (module docs, "Across pores"):
+    /// the faces of `bonds` (intact or broken, every bond the packing had) between the
+    /// disks of `disks`, traced in their configuration; the hole is the bounded face that
+    /// holds the centre; a broken bond joins the two faces it separates, and the crack
+    /// connected to the hole is the set of broken bonds whose faces are joined to the
+    /// hole's. Replaces the lining of [`Self::new`]. Call before [`Self::add`]. Errors
+    /// when `disks` is not the packing of [`Self::new`], a bond names a disk it does not
+    /// have or joins a disk to itself, or no pore of the network holds the centre.
     pub fn across_pores(mut self, disks: &Disks, bonds: &[Bond]) -> Result<Self, LsmError> {
-        let n = self.parent.len() - 1;
+        let n = self.disks;
         if disks.len() != n {
             return Err(LsmError::bad(
                 "disks",
@@ -236,7 +388,7 @@ impl CrackExtent {
                 "is not the hole's packing",
             ));
         }
-        let mut start = vec![0u32; n + 1];
+        let mut pairs = Vec::with_capacity(bonds.len());
         for b in bonds {
             if b.i as usize >= n || b.j as usize >= n {
                 return Err(LsmError::bad(
@@ -245,60 +397,45 @@ impl CrackExtent {
                     "is not the index of a disk",
                 ));
             }
-            start[b.i as usize + 1] += 1;
-            start[b.j as usize + 1] += 1;
-        }
-        for k in 0..n {
-            start[k + 1] += start[k];
-        }
-        let mut items = vec![0u32; start[n] as usize];
-        let mut next: Vec<u32> = start[..n].to_vec();
-        for b in bonds {
-            for (u, v) in [(b.i, b.j), (b.j, b.i)] {
-                items[next[u as usize] as usize] = v;
-                next[u as usize] += 1;
+            if b.i == b.j {
+                return Err(LsmError::bad("bonds", b.i as f64, "joins a disk to itself"));
             }
+            pairs.push((b.i.min(b.j), b.i.max(b.j)));
         }
-        for u in 0..n {
-            let x = disks.x[u];
-            let angle = |v: &u32| {
-                let y = disks.x[*v as usize];
-                (y[1] - x[1]).atan2(y[0] - x[0])
-            };
-            items[start[u] as usize..start[u + 1] as usize]
-                .sort_by(|a, b| angle(a).total_cmp(&angle(b)));
-        }
-        self.pores = Some((start, items));
+        pairs.sort_unstable();
+        pairs.dedup();
+        let (faces, hole) = BondFaces::trace(disks, &pairs, self.centre);
+        let hole = hole.ok_or(LsmError::bad(
+            "centre",
+            self.centre[0],
+            "lies in no pore of the bond network",
+        ))?;
+        self.reset(faces.count);
+        self.hole = hole;
+        self.faces = Some(faces);
         Ok(self)
     }
 
-    /// The disks of the face left of the directed bond `u → v` (at most [`MAX_PORE`];
-    /// `None` for a larger face or a bond not in the network).
-    fn pore(&self, u: usize, v: usize) -> Option<Vec<u32>> {
-        let (start, items) = self.pores.as_ref()?;
-        let around = |k: usize| &items[start[k] as usize..start[k + 1] as usize];
-        let mut face = vec![u as u32];
-        let (mut a, mut b) = (u, v);
-        for _ in 0..MAX_PORE {
-            if b == u {
-                return Some(face);
-            }
-            face.push(b as u32);
-            // the neighbour of b just clockwise of a: the face stays on the left
-            let nb = around(b);
-            let k = nb.iter().position(|&w| w as usize == a)?;
-            let w = nb[(k + nb.len() - 1) % nb.len()] as usize;
-            (a, b) = (b, w);
+    /// The two nodes the broken bond `i`–`j` joins.
+    fn ends(&self, i: usize, j: usize) -> Result<(usize, usize), LsmError> {
+        match &self.faces {
+            None => Ok((i, j)),
+            Some(f) => f
+                .of(i, j)
+                .map(|s| (s[0] as usize, s[1] as usize))
+                .ok_or(LsmError::bad(
+                    "j",
+                    j as f64,
+                    "is not bonded to i in the bond network",
+                )),
         }
-        None
     }
 
     /// Record the broken bond between disks `i` and `j` that broke at `at` (m); returns
     /// the extent of the crack connected to the hole afterwards.
     pub fn add(&mut self, i: usize, j: usize, at: [f64; 2]) -> Result<f64, LsmError> {
-        let n = self.parent.len() - 1;
         for (name, k) in [("i", i), ("j", j)] {
-            if k >= n {
+            if k >= self.disks {
                 return Err(LsmError::bad(name, k as f64, "is not the index of a disk"));
             }
         }
@@ -306,14 +443,8 @@ impl CrackExtent {
             return Err(LsmError::bad("at", f64::NAN, "must be finite"));
         }
         let d = (at[0] - self.centre[0]).hypot(at[1] - self.centre[1]);
-        for (u, v) in [(i, j), (j, i)] {
-            if let Some(face) = self.pore(u, v) {
-                for k in face {
-                    self.union(i, k as usize);
-                }
-            }
-        }
-        let r = self.union(i, j);
+        let (u, v) = self.ends(i, j)?;
+        let r = self.union(u, v);
         self.reach[r] = self.reach[r].max(d);
         Ok(self.extent())
     }
@@ -321,18 +452,38 @@ impl CrackExtent {
     /// The extent `r_c` of the crack connected to the hole (m from the centre), `0` while
     /// no broken bond is connected to it.
     pub fn extent(&self) -> f64 {
-        let mut k = self.parent.len() - 1;
+        let mut k = self.hole;
         while self.parent[k] as usize != k {
             k = self.parent[k] as usize;
         }
         self.reach[k]
     }
 
-    /// Whether disk `i` (an index below the number of disks) is connected to the hole
-    /// through broken bonds or the lining.
-    pub fn connected(&mut self, i: usize) -> bool {
-        let n = self.parent.len() - 1;
-        i < n && self.find(i) == self.find(n)
+    /// The bonds `(i, j)`, `i < j`, that bound the pore holding the hole (with
+    /// [`Self::across_pores`]; empty otherwise).
+    pub fn hole_pore(&self) -> Vec<(usize, usize)> {
+        let Some(f) = &self.faces else {
+            return Vec::new();
+        };
+        f.pairs
+            .iter()
+            .zip(&f.sides)
+            .filter(|(_, s)| s.iter().any(|&k| k as usize == self.hole))
+            .map(|(&(i, j), _)| (i as usize, j as usize))
+            .collect()
+    }
+
+    /// Whether the broken bond between disks `i` and `j` belongs to the crack connected
+    /// to the hole (false for a pair that is not a bond of [`Self::across_pores`]).
+    pub fn on_crack(&mut self, i: usize, j: usize) -> bool {
+        if i >= self.disks || j >= self.disks {
+            return false;
+        }
+        let Ok((u, v)) = self.ends(i, j) else {
+            return false;
+        };
+        let hole = self.find(self.hole);
+        self.find(u) == hole && self.find(v) == hole
     }
 
     /// Add to `loads` (`[f_x, f_y, torque]` per disk, N/m) the forces of the pressure `p`
@@ -379,7 +530,7 @@ impl CrackExtent {
         loads: &mut [[f64; 3]],
         width: impl Fn(&BrokenBond) -> Result<f64, LsmError>,
     ) -> Result<usize, LsmError> {
-        let n = self.parent.len() - 1;
+        let n = self.disks;
         if disks.len() != n || loads.len() != n {
             return Err(LsmError::bad(
                 "loads",
@@ -390,7 +541,6 @@ impl CrackExtent {
         if !p.is_finite() {
             return Err(LsmError::bad("p", p, "must be finite"));
         }
-        let hole = self.find(n);
         let mut flooded = 0;
         for b in broken {
             if b.i >= n || b.j >= n {
@@ -400,7 +550,7 @@ impl CrackExtent {
                     "is not the index of a disk",
                 ));
             }
-            if self.find(b.i) != hole || self.find(b.j) != hole {
+            if !self.on_crack(b.i, b.j) {
                 continue;
             }
             let (xi, xj) = (disks.x[b.i], disks.x[b.j]);
@@ -465,15 +615,15 @@ mod tests {
         // the chain grows from lining disk 1
         assert!((x.add(1, 3, at(4.5)).unwrap() - 4.5).abs() < 1e-12);
         assert!((x.add(4, 5, at(6.5)).unwrap() - 4.5).abs() < 1e-12);
-        assert!(!x.connected(4));
+        assert!(!x.on_crack(4, 5));
         // the link 3–4 joins the chain 4–5 to the crack
         assert!((x.add(3, 4, at(5.5)).unwrap() - 6.5).abs() < 1e-12);
-        assert!(x.connected(5) && !x.connected(6));
+        assert!(x.on_crack(4, 5) && !x.on_crack(6, 7));
         // a nearer break does not lower the extent
         assert!((x.add(0, 2, at(3.2)).unwrap() - 6.5).abs() < 1e-12);
         // joining the isolated pair brings its reach in
         assert!((x.add(5, 6, at(7.0)).unwrap() - 9.0).abs() < 1e-12);
-        assert!(x.connected(7));
+        assert!(x.on_crack(6, 7));
     }
 
     /// A bond of one lining disk counts (the lining is joined to the hole); a crack
@@ -536,50 +686,185 @@ mod tests {
         assert!(e.to_string().starts_with("p = NaN"), "{e}");
     }
 
-    /// A square pore of four disks 0-1-2-3 (bonded around, no diagonal) between the
-    /// hole's lining disk 0 and the far disks: the crack through bond 0–1 and the crack
-    /// through the opposite bond 2–3 share no disk; across pores they are one crack.
-    #[test]
-    fn a_crack_through_a_four_disk_pore_is_one_crack_across_pores() {
+    /// A hexagonal lattice of spacing 1 around a hole of radius 1.5 at the origin (the
+    /// centre and its six neighbours removed; the hole is lined by a ring of twelve
+    /// disks), bonded between touching disks except the pairs `unbonded`; returns the
+    /// disks, bonds, the index of the disk at a point, and the lining.
+    fn holed_lattice(unbonded: &[([f64; 2], [f64; 2])]) -> (Disks, Vec<Bond>, Vec<usize>) {
         use crate::law::BondLaw;
-        let centres = [
-            [2.0, 0.0],
-            [2.0, 1.0],
-            [3.0, 1.0],
-            [3.0, 0.0],
-            [4.0, 0.0],
-            [4.0, 1.0],
-        ];
-        let disks = Disks::new(&centres, &[0.5; 6], 2600.0).unwrap();
-        let law = BondLaw::elastic(1e9, 1e9, 0.0);
-        let bonds: Vec<Bond> = [(0, 1), (1, 2), (2, 3), (0, 3), (3, 4), (2, 5), (4, 5)]
-            .iter()
-            .map(|&(i, j)| Bond::new(&disks, i, j, &law))
-            .collect();
-        for pores in [false, true] {
-            let mut x = CrackExtent::new(6, &[0], [0.0, 0.5]).unwrap();
-            if pores {
-                x = x.across_pores(&disks, &bonds).unwrap();
-            }
-            x.add(0, 3, [2.5, 0.0]).unwrap();
-            // the bond 2–3 on the far side of the pore
-            let e = x.add(1, 2, [2.5, 1.0]).unwrap();
-            assert!((e - 2.5f64.hypot(0.5)).abs() < 1e-12, "{e}");
-            let e = x.add(4, 5, [4.0, 0.5]).unwrap();
-            if pores {
-                // the pore 2-3-4-5 joins 4-5 to the crack
-                assert!((e - 4.0).abs() < 1e-12, "{e}");
-                assert!(x.connected(5));
-            } else {
-                assert!((e - 2.5f64.hypot(0.5)).abs() < 1e-12, "{e}");
-                assert!(!x.connected(5) && !x.connected(4));
+        let h = 3f64.sqrt() / 2.0;
+        let mut centres = Vec::new();
+        for row in -8i32..=8 {
+            for col in -9i32..=9 {
+                let x = [
+                    col as f64 + 0.5 * (row.rem_euclid(2)) as f64,
+                    row as f64 * h,
+                ];
+                if x[0].hypot(x[1]) > 1.5 {
+                    centres.push(x);
+                }
             }
         }
+        let n = centres.len();
+        let disks = Disks::new(&centres, &vec![0.5; n], 2600.0).unwrap();
+        let law = BondLaw::elastic(1e9, 1e9, 0.0);
+        let near = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]) < 1e-9;
+        let mut bonds = Vec::new();
+        for i in 0..n {
+            for j in i + 1..n {
+                let (a, b) = (centres[i], centres[j]);
+                let skip = unbonded
+                    .iter()
+                    .any(|&(p, q)| (near(a, p) && near(b, q)) || (near(a, q) && near(b, p)));
+                if (a[0] - b[0]).hypot(a[1] - b[1]) < 1.01 && !skip {
+                    bonds.push(Bond::new(&disks, i, j, &law));
+                }
+            }
+        }
+        let lining = (0..n)
+            .filter(|&k| centres[k][0].hypot(centres[k][1]) < 2.01)
+            .collect();
+        (disks, bonds, lining)
+    }
+
+    /// The disk of `disks` at `x`.
+    fn at(disks: &Disks, x: [f64; 2]) -> usize {
+        (0..disks.len())
+            .find(|&k| (disks.x[k][0] - x[0]).hypot(disks.x[k][1] - x[1]) < 1e-9)
+            .unwrap()
+    }
+
+    /// Break the bond between the disks at `p` and `q` (at its midpoint); the extent.
+    fn split(x: &mut CrackExtent, disks: &Disks, p: [f64; 2], q: [f64; 2]) -> f64 {
+        let mid = [0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1])];
+        x.add(at(disks, p), at(disks, q), mid).unwrap()
+    }
+
+    const H: f64 = 0.866_025_403_784_438_6;
+
+    /// Euler's formula for the traced faces of the planar bond network of the holed
+    /// lattice: V − E + F = 2 (one component), the hole is one face of twelve sides.
+    #[test]
+    fn the_faces_of_a_holed_lattice_satisfy_euler() {
+        let (disks, bonds, lining) = holed_lattice(&[]);
+        assert_eq!(lining.len(), 12);
+        let x = CrackExtent::new(disks.len(), &lining, [0.0; 2])
+            .unwrap()
+            .across_pores(&disks, &bonds)
+            .unwrap();
+        let f = x.faces.as_ref().unwrap();
+        let (v, e) = (disks.len() as i64, bonds.len() as i64);
+        assert_eq!(v - e + f.count as i64, 2, "V {v}, E {e}, F {}", f.count);
+        let hole_sides = f
+            .sides
+            .iter()
+            .flatten()
+            .filter(|&&s| s as usize == x.hole)
+            .count();
+        assert_eq!(hole_sides, 12);
+    }
+
+    /// A crack from the wall crosses a pore of four disks (the hole's lining disk L0 at
+    /// (2, 0) not bonded to P at (2.5, h)): the wall bond L0–L1 and the bond P–R on the
+    /// far side of the pore share no disk but open the same face, so they are one crack;
+    /// a broken bond that touches the pore's disk R without bounding the pore is not
+    /// joined. Through shared disks alone the far bond is cut off.
+    #[test]
+    fn a_crack_across_a_four_disk_pore_is_one_crack() {
+        let (l0, l1, p, r, r2) = ([2.0, 0.0], [1.5, H], [2.5, H], [3.0, 0.0], [4.0, 0.0]);
+        let (disks, bonds, lining) = holed_lattice(&[(l0, p)]);
+        let wall = 1.75f64.hypot(0.5 * H);
+        let far = 2.75f64.hypot(0.5 * H);
+        for faces in [true, false] {
+            let mut x = CrackExtent::new(disks.len(), &lining, [0.0; 2]).unwrap();
+            if faces {
+                x = x.across_pores(&disks, &bonds).unwrap();
+            }
+            // a microcrack touching R, outside the pore
+            assert_eq!(split(&mut x, &disks, r, r2), 0.0);
+            assert!((split(&mut x, &disks, l0, l1) - wall).abs() < 1e-12);
+            let e = split(&mut x, &disks, p, r);
+            if faces {
+                assert!((e - far).abs() < 1e-12, "{e}");
+                assert!(x.on_crack(at(&disks, p), at(&disks, r)));
+            } else {
+                assert!((e - wall).abs() < 1e-12, "{e}");
+                assert!(!x.on_crack(at(&disks, p), at(&disks, r)));
+            }
+            assert!(!x.on_crack(at(&disks, r), at(&disks, r2)));
+        }
+    }
+
+    /// Two cracks that share a disk but no face stay two cracks; they join when a broken
+    /// bond opens a face of each. Crack 1: the wall bond L0–L1 and L0–P (both bound the
+    /// triangle L0-L1-P). Crack 2: P–Q, Q = (3.5, h), which touches P but bounds only
+    /// the triangles P-Q-R and P-Q-(3, 2h). The bond P–R bounds L0-P-R (opened by
+    /// crack 1) and P-Q-R (opened by crack 2): breaking it joins them.
+    #[test]
+    fn cracks_that_share_a_disk_but_no_face_are_not_joined() {
+        let (l0, l1, p, q, r) = ([2.0, 0.0], [1.5, H], [2.5, H], [3.5, H], [3.0, 0.0]);
+        let (disks, bonds, lining) = holed_lattice(&[]);
+        let mut x = CrackExtent::new(disks.len(), &lining, [0.0; 2])
+            .unwrap()
+            .across_pores(&disks, &bonds)
+            .unwrap();
+        let wall = 1.75f64.hypot(0.5 * H);
+        assert!((split(&mut x, &disks, l0, l1) - wall).abs() < 1e-12);
+        let mouth = 2.25f64.hypot(0.5 * H);
+        assert!((split(&mut x, &disks, l0, p) - mouth).abs() < 1e-12);
+        assert!((split(&mut x, &disks, p, q) - mouth).abs() < 1e-12);
+        assert!(x.on_crack(at(&disks, l0), at(&disks, p)));
+        assert!(!x.on_crack(at(&disks, p), at(&disks, q)));
+        let e = split(&mut x, &disks, p, r);
+        assert!((e - 3.0f64.hypot(H)).abs() < 1e-12, "{e}");
+        assert!(x.on_crack(at(&disks, p), at(&disks, q)));
+        // a pair that is not a bond of the network is an error, not a crack
+        let e = x.add(at(&disks, l0), at(&disks, q), [0.0; 2]).unwrap_err();
+        assert!(e.to_string().starts_with("j = "), "{e}");
+    }
+
+    /// The dry wall's first break does not reach 2a: microcracks run radially out from
+    /// the lining disk L0 at (2, 0) to (5, 0) (each shares a disk with the next, none a
+    /// face), then the wall bond L0–L1 breaks. Through faces the crack is that one bond,
+    /// 1.80 from the centre (2a = 3); through shared disks the microcracks are already
+    /// the wall's crack, 4.5 from the centre.
+    #[test]
+    fn the_dry_walls_first_break_does_not_reach_2a() {
+        let (disks, bonds, lining) = holed_lattice(&[]);
+        let two_a = 3.0;
+        for faces in [true, false] {
+            let mut x = CrackExtent::new(disks.len(), &lining, [0.0; 2]).unwrap();
+            if faces {
+                x = x.across_pores(&disks, &bonds).unwrap();
+            }
+            let mut e = 0.0;
+            for k in 2..5 {
+                e = split(&mut x, &disks, [k as f64, 0.0], [k as f64 + 1.0, 0.0]);
+            }
+            assert_eq!(e, if faces { 0.0 } else { 4.5 });
+            let first = split(&mut x, &disks, [2.0, 0.0], [1.5, H]);
+            if faces {
+                assert!((first - 1.75f64.hypot(0.5 * H)).abs() < 1e-12 && first < two_a);
+            } else {
+                assert!(first >= two_a, "{first}");
+            }
+        }
+    }
+
+    /// The centre must lie in a pore of the network.
+    #[test]
+    fn a_hole_outside_the_network_is_refused() {
+        let (disks, bonds, lining) = holed_lattice(&[]);
+        let e = CrackExtent::new(disks.len(), &lining, [40.0, 0.0])
+            .unwrap()
+            .across_pores(&disks, &bonds)
+            .unwrap_err();
+        assert!(e.to_string().starts_with("centre = 40"), "{e}");
         let e = CrackExtent::new(5, &[0], [0.0; 2])
             .unwrap()
             .across_pores(&disks, &bonds)
             .unwrap_err();
-        assert!(e.to_string().starts_with("disks = 6"), "{e}");
+        assert!(e.to_string().starts_with("disks = "), "{e}");
     }
 
     /// Faces of a hexagonal lattice of diameter d: every bond's power-diagram face is

@@ -63,7 +63,8 @@ pub struct NotchRamp {
     pub max_pressure: f64,
     /// The crack-face length of a flooded bond.
     pub faces: CrackFaces,
-    /// Join the crack across pores ([`CrackExtent::across_pores`]).
+    /// Trace the crack through the pores it opens, the faces of the bond network
+    /// ([`CrackExtent::across_pores`]).
     pub across_pores: bool,
 }
 

@@ -7,8 +7,9 @@
 //! is the set of disks seen from the hole centre (the rays of
 //! [`porofrac_lsm::WallFaces::Rays`]) in the reference configuration, whatever loads the
 //! wall (rays, wetted faces or fluid), so that every loading is measured alike.
-//! With `[loading] crack_across_pores` the crack also joins across the pores it opens
-//! ([`porofrac_lsm::CrackExtent::across_pores`]).
+//! With `[loading] crack_across_pores` the crack is traced through the faces of the bond
+//! network (the pores) it opens, from the pore that holds the hole
+//! ([`porofrac_lsm::CrackExtent::across_pores`]); the lining then plays no part in it.
 //!
 //! Output: `crack.csv` (`time [s],i,j,pressure [Pa],extent [m]`, one row per broken bond in the order
 //! of `broken.csv`), the scene-wide probe `crack_extent` (m) and the `summary.json` keys
@@ -38,7 +39,7 @@ pub struct CrackLog {
 
 impl CrackLog {
     /// The log of the hole of `centre` and `radius` in the reference configuration of
-    /// `solid`; `across_pores`: the crack joins across the pores it opens
+    /// `solid`; `across_pores`: the crack is traced through the pores it opens
     /// ([`CrackExtent::across_pores`]).
     pub fn new(
         solid: &LatticeSolid,

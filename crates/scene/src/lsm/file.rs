@@ -189,12 +189,13 @@ pub struct LoadingSection {
     /// follows without lag, [`porofrac_lsm::CrackExtent::flood_loads`]; default false).
     #[serde(default)]
     pub flood_cracks: bool,
-    /// The crack connected to the hole wall also joins across the pores it opens: a
-    /// broken bond joins every disk of the pores (faces of the bond network, up to 8
-    /// disks) on its two sides, so a crack that crosses a pore of four or more disks is
-    /// one crack for the breakdown event and for `flood_cracks`
-    /// ([`porofrac_lsm::CrackExtent::across_pores`]; default false: only broken bonds
-    /// that share a disk are joined).
+    /// The crack connected to the hole wall is traced through the pores it opens: the
+    /// pores are the faces of the bond network (disk centres joined by bonds), a broken
+    /// bond opens the two faces it separates, and the crack is the set of broken bonds
+    /// reachable from the pore that holds the hole through opened faces; two broken
+    /// bonds that share a disk but no face are not joined. For the breakdown event and
+    /// for `flood_cracks` ([`porofrac_lsm::CrackExtent::across_pores`]; default false:
+    /// broken bonds that share a disk are joined, the lining disks to the hole).
     #[serde(default)]
     pub crack_across_pores: bool,
 }
