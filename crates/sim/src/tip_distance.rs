@@ -28,12 +28,13 @@
 //!    (a crack of one to a few cells at a wall, or one younger than `r`), there is no
 //!    sample: [`TipReading::Short`]. Otherwise `c` is ahead of the tip when its centroid
 //!    lies no more than half a cell behind the farthest failed centroid of the crack near
-//!    it along `t` and, across it, within the band's nodes near the tip; else it lies
-//!    beside the crack ([`TipReading::Beside`]). This admits the cells around the tip
-//!    that share a face with the last failed cells (on triangles the cell that continues
-//!    the crack face to face may lie a little behind the last centroid); which of them
-//!    the crack enters is left to crack tracking ([`porofrac_frac::tracking`]: face to
-//!    face, across the crack's line).
+//!    it along `t`; else it lies beside the crack ([`TipReading::Beside`]). This admits
+//!    every cell around the tip, those beside the last failed cells too: on a zig-zag
+//!    band of triangles the cell that continues the crack face to face may lie beside
+//!    the last failed triangle (when that triangle ends on a vertex, the cells beyond it
+//!    touch it at a node only). Which of them the crack enters is left to crack tracking
+//!    ([`porofrac_frac::tracking`]: face to face, into a cell the crack's line crosses),
+//!    which the rule therefore needs to keep the band one cell wide.
 //! 3. **The opening at `s*`.** The failed cells with centroids within `h` of `s*` along
 //!    the crack are the band there; its mid-line is the mean of their centroids along `n`,
 //!    `η*`. Their nodes within `1.5 h` of `s*` that also belong to an intact cell are the
@@ -170,7 +171,7 @@ pub fn read_tip<const D: usize>(
     let d = xc - mean;
     let along = d - n * d.dot(&n);
     let rho = along.norm();
-    if !(rho > 1e-9 * h) {
+    if rho <= 1e-9 * h || rho.is_nan() {
         return TipReading::Beside;
     }
     let t = along / rho;
@@ -194,19 +195,8 @@ pub fn read_tip<const D: usize>(
     if s_back > s_star - 0.5 * h {
         return TipReading::Short;
     }
-    // Ahead: not behind the last failed centroid by more than half a cell, and across
-    // within the band's nodes near the tip.
-    let (lo, hi) = crack
-        .iter()
-        .zip(&centroids)
-        .filter(|(_, x)| x.dot(&t) >= s_front - 2.0 * h)
-        .flat_map(|(&g, _)| grid.cell_nodes(g).iter())
-        .map(|&i| grid.node(i).dot(&n))
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), s| {
-            (lo.min(s), hi.max(s))
-        });
-    let off = xc.dot(&n);
-    if xc.dot(&t) <= s_front - 0.5 * h || off <= lo || off >= hi {
+    // Ahead: not behind the last failed centroid by more than half a cell.
+    if xc.dot(&t) <= s_front - 0.5 * h {
         return TipReading::Beside;
     }
     // The band at s*: its mid-line and the nodes of its two faces.

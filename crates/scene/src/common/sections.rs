@@ -714,7 +714,9 @@ pub struct Physics {
     /// the nodes of the band's two faces; docs/hydrofrac/validation.md, "A tip rule at a
     /// fixed distance"). A cell beside a crack is held; a cell next to a crack that does
     /// not yet reach this distance behind it (a crack of a few cells at a wall) fails by
-    /// its tensile strength. Default none: one cell behind the tip.
+    /// its tensile strength. Needs crack_tracking (every cell around a tip is read as
+    /// ahead of it; tracking picks the one the crack enters). Default none: one cell
+    /// behind the tip.
     #[schemars(extend("unit" = "m"))]
     pub tip_sample_distance: Option<f64>,
     /// The pore pressure of a cell never falls below this absolute pressure (the fluid's

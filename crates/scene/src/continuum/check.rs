@@ -247,6 +247,13 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
                 "applies with tip_rule = \"opening\" only",
             ));
         }
+        if s.physics.crack_tracking.is_none() {
+            return Err(ls.error(
+                &k(&["physics", "tip_sample_distance"]),
+                "needs crack_tracking (the rule reads every cell around a tip as ahead of \
+                 it; tracking picks the one the crack enters)",
+            ));
+        }
     }
     if let Some(p) = s.physics.cavitation_pressure {
         if !p.is_finite() {

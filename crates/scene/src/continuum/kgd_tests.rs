@@ -310,10 +310,10 @@ fn the_asymptote_tip_rule_refuses_the_recovered_stress() {
     );
 }
 
-/// `tip_sample_distance` applies to the rule `"opening"` only and must be a positive
-/// length: other uses are refused, naming the key.
+/// `tip_sample_distance` applies to the rule `"opening"` with crack tracking only and
+/// must be a positive length: other uses are refused, naming the key.
 #[test]
-fn the_tip_sample_distance_is_refused_without_the_opening_rule_or_when_not_positive() {
+fn the_tip_sample_distance_is_refused_without_the_opening_rule_and_tracking_or_when_not_positive() {
     let parse = |text: &str| match Scene::parse(text, Path::new("kgd.toml"), LawRegistry::default())
     {
         Ok(_) => None,
@@ -340,9 +340,18 @@ fn the_tip_sample_distance_is_refused_without_the_opening_rule_or_when_not_posit
         let err = parse(&text).expect("a distance that is not positive is refused");
         assert!(err.contains("tip_sample_distance"), "{err}");
     }
-    let good = opening.replace(
+    let untracked = opening.replace(
         "\ntip_rule = \"opening\"\n",
         "\ntip_rule = \"opening\"\ntip_sample_distance = 0.05\n",
+    );
+    let err = parse(&untracked).expect("refused without crack tracking");
+    assert!(
+        err.contains("tip_sample_distance") && err.contains("crack_tracking"),
+        "{err}"
+    );
+    let good = opening.replace(
+        "\ntip_rule = \"opening\"\n",
+        "\ntip_rule = \"opening\"\ntip_sample_distance = 0.05\ncrack_tracking = 45.0\n",
     );
     assert_eq!(parse(&good), None);
 }
