@@ -204,6 +204,18 @@ pub enum TipRule {
     /// cell: the tip cell fails exactly when that `K_I` exceeds `K_Ic`, whatever its own
     /// stress and tensile strength (the strength still governs the cells away from tips).
     Opening(Vec<f64>),
+    /// From the opening at a fixed distance behind the tip, for a crack through
+    /// unstructured cells ([`crate::tip_distance`]): an intact cell ahead of a tip fails
+    /// when that `K_I` exceeds `K_Ic`; one beside a crack is held; one next to a crack
+    /// that does not reach the distance behind it (a crack of a few cells at a wall) fails
+    /// by its tensile strength, as away from cracks. The measure keeps the principal
+    /// directions of the cell's own stress, which crack tracking reads.
+    OpeningAt {
+        /// `E′ = E/(1 − ν²)` (Pa) of every cell.
+        e_prime: Vec<f64>,
+        /// The distance `r` (m) behind the tip where the opening is read.
+        distance: f64,
+    },
     /// From the opening behind the tip read with the regime's tip asymptote
     /// ([`crate::tip_asymptote`]): the front's position and speed follow from the opening
     /// on the back line ([`crate::tip_opening`]), and the tip cell fails when the front
@@ -578,6 +590,8 @@ struct OpeningTips {
     mu_prime: Option<f64>,
     /// The fronts at the end of the last step ([`TipRule::Asymptote`]).
     fronts: crate::tip_asymptote::FrontMemory,
+    /// The distance of [`TipRule::OpeningAt`] (m).
+    distance: Option<f64>,
 }
 
 impl OpeningTips {
@@ -585,9 +599,22 @@ impl OpeningTips {
         grid: &Grid<D>,
         settings: &FractureSettings,
     ) -> FractureResult<Option<Self>> {
+        let mut distance = None;
         let (e_prime, mu_prime) = match &settings.tip {
             TipRule::Stress => return Ok(None),
             TipRule::Opening(e_prime) => (e_prime, None),
+            TipRule::OpeningAt {
+                e_prime,
+                distance: r,
+            } => {
+                if !(r.is_finite() && *r > 0.0) {
+                    return Err(FractureError::Input(format!(
+                        "sample distance of the tip rule must be finite and > 0, got {r}"
+                    )));
+                }
+                distance = Some(*r);
+                (e_prime, None)
+            }
             TipRule::Asymptote { e_prime, mu_prime } => {
                 if !(mu_prime.is_finite() && *mu_prime >= 0.0) {
                     return Err(FractureError::Input(format!(
@@ -631,6 +658,7 @@ impl OpeningTips {
             adjacency: NodeCells::new(grid),
             mu_prime,
             fronts: Default::default(),
+            distance,
         }))
     }
 
@@ -643,6 +671,12 @@ impl OpeningTips {
     /// With [`TipRule::Asymptote`] the utilization is instead `d/r`: the distance `d` from
     /// the back line to the front over the step `dt` against the distance `r` to the tip
     /// ([`crate::tip_asymptote`]).
+    ///
+    /// With [`TipRule::OpeningAt`] the tip cell's own stress is shifted by a multiple of
+    /// `I` (its principal directions kept, for crack tracking) so that its `σ₁` is `u S`,
+    /// the utilization `u` being `K_I/K_Ic` ahead of a tip ([`crate::tip_distance`]),
+    /// `σ₁/σ_t` of the unshifted stress next to a crack too short to sample, and 0 beside
+    /// a crack.
     fn measure<const D: usize>(
         &self,
         grid: &Grid<D>,
@@ -662,6 +696,26 @@ impl OpeningTips {
             let Some(r) = self.tips.tip_radius(c, failed) else {
                 continue;
             };
+            let reference = sigma_t.max(k_ic / (2.0 * std::f64::consts::PI * r).sqrt());
+            if let Some(distance) = self.distance {
+                let sigma_1 = porofrac_law::principal(s).values[0];
+                let utilization = match crate::tip_distance::read_tip(
+                    grid,
+                    &self.adjacency,
+                    failed,
+                    c,
+                    u,
+                    distance,
+                ) {
+                    crate::tip_distance::TipReading::Ahead(sample) => {
+                        sample.stress_intensity(self.e_prime[c]) / k_ic
+                    }
+                    crate::tip_distance::TipReading::Short => sigma_1 / sigma_t,
+                    crate::tip_distance::TipReading::Beside => 0.0,
+                };
+                *s += Tensor::<D>::identity() * (utilization * reference - sigma_1);
+                continue;
+            }
             let k = match self.mu_prime {
                 None => crate::tip_opening::tip_stress_intensity(
                     grid,
@@ -678,7 +732,6 @@ impl OpeningTips {
                         k_ic * (f.position - (s.tip.dot(&s.along) - s.distance)) / s.distance
                     }),
             };
-            let reference = sigma_t.max(k_ic / (2.0 * std::f64::consts::PI * r).sqrt());
             *s = Tensor::<D>::identity() * (k.max(0.0) / k_ic * reference);
         }
         out

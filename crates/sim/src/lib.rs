@@ -79,6 +79,7 @@ pub mod solve;
 pub mod standard;
 mod stress_cache;
 pub mod tip_asymptote;
+pub mod tip_distance;
 pub mod tip_opening;
 
 pub use assembly::{assemble, nodal_loads, nodal_loads_of_cells};

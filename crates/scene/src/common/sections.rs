@@ -708,6 +708,17 @@ pub struct Physics {
     /// docs/hydrofrac/validation.md, "KGD, viscosity-dominated"). Both need
     /// fracture = true, flow = true and failure_stress = "cell".
     pub tip_rule: Option<TipRuleChoice>,
+    /// With tip_rule = "opening": read the opening at this distance behind the tip instead
+    /// of one cell behind it, on a crack through any cells (a zig-zag band of triangles;
+    /// the crack's line fitted through the failed cells' centroids, the opening fitted on
+    /// the nodes of the band's two faces; docs/hydrofrac/validation.md, "A tip rule at a
+    /// fixed distance"). A cell beside a crack is held; a cell next to a crack that does
+    /// not yet reach this distance behind it (a crack of a few cells at a wall) fails by
+    /// its tensile strength. Needs crack_tracking (every cell around a tip is read as
+    /// ahead of it; tracking picks the one the crack enters). Default none: one cell
+    /// behind the tip.
+    #[schemars(extend("unit" = "m"))]
+    pub tip_sample_distance: Option<f64>,
     /// The pore pressure of a cell never falls below this absolute pressure (the fluid's
     /// vapour pressure; default none: unbounded suction). A cell that opens faster than
     /// fluid reaches it (a crack tip ahead of the fluid) stays at it, and the volume it

@@ -239,6 +239,22 @@ pub fn check(ls: &LoadedScene, laws: &LawRegistry) -> Result<(), SceneError> {
     if let Some(kf) = s.physics.fracture_permeability {
         positive(ls, &k(&["physics", "fracture_permeability"]), kf)?;
     }
+    if let Some(r) = s.physics.tip_sample_distance {
+        positive(ls, &k(&["physics", "tip_sample_distance"]), r)?;
+        if s.physics.tip_rule != Some(crate::common::sections::TipRuleChoice::Opening) {
+            return Err(ls.error(
+                &k(&["physics", "tip_sample_distance"]),
+                "applies with tip_rule = \"opening\" only",
+            ));
+        }
+        if s.physics.crack_tracking.is_none() {
+            return Err(ls.error(
+                &k(&["physics", "tip_sample_distance"]),
+                "needs crack_tracking (the rule reads every cell around a tip as ahead of \
+                 it; tracking picks the one the crack enters)",
+            ));
+        }
+    }
     if let Some(p) = s.physics.cavitation_pressure {
         if !p.is_finite() {
             return Err(ls.error(

@@ -309,3 +309,49 @@ fn the_asymptote_tip_rule_refuses_the_recovered_stress() {
         "{err}"
     );
 }
+
+/// `tip_sample_distance` applies to the rule `"opening"` with crack tracking only and
+/// must be a positive length: other uses are refused, naming the key.
+#[test]
+fn the_tip_sample_distance_is_refused_without_the_opening_rule_and_tracking_or_when_not_positive() {
+    let parse = |text: &str| match Scene::parse(text, Path::new("kgd.toml"), LawRegistry::default())
+    {
+        Ok(_) => None,
+        Err(e) => Some(e.to_string()),
+    };
+    let base = include_str!("../../../../scenes/kgd_viscosity.toml");
+    let with_asymptote = base.replace(
+        "\ntip_rule = \"asymptote\"\n",
+        "\ntip_rule = \"asymptote\"\ntip_sample_distance = 0.05\n",
+    );
+    assert!(with_asymptote.contains("tip_sample_distance"));
+    let err = parse(&with_asymptote).expect("refused with the rule \"asymptote\"");
+    assert!(
+        err.contains("tip_sample_distance") && err.contains("\"opening\""),
+        "{err}"
+    );
+    let opening = include_str!("../../../../scenes/kgd_toughness.toml");
+    for bad in ["0.0", "-0.1"] {
+        let text = opening.replace(
+            "\ntip_rule = \"opening\"\n",
+            &format!("\ntip_rule = \"opening\"\ntip_sample_distance = {bad}\n"),
+        );
+        assert!(text.contains("tip_sample_distance"));
+        let err = parse(&text).expect("a distance that is not positive is refused");
+        assert!(err.contains("tip_sample_distance"), "{err}");
+    }
+    let untracked = opening.replace(
+        "\ntip_rule = \"opening\"\n",
+        "\ntip_rule = \"opening\"\ntip_sample_distance = 0.05\n",
+    );
+    let err = parse(&untracked).expect("refused without crack tracking");
+    assert!(
+        err.contains("tip_sample_distance") && err.contains("crack_tracking"),
+        "{err}"
+    );
+    let good = opening.replace(
+        "\ntip_rule = \"opening\"\n",
+        "\ntip_rule = \"opening\"\ntip_sample_distance = 0.05\ncrack_tracking = 45.0\n",
+    );
+    assert_eq!(parse(&good), None);
+}

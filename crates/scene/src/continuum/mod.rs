@@ -994,6 +994,8 @@ fn fracture_settings<const D: usize>(ls: &LoadedScene, comp: &Composition<D>) ->
                     e_prime,
                     mu_prime: 12.0 * s.fluid.as_ref().map_or(0.0, |f| f.viscosity),
                 }
+            } else if let Some(distance) = s.physics.tip_sample_distance {
+                porofrac_sim::TipRule::OpeningAt { e_prime, distance }
             } else {
                 porofrac_sim::TipRule::Opening(e_prime)
             };
