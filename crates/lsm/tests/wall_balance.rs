@@ -27,8 +27,17 @@ fn imbalance(disks: &Disks, w: &PressureWall) -> (f64, f64) {
 }
 
 /// A random packing of radii `r` in the box of half-side `half` (or the disk of radius
-/// `half` when `round`) with a hole of radius `a` at `hole` carved out.
-fn packing(half: f64, round: bool, r: [f64; 2], hole: [f64; 2], a: f64, seed: u64) -> Disks {
+/// `half` when `round`) with a hole of radius `a` at `hole` carved out; `None` when the
+/// generator refuses the recipe (it could not relax the packing: a clear error of the
+/// generator, not a case of the property).
+fn try_packing(
+    half: f64,
+    round: bool,
+    r: [f64; 2],
+    hole: [f64; 2],
+    a: f64,
+    seed: u64,
+) -> Option<Disks> {
     let spec = RandomPacking::new([-half, -half], [half, half], r[0], r[1], 0.8, seed);
     let region = if round {
         Region::Disk {
@@ -49,8 +58,12 @@ fn packing(half: f64, round: bool, r: [f64; 2], hole: [f64; 2], a: f64, seed: u6
                 radius: a,
             }],
         )
-        .unwrap();
-    Disks::new(&p.centres, &p.radii, 2600.0).unwrap()
+        .ok()?;
+    Some(Disks::new(&p.centres, &p.radii, 2600.0).unwrap())
+}
+
+fn packing(half: f64, round: bool, r: [f64; 2], hole: [f64; 2], a: f64, seed: u64) -> Disks {
+    try_packing(half, round, r, hole, a, seed).expect("the packing of a fixed recipe relaxes")
 }
 
 proptest! {
@@ -68,7 +81,9 @@ proptest! {
         ox in -0.5f64..0.5,
         oy in -0.5f64..0.5,
     ) {
-        let d = packing(6.0, false, [r_min, r_min * spread], [hx, hy], a, seed);
+        let d = try_packing(6.0, false, [r_min, r_min * spread], [hx, hy], a, seed);
+        prop_assume!(d.is_some());
+        let d = d.unwrap();
         for centre in [[hx, hy], [hx + ox * a, hy + oy * a]] {
             let w = PressureWall::new(&d, centre, a).unwrap();
             let (f, m) = imbalance(&d, &w);

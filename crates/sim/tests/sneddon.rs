@@ -377,15 +377,12 @@ fn rotated_tip_ratios(n: usize, r: f64) -> (f64, f64, [usize; 2]) {
 /// from the nodes it shares with the band (up to a cell apart between the cells around
 /// one tip). Measured 2026-11-29 over the eight cells read as ahead at each tip:
 /// 0.785–1.056 at n = 10, r = 0.2 a; 0.812–0.978 at n = 20, r = 0.2 a; 0.884–0.986 at
-/// n = 20, r = 0.3 a. Asserted: every estimate within those ranges widened by 1 %, cells
-/// read as ahead at both tips only, and no reading at a distance longer than the crack.
+/// n = 20, r = 0.3 a. Asserted: every estimate within 25 % of `K_I` at 10 cells per
+/// half-length and within 20 % at 20, cells read as ahead at both tips only, and no
+/// reading at a distance longer than the crack.
 #[test]
 fn stress_intensity_at_a_distance_on_a_rotated_crack() {
-    for (n, r, lo_bound, hi_bound) in [
-        (10, 0.2, 0.785, 1.056),
-        (20, 0.2, 0.812, 0.978),
-        (20, 0.3, 0.884, 0.986),
-    ] {
+    for (n, r, tolerance) in [(10, 0.2, 0.25), (20, 0.2, 0.2), (20, 0.3, 0.2)] {
         let (lo, hi, ahead) = rotated_tip_ratios(n, r);
         println!(
             "n = {n}, r = {r} a: K_est / K_I from {lo:.4} to {hi:.4} at {ahead:?} cells ahead"
@@ -395,8 +392,8 @@ fn stress_intensity_at_a_distance_on_a_rotated_crack() {
             "n = {n}: cells ahead of the two tips {ahead:?}"
         );
         assert!(
-            lo >= 0.99 * lo_bound && hi <= 1.01 * hi_bound,
-            "n = {n}, r = {r} a: {lo:.4}–{hi:.4}, measured {lo_bound}–{hi_bound}"
+            (lo - 1.0).abs() <= tolerance && (hi - 1.0).abs() <= tolerance,
+            "n = {n}, r = {r} a: K_est / K_I from {lo:.4} to {hi:.4}, allowed 1 ± {tolerance}"
         );
     }
     let (grid, u, band, _) = opened_rotated_band(10);
