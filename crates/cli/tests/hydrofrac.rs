@@ -578,6 +578,29 @@ fn monolithic_and_explicit_pressure_agree_where_both_apply() {
     }
 }
 
+/// The edits that turn the fluid-lag scene into variant C of docs/hydrofrac/validation.md:
+/// the crack's flow from its opening, the pressure bounded by cavitation, the tip rule
+/// from the asymptote with a rock's toughness (1 MPa·√m) and strength (3 MPa), and the rock
+/// within 0.6 m of the well centre left to its strength.
+const VARIANT_C: [(&str, &str); 3] = [
+    (
+        "[[region]]\nname = \"near_well\"",
+        "[[region]]\nname = \"wall\"\nselect = { circle = { center = [15.0, 15.0], \
+         radius = 0.6 } }\nmaterial = \"wall\"\n\n[[region]]\nname = \"near_well\"",
+    ),
+    (
+        "tensile_strength = 2.0e5\n",
+        "tensile_strength = 3.0e6\nfracture_toughness = 1.0e6\n\n[material.wall]\n\
+         youngs_modulus = 1.0e9\npoisson_ratio = 0.3\nporosity = 0.3\n\
+         permeability = 9.869233e-21\ntensile_strength = 3.0e6\n",
+    ),
+    (
+        "fracture_permeability = 1.0e-12\nfailure_stress = \"recovered\"",
+        "crack_flow = \"cubic-law\"\ntip_rule = \"asymptote\"\n\
+         cavitation_pressure = 2.3e3\nfailure_stress = \"cell\"",
+    ),
+];
+
 /// The scene with fluid lag made physical (the crack's flow from its opening, the
 /// pressure bounded by cavitation, a tip rule from the tip asymptote with a rock's
 /// toughness and strength, the rock next to the well left to its strength): at 2 220 s a
@@ -588,28 +611,7 @@ fn monolithic_and_explicit_pressure_agree_where_both_apply() {
 #[test]
 fn a_fresh_solve_just_above_the_residual_limit_is_refined_not_refused() {
     let dir = tmp_dir("hydrofrac-refined-solve");
-    let scene = variant(
-        &dir,
-        &fluid_lag_scene(),
-        &[
-            (
-                "[[region]]\nname = \"near_well\"",
-                "[[region]]\nname = \"wall\"\nselect = { circle = { center = [15.0, 15.0], \
-                 radius = 0.6 } }\nmaterial = \"wall\"\n\n[[region]]\nname = \"near_well\"",
-            ),
-            (
-                "tensile_strength = 2.0e5\n",
-                "tensile_strength = 3.0e6\nfracture_toughness = 1.0e6\n\n[material.wall]\n\
-                 youngs_modulus = 1.0e9\npoisson_ratio = 0.3\nporosity = 0.3\n\
-                 permeability = 9.869233e-21\ntensile_strength = 3.0e6\n",
-            ),
-            (
-                "fracture_permeability = 1.0e-12\nfailure_stress = \"recovered\"",
-                "crack_flow = \"cubic-law\"\ntip_rule = \"asymptote\"\n\
-                 cavitation_pressure = 2.3e3\nfailure_stress = \"cell\"",
-            ),
-        ],
-    );
+    let scene = variant(&dir, &fluid_lag_scene(), &VARIANT_C);
     let out = dir.join("out");
     run_ok(&scene, &out);
     let s = summary(&out);
@@ -633,25 +635,7 @@ fn a_crack_row_of_a_far_larger_scale_is_judged_in_the_scaled_system() {
     let scene = variant(
         &dir,
         &text,
-        &[
-            (
-                "[[region]]\nname = \"near_well\"",
-                "[[region]]\nname = \"wall\"\nselect = { circle = { center = [15.0, 15.0], \
-                 radius = 0.6 } }\nmaterial = \"wall\"\n\n[[region]]\nname = \"near_well\"",
-            ),
-            (
-                "tensile_strength = 2.0e5\n",
-                "tensile_strength = 3.0e6\nfracture_toughness = 1.0e6\n\n[material.wall]\n\
-                 youngs_modulus = 1.0e9\npoisson_ratio = 0.3\nporosity = 0.3\n\
-                 permeability = 9.869233e-21\ntensile_strength = 3.0e6\n",
-            ),
-            (
-                "fracture_permeability = 1.0e-12\nfailure_stress = \"recovered\"",
-                "crack_flow = \"cubic-law\"\ntip_rule = \"asymptote\"\n\
-                 cavitation_pressure = 2.3e3\nfailure_stress = \"cell\"",
-            ),
-            ("refine = 12 ", "refine = 17 #"),
-        ],
+        &[VARIANT_C.as_slice(), &[("refine = 12 ", "refine = 17 #")]].concat(),
     );
     let out = dir.join("out");
     run_ok(&scene, &out);
