@@ -102,6 +102,16 @@ fn max_diff(a: &[f64], b: &[f64]) -> f64 {
         .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
 }
 
+/// The largest change of the displacement between two states, relative to the largest
+/// displacement of `a`, and of the pressure, relative to the largest pressure change of
+/// `a` from `initial`.
+fn relative_changes(a: &BiotState, b: &BiotState, initial: &[f64]) -> (f64, f64) {
+    let du = max_diff(&a.displacement, &b.displacement) / max_abs(&a.displacement);
+    let dp0: Vec<f64> = a.pressure.iter().zip(initial).map(|(p, q)| p - q).collect();
+    let dp = max_diff(&a.pressure, &b.pressure) / max_abs(&dp0);
+    (du, dp)
+}
+
 /// A small non-trivial problem: perturbed cells, a load on half the top, a drained
 /// `xmax` side with a varying pressure, a non-uniform `p₀` and α.
 fn small<const D: usize>(n: usize) -> Setup<D> {
@@ -237,14 +247,7 @@ fn scaling<const D: usize>(n: usize) {
         for f in [1e-3, 1e3] {
             let other = march(sys, &mut Monolithic::new(sys, Some(s0 * f)).unwrap());
             for (a, b) in reference.iter().zip(&other) {
-                let du = max_diff(&a.displacement, &b.displacement) / max_abs(&a.displacement);
-                let dp0: Vec<f64> = a
-                    .pressure
-                    .iter()
-                    .zip(sys.initial_pressure())
-                    .map(|(p, q)| p - q)
-                    .collect();
-                let dp = max_diff(&a.pressure, &b.pressure) / max_abs(&dp0);
+                let (du, dp) = relative_changes(a, b, sys.initial_pressure());
                 println!("{D}D scale s0 = {s0:.3e} × {f:e}: du {du:.1e}, dp {dp:.1e}");
                 assert!(
                     du < 1e-10 && dp < 1e-10,
@@ -336,14 +339,7 @@ fn crack_band<const D: usize>(n: usize) {
         }
         for f in [1e-3, 1e3] {
             for (a, b) in reference.iter().zip(&run(s0 * f)) {
-                let du = max_diff(&a.displacement, &b.displacement) / max_abs(&a.displacement);
-                let dp0: Vec<f64> = a
-                    .pressure
-                    .iter()
-                    .zip(sys.initial_pressure())
-                    .map(|(p, q)| p - q)
-                    .collect();
-                let dp = max_diff(&a.pressure, &b.pressure) / max_abs(&dp0);
+                let (du, dp) = relative_changes(a, b, sys.initial_pressure());
                 println!("{D}D crack band, scale × {f:e}: du {du:.1e}, dp {dp:.1e}");
                 assert!(du < 1e-8 && dp < 1e-8, "{D}D ×{f}: du {du:.2e} dp {dp:.2e}");
             }
