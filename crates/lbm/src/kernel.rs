@@ -109,6 +109,15 @@ impl Grid {
             Layout::Swapped => OPP[i] * self.np() + self.shift(node, OPP[i]),
         }
     }
+    /// Slot and padded node where `f_i(node)` is stored in `layout` ([`Grid::loc`] is
+    /// `slot · np + node` of these).
+    #[inline(always)]
+    pub(crate) fn slot(&self, layout: Layout, node: usize, i: usize) -> (usize, usize) {
+        match layout {
+            Layout::Natural => (i, node),
+            Layout::Swapped => (OPP[i], self.shift(node, OPP[i])),
+        }
+    }
 }
 
 /// What the kernel applies at every node.
@@ -126,6 +135,55 @@ fn band_rows(ny: usize) -> usize {
     ny.div_ceil(4 * t).max(1)
 }
 
+/// The row bands a step of an `ny`-row lattice runs in parallel, as `(first row, rows)`
+/// in interior rows, in the order [`aa_step_hooked`] hands them their hooks.
+pub(crate) fn band_ranges(ny: usize) -> Vec<(usize, usize)> {
+    let rows = band_rows(ny);
+    (0..ny)
+        .step_by(rows)
+        .map(|row0| (row0, rows.min(ny - row0)))
+        .collect()
+}
+
+/// Work a band of a step does on its own rows as soon as they are final.
+///
+/// Every location of the array is read and written in a step by one node only: node `x`
+/// by `A[x][j]` in an even step, by `A[x + c_j][j]` in an odd one (module docs); call it
+/// the location's node. After the band has stepped its rows `row0 ..= last` (interior
+/// rows), every location whose node lies in those rows holds its value after the step,
+/// no later row touches it, and it lies in the band's slices. [`BandHook::rows_done`] is
+/// called after every row with the band's view of the array.
+pub(crate) trait BandHook<T>: Send {
+    /// Rows `row0 ..= last` of the band are stepped.
+    fn rows_done(&mut self, last: usize, view: &mut BandView<'_, '_, T>);
+}
+
+/// No work between rows.
+impl<T> BandHook<T> for () {
+    #[inline(always)]
+    fn rows_done(&mut self, _last: usize, _view: &mut BandView<'_, '_, T>) {}
+}
+
+/// A band's slices of the population array, addressed by slot and padded node.
+pub(crate) struct BandView<'s, 'a, T> {
+    s: &'s mut [&'a mut [T]; 9],
+    /// Padded node of the first element of each slot's slice.
+    start: [usize; 9],
+}
+
+impl<T: Storage> BandView<'_, '_, T> {
+    /// `f` in slot `q` of padded node `node` (a location whose node is in the band).
+    #[inline(always)]
+    pub(crate) fn get(&self, q: usize, node: usize) -> f64 {
+        self.s[q][node - self.start[q]].load(W[q])
+    }
+    /// Set slot `q` of padded node `node` to `f`.
+    #[inline(always)]
+    pub(crate) fn set(&mut self, q: usize, node: usize, f: f64) {
+        self.s[q][node - self.start[q]] = T::store(f, W[q]);
+    }
+}
+
 /// Split the nine direction slices of `pop` into row bands; direction `j` of band `b`
 /// starts at padded row `1 + row0 + shift(j)`.
 #[allow(clippy::type_complexity)]
@@ -140,11 +198,9 @@ fn bands<'a, T>(
         .enumerate()
         .map(|(j, s)| &mut s[shift(j) * w..])
         .collect();
-    let rows = band_rows(g.ny);
-    let mut out = Vec::with_capacity(g.ny.div_ceil(rows));
-    let mut row0 = 0;
-    while row0 < g.ny {
-        let n = rows.min(g.ny - row0);
+    let ranges = band_ranges(g.ny);
+    let mut out = Vec::with_capacity(ranges.len());
+    for (row0, n) in ranges {
         let slices: [&'a mut [T]; 9] = std::array::from_fn(|j| {
             let s = std::mem::take(&mut rest[j]);
             let (head, tail) = s.split_at_mut(n * w);
@@ -152,7 +208,6 @@ fn bands<'a, T>(
             head
         });
         out.push((row0, n, slices));
-        row0 += n;
     }
     out
 }
@@ -168,7 +223,15 @@ pub fn aa_step<T: Storage>(
     mask: Option<&[u8]>,
     phys: Physics,
 ) -> Layout {
-    aa_dispatch(pop, g, layout, mask, None, phys)
+    aa_dispatch(
+        pop,
+        g,
+        layout,
+        mask,
+        None,
+        phys,
+        vec![(); band_ranges(g.ny).len()],
+    )
 }
 
 /// [`aa_step`] over the segments of `runs` only (built from `mask`, see [`crate::runs`]):
@@ -182,28 +245,51 @@ pub fn aa_step_runs<T: Storage>(
     runs: &FluidRuns,
     phys: Physics,
 ) -> Layout {
-    aa_dispatch(pop, g, layout, Some(mask), Some(runs), phys)
+    aa_dispatch(
+        pop,
+        g,
+        layout,
+        Some(mask),
+        Some(runs),
+        phys,
+        vec![(); band_ranges(g.ny).len()],
+    )
 }
 
-fn aa_dispatch<T: Storage>(
+/// [`aa_step`] (with `runs`: [`aa_step_runs`]) that hands each band of [`band_ranges`]
+/// its hook (`hooks[b]` for band `b`), called after every row of the band.
+pub(crate) fn aa_step_hooked<T: Storage, H: BandHook<T>>(
+    pop: &mut [T],
+    g: Grid,
+    layout: Layout,
+    mask: &[u8],
+    runs: Option<&FluidRuns>,
+    phys: Physics,
+    hooks: Vec<H>,
+) -> Layout {
+    aa_dispatch(pop, g, layout, Some(mask), runs, phys, hooks)
+}
+
+fn aa_dispatch<T: Storage, H: BandHook<T>>(
     pop: &mut [T],
     g: Grid,
     layout: Layout,
     mask: Option<&[u8]>,
     runs: Option<&FluidRuns>,
     phys: Physics,
+    hooks: Vec<H>,
 ) -> Layout {
     let force = phys.accel != [0.0, 0.0];
-    let r = runs;
+    let (r, h) = (runs, hooks);
     match (layout, mask, force) {
-        (Layout::Natural, None, false) => aa::<T, false, false, false>(pop, g, &[], r, phys),
-        (Layout::Natural, Some(m), false) => aa::<T, false, true, false>(pop, g, m, r, phys),
-        (Layout::Swapped, None, false) => aa::<T, true, false, false>(pop, g, &[], r, phys),
-        (Layout::Swapped, Some(m), false) => aa::<T, true, true, false>(pop, g, m, r, phys),
-        (Layout::Natural, None, true) => aa::<T, false, false, true>(pop, g, &[], r, phys),
-        (Layout::Natural, Some(m), true) => aa::<T, false, true, true>(pop, g, m, r, phys),
-        (Layout::Swapped, None, true) => aa::<T, true, false, true>(pop, g, &[], r, phys),
-        (Layout::Swapped, Some(m), true) => aa::<T, true, true, true>(pop, g, m, r, phys),
+        (Layout::Natural, None, false) => aa::<T, H, false, false, false>(pop, g, &[], r, phys, h),
+        (Layout::Natural, Some(m), false) => aa::<T, H, false, true, false>(pop, g, m, r, phys, h),
+        (Layout::Swapped, None, false) => aa::<T, H, true, false, false>(pop, g, &[], r, phys, h),
+        (Layout::Swapped, Some(m), false) => aa::<T, H, true, true, false>(pop, g, m, r, phys, h),
+        (Layout::Natural, None, true) => aa::<T, H, false, false, true>(pop, g, &[], r, phys, h),
+        (Layout::Natural, Some(m), true) => aa::<T, H, false, true, true>(pop, g, m, r, phys, h),
+        (Layout::Swapped, None, true) => aa::<T, H, true, false, true>(pop, g, &[], r, phys, h),
+        (Layout::Swapped, Some(m), true) => aa::<T, H, true, true, true>(pop, g, m, r, phys, h),
     }
     match layout {
         Layout::Natural => Layout::Swapped,
@@ -211,36 +297,46 @@ fn aa_dispatch<T: Storage>(
     }
 }
 
-fn aa<T: Storage, const ODD: bool, const MASK: bool, const FORCE: bool>(
+fn aa<T: Storage, H: BandHook<T>, const ODD: bool, const MASK: bool, const FORCE: bool>(
     pop: &mut [T],
     g: Grid,
     mask: &[u8],
     runs: Option<&FluidRuns>,
     phys: Physics,
+    hooks: Vec<H>,
 ) {
     let w = g.stride();
     let nx = g.nx;
-    let bands = bands(pop, g, |j| if ODD { (1 + C[j][1]) as usize } else { 1 });
+    let shift = |j: usize| if ODD { (1 + C[j][1]) as usize } else { 1 };
+    let bands = bands(pop, g, shift);
+    assert_eq!(bands.len(), hooks.len(), "one hook per band");
     let arch = pulp::Arch::new();
-    bands.into_par_iter().for_each(|(row0, n, s)| {
-        arch.dispatch(AaBand::<T, ODD, MASK, FORCE> {
-            s,
-            row0,
-            n,
-            w,
-            nx,
-            mask,
-            runs,
-            phys,
+    bands
+        .into_par_iter()
+        .zip(hooks)
+        .for_each(|((row0, n, s), hook)| {
+            arch.dispatch(AaBand::<T, H, ODD, MASK, FORCE> {
+                s,
+                start: std::array::from_fn(|j| (shift(j) + row0) * w),
+                row0,
+                n,
+                w,
+                nx,
+                mask,
+                runs,
+                phys,
+                hook,
+            });
         });
-    });
 }
 
 /// One band of an AA step, compiled for the widest vector instructions of the processor
 /// (`pulp` picks AVX2 or plain code at run time; the arithmetic is the same, so are the
 /// results).
-struct AaBand<'a, T, const ODD: bool, const MASK: bool, const FORCE: bool> {
+struct AaBand<'a, T, H, const ODD: bool, const MASK: bool, const FORCE: bool> {
     s: [&'a mut [T]; 9],
+    /// Padded node of the first element of each slice.
+    start: [usize; 9],
     row0: usize,
     n: usize,
     w: usize,
@@ -249,16 +345,18 @@ struct AaBand<'a, T, const ODD: bool, const MASK: bool, const FORCE: bool> {
     /// With `MASK`: visit only the segments of each row.
     runs: Option<&'a FluidRuns>,
     phys: Physics,
+    hook: H,
 }
 
-impl<T: Storage, const ODD: bool, const MASK: bool, const FORCE: bool> pulp::WithSimd
-    for AaBand<'_, T, ODD, MASK, FORCE>
+impl<T: Storage, H: BandHook<T>, const ODD: bool, const MASK: bool, const FORCE: bool>
+    pulp::WithSimd for AaBand<'_, T, H, ODD, MASK, FORCE>
 {
     type Output = ();
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, _simd: S) {
         let AaBand {
             mut s,
+            start,
             row0,
             n,
             w,
@@ -266,8 +364,12 @@ impl<T: Storage, const ODD: bool, const MASK: bool, const FORCE: bool> pulp::Wit
             mask,
             runs,
             phys,
+            mut hook,
         } = self;
         for r in 0..n {
+            if r > 0 {
+                hook.rows_done(row0 + r - 1, &mut BandView { s: &mut s, start });
+            }
             let m = if MASK {
                 &mask[(row0 + r + 1) * w + 1..][..nx]
             } else {
@@ -315,6 +417,7 @@ impl<T: Storage, const ODD: bool, const MASK: bool, const FORCE: bool> pulp::Wit
                 phys,
             );
         }
+        hook.rows_done(row0 + n - 1, &mut BandView { s: &mut s, start });
     }
 }
 

@@ -55,7 +55,7 @@ use crate::boundary::{
 use crate::collision::{Collision, Rates};
 use crate::d2q9::{C, OPP, Q, W, cf, feq};
 use crate::geometry::Shape;
-use crate::kernel::{Grid, Layout, Physics};
+use crate::kernel::{BandHook, BandView, Grid, Layout, Physics, Storage};
 use crate::populations::{Populations, Precision};
 use crate::runs::{DEFAULT_GAP, FluidRuns};
 
@@ -236,6 +236,14 @@ pub struct Lattice {
     links: Vec<Vec<ObstacleLink>>,
     /// Unknowns of each obstacle's cut links in the current step (scratch).
     backs: Vec<Vec<f64>>,
+    /// Per obstacle: the first and last interior row of its cut links' fluid nodes, or
+    /// `None` if it has none or one lies within two nodes of the box's edge.
+    link_rows: Vec<Option<(u32, u32)>>,
+    /// Whether obstacles' rules run inside the stream–collide sweep where they can
+    /// ([`Lattice::set_rules_in_sweep`]).
+    rules_in_sweep: bool,
+    /// Scratch of the rules run inside the sweep.
+    in_sweep: InSweep,
     forces: Vec<[f64; 3]>,
     exchange: Vec<[f64; 3]>,
     motion: ObstacleMotion,
@@ -317,6 +325,9 @@ impl Lattice {
             solid_nodes: Vec::new(),
             links: Vec::new(),
             backs: Vec::new(),
+            link_rows: Vec::new(),
+            rules_in_sweep: true,
+            in_sweep: InSweep::default(),
             forces: Vec::new(),
             exchange: Vec::new(),
             motion: ObstacleMotion::Integrated,
@@ -545,6 +556,7 @@ impl Lattice {
         self.solid_nodes.push(Vec::new());
         self.contact.push(None);
         self.links.push(Vec::new());
+        self.link_rows.push(None);
         self.forces.push([0.0; 3]);
         self.exchange.push([0.0; 3]);
         self.scratch.moved.push(true);
@@ -906,14 +918,12 @@ impl Lattice {
         self.visited = self.grid.nx * self.grid.ny;
         self.layout = if self.obstacles.is_empty() {
             self.pop.aa_step(self.grid, self.layout, None, phys)
-        } else if self.skip_solid {
-            self.runs.refresh(&self.mask);
-            self.visited = self.runs.visited_nodes();
-            self.pop
-                .aa_step_runs(self.grid, self.layout, &self.mask, &self.runs, phys)
         } else {
-            self.pop
-                .aa_step(self.grid, self.layout, Some(&self.mask), phys)
+            if self.skip_solid {
+                self.runs.refresh(&self.mask);
+                self.visited = self.runs.visited_nodes();
+            }
+            self.step_with_rules(phys)
         };
         self.apply_copies();
         self.apply_sides();
@@ -1100,88 +1110,135 @@ impl Lattice {
         }
     }
 
-    /// The obstacle rules, in two passes: every obstacle's unknowns and force in parallel
-    /// (a rule reads no unknown of another rule, see [`crate::boundary`]), then the
-    /// unknowns written back.
+    /// The stream–collide step of a lattice with obstacles (over the segments of
+    /// [`crate::runs`] with `skip_solid`). Each band of the parallel sweep
+    /// ([`crate::kernel::band_ranges`]) applies the rules of the obstacles whose cut links
+    /// lie in it, a row from either end, as soon as what they read is final: the
+    /// populations are still in cache. The rule of a link reads and writes four
+    /// locations, those the sweep gives the nodes `x_f`, `x_f2` and `x_b` (see
+    /// [`crate::kernel::BandHook`]), so it may run once the row after the link's is
+    /// stepped. What a rule reads and writes, and the
+    /// order of its sums, are those of [`Lattice::apply_obstacles`], which does the other
+    /// obstacles after the sweep; no rule reads another's unknown, and a body two nodes
+    /// from the box's edge reads nothing the sides' rules write, so the bits are those of
+    /// applying every rule after the sweep. Returns the layout after the step.
+    fn step_with_rules(&mut self, phys: Physics) -> Layout {
+        let (g, lay) = (self.grid, self.layout);
+        let runs = self.skip_solid.then_some(&self.runs);
+        let ranges = crate::kernel::band_ranges(g.ny);
+        let rule = self.rule_kind();
+        let plan = &mut self.in_sweep;
+        plan.fused.clear();
+        plan.fused.resize(self.obstacles.len(), false);
+        plan.bodies.resize_with(ranges.len(), Vec::new);
+        plan.forces.resize_with(ranges.len(), Vec::new);
+        plan.backs.resize_with(ranges.len(), Vec::new);
+        for b in plan.bodies.iter_mut() {
+            b.clear();
+        }
+        if self.rules_in_sweep {
+            let rows = ranges[0].1;
+            for (k, r) in self.link_rows.iter().enumerate() {
+                let Some((lo, hi)) = *r else { continue };
+                let (lo, hi) = (lo as usize, hi as usize);
+                let b = lo / rows;
+                let (row0, n) = ranges[b];
+                // a rule of a link at row j touches what the nodes x_f, x_f2 and x_b of
+                // rows j − 1 ..= j + 1 touch in the sweep: final once row hi + 1 is stepped
+                if lo > row0 && hi + 1 < row0 + n {
+                    plan.bodies[b].push(((hi + 1) as u32, k as u32));
+                    plan.fused[k] = true;
+                }
+            }
+        }
+        let new_layout = match lay {
+            Layout::Natural => Layout::Swapped,
+            Layout::Swapped => Layout::Natural,
+        };
+        let hooks: Vec<RulesInBand<'_>> = plan
+            .bodies
+            .iter_mut()
+            .zip(plan.forces.iter_mut())
+            .zip(plan.backs.iter_mut())
+            .map(|((bodies, forces), back)| {
+                bodies.sort_unstable();
+                forces.clear();
+                RulesInBand {
+                    bodies,
+                    next: 0,
+                    obstacles: &self.obstacles,
+                    links: &self.links,
+                    g,
+                    lay: new_layout,
+                    rule,
+                    back,
+                    forces,
+                }
+            })
+            .collect();
+        let out = self
+            .pop
+            .aa_step_hooked(g, lay, &self.mask, runs, phys, hooks);
+        for band in &self.in_sweep.forces {
+            for &(k, f) in band {
+                self.forces[k as usize] = f;
+            }
+        }
+        out
+    }
+
+    /// Whether the obstacles' rules run inside the stream–collide sweep wherever they can
+    /// (default `true`) or all after it. The results are the same to the bit either way
+    /// (see [`Lattice::step`]); only the time differs.
+    pub fn set_rules_in_sweep(&mut self, on: bool) {
+        self.rules_in_sweep = on;
+    }
+
+    /// How many obstacles' rules the last step ran inside the sweep (the others ran
+    /// after it).
+    pub fn obstacles_in_sweep(&self) -> usize {
+        self.in_sweep.fused.iter().filter(|&&f| f).count()
+    }
+
+    fn rule_kind(&self) -> RuleKind {
+        RuleKind {
+            galilean: self.cfg.momentum_exchange == MomentumExchange::GalileanInvariant,
+            conserve: self.cfg.obstacle_mass == ObstacleMass::Conserved,
+        }
+    }
+
+    /// The rules of the obstacles not done inside the sweep, in two passes: every
+    /// obstacle's unknowns and force in parallel (a rule reads no unknown of another
+    /// rule, see [`crate::boundary`]), then the unknowns written back.
     fn apply_obstacles(&mut self) {
         use rayon::prelude::*;
         let (g, lay) = (self.grid, self.layout);
-        let gi = self.cfg.momentum_exchange == MomentumExchange::GalileanInvariant;
-        let conserve = self.cfg.obstacle_mass == ObstacleMass::Conserved;
+        let np = g.np();
+        let rule = self.rule_kind();
         let mut backs = std::mem::take(&mut self.backs);
         backs.resize_with(self.links.len(), Vec::new);
         let pop = &self.pop;
         let obstacles = &self.obstacles;
+        let fused = &self.in_sweep.fused;
+        let done = |k: usize| fused.get(k).copied().unwrap_or(false);
         self.forces
             .par_iter_mut()
             .zip(backs.par_iter_mut())
             .zip(self.links.par_iter())
             .enumerate()
             .for_each(|(k, ((force, back_k), links))| {
-                let ob = &obstacles[k];
-                let c = ob.shape.center();
-                let mut f = [0.0; 3];
-                back_k.clear();
-                // what the rules return, and the mass they create: Σ (back − into)
-                let (mut gained, mut weights) = (0.0, 0.0);
-                for l in links {
-                    let a = l.alpha as usize;
-                    let i = OPP[a];
-                    let xf = l.node as usize;
-                    let uw = ob.velocity_at(l.xw);
-                    let ca = cf(a);
-                    let wall = 6.0 * W[a] * (ca[0] * uw[0] + ca[1] * uw[1]);
-                    let into = pop.get(g.loc(lay, g.shift(xf, a), a));
-                    let back = if l.f2 == NONE {
-                        into - wall
-                    } else {
-                        let d = l.delta;
-                        ((1.0 - d) * pop.get(g.loc(lay, xf, a))
-                            + d * into
-                            + d * pop.get(g.loc(lay, l.f2 as usize, i))
-                            - wall)
-                            / (1.0 + d)
-                    };
-                    gained += back - into;
-                    weights += W[a];
-                    back_k.push(back);
+                if done(k) {
+                    back_k.clear();
+                    return;
                 }
-                if conserve && weights > 0.0 {
-                    // no net flux through a rigid surface: the mass the rules created
-                    // goes back, shared by the links in proportion to their weights
-                    let per_weight = gained / weights;
-                    for (l, back) in links.iter().zip(back_k.iter_mut()) {
-                        *back -= per_weight * W[l.alpha as usize];
-                    }
-                }
-                for (l, &back) in links.iter().zip(back_k.iter()) {
-                    let a = l.alpha as usize;
-                    let xf = l.node as usize;
-                    let uw = ob.velocity_at(l.xw);
-                    let ca = cf(a);
-                    let into = pop.get(g.loc(lay, g.shift(xf, a), a));
-                    // the reference density's share, 2 w_α ρ₀ c_α: only gauge pressure
-                    // loads the body (zero for a body wetted all round)
-                    let amb = 2.0 * W[a];
-                    let df = if gi {
-                        [
-                            (ca[0] - uw[0]) * into - (-ca[0] - uw[0]) * back - amb * ca[0],
-                            (ca[1] - uw[1]) * into - (-ca[1] - uw[1]) * back - amb * ca[1],
-                        ]
-                    } else {
-                        [ca[0] * (into + back - amb), ca[1] * (into + back - amb)]
-                    };
-                    let r = [l.xw[0] - c[0], l.xw[1] - c[1]];
-                    f[0] += df[0];
-                    f[1] += df[1];
-                    f[2] += r[0] * df[1] - r[1] * df[0];
-                }
-                *force = f;
+                *force = obstacle_rules(g, lay, &obstacles[k], links, rule, back_k, |(q, n)| {
+                    pop.get_slot(np, q, n)
+                });
             });
         for (links, back_k) in self.links.iter().zip(&backs) {
             for (l, &b) in links.iter().zip(back_k) {
-                self.pop
-                    .set(g.loc(lay, l.node as usize, OPP[l.alpha as usize]), b);
+                let (q, n) = g.slot(lay, l.node as usize, OPP[l.alpha as usize]);
+                self.pop.set_slot(np, q, n, b);
             }
         }
         self.backs = backs;
@@ -1497,6 +1554,9 @@ impl Lattice {
         }
         self.links = links;
         for (k, w) in work.iter().enumerate() {
+            if *w == LinkWork::Rebuild {
+                self.link_rows[k] = self.rows_of_links(k);
+            }
             if *w != LinkWork::Keep {
                 self.scratch.linked_at[k] = self.obstacles[k].shape;
             }
@@ -1554,6 +1614,23 @@ impl Lattice {
         }
     }
 
+    /// The first and last interior row of obstacle `k`'s cut links' fluid nodes; `None`
+    /// if it has no link or one lies within two nodes of the box's edge (where the
+    /// sides' rules and the periodic copies act).
+    fn rows_of_links(&self, k: usize) -> Option<(u32, u32)> {
+        let (nx, ny) = (self.grid.nx as isize, self.grid.ny as isize);
+        let mut rows: Option<(u32, u32)> = None;
+        for l in &self.links[k] {
+            let (i, j) = self.ij(l.node as usize);
+            if i < 2 || j < 2 || i > nx - 3 || j > ny - 3 {
+                return None;
+            }
+            let j = j as u32;
+            rows = Some(rows.map_or((j, j), |(lo, hi)| (lo.min(j), hi.max(j))));
+        }
+        rows
+    }
+
     /// The cut links of obstacle `k`: fluid node `(i, j)`, direction `α` into the body and
     /// `δ` (Mora et al. (2015) eq. 6).
     pub fn cut_links_of(&self, k: usize) -> impl Iterator<Item = (usize, usize, usize, f64)> + '_ {
@@ -1579,5 +1656,145 @@ fn moved_by(a: &Shape, b: &Shape) -> f64 {
             d + (x - y).abs() * (half[0] * half[0] + half[1] * half[1]).sqrt()
         }
         _ => d,
+    }
+}
+
+/// The variant of the obstacle rules in use.
+#[derive(Clone, Copy, Debug)]
+struct RuleKind {
+    /// Galilean-invariant momentum exchange.
+    galilean: bool,
+    /// Each body's cut links create no mass ([`ObstacleMass::Conserved`]).
+    conserve: bool,
+}
+
+/// The rules of one obstacle's cut links ([`crate::boundary`]): their unknowns into
+/// `back`, in the order of `links`, and the force and torque the fluid exerts on the
+/// body. `get((slot, node))` reads the populations after the stream–collide step, in
+/// layout `lay`.
+#[inline(always)]
+fn obstacle_rules(
+    g: Grid,
+    lay: Layout,
+    ob: &Obstacle,
+    links: &[ObstacleLink],
+    rule: RuleKind,
+    back: &mut Vec<f64>,
+    get: impl Fn((usize, usize)) -> f64,
+) -> [f64; 3] {
+    let c = ob.shape.center();
+    let mut f = [0.0; 3];
+    back.clear();
+    // what the rules return, and the mass they create: Σ (back − into)
+    let (mut gained, mut weights) = (0.0, 0.0);
+    for l in links {
+        let a = l.alpha as usize;
+        let i = OPP[a];
+        let xf = l.node as usize;
+        let uw = ob.velocity_at(l.xw);
+        let ca = cf(a);
+        let wall = 6.0 * W[a] * (ca[0] * uw[0] + ca[1] * uw[1]);
+        let into = get(g.slot(lay, g.shift(xf, a), a));
+        let b = if l.f2 == NONE {
+            into - wall
+        } else {
+            let d = l.delta;
+            ((1.0 - d) * get(g.slot(lay, xf, a))
+                + d * into
+                + d * get(g.slot(lay, l.f2 as usize, i))
+                - wall)
+                / (1.0 + d)
+        };
+        gained += b - into;
+        weights += W[a];
+        back.push(b);
+    }
+    if rule.conserve && weights > 0.0 {
+        // no net flux through a rigid surface: the mass the rules created goes back,
+        // shared by the links in proportion to their weights
+        let per_weight = gained / weights;
+        for (l, b) in links.iter().zip(back.iter_mut()) {
+            *b -= per_weight * W[l.alpha as usize];
+        }
+    }
+    for (l, &b) in links.iter().zip(back.iter()) {
+        let a = l.alpha as usize;
+        let xf = l.node as usize;
+        let uw = ob.velocity_at(l.xw);
+        let ca = cf(a);
+        let into = get(g.slot(lay, g.shift(xf, a), a));
+        // the reference density's share, 2 w_α ρ₀ c_α: only gauge pressure loads the body
+        // (zero for a body wetted all round)
+        let amb = 2.0 * W[a];
+        let df = if rule.galilean {
+            [
+                (ca[0] - uw[0]) * into - (-ca[0] - uw[0]) * b - amb * ca[0],
+                (ca[1] - uw[1]) * into - (-ca[1] - uw[1]) * b - amb * ca[1],
+            ]
+        } else {
+            [ca[0] * (into + b - amb), ca[1] * (into + b - amb)]
+        };
+        let r = [l.xw[0] - c[0], l.xw[1] - c[1]];
+        f[0] += df[0];
+        f[1] += df[1];
+        f[2] += r[0] * df[1] - r[1] * df[0];
+    }
+    f
+}
+
+/// Scratch of the obstacle rules run inside the sweep, per band of the sweep.
+#[derive(Clone, Debug, Default)]
+struct InSweep {
+    /// Per obstacle: its rules ran inside the sweep of the current step.
+    fused: Vec<bool>,
+    /// Per band: `(row, obstacle)`, the obstacles whose rules the band applies once it
+    /// has stepped `row`.
+    bodies: Vec<Vec<(u32, u32)>>,
+    /// Per band: the force and torque of each obstacle it applied.
+    forces: Vec<Vec<(u32, [f64; 3])>>,
+    /// Per band: the unknowns of the obstacle at hand.
+    backs: Vec<Vec<f64>>,
+}
+
+/// The hook of one band: the rules of its obstacles, each applied and written back as
+/// soon as the rows it reads are final ([`BandHook`]).
+struct RulesInBand<'a> {
+    bodies: &'a [(u32, u32)],
+    next: usize,
+    obstacles: &'a [Obstacle],
+    links: &'a [Vec<ObstacleLink>],
+    g: Grid,
+    /// The layout after the step.
+    lay: Layout,
+    rule: RuleKind,
+    back: &'a mut Vec<f64>,
+    forces: &'a mut Vec<(u32, [f64; 3])>,
+}
+
+impl<T: Storage> BandHook<T> for RulesInBand<'_> {
+    #[inline(always)]
+    fn rows_done(&mut self, last: usize, view: &mut BandView<'_, '_, T>) {
+        while let Some(&(row, k)) = self.bodies.get(self.next) {
+            if row as usize > last {
+                return;
+            }
+            self.next += 1;
+            let (g, lay) = (self.g, self.lay);
+            let links = &self.links[k as usize];
+            let f = obstacle_rules(
+                g,
+                lay,
+                &self.obstacles[k as usize],
+                links,
+                self.rule,
+                self.back,
+                |(q, n)| view.get(q, n),
+            );
+            for (l, &b) in links.iter().zip(self.back.iter()) {
+                let (q, n) = g.slot(lay, l.node as usize, OPP[l.alpha as usize]);
+                view.set(q, n, b);
+            }
+            self.forces.push((k, f));
+        }
     }
 }

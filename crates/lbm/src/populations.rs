@@ -2,7 +2,7 @@
 //! collides in place, and element access for the boundary rules, which compute in `f64`.
 
 use crate::d2q9::{Q, W};
-use crate::kernel::{Grid, Layout, Physics, Storage, aa_step, aa_step_runs};
+use crate::kernel::{BandHook, Grid, Layout, Physics, Storage, aa_step, aa_step_hooked};
 use crate::runs::FluidRuns;
 
 /// The floating-point type the populations are stored in.
@@ -99,6 +99,24 @@ impl Populations {
         }
     }
 
+    /// `f` in slot `q` of padded node `node`, `np` padded nodes per slot.
+    #[inline]
+    pub(crate) fn get_slot(&self, np: usize, q: usize, node: usize) -> f64 {
+        match self {
+            Populations::Double(v) => v[q * np + node],
+            Populations::Single(v, _) => v[q * np + node].load(W[q]),
+        }
+    }
+
+    /// Set slot `q` of padded node `node` to `f`.
+    #[inline]
+    pub(crate) fn set_slot(&mut self, np: usize, q: usize, node: usize, f: f64) {
+        match self {
+            Populations::Double(v) => v[q * np + node] = f,
+            Populations::Single(v, _) => v[q * np + node] = f32::store(f, W[q]),
+        }
+    }
+
     /// Every value as `f64` `f_i`.
     pub(crate) fn to_f64(&self) -> Vec<f64> {
         match self {
@@ -121,18 +139,21 @@ impl Populations {
         }
     }
 
-    /// One fused AA step over the fluid nodes of `runs` ([`aa_step_runs`]).
-    pub(crate) fn aa_step_runs(
+    /// One fused AA step with a hook per band ([`aa_step_hooked`]): over the segments of
+    /// `runs` as [`crate::kernel::aa_step_runs`], or every node with the mask.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn aa_step_hooked<H: BandHook<f64> + BandHook<f32>>(
         &mut self,
         g: Grid,
         layout: Layout,
         mask: &[u8],
-        runs: &FluidRuns,
+        runs: Option<&FluidRuns>,
         phys: Physics,
+        hooks: Vec<H>,
     ) -> Layout {
         match self {
-            Populations::Double(v) => aa_step_runs(v, g, layout, mask, runs, phys),
-            Populations::Single(v, _) => aa_step_runs(v, g, layout, mask, runs, phys),
+            Populations::Double(v) => aa_step_hooked(v, g, layout, mask, runs, phys, hooks),
+            Populations::Single(v, _) => aa_step_hooked(v, g, layout, mask, runs, phys, hooks),
         }
     }
 }
