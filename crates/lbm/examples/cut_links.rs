@@ -9,7 +9,9 @@
 //! Prints, per step, the CPU time summed over the process's threads (Linux
 //! `/proc/self/task/*/schedstat`, insensitive to the load of other processes) and the
 //! wall time: `cargo run --release -p porofrac-lbm --example cut_links -- disks.txt [steps]`.
-//! `RAYON_NUM_THREADS=1` gives the work of one core. Also prints how many of the
+//! `RAYON_NUM_THREADS=1` gives the work of one core. Each case runs three rounds
+//! alternating the obstacle rules inside the stream–collide sweep and after it
+//! (`Lattice::set_rules_in_sweep`). Also prints how many of the
 //! population array's cache lines (64 bytes, natural layout) the obstacle rules load or
 //! store (links spread over every pore touch lines all over the array). And the CPU time of finding the fluid nodes
 //! enclosed alone by disks (`Lattice::enclosed_fluid_nodes`) against a scan node by node.
@@ -167,18 +169,30 @@ fn main() {
         for _ in 0..3 {
             lat.step().expect("step");
         }
-        let (c0, t0) = (cpu_seconds(), Instant::now());
-        for _ in 0..steps {
-            lat.step().expect("step");
+        // three rounds alternating the rules inside the sweep and after it
+        for _ in 0..3 {
+            for in_sweep in [true, false] {
+                lat.set_rules_in_sweep(in_sweep);
+                let (c0, t0) = (cpu_seconds(), Instant::now());
+                let mut bodies = 0;
+                for _ in 0..steps {
+                    lat.step().expect("step");
+                    bodies += lat.obstacles_in_sweep();
+                }
+                let (cpu, wall) = (cpu_seconds() - c0, t0.elapsed().as_secs_f64());
+                println!(
+                    "{}, rules {}: {} cut links, {} fluid nodes, {:.0} of {} bodies in the \
+                     sweep, per step: CPU {:.2} ms, wall {:.2} ms",
+                    if moving { "moving" } else { "at rest" },
+                    if in_sweep { "in the sweep" } else { "after it" },
+                    lat.cut_links(),
+                    lat.fluid_nodes(),
+                    bodies as f64 / steps as f64,
+                    disks.len(),
+                    1e3 * cpu / steps as f64,
+                    1e3 * wall / steps as f64
+                );
+            }
         }
-        let (cpu, wall) = (cpu_seconds() - c0, t0.elapsed().as_secs_f64());
-        println!(
-            "{}: {} cut links, {} fluid nodes, per step: CPU {:.2} ms, wall {:.2} ms",
-            if moving { "moving" } else { "at rest" },
-            lat.cut_links(),
-            lat.fluid_nodes(),
-            1e3 * cpu / steps as f64,
-            1e3 * wall / steps as f64
-        );
     }
 }

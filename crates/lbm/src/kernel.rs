@@ -136,8 +136,8 @@ fn band_rows(ny: usize) -> usize {
 }
 
 /// The row bands a step of an `ny`-row lattice runs in parallel, as `(first row, rows)`
-/// in interior rows, in the order [`aa_step_hooked`] hands them their hooks.
-pub(crate) fn band_ranges(ny: usize) -> Vec<(usize, usize)> {
+/// in interior rows.
+fn band_ranges(ny: usize) -> Vec<(usize, usize)> {
     let rows = band_rows(ny);
     (0..ny)
         .step_by(rows)
@@ -191,6 +191,7 @@ fn bands<'a, T>(
     pop: &'a mut [T],
     g: Grid,
     shift: impl Fn(usize) -> usize,
+    ranges: &[(usize, usize)],
 ) -> Vec<(usize, usize, [&'a mut [T]; 9])> {
     let (w, np) = (g.stride(), g.np());
     let mut rest: Vec<&'a mut [T]> = pop
@@ -198,9 +199,11 @@ fn bands<'a, T>(
         .enumerate()
         .map(|(j, s)| &mut s[shift(j) * w..])
         .collect();
-    let ranges = band_ranges(g.ny);
     let mut out = Vec::with_capacity(ranges.len());
-    for (row0, n) in ranges {
+    let mut next = 0;
+    for &(row0, n) in ranges {
+        assert_eq!(row0, next, "bands cover the rows in order");
+        next = row0 + n;
         let slices: [&'a mut [T]; 9] = std::array::from_fn(|j| {
             let s = std::mem::take(&mut rest[j]);
             let (head, tail) = s.split_at_mut(n * w);
@@ -209,6 +212,7 @@ fn bands<'a, T>(
         });
         out.push((row0, n, slices));
     }
+    assert_eq!(next, g.ny, "bands cover every row");
     out
 }
 
@@ -230,6 +234,7 @@ pub fn aa_step<T: Storage>(
         mask,
         None,
         phys,
+        &band_ranges(g.ny),
         vec![(); band_ranges(g.ny).len()],
     )
 }
@@ -252,12 +257,15 @@ pub fn aa_step_runs<T: Storage>(
         Some(mask),
         Some(runs),
         phys,
+        &band_ranges(g.ny),
         vec![(); band_ranges(g.ny).len()],
     )
 }
 
-/// [`aa_step`] (with `runs`: [`aa_step_runs`]) that hands each band of [`band_ranges`]
-/// its hook (`hooks[b]` for band `b`), called after every row of the band.
+/// [`aa_step`] (with `runs`: [`aa_step_runs`]) over the row bands `ranges` (`(first
+/// row, rows)`, in order, covering every row; any split gives the same bits), handing
+/// band `b` its hook `hooks[b]`, called after every row of the band.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn aa_step_hooked<T: Storage, H: BandHook<T>>(
     pop: &mut [T],
     g: Grid,
@@ -265,11 +273,13 @@ pub(crate) fn aa_step_hooked<T: Storage, H: BandHook<T>>(
     mask: &[u8],
     runs: Option<&FluidRuns>,
     phys: Physics,
+    ranges: &[(usize, usize)],
     hooks: Vec<H>,
 ) -> Layout {
-    aa_dispatch(pop, g, layout, Some(mask), runs, phys, hooks)
+    aa_dispatch(pop, g, layout, Some(mask), runs, phys, ranges, hooks)
 }
 
+#[allow(clippy::too_many_arguments)]
 fn aa_dispatch<T: Storage, H: BandHook<T>>(
     pop: &mut [T],
     g: Grid,
@@ -277,10 +287,11 @@ fn aa_dispatch<T: Storage, H: BandHook<T>>(
     mask: Option<&[u8]>,
     runs: Option<&FluidRuns>,
     phys: Physics,
+    ranges: &[(usize, usize)],
     hooks: Vec<H>,
 ) -> Layout {
     let force = phys.accel != [0.0, 0.0];
-    let (r, h) = (runs, hooks);
+    let (r, h) = (runs, (ranges, hooks));
     match (layout, mask, force) {
         (Layout::Natural, None, false) => aa::<T, H, false, false, false>(pop, g, &[], r, phys, h),
         (Layout::Natural, Some(m), false) => aa::<T, H, false, true, false>(pop, g, m, r, phys, h),
@@ -303,12 +314,12 @@ fn aa<T: Storage, H: BandHook<T>, const ODD: bool, const MASK: bool, const FORCE
     mask: &[u8],
     runs: Option<&FluidRuns>,
     phys: Physics,
-    hooks: Vec<H>,
+    (ranges, hooks): (&[(usize, usize)], Vec<H>),
 ) {
     let w = g.stride();
     let nx = g.nx;
     let shift = |j: usize| if ODD { (1 + C[j][1]) as usize } else { 1 };
-    let bands = bands(pop, g, shift);
+    let bands = bands(pop, g, shift, ranges);
     assert_eq!(bands.len(), hooks.len(), "one hook per band");
     let arch = pulp::Arch::new();
     bands
@@ -490,7 +501,7 @@ fn aa_row<T: Storage, const ODD: bool, const MASK: bool, const FORCE: bool>(
 /// `src` (Natural layout), push into `dst`, wrap the ghost layer of `dst` back into the
 /// interior. Used by the benchmarks and to check the AA kernel.
 pub fn push_step_periodic(src: &[f64], dst: &mut [f64], g: Grid, phys: Physics) {
-    let bands = bands(dst, g, |j| (1 + C[j][1]) as usize);
+    let bands = bands(dst, g, |j| (1 + C[j][1]) as usize, &band_ranges(g.ny));
     let arch = pulp::Arch::new();
     bands.into_par_iter().for_each(|(row0, n, s)| {
         arch.dispatch(PushBand {

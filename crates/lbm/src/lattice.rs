@@ -1125,7 +1125,7 @@ impl Lattice {
     fn step_with_rules(&mut self, phys: Physics) -> Layout {
         let (g, lay) = (self.grid, self.layout);
         let runs = self.skip_solid.then_some(&self.runs);
-        let ranges = crate::kernel::band_ranges(g.ny);
+        let ranges = self.sweep_bands();
         let rule = self.rule_kind();
         let plan = &mut self.in_sweep;
         plan.fused.clear();
@@ -1137,11 +1137,10 @@ impl Lattice {
             b.clear();
         }
         if self.rules_in_sweep {
-            let rows = ranges[0].1;
             for (k, r) in self.link_rows.iter().enumerate() {
                 let Some((lo, hi)) = *r else { continue };
                 let (lo, hi) = (lo as usize, hi as usize);
-                let b = lo / rows;
+                let b = ranges.partition_point(|&(row0, _)| row0 <= lo) - 1;
                 let (row0, n) = ranges[b];
                 // a rule of a link at row j touches what the nodes x_f, x_f2 and x_b of
                 // rows j − 1 ..= j + 1 touch in the sweep: final once row hi + 1 is stepped
@@ -1178,12 +1177,50 @@ impl Lattice {
             .collect();
         let out = self
             .pop
-            .aa_step_hooked(g, lay, &self.mask, runs, phys, hooks);
+            .aa_step_hooked(g, lay, &self.mask, runs, phys, &ranges, hooks);
         for band in &self.in_sweep.forces {
             for &(k, f) in band {
                 self.forces[k as usize] = f;
             }
         }
+        out
+    }
+
+    /// The row bands of the sweep, `(first row, rows)`: two per thread (the rules of an
+    /// obstacle that straddles two bands wait for the end of the sweep, so fewer bands
+    /// leave fewer for then), each split moved by up to a quarter of a band to the row
+    /// that the fewest obstacles straddle.
+    fn sweep_bands(&self) -> Vec<(usize, usize)> {
+        let ny = self.grid.ny;
+        let bands = (2 * rayon::current_num_threads().max(1)).min(ny);
+        let rows = ny.div_ceil(bands);
+        // straddle[s]: obstacles whose rules read rows s − 1 and s (rows lo − 1 ..= hi + 1)
+        let mut straddle = vec![0i32; ny + 2];
+        if self.rules_in_sweep {
+            for &(lo, hi) in self.link_rows.iter().flatten() {
+                straddle[lo as usize] += 1;
+                straddle[(hi as usize + 2).min(ny + 1)] -= 1;
+            }
+            for s in 1..straddle.len() {
+                straddle[s] += straddle[s - 1];
+            }
+        }
+        let mut out = Vec::with_capacity(bands);
+        let mut row0 = 0;
+        for b in 1..bands {
+            let nominal = b * rows;
+            let (a, z) = (
+                (nominal - rows / 4).max(row0 + 1),
+                (nominal + rows / 4).min(ny - 1),
+            );
+            if a > z {
+                break;
+            }
+            let split = (a..=z).min_by_key(|&s| straddle[s]).unwrap_or(nominal);
+            out.push((row0, split - row0));
+            row0 = split;
+        }
+        out.push((row0, ny - row0));
         out
     }
 

@@ -139,8 +139,9 @@ impl Populations {
         }
     }
 
-    /// One fused AA step with a hook per band ([`aa_step_hooked`]): over the segments of
-    /// `runs` as [`crate::kernel::aa_step_runs`], or every node with the mask.
+    /// One fused AA step over the bands `ranges` with a hook per band ([`aa_step_hooked`]):
+    /// over the segments of `runs` as [`crate::kernel::aa_step_runs`], or every node with
+    /// the mask.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn aa_step_hooked<H: BandHook<f64> + BandHook<f32>>(
         &mut self,
@@ -149,11 +150,14 @@ impl Populations {
         mask: &[u8],
         runs: Option<&FluidRuns>,
         phys: Physics,
+        ranges: &[(usize, usize)],
         hooks: Vec<H>,
     ) -> Layout {
         match self {
-            Populations::Double(v) => aa_step_hooked(v, g, layout, mask, runs, phys, hooks),
-            Populations::Single(v, _) => aa_step_hooked(v, g, layout, mask, runs, phys, hooks),
+            Populations::Double(v) => aa_step_hooked(v, g, layout, mask, runs, phys, ranges, hooks),
+            Populations::Single(v, _) => {
+                aa_step_hooked(v, g, layout, mask, runs, phys, ranges, hooks)
+            }
         }
     }
 }
