@@ -34,6 +34,9 @@
 //! No unknown is read by another rule of the same step (a rule reads only what crossed
 //! into a solid or ghost node, or populations of fluid nodes that are not unknowns), except
 //! that obstacle rules may read populations a periodic copy delivered: copies go first.
+//! So the order of the obstacles' rules does not matter, and those of an obstacle whose
+//! cut links are two nodes or more from the box's edge (out of reach of the copies and the
+//! sides' rules) may run before the sides', inside the stream–collide sweep.
 
 /// A side of the box.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

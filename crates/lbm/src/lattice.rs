@@ -892,7 +892,9 @@ impl Lattice {
 
     /// One time step: collide and stream every node, apply the boundary lists, sum the
     /// obstacle forces, add the sources, then (with [`ObstacleMotion::Integrated`]) move
-    /// the obstacles.
+    /// the obstacles. Most obstacles' rules run inside the stream–collide sweep, as soon
+    /// as the rows they read are final ([`Lattice::set_rules_in_sweep`]); the results are
+    /// those of applying them after it.
     pub fn step(&mut self) -> Result<(), LbmError> {
         for (k, ob) in self.obstacles.iter().enumerate() {
             let [lo, hi] = ob.shape.bounds();
