@@ -32,10 +32,19 @@
 //! The scalar functions compute exactly what the lane functions compute, bit for bit, so
 //! an expression gives the same value evaluated alone or in a batch.
 
+// The constants with the digits fdlibm publishes them with (each is the double nearest).
+#![allow(clippy::excessive_precision)]
+
 /// Lanes at or above this magnitude (and non-finite ones) use the standard library.
 const REDUCIBLE: f64 = 1_647_099.0; // just below 2²⁰ π/2
 
-const INV_PIO2: f64 = 6.366_197_723_675_813_824_33e-1;
+/// Whether the kernel's reduction holds for `x` (false for NaN).
+#[inline(always)]
+fn reducible(x: f64) -> bool {
+    x.abs() < REDUCIBLE
+}
+
+const INV_PIO2: f64 = std::f64::consts::FRAC_2_PI;
 /// First 33 bits of π/2.
 const PIO2_1: f64 = 1.570_796_326_734_125_614_17e0;
 /// Next 33 bits of π/2.
@@ -98,36 +107,24 @@ fn kernel(x: f64) -> (f64, f64) {
 
 /// `sin x`.
 pub fn sin(x: f64) -> f64 {
-    if x.abs() < REDUCIBLE {
-        kernel(x).0
-    } else {
-        x.sin()
-    }
+    if reducible(x) { kernel(x).0 } else { x.sin() }
 }
 
 /// `cos x`.
 pub fn cos(x: f64) -> f64 {
-    if x.abs() < REDUCIBLE {
-        kernel(x).1
-    } else {
-        x.cos()
-    }
+    if reducible(x) { kernel(x).1 } else { x.cos() }
 }
 
 /// `(sin x, cos x)`, the values of [`sin`] and [`cos`].
 pub fn sin_cos(x: f64) -> (f64, f64) {
-    if x.abs() < REDUCIBLE {
-        kernel(x)
-    } else {
-        x.sin_cos()
-    }
+    if reducible(x) { kernel(x) } else { x.sin_cos() }
 }
 
 /// [`sin`] of every lane.
 pub fn sin_lanes<const L: usize>(a: &[f64; L]) -> [f64; L] {
     let mut s: [f64; L] = std::array::from_fn(|l| kernel(a[l]).0);
     for (s, &x) in s.iter_mut().zip(a) {
-        if !(x.abs() < REDUCIBLE) {
+        if !reducible(x) {
             *s = x.sin();
         }
     }
@@ -138,7 +135,7 @@ pub fn sin_lanes<const L: usize>(a: &[f64; L]) -> [f64; L] {
 pub fn cos_lanes<const L: usize>(a: &[f64; L]) -> [f64; L] {
     let mut c: [f64; L] = std::array::from_fn(|l| kernel(a[l]).1);
     for (c, &x) in c.iter_mut().zip(a) {
-        if !(x.abs() < REDUCIBLE) {
+        if !reducible(x) {
             *c = x.cos();
         }
     }
@@ -152,7 +149,7 @@ pub fn sin_cos_lanes<const L: usize>(a: &[f64; L]) -> ([f64; L], [f64; L]) {
         (s[l], c[l]) = kernel(a[l]);
     }
     for ((s, c), &x) in s.iter_mut().zip(c.iter_mut()).zip(a) {
-        if !(x.abs() < REDUCIBLE) {
+        if !reducible(x) {
             (*s, *c) = x.sin_cos();
         }
     }
