@@ -13,9 +13,13 @@
 //!
 //! Variables `x, y, z` (m) and `t` (s); constants `pi`, `e`; functions `sin cos tan exp
 //! ln sqrt abs` (one argument) and `min max` (two or more). An expression is compiled
-//! once into a small stack program and then evaluated without allocation.
+//! once into a small stack program and then evaluated without allocation. `sin` and `cos`
+//! are those of [`super::trig`] (within one unit in the last place of the correctly
+//! rounded values, and vectorized over the lanes of a batch).
 
 use std::fmt;
+
+use super::trig;
 
 /// A compiled expression.
 #[derive(Clone, Debug, PartialEq)]
@@ -46,8 +50,8 @@ impl Func {
     /// [`Func::apply`] on every lane, the function chosen once.
     fn apply_lanes(self, a: &[f64; LANES]) -> [f64; LANES] {
         match self {
-            Func::Sin => lanes1(a, f64::sin),
-            Func::Cos => lanes1(a, f64::cos),
+            Func::Sin => trig::sin_lanes(a),
+            Func::Cos => trig::cos_lanes(a),
             Func::Tan => lanes1(a, f64::tan),
             Func::Exp => lanes1(a, f64::exp),
             Func::Ln => lanes1(a, f64::ln),
@@ -58,8 +62,8 @@ impl Func {
 
     fn apply(self, v: f64) -> f64 {
         match self {
-            Func::Sin => v.sin(),
-            Func::Cos => v.cos(),
+            Func::Sin => trig::sin(v),
+            Func::Cos => trig::cos(v),
             Func::Tan => v.tan(),
             Func::Exp => v.exp(),
             Func::Ln => v.ln(),
@@ -643,9 +647,9 @@ impl Program {
     }
 
     /// Where a program takes both `sin a` and `cos a` (a manufactured load's `sin(pi*x)`
-    /// and `cos(pi*x)`), compute them in one `f64::sin_cos` call at the first of the two
+    /// and `cos(pi*x)`), compute them in one `sin_cos` call at the first of the two
     /// nodes: the argument reduction is shared, which makes the pair about as cheap as
-    /// one. `sin_cos` gives the same values as `sin` and `cos` (checked by the tests).
+    /// one. [`trig::sin_cos`] gives the same values as [`trig::sin`] and [`trig::cos`].
     fn pair_sin_cos(&mut self) {
         let mut first: std::collections::HashMap<u32, (Option<usize>, Option<usize>)> =
             std::collections::HashMap::new();
@@ -744,11 +748,7 @@ impl Program {
             let g = |k: u32| &done[k as usize];
             rest[0] = match *node {
                 Node::SinCos(a, si, ci) => {
-                    let a = g(a);
-                    let (mut sin, mut cos) = ([0.0; LANES], [0.0; LANES]);
-                    for l in 0..LANES {
-                        (sin[l], cos[l]) = a[l].sin_cos();
-                    }
+                    let (sin, cos) = trig::sin_cos_lanes(g(a));
                     let later = si.max(ci) as usize - i;
                     (rest[0], rest[later]) = if si < ci { (sin, cos) } else { (cos, sin) };
                     continue;
@@ -798,7 +798,7 @@ impl Program {
             let g = |k: u32| v[k as usize];
             let value = match *node {
                 Node::SinCos(a, si, ci) => {
-                    let (sin, cos) = g(a).sin_cos();
+                    let (sin, cos) = trig::sin_cos(g(a));
                     v[si as usize] = sin;
                     v[ci as usize] = cos;
                     continue;
@@ -1039,7 +1039,8 @@ mod tests {
         assert!(!e.ops.iter().any(|o| matches!(o, Op::Pow)));
         let (x, y) = (0.3, 0.7);
         let pi = std::f64::consts::PI;
-        let want = -x / 52.0 + 9.0 * (pi * pi) * (pi * x).sin() * (pi * y).sin() / 520.0;
+        // The same operations in the same order (sin as the expressions take it).
+        let want = -x / 52.0 + 9.0 * (pi * pi) * trig::sin(pi * x) * trig::sin(pi * y) / 520.0;
         assert_eq!(e.eval(&[x, y], 0.0), want);
         assert_eq!(ev("x^2 + 2^3 - max(1, 2, x)", &[3.0], 0.0), 9.0 + 8.0 - 3.0);
         assert_eq!(ev("(1 + 2)^2 * t", &[], 2.0), 18.0);

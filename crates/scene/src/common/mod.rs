@@ -39,3 +39,4 @@ pub mod sample;
 pub mod scene_errors;
 pub mod sections;
 pub mod snapshot;
+pub mod trig;
