@@ -1567,6 +1567,16 @@ impl<const D: usize> crate::cavitation::CavitationSolver<D> for SchemeSolver<'_>
             _ => Ok(None),
         }
     }
+    fn pressure_accuracy(
+        &mut self,
+        sys: &BiotSystem<'_, D>,
+        cells: &[usize],
+    ) -> crate::biot::BiotResult<Option<Vec<f64>>> {
+        match self.scheme {
+            Scheme::Monolithic(m) => m.pressure_accuracy(sys, cells),
+            _ => Ok(None),
+        }
+    }
 }
 
 #[cfg(test)]
