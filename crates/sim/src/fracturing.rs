@@ -1577,6 +1577,15 @@ impl<const D: usize> crate::cavitation::CavitationSolver<D> for SchemeSolver<'_>
             _ => Ok(None),
         }
     }
+    fn refine(
+        &mut self,
+        sys: &BiotSystem<'_, D>,
+    ) -> crate::biot::BiotResult<Option<crate::BiotStep>> {
+        match self.scheme {
+            Scheme::Monolithic(m) => m.refine_last(sys, self.state),
+            _ => Ok(None),
+        }
+    }
 }
 
 #[cfg(test)]

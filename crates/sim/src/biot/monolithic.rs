@@ -1046,6 +1046,42 @@ impl Monolithic {
         ))
     }
 
+    /// The last step's solve from `state` corrected by one step of iterative refinement
+    /// with the current factors, `z += A⁻¹ (b − A z)` (kept as the last solve: a
+    /// [`Self::pressure_accuracy`] after it estimates the corrected one). `None` when
+    /// `sys` is not the system of the last step's matrix or no step was solved with it.
+    pub fn refine_last<const D: usize>(
+        &mut self,
+        sys: &BiotSystem<'_, D>,
+        state: &BiotState,
+    ) -> BiotResult<Option<BiotStep>> {
+        let Some(dt) = self.factored.as_ref().map(|f| f.dt) else {
+            return Ok(None);
+        };
+        let n = self.num_unknowns();
+        if !self.is_factored(sys, self.s, dt) || self.work.z.len() != n || self.work.rhs.len() != n
+        {
+            return Ok(None);
+        }
+        let mut w = std::mem::take(&mut self.work);
+        let mut r = vec![0.0; n];
+        self.sym_mul_add(&w.z, &mut r);
+        for (ri, b) in r.iter_mut().zip(&w.rhs) {
+            *ri = b - *ri;
+        }
+        let solved = self.low_rank.solve(&mut self.ldlt, &mut r);
+        if solved.is_ok() {
+            for (z, d) in w.z.iter_mut().zip(&r) {
+                *z += d;
+            }
+        }
+        let out = solved
+            .map_err(|e| BiotError::Solver(e.0))
+            .and_then(|()| self.finish(sys, state, &w, false));
+        self.work = w;
+        out.map(Some)
+    }
+
     /// The mechanical part of the right-hand side at `t` into `work.rhs` and the
     /// prescribed displacements into `work.uf` (see `BiotSystem::mechanics_base`), kept
     /// from the first step when the conditions and loads do not depend on time.
