@@ -1567,6 +1567,25 @@ impl<const D: usize> crate::cavitation::CavitationSolver<D> for SchemeSolver<'_>
             _ => Ok(None),
         }
     }
+    fn pressure_accuracy(
+        &mut self,
+        sys: &BiotSystem<'_, D>,
+        cells: &[usize],
+    ) -> crate::biot::BiotResult<Option<Vec<f64>>> {
+        match self.scheme {
+            Scheme::Monolithic(m) => m.pressure_accuracy(sys, cells),
+            _ => Ok(None),
+        }
+    }
+    fn refine(
+        &mut self,
+        sys: &BiotSystem<'_, D>,
+    ) -> crate::biot::BiotResult<Option<crate::BiotStep>> {
+        match self.scheme {
+            Scheme::Monolithic(m) => m.refine_last(sys, self.state),
+            _ => Ok(None),
+        }
+    }
 }
 
 #[cfg(test)]

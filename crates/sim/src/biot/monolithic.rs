@@ -1003,6 +1003,85 @@ impl Monolithic {
         Ok(Some(g))
     }
 
+    /// The accuracy attained by the last step's solve in the pressure of each cell of
+    /// `cells` (Pa): the size of the change one step of iterative refinement with the
+    /// current factors makes there, `s |(A⁻¹ (b − A z))_{n_m + c}|`, the first-order
+    /// estimate of the solve's error in that pressure (the residual `b − A z` of the
+    /// solve read in working precision, with its floor `ε |A| |z|` in the rows of a
+    /// crack opened by centimetres, see the module docs). The solution is not changed.
+    /// `None` when `sys` is not the system of the last step's matrix or no step was
+    /// solved with it.
+    pub fn pressure_accuracy<const D: usize>(
+        &mut self,
+        sys: &BiotSystem<'_, D>,
+        cells: &[usize],
+    ) -> BiotResult<Option<Vec<f64>>> {
+        let Some(dt) = self.factored.as_ref().map(|f| f.dt) else {
+            return Ok(None);
+        };
+        let n = self.num_unknowns();
+        if cells.iter().any(|&c| c >= sys.num_cells()) {
+            return Err(BiotError::Input(format!(
+                "pressure accuracy of cells beyond the system's {}",
+                sys.num_cells()
+            )));
+        }
+        if !self.is_factored(sys, self.s, dt) || self.work.z.len() != n || self.work.rhs.len() != n
+        {
+            return Ok(None);
+        }
+        let mut r = vec![0.0; n];
+        self.sym_mul_add(&self.work.z, &mut r);
+        for (ri, b) in r.iter_mut().zip(&self.work.rhs) {
+            *ri = b - *ri;
+        }
+        self.low_rank
+            .solve(&mut self.ldlt, &mut r)
+            .map_err(|e| BiotError::Solver(e.0))?;
+        Ok(Some(
+            cells
+                .iter()
+                .map(|&c| self.s * r[self.nm + c].abs())
+                .collect(),
+        ))
+    }
+
+    /// The last step's solve from `state` corrected by one step of iterative refinement
+    /// with the current factors, `z += A⁻¹ (b − A z)` (kept as the last solve: a
+    /// [`Self::pressure_accuracy`] after it estimates the corrected one). `None` when
+    /// `sys` is not the system of the last step's matrix or no step was solved with it.
+    pub fn refine_last<const D: usize>(
+        &mut self,
+        sys: &BiotSystem<'_, D>,
+        state: &BiotState,
+    ) -> BiotResult<Option<BiotStep>> {
+        let Some(dt) = self.factored.as_ref().map(|f| f.dt) else {
+            return Ok(None);
+        };
+        let n = self.num_unknowns();
+        if !self.is_factored(sys, self.s, dt) || self.work.z.len() != n || self.work.rhs.len() != n
+        {
+            return Ok(None);
+        }
+        let mut w = std::mem::take(&mut self.work);
+        let mut r = vec![0.0; n];
+        self.sym_mul_add(&w.z, &mut r);
+        for (ri, b) in r.iter_mut().zip(&w.rhs) {
+            *ri = b - *ri;
+        }
+        let solved = self.low_rank.solve(&mut self.ldlt, &mut r);
+        if solved.is_ok() {
+            for (z, d) in w.z.iter_mut().zip(&r) {
+                *z += d;
+            }
+        }
+        let out = solved
+            .map_err(|e| BiotError::Solver(e.0))
+            .and_then(|()| self.finish(sys, state, &w, false));
+        self.work = w;
+        out.map(Some)
+    }
+
     /// The mechanical part of the right-hand side at `t` into `work.rhs` and the
     /// prescribed displacements into `work.uf` (see `BiotSystem::mechanics_base`), kept
     /// from the first step when the conditions and loads do not depend on time.
