@@ -24,11 +24,11 @@
 //!    towards `c`'s centroid, in the plane across `n`.
 //! 2. **Ahead, beside, or too short.** With positions `s = x·t` along the crack and the
 //!    tip `s_tip` the mean position of the nodes `c` shares with failed cells, the sample
-//!    lies at `s* = s_tip − r`. When the crack reaches less than half a cell behind `s*`
-//!    (a crack of one to a few cells at a wall, or one younger than `r`), there is no
-//!    sample: [`TipReading::Short`]. Otherwise `c` is ahead of the tip when its centroid
-//!    lies no more than half a cell behind the farthest failed centroid of the crack near
-//!    it along `t`; else it lies beside the crack ([`TipReading::Beside`]). This admits
+//!    lies at `s* = s_tip − r′` (the distance `r′` of the section "Short cracks": `r`
+//!    behind the tip of a long crack, less behind a short one). When the crack is shorter
+//!    than two cells there is no sample: [`TipReading::Short`]. Otherwise `c` is ahead of
+//!    the tip when its centroid lies no more than half a cell behind the farthest failed
+//!    centroid of the crack near it along `t`; else it lies beside the crack ([`TipReading::Beside`]). This admits
 //!    every cell around the tip, those beside the last failed cells too: on a zig-zag
 //!    band of triangles the cell that continues the crack face to face may lie beside
 //!    the last failed triangle (when that triangle ends on a vertex, the cells beyond it
@@ -42,7 +42,34 @@
 //!    (`x·n > η*`) or the near side. On each face `u·n` is fitted by a line in `s` (least
 //!    squares; the mean when the nodes do not spread along the crack) and evaluated at
 //!    `s*`; the opening is the difference, `w = [u·n]₊(s*) − [u·n]₋(s*)`, and
-//!    `K_I = E′ w / (4 √(2/π) √r)` with `r = s_tip − s*`.
+//!    `K_I = E′ w / (4 √(2/π) √r′)` with `r′ = s_tip − s*`, divided by `√(1 − r′/ℓ)` on a
+//!    short crack (next section).
+//!
+//! # Short cracks
+//!
+//! A crack shorter than `r` (a wing of a few cells at a well, a crack younger than `r`)
+//! has no opening `r` behind its tip, and the `√r` law read far behind the tip of a
+//! short crack reads low: on Sneddon's crack of length `2a` under a pressure `p`,
+//! `w(r) = (4p/E′) √(r (2a − r))` at a distance `r` behind a tip, so the law above gives
+//! `K_I √(1 − r/(2a))`. The crack near `c` is therefore also measured: when the search of
+//! step 1 met no failed cell beyond its reach `r + 3h`, it holds the whole crack, of length
+//! `ℓ = s_tip − s_back + h/2` behind the tip (`s_back` the farthest failed centroid, about
+//! half a cell inside the crack's back end), and the opening is read at
+//!
+//! ```text
+//!   r′ = min(r, max(h, ℓ/4)),        K_I = E′ w(r′) / (4 √(2/π) √r′) / √(1 − r′/ℓ),
+//! ```
+//!
+//! which is exact on Sneddon's profile with `ℓ = 2a`. A crack shorter than two cells
+//! (`r′ > ℓ/2`) is [`TipReading::Short`]: the criteria take it by strength, so a wing
+//! grows by strength by at most a cell or two before its opening is read. A crack the
+//! search cut at its reach is at least `r + 3h` long and is read at `r` without the factor
+//! (as before: the factor is unknown, and at least `√(1 − r/(r + 3h))`).
+//!
+//! A wing from a well is not a crack with two free tips: its back end is the well's wall,
+//! where it stays open, and the crack it belongs to runs across the well into the other
+//! wing, longer than `ℓ`. There the factor overstates `K_I`, by at most `1/√(1 − r′/ℓ)`
+//! (1.15 at `r′ = ℓ/4`, `√2` for a wing of two cells, read at `r′ = h = ℓ/2`).
 //!
 //! The band's faces lie about half a cell off the crack's line, so `w` also holds the
 //! elastic strain of the rock across half a cell on each side: an error of the order of
@@ -64,8 +91,11 @@ use crate::tip_opening::stress_intensity_from_opening;
 pub struct DistanceSample<const D: usize> {
     /// The opening `w` (m) at `s*` (may be negative: a closed crack).
     pub opening: f64,
-    /// The distance `r = s_tip − s*` (m).
+    /// The distance `r′ = s_tip − s*` (m).
     pub distance: f64,
+    /// The length `ℓ` (m) of the crack behind the tip when the search found all of it
+    /// (module docs, "Short cracks"); `None` for a crack longer than its reach.
+    pub crack_length: Option<f64>,
     /// The unit direction `t` along the crack, towards the tip.
     pub along: Point<D>,
     /// The unit normal `n` of the crack.
@@ -75,10 +105,15 @@ pub struct DistanceSample<const D: usize> {
 }
 
 impl<const D: usize> DistanceSample<D> {
-    /// `K_I` (Pa·√m) of this sample in a solid of plane-strain modulus `e_prime` (Pa); a
-    /// closed crack (`w ≤ 0`) gives 0.
+    /// `K_I` (Pa·√m) of this sample in a solid of plane-strain modulus `e_prime` (Pa),
+    /// with Sneddon's factor `1/√(1 − r′/ℓ)` on a crack of known length `ℓ`; a closed crack
+    /// (`w ≤ 0`) gives 0.
     pub fn stress_intensity(&self, e_prime: f64) -> f64 {
-        stress_intensity_from_opening(e_prime, self.opening.max(0.0), self.distance)
+        let k = stress_intensity_from_opening(e_prime, self.opening.max(0.0), self.distance);
+        match self.crack_length {
+            Some(length) => k / (1.0 - self.distance / length).sqrt(),
+            None => k,
+        }
     }
 }
 
@@ -88,7 +123,8 @@ impl<const D: usize> DistanceSample<D> {
 pub enum TipReading<const D: usize> {
     /// The cell lies ahead of a crack tip: the opening behind it.
     Ahead(DistanceSample<D>),
-    /// The crack near the cell does not reach the distance behind it: no sample.
+    /// The crack near the cell is shorter than two cells: no sample (module docs, "Short
+    /// cracks").
     Short,
     /// The cell lies beside a crack (or touches no failed cell).
     Beside,
@@ -145,15 +181,20 @@ pub fn read_tip<const D: usize>(
     let h = crack.iter().map(|&g| cell_size(grid, g)).sum::<f64>() / crack.len() as f64;
     // The crack near `c`: connected through shared nodes, within `r + 3h`.
     let reach = r + 3.0 * h;
+    let mut cut = false;
     let mut next = 0;
     while next < crack.len() {
         let g = crack[next];
         next += 1;
         for &node in grid.cell_nodes(g) {
             for &f in adjacency.of(node) {
-                if failed[f] && (grid.cell_centroid(f) - xc).norm() <= reach && !crack.contains(&f)
-                {
+                if !failed[f] || crack.contains(&f) {
+                    continue;
+                }
+                if (grid.cell_centroid(f) - xc).norm() <= reach {
                     crack.push(f);
+                } else {
+                    cut = true;
                 }
             }
         }
@@ -185,13 +226,25 @@ pub fn read_tip<const D: usize>(
     }
     tip /= count as f64;
     let s_tip = tip.dot(&t);
-    let s_star = s_tip - r;
     let (s_back, s_front) = centroids
         .iter()
         .map(|x| x.dot(&t))
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), s| {
             (lo.min(s), hi.max(s))
         });
+    // The distance read: `r`, or less behind a short crack (module docs, "Short cracks").
+    let crack_length = (!cut).then_some(s_tip - s_back + 0.5 * h);
+    let distance = match crack_length {
+        Some(length) => {
+            let shortened = r.min(h.max(0.25 * length));
+            if shortened > 0.5 * length {
+                return TipReading::Short;
+            }
+            shortened
+        }
+        None => r,
+    };
+    let s_star = s_tip - distance;
     if s_back > s_star - 0.5 * h {
         return TipReading::Short;
     }
@@ -243,7 +296,8 @@ pub fn read_tip<const D: usize>(
     };
     TipReading::Ahead(DistanceSample {
         opening: plus - minus,
-        distance: r,
+        distance,
+        crack_length,
         along: t,
         normal: n,
         tip,
