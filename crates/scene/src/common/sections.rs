@@ -712,9 +712,10 @@ pub struct Physics {
     /// of one cell behind it, on a crack through any cells (a zig-zag band of triangles;
     /// the crack's line fitted through the failed cells' centroids, the opening fitted on
     /// the nodes of the band's two faces; docs/hydrofrac/validation.md, "A tip rule at a
-    /// fixed distance"). A cell beside a crack is held; a cell next to a crack that does
-    /// not yet reach this distance behind it (a crack of a few cells at a wall) fails by
-    /// its tensile strength. Needs crack_tracking (every cell around a tip is read as
+    /// fixed distance"). A cell beside a crack is held. A crack shorter than this distance
+    /// (a wing of a few cells at a wall) is read at a quarter of its length (at least one
+    /// cell) with Sneddon's factor; one shorter than two cells fails by its tensile
+    /// strength ("Short wings read at a quarter of their length"). Needs crack_tracking (every cell around a tip is read as
     /// ahead of it; tracking picks the one the crack enters). Default none: one cell
     /// behind the tip.
     #[schemars(extend("unit" = "m"))]
