@@ -653,7 +653,8 @@ fn a_crack_row_of_a_far_larger_scale_is_judged_in_the_scaled_system() {
 /// solves' accuracy"): the bound's iteration stalled at misses of 3–45 Pa in the pressures
 /// of the cavitating cells, the solves' own error there, above the fixed 1e-7 of the
 /// pressure scale (4.5–5.7 Pa), and the run stopped at 900 s. Held to the solves'
-/// estimated accuracy it reaches 40 minutes (83 fractured cells), and the pressure along
+/// estimated accuracy it reaches 40 minutes (83 fractured cells, measured before short wings
+/// were read at a quarter of their length), and the pressure along
 /// the crack line is nowhere below the bound.
 #[test]
 fn the_bound_is_held_to_the_solves_accuracy_on_a_tough_rock() {
