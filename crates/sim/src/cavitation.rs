@@ -275,6 +275,22 @@ pub const STALL_FLOOR: f64 = 1e-7;
 /// the pressures of the cavitating cells ([`CavitationSolver::pressure_accuracy`]).
 pub const ACCURACY_MULTIPLE: f64 = 2.0;
 
+/// The void sources of the amounts of void `amount` (per unit volume) opened over a step
+/// of length `dt`: `q_c = amount_c V_c / dt`.
+fn set_voids<const D: usize>(
+    system: &mut BiotSystem<'_, D>,
+    amount: &[f64],
+    volumes: &[f64],
+    dt: f64,
+) -> BiotResult<()> {
+    let q = amount
+        .iter()
+        .zip(volumes)
+        .map(|(a, v)| a * v / dt)
+        .collect();
+    system.set_void_source(Some(q))
+}
+
 /// The active-set iteration of [`bounded_step`].
 fn settle<const D: usize>(
     system: &mut BiotSystem<'_, D>,
@@ -402,12 +418,7 @@ fn settle<const D: usize>(
                 for (&c, d) in active.iter().zip(&dx) {
                     amount[c] += d;
                 }
-                let q: Vec<f64> = amount
-                    .iter()
-                    .zip(volumes)
-                    .map(|(a, v)| a * v / dt)
-                    .collect();
-                system.set_void_source(Some(q))?;
+                set_voids(system, &amount, volumes, dt)?;
                 let mut s = step.solve(system)?;
                 solves += 1;
                 if refined && let Some(better) = step.refine(system)? {
@@ -469,12 +480,7 @@ fn settle<const D: usize>(
                 break 'passes;
             };
             amount = voids;
-            let q: Vec<f64> = amount
-                .iter()
-                .zip(volumes)
-                .map(|(a, v)| a * v / dt)
-                .collect();
-            system.set_void_source(Some(q))?;
+            set_voids(system, &amount, volumes, dt)?;
             step.solve(system)?;
             solves += 1;
             let Some(s) = step.refine(system)? else {
