@@ -656,6 +656,32 @@ impl CsrMatrix {
             });
     }
 
+    /// For a matrix in single precision laid out as [`SymCsr`] with the column offsets
+    /// `col_ptr`: its upper triangle into `out` (column `i` is the first `col_ptr[i+1] −
+    /// col_ptr[i]` entries of row `i`), in parallel; false (and `out` untouched) for one
+    /// in double precision.
+    pub(crate) fn upper_single(&self, col_ptr: &[usize], out: &mut Vec<f32>) -> bool {
+        let Values::Single(v) = &self.val else {
+            return false;
+        };
+        let n = self.nrows;
+        out.resize(col_ptr[n], 0.0);
+        let bounds = block_bounds(n, ROWS_PER_TASK * 8);
+        let parts = split_by_items(out, &bounds, |i| col_ptr[i]);
+        parts.into_par_iter().for_each(|(first, part)| {
+            let mut at = 0;
+            let mut i = first;
+            while at < part.len() {
+                let len = col_ptr[i + 1] - col_ptr[i];
+                let p0 = self.row_ptr[i];
+                part[at..at + len].copy_from_slice(&v[p0..p0 + len]);
+                at += len;
+                i += 1;
+            }
+        });
+        true
+    }
+
     /// The transpose, and for each of its entries the position of the same entry in `self`.
     #[cfg(test)]
     pub(crate) fn transpose_with_map(&self) -> (CsrMatrix, Vec<usize>) {

@@ -51,7 +51,7 @@ use faer::dyn_stack::MemBuffer;
 use crate::aggregate::{Blocks, Tentative, aggregate, strength, tentative};
 use crate::coarse::CoarseSolver;
 use crate::csr::{
-    CsrMatrix, SymCsr, check_upper_values, equals_upper, fill_from_upper, par_rows, vec_bytes,
+    CsrMatrix, SymCsr, check_upper_values, dot, equals_upper, fill_from_upper, par_rows, vec_bytes,
     zeros,
 };
 use crate::error::{AmgError, Result, check_finite};
@@ -61,7 +61,7 @@ use crate::product::{
     symbolic_prolongator,
 };
 use crate::smoother::{Chebyshev, SmoothWork, spectral_radius};
-use crate::upper::UpperProduct;
+use crate::upper::{UpperProduct, UpperSingle};
 
 /// Parameters of the setup and the cycle. The defaults suit 2D and 3D elasticity with
 /// rigid-body modes and scalar diffusion with the constant.
@@ -247,6 +247,9 @@ pub struct Amg {
     /// Partition of the product with the caller's upper triangle (built by the
     /// first [`Amg::solve_upper`]).
     upper: Option<UpperProduct>,
+    /// The finest matrix's upper triangle in single precision for its smoother and
+    /// spectral estimate (see [`UPPER_MIN_ENTRIES_PER_ROW`]).
+    fine_upper: Option<UpperSingle>,
     /// False after a failed [`Amg::update_values`].
     valid: bool,
 }
@@ -260,6 +263,16 @@ impl std::fmt::Debug for Amg {
             .finish()
     }
 }
+
+/// A finest matrix stored in single precision with at least this many entries per row on
+/// average (3D elasticity: about 45) is smoothed through its upper triangle
+/// ([`crate::upper::UpperSingle`]): half the bytes of the full rows per product, for a
+/// kernel that gathers along a column and scatters along a row. With shorter rows (2D
+/// elasticity: about 14) the kernel's work per byte outweighs the saving: on a grid of
+/// 2 M equations with 14 entries per row the double-precision upper product took 29 ms
+/// against 16 ms for the full single-precision one, on 0.19 M equations with 43 per row
+/// 5.2 ms against 5.0 ms for the same bytes (docs/BENCHMARKS.md).
+pub const UPPER_MIN_ENTRIES_PER_ROW: usize = 24;
 
 /// `1/a_ii`, or an error naming a non-positive diagonal.
 fn inverse_diagonal(a: &CsrMatrix, level: usize) -> Result<Vec<f64>> {
@@ -321,6 +334,11 @@ impl Amg {
             )));
         }
         let (a0, fine_col_ptr) = matrix.into_parts();
+        let fine_upper = if a0.nnz() >= UPPER_MIN_ENTRIES_PER_ROW * n {
+            UpperSingle::new(&a0, &fine_col_ptr)
+        } else {
+            None
+        };
         let mut levels: Vec<Level> = Vec::new();
         let mut a = a0;
         loop {
@@ -364,7 +382,8 @@ impl Amg {
                 off,
             };
             let mut level = Level::new(a, dinv, Some(transfer));
-            if !smooth_level(&mut level, options) {
+            let op = fine_upper.as_ref().filter(|_| l == 0);
+            if !smooth_level(&mut level, op, &fine_col_ptr, options) {
                 return Err(internal());
             }
             let tr = level.transfer.as_mut().ok_or_else(internal)?;
@@ -407,7 +426,8 @@ impl Amg {
             fine_col_ptr,
             options: options.clone(),
             cg: Default::default(),
-            upper: None,
+            upper: fine_upper.as_ref().map(UpperSingle::partition),
+            fine_upper,
             valid: true,
         })
     }
@@ -456,12 +476,16 @@ impl Amg {
         check_upper_values(values, self.fine_col_ptr[self.n()])?;
         self.valid = false;
         fill_from_upper(&mut self.levels[0].a, &self.fine_col_ptr, values);
+        if let Some(u) = self.fine_upper.as_mut() {
+            u.refresh(&self.levels[0].a, &self.fine_col_ptr);
+        }
         let nl = self.levels.len();
         for l in 0..nl {
             let (lo, hi) = self.levels.split_at_mut(l + 1);
             let level = &mut lo[l];
             level.dinv = inverse_diagonal(&level.a, l)?;
-            if !smooth_level(level, &self.options) {
+            let op = self.fine_upper.as_ref().filter(|_| l == 0);
+            if !smooth_level(level, op, &self.fine_col_ptr, &self.options) {
                 break;
             }
             let tr = level.transfer.as_ref().ok_or_else(internal)?;
@@ -508,6 +532,7 @@ impl Amg {
     /// Cholesky factor is not counted).
     pub fn memory(&self) -> AmgMemory {
         let mut m = AmgMemory {
+            matrices: self.fine_upper.as_ref().map_or(0, UpperSingle::bytes),
             fine_map: vec_bytes(&self.fine_col_ptr),
             vectors: self.cg.iter().map(vec_bytes).sum::<usize>(),
             ..AmgMemory::default()
@@ -596,13 +621,14 @@ impl Amg {
         Ok(())
     }
 
-    /// One V-cycle without checks.
-    pub(crate) fn vcycle(&mut self, rhs: &[f64], out: &mut [f64]) {
+    /// One V-cycle without checks; returns `rhsᵀ out` (summed in the finest
+    /// post-smoother's last pass).
+    pub(crate) fn vcycle(&mut self, rhs: &[f64], out: &mut [f64]) -> f64 {
         let nl = self.levels.len();
         if nl == 1 {
             out.copy_from_slice(rhs);
             self.coarse.solve(out, &mut self.coarse_mem);
-            return;
+            return dot(rhs, out);
         }
         // Down: pre-smooth and restrict the residual.
         for l in 0..nl - 1 {
@@ -622,7 +648,13 @@ impl Amg {
                 d: &mut w.d,
                 dn: &mut w.dn,
             };
-            lev.smoother.smooth(&lev.a, &lev.dinv, b, x, true, true, sw);
+            match self.fine_upper.as_ref().filter(|_| l == 0) {
+                Some(u) => {
+                    let op = u.op(&lev.a, &self.fine_col_ptr);
+                    lev.smoother.smooth(&op, &lev.dinv, b, x, true, true, sw)
+                }
+                None => lev.smoother.smooth(&lev.a, &lev.dinv, b, x, true, true, sw),
+            };
             restrict(&tr.galerkin, &tr.p, &tr.off, &w.r, &mut hi[0].b);
         }
         // Coarsest level.
@@ -632,6 +664,7 @@ impl Amg {
             self.coarse.solve(&mut w.x, &mut self.coarse_mem);
         }
         // Up: prolongate the correction and post-smooth.
+        let mut rhs_out = None;
         for l in (0..nl - 1).rev() {
             let lev = &self.levels[l];
             let Some(tr) = lev.transfer.as_ref() else {
@@ -650,9 +683,17 @@ impl Amg {
                 d: &mut w.d,
                 dn: &mut w.dn,
             };
-            lev.smoother
-                .smooth(&lev.a, &lev.dinv, b, x, false, false, sw);
+            rhs_out = match self.fine_upper.as_ref().filter(|_| l == 0) {
+                Some(u) => {
+                    let op = u.op(&lev.a, &self.fine_col_ptr);
+                    lev.smoother.smooth(&op, &lev.dinv, b, x, false, false, sw)
+                }
+                None => lev
+                    .smoother
+                    .smooth(&lev.a, &lev.dinv, b, x, false, false, sw),
+            };
         }
+        rhs_out.unwrap_or_else(|| dot(rhs, out))
     }
 }
 
@@ -660,13 +701,23 @@ fn internal() -> AmgError {
     AmgError::Input("internal inconsistency of the multigrid hierarchy".into())
 }
 
-/// Numeric part of a level with a transfer: `ρ̂`, the smoother interval and `P`. Returns
-/// false on the coarsest level.
-fn smooth_level(level: &mut Level, options: &AmgOptions) -> bool {
+/// Numeric part of a level with a transfer: `ρ̂`, the smoother interval and `P`, the
+/// products of the estimate through `upper` where given (the finest level's upper
+/// triangle, with the column offsets `col_ptr`). Returns false on the coarsest level.
+fn smooth_level(
+    level: &mut Level,
+    upper: Option<&UpperSingle>,
+    col_ptr: &[usize],
+    options: &AmgOptions,
+) -> bool {
     if level.transfer.is_none() {
         return false;
     }
-    let rho = spectral_radius(&level.a, &level.dinv, options.lanczos_steps);
+    let steps = options.lanczos_steps;
+    let rho = match upper {
+        Some(u) => spectral_radius(&level.a, &u.op(&level.a, col_ptr), &level.dinv, steps),
+        None => spectral_radius(&level.a, &level.a, &level.dinv, steps),
+    };
     level.rho = rho;
     let hi = options.chebyshev_upper * rho;
     level.smoother = Chebyshev {

@@ -68,7 +68,7 @@ pub mod upper;
 
 pub use csr::{CsrMatrix, Precision, SymCsr};
 pub use error::{AmgError, Result};
-pub use hierarchy::{Amg, AmgMemory, AmgOptions, LevelInfo};
+pub use hierarchy::{Amg, AmgMemory, AmgOptions, LevelInfo, UPPER_MIN_ENTRIES_PER_ROW};
 pub use local::{LocalAggregation, aggregate_tentative};
 pub use nullspace::NearNullSpace;
 pub use pcg::CgStats;

@@ -11,9 +11,11 @@
 //!
 //! and `‖e_k‖_A ≤ 2 ((√κ − 1)/(√κ + 1))^k ‖e₀‖_A` with `κ = κ(M A)`: a multigrid
 //! preconditioner with a mesh-independent `κ` gives mesh-independent iteration counts.
-//! Besides the V-cycle an iteration makes four passes over the vectors: the product
-//! `A p_k` with `p_k·A p_k` summed in the same pass, the updates of `x` and `r` with
-//! `‖r_{k+1}‖²`, the dot product `r·z`, and the update of `p`.
+//! Besides the V-cycle an iteration makes three passes over the vectors: the product
+//! `A p_k` with `p_k·A p_k` summed in the same pass, the update of `r` with
+//! `‖r_{k+1}‖²`, and the update of `p` with the update of `x` by the previous `p`
+//! (`x_{k+1} = x_k + α_k p_k` waits for the pass that overwrites `p_k`). The dot product
+//! `r·z` is summed in the last pass of the V-cycle.
 //!
 //! It stops when the recursively updated residual satisfies `‖r_k‖ ≤ tol ‖b‖`, then checks
 //! the true residual `‖b − A x_k‖` (the recursion drifts from it by rounding); if that is
@@ -24,7 +26,7 @@
 //! the tolerance) is [`AmgError::Stagnation`], and the iteration limit is
 //! [`AmgError::NoConvergence`] with the residual reached.
 
-use crate::csr::{Precision, check_upper_values, dot, norm, par_rows, par_zip2_sum};
+use crate::csr::{Precision, check_upper_values, norm, par_rows, par_rows_sum, par_zip2_sum};
 use crate::error::{AmgError, Result, check_finite};
 use crate::hierarchy::Amg;
 
@@ -159,10 +161,10 @@ impl Amg {
                 });
             }
             let alpha = rz / pq;
+            // x += α p waits for the pass that updates p (or for the end).
             let rn = {
-                let (pp, qq): (&[f64], &[f64]) = (p, q);
-                par_zip2_sum(x, r, |i, xi, ri| {
-                    *xi += alpha * pp[i];
+                let qq: &[f64] = q;
+                par_rows_sum(r, |i, ri| {
                     *ri -= alpha * qq[i];
                     *ri * *ri
                 })
@@ -174,7 +176,21 @@ impl Amg {
                     what: format!("residual norm {rn}"),
                 });
             }
-            if rn <= target {
+            let converged = rn <= target;
+            let stagnated = !converged && {
+                if rn < best {
+                    best = rn;
+                    since_best = 0;
+                } else {
+                    since_best += 1;
+                }
+                since_best >= self.options.stagnation_window
+            };
+            if converged || stagnated {
+                let pp: &[f64] = p;
+                par_rows(x, |i, xi| *xi += alpha * pp[i]);
+            }
+            if converged {
                 // Check the true residual.
                 self.fine_residual(upper, b, x, q);
                 let true_rn = norm(q);
@@ -196,22 +212,15 @@ impl Amg {
                 rz = self.restart(r, z, p, it)?;
                 continue;
             }
-            if rn < best {
-                best = rn;
-                since_best = 0;
-            } else {
-                since_best += 1;
-                if since_best >= self.options.stagnation_window {
-                    self.fine_residual(upper, b, x, q);
-                    return Err(AmgError::Stagnation {
-                        iterations: it,
-                        residual: norm(q) / bnorm,
-                        tolerance: tol,
-                    });
-                }
+            if stagnated {
+                self.fine_residual(upper, b, x, q);
+                return Err(AmgError::Stagnation {
+                    iterations: it,
+                    residual: norm(q) / bnorm,
+                    tolerance: tol,
+                });
             }
-            self.vcycle(r, z);
-            let rz_new = dot(r, z);
+            let rz_new = self.vcycle(r, z);
             if rz_new.is_nan() || rz_new <= 0.0 {
                 return Err(AmgError::Breakdown {
                     iteration: it,
@@ -221,7 +230,11 @@ impl Amg {
             let beta = rz_new / rz;
             rz = rz_new;
             let zz: &[f64] = z;
-            par_rows(p, |i, pi| *pi = zz[i] + beta * *pi);
+            par_zip2_sum(x, p, |i, xi, pi| {
+                *xi += alpha * *pi;
+                *pi = zz[i] + beta * *pi;
+                0.0
+            });
         }
         self.fine_residual(upper, b, x, q);
         let true_rn = norm(q);
@@ -245,8 +258,7 @@ impl Amg {
 
     /// `z = M r`, `p = z`; returns `rᵀz` (error if not positive).
     fn restart(&mut self, r: &[f64], z: &mut [f64], p: &mut [f64], it: usize) -> Result<f64> {
-        self.vcycle(r, z);
-        let rz = dot(r, z);
+        let rz = self.vcycle(r, z);
         if rz.is_nan() || rz <= 0.0 {
             return Err(AmgError::Breakdown {
                 iteration: it,

@@ -42,6 +42,7 @@ use nalgebra::DMatrix;
 use rayon::prelude::*;
 
 use crate::csr::{CsrMatrix, par_rows, par_rows_sum, zeros};
+use crate::upper::RowProducts;
 
 /// A pseudo-random number in `[-0.5, 0.5)` from an index (splitmix64).
 fn hash_unit(i: usize) -> f64 {
@@ -71,7 +72,14 @@ fn gershgorin(a: &CsrMatrix, s: &[f64]) -> f64 {
 /// `β_{j+1} = ‖w‖_D`, `q_{j+1} = w / β_{j+1}`. Each step is two passes: the product with
 /// `α_j` summed alongside, and the update with `‖w‖_D²` summed alongside. The division by
 /// `β` is folded into the next step as a scale of the stored vector.
-pub(crate) fn spectral_radius(a: &CsrMatrix, dinv: &[f64], steps: usize) -> f64 {
+/// The products go through `op` (the matrix `a` itself or its upper triangle); Gershgorin's
+/// bound reads `a`.
+pub(crate) fn spectral_radius<P: RowProducts>(
+    a: &CsrMatrix,
+    op: &P,
+    dinv: &[f64],
+    steps: usize,
+) -> f64 {
     let n = a.nrows();
     let s: Vec<f64> = dinv.par_iter().map(|d| d.sqrt()).collect();
     if n <= 1 {
@@ -95,7 +103,7 @@ pub(crate) fn spectral_radius(a: &CsrMatrix, dinv: &[f64], steps: usize) -> f64 
         let bj = if j > 0 { beta[j - 1] } else { 0.0 };
         let (qs, ps) = (q_scale, bj * prev_scale);
         let (qq, qp): (&[f64], &[f64]) = (&q, &q_prev);
-        let aj = a.par_products_sum(qq, &mut w, |i, aq, wi| {
+        let aj = op.products_sum(qq, &mut w, |i, aq, wi| {
             *wi = dinv[i] * aq * qs - ps * qp[i];
             *wi * qq[i] * qs / dinv[i]
         });
@@ -143,22 +151,25 @@ pub(crate) struct SmoothWork<'a> {
 
 impl Chebyshev {
     /// `x ← x + p(D⁻¹A) D⁻¹ (b − A x)` (from `x = 0` when `x_zero`). With `residual`,
-    /// `w.r` holds `b − A x` for the returned `x`.
+    /// `w.r` holds `b − A x` for the returned `x` and the result is `None`; without it the
+    /// result is `Some(bᵀx)` for the returned `x`, summed in the last pass (the
+    /// post-smoother of the finest level gives CG its `rᵀz` this way).
     ///
     /// Each update of `x` is folded into the pass of the next product, and `r₀ = b` is
-    /// read from `b` when `x = 0`; a residual no later step needs is not stored. Degree 2
-    /// from `x = 0` with the residual (the pre-smoother) streams 12 vectors besides the two
-    /// products, from a given `x` without it (the post-smoother) 11.
-    pub(crate) fn smooth(
+    /// read from `b` when `x = 0`; a residual no later step needs is not stored, nor the
+    /// last `d`. Degree 2 from `x = 0` with the residual (the pre-smoother) streams 12
+    /// vectors besides the two products, from a given `x` without it (the post-smoother)
+    /// 10 with `bᵀx` (11 and a separate dot product of 2 before).
+    pub(crate) fn smooth<P: RowProducts>(
         &self,
-        a: &CsrMatrix,
+        a: &P,
         dinv: &[f64],
         b: &[f64],
         x: &mut [f64],
         x_zero: bool,
         residual: bool,
         w: SmoothWork<'_>,
-    ) {
+    ) -> Option<f64> {
         let SmoothWork { r, d, dn } = w;
         let theta = 0.5 * (self.hi + self.lo);
         let delta = 0.5 * (self.hi - self.lo);
@@ -167,27 +178,34 @@ impl Chebyshev {
         if x_zero {
             par_rows(d, |i, di| *di = dinv[i] * b[i] / theta);
         } else {
-            a.par_products2(x, r, d, |i, ax, ri, di| {
+            a.products2(x, r, d, |i, ax, ri, di| {
                 *ri = b[i] - ax;
                 *di = dinv[i] * *ri / theta;
             });
         }
+        let r0 = |i: usize, r: f64| if x_zero { b[i] } else { r };
         if self.degree <= 1 {
             let dd: &[f64] = d;
+            if residual {
+                if x_zero {
+                    x.copy_from_slice(dd);
+                } else {
+                    par_rows(x, |i, xi| *xi += dd[i]);
+                }
+                a.products(dd, r, |i, ad, ri| *ri = r0(i, *ri) - ad);
+                return None;
+            }
             if x_zero {
                 x.copy_from_slice(dd);
-                if residual {
-                    a.par_products(dd, r, |i, ad, ri| *ri = b[i] - ad);
-                }
-            } else {
-                par_rows(x, |i, xi| *xi += dd[i]);
-                if residual {
-                    a.par_products(dd, r, |_, ad, ri| *ri -= ad);
-                }
+                return Some(crate::csr::dot(b, x));
             }
-            return;
+            return Some(par_rows_sum(x, |i, xi| {
+                *xi += dd[i];
+                b[i] * *xi
+            }));
         }
         let mut rho = 1.0 / sigma;
+        let mut bx = None;
         for step in 1..self.degree {
             let rho_n = 1.0 / (2.0 * sigma - rho);
             let c1 = rho_n * rho;
@@ -195,39 +213,40 @@ impl Chebyshev {
             let dd: &[f64] = d;
             let first = step == 1;
             // r_j = r_{j−1} − A d_{j−1}, d_j = c₁ d_{j−1} + c₂ D⁻¹ r_j, x_{j+1} = x_j + d_j
-            // (x_j = x₀ + d₀ still pending on the first step).
-            let pending = |i: usize| if first { dd[i] } else { 0.0 };
-            let keep_r = residual || step + 1 < self.degree;
-            match (first && x_zero, keep_r) {
-                (true, true) => a.par_products3(dd, r, dn, x, |i, ad, ri, dni, xi| {
-                    *ri = b[i] - ad;
-                    *dni = c1 * dd[i] + c2 * dinv[i] * *ri;
-                    *xi = dd[i] + *dni;
-                }),
-                (true, false) => a.par_products2(dd, dn, x, |i, ad, dni, xi| {
-                    *dni = c1 * dd[i] + c2 * dinv[i] * (b[i] - ad);
-                    *xi = dd[i] + *dni;
-                }),
-                (false, true) => a.par_products3(dd, r, dn, x, |i, ad, ri, dni, xi| {
-                    *ri -= ad;
-                    *dni = c1 * dd[i] + c2 * dinv[i] * *ri;
-                    *xi += pending(i) + *dni;
-                }),
-                (false, false) => {
-                    let rr: &[f64] = r;
-                    a.par_products2(dd, dn, x, |i, ad, dni, xi| {
-                        *dni = c1 * dd[i] + c2 * dinv[i] * (rr[i] - ad);
-                        *xi += pending(i) + *dni;
-                    })
+            // (x_j = x₀ + d₀ still pending on the first step, x₀ = 0 when x_zero).
+            let new_x = |i: usize, xi: f64, dni: f64| {
+                if first && x_zero {
+                    dd[i] + dni
+                } else if first {
+                    xi + (dd[i] + dni)
+                } else {
+                    xi + dni
                 }
+            };
+            if residual || step + 1 < self.degree {
+                a.products3(dd, r, dn, x, |i, ad, ri, dni, xi| {
+                    *ri = if first { r0(i, *ri) } else { *ri } - ad;
+                    *dni = c1 * dd[i] + c2 * dinv[i] * *ri;
+                    *xi = new_x(i, *xi, *dni);
+                });
+            } else {
+                // The last step: neither r_j nor d_j is needed after it.
+                let rr: &[f64] = r;
+                bx = Some(a.products_sum(dd, x, |i, ad, xi| {
+                    let r_prev = if first { r0(i, rr[i]) } else { rr[i] };
+                    let dni = c1 * dd[i] + c2 * dinv[i] * (r_prev - ad);
+                    *xi = new_x(i, *xi, dni);
+                    b[i] * *xi
+                }));
             }
             std::mem::swap(d, dn);
             rho = rho_n;
         }
         if residual {
             let dd: &[f64] = d;
-            a.par_products(dd, r, |_, ad, ri| *ri -= ad);
+            a.products(dd, r, |_, ad, ri| *ri -= ad);
         }
+        bx
     }
 }
 
@@ -279,7 +298,7 @@ mod tests {
         let a = laplace_1d(n);
         let dinv = vec![0.5; n];
         let exact = 1.0 + (std::f64::consts::PI / (n as f64 + 1.0)).cos();
-        let est = spectral_radius(a.matrix(), &dinv, 12);
+        let est = spectral_radius(a.matrix(), a.matrix(), &dinv, 12);
         assert!(est <= exact * (1.0 + 1e-12), "{est} > {exact}");
         // Gershgorin gives 2 (= 1 + 1, not attained); Lanczos lands within 2 %.
         assert!(est > 0.98 * exact, "{est} vs {exact}");

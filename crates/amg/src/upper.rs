@@ -30,13 +30,17 @@
 
 use rayon::prelude::*;
 
-use crate::csr::{CsrMatrix, prefetch_ahead};
+use std::sync::Mutex;
+
+use crate::csr::{
+    CsrMatrix, ROWS_PER_TASK, Value, par_rows, par_rows_sum, par_zip2_sum, prefetch_ahead,
+};
 
 /// Rows per part at least.
 const MIN_PART: usize = 4096;
 
 /// The partition of the upper-triangle product for one pattern.
-#[derive(Debug, Default)]
+#[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct UpperProduct {
     /// Rows per part (the last part may be shorter).
     part: usize,
@@ -80,11 +84,11 @@ impl UpperProduct {
     /// along column `i`, diagonal included), `xᵀ A x = Σ_i x_i (2 g_i − u_ii x_i)`. Each
     /// part sums its rows; the part sums are added in part order, so the result does not
     /// depend on the number of threads either.
-    pub(crate) fn apply(
+    pub(crate) fn apply<T: Value>(
         &self,
         full: &CsrMatrix,
         col_ptr: &[usize],
-        upper: &[f64],
+        upper: &[T],
         x: &[f64],
         y: &mut [f64],
     ) -> f64 {
@@ -127,9 +131,9 @@ impl UpperProduct {
                             m += 1;
                         }
                         match m {
-                            1 => p.group::<1>(full, col_ptr, upper, x, i),
-                            2 => p.group::<2>(full, col_ptr, upper, x, i),
-                            _ => p.group::<3>(full, col_ptr, upper, x, i),
+                            1 => p.group::<1, T>(full, col_ptr, upper, x, i),
+                            2 => p.group::<2, T>(full, col_ptr, upper, x, i),
+                            _ => p.group::<3, T>(full, col_ptr, upper, x, i),
                         }
                         i += m;
                     }
@@ -154,7 +158,14 @@ struct Part<'a> {
 
 impl Part<'_> {
     /// Gather and scatter of one row with column indices, entry by entry.
-    fn row(&mut self, full: &CsrMatrix, col_ptr: &[usize], upper: &[f64], x: &[f64], i: usize) {
+    fn row<T: Value>(
+        &mut self,
+        full: &CsrMatrix,
+        col_ptr: &[usize],
+        upper: &[T],
+        x: &[f64],
+        i: usize,
+    ) {
         let vals = &upper[col_ptr[i]..col_ptr[i + 1]];
         let xi = x[i];
         let mut acc = 0.0;
@@ -162,7 +173,7 @@ impl Part<'_> {
         let mut q = 0;
         full.for_each_col_prefix(i, vals.len(), |c| {
             let c = c as usize;
-            let v = vals[q];
+            let v = vals[q].get();
             acc += v * x[c];
             q += 1;
             if c < i {
@@ -180,16 +191,16 @@ impl Part<'_> {
     /// piece of `y` updated once for all `M` rows. The few columns from `i` on (the
     /// node's own block) follow row by row.
     #[inline(always)]
-    fn group<const M: usize>(
+    fn group<const M: usize, T: Value>(
         &mut self,
         full: &CsrMatrix,
         col_ptr: &[usize],
-        upper: &[f64],
+        upper: &[T],
         x: &[f64],
         i: usize,
     ) {
         prefetch_ahead(upper, col_ptr[i]);
-        let vals: [&[f64]; M] = std::array::from_fn(|r| &upper[col_ptr[i + r]..col_ptr[i + r + 1]]);
+        let vals: [&[T]; M] = std::array::from_fn(|r| &upper[col_ptr[i + r]..col_ptr[i + r + 1]]);
         let xr: [f64; M] = std::array::from_fn(|r| x[i + r]);
         let mut acc = [0.0; M];
         let mut q = 0;
@@ -201,7 +212,7 @@ impl Part<'_> {
                 // Columns before `i`.
                 let e = (s + l).min(i);
                 if s < e {
-                    let v: [&[f64]; M] = std::array::from_fn(|r| &vals[r][q..q + e - s]);
+                    let v: [&[T]; M] = std::array::from_fn(|r| &vals[r][q..q + e - s]);
                     let y = &mut self.y[s - self.base..e - self.base];
                     joint(&v, &x[s..e], &xr, &mut acc, y);
                     q += e - s;
@@ -223,7 +234,7 @@ impl Part<'_> {
             let row = i + r;
             let mut diag = 0.0;
             for (t, &c) in tail[..ntail].iter().enumerate() {
-                let Some(&v) = vals[r].get(q + t) else {
+                let Some(v) = vals[r].get(q + t).map(|v| v.get()) else {
                     break;
                 };
                 acc[r] += v * x[c];
@@ -241,8 +252,8 @@ impl Part<'_> {
 
 /// `acc_r += v_r · xs` and `y += Σ_r v_r x_r` over one piece of columns.
 #[inline(always)]
-fn joint<const M: usize>(
-    v: &[&[f64]; M],
+fn joint<const M: usize, T: Value>(
+    v: &[&[T]; M],
     xs: &[f64],
     xr: &[f64; M],
     acc: &mut [f64; M],
@@ -251,11 +262,178 @@ fn joint<const M: usize>(
     for (t, (xc, yc)) in xs.iter().zip(y.iter_mut()).enumerate() {
         let mut s = 0.0;
         for r in 0..M {
-            let u = v[r][t];
+            let u = v[r][t].get();
             acc[r] += u * xc;
             s += u * xr[r];
         }
         *yc += s;
+    }
+}
+
+/// The products of a smoother or of the spectral estimate: `f(i, (A x)_i, …)` for every
+/// row, with the entries of any number of output vectors at row `i`. [`CsrMatrix`] computes
+/// `(A x)_i` row by row inside the pass; [`UpperOp`] computes `A x` first.
+pub(crate) trait RowProducts: Sync {
+    /// `f(i, (A x)_i, &mut y[i])` for every row.
+    fn products<F>(&self, x: &[f64], y: &mut [f64], f: F)
+    where
+        F: Fn(usize, f64, &mut f64) + Sync + Send;
+    /// `Σ_i f(i, (A x)_i, &mut y[i])`, summed by blocks of rows in a fixed order.
+    fn products_sum<F>(&self, x: &[f64], y: &mut [f64], f: F) -> f64
+    where
+        F: Fn(usize, f64, &mut f64) -> f64 + Sync + Send;
+    /// `f(i, (A x)_i, &mut y[i], &mut z[i])` for every row.
+    fn products2<F>(&self, x: &[f64], y: &mut [f64], z: &mut [f64], f: F)
+    where
+        F: Fn(usize, f64, &mut f64, &mut f64) + Sync + Send;
+    /// `f(i, (A x)_i, &mut y[i], &mut z[i], &mut w[i])` for every row.
+    fn products3<F>(&self, x: &[f64], y: &mut [f64], z: &mut [f64], w: &mut [f64], f: F)
+    where
+        F: Fn(usize, f64, &mut f64, &mut f64, &mut f64) + Sync + Send;
+}
+
+impl RowProducts for CsrMatrix {
+    fn products<F>(&self, x: &[f64], y: &mut [f64], f: F)
+    where
+        F: Fn(usize, f64, &mut f64) + Sync + Send,
+    {
+        self.par_products(x, y, f)
+    }
+    fn products_sum<F>(&self, x: &[f64], y: &mut [f64], f: F) -> f64
+    where
+        F: Fn(usize, f64, &mut f64) -> f64 + Sync + Send,
+    {
+        self.par_products_sum(x, y, f)
+    }
+    fn products2<F>(&self, x: &[f64], y: &mut [f64], z: &mut [f64], f: F)
+    where
+        F: Fn(usize, f64, &mut f64, &mut f64) + Sync + Send,
+    {
+        self.par_products2(x, y, z, f)
+    }
+    fn products3<F>(&self, x: &[f64], y: &mut [f64], z: &mut [f64], w: &mut [f64], f: F)
+    where
+        F: Fn(usize, f64, &mut f64, &mut f64, &mut f64) + Sync + Send,
+    {
+        self.par_products3(x, y, z, w, f)
+    }
+}
+
+/// The upper triangle of a symmetric matrix in single precision, kept next to its full
+/// single-precision rows: the products of the finest level's smoother and spectral
+/// estimate then read 4 bytes per entry of the upper triangle, about half of the full
+/// matrix's values (see [`crate::hierarchy`] for when the hierarchy uses it).
+#[derive(Debug)]
+pub(crate) struct UpperSingle {
+    part: UpperProduct,
+    vals: Vec<f32>,
+    /// `A x` of the last product.
+    ax: Mutex<Vec<f64>>,
+}
+
+impl UpperSingle {
+    /// The upper triangle of `full` (a matrix stored in single precision, laid out as
+    /// [`crate::SymCsr`] with the column offsets `col_ptr`); `None` for one in double
+    /// precision.
+    pub(crate) fn new(full: &CsrMatrix, col_ptr: &[usize]) -> Option<Self> {
+        let mut vals = Vec::new();
+        if !full.upper_single(col_ptr, &mut vals) {
+            return None;
+        }
+        Some(Self {
+            part: UpperProduct::new(full, col_ptr),
+            vals,
+            ax: Mutex::new(Vec::new()),
+        })
+    }
+
+    /// Copy the values of `full` again (after new values on the same pattern).
+    pub(crate) fn refresh(&mut self, full: &CsrMatrix, col_ptr: &[usize]) {
+        full.upper_single(col_ptr, &mut self.vals);
+    }
+
+    /// The partition of the product.
+    pub(crate) fn partition(&self) -> UpperProduct {
+        self.part
+    }
+
+    /// Heap bytes held.
+    pub(crate) fn bytes(&self) -> usize {
+        crate::csr::vec_bytes(&self.vals)
+            + self.ax.lock().map_or(0, |ax| crate::csr::vec_bytes(&ax))
+    }
+
+    /// The operator on the pattern of `full`.
+    pub(crate) fn op<'a>(&'a self, full: &'a CsrMatrix, col_ptr: &'a [usize]) -> UpperOp<'a> {
+        UpperOp {
+            upper: self,
+            full,
+            col_ptr,
+        }
+    }
+}
+
+/// [`UpperSingle`] on its pattern: `A x` by [`UpperProduct::apply`] into a buffer, then
+/// the rows' functions in parallel blocks (the same blocks as [`CsrMatrix`]'s passes).
+pub(crate) struct UpperOp<'a> {
+    upper: &'a UpperSingle,
+    full: &'a CsrMatrix,
+    col_ptr: &'a [usize],
+}
+
+impl UpperOp<'_> {
+    /// `g(ax)` with `ax = A x`.
+    fn with_product<R>(&self, x: &[f64], g: impl FnOnce(&[f64]) -> R) -> R {
+        let mut ax = self.upper.ax.lock().unwrap_or_else(|e| e.into_inner());
+        ax.resize(self.full.nrows(), 0.0);
+        let _ = self
+            .upper
+            .part
+            .apply(self.full, self.col_ptr, &self.upper.vals, x, &mut ax);
+        g(&ax)
+    }
+}
+
+impl RowProducts for UpperOp<'_> {
+    fn products<F>(&self, x: &[f64], y: &mut [f64], f: F)
+    where
+        F: Fn(usize, f64, &mut f64) + Sync + Send,
+    {
+        self.with_product(x, |ax| par_rows(y, |i, yi| f(i, ax[i], yi)))
+    }
+    fn products_sum<F>(&self, x: &[f64], y: &mut [f64], f: F) -> f64
+    where
+        F: Fn(usize, f64, &mut f64) -> f64 + Sync + Send,
+    {
+        self.with_product(x, |ax| par_rows_sum(y, |i, yi| f(i, ax[i], yi)))
+    }
+    fn products2<F>(&self, x: &[f64], y: &mut [f64], z: &mut [f64], f: F)
+    where
+        F: Fn(usize, f64, &mut f64, &mut f64) + Sync + Send,
+    {
+        self.with_product(x, |ax| {
+            par_zip2_sum(y, z, |i, yi, zi| {
+                f(i, ax[i], yi, zi);
+                0.0
+            });
+        })
+    }
+    fn products3<F>(&self, x: &[f64], y: &mut [f64], z: &mut [f64], w: &mut [f64], f: F)
+    where
+        F: Fn(usize, f64, &mut f64, &mut f64, &mut f64) + Sync + Send,
+    {
+        self.with_product(x, |ax| {
+            y.par_chunks_mut(ROWS_PER_TASK)
+                .zip(z.par_chunks_mut(ROWS_PER_TASK))
+                .zip(w.par_chunks_mut(ROWS_PER_TASK))
+                .enumerate()
+                .for_each(|(b, ((ys, zs), ws))| {
+                    let base = b * ROWS_PER_TASK;
+                    for k in 0..ys.len() {
+                        f(base + k, ax[base + k], &mut ys[k], &mut zs[k], &mut ws[k]);
+                    }
+                });
+        })
     }
 }
 
@@ -350,6 +528,100 @@ mod tests {
         assert!(y.iter().zip(&y2).all(|(a, b)| a.to_bits() == b.to_bits()));
         assert_eq!(energy.to_bits(), energy2.to_bits());
         up
+    }
+
+    /// The upper triangle in single precision gives the products of the full
+    /// single-precision rows, in all four forms, to the rounding of the different order of
+    /// the sums (the values are the same `f32`s), and the same bits on one thread and two.
+    #[test]
+    fn single_upper_products_match_the_full_rows() {
+        use crate::csr::Precision;
+        let nodes = 6000;
+        let (col_ptr, rows, vals) = node_band(nodes, 3, &[0, 1, 2, 30, 31]);
+        let n = 3 * nodes;
+        let a = SymCsr::from_upper_csc_in(Precision::Single, n, &col_ptr, &rows, &vals).unwrap();
+        let full = a.matrix();
+        let upper = UpperSingle::new(full, &col_ptr).unwrap();
+        assert!(
+            UpperSingle::new(
+                SymCsr::from_upper_csc(n, &col_ptr, &rows, &vals)
+                    .unwrap()
+                    .matrix(),
+                &col_ptr
+            )
+            .is_none()
+        );
+        let op = upper.op(full, &col_ptr);
+        let x: Vec<f64> = (0..n).map(|i| (0.1 * i as f64).cos()).collect();
+        let w: Vec<f64> = (0..n).map(|i| 1.0 + (0.3 * i as f64).sin()).collect();
+        let close = |u: &[f64], v: &[f64]| {
+            u.iter()
+                .zip(v)
+                .all(|(p, q)| (p - q).abs() <= 1e-13 * q.abs().max(1.0))
+        };
+        // Every form through one operator; the outputs of all four.
+        let forms = |p: &dyn Fn(&mut [Vec<f64>; 5]) -> f64| {
+            let mut out: [Vec<f64>; 5] = std::array::from_fn(|_| vec![0.0; n]);
+            let s = p(&mut out);
+            (out, s)
+        };
+        let via_full = forms(&|o: &mut [Vec<f64>; 5]| {
+            let [y0, y1, y2, y3, y4] = o;
+            full.par_products(&x, y0, |i, ax, y| *y = ax * w[i]);
+            full.par_products2(&x, y1, y2, |_, ax, y, z| (*y, *z) = (ax, 2.0 * ax));
+            full.par_products3(&x, y3, y4, y2, |_, ax, y, z, v| {
+                (*y, *z, *v) = (ax - 1.0, ax + 1.0, *v + ax)
+            });
+            full.par_products_sum(&x, y1, |i, ax, y| {
+                *y += ax;
+                ax * x[i]
+            })
+        });
+        let via_upper = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| {
+                    forms(&|o: &mut [Vec<f64>; 5]| {
+                        let [y0, y1, y2, y3, y4] = o;
+                        op.products(&x, y0, |i, ax, y| *y = ax * w[i]);
+                        op.products2(&x, y1, y2, |_, ax, y, z| (*y, *z) = (ax, 2.0 * ax));
+                        op.products3(&x, y3, y4, y2, |_, ax, y, z, v| {
+                            (*y, *z, *v) = (ax - 1.0, ax + 1.0, *v + ax)
+                        });
+                        op.products_sum(&x, y1, |i, ax, y| {
+                            *y += ax;
+                            ax * x[i]
+                        })
+                    })
+                })
+        };
+        let (want, want_sum) = via_full;
+        let (got, sum) = via_upper(2);
+        for (g, w) in got.iter().zip(&want) {
+            assert!(close(g, w));
+        }
+        assert!((sum - want_sum).abs() <= 1e-12 * want_sum.abs());
+        let (got1, sum1) = via_upper(1);
+        assert_eq!(sum.to_bits(), sum1.to_bits());
+        for (g, h) in got.iter().zip(&got1) {
+            assert!(g.iter().zip(h).all(|(p, q)| p.to_bits() == q.to_bits()));
+        }
+        // New values on the same pattern: the copy follows them.
+        let doubled: Vec<f64> = vals.iter().map(|v| 2.0 * v).collect();
+        let mut a2 = a.clone();
+        a2.set_values(&doubled).unwrap();
+        let mut upper2 = UpperSingle::new(full, &col_ptr).unwrap();
+        upper2.refresh(a2.matrix(), &col_ptr);
+        let mut y = vec![0.0; n];
+        upper2
+            .op(a2.matrix(), &col_ptr)
+            .products(&x, &mut y, |_, ax, y| *y = ax);
+        let mut ax = vec![0.0; n];
+        full.par_products(&x, &mut ax, |_, v, y| *y = v);
+        let twice: Vec<f64> = ax.iter().map(|v| 2.0 * v).collect();
+        assert!(close(&y, &twice));
     }
 
     #[test]
