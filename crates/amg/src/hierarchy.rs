@@ -34,7 +34,9 @@
 //! preconditioner, and CG multiplies by the caller's double-precision upper triangle
 //! ([`Amg::solve_upper`], [`crate::upper`]), so the solution and its residual are those of
 //! `A`. The iterations stay within a few of the double-precision hierarchy's (tested on
-//! E2, E3 and at ν = 0.499).
+//! E2, E3 and at ν = 0.499). With long rows ([`UPPER_MIN_ENTRIES_PER_ROW`]) the finest
+//! level's smoother and spectral estimate multiply by a single-precision copy of the upper
+//! triangle instead of the full rows: the same `f32` values, half the bytes.
 //!
 //! # V-cycle
 //!
@@ -265,10 +267,10 @@ impl std::fmt::Debug for Amg {
 }
 
 /// A finest matrix stored in single precision with at least this many entries per row on
-/// average (3D elasticity: about 45) is smoothed through its upper triangle
-/// ([`crate::upper::UpperSingle`]): half the bytes of the full rows per product, for a
-/// kernel that gathers along a column and scatters along a row. With shorter rows (2D
-/// elasticity: about 14) the kernel's work per byte outweighs the saving: on a grid of
+/// average (3D elasticity: about 43) is smoothed through its upper triangle, kept in
+/// single precision next to the full rows ([`crate::upper`]): half the bytes of the full
+/// rows per product, for a kernel that gathers along a column and scatters along a row.
+/// With shorter rows (2D elasticity: about 14) the kernel's work per byte outweighs the saving: on a grid of
 /// 2 M equations with 14 entries per row the double-precision upper product took 29 ms
 /// against 16 ms for the full single-precision one, on 0.19 M equations with 43 per row
 /// 5.2 ms against 5.0 ms for the same bytes (docs/BENCHMARKS.md).

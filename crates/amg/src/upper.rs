@@ -27,6 +27,12 @@
 //!
 //! Traffic: one read of the `8 B` upper values (about half the full matrix) and of the
 //! pattern's run tables, instead of `8 B` for every entry of the full matrix.
+//!
+//! The kernel is generic over the stored precision: `UpperSingle` keeps the upper
+//! triangle of a hierarchy's single-precision finest matrix as `f32` (`4 B` per upper
+//! entry against `4 B` per full entry for the full rows), and `UpperOp` runs the
+//! smoother's and the spectral estimate's fused row updates (`RowProducts`) on its
+//! products.
 
 use rayon::prelude::*;
 
