@@ -15,7 +15,13 @@
 # (default scenes/hydrofrac_seed.toml; it must hold a line `refine = 12 ...`); SET keys
 # given to every run as `--set` (space-separated `key=value`, e.g.
 # SET="physics.cavitation_pressure=2.3e3" for the fluid-lag scene bounded by cavitation).
-# Also printed: the fractured cells and the reach at every 300 s.
+# Also printed: the fractured cells and the reach of each wing at every 300 s, the total
+# length (tip to tip: the two wings' reaches added), the one-crack offset (the largest
+# distance from the line x = 15 m of a fractured centroid beyond two cells of the wall,
+# against the cell `√2/refine`, as in crates/cli/tests/hydrofrac.rs), and the changes of
+# the reach, of each wing and of the total length between the two finest grids. With
+# RUN=0 the runs already in OUTDIR are only read (e.g. grids run one per call, possibly
+# with a different `SET="schedule.dt=..."` each).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 bin=${PORO_BIN:-$root/target/release/porofrac}
@@ -26,6 +32,7 @@ refines=("$@")
 [ ${#refines[@]} -eq 0 ] && refines=(12 17 24)
 mkdir -p "$out"
 for r in "${refines[@]}"; do
+    [ "${RUN:-1}" = 0 ] && break
     d=$out/refine_$r
     mkdir -p "$d"
     sed -e "s/^refine = 12 .*/refine = $r/" -e "0,/^name = \".*\"/s//name = \"hydrofrac_refine_$r\"/" \
@@ -48,27 +55,36 @@ for r in refines:
     cells = [(float(f["x [m]"]) - cx, float(f["y [m]"]) - cy, float(f["time [s]"]))
              for f in csv.DictReader(open(d / "fracture.csv"))]
     pts = [(x, y) for x, y, t in cells if t <= 2400.0]
-    history = [(sum(1 for _, _, t in cells if t <= T),
-                max([math.hypot(x, y) for x, y, t in cells if t <= T], default=0.0))
-               for T in range(300, 2401, 300)]
+
+    def wings(T):
+        up = max([math.hypot(x, y) for x, y, t in cells if t <= T and y > 0], default=0.0)
+        down = max([math.hypot(x, y) for x, y, t in cells if t <= T and y < 0], default=0.0)
+        return up, down
+
+    history = [(sum(1 for _, _, t in cells if t <= T), *wings(T)) for T in range(300, 2401, 300)]
     # Axis through the centre: principal direction of the second moments about the centre.
     sxx = sum(x * x for x, _ in pts); syy = sum(y * y for _, y in pts); sxy = sum(x * y for x, y in pts)
     ang = 0.5 * math.degrees(math.atan2(2 * sxy, sxx - syy)) % 180.0
-    dist = [math.hypot(x, y) for x, y in pts]
-    up = max([h for (x, y), h in zip(pts, dist) if y > 0], default=0.0)
-    down = max([h for (x, y), h in zip(pts, dist) if y < 0], default=0.0)
-    rows.append((r, s["cells"], len(pts), up, down, max(up, down), ang, s["wall_seconds"]["total"], history))
-print("| h (m) | refine | cells | fractured | reach up (m) | reach down (m) | reach (m) | direction (° from x) | wall (s) |")
-print("|---|---|---|---|---|---|---|---|---|")
-for r, c, n, up, down, reach, ang, wall, _ in rows:
-    print(f"| 1/{r} | {r} | {c} | {n} | {up:.3f} | {down:.3f} | {reach:.3f} | {ang:.1f} | {wall:.1f} |")
-print("\nfractured cells / reach (m) against time\n")
+    up, down = wings(2400.0)
+    cell = math.sqrt(2.0) / r
+    off = max([abs(x) for x, y in pts if abs(y) > 0.25 + 2 * cell], default=0.0)
+    rows.append(dict(r=r, cells=s["cells"], n=len(pts), up=up, down=down, reach=max(up, down),
+                     total=up + down, ang=ang, off=off, cell=cell,
+                     wall=s["wall_seconds"]["total"], history=history))
+print("| h (m) | refine | cells | fractured | reach up (m) | reach down (m) | reach (m) | total (m) | direction (° from x) | off (m) / cell (m) | wall (s) |")
+print("|---|---|---|---|---|---|---|---|---|---|---|")
+for w in rows:
+    print(f"| 1/{w['r']} | {w['r']} | {w['cells']} | {w['n']} | {w['up']:.3f} | {w['down']:.3f} | {w['reach']:.3f} | "
+          f"{w['total']:.3f} | {w['ang']:.1f} | {w['off']:.3f} / {w['cell']:.3f} | {w['wall']:.1f} |")
+print("\nfractured cells / reach up / reach down (m) against time\n")
 print("| refine | " + " | ".join(f"{T} s" for T in range(300, 2401, 300)) + " |")
 print("|---" * 9 + "|")
-for row in rows:
-    print(f"| {row[0]} | " + " | ".join(f"{n} / {h:.2f}" for n, h in row[8]) + " |")
+for w in rows:
+    print(f"| {w['r']} | " + " | ".join(f"{n} / {u:.2f} / {d:.2f}" for n, u, d in w["history"]) + " |")
 if len(rows) >= 2:
     a, b = rows[-2], rows[-1]
-    print(f"\nbetween refine {a[0]} and {b[0]}: reach change {abs(b[5] - a[5]) / b[5] * 100:.1f} % "
-          f"(issue: < 10 %), direction change {abs(b[6] - a[6]):.1f}° (issue: < 5°)")
+    change = {k: abs(b[k] - a[k]) / b[k] * 100 if b[k] > 0 else float("inf") for k in ("reach", "up", "down", "total")}
+    print(f"\nbetween refine {a['r']} and {b['r']}: reach change {change['reach']:.1f} %, "
+          f"direction change {abs(b['ang'] - a['ang']):.1f}°; upper wing {change['up']:.1f} %, "
+          f"lower wing {change['down']:.1f} %, total length {change['total']:.1f} %")
 PY

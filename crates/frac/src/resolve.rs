@@ -7,7 +7,16 @@
 //! [`FailurePolicy`]; the default fails, per round, every violating cell whose utilization
 //! is within 1 % of the largest, so symmetric states fail together while a redistributed
 //! stress gets the chance to relieve neighbours.
+//!
+//! [`FailurePolicy::MostCriticalNear`] takes the largest utilization near each cell
+//! instead (within a radius of its centroid): the cells most critical in their own
+//! neighbourhood fail together, one per crack tip, say, when the tips lie farther apart
+//! than the radius. The global rule lets one tip grow alone whenever its utilization
+//! exceeds the other's, even when both exceed 1: under one pressure the two tips of a
+//! crack have the same stress intensity, and a reading that differs by a few percent
+//! between them then decides which wing grows.
 
+use porofrac_grid::Point;
 use porofrac_law::Tensor;
 
 use crate::toughness::CrackTips;
@@ -18,13 +27,16 @@ use crate::{Combined, FailureState};
 /// `class_of_cell[c]` the class of cell `c` (an empty [`Combined`] never fails); with
 /// `tips`, the cells next to a crack check their toughness too ([`crate::toughness`]).
 #[derive(Clone, Copy)]
-pub struct CellCriteria<'a> {
+pub struct CellCriteria<'a, const D: usize> {
     /// The criterion of every class.
     pub criteria: &'a [Combined],
     /// The class of every cell.
     pub class_of_cell: &'a [usize],
     /// Crack-tip cells and their radii, for the criteria with a toughness.
     pub tips: Option<&'a CrackTips>,
+    /// The centroid of every cell, for [`FailurePolicy::MostCriticalNear`] (without them
+    /// that policy is [`FailurePolicy::MostCritical`]).
+    pub centroids: Option<&'a [Point<D>]>,
 }
 
 /// Which violating cells fail in one round.
@@ -36,6 +48,14 @@ pub enum FailurePolicy {
     MostCritical {
         /// In (0, 1].
         fraction: f64,
+    },
+    /// Violating cells with utilization ≥ `fraction` × the largest utilization of the
+    /// violating cells within `radius` of their centroid (module docs).
+    MostCriticalNear {
+        /// In (0, 1].
+        fraction: f64,
+        /// The radius (m) of a cell's neighbourhood.
+        radius: f64,
     },
 }
 
@@ -75,7 +95,7 @@ pub enum ResolveError<E> {
 pub fn resolve<const D: usize, S, E>(
     state: &mut FailureState,
     time: f64,
-    criteria: CellCriteria<'_>,
+    criteria: CellCriteria<'_, D>,
     policy: FailurePolicy,
     mut tracking: Option<&mut CrackTracking<D>>,
     max_solves: usize,
@@ -110,17 +130,34 @@ pub fn resolve<const D: usize, S, E>(
         if violating.is_empty() {
             return Ok((solution, stress, new_failures, round));
         }
-        let threshold = match policy {
-            FailurePolicy::All => f64::NEG_INFINITY,
-            FailurePolicy::MostCritical { fraction } => {
-                fraction
-                    * violating
+        let largest = violating
+            .iter()
+            .map(|v| v.1)
+            .fold(f64::NEG_INFINITY, f64::max);
+        let chosen: Vec<bool> = match (policy, criteria.centroids) {
+            (FailurePolicy::All, _) => vec![true; violating.len()],
+            (FailurePolicy::MostCriticalNear { fraction, radius }, Some(x)) => violating
+                .iter()
+                .map(|&(c, u, _)| {
+                    let near = violating
                         .iter()
-                        .map(|v| v.1)
-                        .fold(f64::NEG_INFINITY, f64::max)
-            }
+                        .filter(|w| (x[w.0] - x[c]).norm() <= radius)
+                        .map(|w| w.1)
+                        .fold(f64::NEG_INFINITY, f64::max);
+                    u >= fraction * near
+                })
+                .collect(),
+            (
+                FailurePolicy::MostCritical { fraction }
+                | FailurePolicy::MostCriticalNear { fraction, .. },
+                _,
+            ) => violating
+                .iter()
+                .map(|v| v.1 >= fraction * largest)
+                .collect(),
         };
-        violating.retain(|v| v.1 >= threshold);
+        let mut keep = chosen.into_iter();
+        violating.retain(|_| keep.next().unwrap_or(false));
         // Every crack point is taken on the lines of the cells failed before this round.
         if let Some(t) = tracking.as_deref_mut() {
             for &(c, _, _) in &violating {
@@ -163,6 +200,7 @@ mod tests {
                 criteria: std::slice::from_ref(&criterion),
                 class_of_cell: &class,
                 tips,
+                centroids: None,
             },
             policy,
             None,
@@ -203,6 +241,7 @@ mod tests {
                 criteria: &criteria,
                 class_of_cell: &class,
                 tips: None,
+                centroids: None,
             },
             FailurePolicy::default(),
             None,
@@ -266,6 +305,63 @@ mod tests {
                 ..
             }
         ));
+    }
+
+    /// Cells at x = 0, 0.5 and 10 with utilizations 3, 2 and 1.5 (σ_t = 1, stresses
+    /// unchanged by failures), one round: the global rule fails cell 0 alone; the rule
+    /// near each cell, with a radius of 1, fails cell 0 and cell 2 (the largest within 1
+    /// of it is its own), not cell 1 (cell 0 lies within 1 of it); with a radius of 20 it
+    /// is the global rule; without centroids too.
+    #[test]
+    fn the_most_critical_near_each_cell_fail_together_when_far_apart() {
+        let criterion = Combined {
+            tensile: Some(Tensile::new(1.0).unwrap()),
+            shear: None,
+            toughness: None,
+        };
+        let class = vec![0; 3];
+        let x: Vec<Point<2>> = [0.0, 0.5, 10.0]
+            .iter()
+            .map(|&a| Point::<2>::new(a, 0.0))
+            .collect();
+        let sigma = [3.0, 2.0, 1.5];
+        let one_round = |policy: FailurePolicy, centroids: Option<&[Point<2>]>| {
+            let mut st = FailureState::new(3);
+            let _ = resolve::<2, (), ()>(
+                &mut st,
+                0.0,
+                CellCriteria {
+                    criteria: std::slice::from_ref(&criterion),
+                    class_of_cell: &class,
+                    tips: None,
+                    centroids,
+                },
+                policy,
+                None,
+                1,
+                |_| {
+                    Ok((
+                        (),
+                        sigma
+                            .iter()
+                            .map(|&s| Tensor::<2>::new(s, 0.0, 0.0, 0.0))
+                            .collect(),
+                    ))
+                },
+            );
+            st.flags().to_vec()
+        };
+        let near = |radius| FailurePolicy::MostCriticalNear {
+            fraction: 0.99,
+            radius,
+        };
+        assert_eq!(
+            one_round(FailurePolicy::default(), Some(&x)),
+            [true, false, false]
+        );
+        assert_eq!(one_round(near(1.0), Some(&x)), [true, false, true]);
+        assert_eq!(one_round(near(20.0), Some(&x)), [true, false, false]);
+        assert_eq!(one_round(near(1.0), None), [true, false, false]);
     }
 
     /// Three unit squares in a row with constant stresses σ₁ = 3, 2, 2 and σ_t = 1. Cell 0

@@ -209,7 +209,12 @@ pub enum TipRule {
     /// when that `K_I` exceeds `K_Ic`; one beside a crack is held; one next to a crack
     /// that does not reach the distance behind it (a crack of a few cells at a wall) fails
     /// by its tensile strength, as away from cracks. The measure keeps the principal
-    /// directions of the cell's own stress, which crack tracking reads.
+    /// directions of the cell's own stress, which crack tracking reads. Under the
+    /// policy [`FailurePolicy::MostCritical`] the cells fail per round by the largest
+    /// utilization within the distance of them ([`FailurePolicy::MostCriticalNear`]):
+    /// the most critical cell of every tip, so the tips of a crack under one pressure
+    /// grow together when each reads more than `K_Ic` ([`crate::tip_distance`], "Which
+    /// tips grow").
     OpeningAt {
         /// `E′ = E/(1 − ν²)` (Pa) of every cell.
         e_prime: Vec<f64>,
@@ -230,6 +235,21 @@ pub enum TipRule {
 }
 
 impl FractureSettings {
+    /// The policy the resolution applies: [`Self::policy`], except that
+    /// [`TipRule::OpeningAt`] takes [`FailurePolicy::MostCritical`] near each cell, within
+    /// its sample distance.
+    pub fn policy_of_rule(&self) -> FailurePolicy {
+        match (&self.tip, self.policy) {
+            (TipRule::OpeningAt { distance, .. }, FailurePolicy::MostCritical { fraction }) => {
+                FailurePolicy::MostCriticalNear {
+                    fraction,
+                    radius: *distance,
+                }
+            }
+            (_, policy) => policy,
+        }
+    }
+
     /// Settings with the given criteria, default policy, cell stress, 500 rounds, 30
     /// active-set iterations and tolerance 1e-6.
     pub fn new(criteria: Vec<Combined>, class_of_cell: Vec<usize>) -> Self {
@@ -351,8 +371,9 @@ impl<const D: usize> FailureResolution<D> {
                 criteria: &self.settings.criteria,
                 class_of_cell: &self.settings.class_of_cell,
                 tips: self.tips.as_ref(),
+                centroids: Some(grid.cell_centroids()),
             },
-            self.settings.policy,
+            self.settings.policy_of_rule(),
             self.tracking.as_mut(),
             if can_fail {
                 self.settings.max_rounds

@@ -71,6 +71,20 @@
 //! wing, longer than `ℓ`. There the factor overstates `K_I`, by at most `1/√(1 − r′/ℓ)`
 //! (1.15 at `r′ = ℓ/4`, `√2` for a wing of two cells, read at `r′ = h = ℓ/2`).
 //!
+//! # Which tips grow
+//!
+//! The failure resolution fails, per round, the cells whose utilization is within 1 % of
+//! the largest ([`porofrac_frac::FailurePolicy::MostCritical`]). Under one pressure the two
+//! tips of a toughness-dominated crack have the same `K_I`, and their readings differ by
+//! the scatter of the reading (the tip's position, below: ±10–20 % on Sneddon's crack at
+//! 10 cells per half-length): with the largest utilization of the whole body, the tip
+//! that reads higher grows alone, round after round, even while the other reads more than
+//! `K_Ic` too, and the other waits until the first reaches a cell that reads low. With
+//! this rule the largest utilization is therefore taken near each cell, within `r` of its
+//! centroid ([`porofrac_frac::FailurePolicy::MostCriticalNear`],
+//! [`crate::FractureSettings::policy_of_rule`]): the most critical cell of every tip
+//! fails in the same round, and a tip waits only while its own reading is below `K_Ic`.
+//!
 //! The band's faces lie about half a cell off the crack's line, so `w` also holds the
 //! elastic strain of the rock across half a cell on each side: an error of the order of
 //! `ε h / w`, which vanishes with the cells. The tip position is that of the band's
