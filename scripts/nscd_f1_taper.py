@@ -4,6 +4,7 @@
     python3 scripts/nscd_f1_taper.py OUT_DIR [--scale S] [--speed V] [--every K]
                                      [--phi PHI ...] [--mu-base MU ...]
     python3 scripts/nscd_f1_taper.py --table [--phi PHI ...] [--mu-base MU ...]
+    python3 scripts/nscd_f1_taper.py --check
 
 Measured on the particle frames of OUT_DIR (as written by `porofrac run` for
 scenes/nscd/forced_fold_*.toml; S = 0.2 for the reduced scene), every K-th frame:
@@ -32,7 +33,13 @@ base, dry, no cohesion; Dahlen's exact solution) solves
 phi the assembly's friction angle and mu_b the grip the base transmits (a base stronger
 than the assembly shears inside it: phi_b is capped at phi). The script prints a_c and
 the wall travel (and time) at which the predicted toe reaches W6's left edge (the
-paper's x = 588 m, scaled), for each phi and mu_b asked. Nothing is written.
+paper's x = 588 m, scaled), for each phi and mu_b asked. Nothing is written unless
+--plot names a PNG.
+
+--check tests the two functions: a frictionless base stands at a_c = 0; for a small
+mu_b the taper is Dahlen's linearised a_c = mu_b / (1 + K), K = 2 sin phi / (1 - sin
+phi) (to 1e-3 at mu_b = 0.01); a base stronger than the assembly gives the same a_c as
+phi_b = phi; the wall travel s* returned puts the predicted toe on the target (1e-9 m).
 """
 import argparse
 import math
@@ -127,6 +134,23 @@ def plot(a, meas, loads, area0, h_s, w6_edge):
     print(f"wrote {a.plot}")
 
 
+def check():
+    """The checks of --check (module docs); raises AssertionError on a miss."""
+    for phi in (20.0, 30.0, 40.0):
+        sp = math.sin(math.radians(phi))
+        k = 2.0 * sp / (1.0 - sp)
+        assert abs(critical_taper(phi, 0.0)) < 1e-12
+        lin = math.degrees(0.01 / (1.0 + k))
+        assert abs(critical_taper(phi, 0.01) / lin - 1.0) < 1e-3, (phi, critical_taper(phi, 0.01), lin)
+        strong = critical_taper(phi, 10.0)
+        assert abs(strong - critical_taper(phi, math.tan(math.radians(phi)))) < 1e-9
+    for a_deg, area0, h, target in ((12.0, 8993.3, 28.1, 588.0), (19.5, 407.0, 4.86, 117.6)):
+        sstar = toe_reaches(a_deg, area0, h, target)
+        toe = sstar + math.sqrt(2.0 * (area0 + h * sstar) / math.tan(math.radians(a_deg)))
+        assert 0.0 < sstar < target and abs(toe - target) < 1e-9, (sstar, toe)
+    print("nscd_f1_taper checks: ok")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("out", nargs="?")
@@ -136,9 +160,13 @@ def main():
     ap.add_argument("--phi", type=float, nargs="+", default=[20.0, 25.0, 30.0])
     ap.add_argument("--mu-base", type=float, nargs="+", default=[0.24, 0.4, 0.8])
     ap.add_argument("--table", action="store_true")
+    ap.add_argument("--check", action="store_true")
     ap.add_argument("--plot", default=None,
                     help="write the toe, the cells' loading and the predicted toes to this PNG")
     a = ap.parse_args()
+    if a.check:
+        check()
+        return
     s = a.scale
     w6_edge = (CELLS[5][0] - CELLS[5][2]) * s
     if a.table or a.out is None:
