@@ -14,7 +14,9 @@
 #   base_mu08     the base's own friction μ_b = 0.8 (the disks' μ stays 0.4)
 #   base_mu0      a frictionless base, μ_b = 0 (the other bound)
 #   slow          the left wall at 0.25 m/s for 200 s (the same 50 m of shortening)
+#   slow01        the left wall at 0.1 m/s for 500 s (20 000 steps; the quasi-static check)
 #   dt_half       steps of 0.0125 s (8 000 steps)
+#   theta1        θ = 1 (backward Euler) instead of ½
 #   long          the layer 400 m long (W1-W6 where they were; the right wall at 400 m)
 #   low_wall      the left wall only as high as the wedge (16 m)
 #   cohesion      γ = 1e3 N/m, d_w = 5 mm between all disks
@@ -35,7 +37,12 @@ slow)
     sets=(--set 'wall.2.velocity=[0.25, 0.0]' --set schedule.end_time=200.0)
     speed=0.25
     ;;
+slow01)
+    sets=(--set 'wall.2.velocity=[0.1, 0.0]' --set schedule.end_time=500.0)
+    speed=0.1
+    ;;
 dt_half) sets=(--set schedule.dt=0.0125) ;;
+theta1) sets=(--set nscd.theta=1.0) ;;
 long)
     sets=(--set 'particles.polygon=[[0.0, 0.0], [400.0, 0.0], [400.0, 6.0], [60.0, 6.0], [15.0, 16.0], [0.0, 16.0]]'
         --set 'wall.1.to=[410.0, 0.0]' --set 'wall.3.from=[400.0, 48.0]' --set 'wall.3.to=[400.0, 0.0]')
