@@ -124,10 +124,11 @@ def plot(a, meas, loads, area0, h_s, w6_edge):
         t = math.tan(math.radians(alpha))
         ax.plot(sv, sv + np.sqrt(2.0 * (area0 + h_s * sv) / t), "g" + style,
                 label=f"toe of a {alpha:g} deg wedge (no dilatancy)")
-    ax.axhline(w6_edge, color="r", lw=0.8)
+    ax.axhline(w6_edge, color="r", lw=0.8, label=f"W6's left edge, x = {w6_edge:g} m")
     ax.set_xlabel("wall travel s (m)")
     ax.set_ylabel("x (m)")
-    ax.set_title(os.path.basename(os.path.normpath(a.out)))
+    ax.set_title("F1: the thrust zone's toe against the wall's travel ("
+                 + os.path.basename(os.path.normpath(a.out)) + ")")
     ax.legend(fontsize=7, loc="upper left")
     fig.tight_layout()
     fig.savefig(a.plot, dpi=110)
