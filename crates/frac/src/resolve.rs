@@ -15,12 +15,6 @@
 //! exceeds the other's, even when both exceed 1: under one pressure the two tips of a
 //! crack have the same stress intensity, and a reading that differs by a few percent
 //! between them then decides which wing grows.
-//!
-//! Under the same rule, with crack tracking, a tip that tracking's line rule alone holds
-//! (violating cells next to the crack, none admitted because the recorded line misses
-//! them, [`crate::tracking`]) continues: when no admitted violating cell lies within the
-//! radius of a held one, the held cell nearest the line of its failed face neighbour fails
-//! too, one per radius per round, its crack point projected on that line.
 
 use porofrac_grid::Point;
 use porofrac_law::Tensor;
@@ -56,8 +50,7 @@ pub enum FailurePolicy {
         fraction: f64,
     },
     /// Violating cells with utilization ≥ `fraction` × the largest utilization of the
-    /// violating cells within `radius` of their centroid; with crack tracking, a tip held
-    /// by its line rule alone continues, one cell per `radius` per round (module docs).
+    /// violating cells within `radius` of their centroid (module docs).
     MostCriticalNear {
         /// In (0, 1].
         fraction: f64,

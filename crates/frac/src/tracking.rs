@@ -46,17 +46,6 @@
 //!
 //! Violating cells that are not admissible stay intact in this round (the criterion is
 //! checked again after every re-solve).
-//!
-//! Where a recorded line leaves its cell next to a vertex, it misses the face neighbours
-//! beyond that vertex by a sliver (millimetres on cells of 80 mm) and enters a cell that
-//! touches the crack at the node only: rule (ii) then refuses every cell ahead, and a tip
-//! reading above its toughness is held by the geometry alone until a failure elsewhere
-//! gives it a face neighbour its line crosses. [`CrackTracking::continuation`] names, for
-//! such a cell, the line of rule (i)'s face neighbours that passes nearest it;
-//! [`crate::resolve()`] under [`crate::FailurePolicy::MostCriticalNear`] fails the held
-//! violating cell nearest that line, one per tip per round, and only where no admitted
-//! violating cell lies near. A margin in rule (ii) instead admits every cell within it,
-//! beside the line as well as ahead, and widens the crack into a band.
 
 use porofrac_grid::{Grid, Point};
 use porofrac_law::Tensor;

@@ -214,8 +214,7 @@ pub enum TipRule {
     /// utilization within the distance of them ([`FailurePolicy::MostCriticalNear`]):
     /// the most critical cell of every tip, so the tips of a crack under one pressure
     /// grow together when each reads more than `K_Ic` ([`crate::tip_distance`], "Which
-    /// tips grow"), and a tip that crack tracking's line rule alone holds continues into
-    /// the cell nearest its line ([`porofrac_frac::CrackTracking::continuation`]).
+    /// tips grow").
     OpeningAt {
         /// `E′ = E/(1 − ν²)` (Pa) of every cell.
         e_prime: Vec<f64>,

@@ -84,10 +84,6 @@
 //! centroid ([`porofrac_frac::FailurePolicy::MostCriticalNear`],
 //! [`crate::FractureSettings::policy_of_rule`]): the most critical cell of every tip
 //! fails in the same round, and a tip waits only while its own reading is below `K_Ic`.
-//! A tip that reads above `K_Ic` while crack tracking's line rule refuses every cell ahead
-//! of it (the line leaving the last cell next to a vertex) continues into the violating
-//! face neighbour nearest that line, one per tip per round
-//! ([`porofrac_frac::CrackTracking::continuation`]).
 //!
 //! The band's faces lie about half a cell off the crack's line, so `w` also holds the
 //! elastic strain of the rock across half a cell on each side: an error of the order of
