@@ -103,16 +103,9 @@ pub fn resolve<const D: usize, S, E>(
 ) -> Result<(S, Vec<Tensor<D>>, usize, usize), ResolveError<E>> {
     // Returns the solution, its cell stresses, the cells failed here and the solves done.
     let mut new_failures = 0;
-    let near = match (policy, criteria.centroids) {
-        (FailurePolicy::MostCriticalNear { radius, .. }, Some(x)) => Some((radius, x)),
-        _ => None,
-    };
     for round in 1..=max_solves {
         let (solution, stress) = solve(state).map_err(ResolveError::Solve)?;
         let mut violating: Vec<(usize, f64, crate::FailureMode)> = Vec::new();
-        // Violating cells refused by tracking's rule (ii) alone, with the distance of the
-        // nearest line (per tip continuation, module docs).
-        let mut held: Vec<(usize, f64, crate::FailureMode)> = Vec::new();
         for (c, s) in stress.iter().enumerate() {
             if state.is_failed(c) {
                 continue;
@@ -129,31 +122,12 @@ pub fn resolve<const D: usize, S, E>(
                 if let Some(t) = tracking.as_deref()
                     && !t.admits(c, s, state.flags())
                 {
-                    if near.is_some()
-                        && let Some((_, d)) = t.continuation(c, s, state.flags())
-                    {
-                        held.push((c, d, mode));
-                    }
                     continue;
                 }
                 violating.push((c, crit.utilization_at(s, tip), mode));
             }
         }
-        // A tip held by rule (ii): no admitted violating cell within the radius; the
-        // held cell nearest its line fails, one per radius.
-        if let Some((radius, x)) = near {
-            held.sort_by(|a, b| a.1.total_cmp(&b.1));
-            let mut continued: Vec<(usize, f64, crate::FailureMode)> = Vec::new();
-            for &(c, d, mode) in &held {
-                let free = |w: &(usize, f64, crate::FailureMode)| (x[w.0] - x[c]).norm() > radius;
-                if violating.iter().all(free) && continued.iter().all(free) {
-                    continued.push((c, d, mode));
-                }
-            }
-            // Appended after the choice below, whatever their utilization.
-            held = continued;
-        }
-        if violating.is_empty() && held.is_empty() {
+        if violating.is_empty() {
             return Ok((solution, stress, new_failures, round));
         }
         let largest = violating
@@ -184,7 +158,6 @@ pub fn resolve<const D: usize, S, E>(
         };
         let mut keep = chosen.into_iter();
         violating.retain(|_| keep.next().unwrap_or(false));
-        violating.extend(held);
         // Every crack point is taken on the lines of the cells failed before this round.
         if let Some(t) = tracking.as_deref_mut() {
             for &(c, _, _) in &violating {
@@ -389,73 +362,6 @@ mod tests {
         assert_eq!(one_round(near(1.0), Some(&x)), [true, false, true]);
         assert_eq!(one_round(near(20.0), Some(&x)), [true, false, false]);
         assert_eq!(one_round(near(1.0), None), [true, false, false]);
-    }
-
-    /// A column of nine unit squares, cells 3–5 failed with their line x = 1.001 (σ₁
-    /// along x), which misses cells 2 and 6 by 1 mm; both violate (σ₁ = 2, σ_t = 1, the
-    /// stresses unchanged by failures), the others do not. The global rule fails neither
-    /// (tracking holds both tips); the rule near each cell fails both in the first round
-    /// when they lie farther apart than the radius (1.5), one per round when not (10);
-    /// the cells' crack points lie on the line.
-    #[test]
-    fn a_tip_held_by_the_line_alone_continues_one_cell_per_tip_per_round() {
-        let grid = porofrac_grid::generate::cartesian([0.0, 0.0].into(), [1.0, 9.0].into(), [1, 9])
-            .unwrap();
-        let criterion = Combined {
-            tensile: Some(Tensile::new(1.0).unwrap()),
-            shear: None,
-            toughness: None,
-        };
-        let class = vec![0; 9];
-        let sigma = [0.5, 0.5, 2.0, 0.5, 0.5, 0.5, 2.0, 0.5, 0.5];
-        let n = Point::<2>::new(1.0, 0.0);
-        let run = |policy: FailurePolicy| {
-            let mut t = CrackTracking::new(&grid, 30.0).unwrap();
-            let points: Vec<Point<2>> = (3..6)
-                .map(|j| Point::<2>::new(1.001, j as f64 + 0.5))
-                .collect();
-            t.restore(&[3, 4, 5], &[n; 3], &points).unwrap();
-            let mut st = FailureState::new(9);
-            for c in 3..6 {
-                st.fail(c, 0.0, crate::FailureMode::Tensile);
-            }
-            let (_, _, failures, solves) = resolve::<2, (), ()>(
-                &mut st,
-                1.0,
-                CellCriteria {
-                    criteria: std::slice::from_ref(&criterion),
-                    class_of_cell: &class,
-                    tips: None,
-                    centroids: Some(grid.cell_centroids()),
-                },
-                policy,
-                Some(&mut t),
-                10,
-                |_| {
-                    Ok((
-                        (),
-                        sigma
-                            .iter()
-                            .map(|&s| Tensor::<2>::new(s, 0.0, 0.0, 0.0))
-                            .collect(),
-                    ))
-                },
-            )
-            .unwrap();
-            for c in [2, 6] {
-                if let Some(p) = t.point(c) {
-                    assert!((p[0] - 1.001).abs() < 1e-12, "cell {c}: {p:?}");
-                }
-            }
-            (st.flags()[2], st.flags()[6], failures, solves)
-        };
-        let near = |radius| FailurePolicy::MostCriticalNear {
-            fraction: 0.99,
-            radius,
-        };
-        assert_eq!(run(FailurePolicy::default()), (false, false, 0, 1));
-        assert_eq!(run(near(1.5)), (true, true, 2, 2));
-        assert_eq!(run(near(10.0)), (true, true, 2, 3));
     }
 
     /// Three unit squares in a row with constant stresses σ₁ = 3, 2, 2 and σ_t = 1. Cell 0

@@ -163,7 +163,6 @@ impl<const D: usize> CrackTracking<D> {
         let point = self
             .parents(c, own, failed)
             .min_by(|a, b| a.1.total_cmp(&b.1))
-            .or_else(|| self.nearest_line(c, own, failed))
             .map_or(x, |(f, _)| {
                 let (n, p) = self.line(f, own);
                 x - n * (x - p).dot(&n)
@@ -243,34 +242,6 @@ impl<const D: usize> CrackTracking<D> {
             .any(|&f| failed[f] && (self.centroids[f] - x).norm_squared() < r2)
     }
 
-    /// The continuation of a crack held by rule (ii): the failed face neighbour of `c`
-    /// within the kink limit (rule (i)) whose crack line passes nearest `c`'s centroid,
-    /// with that distance, whether or not the line crosses `c`. `None` when `c` has no
-    /// such neighbour. A line that leaves its cell next to a vertex misses the face
-    /// neighbours beyond it by a sliver and enters a cell that touches the crack at that
-    /// node only, so a tip reading above its toughness may be held by rule (ii) alone;
-    /// [`crate::resolve()`] under [`crate::FailurePolicy::MostCriticalNear`] then fails
-    /// the violating cell nearest the line, one per tip per round, and
-    /// [`Self::record`] projects its crack point on that line (the line does not drift).
-    pub fn continuation(&self, c: usize, s: &Tensor<D>, failed: &[bool]) -> Option<(usize, f64)> {
-        if self
-            .parents(c, largest_principal_direction(s), failed)
-            .next()
-            .is_some()
-        {
-            return None;
-        }
-        self.nearest_line(c, largest_principal_direction(s), failed)
-    }
-
-    /// The failed face neighbour of `c` within the kink limit whose line passes nearest
-    /// `c`'s centroid, with that distance.
-    fn nearest_line(&self, c: usize, own: Point<D>, failed: &[bool]) -> Option<(usize, f64)> {
-        self.lines_near(c, own, failed)
-            .map(|(f, d, _)| (f, d))
-            .min_by(|a, b| a.1.total_cmp(&b.1))
-    }
-
     /// The crack normal and point of failed cell `f` (`own` and its centroid when not
     /// recorded).
     fn line(&self, f: usize, own: Point<D>) -> (Point<D>, Point<D>) {
@@ -288,19 +259,6 @@ impl<const D: usize> CrackTracking<D> {
         own: Point<D>,
         failed: &'s [bool],
     ) -> impl Iterator<Item = (usize, f64)> + 's {
-        self.lines_near(c, own, failed)
-            .filter_map(|(f, d, crosses)| crosses.then_some((f, d)))
-    }
-
-    /// The failed face neighbours of `c` within the kink limit (rule (i)), with the
-    /// distance of `c`'s centroid from their crack line and whether that line crosses `c`
-    /// (rule (ii)).
-    fn lines_near<'s>(
-        &'s self,
-        c: usize,
-        own: Point<D>,
-        failed: &'s [bool],
-    ) -> impl Iterator<Item = (usize, f64, bool)> + 's {
         let x = self.centroids[c];
         let cell = &self.nodes[self.node_pos[c]..self.node_pos[c + 1]];
         self.face_neighbours[c]
@@ -321,7 +279,7 @@ impl<const D: usize> CrackTracking<D> {
                 let at = p.dot(&n);
                 let tol = 1e-12 * (hi - lo);
                 let crosses = lo - tol <= at && at <= hi + tol;
-                in_plane.then_some((f, (x - p).dot(&n).abs(), crosses))
+                (in_plane && crosses).then_some((f, (x - p).dot(&n).abs()))
             })
     }
 }
@@ -467,41 +425,6 @@ mod tests {
         // The cell up and right: within 60° of the crack plane (45°) but off its line.
         assert!(!t.admits(18, &sx, &failed));
         assert!(t.admits(17, &sx, &failed));
-    }
-
-    /// A column of five unit squares, cells 1 and 2 failed with their line x = 1.001 (σ₁
-    /// along x): the line misses cell 3 above by 1 mm, so rule (ii) refuses it; its
-    /// continuation is cell 2's line, 0.501 from its centroid, and the crack point it
-    /// records lies on that line. A cell whose σ₁ kinks beyond the limit, or that has
-    /// no failed face neighbour, has none; nor has a cell the line crosses.
-    #[test]
-    fn a_line_missing_the_cell_ahead_by_a_sliver_continues_into_it() {
-        let g = cartesian([0.0, 0.0].into(), [1.0, 5.0].into(), [1, 5]).unwrap();
-        let mut t = CrackTracking::new(&g, 30.0).unwrap();
-        let sx = Tensor::<2>::new(1.0, 0.0, 0.0, -1.0);
-        let sy = Tensor::<2>::new(-1.0, 0.0, 0.0, 1.0);
-        let n = Point::<2>::new(1.0, 0.0);
-        let (p1, p2) = (Point::<2>::new(1.001, 1.5), Point::<2>::new(1.001, 2.5));
-        t.restore(&[1, 2], &[n, n], &[p1, p2]).unwrap();
-        let mut failed = vec![false; 5];
-        failed[1] = true;
-        failed[2] = true;
-        assert!(!t.admits(3, &sx, &failed) && !t.admits(0, &sx, &failed));
-        let (f, d) = t.continuation(3, &sx, &failed).unwrap();
-        assert_eq!(f, 2);
-        assert!((d - 0.501).abs() < 1e-12, "{d}");
-        assert_eq!(t.continuation(0, &sx, &failed).map(|c| c.0), Some(1));
-        assert!(t.continuation(3, &sy, &failed).is_none(), "kink of 90°");
-        assert!(
-            t.continuation(4, &sx, &failed).is_none(),
-            "no failed face neighbour"
-        );
-        t.record(3, &sx, &failed);
-        assert!((t.point(3).unwrap() - Point::<2>::new(1.001, 3.5)).norm() < 1e-12);
-        // The line x = 0.5 crosses cell 3: rule (ii) admits it, no continuation needed.
-        let q = Point::<2>::new(0.5, 2.5);
-        t.restore(&[1, 2], &[n, n], &[p1, q]).unwrap();
-        assert!(t.admits(3, &sx, &failed) && t.continuation(3, &sx, &failed).is_none());
     }
 
     #[test]
