@@ -266,6 +266,27 @@ impl std::fmt::Debug for Amg {
     }
 }
 
+/// The finest operator with the caller's double-precision values ([`Amg::operator`]).
+pub struct FineOperator<'a> {
+    amg: &'a Amg,
+    values: &'a [f64],
+}
+
+impl FineOperator<'_> {
+    /// `y = A x`; returns `xᵀ A x`. Errors: wrong lengths.
+    pub fn apply(&self, x: &[f64], y: &mut [f64]) -> Result<f64> {
+        let n = self.amg.n();
+        if x.len() != n || y.len() != n {
+            return Err(AmgError::Input(format!(
+                "product with vectors of length {} and {}, want {n}",
+                x.len(),
+                y.len()
+            )));
+        }
+        Ok(self.amg.fine_product(Some(self.values), x, y))
+    }
+}
+
 /// A finest matrix stored in single precision with at least this many entries per row on
 /// average (3D elasticity: about 43) is smoothed through its upper triangle, kept in
 /// single precision next to the full rows ([`crate::upper`]): half the bytes of the full
@@ -584,21 +605,43 @@ impl Amg {
         }
     }
 
-    /// `y = A x` with the finest matrix as stored (`upper = None`) or with the caller's
-    /// double-precision upper triangle `upper` on the finest pattern; returns `xᵀ y`
-    /// (summed in the same pass).
-    pub(crate) fn fine_product(&mut self, upper: Option<&[f64]>, x: &[f64], y: &mut [f64]) -> f64 {
-        let a = &self.levels[0].a;
-        match upper {
-            None => a.par_products_sum(x, y, |i, ax, yi| {
-                *yi = ax;
-                ax * x[i]
-            }),
-            Some(values) => self
-                .upper
-                .get_or_insert_with(|| UpperProduct::new(a, &self.fine_col_ptr))
-                .apply(a, &self.fine_col_ptr, values, x, y),
+    /// Make ready the product with the caller's double-precision upper triangle
+    /// ([`Self::fine_product`]): the partition of the upper-triangle kernel.
+    pub(crate) fn prepare_operator(&mut self, upper: Option<&[f64]>) {
+        if upper.is_some() && self.upper.is_none() {
+            self.upper = Some(UpperProduct::new(&self.levels[0].a, &self.fine_col_ptr));
         }
+    }
+
+    /// `y = A x` with the finest matrix as stored (`upper = None`) or with the caller's
+    /// double-precision upper triangle `upper` on the finest pattern, as made ready by
+    /// [`Self::prepare_operator`]; returns `xᵀ y` (summed in the same pass).
+    pub(crate) fn fine_product(&self, upper: Option<&[f64]>, x: &[f64], y: &mut [f64]) -> f64 {
+        let a = &self.levels[0].a;
+        let times = |i: usize, ax: f64, yi: &mut f64| {
+            *yi = ax;
+            ax * x[i]
+        };
+        match upper {
+            None => a.par_products_sum(x, y, times),
+            Some(values) => {
+                let part = self
+                    .upper
+                    .unwrap_or_else(|| UpperProduct::new(a, &self.fine_col_ptr));
+                part.apply(a, &self.fine_col_ptr, values, x, y)
+            }
+        }
+    }
+
+    /// The operator [`Self::solve_upper`] multiplies by for the upper-triangle `values`.
+    ///
+    /// Errors: `values` of the wrong length or not finite, a hierarchy left unusable by a
+    /// failed [`Self::update_values`].
+    pub fn operator<'a>(&'a mut self, values: &'a [f64]) -> Result<FineOperator<'a>> {
+        self.check_valid()?;
+        check_upper_values(values, self.upper_nnz())?;
+        self.prepare_operator(Some(values));
+        Ok(FineOperator { amg: self, values })
     }
 
     /// Number of upper-triangle entries of the finest matrix.

@@ -68,7 +68,9 @@ pub mod upper;
 
 pub use csr::{CsrMatrix, Precision, SymCsr};
 pub use error::{AmgError, Result};
-pub use hierarchy::{Amg, AmgMemory, AmgOptions, LevelInfo, UPPER_MIN_ENTRIES_PER_ROW};
+pub use hierarchy::{
+    Amg, AmgMemory, AmgOptions, FineOperator, LevelInfo, UPPER_MIN_ENTRIES_PER_ROW,
+};
 pub use local::{LocalAggregation, aggregate_tentative};
 pub use nullspace::NearNullSpace;
 pub use pcg::CgStats;

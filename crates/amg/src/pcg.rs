@@ -112,6 +112,7 @@ impl Amg {
         }
         check_finite(b, "right-hand side")?;
         check_finite(x, "initial guess")?;
+        self.prepare_operator(upper);
         let mut v = std::mem::take(&mut self.cg);
         for w in v.iter_mut() {
             w.resize(n, 0.0);
@@ -247,7 +248,7 @@ impl Amg {
 
     /// `r = b − A x` with the operator of [`Self::fine_product`] (`r = b` without a
     /// product when `x = 0`, the usual first guess).
-    fn fine_residual(&mut self, upper: Option<&[f64]>, b: &[f64], x: &[f64], r: &mut [f64]) {
+    fn fine_residual(&self, upper: Option<&[f64]>, b: &[f64], x: &[f64], r: &mut [f64]) {
         if x.iter().all(|&v| v == 0.0) {
             r.copy_from_slice(b);
             return;

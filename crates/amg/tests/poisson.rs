@@ -422,3 +422,64 @@ proptest! {
         prop_assert!(s.iterations <= 40, "{s:?}");
     }
 }
+
+/// CG's operator ([`Amg::operator`]) on a hierarchy stored in single precision multiplies
+/// by the caller's double-precision values, not by the stored `f32` rounding: it matches
+/// the double-precision matrix to rounding (1e-14 relative), while the stored rows miss by
+/// about the `f32` rounding of values that are not representable in `f32`.
+#[test]
+fn cg_operator_multiplies_by_the_double_precision_values() {
+    let m = 40;
+    let n = m * m;
+    let plain = laplace_2d(m);
+    // Values 4 + 0.1·(1/3), −1 + 0.1·(1/7): not representable in f32.
+    let values: Vec<f64> = laplace_values(m)
+        .iter()
+        .map(|&v| {
+            if v > 0.0 {
+                v + 0.1 / 3.0
+            } else {
+                v + 0.1 / 7.0
+            }
+        })
+        .collect();
+    let mut exact = plain.clone();
+    exact.set_values(&values).unwrap();
+    let mut cp = vec![0];
+    let mut ri = vec![];
+    for c in 0..n {
+        plain.matrix().for_each_col(c, |r| {
+            if (r as usize) <= c {
+                ri.push(r as usize);
+            }
+        });
+        cp.push(ri.len());
+    }
+    let single =
+        SymCsr::from_upper_csc_in(porofrac_amg::Precision::Single, n, &cp, &ri, &values).unwrap();
+    let mut amg = Amg::scalar(single, &small_coarse()).unwrap();
+    let x: Vec<f64> = (0..n).map(|i| (0.37 * i as f64).sin()).collect();
+    let mut want = vec![0.0; n];
+    exact.mul(&x, &mut want).unwrap();
+    let mut stored = vec![0.0; n];
+    amg.matrix().mul(&x, &mut stored).unwrap();
+    let mut got = vec![0.0; n];
+    let op = amg.operator(&values).unwrap();
+    let energy = op.apply(&x, &mut got).unwrap();
+    let scale = want.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    let miss = |y: &[f64]| {
+        y.iter()
+            .zip(&want)
+            .fold(0.0f64, |a, (p, q)| a.max((p - q).abs()))
+            / scale
+    };
+    assert!(miss(&got) <= 1e-14, "operator misses by {:e}", miss(&got));
+    assert!(
+        miss(&stored) >= 1e-9,
+        "f32 rows miss by {:e}",
+        miss(&stored)
+    );
+    let want_energy: f64 = x.iter().zip(&want).map(|(a, b)| a * b).sum();
+    assert!((energy - want_energy).abs() <= 1e-13 * want_energy.abs());
+    assert!(op.apply(&x[1..], &mut got).is_err());
+}

@@ -2,8 +2,11 @@
 //! precision, `elasticity_amg_options`, CG through `Amg::solve_upper` with the
 //! double-precision values to 1e-8. Times, best of `REPS` builds, the single-precision full
 //! rows (`SymCsr`), the hierarchy, CG, and one V-cycle (`Amg::apply`, mean of ten).
+//! First CG's product (`Amg::operator`) and the single-precision full rows' product, mean
+//! of twenty each, alternated, best of `REPS`.
 //!
-//! `cargo run --release -p porofrac-sim --features fixtures --example amg_single -- e3 40 [REPS]`
+//! `cargo run --release -p porofrac-sim --features fixtures --example amg_single -- e3 40 [REPS]
+//! [products]` (`products`: the products only)
 
 mod amg_common;
 
@@ -25,6 +28,10 @@ fn main() {
 }
 
 fn run<const D: usize>(sys: &amg_common::System<D>, reps: usize) {
+    products(sys, reps);
+    if std::env::args().nth(4).as_deref() == Some("products") {
+        return;
+    }
     let options = elasticity_amg_options(D);
     let mut best = [f64::INFINITY; 4];
     let (mut iterations, mut residual) = (0, 0.0);
@@ -66,5 +73,41 @@ fn run<const D: usize>(sys: &amg_common::System<D>, reps: usize) {
         best[1],
         best[2],
         1e3 * best[3]
+    );
+}
+
+/// Best of `reps` means of twenty products: CG's (through [`Amg::operator`], the
+/// double-precision upper triangle) and the single-precision full rows', alternated.
+fn products<const D: usize>(sys: &amg_common::System<D>, reps: usize) {
+    let sym = SymCsr::from_upper_csc_in(
+        Precision::Single,
+        sys.n(),
+        sys.pattern.col_ptr(),
+        sys.pattern.row_idx(),
+        &sys.values,
+    )
+    .expect("matrix");
+    let options = elasticity_amg_options(D);
+    let mut amg = Amg::elasticity(sym, &sys.coords, D, &sys.eq_dofs, &options).expect("setup");
+    let x: Vec<f64> = (0..sys.n()).map(|i| (0.001 * i as f64).sin()).collect();
+    let mut y = vec![0.0; sys.n()];
+    let mut best = [f64::INFINITY; 2];
+    for _ in 0..reps.max(1) {
+        let op = amg.operator(&sys.values).expect("operator");
+        let t = Instant::now();
+        for _ in 0..20 {
+            op.apply(&x, &mut y).expect("product");
+        }
+        best[0] = best[0].min(t.elapsed().as_secs_f64() / 20.0);
+        let t = Instant::now();
+        for _ in 0..20 {
+            amg.matrix().mul(&x, &mut y).expect("product");
+        }
+        best[1] = best[1].min(t.elapsed().as_secs_f64() / 20.0);
+    }
+    println!(
+        "CG product (double-precision upper triangle) {:.2} ms; single-precision full rows {:.2} ms",
+        1e3 * best[0],
+        1e3 * best[1]
     );
 }
